@@ -1,0 +1,140 @@
+# rtsh — a ray tracer and command shell that lives in the terminal.
+#
+#   make            build ./rtsh
+#   make run        build and open the shell on the built-in showcase scene
+#   make test       build and run every test, then again under ASan+UBSan, and
+#                   the threaded tests under TSan
+#   make bench      build and run the benchmark (writes build/bench.tsv)
+#   make install    PREFIX=/usr/local DESTDIR=  (binary, man pages, scenes)
+#
+# Variants build in their own folder: `make BUILD=build/asan SAN=address,undefined`.
+
+PREFIX  ?= /usr/local
+DESTDIR ?=
+BUILD   ?= build
+SAN     ?=
+OPT     ?= -O2
+
+CC      ?= cc
+VERSION := 0.1.0
+CSTD    := -std=c17
+WARN    := -Wall -Wextra -Wpedantic -Werror -Wshadow -Wstrict-prototypes -Wmissing-prototypes -Wvla
+CPPFLAGS += -Iinclude -Isrc -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -DRTSH_VERSION=\"$(VERSION)\"
+CFLAGS  ?= $(OPT) -g
+CFLAGS  += $(CSTD) $(WARN) -pthread -MMD -MP
+LDLIBS_CORE := -lpng -lm -pthread
+LDLIBS_FRONT := -lreadline -lncursesw $(LDLIBS_CORE)
+
+ifneq ($(SAN),)
+CFLAGS  += -fsanitize=$(SAN) -fno-omit-frame-pointer -fno-sanitize-recover=all
+LDFLAGS += -fsanitize=$(SAN)
+endif
+
+CORE_SRC  := $(sort $(wildcard src/core/*.c src/core/*/*.c src/scene/*.c))
+FRONT_SRC := $(sort $(wildcard src/term/*.c src/shell/*.c))
+CORE_OBJ  := $(CORE_SRC:%.c=$(BUILD)/%.o)
+FRONT_OBJ := $(FRONT_SRC:%.c=$(BUILD)/%.o)
+MAIN_OBJ  := $(BUILD)/src/main.o
+LIB       := $(BUILD)/librtsh.a
+FRONTLIB  := $(BUILD)/librtsh-front.a
+
+TEST_SRC  := $(sort $(wildcard tests/unit/test_*.c))
+TEST_BIN  := $(TEST_SRC:tests/unit/%.c=$(BUILD)/tests/%)
+BENCH_SRC := bench/bench.c
+BENCH_BIN := $(BUILD)/bench/bench
+
+# The binary: ./rtsh for the default build, $(BUILD)/rtsh for variants.
+ifeq ($(BUILD),build)
+BIN := rtsh
+else
+BIN := $(BUILD)/rtsh
+endif
+
+.PHONY: all run test test-bins test-unit test-scripts bench bench-quick install uninstall \
+        clean deps check-man
+
+all: deps $(BIN)
+
+deps:
+	@sh tests/deps.sh
+
+$(BIN): $(MAIN_OBJ) $(FRONTLIB) $(LIB)
+	@echo "  LD      $@"
+	@$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS_FRONT)
+
+$(LIB): $(CORE_OBJ)
+	@mkdir -p $(@D)
+	@echo "  AR      $@"
+	@rm -f $@ && $(AR) rcs $@ $^
+
+$(FRONTLIB): $(FRONT_OBJ)
+	@mkdir -p $(@D)
+	@echo "  AR      $@"
+	@rm -f $@ && $(AR) rcs $@ $^
+
+$(BUILD)/%.o: %.c
+	@mkdir -p $(@D)
+	@echo "  CC      $<"
+	@$(CC) $(CPPFLAGS) $(CFLAGS) -c -o $@ $<
+
+# The built-in showcase scene, compiled in so `rtsh` works from any folder.
+$(BUILD)/src/shell/builtin_scene.o: $(BUILD)/gen/showcase.inc
+$(BUILD)/gen/showcase.inc: scenes/showcase.rt
+	@mkdir -p $(@D)
+	sh tests/embed.sh $< > $@
+
+$(BUILD)/tests/%: tests/unit/%.c $(FRONTLIB) $(LIB)
+	@mkdir -p $(@D)
+	@echo "  TEST    $@"
+	@$(CC) $(CPPFLAGS) -Itests/unit $(CFLAGS) $(LDFLAGS) -o $@ $< $(FRONTLIB) $(LIB) -lcmocka $(LDLIBS_FRONT)
+
+$(BENCH_BIN): $(BENCH_SRC) $(FRONTLIB) $(LIB)
+	@mkdir -p $(@D)
+	$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -o $@ $< $(FRONTLIB) $(LIB) $(LDLIBS_FRONT)
+
+run: all
+	./$(BIN)
+
+test-bins: $(TEST_BIN)
+
+# The whole suite: plain build, tmux end to end, then ASan+UBSan, then TSan on
+# the threaded tests; the last line is "N passed, N failed".
+test: deps
+	@sh tests/run-all.sh
+
+test-unit: $(BIN) $(TEST_BIN)
+	@sh tests/run-unit.sh $(BUILD) $(TEST_BIN)
+
+test-scripts: $(BIN)
+	@sh tests/run-scripts.sh ./$(BIN)
+
+bench: all $(BENCH_BIN)
+	./$(BENCH_BIN) --out $(BUILD)/bench.tsv
+
+bench-quick: all $(BENCH_BIN)
+	./$(BENCH_BIN) --quick --out $(BUILD)/bench-quick.tsv
+
+check-man:
+	@for m in man/rtsh.1 man/rtsh.5; do \
+		out=$$(LC_ALL=C.UTF-8 MANWIDTH=80 groff -man -ww -z $$m 2>&1); \
+		if [ -n "$$out" ]; then echo "$$m: $$out"; exit 1; fi; \
+		if command -v mandoc >/dev/null 2>&1; then mandoc -Tlint -W warning $$m || exit 1; fi; \
+	done; echo "man pages clean"
+
+install: all
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/man/man1 \
+		$(DESTDIR)$(PREFIX)/share/man/man5 $(DESTDIR)$(PREFIX)/share/rtsh/scenes
+	install -m 755 $(BIN) $(DESTDIR)$(PREFIX)/bin/rtsh
+	install -m 644 man/rtsh.1 $(DESTDIR)$(PREFIX)/share/man/man1/rtsh.1
+	install -m 644 man/rtsh.5 $(DESTDIR)$(PREFIX)/share/man/man5/rtsh.5
+	install -m 644 scenes/*.rt $(DESTDIR)$(PREFIX)/share/rtsh/scenes/
+
+uninstall:
+	rm -f $(DESTDIR)$(PREFIX)/bin/rtsh $(DESTDIR)$(PREFIX)/share/man/man1/rtsh.1 \
+		$(DESTDIR)$(PREFIX)/share/man/man5/rtsh.5
+	rm -rf $(DESTDIR)$(PREFIX)/share/rtsh
+
+clean:
+	rm -rf build rtsh
+
+-include $(CORE_OBJ:.o=.d) $(FRONT_OBJ:.o=.d) $(MAIN_OBJ:.o=.d)

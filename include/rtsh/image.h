@@ -1,0 +1,46 @@
+/* rtsh — image files and atomic writes.
+ *
+ * PPM P6 (8-bit sRGB), PFM (linear 32-bit float, little-endian, bottom row
+ * first as the format requires) and PNG (8-bit sRGB, libpng). Every file is
+ * written to a temporary file in the same folder and renamed over the
+ * target, so an interrupted save never destroys an older file.
+ */
+#ifndef RTSH_IMAGE_H
+#define RTSH_IMAGE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "rtsh/error.h"
+#include "rtsh/render.h"
+
+typedef enum image_format {
+	IMAGE_UNKNOWN,
+	IMAGE_PPM,
+	IMAGE_PFM,
+	IMAGE_PNG,
+} image_format;
+
+/* By the path's extension (case-insensitive). */
+image_format image_format_of(const char *path);
+
+/* Linear [0,1] to 8-bit sRGB, rounded, clamped; exact inverse of srgb8_to_linear
+ * on the 256 codes. */
+uint8_t linear_to_srgb8(double v);
+double srgb8_to_linear(double code);
+
+/* Writes the framebuffer; `exposure` is in stops (radiance x 2^exposure). */
+bool image_write(const char *path, const framebuffer *fb, double exposure, rt_error *err);
+
+/* Readers for tests and tools: a new framebuffer with linear values (PPM
+ * codes are sRGB-decoded). NULL with err set on failure. */
+framebuffer *image_read_pfm(const char *path, rt_error *err);
+framebuffer *image_read_ppm(const char *path, rt_error *err);
+
+/* Writes a file atomically: `write` fills the temporary file; on success it
+ * is flushed, synced and renamed over path; on failure path is untouched. */
+typedef bool (*file_writer_fn)(FILE *f, void *ctx, rt_error *err);
+bool file_write_atomic(const char *path, file_writer_fn write, void *ctx, rt_error *err);
+
+#endif

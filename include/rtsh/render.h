@@ -1,0 +1,99 @@
+/* rtsh — rendering: settings, the framebuffer and render jobs.
+ *
+ * A render job traces a range of samples [sample_begin, sample_end) for
+ * every pixel of a framebuffer, with `threads` workers pulling small tiles
+ * from a shared atomic counter. Every random number is a function of
+ * (pixel, sample, seed), and each pixel's samples are summed in sample order,
+ * so the image is bit-identical for any thread count, any tile order and any
+ * split of the samples into passes (progressive preview == batch render).
+ */
+#ifndef RTSH_RENDER_H
+#define RTSH_RENDER_H
+
+#include <stdatomic.h>
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "rtsh/error.h"
+#include "rtsh/world.h"
+
+typedef enum render_mode {
+	MODE_WHITTED,
+	MODE_PATH,
+} render_mode;
+
+const char *render_mode_name(render_mode m);
+
+typedef struct render_settings {
+	int width, height; /* full resolution */
+	int samples;       /* per pixel */
+	int depth;         /* reflection depth (whitted) / bounces (path) */
+	int threads;       /* 0 = the online CPU count */
+	render_mode mode;
+	uint64_t seed;
+	double exposure;   /* stops; output = radiance x 2^exposure */
+} render_settings;
+
+render_settings render_settings_default(void);
+/* Applies the hints of a scene file (R, set lines) over s. */
+void render_settings_apply_hints(render_settings *s, const scene_hints *h);
+/* The thread count to use: s->threads, or the online CPUs when 0. */
+int render_threads(const render_settings *s);
+
+/* A linear-light image. rgb holds w*h*3 floats, rows top to bottom: the mean
+ * of the samples so far. sum holds the running per-pixel sums (double) and
+ * spp how many samples they contain. */
+typedef struct framebuffer {
+	int w, h;
+	float *rgb;
+	double *sum;
+	int spp;
+} framebuffer;
+
+/* NULL when out of memory or the size is not in 1..RENDER_MAX_DIM. */
+framebuffer *fb_new(int w, int h);
+void fb_free(framebuffer *fb);
+/* Clears to black with no samples. */
+void fb_clear(framebuffer *fb);
+
+#define RENDER_MAX_DIM 16384
+#define RENDER_TILE 16
+
+typedef enum render_status {
+	RENDER_DONE,
+	RENDER_CANCELLED,
+	RENDER_FAILED,
+} render_status;
+
+/* Called from the thread that runs render_run, about every 100 ms and once at
+ * the end, with the tiles done so far. */
+typedef void (*render_progress_fn)(void *ctx, long done, long total);
+
+typedef struct render_job {
+	const world *w;
+	render_settings set;   /* mode, depth, seed, threads, samples (= total target) */
+	framebuffer *fb;       /* the image size is fb->w x fb->h */
+	int sample_begin;      /* must equal fb->spp: passes are added in order */
+	int sample_end;        /* <= set.samples */
+	atomic_bool *cancel;   /* optional: set to stop; checked per tile */
+	render_progress_fn progress; /* optional */
+	void *progress_ctx;
+} render_job;
+
+/* Runs the job to the end or until cancelled. On RENDER_DONE the fb holds
+ * sample_end samples per pixel; on RENDER_CANCELLED the fb is unchanged in
+ * spp but may hold a partial pass in rgb (the front end shows or drops it). */
+render_status render_run(render_job *job, rt_error *err);
+
+/* Convenience: a new framebuffer of s->width x s->height with all s->samples
+ * samples. NULL (err set) on failure or cancellation. */
+framebuffer *render_image(const world *w, const render_settings *s, atomic_bool *cancel,
+                          render_progress_fn progress, void *ctx, rt_error *err);
+
+/* The radiance along one camera sample: the integrators (whitted.c, path.c).
+ * px, py: pixel; sample: index; the random stream depends only on these and
+ * the seed. */
+vec3 render_sample(const world *w, const render_settings *s, int px, int py, int fw, int fh,
+                   int sample);
+
+#endif

@@ -1,0 +1,46 @@
+/* rtsh — reading and writing .rt scene files.
+ *
+ * One parser for every dialect, mixed freely in one file: the 42 miniRT
+ * format, its 2019 variant (R, c, l, sq, tr) and the extended format of the
+ * miniRT seed (position rotation scaling colour material [shear]), with
+ * optional trailing key=value extensions. See rtsh(5).
+ *
+ * Errors read "FILE:LINE:COL: what is wrong; expected ...". The parser never
+ * crashes or hangs on any input: NUL bytes, huge or non-finite numbers,
+ * enormous lines and empty files all give an error.
+ */
+#ifndef RTSH_RTFILE_H
+#define RTSH_RTFILE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdio.h>
+
+#include "rtsh/error.h"
+#include "rtsh/scene.h"
+
+typedef struct rt_load_opts {
+	bool strict;               /* the 42 subject's rules (rtsh --strict) */
+	const rt_warnings *warn;   /* optional sink for warnings */
+} rt_load_opts;
+
+/* Loads a scene file; NULL with err set on failure. opts may be NULL. */
+scene *rt_load_file(const char *path, const rt_load_opts *opts, rt_error *err);
+/* Loads a scene from memory; `name` is the file name used in messages. */
+scene *rt_load_string(const char *text, size_t len, const char *name, const rt_load_opts *opts,
+                      rt_error *err);
+/* Parses one line (no newline) into s, as the shell's `add LINE` does. The
+ * once-only elements (A, C) replace the existing ones. */
+bool rt_parse_line(scene *s, const char *line, const char *name, int lineno,
+                   const rt_load_opts *opts, rt_error *err);
+
+/* Writes the scene as .rt text; load(write(s)) is equal to s (scene_equal). */
+bool rt_write(const scene *s, FILE *f, rt_error *err);
+/* Writes the scene to path atomically. */
+bool rt_save(const scene *s, const char *path, rt_error *err);
+/* The one .rt line for an element (no newline), as `list` shows it. */
+void rt_format_object(const object *o, char *buf, size_t size);
+void rt_format_light(const light *l, char *buf, size_t size);
+void rt_format_camera(const camera *c, char *buf, size_t size);
+
+#endif

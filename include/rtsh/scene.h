@@ -1,0 +1,158 @@
+/* rtsh — the scene model: what a .rt file says, as the user wrote it.
+ *
+ * The model keeps user-facing values (sRGB colours 0..255, directions as
+ * written, degrees, diameters) so that load -> save -> load is exact. The
+ * render core derives everything else (unit vectors, linear colours,
+ * matrices) when it prepares a world (world.h) from a scene.
+ *
+ * Ownership: a scene owns its arrays; scene_free releases everything.
+ */
+#ifndef RTSH_SCENE_H
+#define RTSH_SCENE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "rtsh/error.h"
+#include "rtsh/math.h"
+
+typedef enum obj_kind {
+	OBJ_SPHERE,
+	OBJ_PLANE,
+	OBJ_CYLINDER,
+	OBJ_CONE,
+	OBJ_CUBE,
+	OBJ_DISC,
+	OBJ_RECT,
+	OBJ_TRIANGLE,
+	OBJ_KIND_COUNT
+} obj_kind;
+
+/* The .rt identifier ("sp", "pl", ...) and the English name of a kind. */
+const char *obj_kind_id(obj_kind k);
+const char *obj_kind_name(obj_kind k);
+/* Kind from an identifier ("sp", "sq" -> OBJ_RECT, "tr", ...); -1 if none. */
+int obj_kind_from_id(const char *id);
+
+typedef struct material {
+	vec3 color;        /* sRGB, 0..255 per channel, as written */
+	double diffuse;    /* [0,1] scale of the Lambertian albedo */
+	double specular;   /* [0,1] Phong specular weight */
+	double shininess;  /* [1,500] Phong exponent */
+	double reflective; /* [0,1] mirror weight */
+	/* Extensions, written as trailing key=value fields; the defaults
+	 * below mean "absent" and are not written back. */
+	double fuzz;     /* fuzz=   [0,1] roughness of the mirror lobe (0) */
+	double metal;    /* metal=  [0,1] tint reflections by colour (0) */
+	double ior;      /* ior=    0 opaque, else refractive index >= 1 (0) */
+	double emission; /* emit=   emitted radiance = emit x colour (0) */
+	int checker;     /* checker= 0 none, else squares per unit (0) */
+} material;
+
+/* The default material of a 42-format object: diffuse 0.9, specular 0.9,
+ * shininess 200, reflective 0, no extensions. */
+material material_default(vec3 color);
+
+/* An object. The writer uses the short 42 form (sp c d rgb, pl p n rgb,
+ * cy/co c axis d h rgb, sq, tr) whenever it loses nothing, and the extended
+ * form otherwise. */
+typedef struct object {
+	obj_kind kind;
+	vec3 pos;         /* centre (sphere, cube, cylinder, cone, disc, rect) or point (plane) */
+	vec3 dir;         /* where the local +Y axis points, as written; never zero */
+	double twist;     /* degrees about dir (twist=) */
+	vec3 scale;       /* extents on the local axes, all > 0 (see rtsh(5)) */
+	double shear[6];  /* xy xz yx yz zx zy; all zero = none */
+	vec3 tri[3];      /* OBJ_TRIANGLE: the vertices (pos/dir/scale unused) */
+	material mat;
+} object;
+
+typedef struct light {
+	vec3 pos;
+	double ratio; /* brightness [0,1] */
+	vec3 color;   /* sRGB 0..255 */
+} light;
+
+typedef struct camera {
+	vec3 pos;
+	vec3 dir;   /* as written; never zero */
+	double fov; /* horizontal, degrees, (0,180) */
+} camera;
+
+typedef struct ambient {
+	double ratio; /* [0,1] */
+	vec3 color;   /* sRGB 0..255 */
+} ambient;
+
+/* The path tracer's sky: a gradient from horizon to zenith. */
+typedef struct sky {
+	vec3 zenith;     /* sRGB 0..255 */
+	vec3 horizon;    /* sRGB 0..255 */
+	double strength; /* radiance scale, >= 0 */
+} sky;
+
+/* Per-scene render hints from the file (`R`, `set` lines). scene_new sets
+ * them all to "unset": width, height and samples 0, depth and mode -1. */
+typedef struct scene_hints {
+	int width, height; /* R w h, or set resolution WxH */
+	int samples;       /* set samples N */
+	int depth;         /* set depth N (0 is a valid depth) */
+	int mode;          /* set mode whitted|path: -1 unset, else render_mode */
+} scene_hints;
+
+typedef struct scene {
+	bool has_ambient;
+	ambient amb;
+	camera *cams; /* at least one in a loaded scene */
+	size_t ncams, cap_cams;
+	size_t cam; /* the active camera */
+	light *lights;
+	size_t nlights, cap_lights;
+	object *objs;
+	size_t nobjs, cap_objs;
+	bool has_sky;
+	sky sky;
+	scene_hints hints;
+} scene;
+
+scene *scene_new(void);
+void scene_free(scene *s);
+/* A deep copy; NULL when out of memory. */
+scene *scene_clone(const scene *s);
+/* True when a and b describe the identical scene, value for value. */
+bool scene_equal(const scene *a, const scene *b);
+bool object_equal(const object *a, const object *b);
+
+/* Appending copies the element; false (err set) when out of memory. */
+bool scene_add_object(scene *s, const object *o, rt_error *err);
+bool scene_add_light(scene *s, const light *l, rt_error *err);
+bool scene_add_camera(scene *s, const camera *c, rt_error *err);
+/* Removes element i (0-based), keeping the order of the others. */
+void scene_remove_object(scene *s, size_t i);
+void scene_remove_light(scene *s, size_t i);
+/* Inserts a copy of o so that it becomes element i (0-based). */
+bool scene_insert_object(scene *s, size_t i, const object *o, rt_error *err);
+bool scene_insert_light(scene *s, size_t i, const light *l, rt_error *err);
+/* The active camera; a scene without one gets the default camera. */
+camera scene_camera(const scene *s);
+
+/* A unit-size object of kind k at the origin with the default material. */
+object object_make(obj_kind k, vec3 color);
+/* Checks the object can be rendered: finite numbers, non-zero dir, positive
+ * scale, an invertible shear, a non-degenerate triangle. */
+bool object_validate(const object *o, rt_error *err);
+/* Local-to-world transform: T(pos) * R(dir, twist) * Shear * S(scale / 2),
+ * mapping the unit shape (extent [-1,1], see shape.h) to the object.
+ * Triangles: identity. False if not invertible. */
+bool object_xform(const object *o, xform *out);
+/* Centre of an object (triangles: the centroid). */
+vec3 object_center(const object *o);
+/* Edits in world space: move by d; rotate by Euler angles (degrees, applied
+ * about X, then Y, then Z) about the object's centre; multiply the scale.
+ * Rotation updates dir and twist so that the result saves exactly. */
+void object_move(object *o, vec3 d);
+bool object_rotate(object *o, vec3 deg, rt_error *err);
+bool object_scale(object *o, vec3 factor, rt_error *err);
+
+#endif

@@ -1,0 +1,293 @@
+/* rtsh — image files and atomic writes (image.h). */
+#include "rtsh/image.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <png.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+image_format image_format_of(const char *path)
+{
+	const char *dot = strrchr(path, '.');
+	const char *slash = strrchr(path, '/');
+	if (!dot || (slash && dot < slash))
+		return IMAGE_UNKNOWN;
+	if (strcasecmp(dot, ".ppm") == 0)
+		return IMAGE_PPM;
+	if (strcasecmp(dot, ".pfm") == 0)
+		return IMAGE_PFM;
+	if (strcasecmp(dot, ".png") == 0)
+		return IMAGE_PNG;
+	return IMAGE_UNKNOWN;
+}
+
+/* The 8-bit code whose sRGB decoding is nearest to v: the encoding
+ * (IEC 61966-2-1) rounded to nearest. */
+uint8_t linear_to_srgb8(double v)
+{
+	if (!(v > 0.0))
+		return 0;
+	if (v >= 1.0)
+		return 255;
+	double s = v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
+	return (uint8_t)(s * 255.0 + 0.5);
+}
+
+double srgb8_to_linear(double code)
+{
+	double c = code / 255.0;
+	return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4);
+}
+
+bool file_write_atomic(const char *path, file_writer_fn write, void *ctx, rt_error *err)
+{
+	size_t n = strlen(path);
+	char *tmp = malloc(n + 32);
+	if (!tmp)
+		return rt_error_set(err, "%s: out of memory", path);
+	/* The temporary file sits beside the target so rename() stays on one
+	 * file system and is atomic. */
+	const char *slash = strrchr(path, '/');
+	size_t dir = slash ? (size_t)(slash - path) + 1 : 0;
+	snprintf(tmp, n + 32, "%.*s.%s.tmp.XXXXXX", (int)dir, path, path + dir);
+	int fd = mkstemp(tmp);
+	if (fd < 0) {
+		rt_error_at(err, path, 0, 0, "cannot create a file in that folder (%s); expected a writable folder",
+		            strerror(errno));
+		free(tmp);
+		return false;
+	}
+	FILE *f = fdopen(fd, "wb");
+	if (!f) {
+		close(fd);
+		unlink(tmp);
+		free(tmp);
+		return rt_error_at(err, path, 0, 0, "cannot write (%s)", strerror(errno));
+	}
+	bool ok = write(f, ctx, err);
+	if (ok && (fflush(f) != 0 || ferror(f) || fsync(fd) != 0)) {
+		rt_error_at(err, path, 0, 0, "write failed (%s); expected free space", strerror(errno));
+		ok = false;
+	}
+	if (fclose(f) != 0 && ok) {
+		rt_error_at(err, path, 0, 0, "write failed (%s); expected free space", strerror(errno));
+		ok = false;
+	}
+	if (ok) {
+		/* mkstemp makes the file 0600; give it the usual mode. */
+		mode_t mask = umask(0);
+		umask(mask);
+		chmod(tmp, 0666 & ~mask);
+		if (rename(tmp, path) != 0) {
+			rt_error_at(err, path, 0, 0, "cannot replace the file (%s)", strerror(errno));
+			ok = false;
+		}
+	}
+	if (!ok)
+		unlink(tmp);
+	free(tmp);
+	return ok;
+}
+
+typedef struct image_ctx {
+	const framebuffer *fb;
+	double gain;
+	const char *path;
+} image_ctx;
+
+static uint8_t *encode_rows(const image_ctx *c)
+{
+	const framebuffer *fb = c->fb;
+	size_t n = (size_t)fb->w * (size_t)fb->h * 3;
+	uint8_t *px = malloc(n);
+	if (!px)
+		return NULL;
+	for (size_t i = 0; i < n; i++)
+		px[i] = linear_to_srgb8(fb->rgb[i] * c->gain);
+	return px;
+}
+
+static bool write_ppm(FILE *f, void *vctx, rt_error *err)
+{
+	image_ctx *c = vctx;
+	uint8_t *px = encode_rows(c);
+	if (!px)
+		return rt_error_at(err, c->path, 0, 0, "out of memory");
+	fprintf(f, "P6\n%d %d\n255\n", c->fb->w, c->fb->h);
+	size_t n = (size_t)c->fb->w * (size_t)c->fb->h * 3;
+	bool ok = fwrite(px, 1, n, f) == n;
+	free(px);
+	return ok || rt_error_at(err, c->path, 0, 0, "write failed");
+}
+
+static bool write_pfm(FILE *f, void *vctx, rt_error *err)
+{
+	image_ctx *c = vctx;
+	const framebuffer *fb = c->fb;
+	/* A negative scale means little-endian; rows go bottom to top. */
+	fprintf(f, "PF\n%d %d\n-1.0\n", fb->w, fb->h);
+	float *row = malloc((size_t)fb->w * 3 * sizeof *row);
+	if (!row)
+		return rt_error_at(err, c->path, 0, 0, "out of memory");
+	bool ok = true;
+	for (int y = fb->h - 1; y >= 0 && ok; y--) {
+		const float *src = fb->rgb + (size_t)y * fb->w * 3;
+		for (int i = 0; i < fb->w * 3; i++) {
+			float v = (float)(src[i] * c->gain);
+			uint32_t bits;
+			memcpy(&bits, &v, 4);
+			uint8_t le[4] = {(uint8_t)bits, (uint8_t)(bits >> 8), (uint8_t)(bits >> 16),
+			                 (uint8_t)(bits >> 24)};
+			memcpy(&row[i], le, 4);
+		}
+		ok = fwrite(row, sizeof *row, (size_t)fb->w * 3, f) == (size_t)fb->w * 3;
+	}
+	free(row);
+	return ok || rt_error_at(err, c->path, 0, 0, "write failed");
+}
+
+static bool write_png(FILE *f, void *vctx, rt_error *err)
+{
+	image_ctx *c = vctx;
+	uint8_t *px = encode_rows(c);
+	png_bytep *rows = malloc((size_t)c->fb->h * sizeof *rows);
+	if (!px || !rows) {
+		free(px);
+		free(rows);
+		return rt_error_at(err, c->path, 0, 0, "out of memory");
+	}
+	png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
+	png_infop info = png ? png_create_info_struct(png) : NULL;
+	bool ok = false;
+	if (png && info && !setjmp(png_jmpbuf(png))) {
+		png_init_io(png, f);
+		png_set_IHDR(png, info, (png_uint_32)c->fb->w, (png_uint_32)c->fb->h, 8, PNG_COLOR_TYPE_RGB,
+		             PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+		png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+		for (int y = 0; y < c->fb->h; y++)
+			rows[y] = px + (size_t)y * c->fb->w * 3;
+		png_write_info(png, info);
+		png_write_image(png, rows);
+		png_write_end(png, NULL);
+		ok = true;
+	}
+	png_destroy_write_struct(&png, &info);
+	free(rows);
+	free(px);
+	return ok || rt_error_at(err, c->path, 0, 0, "PNG encoding failed");
+}
+
+bool image_write(const char *path, const framebuffer *fb, double exposure, rt_error *err)
+{
+	image_ctx c = {fb, exp2(exposure), path};
+	switch (image_format_of(path)) {
+	case IMAGE_PPM:
+		return file_write_atomic(path, write_ppm, &c, err);
+	case IMAGE_PFM:
+		return file_write_atomic(path, write_pfm, &c, err);
+	case IMAGE_PNG:
+		return file_write_atomic(path, write_png, &c, err);
+	default:
+		return rt_error_at(err, path, 0, 0, "unknown image type; expected .ppm, .pfm or .png");
+	}
+}
+
+/* Reads the netpbm header "MAGIC W H MAX" (whitespace and # comments). */
+static bool read_header(FILE *f, const char *magic, int *w, int *h, double *max)
+{
+	char m[3] = {0};
+	if (fread(m, 1, 2, f) != 2 || memcmp(m, magic, 2) != 0)
+		return false;
+	double v[3];
+	for (int i = 0; i < 3; i++) {
+		int ch;
+		while ((ch = fgetc(f)) != EOF && (ch == ' ' || ch == '\t' || ch == '\r' || ch == '\n' || ch == '#'))
+			if (ch == '#')
+				while ((ch = fgetc(f)) != EOF && ch != '\n')
+					;
+		if (ch == EOF)
+			return false;
+		ungetc(ch, f);
+		if (fscanf(f, "%lf", &v[i]) != 1)
+			return false;
+	}
+	fgetc(f); /* the single whitespace before the data */
+	if (!(v[0] >= 1 && v[0] <= RENDER_MAX_DIM && v[1] >= 1 && v[1] <= RENDER_MAX_DIM))
+		return false;
+	*w = (int)v[0];
+	*h = (int)v[1];
+	*max = v[2];
+	return true;
+}
+
+framebuffer *image_read_pfm(const char *path, rt_error *err)
+{
+	FILE *f = fopen(path, "rb");
+	if (!f) {
+		rt_error_at(err, path, 0, 0, "cannot open (%s)", strerror(errno));
+		return NULL;
+	}
+	int w, h;
+	double scale;
+	framebuffer *fb = NULL;
+	if (!read_header(f, "PF", &w, &h, &scale) || !(fb = fb_new(w, h))) {
+		fclose(f);
+		rt_error_at(err, path, 0, 0, "not a PFM colour image; expected PF W H SCALE");
+		return NULL;
+	}
+	bool big = scale > 0;
+	for (int y = h - 1; y >= 0; y--)
+		for (int i = 0; i < w * 3; i++) {
+			uint8_t b[4];
+			if (fread(b, 1, 4, f) != 4) {
+				fclose(f);
+				fb_free(fb);
+				rt_error_at(err, path, 0, 0, "PFM data ends early");
+				return NULL;
+			}
+			uint32_t bits = big ? (uint32_t)b[0] << 24 | (uint32_t)b[1] << 16 | (uint32_t)b[2] << 8 | b[3]
+			                    : (uint32_t)b[3] << 24 | (uint32_t)b[2] << 16 | (uint32_t)b[1] << 8 | b[0];
+			float v;
+			memcpy(&v, &bits, 4);
+			fb->rgb[(size_t)y * w * 3 + i] = v;
+		}
+	fclose(f);
+	fb->spp = 0;
+	return fb;
+}
+
+framebuffer *image_read_ppm(const char *path, rt_error *err)
+{
+	FILE *f = fopen(path, "rb");
+	if (!f) {
+		rt_error_at(err, path, 0, 0, "cannot open (%s)", strerror(errno));
+		return NULL;
+	}
+	int w, h;
+	double max;
+	framebuffer *fb = NULL;
+	if (!read_header(f, "P6", &w, &h, &max) || max != 255 || !(fb = fb_new(w, h))) {
+		fclose(f);
+		rt_error_at(err, path, 0, 0, "not an 8-bit PPM image; expected P6 W H 255");
+		return NULL;
+	}
+	size_t n = (size_t)w * h * 3;
+	uint8_t *px = malloc(n);
+	bool ok = px && fread(px, 1, n, f) == n;
+	fclose(f);
+	if (!ok) {
+		free(px);
+		fb_free(fb);
+		rt_error_at(err, path, 0, 0, "PPM data ends early");
+		return NULL;
+	}
+	for (size_t i = 0; i < n; i++)
+		fb->rgb[i] = (float)srgb8_to_linear(px[i]);
+	free(px);
+	return fb;
+}

@@ -1,0 +1,219 @@
+/* rtsh — 4x4 matrices and transforms (math.h). */
+#include "rtsh/math.h"
+
+mat4 m4_identity(void)
+{
+	mat4 r = {{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}}};
+	return r;
+}
+
+mat4 m4_mul(mat4 a, mat4 b)
+{
+	mat4 r;
+	for (int i = 0; i < 4; i++)
+		for (int j = 0; j < 4; j++) {
+			double s = 0.0;
+			for (int k = 0; k < 4; k++)
+				s += a.m[i][k] * b.m[k][j];
+			r.m[i][j] = s;
+		}
+	return r;
+}
+
+mat4 m4_transpose(mat4 a)
+{
+	mat4 r;
+	for (int i = 0; i < 4; i++)
+		for (int j = 0; j < 4; j++)
+			r.m[i][j] = a.m[j][i];
+	return r;
+}
+
+bool m4_invert(mat4 a, mat4 *out)
+{
+	mat4 inv = m4_identity();
+	double scale = 0.0;
+	for (int i = 0; i < 4; i++)
+		for (int j = 0; j < 4; j++) {
+			if (!isfinite(a.m[i][j]))
+				return false;
+			scale = fmax(scale, fabs(a.m[i][j]));
+		}
+	if (scale == 0.0)
+		return false;
+	for (int col = 0; col < 4; col++) {
+		int piv = col;
+		for (int r = col + 1; r < 4; r++)
+			if (fabs(a.m[r][col]) > fabs(a.m[piv][col]))
+				piv = r;
+		/* A pivot this small relative to the matrix means it is singular
+		 * to working precision. */
+		if (fabs(a.m[piv][col]) <= 1e-14 * scale)
+			return false;
+		if (piv != col)
+			for (int j = 0; j < 4; j++) {
+				double t = a.m[col][j];
+				a.m[col][j] = a.m[piv][j];
+				a.m[piv][j] = t;
+				t = inv.m[col][j];
+				inv.m[col][j] = inv.m[piv][j];
+				inv.m[piv][j] = t;
+			}
+		double p = 1.0 / a.m[col][col];
+		for (int j = 0; j < 4; j++) {
+			a.m[col][j] *= p;
+			inv.m[col][j] *= p;
+		}
+		for (int r = 0; r < 4; r++) {
+			if (r == col || a.m[r][col] == 0.0)
+				continue;
+			double f = a.m[r][col];
+			for (int j = 0; j < 4; j++) {
+				a.m[r][j] -= f * a.m[col][j];
+				inv.m[r][j] -= f * inv.m[col][j];
+			}
+		}
+	}
+	for (int i = 0; i < 4; i++)
+		for (int j = 0; j < 4; j++)
+			if (!isfinite(inv.m[i][j]))
+				return false;
+	*out = inv;
+	return true;
+}
+
+mat4 m4_translate(vec3 t)
+{
+	mat4 r = m4_identity();
+	r.m[0][3] = t.x;
+	r.m[1][3] = t.y;
+	r.m[2][3] = t.z;
+	return r;
+}
+
+mat4 m4_scale(vec3 s)
+{
+	mat4 r = m4_identity();
+	r.m[0][0] = s.x;
+	r.m[1][1] = s.y;
+	r.m[2][2] = s.z;
+	return r;
+}
+
+mat4 m4_rotate_x(double a)
+{
+	mat4 r = m4_identity();
+	double c = cos(a), s = sin(a);
+	r.m[1][1] = c;
+	r.m[1][2] = -s;
+	r.m[2][1] = s;
+	r.m[2][2] = c;
+	return r;
+}
+
+mat4 m4_rotate_y(double a)
+{
+	mat4 r = m4_identity();
+	double c = cos(a), s = sin(a);
+	r.m[0][0] = c;
+	r.m[0][2] = s;
+	r.m[2][0] = -s;
+	r.m[2][2] = c;
+	return r;
+}
+
+mat4 m4_rotate_z(double a)
+{
+	mat4 r = m4_identity();
+	double c = cos(a), s = sin(a);
+	r.m[0][0] = c;
+	r.m[0][1] = -s;
+	r.m[1][0] = s;
+	r.m[1][1] = c;
+	return r;
+}
+
+mat4 m4_rotate_axis(vec3 k, double a)
+{
+	/* Rodrigues: R = cI + s[k]x + (1-c) k k^T */
+	double c = cos(a), s = sin(a), t = 1.0 - c;
+	mat4 r = m4_identity();
+	r.m[0][0] = c + t * k.x * k.x;
+	r.m[0][1] = t * k.x * k.y - s * k.z;
+	r.m[0][2] = t * k.x * k.z + s * k.y;
+	r.m[1][0] = t * k.y * k.x + s * k.z;
+	r.m[1][1] = c + t * k.y * k.y;
+	r.m[1][2] = t * k.y * k.z - s * k.x;
+	r.m[2][0] = t * k.z * k.x - s * k.y;
+	r.m[2][1] = t * k.z * k.y + s * k.x;
+	r.m[2][2] = c + t * k.z * k.z;
+	return r;
+}
+
+mat4 m4_shear(const double s[6])
+{
+	mat4 r = m4_identity();
+	r.m[0][1] = s[0]; /* xy */
+	r.m[0][2] = s[1]; /* xz */
+	r.m[1][0] = s[2]; /* yx */
+	r.m[1][2] = s[3]; /* yz */
+	r.m[2][0] = s[4]; /* zx */
+	r.m[2][1] = s[5]; /* zy */
+	return r;
+}
+
+mat4 m4_orient(vec3 d, double twist)
+{
+	/* Shortest arc from +Y to d: for d = (x,y,z), the axis is Y x d =
+	 * (z, 0, -x) and cos = y. Written out to stay exact for d = +Y. */
+	mat4 r = m4_identity();
+	double c = d.y;
+	if (c < -1.0 + 1e-12) {
+		r = m4_rotate_x(RT_PI);
+	} else {
+		/* R = cI + [k]x + k k^T / (1 + c), with k = Y x d (unnormalised). */
+		double kx = d.z, kz = -d.x, f = 1.0 / (1.0 + c);
+		r.m[0][0] = c + kx * kx * f;
+		r.m[0][1] = -kz;
+		r.m[0][2] = kx * kz * f;
+		r.m[1][0] = kz;
+		r.m[1][1] = c;
+		r.m[1][2] = -kx;
+		r.m[2][0] = kz * kx * f;
+		r.m[2][1] = kx;
+		r.m[2][2] = c + kz * kz * f;
+	}
+	if (twist != 0.0)
+		r = m4_mul(r, m4_rotate_y(twist));
+	return r;
+}
+
+xform xf_identity(void)
+{
+	return (xform){m4_identity(), m4_identity()};
+}
+
+bool xf_make(mat4 m, xform *out)
+{
+	mat4 inv;
+	if (!m4_invert(m, &inv))
+		return false;
+	out->m = m;
+	out->inv = inv;
+	return true;
+}
+
+xform xf_then(xform a, xform b)
+{
+	return (xform){m4_mul(b.m, a.m), m4_mul(a.inv, b.inv)};
+}
+
+box xf_box(const xform *x, box b)
+{
+	box r = box_empty();
+	for (int i = 0; i < 8; i++) {
+		vec3 p = {i & 1 ? b.hi.x : b.lo.x, i & 2 ? b.hi.y : b.lo.y, i & 4 ? b.hi.z : b.lo.z};
+		r = box_add(r, m4_point(&x->m, p));
+	}
+	return r;
+}

@@ -1,0 +1,285 @@
+/* rtsh — render jobs: tiles pulled from an atomic counter by a pool of
+ * pthreads; each pixel's samples are summed in sample order (render.h). */
+#include "rtsh/render.h"
+
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "integrators.h"
+
+const char *render_mode_name(render_mode m)
+{
+	return m == MODE_PATH ? "path" : "whitted";
+}
+
+render_settings render_settings_default(void)
+{
+	return (render_settings){
+		.width = 1280,
+		.height = 720,
+		.samples = 1,
+		.depth = 5,
+		.threads = 0,
+		.mode = MODE_WHITTED,
+		.seed = 1,
+		.exposure = 0.0,
+	};
+}
+
+void render_settings_apply_hints(render_settings *s, const scene_hints *h)
+{
+	if (h->width > 0 && h->height > 0) {
+		s->width = h->width < RENDER_MAX_DIM ? h->width : RENDER_MAX_DIM;
+		s->height = h->height < RENDER_MAX_DIM ? h->height : RENDER_MAX_DIM;
+	}
+	if (h->samples > 0)
+		s->samples = h->samples;
+	if (h->depth >= 0)
+		s->depth = h->depth;
+	if (h->mode >= 0)
+		s->mode = (render_mode)h->mode;
+}
+
+int render_threads(const render_settings *s)
+{
+	if (s->threads > 0)
+		return s->threads;
+	long n = sysconf(_SC_NPROCESSORS_ONLN);
+	return n < 1 ? 1 : n > 256 ? 256 : (int)n;
+}
+
+framebuffer *fb_new(int w, int h)
+{
+	if (w < 1 || h < 1 || w > RENDER_MAX_DIM || h > RENDER_MAX_DIM)
+		return NULL;
+	framebuffer *fb = calloc(1, sizeof *fb);
+	if (!fb)
+		return NULL;
+	size_t n = (size_t)w * (size_t)h * 3;
+	fb->w = w;
+	fb->h = h;
+	fb->rgb = calloc(n, sizeof *fb->rgb);
+	fb->sum = calloc(n, sizeof *fb->sum);
+	if (!fb->rgb || !fb->sum) {
+		fb_free(fb);
+		return NULL;
+	}
+	return fb;
+}
+
+void fb_free(framebuffer *fb)
+{
+	if (!fb)
+		return;
+	free(fb->rgb);
+	free(fb->sum);
+	free(fb);
+}
+
+void fb_clear(framebuffer *fb)
+{
+	size_t n = (size_t)fb->w * (size_t)fb->h * 3;
+	memset(fb->rgb, 0, n * sizeof *fb->rgb);
+	memset(fb->sum, 0, n * sizeof *fb->sum);
+	fb->spp = 0;
+}
+
+vec3 render_sample(const world *w, const render_settings *s, int px, int py, int fw, int fh, int sample)
+{
+	uint64_t pixel = (uint64_t)py * (uint64_t)fw + (uint64_t)px;
+	rng g = rng_for(s->seed, pixel, (uint64_t)sample);
+	double u = 0.5, v = 0.5;
+	if (s->samples > 1)
+		pixel_offset((uint32_t)sample, rng_u64(&g), &u, &v);
+	ray r = cam_ray(&w->cam, px + u, py + v, fw, fh);
+	vec3 c = s->mode == MODE_PATH ? path_radiance(w, s, r, &g) : whitted_radiance(w, s, r);
+	/* A NaN or infinity from a degenerate case must not poison the pixel. */
+	if (!v3_finite(c))
+		c = v3(0, 0, 0);
+	return c;
+}
+
+typedef struct shared {
+	render_job *job;
+	int tiles_x;
+	long tiles;
+	atomic_long next;
+	atomic_long done;
+	atomic_int running;
+	pthread_mutex_t lock;
+	pthread_cond_t finished;
+} shared;
+
+static void render_tile(shared *sh, long t)
+{
+	render_job *job = sh->job;
+	framebuffer *fb = job->fb;
+	int x0 = (int)(t % sh->tiles_x) * RENDER_TILE, y0 = (int)(t / sh->tiles_x) * RENDER_TILE;
+	int x1 = x0 + RENDER_TILE < fb->w ? x0 + RENDER_TILE : fb->w;
+	int y1 = y0 + RENDER_TILE < fb->h ? y0 + RENDER_TILE : fb->h;
+	double inv = 1.0 / job->sample_end;
+	for (int y = y0; y < y1; y++)
+		for (int x = x0; x < x1; x++) {
+			size_t i = ((size_t)y * (size_t)fb->w + (size_t)x) * 3;
+			double r = fb->sum[i], g = fb->sum[i + 1], b = fb->sum[i + 2];
+			for (int s = job->sample_begin; s < job->sample_end; s++) {
+				vec3 c = render_sample(job->w, &job->set, x, y, fb->w, fb->h, s);
+				r += c.x;
+				g += c.y;
+				b += c.z;
+			}
+			fb->sum[i] = r;
+			fb->sum[i + 1] = g;
+			fb->sum[i + 2] = b;
+			fb->rgb[i] = (float)(r * inv);
+			fb->rgb[i + 1] = (float)(g * inv);
+			fb->rgb[i + 2] = (float)(b * inv);
+		}
+}
+
+static void *worker(void *arg)
+{
+	shared *sh = arg;
+	for (;;) {
+		if (sh->job->cancel && atomic_load_explicit(sh->job->cancel, memory_order_relaxed))
+			break;
+		long t = atomic_fetch_add(&sh->next, 1);
+		if (t >= sh->tiles)
+			break;
+		render_tile(sh, t);
+		atomic_fetch_add(&sh->done, 1);
+	}
+	pthread_mutex_lock(&sh->lock);
+	if (atomic_fetch_sub(&sh->running, 1) == 1)
+		pthread_cond_signal(&sh->finished);
+	pthread_mutex_unlock(&sh->lock);
+	return NULL;
+}
+
+static double now_seconds(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+static void report(render_job *job, shared *sh)
+{
+	if (job->progress)
+		job->progress(job->progress_ctx, atomic_load(&sh->done), sh->tiles);
+}
+
+render_status render_run(render_job *job, rt_error *err)
+{
+	framebuffer *fb = job->fb;
+	if (job->sample_begin != fb->spp || job->sample_end <= job->sample_begin) {
+		rt_error_set(err, "render pass %d..%d does not follow the %d samples done",
+		             job->sample_begin, job->sample_end, fb->spp);
+		return RENDER_FAILED;
+	}
+	shared sh;
+	sh.job = job;
+	sh.tiles_x = (fb->w + RENDER_TILE - 1) / RENDER_TILE;
+	sh.tiles = (long)sh.tiles_x * ((fb->h + RENDER_TILE - 1) / RENDER_TILE);
+	atomic_init(&sh.next, 0);
+	atomic_init(&sh.done, 0);
+	int n = render_threads(&job->set);
+	if (n > sh.tiles)
+		n = (int)sh.tiles;
+	atomic_init(&sh.running, n);
+	pthread_mutex_init(&sh.lock, NULL);
+	pthread_cond_init(&sh.finished, NULL);
+
+	pthread_t *tid = n > 1 ? calloc((size_t)n, sizeof *tid) : NULL;
+	int started = 0;
+	if (tid)
+		for (; started < n; started++)
+			if (pthread_create(&tid[started], NULL, worker, &sh) != 0)
+				break;
+	if (started == 0) {
+		/* One thread (or none could start): work here, reporting about
+		 * every 100 ms. */
+		double last = now_seconds();
+		for (;;) {
+			if (job->cancel && atomic_load(job->cancel))
+				break;
+			long t = atomic_fetch_add(&sh.next, 1);
+			if (t >= sh.tiles)
+				break;
+			render_tile(&sh, t);
+			atomic_fetch_add(&sh.done, 1);
+			if (job->progress && now_seconds() - last >= 0.1) {
+				last = now_seconds();
+				report(job, &sh);
+			}
+		}
+	} else {
+		if (started < n) {
+			/* Fewer threads than asked: the missing ones count as finished. */
+			pthread_mutex_lock(&sh.lock);
+			atomic_fetch_sub(&sh.running, n - started);
+			pthread_mutex_unlock(&sh.lock);
+		}
+		pthread_mutex_lock(&sh.lock);
+		while (atomic_load(&sh.running) > 0) {
+			struct timespec ts;
+			clock_gettime(CLOCK_REALTIME, &ts);
+			ts.tv_nsec += 100 * 1000 * 1000;
+			if (ts.tv_nsec >= 1000000000L) {
+				ts.tv_sec++;
+				ts.tv_nsec -= 1000000000L;
+			}
+			pthread_cond_timedwait(&sh.finished, &sh.lock, &ts);
+			if (atomic_load(&sh.running) > 0 && job->progress) {
+				pthread_mutex_unlock(&sh.lock);
+				report(job, &sh);
+				pthread_mutex_lock(&sh.lock);
+			}
+		}
+		pthread_mutex_unlock(&sh.lock);
+		for (int i = 0; i < started; i++)
+			pthread_join(tid[i], NULL);
+	}
+	free(tid);
+	pthread_mutex_destroy(&sh.lock);
+	pthread_cond_destroy(&sh.finished);
+	report(job, &sh);
+	if (atomic_load(&sh.done) < sh.tiles) {
+		fb->spp = 0; /* the sums now mix passes: the next pass must start over */
+		return RENDER_CANCELLED;
+	}
+	fb->spp = job->sample_end;
+	return RENDER_DONE;
+}
+
+framebuffer *render_image(const world *w, const render_settings *s, atomic_bool *cancel,
+                          render_progress_fn progress, void *ctx, rt_error *err)
+{
+	framebuffer *fb = fb_new(s->width, s->height);
+	if (!fb) {
+		rt_error_set(err, "cannot make a %dx%d image; expected 1..%d pixels a side, and memory",
+		             s->width, s->height, RENDER_MAX_DIM);
+		return NULL;
+	}
+	render_job job = {
+		.w = w,
+		.set = *s,
+		.fb = fb,
+		.sample_begin = 0,
+		.sample_end = s->samples,
+		.cancel = cancel,
+		.progress = progress,
+		.progress_ctx = ctx,
+	};
+	render_status st = render_run(&job, err);
+	if (st != RENDER_DONE) {
+		if (st == RENDER_CANCELLED)
+			rt_error_set(err, "render stopped");
+		fb_free(fb);
+		return NULL;
+	}
+	return fb;
+}

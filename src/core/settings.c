@@ -1,0 +1,149 @@
+/* rtsh — the settings table (settings.h). */
+#include "rtsh/settings.h"
+
+#include <errno.h>
+#include <stddef.h>
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+const setting_def settings_table[] = {
+#define AT(field) offsetof(render_settings, field)
+	{"resolution", SETTING_RESOLUTION, 1, RENDER_MAX_DIM, AT(width), "full-resolution image size, WxH"},
+	{"samples", SETTING_INT, 1, 1000000, AT(samples), "samples (rays or paths) per pixel"},
+	{"depth", SETTING_INT, 0, 1000, AT(depth), "reflection depth (whitted) or bounces (path)"},
+	{"mode", SETTING_MODE, 0, 1, AT(mode), "render mode: whitted or path"},
+	{"threads", SETTING_INT, 0, 256, AT(threads), "render threads; 0 = one per online CPU"},
+	{"seed", SETTING_U64, 0, 0, AT(seed), "random seed of the sampler"},
+	{"exposure", SETTING_DOUBLE, -20, 20, AT(exposure), "exposure in stops: output = radiance x 2^exposure"},
+#undef AT
+};
+const size_t settings_count = sizeof settings_table / sizeof settings_table[0];
+
+const setting_def *settings_find(const char *name, rt_error *err)
+{
+	const setting_def *found = NULL;
+	size_t len = strlen(name);
+	int matches = 0;
+	for (size_t i = 0; i < settings_count; i++) {
+		if (strcmp(settings_table[i].name, name) == 0)
+			return &settings_table[i];
+		if (len && strncmp(settings_table[i].name, name, len) == 0) {
+			found = &settings_table[i];
+			matches++;
+		}
+	}
+	if (matches == 1)
+		return found;
+	char names[256] = "";
+	for (size_t i = 0; i < settings_count; i++) {
+		strncat(names, " ", sizeof names - strlen(names) - 1);
+		strncat(names, settings_table[i].name, sizeof names - strlen(names) - 1);
+	}
+	rt_error_set(err, "%s setting \"%s\"; expected one of%s", matches ? "ambiguous" : "unknown", name,
+	             names);
+	return NULL;
+}
+
+static void *field(render_settings *s, const setting_def *def)
+{
+	return (char *)s + def->offset;
+}
+
+static const void *cfield(const render_settings *s, const setting_def *def)
+{
+	return (const char *)s + def->offset;
+}
+
+/* A whole number in [min, max] filling all of s. */
+static bool parse_long(const char *s, double min, double max, long *out)
+{
+	if (!*s)
+		return false;
+	char *end;
+	errno = 0;
+	long v = strtol(s, &end, 10);
+	if (errno || *end || v < min || v > max)
+		return false;
+	*out = v;
+	return true;
+}
+
+bool settings_set(render_settings *s, const setting_def *def, const char *value, rt_error *err)
+{
+	long a, b;
+	switch (def->type) {
+	case SETTING_INT:
+		if (!parse_long(value, def->min, def->max, &a))
+			return rt_error_set(err, "%s \"%s\" is not valid; expected a whole number in %g..%g",
+			                    def->name, value, def->min, def->max);
+		*(int *)field(s, def) = (int)a;
+		return true;
+	case SETTING_U64: {
+		char *end;
+		errno = 0;
+		unsigned long long v = strtoull(value, &end, 10);
+		if (!*value || *value == '-' || errno || *end)
+			return rt_error_set(err, "%s \"%s\" is not valid; expected a whole number >= 0",
+			                    def->name, value);
+		*(uint64_t *)field(s, def) = v;
+		return true;
+	}
+	case SETTING_DOUBLE: {
+		char *end;
+		double v = strtod(value, &end);
+		if (!*value || *end || !(v >= def->min && v <= def->max))
+			return rt_error_set(err, "%s \"%s\" is not valid; expected a number in %g..%g",
+			                    def->name, value, def->min, def->max);
+		*(double *)field(s, def) = v;
+		return true;
+	}
+	case SETTING_RESOLUTION: {
+		const char *x = strpbrk(value, "xX");
+		char wbuf[32];
+		if (!x || (size_t)(x - value) >= sizeof wbuf)
+			return rt_error_set(err, "resolution \"%s\" is not valid; expected WxH like 1280x720",
+			                    value);
+		memcpy(wbuf, value, (size_t)(x - value));
+		wbuf[x - value] = '\0';
+		if (!parse_long(wbuf, def->min, def->max, &a) || !parse_long(x + 1, def->min, def->max, &b))
+			return rt_error_set(err, "resolution \"%s\" is not valid; expected WxH with each of W "
+			                         "and H in %g..%g",
+			                    value, def->min, def->max);
+		s->width = (int)a;
+		s->height = (int)b;
+		return true;
+	}
+	case SETTING_MODE:
+		if (strcmp(value, "whitted") == 0)
+			s->mode = MODE_WHITTED;
+		else if (strcmp(value, "path") == 0)
+			s->mode = MODE_PATH;
+		else
+			return rt_error_set(err, "mode \"%s\" is not valid; expected whitted or path", value);
+		return true;
+	}
+	return rt_error_set(err, "internal: setting %s has no type", def->name);
+}
+
+void settings_format(const render_settings *s, const setting_def *def, char *buf, size_t size)
+{
+	switch (def->type) {
+	case SETTING_INT:
+		snprintf(buf, size, "%d", *(const int *)cfield(s, def));
+		return;
+	case SETTING_U64:
+		snprintf(buf, size, "%" PRIu64, *(const uint64_t *)cfield(s, def));
+		return;
+	case SETTING_DOUBLE:
+		snprintf(buf, size, "%g", *(const double *)cfield(s, def));
+		return;
+	case SETTING_RESOLUTION:
+		snprintf(buf, size, "%dx%d", s->width, s->height);
+		return;
+	case SETTING_MODE:
+		snprintf(buf, size, "%s", render_mode_name(s->mode));
+		return;
+	}
+}

@@ -1,0 +1,24 @@
+/* rtsh — shading helpers shared by the integrators. */
+#include "integrators.h"
+
+vec3 world_background(const world *w, vec3 dir, render_mode mode)
+{
+	if (w->has_sky) {
+		/* The height gradient of the path-tracer seed: horizon at and
+		 * below y = 0, zenith straight up. */
+		double t = clampd(dir.y / v3_len(dir), 0.0, 1.0);
+		return v3_lerp(w->sky_horizon, w->sky_zenith, t);
+	}
+	return mode == MODE_PATH ? w->ambient : v3(0, 0, 0);
+}
+
+vec3 hit_albedo(const mat_lin *m, const hit *h)
+{
+	if (m->checker <= 0.0)
+		return m->albedo;
+	/* Alternate squares of side 1/checker object units are darkened. */
+	double k = m->checker;
+	long s = (long)floor(h->local.x * k + 1e-9) + (long)floor(h->local.y * k + 1e-9) +
+	         (long)floor(h->local.z * k + 1e-9);
+	return (s & 1) ? v3_scale(m->albedo, 0.2) : m->albedo;
+}

@@ -1,0 +1,62 @@
+/* rtsh — the unit cone: apex (0,1,0), base of radius 1 at y = -1, capped.
+ * Its side is x^2 + z^2 = k^2 (y - 1)^2 with k = 1/2, for -1 <= y <= 1. */
+#include "shapes.h"
+
+static void keep(double tt, vec3 nn, double tmin, double *best, vec3 *n)
+{
+	if (tt > tmin && tt < *best) {
+		*best = tt;
+		*n = nn;
+	}
+}
+
+static void side(vec3 o, vec3 d, double tt, double tmin, double *best, vec3 *n)
+{
+	double y = o.y + d.y * tt;
+	if (!(y >= -1.0 && y <= 1.0))
+		return;
+	double x = o.x + d.x * tt, z = o.z + d.z * tt;
+	/* The gradient of x^2 + z^2 - k^2 (y-1)^2, halved; at the apex it
+	 * vanishes and the axis stands in. */
+	vec3 g = v3(x, -0.25 * (y - 1.0), z);
+	if (v3_len2(g) == 0.0)
+		g = v3(0, 1, 0);
+	keep(tt, g, tmin, best, n);
+}
+
+bool cone_intersect(vec3 o, vec3 d, double tmin, double tmax, double *t, vec3 *n)
+{
+	const double k2 = 0.25;
+	double best = tmax;
+	double oy = o.y - 1.0;
+	double a = d.x * d.x + d.z * d.z - k2 * d.y * d.y;
+	double b = o.x * d.x + o.z * d.z - k2 * oy * d.y;
+	double c = o.x * o.x + o.z * o.z - k2 * oy * oy;
+	double t0, t1;
+	if (fabs(a) > 1e-12 * v3_dot(d, d)) {
+		if (solve_quadratic_half(a, b, c, &t0, &t1)) {
+			side(o, d, t0, tmin, &best, n);
+			side(o, d, t1, tmin, &best, n);
+		}
+	} else if (b != 0.0) {
+		/* The ray runs parallel to a generatrix: one root of 2bt + c = 0. */
+		side(o, d, -c / (2.0 * b), tmin, &best, n);
+	}
+	if (d.y != 0.0) {
+		double tc = (-1.0 - o.y) / d.y;
+		double x = o.x + d.x * tc, z = o.z + d.z * tc;
+		if (x * x + z * z <= 1.0)
+			keep(tc, v3(0, -1, 0), tmin, &best, n);
+	}
+	if (best >= tmax)
+		return false;
+	*t = best;
+	return true;
+}
+
+bool cone_occluded(vec3 o, vec3 d, double tmin, double tmax)
+{
+	double t;
+	vec3 n;
+	return cone_intersect(o, d, tmin, tmax, &t, &n);
+}

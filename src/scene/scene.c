@@ -1,0 +1,374 @@
+/* rtsh — the scene model (scene.h). */
+#include "rtsh/scene.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static const struct {
+	const char *id, *name;
+} kind_names[OBJ_KIND_COUNT] = {
+	[OBJ_SPHERE] = {"sp", "sphere"},
+	[OBJ_PLANE] = {"pl", "plane"},
+	[OBJ_CYLINDER] = {"cy", "cylinder"},
+	[OBJ_CONE] = {"co", "cone"},
+	[OBJ_CUBE] = {"cu", "cube"},
+	[OBJ_DISC] = {"di", "disc"},
+	[OBJ_RECT] = {"rc", "rectangle"},
+	[OBJ_TRIANGLE] = {"tr", "triangle"},
+};
+
+const char *obj_kind_id(obj_kind k)
+{
+	return (unsigned)k < OBJ_KIND_COUNT ? kind_names[k].id : "?";
+}
+
+const char *obj_kind_name(obj_kind k)
+{
+	return (unsigned)k < OBJ_KIND_COUNT ? kind_names[k].name : "object";
+}
+
+int obj_kind_from_id(const char *id)
+{
+	for (int k = 0; k < OBJ_KIND_COUNT; k++)
+		if (strcmp(id, kind_names[k].id) == 0)
+			return k;
+	if (strcmp(id, "sq") == 0)
+		return OBJ_RECT;
+	return -1;
+}
+
+material material_default(vec3 color)
+{
+	return (material){
+		.color = color,
+		.diffuse = 0.9,
+		.specular = 0.9,
+		.shininess = 200.0,
+		.reflective = 0.0,
+	};
+}
+
+scene *scene_new(void)
+{
+	scene *s = calloc(1, sizeof(scene));
+	if (s) {
+		s->hints.depth = -1;
+		s->hints.mode = -1;
+	}
+	return s;
+}
+
+void scene_free(scene *s)
+{
+	if (!s)
+		return;
+	free(s->cams);
+	free(s->lights);
+	free(s->objs);
+	free(s);
+}
+
+static void *dup_array(const void *p, size_t n, size_t size, bool *ok)
+{
+	if (n == 0)
+		return NULL;
+	void *q = malloc(n * size);
+	if (!q) {
+		*ok = false;
+		return NULL;
+	}
+	memcpy(q, p, n * size);
+	return q;
+}
+
+scene *scene_clone(const scene *s)
+{
+	scene *c = malloc(sizeof *c);
+	if (!c)
+		return NULL;
+	*c = *s;
+	bool ok = true;
+	c->cams = dup_array(s->cams, s->ncams, sizeof *s->cams, &ok);
+	c->lights = dup_array(s->lights, s->nlights, sizeof *s->lights, &ok);
+	c->objs = dup_array(s->objs, s->nobjs, sizeof *s->objs, &ok);
+	c->cap_cams = s->ncams;
+	c->cap_lights = s->nlights;
+	c->cap_objs = s->nobjs;
+	if (!ok) {
+		scene_free(c);
+		return NULL;
+	}
+	return c;
+}
+
+static bool material_equal(const material *a, const material *b)
+{
+	return v3_eq(a->color, b->color) && a->diffuse == b->diffuse && a->specular == b->specular &&
+	       a->shininess == b->shininess && a->reflective == b->reflective && a->fuzz == b->fuzz &&
+	       a->metal == b->metal && a->ior == b->ior && a->emission == b->emission &&
+	       a->checker == b->checker;
+}
+
+bool object_equal(const object *a, const object *b)
+{
+	if (a->kind != b->kind || !material_equal(&a->mat, &b->mat))
+		return false;
+	if (a->kind == OBJ_TRIANGLE)
+		return v3_eq(a->tri[0], b->tri[0]) && v3_eq(a->tri[1], b->tri[1]) &&
+		       v3_eq(a->tri[2], b->tri[2]);
+	for (int i = 0; i < 6; i++)
+		if (a->shear[i] != b->shear[i])
+			return false;
+	return v3_eq(a->pos, b->pos) && v3_eq(a->dir, b->dir) && a->twist == b->twist &&
+	       v3_eq(a->scale, b->scale);
+}
+
+static bool light_equal(const light *a, const light *b)
+{
+	return v3_eq(a->pos, b->pos) && a->ratio == b->ratio && v3_eq(a->color, b->color);
+}
+
+static bool camera_equal(const camera *a, const camera *b)
+{
+	return v3_eq(a->pos, b->pos) && v3_eq(a->dir, b->dir) && a->fov == b->fov;
+}
+
+bool scene_equal(const scene *a, const scene *b)
+{
+	if (a->has_ambient != b->has_ambient || a->ncams != b->ncams || a->cam != b->cam ||
+	    a->nlights != b->nlights || a->nobjs != b->nobjs || a->has_sky != b->has_sky)
+		return false;
+	if (a->has_ambient && (a->amb.ratio != b->amb.ratio || !v3_eq(a->amb.color, b->amb.color)))
+		return false;
+	if (a->has_sky && (!v3_eq(a->sky.zenith, b->sky.zenith) ||
+	                   !v3_eq(a->sky.horizon, b->sky.horizon) ||
+	                   a->sky.strength != b->sky.strength))
+		return false;
+	if (memcmp(&a->hints, &b->hints, sizeof a->hints) != 0)
+		return false;
+	for (size_t i = 0; i < a->ncams; i++)
+		if (!camera_equal(&a->cams[i], &b->cams[i]))
+			return false;
+	for (size_t i = 0; i < a->nlights; i++)
+		if (!light_equal(&a->lights[i], &b->lights[i]))
+			return false;
+	for (size_t i = 0; i < a->nobjs; i++)
+		if (!object_equal(&a->objs[i], &b->objs[i]))
+			return false;
+	return true;
+}
+
+/* Makes room for one more element of an array that grows by doubling. */
+static bool grow(void **arr, size_t *cap, size_t n, size_t size, rt_error *err)
+{
+	if (n < *cap)
+		return true;
+	size_t ncap = *cap ? *cap * 2 : 8;
+	if (ncap > SIZE_MAX / size)
+		return rt_error_set(err, "out of memory; the scene is too large");
+	void *p = realloc(*arr, ncap * size);
+	if (!p)
+		return rt_error_set(err, "out of memory; the scene is too large");
+	*arr = p;
+	*cap = ncap;
+	return true;
+}
+
+bool scene_insert_object(scene *s, size_t i, const object *o, rt_error *err)
+{
+	if (!grow((void **)&s->objs, &s->cap_objs, s->nobjs, sizeof *o, err))
+		return false;
+	if (i > s->nobjs)
+		i = s->nobjs;
+	memmove(&s->objs[i + 1], &s->objs[i], (s->nobjs - i) * sizeof *o);
+	s->objs[i] = *o;
+	s->nobjs++;
+	return true;
+}
+
+bool scene_insert_light(scene *s, size_t i, const light *l, rt_error *err)
+{
+	if (!grow((void **)&s->lights, &s->cap_lights, s->nlights, sizeof *l, err))
+		return false;
+	if (i > s->nlights)
+		i = s->nlights;
+	memmove(&s->lights[i + 1], &s->lights[i], (s->nlights - i) * sizeof *l);
+	s->lights[i] = *l;
+	s->nlights++;
+	return true;
+}
+
+bool scene_add_object(scene *s, const object *o, rt_error *err)
+{
+	return scene_insert_object(s, s->nobjs, o, err);
+}
+
+bool scene_add_light(scene *s, const light *l, rt_error *err)
+{
+	return scene_insert_light(s, s->nlights, l, err);
+}
+
+bool scene_add_camera(scene *s, const camera *c, rt_error *err)
+{
+	if (!grow((void **)&s->cams, &s->cap_cams, s->ncams, sizeof *c, err))
+		return false;
+	s->cams[s->ncams++] = *c;
+	return true;
+}
+
+void scene_remove_object(scene *s, size_t i)
+{
+	if (i >= s->nobjs)
+		return;
+	memmove(&s->objs[i], &s->objs[i + 1], (s->nobjs - i - 1) * sizeof *s->objs);
+	s->nobjs--;
+}
+
+void scene_remove_light(scene *s, size_t i)
+{
+	if (i >= s->nlights)
+		return;
+	memmove(&s->lights[i], &s->lights[i + 1], (s->nlights - i - 1) * sizeof *s->lights);
+	s->nlights--;
+}
+
+camera scene_camera(const scene *s)
+{
+	if (s->ncams == 0)
+		return (camera){v3(0, 0, -5), v3(0, 0, 1), 70.0};
+	return s->cams[s->cam < s->ncams ? s->cam : 0];
+}
+
+object object_make(obj_kind k, vec3 color)
+{
+	object o;
+	memset(&o, 0, sizeof o);
+	o.kind = k;
+	o.dir = v3(0, 1, 0);
+	o.scale = v3(1, 1, 1);
+	o.mat = material_default(color);
+	if (k == OBJ_TRIANGLE) {
+		o.tri[0] = v3(-0.5, -0.5, 0);
+		o.tri[1] = v3(0.5, -0.5, 0);
+		o.tri[2] = v3(0, 0.5, 0);
+	}
+	return o;
+}
+
+static bool has_shear(const object *o)
+{
+	for (int i = 0; i < 6; i++)
+		if (o->shear[i] != 0.0)
+			return true;
+	return false;
+}
+
+bool object_xform(const object *o, xform *out)
+{
+	if (o->kind == OBJ_TRIANGLE) {
+		*out = xf_identity();
+		return true;
+	}
+	double len = v3_len(o->dir);
+	if (!(len > 0.0) || !isfinite(len))
+		return false;
+	vec3 s = o->scale;
+	if (o->kind == OBJ_PLANE)
+		s = v3(2, 2, 2); /* a plane has no size: object units are world units */
+	mat4 m = m4_mul(m4_translate(o->pos), m4_orient(v3_scale(o->dir, 1.0 / len), deg_to_rad(o->twist)));
+	if (has_shear(o))
+		m = m4_mul(m, m4_shear(o->shear));
+	m = m4_mul(m, m4_scale(v3_scale(s, 0.5)));
+	return xf_make(m, out);
+}
+
+vec3 object_center(const object *o)
+{
+	if (o->kind == OBJ_TRIANGLE)
+		return v3_scale(v3_add(v3_add(o->tri[0], o->tri[1]), o->tri[2]), 1.0 / 3.0);
+	return o->pos;
+}
+
+bool object_validate(const object *o, rt_error *err)
+{
+	const char *name = obj_kind_name(o->kind);
+	if (o->kind == OBJ_TRIANGLE) {
+		for (int i = 0; i < 3; i++)
+			if (!v3_finite(o->tri[i]))
+				return rt_error_set(err, "triangle vertex %d is not finite; expected numbers", i + 1);
+		vec3 n = v3_cross(v3_sub(o->tri[1], o->tri[0]), v3_sub(o->tri[2], o->tri[0]));
+		double scale = fmax(v3_len2(v3_sub(o->tri[1], o->tri[0])), v3_len2(v3_sub(o->tri[2], o->tri[0])));
+		if (!(v3_len(n) > 1e-12 * scale))
+			return rt_error_set(err, "triangle has no area (its vertices are on one line); "
+			                         "expected three points not in a line");
+		return true;
+	}
+	if (!v3_finite(o->pos) || !v3_finite(o->dir) || !v3_finite(o->scale) || !isfinite(o->twist))
+		return rt_error_set(err, "%s has a number that is not finite; expected finite numbers", name);
+	if (!(v3_len(o->dir) > 0.0))
+		return rt_error_set(err, "%s direction is the zero vector; expected a non-zero direction", name);
+	if (o->kind != OBJ_PLANE && !(o->scale.x > 0 && o->scale.y > 0 && o->scale.z > 0))
+		return rt_error_set(err, "%s scaling has a component <= 0; expected sizes > 0", name);
+	xform x;
+	if (!object_xform(o, &x))
+		return rt_error_set(err, "%s transform is not invertible (check the shear); "
+		                         "expected a shear that keeps the shape solid", name);
+	return true;
+}
+
+void object_move(object *o, vec3 d)
+{
+	if (o->kind == OBJ_TRIANGLE) {
+		for (int i = 0; i < 3; i++)
+			o->tri[i] = v3_add(o->tri[i], d);
+		return;
+	}
+	o->pos = v3_add(o->pos, d);
+}
+
+/* Reads (dir, twist) back from a rotation matrix r = orient(dir, twist). */
+static void orient_decompose(const mat4 *r, vec3 *dir, double *twist_deg)
+{
+	vec3 d = v3(r->m[0][1], r->m[1][1], r->m[2][1]);
+	d = v3_norm(d);
+	mat4 base = m4_orient(d, 0.0);
+	/* base^T r is a rotation about Y by the twist. */
+	mat4 t = m4_mul(m4_transpose(base), *r);
+	double ang = atan2(t.m[0][2], t.m[0][0]);
+	*dir = d;
+	*twist_deg = rad_to_deg(ang);
+	if (fabs(*twist_deg) < 1e-9)
+		*twist_deg = 0.0;
+}
+
+bool object_rotate(object *o, vec3 deg, rt_error *err)
+{
+	mat4 q = m4_mul(m4_rotate_z(deg_to_rad(deg.z)),
+	                m4_mul(m4_rotate_y(deg_to_rad(deg.y)), m4_rotate_x(deg_to_rad(deg.x))));
+	if (!v3_finite(deg))
+		return rt_error_set(err, "rotation angles are not finite; expected degrees");
+	if (o->kind == OBJ_TRIANGLE) {
+		vec3 c = object_center(o);
+		for (int i = 0; i < 3; i++)
+			o->tri[i] = v3_add(c, m4_vector(&q, v3_sub(o->tri[i], c)));
+		return true;
+	}
+	double len = v3_len(o->dir);
+	mat4 r = m4_mul(q, m4_orient(v3_scale(o->dir, 1.0 / len), deg_to_rad(o->twist)));
+	orient_decompose(&r, &o->dir, &o->twist);
+	return true;
+}
+
+bool object_scale(object *o, vec3 f, rt_error *err)
+{
+	if (!(f.x > 0 && f.y > 0 && f.z > 0) || !v3_finite(f))
+		return rt_error_set(err, "scale factors must be > 0; expected SX,SY,SZ like 2,2,2");
+	if (o->kind == OBJ_TRIANGLE) {
+		vec3 c = object_center(o);
+		for (int i = 0; i < 3; i++)
+			o->tri[i] = v3_add(c, v3_mul(v3_sub(o->tri[i], c), f));
+		return true;
+	}
+	o->scale = v3_mul(o->scale, f);
+	return true;
+}

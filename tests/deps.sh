@@ -1,0 +1,27 @@
+#!/bin/sh
+# Checks that the build's libraries are installed; on Debian, as root,
+# installs what is missing, otherwise prints the exact command to run.
+# Called by `make` before every build; quiet when all is present.
+missing=""
+have_header() {
+	printf '#include <%s>\n' "$1" | ${CC:-cc} -E -x c - >/dev/null 2>&1
+}
+have_header png.h || missing="$missing libpng-dev"
+have_header readline/readline.h || missing="$missing libreadline-dev"
+have_header ncurses.h || missing="$missing libncurses-dev"
+printf '#include <stdarg.h>\n#include <stddef.h>\n#include <setjmp.h>\n#include <cmocka.h>\n' |
+	${CC:-cc} -E -x c - >/dev/null 2>&1 || missing="$missing libcmocka-dev"
+command -v ${CC:-cc} >/dev/null 2>&1 || missing="$missing build-essential"
+[ -z "$missing" ] && exit 0
+cmd="apt-get install -y$missing"
+if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+	echo "rtsh: installing$missing" >&2
+	if DEBIAN_FRONTEND=noninteractive apt-get install -y $missing >/dev/null 2>&1 ||
+		{ apt-get update >/dev/null 2>&1 && DEBIAN_FRONTEND=noninteractive apt-get install -y $missing >/dev/null; }; then
+		exit 0
+	fi
+	echo "rtsh: could not install the packages; run: $cmd" >&2
+	exit 1
+fi
+echo "rtsh: missing build dependencies; run: sudo $cmd" >&2
+exit 1

@@ -1,0 +1,30 @@
+#!/bin/sh
+# The whole test suite, as `make test` runs it: the unit tests and the
+# command-file tests on the plain build, the end-to-end tmux test, then the
+# unit and command-file tests again under AddressSanitizer +
+# UndefinedBehaviorSanitizer, and the threaded tests under ThreadSanitizer.
+# Goes on after a failure; the last line is "N passed, N failed".
+set -u
+MAKE=${MAKE:-make}
+results=build/test-results
+rm -rf "$results"; mkdir -p "$results"
+export RTSH_TEST_RESULTS="$PWD/$results"
+status=0
+step() { # name, command...
+	name=$1; shift
+	echo "=== $name"
+	"$@" || status=1
+}
+step "build" $MAKE --no-print-directory -s all test-bins
+step "unit tests" sh tests/run-unit.sh build build/tests/test_*
+step "command-file tests" sh tests/run-scripts.sh ./rtsh
+step "end-to-end (tmux)" sh tests/e2e/run.sh ./rtsh
+step "build (ASan+UBSan)" $MAKE --no-print-directory -s BUILD=build/asan SAN=address,undefined OPT=-O1 build/asan/rtsh test-bins
+ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+	step "unit tests (ASan+UBSan)" sh tests/run-unit.sh build/asan build/asan/tests/test_*
+ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+	step "command-file tests (ASan+UBSan)" sh tests/run-scripts.sh build/asan/rtsh
+step "build (TSan)" $MAKE --no-print-directory -s BUILD=build/tsan SAN=thread OPT=-O1 build/tsan/tests/test_render
+TSAN_OPTIONS=halt_on_error=1 step "threaded tests (TSan)" sh tests/run-unit.sh build/tsan build/tsan/tests/test_render
+sh tests/summary.sh "$results" || status=1
+exit $status
