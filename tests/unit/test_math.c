@@ -1,0 +1,214 @@
+/* rtsh — tests of the math value types: matrices, inverses, transforms. */
+#include "testutil.h"
+
+#include "rtsh/scene.h"
+
+static void assert_identity(mat4 m, double tol)
+{
+	for (int i = 0; i < 4; i++)
+		for (int j = 0; j < 4; j++)
+			assert_near(m.m[i][j], i == j ? 1.0 : 0.0, tol);
+}
+
+static mat4 random_affine(test_rng *r)
+{
+	double sh[6];
+	for (int i = 0; i < 6; i++)
+		sh[i] = trange(r, -0.4, 0.4);
+	mat4 m = m4_translate(v3(trange(r, -10, 10), trange(r, -10, 10), trange(r, -10, 10)));
+	m = m4_mul(m, m4_rotate_axis(tdir(r), trange(r, 0, 2 * RT_PI)));
+	m = m4_mul(m, m4_shear(sh));
+	return m4_mul(m, m4_scale(v3(trange(r, 0.1, 5), trange(r, 0.1, 5), trange(r, 0.1, 5))));
+}
+
+static void test_inverse_product_is_identity(void **state)
+{
+	(void)state;
+	test_rng r = {42};
+	for (int k = 0; k < 1000; k++) {
+		mat4 m = random_affine(&r), inv;
+		assert_true(m4_invert(m, &inv));
+		assert_identity(m4_mul(m, inv), 1e-12);
+		assert_identity(m4_mul(inv, m), 1e-12);
+	}
+	/* A general (projective) matrix with a hand-checked inverse:
+	 * [[2,0,0,0],[0,4,0,0],[0,0,8,0],[1,0,0,1]]^-1 = [[.5,0,0,0],[0,.25,0,0],[0,0,.125,0],[-.5,0,0,1]] */
+	mat4 p = {{{2, 0, 0, 0}, {0, 4, 0, 0}, {0, 0, 8, 0}, {1, 0, 0, 1}}}, pinv;
+	assert_true(m4_invert(p, &pinv));
+	assert_near(pinv.m[0][0], 0.5, 1e-15);
+	assert_near(pinv.m[1][1], 0.25, 1e-15);
+	assert_near(pinv.m[2][2], 0.125, 1e-15);
+	assert_near(pinv.m[3][0], -0.5, 1e-15);
+	assert_near(pinv.m[3][3], 1.0, 1e-15);
+}
+
+static void test_singular_matrices_are_refused(void **state)
+{
+	(void)state;
+	mat4 out = m4_identity();
+	assert_false(m4_invert(m4_scale(v3(1, 0, 1)), &out));
+	/* Shearing x by y and y by x with both 1 flattens the xy plane. */
+	double sh[6] = {1, 0, 1, 0, 0, 0};
+	assert_false(m4_invert(m4_shear(sh), &out));
+	mat4 nan = m4_identity();
+	nan.m[1][2] = NAN;
+	assert_false(m4_invert(nan, &out));
+	assert_identity(out, 0); /* untouched */
+}
+
+static void test_points_vectors_normals(void **state)
+{
+	(void)state;
+	mat4 t = m4_translate(v3(1, -2, 3));
+	assert_vec_near(m4_point(&t, v3(1, 1, 1)), v3(2, -1, 4), 0);
+	/* vectors ignore translation */
+	assert_vec_near(m4_vector(&t, v3(1, 1, 1)), v3(1, 1, 1), 0);
+
+	mat4 s = m4_scale(v3(2, 3, 4));
+	assert_vec_near(m4_point(&s, v3(1, 1, 1)), v3(2, 3, 4), 0);
+
+	/* Quarter turns: x to y about z, y to z about x, z to x about y. */
+	mat4 rz = m4_rotate_z(RT_PI / 2), rx = m4_rotate_x(RT_PI / 2), ry = m4_rotate_y(RT_PI / 2);
+	assert_vec_near(m4_vector(&rz, v3(1, 0, 0)), v3(0, 1, 0), 1e-15);
+	assert_vec_near(m4_vector(&rx, v3(0, 1, 0)), v3(0, 0, 1), 1e-15);
+	assert_vec_near(m4_vector(&ry, v3(0, 0, 1)), v3(1, 0, 0), 1e-15);
+
+	/* Each shear component moves one coordinate in proportion to another. */
+	const vec3 p = {2, 3, 4};
+	const vec3 expect[6] = {{2 + 3, 3, 4}, {2 + 4, 3, 4}, {2, 3 + 2, 4},
+	                        {2, 3 + 4, 4}, {2, 3, 4 + 2}, {2, 3, 4 + 3}};
+	for (int i = 0; i < 6; i++) {
+		double sh[6] = {0};
+		sh[i] = 1;
+		mat4 m = m4_shear(sh);
+		assert_vec_near(m4_point(&m, p), expect[i], 0);
+	}
+
+	/* The ellipsoid x^2 + 4y^2 + z^2 = 1 is the unit sphere scaled by
+	 * (1, 1/2, 1). At its point (0.6, 0.4, 0) the gradient (2x, 8y, 2z) is
+	 * (1.2, 3.2, 0): the normal is (1.2, 3.2, 0) / |(1.2, 3.2, 0)|. The
+	 * sphere's own normal there is its local point (0.6, 0.8, 0). */
+	xform x;
+	assert_true(xf_make(m4_scale(v3(1, 0.5, 1)), &x));
+	vec3 local = m4_point(&x.inv, v3(0.6, 0.4, 0));
+	assert_vec_near(local, v3(0.6, 0.8, 0), 1e-15);
+	vec3 n = v3_norm(m4_normal(&x.inv, local));
+	double len = sqrt(1.2 * 1.2 + 3.2 * 3.2);
+	assert_vec_near(n, v3(1.2 / len, 3.2 / len, 0), 1e-15);
+}
+
+static void test_transform_composition(void **state)
+{
+	(void)state;
+	xform a, b;
+	assert_true(xf_make(m4_scale(v3(2, 2, 2)), &a));
+	assert_true(xf_make(m4_translate(v3(1, 0, 0)), &b));
+	/* scale first, then translate: (1,1,1) -> (2,2,2) -> (3,2,2) */
+	xform ab = xf_then(a, b);
+	assert_vec_near(m4_point(&ab.m, v3(1, 1, 1)), v3(3, 2, 2), 0);
+	assert_vec_near(m4_point(&ab.inv, v3(3, 2, 2)), v3(1, 1, 1), 0);
+	/* the box of a unit cube turned 45 degrees about y */
+	xform r;
+	assert_true(xf_make(m4_rotate_y(RT_PI / 4), &r));
+	box bb = xf_box(&r, (box){v3(-1, -1, -1), v3(1, 1, 1)});
+	assert_near(bb.hi.x, sqrt(2.0), 1e-12);
+	assert_near(bb.lo.z, -sqrt(2.0), 1e-12);
+	assert_near(bb.hi.y, 1.0, 1e-12);
+}
+
+static void test_orient(void **state)
+{
+	(void)state;
+	test_rng r = {7};
+	for (int k = 0; k < 500; k++) {
+		vec3 d = tdir(&r);
+		double tw = trange(&r, -RT_PI, RT_PI);
+		mat4 m = m4_orient(d, tw);
+		/* +Y goes to d, and the matrix is a rotation: M M^T = I, det +1 */
+		assert_vec_near(m4_vector(&m, v3(0, 1, 0)), d, 1e-12);
+		mat4 mmt = m4_mul(m, m4_transpose(m));
+		assert_identity(mmt, 1e-12);
+		vec3 c0 = v3(m.m[0][0], m.m[1][0], m.m[2][0]), c1 = v3(m.m[0][1], m.m[1][1], m.m[2][1]),
+		     c2 = v3(m.m[0][2], m.m[1][2], m.m[2][2]);
+		assert_near(v3_dot(v3_cross(c0, c1), c2), 1.0, 1e-12);
+	}
+	/* straight down: a half turn about x */
+	mat4 down = m4_orient(v3(0, -1, 0), 0);
+	assert_vec_near(m4_vector(&down, v3(0, 1, 0)), v3(0, -1, 0), 1e-15);
+	/* +Y unchanged by the shortest arc, and a twist of 90 degrees turns
+	 * x to -z (a right-handed turn about y). */
+	mat4 up = m4_orient(v3(0, 1, 0), RT_PI / 2);
+	assert_vec_near(m4_vector(&up, v3(1, 0, 0)), v3(0, 0, -1), 1e-15);
+}
+
+/* Rotating an object composes a world rotation with its orientation, and the
+ * (dir, twist) it keeps rebuild exactly that orientation. */
+static void test_object_rotate(void **state)
+{
+	(void)state;
+	test_rng r = {99};
+	for (int k = 0; k < 300; k++) {
+		object o = object_make(OBJ_CUBE, v3(255, 255, 255));
+		o.dir = v3_scale(tdir(&r), trange(&r, 0.5, 3)); /* as written: any length */
+		o.twist = trange(&r, -180, 180);
+		o.pos = v3(1, 2, 3);
+		vec3 deg = v3(trange(&r, -180, 180), trange(&r, -180, 180), trange(&r, -180, 180));
+		mat4 before = m4_orient(v3_norm(o.dir), deg_to_rad(o.twist));
+		mat4 q = m4_mul(m4_rotate_z(deg_to_rad(deg.z)),
+		                m4_mul(m4_rotate_y(deg_to_rad(deg.y)), m4_rotate_x(deg_to_rad(deg.x))));
+		assert_true(object_rotate(&o, deg, NULL));
+		mat4 after = m4_orient(v3_norm(o.dir), deg_to_rad(o.twist));
+		mat4 expect = m4_mul(q, before);
+		for (int i = 0; i < 3; i++)
+			for (int j = 0; j < 3; j++)
+				assert_near(after.m[i][j], expect.m[i][j], 1e-9);
+		assert_vec_near(o.pos, v3(1, 2, 3), 0); /* about its own centre */
+	}
+	/* 90 degrees about z turns an upright cylinder's axis to -x. */
+	object c = object_make(OBJ_CYLINDER, v3(1, 1, 1));
+	assert_true(object_rotate(&c, v3(0, 0, 90), NULL));
+	assert_vec_near(c.dir, v3(-1, 0, 0), 1e-15);
+}
+
+static void test_object_xform_sizes(void **state)
+{
+	(void)state;
+	/* scale = diameters: a sphere of scale (2,4,6) reaches 1, 2, 3 from its
+	 * centre along x, y, z. */
+	object o = object_make(OBJ_SPHERE, v3(1, 1, 1));
+	o.scale = v3(2, 4, 6);
+	o.pos = v3(10, 0, 0);
+	xform x;
+	assert_true(object_xform(&o, &x));
+	assert_vec_near(m4_point(&x.m, v3(1, 0, 0)), v3(11, 0, 0), 1e-15);
+	assert_vec_near(m4_point(&x.m, v3(0, 1, 0)), v3(10, 2, 0), 1e-15);
+	assert_vec_near(m4_point(&x.m, v3(0, 0, 1)), v3(10, 0, 3), 1e-15);
+	/* a cylinder along x of diameter 2, height 4: its cap centre (local y=1)
+	 * is 2 along x */
+	object c = object_make(OBJ_CYLINDER, v3(1, 1, 1));
+	c.dir = v3(3, 0, 0);
+	c.scale = v3(2, 4, 2);
+	assert_true(object_xform(&c, &x));
+	assert_vec_near(m4_point(&x.m, v3(0, 1, 0)), v3(2, 0, 0), 1e-15);
+	/* a shear that flattens is reported */
+	object bad = object_make(OBJ_CUBE, v3(1, 1, 1));
+	bad.shear[0] = 1;
+	bad.shear[2] = 1;
+	rt_error err;
+	assert_false(object_validate(&bad, &err));
+	assert_non_null(strstr(err.msg, "not invertible"));
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_inverse_product_is_identity),
+		cmocka_unit_test(test_singular_matrices_are_refused),
+		cmocka_unit_test(test_points_vectors_normals),
+		cmocka_unit_test(test_transform_composition),
+		cmocka_unit_test(test_orient),
+		cmocka_unit_test(test_object_rotate),
+		cmocka_unit_test(test_object_xform_sizes),
+	};
+	return cmocka_run_group_tests_name("math", tests, NULL, NULL);
+}

@@ -1,0 +1,393 @@
+/* rtsh — tests of the renderer: a Phong value computed by hand, shadows,
+ * reflections, the sRGB transfer, thread-count invariance, progressive
+ * passes, cancelling, image files, and an end-to-end render through the rtsh
+ * binary checked against the projection formula. */
+#include "testutil.h"
+
+#include <stdatomic.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "rtsh/image.h"
+#include "rtsh/render.h"
+#include "rtsh/scene.h"
+#include "rtsh/world.h"
+
+/* The sRGB decoding of an 8-bit code, from IEC 61966-2-1. */
+static double srgb_decode(double code)
+{
+	double c = code / 255.0;
+	return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4);
+}
+
+static scene *base_scene(vec3 cam_pos, vec3 cam_dir, double fov)
+{
+	scene *s = scene_new();
+	camera c = {cam_pos, cam_dir, fov};
+	assert_true(scene_add_camera(s, &c, NULL));
+	return s;
+}
+
+static void add_light(scene *s, vec3 pos, double ratio)
+{
+	light l = {pos, ratio, v3(255, 255, 255)};
+	assert_true(scene_add_light(s, &l, NULL));
+}
+
+static object sphere(vec3 c, double diameter, vec3 color)
+{
+	object o = object_make(OBJ_SPHERE, color);
+	o.pos = c;
+	o.scale = v3_splat(diameter);
+	return o;
+}
+
+/* Renders s at w x h with the given settings; returns the framebuffer. */
+static framebuffer *render(const scene *s, int w, int h, int samples, int depth, int threads,
+                           render_mode mode)
+{
+	world *wd = world_build(s, NULL);
+	assert_non_null(wd);
+	render_settings set = render_settings_default();
+	set.width = w;
+	set.height = h;
+	set.samples = samples;
+	set.depth = depth;
+	set.threads = threads;
+	set.mode = mode;
+	framebuffer *fb = render_image(wd, &set, NULL, NULL, NULL, NULL);
+	assert_non_null(fb);
+	world_free(wd);
+	return fb;
+}
+
+static vec3 pixel(const framebuffer *fb, int x, int y)
+{
+	const float *p = fb->rgb + ((size_t)y * fb->w + x) * 3;
+	return v3(p[0], p[1], p[2]);
+}
+
+/* The centre pixel of a 101x101 image looks straight down the camera axis
+ * ((50 + 0.5) * 2 / 101 - 1 = 0). Camera at z = -5, a sphere of radius 1 at
+ * the origin: the hit is (0,0,-1) with normal (0,0,-1), view v = (0,0,-1).
+ * Light at (3,0,-5): to the light L = (3,0,-4)/5, N.L = 0.8. The mirror of
+ * -L about N is R = (-0.6, 0, -0.8), so R.V = 0.8. Colour 128 grey decodes
+ * to a = srgb(128); ambient 0.1 white; diffuse 0.9, specular 0.5,
+ * shininess 10; light ratio 0.7 white:
+ *   0.1 a + 0.7 * 0.9 * 0.8 a + 0.7 * 0.5 * 0.8^10 */
+static void test_phong_by_hand(void **state)
+{
+	(void)state;
+	scene *s = base_scene(v3(0, 0, -5), v3(0, 0, 1), 60);
+	s->has_ambient = true;
+	s->amb = (ambient){0.1, v3(255, 255, 255)};
+	add_light(s, v3(3, 0, -5), 0.7);
+	object o = sphere(v3(0, 0, 0), 2, v3(128, 128, 128));
+	o.mat.diffuse = 0.9;
+	o.mat.specular = 0.5;
+	o.mat.shininess = 10;
+	assert_true(scene_add_object(s, &o, NULL));
+	framebuffer *fb = render(s, 101, 101, 1, 0, 1, MODE_WHITTED);
+	double a = srgb_decode(128);
+	double expect = 0.1 * a + 0.7 * 0.9 * 0.8 * a + 0.7 * 0.5 * pow(0.8, 10);
+	vec3 c = pixel(fb, 50, 50);
+	assert_near(c.x, expect, 1e-6);
+	assert_near(c.y, expect, 1e-6);
+	assert_near(c.z, expect, 1e-6);
+	/* the corner pixel sees nothing: black background in whitted mode */
+	assert_vec_near(pixel(fb, 0, 0), v3(0, 0, 0), 0);
+	fb_free(fb);
+	scene_free(s);
+}
+
+/* A plane y = 0 lit from straight above by a light at (0,10,0); a sphere of
+ * radius 0.5 at (0,2,0) shadows the origin. The camera at (0,1,-5) looks at
+ * the origin, passing far below the blocker. Lit: ambient + diffuse (N.L = 1)
+ * + specular 0.9 * (R.V)^200 with R = (0,1,0), V = (0,1,-5)/sqrt 26;
+ * shadowed: ambient only. */
+static void test_shadow(void **state)
+{
+	(void)state;
+	for (int blocked = 0; blocked < 2; blocked++) {
+		scene *s = base_scene(v3(0, 1, -5), v3(0, -1, 5), 40);
+		s->has_ambient = true;
+		s->amb = (ambient){0.2, v3(255, 255, 255)};
+		add_light(s, v3(0, 10, 0), 1.0);
+		object p = object_make(OBJ_PLANE, v3(255, 255, 255));
+		assert_true(scene_add_object(s, &p, NULL));
+		if (blocked) {
+			object b = sphere(v3(0, 2, 0), 1, v3(255, 0, 0));
+			assert_true(scene_add_object(s, &b, NULL));
+		}
+		framebuffer *fb = render(s, 101, 101, 1, 0, 2, MODE_WHITTED);
+		double lit = 0.2 + 0.9 + 0.9 * pow(1 / sqrt(26.0), 200);
+		assert_near(pixel(fb, 50, 50).x, blocked ? 0.2 : lit, 1e-6);
+		fb_free(fb);
+		scene_free(s);
+	}
+}
+
+/* A mirror sphere facing the camera reflects an emitter behind the camera.
+ * Mirror: diffuse 0, specular 0, reflective k; emitter: emit 1 white, so its
+ * radiance is 1. Whitted blends local (0 here) and reflected by k; depth 0
+ * turns reflections off. */
+static void test_reflection(void **state)
+{
+	(void)state;
+	const double ks[] = {1.0, 0.5, 0.25};
+	for (int depth = 0; depth <= 1; depth++)
+		for (size_t i = 0; i < 3; i++) {
+			scene *s = base_scene(v3(0, 0, -5), v3(0, 0, 1), 60);
+			object m = sphere(v3(0, 0, 0), 2, v3(255, 255, 255));
+			m.mat.diffuse = 0;
+			m.mat.specular = 0;
+			m.mat.reflective = ks[i];
+			object e = sphere(v3(0, 0, -30), 10, v3(255, 255, 255));
+			e.mat.emission = 1;
+			e.mat.diffuse = 0;
+			e.mat.specular = 0;
+			assert_true(scene_add_object(s, &m, NULL));
+			assert_true(scene_add_object(s, &e, NULL));
+			framebuffer *fb = render(s, 101, 101, 1, depth, 1, MODE_WHITTED);
+			assert_near(pixel(fb, 50, 50).x, depth ? ks[i] : 0.0, 1e-9);
+			fb_free(fb);
+			scene_free(s);
+		}
+}
+
+/* A scene with every kind of shape, for the invariance tests. */
+static scene *busy_scene(void)
+{
+	scene *s = base_scene(v3(0, 2, -8), v3(0, -0.2, 1), 70);
+	s->has_ambient = true;
+	s->amb = (ambient){0.2, v3(200, 220, 255)};
+	add_light(s, v3(-4, 6, -5), 0.8);
+	add_light(s, v3(4, 3, -3), 0.4);
+	test_rng r = {11};
+	for (int k = 0; k < OBJ_KIND_COUNT * 3; k++) {
+		object o = object_make((obj_kind)(k % OBJ_KIND_COUNT),
+		                       v3(trange(&r, 0, 255), trange(&r, 0, 255), trange(&r, 0, 255)));
+		o.pos = v3(trange(&r, -4, 4), trange(&r, 0, 3), trange(&r, -2, 4));
+		o.dir = tdir(&r);
+		o.scale = v3(trange(&r, 0.5, 2), trange(&r, 0.5, 2), trange(&r, 0.5, 2));
+		o.mat.reflective = trange(&r, 0, 0.6);
+		if (o.kind == OBJ_TRIANGLE)
+			for (int i = 0; i < 3; i++)
+				o.tri[i] = v3_add(o.pos, v3(trange(&r, -1, 1), trange(&r, -1, 1), trange(&r, -1, 1)));
+		if (o.kind == OBJ_PLANE) {
+			o.pos = v3(0, -0.5, 0);
+			o.dir = v3(0, 1, 0.1);
+		}
+		assert_true(scene_add_object(s, &o, NULL));
+	}
+	return s;
+}
+
+static void test_threads_identical(void **state)
+{
+	(void)state;
+	scene *s = busy_scene();
+	for (int mode = MODE_WHITTED; mode <= MODE_PATH; mode++) {
+		framebuffer *one = render(s, 67, 45, 3, 4, 1, (render_mode)mode);
+		const int counts[] = {2, 7};
+		for (int i = 0; i < 2; i++) {
+			framebuffer *fb = render(s, 67, 45, 3, 4, counts[i], (render_mode)mode);
+			assert_memory_equal(one->rgb, fb->rgb, sizeof(float) * 67 * 45 * 3);
+			fb_free(fb);
+		}
+		fb_free(one);
+	}
+	scene_free(s);
+}
+
+/* Four passes of one sample each give exactly the image of one pass of four. */
+static void test_progressive_equals_batch(void **state)
+{
+	(void)state;
+	scene *s = busy_scene();
+	world *w = world_build(s, NULL);
+	render_settings set = render_settings_default();
+	set.width = 40;
+	set.height = 30;
+	set.samples = 4;
+	set.threads = 2;
+	set.mode = MODE_PATH;
+	framebuffer *batch = render_image(w, &set, NULL, NULL, NULL, NULL);
+	framebuffer *prog = fb_new(40, 30);
+	for (int k = 0; k < 4; k++) {
+		render_job job = {.w = w, .set = set, .fb = prog, .sample_begin = k, .sample_end = k + 1};
+		assert_int_equal(render_run(&job, NULL), RENDER_DONE);
+	}
+	assert_int_equal(prog->spp, 4);
+	assert_memory_equal(batch->rgb, prog->rgb, sizeof(float) * 40 * 30 * 3);
+	/* a pass that does not follow the samples done is refused */
+	render_job bad = {.w = w, .set = set, .fb = prog, .sample_begin = 2, .sample_end = 3};
+	rt_error err;
+	assert_int_equal(render_run(&bad, &err), RENDER_FAILED);
+	fb_free(batch);
+	fb_free(prog);
+	world_free(w);
+	scene_free(s);
+}
+
+static void test_cancel(void **state)
+{
+	(void)state;
+	scene *s = busy_scene();
+	world *w = world_build(s, NULL);
+	render_settings set = render_settings_default();
+	set.width = 64;
+	set.height = 64;
+	set.threads = 2;
+	atomic_bool cancel;
+	atomic_init(&cancel, true);
+	rt_error err;
+	assert_null(render_image(w, &set, &cancel, NULL, NULL, &err));
+	assert_non_null(strstr(err.msg, "stopped"));
+	world_free(w);
+	scene_free(s);
+}
+
+static void test_srgb(void **state)
+{
+	(void)state;
+	/* every code decodes and re-encodes to itself */
+	for (int c = 0; c < 256; c++) {
+		assert_near(srgb8_to_linear(c), srgb_decode(c), 1e-15);
+		assert_int_equal(linear_to_srgb8(srgb_decode(c)), c);
+	}
+	/* linear 0.5 is code 188 (0.7354 * 255 = 187.5...) and clamping */
+	assert_int_equal(linear_to_srgb8(0.5), 188);
+	assert_int_equal(linear_to_srgb8(-1), 0);
+	assert_int_equal(linear_to_srgb8(7), 255);
+	assert_int_equal(linear_to_srgb8(NAN), 0);
+	/* the world decodes .rt colours the same way */
+	vec3 l = srgb255_to_linear(v3(0, 128, 255));
+	assert_near(l.x, 0, 0);
+	assert_near(l.y, srgb_decode(128), 1e-15);
+	assert_near(l.z, 1, 1e-15);
+}
+
+static void test_image_files(void **state)
+{
+	(void)state;
+	framebuffer *fb = fb_new(5, 3);
+	for (int i = 0; i < 5 * 3 * 3; i++)
+		fb->rgb[i] = (float)(i * 0.03125);
+	char dir[] = "/tmp/rtsh-test-XXXXXX";
+	assert_non_null(mkdtemp(dir));
+	char path[256];
+	snprintf(path, sizeof path, "%s/a.pfm", dir);
+	assert_true(image_write(path, fb, 0.0, NULL));
+	framebuffer *back = image_read_pfm(path, NULL);
+	assert_non_null(back);
+	assert_memory_equal(back->rgb, fb->rgb, sizeof(float) * 45); /* exact, row order kept */
+	fb_free(back);
+	/* exposure +1 doubles the stored values */
+	assert_true(image_write(path, fb, 1.0, NULL));
+	back = image_read_pfm(path, NULL);
+	assert_near(back->rgb[7], 2 * fb->rgb[7], 0);
+	fb_free(back);
+	/* PPM: codes are the sRGB encoding */
+	snprintf(path, sizeof path, "%s/a.ppm", dir);
+	assert_true(image_write(path, fb, 0.0, NULL));
+	back = image_read_ppm(path, NULL);
+	assert_non_null(back);
+	for (int i = 0; i < 45; i++)
+		assert_near(back->rgb[i], srgb_decode(linear_to_srgb8(fb->rgb[i])), 1e-6);
+	fb_free(back);
+	/* PNG: the signature is there */
+	snprintf(path, sizeof path, "%s/a.png", dir);
+	assert_true(image_write(path, fb, 0.0, NULL));
+	FILE *f = fopen(path, "rb");
+	unsigned char sig[8];
+	assert_int_equal(fread(sig, 1, 8, f), 8);
+	fclose(f);
+	assert_memory_equal(sig, "\x89PNG\r\n\x1a\n", 8);
+	/* an unknown type is refused and leaves the old file alone */
+	rt_error err;
+	snprintf(path, sizeof path, "%s/a.bmp", dir);
+	assert_false(image_write(path, fb, 0.0, &err));
+	assert_non_null(strstr(err.msg, "expected .ppm"));
+	/* a failed write (folder not writable) keeps the old file */
+	snprintf(path, sizeof path, "%s/a.ppm", dir);
+	struct stat before, after;
+	assert_int_equal(stat(path, &before), 0);
+	if (geteuid() != 0) { /* root may write anywhere */
+		chmod(dir, 0500);
+		assert_false(image_write(path, fb, 0.0, &err));
+		chmod(dir, 0700);
+		assert_int_equal(stat(path, &after), 0);
+		assert_int_equal(before.st_size, after.st_size);
+	}
+	/* no temporary file is left behind */
+	char cmd[512];
+	snprintf(cmd, sizeof cmd, "ls -a %s | grep -c tmp > /dev/null", dir);
+	assert_int_not_equal(system(cmd), 0);
+	snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+	assert_int_equal(system(cmd), 0);
+	fb_free(fb);
+}
+
+/* End to end: scenes/basic.rt through the rtsh binary. The sphere of radius
+ * 0.5 seen from 5 units away subtends a half-angle asin(0.5/5); on the image
+ * plane at distance 1 its outline is a circle of radius tan(asin(0.1)),
+ * which is tan(asin 0.1) / tan(35 deg) * W/2 pixels for the 70 degree
+ * horizontal FOV. Every other pixel is black (no sky). */
+static void test_basic_silhouette(void **state)
+{
+	(void)state;
+	char out[] = "/tmp/rtsh-basic-XXXXXX.pfm";
+	int fd = mkstemps(out, 4);
+	assert_true(fd >= 0);
+	close(fd);
+	char cmd[512];
+	snprintf(cmd, sizeof cmd, "%s scenes/basic.rt -o %s -r 240x240 -s 1 -q", test_rtsh_bin(), out);
+	assert_int_equal(system(cmd), 0);
+	framebuffer *fb = image_read_pfm(out, NULL);
+	unlink(out);
+	assert_non_null(fb);
+	assert_int_equal(fb->w, 240);
+	double r_px = tan(asin(0.1)) / tan(deg_to_rad(35)) * 120;
+	int lit = 0, row = 0;
+	for (int y = 0; y < 240; y++)
+		for (int x = 0; x < 240; x++) {
+			vec3 c = pixel(fb, x, y);
+			if (c.x > 0) {
+				lit++;
+				row += y == 120;
+				/* red: only the specular highlight adds green and blue */
+				assert_true(c.x >= c.y);
+			}
+		}
+	/* pixel centres inside the circle: the area within 1% */
+	assert_near(lit, RT_PI * r_px * r_px, 0.01 * RT_PI * r_px * r_px);
+	assert_near(row, 2 * r_px, 2);
+	/* the light at (2,0,-10) puts the highlight right of centre */
+	int bright_x = 0;
+	double best = -1;
+	for (int x = 0; x < 240; x++)
+		if (pixel(fb, x, 120).y > best) {
+			best = pixel(fb, x, 120).y;
+			bright_x = x;
+		}
+	assert_true(bright_x > 120);
+	fb_free(fb);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_phong_by_hand),
+		cmocka_unit_test(test_shadow),
+		cmocka_unit_test(test_reflection),
+		cmocka_unit_test(test_threads_identical),
+		cmocka_unit_test(test_progressive_equals_batch),
+		cmocka_unit_test(test_cancel),
+		cmocka_unit_test(test_srgb),
+		cmocka_unit_test(test_image_files),
+		cmocka_unit_test(test_basic_silhouette),
+	};
+	return cmocka_run_group_tests_name("render", tests, NULL, NULL);
+}
