@@ -1,0 +1,50 @@
+/* rtsh — what the .rt reader and writer share (rtfile_read.c, rtfile_write.c).
+ *
+ * The trailing key=value fields of objects live in ONE table, rt_keys: the
+ * reader parses and range-checks them from it and the writer emits every
+ * field whose value differs from the row's default. Adding a material key is
+ * adding a row (and documenting it in man/rtsh.5).
+ */
+#ifndef RTSH_RTFILE_PRIV_H
+#define RTSH_RTFILE_PRIV_H
+
+#include <locale.h>
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "rtsh/scene.h"
+
+/* Numbers in .rt files never exceed this magnitude. Scenes in the wild use
+ * coordinates up to 1.5e18 (and -2^31 is common); 1e20 keeps every product
+ * the renderer forms far from overflow. */
+#define RT_NUM_MAX 1e20
+#define RT_NUM_MAX_TEXT "1e20"
+
+typedef struct rt_key {
+	const char *name;   /* as written before '=' */
+	size_t offset;      /* of the field in struct object */
+	bool is_int;        /* an int field (else double) */
+	bool triangles;     /* allowed on triangles */
+	double min, max;    /* inclusive range */
+	double def;         /* the value that means "absent"; not written */
+	bool (*extra)(double v); /* a further rule within [min,max], or NULL */
+	const char *expect; /* what a valid value is, for messages */
+} rt_key;
+
+extern const rt_key rt_keys[];
+extern const size_t rt_nkeys;
+
+/* The key's value in o, as a double. */
+double rt_key_get(const rt_key *k, const object *o);
+/* Stores v (already checked) in o. */
+void rt_key_set(const rt_key *k, object *o, double v);
+
+/* Numbers are read and written in the "C" locale whatever the program's
+ * locale is: rt_numloc_enter switches the calling thread, leave restores. */
+typedef struct rt_numloc {
+	locale_t c, old;
+} rt_numloc;
+void rt_numloc_enter(rt_numloc *l);
+void rt_numloc_leave(rt_numloc *l);
+
+#endif

@@ -1,0 +1,1201 @@
+/* rtsh — the .rt reader: one lexer and one parser for every dialect.
+ *
+ * The file is read into memory whole and cut into lines (LF, CRLF or CR).
+ * Each line is cut into tokens that remember their column; blanks next to
+ * a comma are dropped so that "1, 2, 3" is one vector field. Each element
+ * has an entry in `elements` (identifier, name, usage, parser); the parsers
+ * check every field against its range and report the first problem as
+ * "FILE:LINE:COL: <element> <field> "<token>" <problem>; expected <what>".
+ * The grammar, the ranges and the dialects are documented in rtsh(5).
+ */
+#include <errno.h>
+#include <float.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "rtsh/render.h"
+#include "rtsh/rtfile.h"
+#include "scene/rtfile_priv.h"
+
+/* Files larger than this are refused rather than read. */
+#define RT_FILE_MAX ((size_t)1 << 30)
+/* --strict: a direction is unit length when |length - 1| <= this. */
+#define STRICT_UNIT_TOL 1e-2
+/* The renderable ends of the field of view, for fov 0 and 180. */
+#define FOV_MIN 0.01
+#define FOV_MAX 179.99
+
+/* --- the key=value table (shared with the writer) --- */
+
+static bool ior_rule(double v) { return v == 0.0 || v >= 1.0; }
+
+const rt_key rt_keys[] = {
+	{"twist", offsetof(object, twist), false, false, -RT_NUM_MAX, RT_NUM_MAX, 0, NULL,
+	 "twist in degrees"},
+	{"fuzz", offsetof(object, mat.fuzz), false, true, 0, 1, 0, NULL, "fuzz in [0,1]"},
+	{"metal", offsetof(object, mat.metal), false, true, 0, 1, 0, NULL, "metal in [0,1]"},
+	{"ior", offsetof(object, mat.ior), false, true, 0, 10, 0, ior_rule,
+	 "ior 0 (opaque) or a refractive index in [1,10]"},
+	{"emit", offsetof(object, mat.emission), false, true, 0, 1e6, 0, NULL,
+	 "emit in [0,1e6]"},
+	{"checker", offsetof(object, mat.checker), true, true, 0, 1000, 0, NULL,
+	 "checker a whole number in [0,1000]"},
+};
+const size_t rt_nkeys = sizeof rt_keys / sizeof rt_keys[0];
+
+double rt_key_get(const rt_key *k, const object *o)
+{
+	const char *base = (const char *)o + k->offset;
+	if (k->is_int)
+		return *(const int *)(const void *)base;
+	return *(const double *)(const void *)base;
+}
+
+void rt_key_set(const rt_key *k, object *o, double v)
+{
+	char *base = (char *)o + k->offset;
+	if (k->is_int)
+		*(int *)(void *)base = (int)v;
+	else
+		*(double *)(void *)base = v;
+}
+
+void rt_numloc_enter(rt_numloc *l)
+{
+	l->c = newlocale(LC_NUMERIC_MASK, "C", (locale_t)0);
+	l->old = l->c ? uselocale(l->c) : (locale_t)0;
+}
+
+void rt_numloc_leave(rt_numloc *l)
+{
+	if (l->c) {
+		uselocale(l->old);
+		freelocale(l->c);
+	}
+}
+
+/* --- the parser state --- */
+
+typedef struct tok {
+	const char *s; /* NUL-terminated, blanks beside commas removed */
+	size_t len;
+	int col;       /* 1-based byte column of the first character */
+	int endcol;    /* the column just after the token */
+} tok;
+
+typedef struct parser {
+	scene *s;
+	const char *name; /* the file name in messages */
+	bool strict;
+	bool single;      /* rt_parse_line: once-only elements replace */
+	const rt_warnings *warn;
+	rt_error *err;
+	int line;
+	/* The line of the first A, C, L, R (or set resolution), sky and set
+	 * samples/depth/mode seen; 0 = none yet. */
+	int line_a, line_c, line_l, line_r, line_sky, line_set[3];
+	size_t cam_c;     /* index of the C camera */
+	size_t nelems;    /* elements read */
+	tok *toks;
+	size_t ntoks, cap_toks;
+	size_t np;        /* positional fields after the identifier */
+	int endcol;       /* the column after the line's last token */
+	char *text;
+	size_t cap_text;
+	char quote[96];   /* a token shortened for a message */
+} parser;
+
+typedef struct elem_def elem_def;
+struct elem_def {
+	const char *id;
+	const char *name;   /* in messages */
+	int kind;           /* obj_kind, or -1 for the other elements */
+	bool strict;        /* allowed by --strict */
+	bool (*parse)(parser *p, const elem_def *e);
+	const char *usage;  /* every accepted form */
+	const char *usage42; /* the 42 subject's form, or NULL */
+};
+
+static bool fail(parser *p, int col, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+
+static bool fail(parser *p, int col, const char *fmt, ...)
+{
+	char msg[RT_ERROR_MSG_MAX];
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(msg, sizeof msg, fmt, ap);
+	va_end(ap);
+	return rt_error_at(p->err, p->name, p->line, col, "%s", msg);
+}
+
+/* The token for a message: at most 40 bytes, cut on a character boundary. */
+static const char *quoted(parser *p, const tok *t)
+{
+	size_t n = t->len;
+	if (n <= 40) {
+		snprintf(p->quote, sizeof p->quote, "%s", t->s);
+		return p->quote;
+	}
+	n = 37;
+	while (n > 0 && ((unsigned char)t->s[n] & 0xC0) == 0x80)
+		n--;
+	snprintf(p->quote, sizeof p->quote, "%.*s...", (int)n, t->s);
+	return p->quote;
+}
+
+static bool fail_tok(parser *p, const tok *t, const char *elem, const char *field, const char *what,
+                     const char *expect)
+{
+	return fail(p, t->col, "%s %s \"%s\" %s; expected %s", elem, field, quoted(p, t), what, expect);
+}
+
+/* --- lexing --- */
+
+static bool is_blank(char c) { return c == ' ' || c == '\t'; }
+
+static bool comment_at(const char *s, size_t i, size_t len)
+{
+	return s[i] == '#' || (s[i] == '/' && i + 1 < len && s[i + 1] == '/');
+}
+
+static bool push_tok(parser *p, tok t)
+{
+	if (p->ntoks == p->cap_toks) {
+		size_t cap = p->cap_toks ? p->cap_toks * 2 : 16;
+		tok *n = realloc(p->toks, cap * sizeof *n);
+		if (!n)
+			return rt_error_set(p->err, "out of memory");
+		p->toks = n;
+		p->cap_toks = cap;
+	}
+	p->toks[p->ntoks++] = t;
+	return true;
+}
+
+/* Cuts the line s[0..len) into p->toks. */
+static bool lex_line(parser *p, const char *s, size_t len)
+{
+	p->ntoks = 0;
+	p->endcol = 1;
+	for (size_t i = 0; i < len; i++) {
+		unsigned char c = (unsigned char)s[i];
+		if ((c < 0x20 && c != '\t') || c == 0x7F) {
+			if (c == 0)
+				return fail(p, (int)i + 1, "a NUL byte; expected text (is this a binary file?)");
+			return fail(p, (int)i + 1, "control character 0x%02X; expected text", c);
+		}
+	}
+	if (len + 2 > p->cap_text) {
+		char *n = realloc(p->text, len + 2);
+		if (!n)
+			return rt_error_set(p->err, "out of memory");
+		p->text = n;
+		p->cap_text = len + 2;
+	}
+	/* Tokens are copied to p->text; a token and its NUL never take more
+	 * room than its span and the blank after it, so len + 1 bytes do. */
+	char *out = p->text;
+	size_t i = 0;
+	while (i < len) {
+		if (is_blank(s[i])) {
+			i++;
+			continue;
+		}
+		if (comment_at(s, i, len))
+			break;
+		tok t = {.s = out, .col = (int)i + 1};
+		for (;;) {
+			while (i < len && !is_blank(s[i]) && !comment_at(s, i, len))
+				*out++ = s[i++];
+			t.endcol = (int)i + 1;
+			size_t j = i;
+			while (j < len && is_blank(s[j]))
+				j++;
+			bool more = j < len && !comment_at(s, j, len);
+			if (j > i && more && (out[-1] == ',' || s[j] == ',')) {
+				i = j;
+				continue;
+			}
+			break;
+		}
+		t.len = (size_t)(out - t.s);
+		*out++ = '\0';
+		p->endcol = t.endcol;
+		if (!push_tok(p, t))
+			return false;
+	}
+	return true;
+}
+
+/* --- numbers --- */
+
+static bool is_digit(char c) { return c >= '0' && c <= '9'; }
+
+/* The end of the decimal number that starts at s, or NULL if none does:
+ * [+-] (digits [. digits] | . digits) [(e|E) [+-] digits]. */
+static const char *scan_decimal(const char *s, const char *end)
+{
+	const char *q = s;
+	if (q < end && (*q == '+' || *q == '-'))
+		q++;
+	size_t ndig = 0;
+	while (q < end && is_digit(*q)) {
+		q++;
+		ndig++;
+	}
+	if (q < end && *q == '.') {
+		q++;
+		while (q < end && is_digit(*q)) {
+			q++;
+			ndig++;
+		}
+	}
+	if (ndig == 0)
+		return NULL;
+	if (q < end && (*q == 'e' || *q == 'E')) {
+		q++;
+		if (q < end && (*q == '+' || *q == '-'))
+			q++;
+		const char *e0 = q;
+		while (q < end && is_digit(*q))
+			q++;
+		if (q == e0)
+			return NULL;
+	}
+	return q;
+}
+
+typedef enum num_status { NUM_OK, NUM_EMPTY, NUM_BAD, NUM_BIG } num_status;
+
+/* Reads s[0..len), which must be followed by ',', 'x' or NUL. */
+static num_status num_parse(const char *s, size_t len, double *out)
+{
+	if (len == 0)
+		return NUM_EMPTY;
+	if (scan_decimal(s, s + len) != s + len)
+		return NUM_BAD;
+	/* The syntax is checked: strtod reads exactly these bytes, except that
+	 * "0x" would start a hexadecimal number, so copy the short ones. */
+	char buf[64];
+	double v;
+	if (len < sizeof buf) {
+		memcpy(buf, s, len);
+		buf[len] = '\0';
+		v = strtod(buf, NULL);
+	} else {
+		v = strtod(s, NULL);
+	}
+	if (!(fabs(v) <= RT_NUM_MAX))
+		return NUM_BIG;
+	*out = v;
+	return NUM_OK;
+}
+
+/* A field's range: lo..hi (lo excluded when lo_open), whole numbers only
+ * when whole; `expect` says so in words. */
+typedef struct range {
+	double lo, hi;
+	bool lo_open, whole;
+	const char *expect;
+} range;
+
+static const range R_ANY = {-RT_NUM_MAX, RT_NUM_MAX, false, false, "a number"};
+static const range R_RATIO = {0, 1, false, false, "a number in [0,1]"};
+static const range R_POS = {0, RT_NUM_MAX, true, false, "a number > 0"};
+static const range R_NONNEG = {0, RT_NUM_MAX, false, false, "a number >= 0"};
+static const range R_FOV = {0, 180, false, false, "degrees in [0,180]"};
+static const range R_SHINE = {1, 500, false, false, "a number in [1,500]"};
+static const range R_SIZE = {1, 1e9, false, true, "a whole number in [1,1e9]"};
+static const range R_COLOR = {0, 255, false, false, "R,G,B each in [0,255]"};
+static const range R_COLOR42 = {0, 255, false, true,
+				"R,G,B whole numbers in [0,255] (strict mode)"};
+static const range R_SCALE = {0, RT_NUM_MAX, true, false, "three numbers > 0"};
+
+/* NULL when v is in r, else what is wrong. */
+static const char *range_problem(const range *r, double v)
+{
+	if (r->whole && v != floor(v))
+		return "not a whole number";
+	if (r->lo_open && v <= r->lo)
+		return r->lo == 0 ? "not positive" : "out of range";
+	if (v < r->lo || v > r->hi)
+		return "out of range";
+	return NULL;
+}
+
+static bool get_num(parser *p, const tok *t, const char *elem, const char *field, const range *r,
+                    double *out)
+{
+	double v = 0;
+	num_status st = memchr(t->s, ',', t->len) ? NUM_BAD : num_parse(t->s, t->len, &v);
+	if (st == NUM_BIG)
+		return fail_tok(p, t, elem, field, "is out of range", "a magnitude up to " RT_NUM_MAX_TEXT);
+	if (st != NUM_OK)
+		return fail_tok(p, t, elem, field, "is not a number", r->expect);
+	const char *bad = range_problem(r, v);
+	if (bad) {
+		char what[64];
+		snprintf(what, sizeof what, "is %s", bad);
+		return fail_tok(p, t, elem, field, what, r->expect);
+	}
+	*out = v;
+	return true;
+}
+
+/* A vector of n numbers separated by commas; `shape` names them ("X,Y,Z"). */
+static bool get_tuple(parser *p, const tok *t, const char *elem, const char *field, int n,
+                      const char *shape, const range *r, double *out)
+{
+	int count = 1;
+	for (size_t i = 0; i < t->len; i++)
+		count += t->s[i] == ',';
+	char what[64];
+	for (size_t i = 0; i < t->len; i++)
+		if (t->s[i] == ',' && (i == 0 || i + 1 == t->len || t->s[i + 1] == ','))
+			return fail_tok(p, t, elem, field, "has an empty component", shape);
+	if (count != n) {
+		if (count == 1)
+			snprintf(what, sizeof what, "is not a vector");
+		else
+			snprintf(what, sizeof what, "has %d components", count);
+		return fail_tok(p, t, elem, field, what, shape);
+	}
+	const char *c = t->s, *end = t->s + t->len;
+	for (int k = 0; k < n; k++) {
+		const char *e = memchr(c, ',', (size_t)(end - c));
+		if (!e)
+			e = end;
+		double v = 0;
+		switch (num_parse(c, (size_t)(e - c), &v)) {
+		case NUM_EMPTY:
+			return fail_tok(p, t, elem, field, "has an empty component", shape);
+		case NUM_BAD:
+			return fail_tok(p, t, elem, field, "has a component that is not a number",
+			                shape);
+		case NUM_BIG:
+			return fail_tok(p, t, elem, field, "is out of range",
+			                "a magnitude up to " RT_NUM_MAX_TEXT);
+		case NUM_OK:
+			break;
+		}
+		const char *bad = range_problem(r, v);
+		if (bad) {
+			if (strcmp(bad, "out of range") == 0)
+				snprintf(what, sizeof what, "is out of range");
+			else
+				snprintf(what, sizeof what, "has a component that is %s", bad);
+			return fail_tok(p, t, elem, field, what, r->expect);
+		}
+		out[k] = v;
+		c = e + 1;
+	}
+	return true;
+}
+
+static bool get_vec(parser *p, const tok *t, const char *elem, const char *field, const range *r,
+                    vec3 *out)
+{
+	double v[3];
+	if (!get_tuple(p, t, elem, field, 3, "X,Y,Z", r, v))
+		return false;
+	*out = v3(v[0], v[1], v[2]);
+	return true;
+}
+
+static bool get_color(parser *p, const tok *t, const char *elem, const char *field, vec3 *out)
+{
+	double v[3];
+	const range *r = p->strict ? &R_COLOR42 : &R_COLOR;
+	if (!get_tuple(p, t, elem, field, 3, "R,G,B", r, v))
+		return false;
+	*out = v3(v[0], v[1], v[2]);
+	return true;
+}
+
+/* A direction: not zero, long enough to normalise; under --strict, unit
+ * length with components in [-1,1]. */
+static bool get_dir(parser *p, const tok *t, const char *elem, const char *field, vec3 *out)
+{
+	vec3 d;
+	if (!get_vec(p, t, elem, field, &R_ANY, &d))
+		return false;
+	if (d.x == 0 && d.y == 0 && d.z == 0)
+		return fail(p, t->col, "%s %s is the zero vector; expected a non-zero direction", elem,
+		            field);
+	if (v3_len2(d) < DBL_MIN)
+		return fail_tok(p, t, elem, field, "is too short to normalise",
+		                "a direction of length > 1e-150");
+	if (p->strict) {
+		if (v3_max_abs(d) > 1)
+			return fail_tok(p, t, elem, field, "has a component outside [-1,1]",
+			                "a unit vector (strict mode)");
+		if (fabs(v3_len(d) - 1) > STRICT_UNIT_TOL) {
+			char what[64];
+			snprintf(what, sizeof what, "is not a unit vector (length %.4g)", v3_len(d));
+			return fail_tok(p, t, elem, field, what,
+			                "a unit vector, length 1 within 0.01 (strict mode)");
+		}
+	}
+	*out = d;
+	return true;
+}
+
+/* --- field counts --- */
+
+static bool count_ok(parser *p, const elem_def *e, size_t lo, size_t hi, const char *usage)
+{
+	if (p->np < lo)
+		return fail(p, p->endcol, "%s: too few fields; expected %s", e->name, usage);
+	if (p->np > hi)
+		return fail(p, p->toks[hi + 1].col, "%s: too many fields; expected %s", e->name, usage);
+	return true;
+}
+
+/* The usage to quote: only the 42 form under --strict. */
+static const char *usage_of(const parser *p, const elem_def *e)
+{
+	return p->strict && e->usage42 ? e->usage42 : e->usage;
+}
+
+/* Key=value fields are for objects only. */
+static bool no_keys(parser *p, const elem_def *e)
+{
+	if (p->np + 1 < p->ntoks) {
+		const tok *t = &p->toks[p->np + 1];
+		return fail(p, t->col, "%s field \"%s\" is a key=value field; expected %s", e->name,
+		            quoted(p, t), e->usage);
+	}
+	return true;
+}
+
+/* A once-only element seen before: an identical repeat is ignored with a
+ * warning, a different one is an error. Returns 1 to store the element, 0
+ * to skip it, -1 on error. rt_parse_line replaces instead. */
+static int once(parser *p, const elem_def *e, const char *what, int *first, bool same)
+{
+	if (p->single || *first == 0) {
+		*first = p->line;
+		return 1;
+	}
+	if (same && !p->strict) {
+		rt_warn(p->warn, p->name, p->line, p->toks[0].col,
+		        "%s: this %s line repeats line %d; ignored", e->name, what, *first);
+		return 0;
+	}
+	fail(p, p->toks[0].col, "%s: a second %s line; expected only one (the first is on line %d)",
+	     e->name, what, *first);
+	return -1;
+}
+
+/* --- the elements --- */
+
+static bool parse_ambient(parser *p, const elem_def *e)
+{
+	ambient a;
+	if (!no_keys(p, e) || !count_ok(p, e, 2, 2, e->usage) ||
+	    !get_num(p, &p->toks[1], e->name, "ratio", &R_RATIO, &a.ratio) ||
+	    !get_color(p, &p->toks[2], e->name, "colour", &a.color))
+		return false;
+	bool same = p->s->has_ambient && p->s->amb.ratio == a.ratio && v3_eq(p->s->amb.color, a.color);
+	int r = once(p, e, "A", &p->line_a, same);
+	if (r > 0) {
+		p->s->has_ambient = true;
+		p->s->amb = a;
+	}
+	return r >= 0;
+}
+
+static bool parse_camera(parser *p, const elem_def *e)
+{
+	camera c;
+	if (!no_keys(p, e) || !count_ok(p, e, 3, 3, e->usage) ||
+	    !get_vec(p, &p->toks[1], e->name, "position", &R_ANY, &c.pos) ||
+	    !get_dir(p, &p->toks[2], e->name, "direction", &c.dir) ||
+	    !get_num(p, &p->toks[3], e->name, "fov", &R_FOV, &c.fov))
+		return false;
+	if (c.fov < FOV_MIN || c.fov > FOV_MAX) {
+		double to = c.fov < FOV_MIN ? FOV_MIN : FOV_MAX;
+		rt_warn(p->warn, p->name, p->line, p->toks[3].col,
+		        "camera fov \"%s\" is clamped to %g degrees; expected an angle strictly "
+		        "between 0 and 180",
+		        quoted(p, &p->toks[3]), to);
+		c.fov = to;
+	}
+	scene *s = p->s;
+	if (strcmp(e->id, "C") != 0)
+		return scene_add_camera(s, &c, p->err);
+	if (p->single) {
+		if (s->ncams == 0)
+			return scene_add_camera(s, &c, p->err);
+		s->cams[s->cam] = c;
+		return true;
+	}
+	bool same = false;
+	if (p->line_c) {
+		const camera *o = &s->cams[p->cam_c];
+		same = v3_eq(o->pos, c.pos) && v3_eq(o->dir, c.dir) && o->fov == c.fov;
+	}
+	int r = once(p, e, "C", &p->line_c, same);
+	if (r > 0) {
+		p->cam_c = s->ncams;
+		return scene_add_camera(s, &c, p->err);
+	}
+	return r >= 0;
+}
+
+static bool parse_light(parser *p, const elem_def *e)
+{
+	light l = {.color = v3_splat(255)};
+	if (!no_keys(p, e) || !count_ok(p, e, p->strict ? 3 : 2, 3, usage_of(p, e)) ||
+	    !get_vec(p, &p->toks[1], e->name, "position", &R_ANY, &l.pos) ||
+	    !get_num(p, &p->toks[2], e->name, "ratio", &R_RATIO, &l.ratio))
+		return false;
+	if (p->np == 3 && !get_color(p, &p->toks[3], e->name, "colour", &l.color))
+		return false;
+	if (p->strict && p->line_l)
+		return fail(p, p->toks[0].col,
+		            "light: a second L line; expected exactly one in strict mode (the first "
+		            "is on line %d)",
+		            p->line_l);
+	if (!p->line_l)
+		p->line_l = p->line;
+	return scene_add_light(p->s, &l, p->err);
+}
+
+static bool parse_resolution(parser *p, const elem_def *e)
+{
+	double w, h;
+	if (!no_keys(p, e) || !count_ok(p, e, 2, 2, e->usage) ||
+	    !get_num(p, &p->toks[1], e->name, "width", &R_SIZE, &w) ||
+	    !get_num(p, &p->toks[2], e->name, "height", &R_SIZE, &h))
+		return false;
+	scene_hints *hn = &p->s->hints;
+	int r = once(p, e, "R", &p->line_r, hn->width == (int)w && hn->height == (int)h);
+	if (r > 0) {
+		hn->width = (int)w;
+		hn->height = (int)h;
+	}
+	return r >= 0;
+}
+
+static bool parse_sky(parser *p, const elem_def *e)
+{
+	sky k = {.strength = 1};
+	if (!no_keys(p, e) || !count_ok(p, e, 2, 3, e->usage) ||
+	    !get_color(p, &p->toks[1], e->name, "zenith colour", &k.zenith) ||
+	    !get_color(p, &p->toks[2], e->name, "horizon colour", &k.horizon))
+		return false;
+	if (p->np == 3 && !get_num(p, &p->toks[3], e->name, "strength", &R_NONNEG, &k.strength))
+		return false;
+	const sky *o = &p->s->sky;
+	bool same = p->s->has_sky && v3_eq(o->zenith, k.zenith) && v3_eq(o->horizon, k.horizon) &&
+	            o->strength == k.strength;
+	int r = once(p, e, "sky", &p->line_sky, same);
+	if (r > 0) {
+		p->s->has_sky = true;
+		p->s->sky = k;
+	}
+	return r >= 0;
+}
+
+/* `set resolution WxH`: two whole numbers >= 1. */
+static bool get_resolution(parser *p, const tok *t, int *w, int *h)
+{
+	static const char expect[] = "WIDTHxHEIGHT, whole numbers >= 1";
+	const char *x = memchr(t->s, 'x', t->len);
+	if (!x)
+		x = memchr(t->s, 'X', t->len);
+	double v[2];
+	if (!x || memchr(t->s, ',', t->len))
+		return fail_tok(p, t, "set", "resolution", "is not WxH", expect);
+	size_t lens[2] = {(size_t)(x - t->s), t->len - (size_t)(x - t->s) - 1};
+	const char *starts[2] = {t->s, x + 1};
+	for (int k = 0; k < 2; k++) {
+		num_status st = num_parse(starts[k], lens[k], &v[k]);
+		if (st == NUM_BIG)
+			return fail_tok(p, t, "set", "resolution", "is out of range", expect);
+		if (st != NUM_OK)
+			return fail_tok(p, t, "set", "resolution", "is not WxH", expect);
+		const char *bad = range_problem(&R_SIZE, v[k]);
+		if (bad) {
+			char what[64];
+			snprintf(what, sizeof what, "has a size that is %s", bad);
+			return fail_tok(p, t, "set", "resolution", what, expect);
+		}
+	}
+	*w = (int)v[0];
+	*h = (int)v[1];
+	return true;
+}
+
+static bool parse_set(parser *p, const elem_def *e)
+{
+	static const char *const keys[] = {"samples", "depth", "mode", "resolution"};
+	static const range r_samples = {1, 1000000, false, true, "a whole number in [1,1000000]"};
+	static const range r_depth = {0, 1000, false, true, "a whole number in [0,1000]"};
+	if (!no_keys(p, e) || !count_ok(p, e, 2, 2, e->usage))
+		return false;
+	const tok *k = &p->toks[1], *v = &p->toks[2];
+	size_t i = 0;
+	while (i < 4 && strcmp(k->s, keys[i]) != 0)
+		i++;
+	if (i == 4)
+		return fail_tok(p, k, "set", "key", "is unknown",
+		                "one of samples depth mode resolution");
+	scene_hints *hn = &p->s->hints;
+	double d = 0;
+	int r;
+	switch (i) {
+	case 0:
+		if (!get_num(p, v, "set", "samples", &r_samples, &d))
+			return false;
+		r = once(p, e, "set samples", &p->line_set[0], hn->samples == (int)d);
+		if (r > 0)
+			hn->samples = (int)d;
+		break;
+	case 1:
+		if (!get_num(p, v, "set", "depth", &r_depth, &d))
+			return false;
+		r = once(p, e, "set depth", &p->line_set[1], hn->depth == (int)d);
+		if (r > 0)
+			hn->depth = (int)d;
+		break;
+	case 2: {
+		int m;
+		if (strcmp(v->s, "whitted") == 0)
+			m = MODE_WHITTED;
+		else if (strcmp(v->s, "path") == 0)
+			m = MODE_PATH;
+		else
+			return fail_tok(p, v, "set", "mode", "is unknown", "whitted or path");
+		r = once(p, e, "set mode", &p->line_set[2], hn->mode == m);
+		if (r > 0)
+			hn->mode = m;
+		break;
+	}
+	default: {
+		int w = 0, h = 0;
+		if (!get_resolution(p, v, &w, &h))
+			return false;
+		r = once(p, e, "resolution (R or set resolution)", &p->line_r,
+		         hn->width == w && hn->height == h);
+		if (r > 0) {
+			hn->width = w;
+			hn->height = h;
+		}
+		break;
+	}
+	}
+	return r >= 0;
+}
+
+/* The trailing key=value fields of an object, from rt_keys. */
+static bool parse_keys(parser *p, const elem_def *e, object *o)
+{
+	unsigned seen = 0;
+	for (size_t i = p->np + 1; i < p->ntoks; i++) {
+		const tok *t = &p->toks[i];
+		if (p->strict)
+			return fail_tok(p, t, e->name, "key", "is not allowed in strict mode",
+			                "no key=value fields");
+		const char *eq = memchr(t->s, '=', t->len);
+		if (!eq)
+			return fail(p, t->col,
+			            "%s field \"%s\" comes after the key=value fields; expected the "
+			            "key=value fields last",
+			            e->name, quoted(p, t));
+		size_t nlen = (size_t)(eq - t->s);
+		size_t k = 0;
+		while (k < rt_nkeys &&
+		       !(strlen(rt_keys[k].name) == nlen && memcmp(rt_keys[k].name, t->s, nlen) == 0))
+			k++;
+		bool tri = o->kind == OBJ_TRIANGLE;
+		if (k == rt_nkeys || (tri && !rt_keys[k].triangles)) {
+			char list[256] = "";
+			size_t used = 0;
+			for (size_t j = 0; j < rt_nkeys; j++)
+				if (!tri || rt_keys[j].triangles)
+					used += (size_t)snprintf(list + used, sizeof list - used, "%s%s=",
+					                         used ? " " : "", rt_keys[j].name);
+			return fail_tok(p, t, e->name, "key",
+			                k == rt_nkeys ? "is unknown" : "does not apply to triangles",
+			                list);
+		}
+		const rt_key *key = &rt_keys[k];
+		if (seen & (1u << k))
+			return fail_tok(p, t, e->name, "key", "repeats a key", "each key at most once");
+		seen |= 1u << k;
+		double v = 0;
+		const char *val = eq + 1;
+		num_status st = num_parse(val, t->len - nlen - 1, &v);
+		if (st == NUM_BIG)
+			return fail_tok(p, t, e->name, "key", "is out of range", key->expect);
+		if (st != NUM_OK)
+			return fail_tok(p, t, e->name, "key", "has a value that is not a number",
+			                key->expect);
+		if (v < key->min || v > key->max || (key->is_int && v != floor(v)) ||
+		    (key->extra && !key->extra(v)))
+			return fail_tok(p, t, e->name, "key", "is out of range", key->expect);
+		rt_key_set(key, o, v);
+	}
+	return true;
+}
+
+/* A 42-form size (diameter, height, side) of exactly 0, which the wild
+ * corpus has: outside --strict it is accepted and the object, having no
+ * volume, is left out with a warning. */
+typedef struct zero_size {
+	const tok *t;
+	const char *field;
+} zero_size;
+
+static bool get_size(parser *p, const tok *t, const char *elem, const char *field, double *out,
+                     zero_size *zero)
+{
+	double v;
+	if (!p->strict && !memchr(t->s, ',', t->len) && num_parse(t->s, t->len, &v) == NUM_OK &&
+	    v == 0) {
+		if (!zero->t)
+			*zero = (zero_size){t, field};
+		*out = 0;
+		return true;
+	}
+	return get_num(p, t, elem, field, &R_POS, out);
+}
+
+/* Keys, validation, then the object joins the scene (unless it has a zero
+ * size, see get_size). */
+static bool add_object(parser *p, const elem_def *e, object *o, const zero_size *zero)
+{
+	if (!parse_keys(p, e, o))
+		return false;
+	if (zero && zero->t) {
+		rt_warn(p->warn, p->name, p->line, zero->t->col,
+		        "%s %s \"%s\" is zero: the %s has no volume and is left out", e->name,
+		        zero->field, quoted(p, zero->t), e->name);
+		return true;
+	}
+	rt_error verr;
+	rt_error_clear(&verr);
+	if (!object_validate(o, &verr))
+		return fail(p, p->toks[0].col, "%s: %s", e->name, verr.msg);
+	return scene_add_object(p->s, o, p->err);
+}
+
+/* DIFFUSE SPECULAR SHININESS REFLECTIVE from toks[first..first+3]. */
+static bool get_material(parser *p, const elem_def *e, size_t first, material *m)
+{
+	const tok *t = &p->toks[first];
+	return get_num(p, &t[0], e->name, "diffuse", &R_RATIO, &m->diffuse) &&
+	       get_num(p, &t[1], e->name, "specular", &R_RATIO, &m->specular) &&
+	       get_num(p, &t[2], e->name, "shininess", &R_SHINE, &m->shininess) &&
+	       get_num(p, &t[3], e->name, "reflective", &R_RATIO, &m->reflective);
+}
+
+/* The material group is all four fields or none. */
+static bool group_ok(parser *p, const elem_def *e, size_t first)
+{
+	if (p->np > first && p->np < first + 4)
+		return fail(p, p->toks[first + 1].col,
+		            "%s: %zu of the 4 material fields; expected DIFFUSE SPECULAR SHININESS "
+		            "REFLECTIVE together or none of them",
+		            e->name, p->np - first);
+	return true;
+}
+
+/* ID POS ROT SCALE R,G,B [DIFFUSE SPECULAR SHININESS REFLECTIVE [SHEAR]] */
+static bool parse_extended(parser *p, const elem_def *e)
+{
+	if (p->strict)
+		return fail(p, p->toks[0].col,
+		            "%s: the extended form is not allowed in strict mode; expected %s", e->name,
+		            e->usage42);
+	if (!count_ok(p, e, 4, 9, e->usage) || !group_ok(p, e, 4))
+		return false;
+	const tok *t = p->toks;
+	vec3 pos, dir, scale, color;
+	if (!get_vec(p, &t[1], e->name, "position", &R_ANY, &pos) ||
+	    !get_dir(p, &t[2], e->name, "rotation", &dir) ||
+	    !get_vec(p, &t[3], e->name, "scaling", &R_SCALE, &scale) ||
+	    !get_color(p, &t[4], e->name, "colour", &color))
+		return false;
+	object o = object_make((obj_kind)e->kind, color);
+	o.pos = pos;
+	o.dir = dir;
+	o.scale = scale;
+	if (p->np >= 8 && !get_material(p, e, 5, &o.mat))
+		return false;
+	if (p->np == 9 && !get_tuple(p, &t[9], e->name, "shear", 6, "XY,XZ,YX,YZ,ZX,ZY", &R_ANY,
+	                             o.shear))
+		return false;
+	return add_object(p, e, &o, NULL);
+}
+
+/* A 42-form object: the kind's defaults, then the fields the caller sets. */
+static object short_object(const elem_def *e, vec3 pos, vec3 dir, vec3 scale, vec3 color)
+{
+	object o = object_make((obj_kind)e->kind, color);
+	o.pos = pos;
+	o.dir = dir;
+	o.twist = 0;
+	o.scale = scale;
+	memset(o.shear, 0, sizeof o.shear);
+	o.mat = material_default(color);
+	return o;
+}
+
+static bool plain_number(const tok *t) { return !memchr(t->s, ',', t->len); }
+
+static bool parse_sphere(parser *p, const elem_def *e)
+{
+	if (p->np < 2 || !plain_number(&p->toks[2]))
+		return parse_extended(p, e);
+	vec3 c, color;
+	double d;
+	zero_size zero = {0};
+	if (!count_ok(p, e, 3, 3, usage_of(p, e)) ||
+	    !get_vec(p, &p->toks[1], e->name, "center", &R_ANY, &c) ||
+	    !get_size(p, &p->toks[2], e->name, "diameter", &d, &zero) ||
+	    !get_color(p, &p->toks[3], e->name, "colour", &color))
+		return false;
+	object o = short_object(e, c, v3(0, 1, 0), v3_splat(d), color);
+	return add_object(p, e, &o, &zero);
+}
+
+static bool parse_plane(parser *p, const elem_def *e)
+{
+	if (p->np > 3)
+		return parse_extended(p, e);
+	vec3 pt, n, color;
+	if (!count_ok(p, e, 3, 3, usage_of(p, e)) ||
+	    !get_vec(p, &p->toks[1], e->name, "point", &R_ANY, &pt) ||
+	    !get_dir(p, &p->toks[2], e->name, "normal", &n) ||
+	    !get_color(p, &p->toks[3], e->name, "colour", &color))
+		return false;
+	object o = short_object(e, pt, n, v3_splat(1), color);
+	return add_object(p, e, &o, NULL);
+}
+
+/* cy and co */
+static bool parse_tube(parser *p, const elem_def *e)
+{
+	if (p->np < 3 || !plain_number(&p->toks[3]))
+		return parse_extended(p, e);
+	vec3 c, axis, color;
+	double d, h;
+	zero_size zero = {0};
+	if (!count_ok(p, e, 5, 5, usage_of(p, e)) ||
+	    !get_vec(p, &p->toks[1], e->name, "center", &R_ANY, &c) ||
+	    !get_dir(p, &p->toks[2], e->name, "axis", &axis) ||
+	    !get_size(p, &p->toks[3], e->name, "diameter", &d, &zero) ||
+	    !get_size(p, &p->toks[4], e->name, "height", &h, &zero) ||
+	    !get_color(p, &p->toks[5], e->name, "colour", &color))
+		return false;
+	object o = short_object(e, c, axis, v3(d, h, d), color);
+	return add_object(p, e, &o, &zero);
+}
+
+static bool parse_square(parser *p, const elem_def *e)
+{
+	vec3 c, n, color;
+	double side;
+	zero_size zero = {0};
+	if (!count_ok(p, e, 4, 4, e->usage) ||
+	    !get_vec(p, &p->toks[1], e->name, "center", &R_ANY, &c) ||
+	    !get_dir(p, &p->toks[2], e->name, "normal", &n) ||
+	    !get_size(p, &p->toks[3], e->name, "side", &side, &zero) ||
+	    !get_color(p, &p->toks[4], e->name, "colour", &color))
+		return false;
+	object o = short_object(e, c, n, v3(side, 1, side), color);
+	return add_object(p, e, &o, &zero);
+}
+
+static bool parse_triangle(parser *p, const elem_def *e)
+{
+	static const char *const names[3] = {"first point", "second point", "third point"};
+	vec3 v[3], color;
+	if (!count_ok(p, e, 4, 8, e->usage) || !group_ok(p, e, 4))
+		return false;
+	for (int k = 0; k < 3; k++)
+		if (!get_vec(p, &p->toks[1 + k], e->name, names[k], &R_ANY, &v[k]))
+			return false;
+	if (!get_color(p, &p->toks[4], e->name, "colour", &color))
+		return false;
+	object o = object_make(OBJ_TRIANGLE, color);
+	if (p->np == 8 && !get_material(p, e, 5, &o.mat))
+		return false;
+	vec3 n = v3_cross(v3_sub(v[1], v[0]), v3_sub(v[2], v[0]));
+	if (n.x == 0 && n.y == 0 && n.z == 0)
+		return fail(p, p->toks[1].col,
+		            "triangle: the three points are on one line; expected the corners of a "
+		            "triangle of non-zero area");
+	memcpy(o.tri, v, sizeof v);
+	return add_object(p, e, &o, NULL);
+}
+
+#define EXT_TAIL " POS ROT SCALE R,G,B [DIFFUSE SPECULAR SHININESS REFLECTIVE [SHEAR]]"
+
+static const elem_def elements[] = {
+	{"A", "ambient", -1, true, parse_ambient, "A RATIO R,G,B", NULL},
+	{"C", "camera", -1, true, parse_camera, "C POSITION DIRECTION FOV", NULL},
+	{"c", "camera", -1, false, parse_camera, "c POSITION DIRECTION FOV", NULL},
+	{"L", "light", -1, true, parse_light, "L POSITION RATIO [R,G,B]", "L POSITION RATIO R,G,B"},
+	{"l", "light", -1, false, parse_light, "l POSITION RATIO [R,G,B]", NULL},
+	{"R", "resolution", -1, false, parse_resolution, "R WIDTH HEIGHT", NULL},
+	{"sp", "sphere", OBJ_SPHERE, true, parse_sphere,
+	 "sp CENTER DIAMETER R,G,B" " or sp" EXT_TAIL, "sp CENTER DIAMETER R,G,B"},
+	{"pl", "plane", OBJ_PLANE, true, parse_plane,
+	 "pl POINT NORMAL R,G,B" " or pl" EXT_TAIL, "pl POINT NORMAL R,G,B"},
+	{"cy", "cylinder", OBJ_CYLINDER, true, parse_tube,
+	 "cy CENTER AXIS DIAMETER HEIGHT R,G,B" " or cy" EXT_TAIL,
+	 "cy CENTER AXIS DIAMETER HEIGHT R,G,B"},
+	{"co", "cone", OBJ_CONE, false, parse_tube,
+	 "co CENTER AXIS DIAMETER HEIGHT R,G,B" " or co" EXT_TAIL, NULL},
+	{"cu", "cube", OBJ_CUBE, false, parse_extended, "cu" EXT_TAIL, NULL},
+	{"di", "disc", OBJ_DISC, false, parse_extended, "di" EXT_TAIL, NULL},
+	{"rc", "rectangle", OBJ_RECT, false, parse_extended, "rc" EXT_TAIL, NULL},
+	{"sq", "square", OBJ_RECT, false, parse_square, "sq CENTER NORMAL SIDE R,G,B", NULL},
+	{"tr", "triangle", OBJ_TRIANGLE, false, parse_triangle,
+	 "tr P1 P2 P3 R,G,B [DIFFUSE SPECULAR SHININESS REFLECTIVE]", NULL},
+	{"sky", "sky", -1, false, parse_sky, "sky ZENITH_R,G,B HORIZON_R,G,B [STRENGTH]", NULL},
+	{"set", "set", -1, false, parse_set, "set samples|depth|mode|resolution VALUE", NULL},
+};
+#define NELEMENTS (sizeof elements / sizeof elements[0])
+
+/* Parses the tokens of one line (at least one). */
+static bool parse_tokens(parser *p)
+{
+	const tok *id = &p->toks[0];
+	const elem_def *e = NULL;
+	for (size_t i = 0; i < NELEMENTS && !e; i++)
+		if (strcmp(elements[i].id, id->s) == 0)
+			e = &elements[i];
+	if (!e || (p->strict && !e->strict)) {
+		char list[128] = "";
+		size_t used = 0;
+		for (size_t i = 0; i < NELEMENTS; i++)
+			if (!p->strict || elements[i].strict)
+				used += (size_t)snprintf(list + used, sizeof list - used, " %s",
+				                         elements[i].id);
+		return fail(p, id->col, "%s element \"%s\"; expected one of%s%s",
+		            e ? "strict mode does not allow the" : "unknown", quoted(p, id), list,
+		            p->strict ? " (strict mode)" : "");
+	}
+	p->np = p->ntoks - 1;
+	if (e->kind >= 0)
+		for (size_t i = 1; i < p->ntoks; i++)
+			if (memchr(p->toks[i].s, '=', p->toks[i].len)) {
+				p->np = i - 1;
+				break;
+			}
+	p->nelems++;
+	return e->parse(p, e);
+}
+
+static bool parse_line(parser *p, const char *s, size_t len)
+{
+	if (!lex_line(p, s, len))
+		return false;
+	return p->ntoks == 0 || parse_tokens(p);
+}
+
+static bool parse_text(parser *p, const char *text, size_t len)
+{
+	size_t i = 0;
+	p->line = 1;
+	while (i < len) {
+		size_t j = i;
+		while (j < len && text[j] != '\n' && text[j] != '\r')
+			j++;
+		if (!parse_line(p, text + i, j - i))
+			return false;
+		if (j + 1 < len && text[j] == '\r' && text[j + 1] == '\n')
+			j++;
+		i = j + 1;
+		p->line++;
+	}
+	return true;
+}
+
+/* The whole-file rules, once every line is read. */
+static bool finish(parser *p)
+{
+	scene *s = p->s;
+	p->line = 0;
+	if (p->nelems == 0)
+		return fail(p, 0, "no elements; expected a scene with at least a C line");
+	if (p->strict) {
+		if (!p->line_a)
+			return fail(p, 0, "no ambient light; expected an A line (strict mode)");
+		if (!p->line_c)
+			return fail(p, 0, "no camera; expected a C line");
+		if (!p->line_l)
+			return fail(p, 0, "no light; expected an L line (strict mode)");
+	}
+	if (s->ncams == 0) {
+		camera c = scene_camera(s);
+		rt_warn(p->warn, p->name, 0, 0,
+		        "no camera; expected a C line (using the default camera at %g,%g,%g looking "
+		        "along %g,%g,%g)",
+		        c.pos.x, c.pos.y, c.pos.z, c.dir.x, c.dir.y, c.dir.z);
+		if (!scene_add_camera(s, &c, p->err))
+			return false;
+	}
+	s->cam = 0;
+	return true;
+}
+
+static void parser_init(parser *p, scene *s, const char *name, const rt_load_opts *opts,
+                        rt_error *err)
+{
+	memset(p, 0, sizeof *p);
+	p->s = s;
+	p->name = name ? name : "";
+	p->strict = opts && opts->strict;
+	p->warn = opts ? opts->warn : NULL;
+	p->err = err;
+}
+
+static void parser_done(parser *p)
+{
+	free(p->toks);
+	free(p->text);
+}
+
+static bool has_rt_extension(const char *name)
+{
+	size_t n = strlen(name);
+	return n >= 3 && strcmp(name + n - 3, ".rt") == 0;
+}
+
+scene *rt_load_string(const char *text, size_t len, const char *name, const rt_load_opts *opts,
+                      rt_error *err)
+{
+	scene *s = scene_new();
+	if (!s) {
+		rt_error_set(err, "out of memory");
+		return NULL;
+	}
+	parser p;
+	parser_init(&p, s, name, opts, err);
+	bool ok;
+	if (p.strict && !has_rt_extension(p.name)) {
+		ok = fail(&p, 0, "the file name does not end in .rt; expected a .rt file (strict mode)");
+	} else {
+		rt_numloc loc;
+		rt_numloc_enter(&loc);
+		ok = parse_text(&p, text, len) && finish(&p);
+		rt_numloc_leave(&loc);
+	}
+	parser_done(&p);
+	if (!ok) {
+		scene_free(s);
+		return NULL;
+	}
+	return s;
+}
+
+/* The whole file in a new buffer; NULL with err set on failure. */
+static char *read_file(const char *path, size_t *len, rt_error *err)
+{
+	FILE *f = fopen(path, "rb");
+	if (!f) {
+		rt_error_at(err, path, 0, 0, "cannot open: %s; expected a readable .rt file",
+		            strerror(errno));
+		return NULL;
+	}
+	struct stat st;
+	size_t cap = 1 << 16;
+	if (fstat(fileno(f), &st) == 0) {
+		if (S_ISDIR(st.st_mode)) {
+			fclose(f);
+			rt_error_at(err, path, 0, 0, "is a directory; expected a .rt file");
+			return NULL;
+		}
+		if (S_ISREG(st.st_mode) && (unsigned long long)st.st_size > RT_FILE_MAX) {
+			fclose(f);
+			rt_error_at(err, path, 0, 0,
+			            "the file is larger than 1 GiB; expected a scene of at most 1 GiB");
+			return NULL;
+		}
+		if (S_ISREG(st.st_mode))
+			cap = (size_t)st.st_size + 1;
+	}
+	char *buf = NULL;
+	size_t n = 0;
+	for (;;) {
+		if (n == cap || !buf) {
+			size_t ncap = buf ? cap * 2 : cap;
+			if (ncap > RT_FILE_MAX + 1)
+				ncap = RT_FILE_MAX + 1;
+			char *nb = realloc(buf, ncap);
+			if (!nb) {
+				rt_error_at(err, path, 0, 0, "out of memory reading the file");
+				goto fail;
+			}
+			buf = nb;
+			cap = ncap;
+		}
+		size_t want = cap - n;
+		size_t got = fread(buf + n, 1, want, f);
+		n += got;
+		if (n > RT_FILE_MAX) {
+			rt_error_at(err, path, 0, 0,
+			            "the file is larger than 1 GiB; expected a scene of at most 1 GiB");
+			goto fail;
+		}
+		if (got < want) {
+			if (ferror(f)) {
+				rt_error_at(err, path, 0, 0, "cannot read: %s", strerror(errno));
+				goto fail;
+			}
+			break;
+		}
+	}
+	fclose(f);
+	*len = n;
+	return buf;
+fail:
+	free(buf);
+	fclose(f);
+	return NULL;
+}
+
+scene *rt_load_file(const char *path, const rt_load_opts *opts, rt_error *err)
+{
+	if (opts && opts->strict && !has_rt_extension(path)) {
+		rt_error_at(err, path, 0, 0,
+		            "the file name does not end in .rt; expected a .rt file (strict mode)");
+		return NULL;
+	}
+	size_t len = 0;
+	char *text = read_file(path, &len, err);
+	if (!text)
+		return NULL;
+	scene *s = rt_load_string(text, len, path, opts, err);
+	free(text);
+	return s;
+}
+
+bool rt_parse_line(scene *s, const char *line, const char *name, int lineno,
+                   const rt_load_opts *opts, rt_error *err)
+{
+	parser p;
+	parser_init(&p, s, name, opts, err);
+	p.single = true;
+	p.line = lineno;
+	rt_numloc loc;
+	rt_numloc_enter(&loc);
+	bool ok = lex_line(&p, line, strlen(line));
+	if (ok && p.ntoks == 0)
+		ok = fail(&p, 0, "no element; expected an element line such as sp 0,0,0 1 255,0,0");
+	if (ok)
+		ok = parse_tokens(&p);
+	rt_numloc_leave(&loc);
+	parser_done(&p);
+	return ok;
+}

@@ -1,0 +1,311 @@
+/* rtsh — the .rt writer: the scene model back to text that loads to an
+ * identical scene (rtsh(5)).
+ *
+ * Each object is written in the short 42 form when that form loses nothing
+ * and in the extended form otherwise; extension keys come from the same
+ * table as the reader's (rt_keys), so a new key is written once it has a row.
+ * Numbers are printed with the fewest digits (15, 16 or 17) that read back
+ * to the same double, always in the "C" locale.
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rtsh/image.h"
+#include "rtsh/render.h"
+#include "rtsh/rtfile.h"
+#include "scene/rtfile_priv.h"
+
+/* A bounded string builder: output is cut at size - 1 bytes, always
+ * NUL-terminated. */
+typedef struct sbuf {
+	char *buf;
+	size_t size, len;
+} sbuf;
+
+static sbuf sb_make(char *buf, size_t size)
+{
+	if (size)
+		buf[0] = '\0';
+	return (sbuf){buf, size, 0};
+}
+
+static void sb_put(sbuf *b, const char *s)
+{
+	if (b->size == 0)
+		return;
+	size_t n = strlen(s);
+	size_t room = b->size - 1 - b->len;
+	if (n > room)
+		n = room;
+	memcpy(b->buf + b->len, s, n);
+	b->len += n;
+	b->buf[b->len] = '\0';
+}
+
+static void sb_num(sbuf *b, double v)
+{
+	char t[40];
+	if (v == floor(v) && fabs(v) < 1e15) { /* whole numbers (colours): exact, and fast */
+		snprintf(t, sizeof t, "%s%lld", signbit(v) && v == 0 ? "-" : "", (long long)v);
+		sb_put(b, t);
+		return;
+	}
+	for (int prec = 15; prec <= 17; prec++) {
+		snprintf(t, sizeof t, "%.*g", prec, v);
+		if (strtod(t, NULL) == v)
+			break;
+	}
+	sb_put(b, t);
+}
+
+/* " " then the number */
+static void sb_field(sbuf *b, double v)
+{
+	sb_put(b, " ");
+	sb_num(b, v);
+}
+
+static void sb_vec(sbuf *b, vec3 v)
+{
+	sb_field(b, v.x);
+	sb_put(b, ",");
+	sb_num(b, v.y);
+	sb_put(b, ",");
+	sb_num(b, v.z);
+}
+
+static bool base_material_default(const material *m)
+{
+	material d = material_default(m->color);
+	return m->diffuse == d.diffuse && m->specular == d.specular && m->shininess == d.shininess &&
+	       m->reflective == d.reflective;
+}
+
+static bool has_shear(const object *o)
+{
+	for (int i = 0; i < 6; i++)
+		if (o->shear[i] != 0)
+			return true;
+	return false;
+}
+
+/* True when the object is exactly what its 42 (or 2019) short form reads to. */
+static bool short_form_ok(const object *o)
+{
+	if (o->twist != 0 || has_shear(o) || !base_material_default(&o->mat))
+		return false;
+	vec3 s = o->scale;
+	switch (o->kind) {
+	case OBJ_SPHERE:
+		return v3_eq(o->dir, v3(0, 1, 0)) && s.x == s.y && s.y == s.z;
+	case OBJ_PLANE:
+		return v3_eq(s, v3_splat(1));
+	case OBJ_CYLINDER:
+	case OBJ_CONE:
+		return s.x == s.z;
+	case OBJ_RECT:
+		return s.x == s.z && s.y == 1;
+	default:
+		return false;
+	}
+}
+
+static void fmt_material(sbuf *b, const material *m)
+{
+	sb_field(b, m->diffuse);
+	sb_field(b, m->specular);
+	sb_field(b, m->shininess);
+	sb_field(b, m->reflective);
+}
+
+static void fmt_keys(sbuf *b, const object *o)
+{
+	for (size_t i = 0; i < rt_nkeys; i++) {
+		const rt_key *k = &rt_keys[i];
+		double v = rt_key_get(k, o);
+		if (v == k->def || (o->kind == OBJ_TRIANGLE && !k->triangles))
+			continue;
+		sb_put(b, " ");
+		sb_put(b, k->name);
+		sb_put(b, "=");
+		sb_num(b, v);
+	}
+}
+
+static void fmt_object(sbuf *b, const object *o)
+{
+	const material *m = &o->mat;
+	if (o->kind == OBJ_TRIANGLE) {
+		sb_put(b, "tr");
+		for (int i = 0; i < 3; i++)
+			sb_vec(b, o->tri[i]);
+		sb_vec(b, m->color);
+		if (!base_material_default(m))
+			fmt_material(b, m);
+	} else if (short_form_ok(o)) {
+		vec3 s = o->scale;
+		sb_put(b, o->kind == OBJ_RECT ? "sq" : obj_kind_id(o->kind));
+		sb_vec(b, o->pos);
+		switch (o->kind) {
+		case OBJ_SPHERE:
+			sb_field(b, s.x);
+			break;
+		case OBJ_PLANE:
+			sb_vec(b, o->dir);
+			break;
+		case OBJ_RECT:
+			sb_vec(b, o->dir);
+			sb_field(b, s.x);
+			break;
+		default: /* cylinder, cone */
+			sb_vec(b, o->dir);
+			sb_field(b, s.x);
+			sb_field(b, s.y);
+			break;
+		}
+		sb_vec(b, m->color);
+	} else {
+		sb_put(b, o->kind == OBJ_RECT ? "rc" : obj_kind_id(o->kind));
+		sb_vec(b, o->pos);
+		sb_vec(b, o->dir);
+		sb_vec(b, o->scale);
+		sb_vec(b, m->color);
+		fmt_material(b, m);
+		if (has_shear(o)) {
+			sb_put(b, " ");
+			for (int i = 0; i < 6; i++) {
+				if (i)
+					sb_put(b, ",");
+				sb_num(b, o->shear[i]);
+			}
+		}
+	}
+	fmt_keys(b, o);
+}
+
+static void fmt_light(sbuf *b, const light *l)
+{
+	sb_put(b, "L");
+	sb_vec(b, l->pos);
+	sb_field(b, l->ratio);
+	sb_vec(b, l->color);
+}
+
+static void fmt_camera(sbuf *b, const camera *c, const char *id)
+{
+	sb_put(b, id);
+	sb_vec(b, c->pos);
+	sb_vec(b, c->dir);
+	sb_field(b, c->fov);
+}
+
+void rt_format_object(const object *o, char *buf, size_t size)
+{
+	rt_numloc loc;
+	rt_numloc_enter(&loc);
+	sbuf b = sb_make(buf, size);
+	fmt_object(&b, o);
+	rt_numloc_leave(&loc);
+}
+
+void rt_format_light(const light *l, char *buf, size_t size)
+{
+	rt_numloc loc;
+	rt_numloc_enter(&loc);
+	sbuf b = sb_make(buf, size);
+	fmt_light(&b, l);
+	rt_numloc_leave(&loc);
+}
+
+void rt_format_camera(const camera *c, char *buf, size_t size)
+{
+	rt_numloc loc;
+	rt_numloc_enter(&loc);
+	sbuf b = sb_make(buf, size);
+	fmt_camera(&b, c, "C");
+	rt_numloc_leave(&loc);
+}
+
+/* Longer than any line the formatters make. */
+#define LINE_MAX_LEN 2048
+
+static void put_line(FILE *f, sbuf *b)
+{
+	fputs(b->buf, f);
+	fputc('\n', f);
+	*b = sb_make(b->buf, b->size);
+}
+
+static void write_scene(const scene *s, FILE *f)
+{
+	char line[LINE_MAX_LEN];
+	sbuf b = sb_make(line, sizeof line);
+	fputs("# rtsh scene (the format is described in rtsh(5))\n", f);
+	const scene_hints *h = &s->hints;
+	if (h->width > 0 && h->height > 0)
+		fprintf(f, "R %d %d\n", h->width, h->height);
+	if (h->samples > 0)
+		fprintf(f, "set samples %d\n", h->samples);
+	if (h->depth >= 0)
+		fprintf(f, "set depth %d\n", h->depth);
+	if (h->mode == MODE_WHITTED || h->mode == MODE_PATH)
+		fprintf(f, "set mode %s\n", h->mode == MODE_PATH ? "path" : "whitted");
+	if (s->has_ambient) {
+		sb_put(&b, "A");
+		sb_field(&b, s->amb.ratio);
+		sb_vec(&b, s->amb.color);
+		put_line(f, &b);
+	}
+	for (size_t i = 0; i < s->ncams; i++) {
+		fmt_camera(&b, &s->cams[i], i == 0 ? "C" : "c");
+		put_line(f, &b);
+	}
+	for (size_t i = 0; i < s->nlights; i++) {
+		fmt_light(&b, &s->lights[i]);
+		put_line(f, &b);
+	}
+	if (s->has_sky) {
+		sb_put(&b, "sky");
+		sb_vec(&b, s->sky.zenith);
+		sb_vec(&b, s->sky.horizon);
+		if (s->sky.strength != 1)
+			sb_field(&b, s->sky.strength);
+		put_line(f, &b);
+	}
+	for (size_t i = 0; i < s->nobjs; i++) {
+		fmt_object(&b, &s->objs[i]);
+		put_line(f, &b);
+	}
+}
+
+bool rt_write(const scene *s, FILE *f, rt_error *err)
+{
+	rt_numloc loc;
+	rt_numloc_enter(&loc);
+	errno = 0;
+	write_scene(s, f);
+	rt_numloc_leave(&loc);
+	if (fflush(f) != 0 || ferror(f))
+		return rt_error_set(err, "cannot write the scene: %s",
+		                    errno ? strerror(errno) : "write error");
+	return true;
+}
+
+typedef struct save_ctx {
+	const scene *s;
+} save_ctx;
+
+static bool save_writer(FILE *f, void *ctx, rt_error *err)
+{
+	const save_ctx *c = ctx;
+	return rt_write(c->s, f, err);
+}
+
+bool rt_save(const scene *s, const char *path, rt_error *err)
+{
+	save_ctx c = {s};
+	return file_write_atomic(path, save_writer, &c, err);
+}
