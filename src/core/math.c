@@ -29,28 +29,68 @@ mat4 m4_transpose(mat4 a)
 	return r;
 }
 
+/* The inverse of an affine matrix [A t; 0 1] is [A^-1, -A^-1 t; 0 1]. A is
+ * inverted by its adjugate; it counts as singular when its determinant is
+ * tiny next to the product of its column lengths (the volume a unit cube
+ * keeps, relative to a box of the same edge lengths), which is independent
+ * of the overall scale and of the translation. */
+static bool affine_invert(const mat4 *a, mat4 *out)
+{
+	const double(*m)[4] = a->m;
+	double c00 = m[1][1] * m[2][2] - m[1][2] * m[2][1];
+	double c01 = m[1][2] * m[2][0] - m[1][0] * m[2][2];
+	double c02 = m[1][0] * m[2][1] - m[1][1] * m[2][0];
+	double det = m[0][0] * c00 + m[0][1] * c01 + m[0][2] * c02;
+	double vol = 1.0;
+	for (int j = 0; j < 3; j++)
+		vol *= sqrt(m[0][j] * m[0][j] + m[1][j] * m[1][j] + m[2][j] * m[2][j]);
+	if (!(fabs(det) > 1e-12 * vol) || !isfinite(det))
+		return false;
+	double id = 1.0 / det;
+	mat4 r = m4_identity();
+	r.m[0][0] = c00 * id;
+	r.m[1][0] = c01 * id;
+	r.m[2][0] = c02 * id;
+	r.m[0][1] = (m[0][2] * m[2][1] - m[0][1] * m[2][2]) * id;
+	r.m[1][1] = (m[0][0] * m[2][2] - m[0][2] * m[2][0]) * id;
+	r.m[2][1] = (m[0][1] * m[2][0] - m[0][0] * m[2][1]) * id;
+	r.m[0][2] = (m[0][1] * m[1][2] - m[0][2] * m[1][1]) * id;
+	r.m[1][2] = (m[0][2] * m[1][0] - m[0][0] * m[1][2]) * id;
+	r.m[2][2] = (m[0][0] * m[1][1] - m[0][1] * m[1][0]) * id;
+	for (int i = 0; i < 3; i++)
+		r.m[i][3] = -(r.m[i][0] * m[0][3] + r.m[i][1] * m[1][3] + r.m[i][2] * m[2][3]);
+	*out = r;
+	return true;
+}
+
 bool m4_invert(mat4 a, mat4 *out)
 {
-	mat4 inv = m4_identity();
-	double scale = 0.0;
 	for (int i = 0; i < 4; i++)
-		for (int j = 0; j < 4; j++) {
+		for (int j = 0; j < 4; j++)
 			if (!isfinite(a.m[i][j]))
 				return false;
-			scale = fmax(scale, fabs(a.m[i][j]));
-		}
-	if (scale == 0.0)
-		return false;
+	if (a.m[3][0] == 0.0 && a.m[3][1] == 0.0 && a.m[3][2] == 0.0 && a.m[3][3] == 1.0)
+		return affine_invert(&a, out);
+
+	/* General matrices: Gauss-Jordan elimination with scaled partial
+	 * pivoting (each row compared relative to its largest element). */
+	mat4 inv = m4_identity();
+	double rowmax[4];
+	for (int i = 0; i < 4; i++) {
+		rowmax[i] = 0.0;
+		for (int j = 0; j < 4; j++)
+			rowmax[i] = fmax(rowmax[i], fabs(a.m[i][j]));
+		if (rowmax[i] == 0.0)
+			return false;
+	}
 	for (int col = 0; col < 4; col++) {
 		int piv = col;
 		for (int r = col + 1; r < 4; r++)
-			if (fabs(a.m[r][col]) > fabs(a.m[piv][col]))
+			if (fabs(a.m[r][col]) / rowmax[r] > fabs(a.m[piv][col]) / rowmax[piv])
 				piv = r;
-		/* A pivot this small relative to the matrix means it is singular
-		 * to working precision. */
-		if (fabs(a.m[piv][col]) <= 1e-14 * scale)
+		if (fabs(a.m[piv][col]) <= 1e-14 * rowmax[piv])
 			return false;
-		if (piv != col)
+		if (piv != col) {
 			for (int j = 0; j < 4; j++) {
 				double t = a.m[col][j];
 				a.m[col][j] = a.m[piv][j];
@@ -59,6 +99,10 @@ bool m4_invert(mat4 a, mat4 *out)
 				inv.m[col][j] = inv.m[piv][j];
 				inv.m[piv][j] = t;
 			}
+			double t = rowmax[col];
+			rowmax[col] = rowmax[piv];
+			rowmax[piv] = t;
+		}
 		double p = 1.0 / a.m[col][col];
 		for (int j = 0; j < 4; j++) {
 			a.m[col][j] *= p;
