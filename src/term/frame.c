@@ -1,0 +1,471 @@
+/* rtsh — the half-block frame encoder (frame.h).
+ *
+ * Per row, the cells that changed are grouped in runs (a gap of up to
+ * GAP_FILL unchanged cells is sent again rather than skipped, as a cursor
+ * move costs about as much). Within a run, each cell has one or two ways to
+ * be drawn (space or full block for one colour; upper or lower half block
+ * for two), and a Viterbi pass over the run picks the ways that need the
+ * fewest SGR bytes, given that a space keeps the foreground and a full
+ * block keeps the background of the cell before.
+ */
+#include "term/frame.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rtsh/image.h"
+
+#define UNKNOWN 0xffffffffu /* SGR state not known */
+#define GAP_FILL 3
+
+frame *frame_new(int cols, int rows, frame_palette pal)
+{
+	if (cols < 1 || rows < 1)
+		return NULL;
+	frame *f = calloc(1, sizeof *f);
+	if (!f)
+		return NULL;
+	size_t n = (size_t)cols * (size_t)rows;
+	f->cols = cols;
+	f->rows = rows;
+	f->pal = pal;
+	f->sync = true;
+	f->cur = calloc(n, sizeof *f->cur);
+	f->shown = calloc(n, sizeof *f->shown);
+	abuf_init(&f->out);
+	if (!f->cur || !f->shown) {
+		frame_free(f);
+		return NULL;
+	}
+	frame_clear(f);
+	return f;
+}
+
+void frame_free(frame *f)
+{
+	if (!f)
+		return;
+	free(f->cur);
+	free(f->shown);
+	abuf_free(&f->out);
+	free(f);
+}
+
+void frame_invalidate(frame *f)
+{
+	f->have_shown = false;
+}
+
+void frame_clear(frame *f)
+{
+	frame_cell blank = {FRAME_DEFAULT, FRAME_DEFAULT};
+	if (f->pal == PALETTE_NONE)
+		blank = (frame_cell){' ', ' '};
+	for (size_t i = 0; i < (size_t)f->cols * (size_t)f->rows; i++)
+		f->cur[i] = blank;
+}
+
+/* --- palettes --- */
+
+static const uint8_t xterm16[16][3] = {
+	{0, 0, 0},       {205, 0, 0},   {0, 205, 0},   {205, 205, 0},
+	{0, 0, 238},     {205, 0, 205}, {0, 205, 205}, {229, 229, 229},
+	{127, 127, 127}, {255, 0, 0},   {0, 255, 0},   {255, 255, 0},
+	{92, 92, 255},   {255, 0, 255}, {0, 255, 255}, {255, 255, 255},
+};
+static const uint8_t cube_level[6] = {0, 95, 135, 175, 215, 255};
+
+void palette_rgb(unsigned index, uint8_t rgb[3])
+{
+	if (index < 16) {
+		memcpy(rgb, xterm16[index], 3);
+	} else if (index < 232) {
+		unsigned c = index - 16;
+		rgb[0] = cube_level[c / 36];
+		rgb[1] = cube_level[c / 6 % 6];
+		rgb[2] = cube_level[c % 6];
+	} else {
+		rgb[0] = rgb[1] = rgb[2] = (uint8_t)(8 + 10 * (index > 255 ? 23 : index - 232));
+	}
+}
+
+/* The cube level nearest to v (the levels are not evenly spaced). */
+static int cube_nearest(int v)
+{
+	int best = 0;
+	for (int i = 1; i < 6; i++)
+		if (abs(v - cube_level[i]) < abs(v - cube_level[best]))
+			best = i;
+	return best;
+}
+
+static int dist2(int r, int g, int b, const uint8_t c[3])
+{
+	int dr = r - c[0], dg = g - c[1], db = b - c[2];
+	return dr * dr + dg * dg + db * db;
+}
+
+uint8_t palette_256(uint8_t r, uint8_t g, uint8_t b)
+{
+	/* The cube is a grid: its nearest point is the nearest level per channel. */
+	int cube = 16 + 36 * cube_nearest(r) + 6 * cube_nearest(g) + cube_nearest(b);
+	/* The nearest grey (v,v,v) is at the mean; the ramp's nearest level to
+	 * the mean is then the nearest ramp colour. */
+	double mean = (r + g + b) / 3.0;
+	int k = (int)lround((mean - 8) / 10);
+	k = k < 0 ? 0 : k > 23 ? 23 : k;
+	int grey = 232 + k;
+	uint8_t cc[3], gc[3];
+	palette_rgb((unsigned)cube, cc);
+	palette_rgb((unsigned)grey, gc);
+	return (uint8_t)(dist2(r, g, b, gc) < dist2(r, g, b, cc) ? grey : cube);
+}
+
+uint8_t palette_16(uint8_t r, uint8_t g, uint8_t b)
+{
+	int best = 0;
+	for (int i = 1; i < 16; i++)
+		if (dist2(r, g, b, xterm16[i]) < dist2(r, g, b, xterm16[best]))
+			best = i;
+	return (uint8_t)best;
+}
+
+uint32_t palette_quantize(frame_palette pal, uint8_t r, uint8_t g, uint8_t b)
+{
+	switch (pal) {
+	case PALETTE_TRUECOLOR:
+		return (uint32_t)r << 16 | (uint32_t)g << 8 | b;
+	case PALETTE_256:
+		return palette_256(r, g, b);
+	case PALETTE_16:
+		return palette_16(r, g, b);
+	case PALETTE_NONE:
+		break;
+	}
+	uint8_t c[3] = {r, g, b};
+	return (uint32_t)frame_ascii(c, c);
+}
+
+char frame_ascii(const uint8_t top[3], const uint8_t bot[3])
+{
+	static const char ramp[] = " .:-=+*#%@";
+	/* Rec. 709 luma weights on the sRGB codes, 0..255 for both pixels. */
+	double y = (0.2126 * (top[0] + bot[0]) + 0.7152 * (top[1] + bot[1]) + 0.0722 * (top[2] + bot[2])) / 2;
+	int i = (int)(y * 10 / 256);
+	return ramp[i < 0 ? 0 : i > 9 ? 9 : i];
+}
+
+void frame_srgb_from_linear(const float *rgb, size_t npix, double exposure, uint8_t *out)
+{
+	double k = exp2(exposure);
+	for (size_t i = 0; i < npix * 3; i++)
+		out[i] = linear_to_srgb8(rgb[i] * k);
+}
+
+void frame_put_image(frame *f, const uint8_t *rgb, int w, int h, int ox, int oy)
+{
+	int ph = 2 * f->rows;
+	if (f->pal == PALETTE_NONE) {
+		/* One character per cell: only whole cells of the image count. */
+		for (int cy = 0; cy < f->rows; cy++) {
+			int y0 = 2 * cy - oy, y1 = y0 + 1;
+			if (y0 < 0 || y1 >= h)
+				continue;
+			for (int cx = 0; cx < f->cols; cx++) {
+				int x = cx - ox;
+				if (x < 0 || x >= w)
+					continue;
+				char c = frame_ascii(rgb + ((size_t)y0 * w + x) * 3, rgb + ((size_t)y1 * w + x) * 3);
+				f->cur[(size_t)cy * f->cols + cx] = (frame_cell){(uint8_t)c, (uint8_t)c};
+			}
+		}
+		return;
+	}
+	for (int y = 0; y < h; y++) {
+		int py = y + oy;
+		if (py < 0 || py >= ph)
+			continue;
+		for (int x = 0; x < w; x++) {
+			int px = x + ox;
+			if (px < 0 || px >= f->cols)
+				continue;
+			const uint8_t *p = rgb + ((size_t)y * w + x) * 3;
+			uint32_t v = palette_quantize(f->pal, p[0], p[1], p[2]);
+			frame_cell *c = &f->cur[(size_t)(py / 2) * f->cols + px];
+			if (py % 2 == 0)
+				c->top = v;
+			else
+				c->bot = v;
+		}
+	}
+}
+
+/* --- SGR --- */
+
+static int digits(unsigned v)
+{
+	return v >= 100 ? 3 : v >= 10 ? 2 : 1;
+}
+
+/* The length of the SGR parameters that set colour v as fg or bg. */
+static int param_len(frame_palette pal, uint32_t v, bool bg)
+{
+	if (v == FRAME_DEFAULT)
+		return 2; /* 49 (39 is never needed: the default is only a background) */
+	switch (pal) {
+	case PALETTE_TRUECOLOR:
+		return 7 + digits(v >> 16) + digits(v >> 8 & 255) + digits(v & 255);
+	case PALETTE_256:
+		return 5 + digits(v);
+	case PALETTE_16:
+		return bg && v >= 8 ? 3 : 2;
+	case PALETTE_NONE:
+		break;
+	}
+	return 0;
+}
+
+static void put_param(abuf *a, frame_palette pal, uint32_t v, bool bg)
+{
+	if (v == FRAME_DEFAULT) {
+		abuf_str(a, bg ? "49" : "39");
+		return;
+	}
+	switch (pal) {
+	case PALETTE_TRUECOLOR:
+		abuf_str(a, bg ? "48;2;" : "38;2;");
+		abuf_uint(a, v >> 16);
+		abuf_char(a, ';');
+		abuf_uint(a, v >> 8 & 255);
+		abuf_char(a, ';');
+		abuf_uint(a, v & 255);
+		return;
+	case PALETTE_256:
+		abuf_str(a, bg ? "48;5;" : "38;5;");
+		abuf_uint(a, v);
+		return;
+	case PALETTE_16:
+		abuf_uint(a, v < 8 ? (bg ? 40 : 30) + v : (bg ? 100 : 90) + v - 8);
+		return;
+	case PALETTE_NONE:
+		return;
+	}
+}
+
+/* The ways to draw a cell. */
+enum glyph { G_SPACE, G_FULL, G_UPPER, G_LOWER };
+static const char *const glyph_utf8[] = {" ", "\xe2\x96\x88", "\xe2\x96\x80", "\xe2\x96\x84"};
+static const int glyph_len[] = {1, 3, 3, 3};
+
+typedef struct sgr {
+	uint32_t fg, bg;
+} sgr;
+
+typedef struct way {
+	enum glyph g;
+	uint32_t fg, bg; /* UNKNOWN: this way keeps the current one */
+} way;
+
+/* The one or two ways to draw cell c; returns how many. */
+static int ways_of(frame_cell c, way w[2])
+{
+	if (c.top == c.bot) {
+		int n = 0;
+		w[n++] = (way){G_SPACE, UNKNOWN, c.top};
+		if (c.top != FRAME_DEFAULT)
+			w[n++] = (way){G_FULL, c.top, UNKNOWN};
+		return n;
+	}
+	int n = 0;
+	if (c.top != FRAME_DEFAULT)
+		w[n++] = (way){G_UPPER, c.top, c.bot};
+	if (c.bot != FRAME_DEFAULT)
+		w[n++] = (way){G_LOWER, c.bot, c.top};
+	return n;
+}
+
+/* Bytes to go from state s to way w, and the state after. */
+static int way_cost(frame_palette pal, sgr s, way w, sgr *after)
+{
+	bool set_fg = w.fg != UNKNOWN && w.fg != s.fg;
+	bool set_bg = w.bg != UNKNOWN && w.bg != s.bg;
+	int n = glyph_len[w.g];
+	if (set_fg || set_bg)
+		n += 3 + (set_fg ? param_len(pal, w.fg, false) : 0) + (set_bg ? param_len(pal, w.bg, true) : 0) +
+		     (set_fg && set_bg);
+	after->fg = w.fg != UNKNOWN ? w.fg : s.fg;
+	after->bg = w.bg != UNKNOWN ? w.bg : s.bg;
+	return n;
+}
+
+static void emit_way(abuf *a, frame_palette pal, sgr *s, way w)
+{
+	bool set_fg = w.fg != UNKNOWN && w.fg != s->fg;
+	bool set_bg = w.bg != UNKNOWN && w.bg != s->bg;
+	if (set_fg || set_bg) {
+		abuf_str(a, "\x1b[");
+		if (set_fg)
+			put_param(a, pal, w.fg, false);
+		if (set_fg && set_bg)
+			abuf_char(a, ';');
+		if (set_bg)
+			put_param(a, pal, w.bg, true);
+		abuf_char(a, 'm');
+	}
+	way_cost(pal, *s, w, s);
+	abuf_str(a, glyph_utf8[w.g]);
+}
+
+typedef struct node {
+	int cost;
+	sgr st;
+	signed char back; /* the way chosen for the cell before */
+} node;
+
+/* Draws cells [a, b) of a row, from SGR state *s, with the fewest bytes the
+ * Viterbi pass finds. */
+static void emit_run(frame_palette pal, abuf *out, const frame_cell *row, int a, int b, sgr *s)
+{
+	if (pal == PALETTE_NONE) {
+		for (int x = a; x < b; x++)
+			abuf_char(out, (char)row[x].top);
+		return;
+	}
+	int n = b - a;
+	node stack_nodes[2 * 64];
+	node *nodes = n <= 64 ? stack_nodes : malloc(sizeof *nodes * 2 * (size_t)n);
+	if (!nodes) {
+		out->failed = true;
+		return;
+	}
+	way w[2];
+	for (int i = 0; i < n; i++) {
+		int k = ways_of(row[a + i], w);
+		for (int o = 0; o < 2; o++) {
+			node *nd = &nodes[2 * i + o];
+			nd->cost = -1;
+			if (o >= k)
+				continue;
+			if (i == 0) {
+				nd->cost = way_cost(pal, *s, w[o], &nd->st);
+				nd->back = -1;
+				continue;
+			}
+			for (int p = 0; p < 2; p++) {
+				const node *pv = &nodes[2 * (i - 1) + p];
+				if (pv->cost < 0)
+					continue;
+				sgr st;
+				int c = pv->cost + way_cost(pal, pv->st, w[o], &st);
+				if (nd->cost < 0 || c < nd->cost) {
+					nd->cost = c;
+					nd->st = st;
+					nd->back = (signed char)p;
+				}
+			}
+		}
+	}
+	/* Walk back from the cheapest end, then draw forwards. */
+	signed char *choice = malloc((size_t)n);
+	if (!choice) {
+		out->failed = true;
+		if (nodes != stack_nodes)
+			free(nodes);
+		return;
+	}
+	int o = nodes[2 * (n - 1) + 1].cost >= 0 && nodes[2 * (n - 1) + 1].cost < nodes[2 * (n - 1)].cost;
+	for (int i = n - 1; i >= 0; i--) {
+		choice[i] = (signed char)o;
+		o = nodes[2 * i + o].back;
+	}
+	for (int i = 0; i < n; i++) {
+		ways_of(row[a + i], w);
+		emit_way(out, pal, s, w[(int)choice[i]]);
+	}
+	free(choice);
+	if (nodes != stack_nodes)
+		free(nodes);
+}
+
+static bool cell_eq(frame_cell a, frame_cell b)
+{
+	return a.top == b.top && a.bot == b.bot;
+}
+
+static void cursor_to(abuf *a, int row, int col)
+{
+	abuf_str(a, "\x1b[");
+	abuf_uint(a, (unsigned)row + 1);
+	if (col > 0) {
+		abuf_char(a, ';');
+		abuf_uint(a, (unsigned)col + 1);
+	}
+	abuf_char(a, 'H');
+}
+
+const abuf *frame_update(frame *f)
+{
+	abuf *out = &f->out;
+	abuf_reset(out);
+	sgr s = {UNKNOWN, UNKNOWN};
+	int cur_row = -1, cur_col = -1; /* where the cursor is, in frame cells */
+	for (int y = 0; y < f->rows; y++) {
+		const frame_cell *row = f->cur + (size_t)y * f->cols;
+		const frame_cell *old = f->shown + (size_t)y * f->cols;
+		int x = 0;
+		for (;;) {
+			while (x < f->cols && f->have_shown && cell_eq(row[x], old[x]))
+				x++;
+			if (x >= f->cols)
+				break;
+			/* A run from x: extend over changed cells and short gaps. */
+			int end = x + 1;
+			for (int k = end; k < f->cols; k++) {
+				if (!f->have_shown || !cell_eq(row[k], old[k]))
+					end = k + 1;
+				else if (k - end >= GAP_FILL)
+					break;
+			}
+			if (out->len == 0) {
+				if (f->sync)
+					abuf_str(out, "\x1b[?2026h");
+				abuf_str(out, "\x1b" "7\x1b[?25l");
+			}
+			if (cur_row == y && cur_col < x) {
+				abuf_str(out, "\x1b[");
+				if (x - cur_col > 1)
+					abuf_uint(out, (unsigned)(x - cur_col));
+				abuf_char(out, 'C');
+			} else if (cur_row != y || cur_col != x) {
+				cursor_to(out, f->y0 + y, f->x0 + x);
+			}
+			emit_run(f->pal, out, row, x, end, &s);
+			cur_row = y;
+			cur_col = end;
+			x = end;
+		}
+	}
+	if (out->len > 0) {
+		abuf_str(out, "\x1b[m\x1b" "8\x1b[?25h");
+		if (f->sync)
+			abuf_str(out, "\x1b[?2026l");
+	}
+	if (!out->failed) {
+		memcpy(f->shown, f->cur, sizeof *f->cur * (size_t)f->cols * (size_t)f->rows);
+		f->have_shown = true;
+	} else {
+		abuf_reset(out);
+		f->have_shown = false;
+	}
+	return out;
+}
+
+void frame_text(const frame *f, abuf *out)
+{
+	for (int y = 0; y < f->rows; y++) {
+		sgr s = {UNKNOWN, FRAME_DEFAULT}; /* after a reset */
+		emit_run(f->pal, out, f->cur + (size_t)y * f->cols, 0, f->cols, &s);
+		abuf_str(out, f->pal == PALETTE_NONE ? "\n" : "\x1b[m\n");
+	}
+}

@@ -1,0 +1,98 @@
+/* rtsh — the half-block frame encoder.
+ *
+ * A frame is a grid of character cells; each cell shows two stacked pixels
+ * with U+2580 UPPER HALF BLOCK (foreground = upper pixel, background = lower
+ * pixel), or whichever of space, U+2584 LOWER HALF BLOCK and U+2588 FULL
+ * BLOCK costs fewer bytes for the same two colours. The encoder keeps the
+ * cells the terminal shows and sends only the cells that changed.
+ *
+ * Every escape sequence this module sends (ESC = \e, CSI = \e[):
+ *   \e[?2026h  \e[?2026l   begin / end synchronized update (DEC mode 2026)
+ *   \e7  \e8               save / restore the cursor (and its attributes)
+ *   \e[?25l  \e[?25h       hide / show the cursor
+ *   \e[R;CH  \e[RH         move the cursor to row R, column C (1-based)
+ *   \e[NC                  move the cursor N columns right
+ *   \e[...m                SGR: 38;2;R;G;B and 48;2;R;G;B (24-bit), 38;5;N
+ *                          and 48;5;N (256 colours), 30-37 90-97 40-47
+ *                          100-107 (16 colours), 49 (default background),
+ *                          and \e[m (reset); several joined by ';'
+ * and, in text mode (.ans files, `show`), "\e[m\n" at the end of each row.
+ */
+#ifndef RTSH_FRAME_H
+#define RTSH_FRAME_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "term/abuf.h"
+
+typedef enum frame_palette {
+	PALETTE_TRUECOLOR, /* cells hold 0xRRGGBB */
+	PALETTE_256,       /* cells hold an xterm index 16..255 (cube and grey ramp) */
+	PALETTE_16,        /* cells hold an index 0..15 */
+	PALETTE_NONE,      /* cells hold an ASCII character (no colour at all) */
+} frame_palette;
+
+/* The terminal's default background (letterbox bars). */
+#define FRAME_DEFAULT 0xff000000u
+
+/* Two stacked pixels, quantised for the frame's palette. In PALETTE_NONE a
+ * cell is one character: top == bot == its code. */
+typedef struct frame_cell {
+	uint32_t top, bot;
+} frame_cell;
+
+typedef struct frame {
+	int cols, rows;    /* cells */
+	int x0, y0;        /* the top-left cell on the screen, 0-based */
+	frame_palette pal;
+	bool sync;         /* bracket each update with DEC mode 2026 */
+	frame_cell *cur;   /* what the next update shows: cols x rows */
+	frame_cell *shown; /* what the terminal shows */
+	bool have_shown;   /* false: the next update sends every cell */
+	abuf out;
+} frame;
+
+/* A new frame of cols x rows cells, all default background; NULL when out
+ * of memory or a size is < 1. */
+frame *frame_new(int cols, int rows, frame_palette pal);
+void frame_free(frame *f);
+/* Forgets what the terminal shows (after the screen was cleared). */
+void frame_invalidate(frame *f);
+
+/* Sets every cell to the default background. */
+void frame_clear(frame *f);
+/* Puts an image of w x h sRGB pixels (3 bytes each, rows top to bottom) at
+ * pixel (ox, oy) of the frame's cols x 2*rows pixel canvas; pixels outside
+ * the image keep their value. */
+void frame_put_image(frame *f, const uint8_t *rgb, int w, int h, int ox, int oy);
+
+/* The update that turns what the terminal shows into the current cells, as
+ * one buffer for one write(); empty (len 0) when nothing changed. The
+ * current cells then count as shown. */
+const abuf *frame_update(frame *f);
+/* The current cells as ANSI text for a file or a pipe: every row, each
+ * ended by "\e[m\n" (PALETTE_NONE: plain text lines). */
+void frame_text(const frame *f, abuf *out);
+
+/* --- colour --- */
+/* The cell value of an sRGB colour in a palette (PALETTE_NONE: see
+ * frame_ascii). */
+uint32_t palette_quantize(frame_palette pal, uint8_t r, uint8_t g, uint8_t b);
+/* The nearest xterm colour (squared RGB distance) among the 6x6x6 cube
+ * (16..231: levels 0,95,135,175,215,255) and the grey ramp (232..255:
+ * 8,18,...,238); the cube wins a tie. */
+uint8_t palette_256(uint8_t r, uint8_t g, uint8_t b);
+/* The nearest of the 16 xterm default colours. */
+uint8_t palette_16(uint8_t r, uint8_t g, uint8_t b);
+/* The RGB value of an xterm palette index 0..255. */
+void palette_rgb(unsigned index, uint8_t rgb[3]);
+/* The character for a cell of two pixels with no colour: " .:-=+*#%@" by
+ * mean luminance. */
+char frame_ascii(const uint8_t top[3], const uint8_t bot[3]);
+
+/* Linear-light floats (3 per pixel) to sRGB bytes, radiance x 2^exposure. */
+void frame_srgb_from_linear(const float *rgb, size_t npix, double exposure, uint8_t *out);
+
+#endif
