@@ -986,12 +986,11 @@ static bool parse_tokens(parser *p)
 		            p->strict ? " (strict mode)" : "");
 	}
 	p->np = p->ntoks - 1;
-	if (e->kind >= 0)
-		for (size_t i = 1; i < p->ntoks; i++)
-			if (memchr(p->toks[i].s, '=', p->toks[i].len)) {
-				p->np = i - 1;
-				break;
-			}
+	for (size_t i = 1; i < p->ntoks; i++)
+		if (memchr(p->toks[i].s, '=', p->toks[i].len)) {
+			p->np = i - 1;
+			break;
+		}
 	p->nelems++;
 	return e->parse(p, e);
 }
