@@ -263,13 +263,17 @@ static void finish_hit(const prim *p, const ray *r, double t, vec3 nl, hit *h)
 
 /* --- the tree walk --- */
 
+static inline double mn(double a, double b) { return a < b ? a : b; }
+static inline double mx(double a, double b) { return a > b ? a : b; }
+
 static inline bool slab(const box *b, vec3 o, vec3 inv, double tmin, double tmax)
 {
 	double tx0 = (b->lo.x - o.x) * inv.x, tx1 = (b->hi.x - o.x) * inv.x;
 	double ty0 = (b->lo.y - o.y) * inv.y, ty1 = (b->hi.y - o.y) * inv.y;
 	double tz0 = (b->lo.z - o.z) * inv.z, tz1 = (b->hi.z - o.z) * inv.z;
-	double lo = fmax(fmax(fmin(tx0, tx1), fmin(ty0, ty1)), fmax(fmin(tz0, tz1), tmin));
-	double hi = fmin(fmin(fmax(tx0, tx1), fmax(ty0, ty1)), fmin(fmax(tz0, tz1), tmax));
+	/* Plain comparisons, not fmin/fmax: those are library calls on x86-64. */
+	double lo = mx(mx(mn(tx0, tx1), mn(ty0, ty1)), mx(mn(tz0, tz1), tmin));
+	double hi = mn(mn(mx(tx0, tx1), mx(ty0, ty1)), mn(mx(tz0, tz1), tmax));
 	return lo <= hi;
 }
 
