@@ -12,6 +12,44 @@ vec3 whitted_radiance(const world *w, const render_settings *s, ray r);
  * own random stream. */
 vec3 path_radiance(const world *w, const render_settings *s, ray r, rng *g);
 
+/* The scattering at one path vertex (path.c): the material's lobes, each
+ * with its share of the energy (shares sum to at most 1; see rtsh(5),
+ * "Materials"), in the frame of the side the ray arrived on. */
+typedef struct bsdf {
+	vec3 n;        /* unit normal, flipped onto the side of wo */
+	vec3 wo;       /* unit direction back along the arriving ray */
+	double cos_o;  /* n . wo, >= 0 */
+	bool front;    /* wo is on the outward side (glass: entering) */
+	vec3 kd;       /* Lambert: share x albedo */
+	vec3 ks;       /* normalised Phong about the mirror direction: share */
+	double ns;     /* its exponent (shininess) */
+	vec3 km;       /* mirror / metal: share x tint (Schlick) */
+	double nm;     /* its Phong exponent (from fuzz); < 0 for a perfect mirror */
+	vec3 kt;       /* glass transmission tint (reflection is white) */
+	double wg;     /* glass share */
+	double ior;    /* glass refractive index */
+	double p[4];   /* lobe choice probabilities: d, s, m, g (sum 1, or all 0) */
+	double total;  /* sum of the lobes' choice weights (0: absorbs everything) */
+	bool smooth;   /* some non-delta lobe: point lights are seen through it */
+} bsdf;
+
+typedef struct bsdf_sample {
+	vec3 wi;       /* the new direction (unit) */
+	vec3 weight;   /* f cos / pdf, the lobe choice included (energy) */
+	double radiance_scale; /* (eta_i / eta_t)^2 on refraction, else 1 */
+	bool transmit; /* wi goes through the surface */
+	bool delta;    /* from a perfect mirror or glass lobe */
+} bsdf_sample;
+
+/* The bsdf of material m at hit h seen from wo (unit, pointing away). */
+void bsdf_make(bsdf *b, const mat_lin *m, const hit *h, vec3 wo);
+/* The BSDF value f(wi, wo) of the non-delta lobes (per steradian). */
+vec3 bsdf_eval(const bsdf *b, vec3 wi);
+/* Samples a direction from u1, u2, u3 in [0,1); false when the path is absorbed. */
+bool bsdf_sample_dir(const bsdf *b, double u1, double u2, double u3, bsdf_sample *out);
+/* The Phong exponent of a mirror lobe of roughness fuzz in (0,1]. */
+double fuzz_exponent(double fuzz);
+
 /* What a ray that leaves the scene sees: the sky if the scene has one, else
  * black (whitted) or the ambient colour as a uniform sky (path). */
 vec3 world_background(const world *w, vec3 dir, render_mode mode);

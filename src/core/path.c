@@ -1,29 +1,250 @@
-/* rtsh — the path-tracing integrator: Lambertian diffuse with cosine-weighted
- * sampling, mirror reflection, next-event estimation toward the point lights,
- * emission, the sky, and Russian roulette.
+/* rtsh — the path-tracing integrator: a Monte-Carlo estimate of the
+ * rendering equation (Kajiya, "The rendering equation", SIGGRAPH 1986).
+ *
+ * One path per camera sample. At every vertex the path adds the emission it
+ * finds, adds next-event estimation toward every point light (a shadow ray
+ * each; point lights cannot be hit by a path, so nothing is counted twice),
+ * then picks one lobe of the material and continues in a direction sampled
+ * from it. Russian roulette ends paths after the third bounce without bias
+ * (Arvo & Kirk, "Particle transport and image synthesis", 1990).
+ *
+ * Materials are a mix of lobes whose shares never sum above 1 (rtsh(5),
+ * "Materials"):
+ *   mirror   share `reflective`; tinted by the colour x `metal` with
+ *            Schlick's Fresnel; `fuzz` widens it into a Phong lobe
+ *   glass    when ior >= 1, the rest: exact dielectric Fresnel, refraction
+ *            tinted by the colour, total internal reflection
+ *   diffuse  otherwise the rest, split between Lambert (`diffuse` x colour)
+ *   specular and a normalised Phong lobe (`specular`, `shininess`), both
+ *            scaled down together when diffuse + specular > 1
+ * Surfaces are two-sided: the normal is turned to the side the ray came
+ * from; glass uses the side to know whether the ray enters or leaves.
  *
  * Point lights follow the Whitted convention (no fall-off): a light of
- * radiance-ratio L gives a white Lambertian surface facing it the outgoing
- * radiance L, i.e. irradiance pi * L * cos(theta). */
+ * radiance ratio L gives a surface the irradiance pi * L * cos(theta), so a
+ * white Lambertian surface facing it sends back exactly L. */
 #include "integrators.h"
 
-/* A cosine-weighted direction about the unit normal n (Malley's method). */
+/* An orthonormal basis (t, b) around the unit vector n (Duff et al.,
+ * "Building an orthonormal basis, revisited", JCGT 2017). */
+static void basis(vec3 n, vec3 *t, vec3 *b)
+{
+	double sign = copysign(1.0, n.z);
+	double a = -1.0 / (sign + n.z), c = n.x * n.y * a;
+	*t = v3(1.0 + sign * n.x * n.x * a, sign * c, -sign * n.x);
+	*b = v3(c, sign + n.y * n.y * a, -n.y);
+}
+
+/* The direction (sin a cos phi, sin a sin phi, cos a) about axis. */
+static vec3 around(vec3 axis, double cos_a, double phi)
+{
+	vec3 t, b;
+	basis(axis, &t, &b);
+	double sin_a = sqrt(fmax(0.0, 1.0 - cos_a * cos_a));
+	return v3_add(v3_add(v3_scale(t, sin_a * cos(phi)), v3_scale(b, sin_a * sin(phi))),
+	              v3_scale(axis, cos_a));
+}
+
+/* Cosine-weighted about n, pdf cos / pi (Malley's method). */
 static vec3 sample_cosine(vec3 n, double u1, double u2)
 {
-	double r = sqrt(u1), phi = 2.0 * RT_PI * u2;
-	double x = r * cos(phi), y = r * sin(phi), z = sqrt(fmax(0.0, 1.0 - u1));
-	/* An orthonormal basis around n (Duff et al., "Building an orthonormal
-	 * basis, revisited", 2017). */
-	double sign = copysign(1.0, n.z);
-	double a = -1.0 / (sign + n.z), b = n.x * n.y * a;
-	vec3 t = v3(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
-	vec3 bt = v3(b, sign + n.y * n.y * a, -n.y);
-	return v3_add(v3_add(v3_scale(t, x), v3_scale(bt, y)), v3_scale(n, z));
+	return around(n, sqrt(fmax(0.0, 1.0 - u1)), 2.0 * RT_PI * u2);
+}
+
+/* Proportional to cos^e of the angle to axis, pdf (e + 1) / (2 pi) cos^e
+ * (Lafortune & Willems, "Using the modified Phong reflectance model for
+ * physically based rendering", 1994). */
+static vec3 sample_phong(vec3 axis, double e, double u1, double u2)
+{
+	return around(axis, pow(u1, 1.0 / (e + 1.0)), 2.0 * RT_PI * u2);
+}
+
+/* The normalised Phong lobe (e + 2) / (2 pi) cos^e a: its albedo is 1 at
+ * normal incidence and less elsewhere (Lafortune & Willems 1994). */
+static double phong_lobe(double cos_a, double e)
+{
+	return cos_a > 0.0 ? (e + 2.0) * (0.5 / RT_PI) * pow(cos_a, e) : 0.0;
+}
+
+/* Reflectance of a smooth dielectric for unpolarised light, from the
+ * Fresnel equations (Born & Wolf, "Principles of Optics", 1.5.2; pbrt 4th
+ * ed. 9.3.2). cos_i > 0 on the incident side; eta = eta_t / eta_i. Sets
+ * *cos_t for the refracted ray; 1 on total internal reflection. */
+static double fresnel_dielectric(double cos_i, double eta, double *cos_t)
+{
+	double sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
+	if (sin2_t >= 1.0) {
+		*cos_t = 0.0;
+		return 1.0;
+	}
+	double ct = sqrt(1.0 - sin2_t);
+	double rs = (cos_i - eta * ct) / (cos_i + eta * ct);
+	double rp = (eta * cos_i - ct) / (eta * cos_i + ct);
+	*cos_t = ct;
+	return 0.5 * (rs * rs + rp * rp);
+}
+
+double fuzz_exponent(double fuzz)
+{
+	/* A mirror direction perturbed by fuzz times a random point of the unit
+	 * ball (the seed's metal) spreads by E[a^2] = 0.4 fuzz^2; the lobe
+	 * cos^e a spreads by E[a^2] ~ 2 / (e + 2). Equal when: */
+	return 5.0 / (fuzz * fuzz) - 2.0;
+}
+
+void bsdf_make(bsdf *b, const mat_lin *m, const hit *h, vec3 wo)
+{
+	*b = (bsdf){0};
+	b->n = h->front ? h->n : v3_neg(h->n);
+	b->wo = wo;
+	b->front = h->front;
+	b->cos_o = fmax(0.0, v3_dot(b->n, wo));
+	vec3 albedo = hit_albedo(m, h);
+	double mirror = clampd(m->reflective, 0.0, 1.0), rest = 1.0 - mirror;
+	double w[4] = {0, 0, 0, 0};
+	if (m->ior >= 1.0) {
+		b->wg = rest;
+		b->kt = albedo;
+		b->ior = m->ior;
+		w[3] = rest;
+	} else {
+		double d = clampd(m->diffuse, 0.0, 1.0), s = clampd(m->specular, 0.0, 1.0);
+		double k = d + s > 1.0 ? rest / (d + s) : rest;
+		b->kd = v3_scale(albedo, d * k);
+		b->ks = v3_splat(s * k);
+		b->ns = fmax(m->shininess, 0.0);
+		w[0] = v3_max_comp(b->kd);
+		w[1] = s * k;
+	}
+	if (mirror > 0.0) {
+		/* Schlick's Fresnel for a conductor whose normal-incidence
+		 * reflectance is the tint (Schlick, "An inexpensive BRDF model for
+		 * physically-based rendering", 1994). */
+		vec3 f0 = v3_lerp(v3_splat(1.0), albedo, clampd(m->metal, 0.0, 1.0));
+		double x = 1.0 - b->cos_o, x5 = x * x * x * x * x;
+		b->km = v3_scale(v3_add(f0, v3_scale(v3_sub(v3_splat(1.0), f0), x5)), mirror);
+		b->nm = m->fuzz > 0.0 ? fuzz_exponent(fmin(m->fuzz, 1.0)) : -1.0;
+		w[2] = v3_max_comp(b->km);
+	} else {
+		b->nm = -1.0;
+	}
+	b->total = w[0] + w[1] + w[2] + w[3];
+	if (b->total > 0.0)
+		for (int i = 0; i < 4; i++)
+			b->p[i] = w[i] / b->total;
+	b->smooth = w[0] > 0.0 || w[1] > 0.0 || (w[2] > 0.0 && b->nm >= 0.0);
+}
+
+vec3 bsdf_eval(const bsdf *b, vec3 wi)
+{
+	double c = v3_dot(b->n, wi);
+	if (c <= 0.0 || !b->smooth)
+		return v3(0, 0, 0);
+	vec3 f = v3_scale(b->kd, 1.0 / RT_PI);
+	vec3 r = v3_sub(v3_scale(b->n, 2.0 * b->cos_o), b->wo); /* wo mirrored */
+	double cos_r = v3_dot(wi, r);
+	if (b->p[1] > 0.0)
+		f = v3_madd(f, b->ks, phong_lobe(cos_r, b->ns));
+	if (b->p[2] > 0.0 && b->nm >= 0.0)
+		f = v3_madd(f, b->km, phong_lobe(cos_r, b->nm));
+	return f;
+}
+
+bool bsdf_sample_dir(const bsdf *b, double u0, double u1, double u2, bsdf_sample *out)
+{
+	if (!(b->total > 0.0))
+		return false;
+	int lobe = 0;
+	double acc = b->p[0];
+	while (lobe < 3 && (u0 >= acc || b->p[lobe] == 0.0))
+		acc += b->p[++lobe];
+	while (lobe > 0 && b->p[lobe] == 0.0) /* u0 past a sum rounded below 1 */
+		lobe--;
+	/* Each lobe's f cos / pdf, times 1 / (its choice probability). */
+	double inv_p = 1.0 / b->p[lobe];
+	vec3 r = v3_sub(v3_scale(b->n, 2.0 * b->cos_o), b->wo);
+	out->radiance_scale = 1.0;
+	out->transmit = false;
+	out->delta = false;
+	switch (lobe) {
+	case 0: /* Lambert: f cos / pdf = (kd / pi) cos / (cos / pi) */
+		out->wi = sample_cosine(b->n, u1, u2);
+		out->weight = v3_scale(b->kd, inv_p);
+		return true;
+	case 1:
+	case 2: {
+		double e = lobe == 1 ? b->ns : b->nm;
+		vec3 k = lobe == 1 ? b->ks : b->km;
+		if (e < 0.0) { /* a perfect mirror */
+			out->wi = r;
+			out->weight = v3_scale(k, inv_p);
+			out->delta = true;
+			return true;
+		}
+		out->wi = sample_phong(r, e, u1, u2);
+		double c = v3_dot(out->wi, b->n);
+		if (c <= 0.0)
+			return false; /* below the surface: the lobe's lost energy */
+		/* ((e+2)/(2 pi) cos^e a) cos / ((e+1)/(2 pi) cos^e a) */
+		out->weight = v3_scale(k, inv_p * (e + 2.0) / (e + 1.0) * c);
+		return true;
+	}
+	default: { /* glass: reflect with probability F, else refract */
+		double eta = b->front ? b->ior : 1.0 / b->ior, cos_t;
+		double f = fresnel_dielectric(b->cos_o, eta, &cos_t);
+		out->delta = true;
+		if (u1 < f) {
+			out->wi = r;
+			out->weight = v3_splat(b->wg * inv_p);
+			return true;
+		}
+		/* Snell's law in vector form (pbrt 4th ed. 9.3.2). */
+		vec3 t = v3_add(v3_scale(b->wo, -1.0 / eta), v3_scale(b->n, b->cos_o / eta - cos_t));
+		out->wi = v3_norm(t);
+		out->weight = v3_scale(b->kt, b->wg * inv_p);
+		/* Radiance is compressed by (eta_t / eta_i)^2 across the
+		 * interface (Veach, thesis 1997, 5.2). */
+		out->radiance_scale = 1.0 / (eta * eta);
+		out->transmit = true;
+		return true;
+	}
+	}
+}
+
+/* Next-event estimation: the light the point lights send to the vertex
+ * through its smooth lobes. */
+static vec3 direct_light(const world *w, const bsdf *b, vec3 p)
+{
+	vec3 sum = v3(0, 0, 0);
+	for (size_t i = 0; i < w->nlights; i++) {
+		const light_lin *l = &w->lights[i];
+		vec3 to = v3_sub(l->pos, p);
+		double dist = v3_len(to);
+		if (!(dist > 0.0))
+			continue;
+		vec3 wi = v3_scale(to, 1.0 / dist);
+		double c = v3_dot(b->n, wi);
+		if (c <= 0.0)
+			continue;
+		vec3 f = bsdf_eval(b, wi);
+		if (f.x <= 0.0 && f.y <= 0.0 && f.z <= 0.0)
+			continue;
+		ray sr = {p, wi};
+		if (world_occluded(w, &sr, 0.0, dist))
+			continue;
+		/* f x irradiance, the irradiance being pi L cos (see above) */
+		sum = v3_add(sum, v3_mul(f, v3_scale(l->radiance, RT_PI * c)));
+	}
+	return sum;
 }
 
 vec3 path_radiance(const world *w, const render_settings *s, ray r, rng *g)
 {
 	vec3 radiance = v3(0, 0, 0), thr = v3(1, 1, 1);
+	/* The product of (eta_t / eta_i)^2 over the refractions so far: it
+	 * undoes their radiance scaling for Russian roulette (pbrt 4th ed.
+	 * 13.1.5). */
+	double eta_scale = 1.0;
 	for (int bounce = 0;; bounce++) {
 		hit h;
 		if (!world_intersect(w, &r, 0.0, INFINITY, &h)) {
@@ -34,38 +255,24 @@ vec3 path_radiance(const world *w, const render_settings *s, ray r, rng *g)
 		radiance = v3_add(radiance, v3_mul(thr, m->emission));
 		if (bounce >= s->depth)
 			break;
-		vec3 n = h.front ? h.n : v3_neg(h.n);
-		vec3 albedo = hit_albedo(m, &h);
-		vec3 p = offset_point(w, h.p, n);
+		bsdf b;
+		bsdf_make(&b, m, &h, v3_neg(r.d));
+		vec3 p = offset_point(w, h.p, b.n);
+		if (b.smooth && w->nlights)
+			radiance = v3_add(radiance, v3_mul(thr, direct_light(w, &b, p)));
 
-		/* Choose the mirror lobe with probability `reflective`. */
-		if (m->reflective > 0.0 && rng_next(g) < m->reflective) {
-			vec3 tint = v3_lerp(v3(1, 1, 1), albedo, m->metal);
-			thr = v3_mul(thr, tint);
-			r = (ray){p, v3_reflect(r.d, n)};
-		} else {
-			vec3 kd = v3_scale(albedo, m->diffuse);
-			for (size_t i = 0; i < w->nlights; i++) {
-				const light_lin *l = &w->lights[i];
-				vec3 to = v3_sub(l->pos, p);
-				double dist = v3_len(to);
-				if (!(dist > 0.0))
-					continue;
-				vec3 ld = v3_scale(to, 1.0 / dist);
-				double ndl = v3_dot(n, ld);
-				if (ndl <= 0.0)
-					continue;
-				ray sr = {p, ld};
-				if (!world_occluded(w, &sr, 0.0, dist))
-					radiance = v3_add(radiance, v3_mul(thr, v3_mul(kd, v3_scale(l->radiance, ndl))));
-			}
-			double u1 = rng_next(g), u2 = rng_next(g);
-			r = (ray){p, sample_cosine(n, u1, u2)};
-			thr = v3_mul(thr, kd); /* f cos / pdf = (kd / pi) cos / (cos / pi) */
-		}
-		/* Russian roulette after three bounces keeps the estimate unbiased. */
+		double u0 = rng_next(g), u1 = rng_next(g), u2 = rng_next(g);
+		bsdf_sample bs;
+		if (!bsdf_sample_dir(&b, u0, u1, u2, &bs))
+			break;
+		thr = v3_mul(thr, v3_scale(bs.weight, bs.radiance_scale));
+		eta_scale /= bs.radiance_scale;
+		r = (ray){bs.transmit ? offset_point(w, h.p, v3_neg(b.n)) : p, bs.wi};
+
+		/* Russian roulette after the third bounce: survive with q, weigh
+		 * the survivors by 1 / q. */
 		if (bounce >= 3) {
-			double q = fmin(0.95, v3_max_comp(thr));
+			double q = fmin(0.95, v3_max_comp(thr) * eta_scale);
 			if (!(q > 0.0) || rng_next(g) >= q)
 				break;
 			thr = v3_scale(thr, 1.0 / q);
