@@ -24,13 +24,21 @@ typedef struct rt_load_opts {
 	const rt_warnings *warn;   /* optional sink for warnings */
 } rt_load_opts;
 
-/* Loads a scene file; NULL with err set on failure. opts may be NULL. */
+/* Loads a scene file (at most 1 GiB); NULL with err set on the first
+ * problem. opts may be NULL. Non-fatal notes go to opts->warn: a clamped
+ * FOV, an A/C/R/sky/set line that repeats the first one exactly (ignored),
+ * a 42-form object of size 0 (left out), no camera (the default camera is
+ * added; with opts->strict that is an error). A loaded scene has at least
+ * one camera and cam == 0. */
 scene *rt_load_file(const char *path, const rt_load_opts *opts, rt_error *err);
-/* Loads a scene from memory; `name` is the file name used in messages. */
+/* Loads a scene from memory (text need not be NUL-terminated); `name` is the
+ * file name used in messages. */
 scene *rt_load_string(const char *text, size_t len, const char *name, const rt_load_opts *opts,
                       rt_error *err);
 /* Parses one line (no newline) into s, as the shell's `add LINE` does. The
- * once-only elements (A, C) replace the existing ones. */
+ * once-only elements replace the existing ones: A the ambient, C the active
+ * camera (or adds one if there is none), R, sky and set their values. On
+ * error s is unchanged. */
 bool rt_parse_line(scene *s, const char *line, const char *name, int lineno,
                    const rt_load_opts *opts, rt_error *err);
 
