@@ -1,0 +1,230 @@
+/* rtsh — the full-screen layout (screen.h). */
+#include "term/screen.h"
+
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/ioctl.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include "term/abuf.h"
+
+#define ENTER_SEQ "\x1b[?1049h"
+#define RESTORE_SEQ "\x1b[r\x1b[m\x1b[?2026l\x1b[?25h\x1b[?1049l"
+
+/* What the crash handler needs, set before it is installed. */
+static int restore_fd = -1;
+static struct termios saved_modes;
+static volatile sig_atomic_t have_modes;
+
+static void crash_handler(int sig)
+{
+	if (restore_fd >= 0) {
+		ssize_t r = write(restore_fd, RESTORE_SEQ, sizeof RESTORE_SEQ - 1);
+		(void)r;
+		if (have_modes)
+			tcsetattr(restore_fd, TCSANOW, &saved_modes);
+	}
+	/* SA_RESETHAND made the action the default again: the signal kills us
+	 * (with a core dump) once this handler returns. */
+	raise(sig);
+}
+
+static const int crash_signals[] = {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT};
+
+static void crash_handlers(bool on)
+{
+	struct sigaction sa;
+	memset(&sa, 0, sizeof sa);
+	sigemptyset(&sa.sa_mask);
+	sa.sa_handler = on ? crash_handler : SIG_DFL;
+	sa.sa_flags = on ? SA_RESETHAND : 0;
+	for (size_t i = 0; i < sizeof crash_signals / sizeof crash_signals[0]; i++)
+		sigaction(crash_signals[i], &sa, NULL);
+}
+
+void screen_fit(int cols, int rows, double aspect, bool whole_cells, int *w, int *h)
+{
+	int cw = cols, ch = 2 * rows;
+	if (!(aspect > 0) || !isfinite(aspect))
+		aspect = 16.0 / 9.0;
+	if ((double)cw / ch > aspect) {
+		*h = ch;
+		*w = (int)lround(ch * aspect);
+	} else {
+		*w = cw;
+		*h = (int)lround(cw / aspect);
+	}
+	if (whole_cells)
+		*h &= ~1;
+	*w = *w < 1 ? 1 : *w > cw ? cw : *w;
+	*h = *h < (whole_cells ? 2 : 1) ? (whole_cells ? 2 : 1) : *h > ch ? ch : *h;
+}
+
+static void query_size(screen *s)
+{
+	struct winsize ws;
+	if (ioctl(s->fd, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 0 && ws.ws_row > 0) {
+		s->cols = ws.ws_col;
+		s->rows = ws.ws_row;
+	} else {
+		s->cols = 80;
+		s->rows = 24;
+	}
+}
+
+/* Picture rows, status row and scroll region for the current size. */
+static void compute_layout(screen *s)
+{
+	int region = s->rows / 5;
+	region = region < 3 ? 3 : region > 10 ? 10 : region;
+	int avail = s->rows - 1 - region;
+	if (avail < 3 || s->cols < 8) {
+		s->pic_rows = 0;
+		s->status_row = s->rows >= 3 ? 0 : -1;
+		s->region_top = s->status_row + 1;
+		s->img_w = s->img_h = 0;
+		return;
+	}
+	/* Rows the picture needs at full width; the rest goes to the region. */
+	int need = (int)ceil(s->cols / s->aspect / 2.0);
+	s->pic_rows = need < avail ? need : avail;
+	s->status_row = s->pic_rows;
+	s->region_top = s->pic_rows + 1;
+	screen_fit(s->cols, s->pic_rows, s->aspect, s->pal == PALETTE_NONE, &s->img_w, &s->img_h);
+	s->img_x = (s->cols - s->img_w) / 2;
+	s->img_y = (2 * s->pic_rows - s->img_h) / 2;
+	if (s->pal == PALETTE_NONE)
+		s->img_y &= ~1;
+}
+
+static void put(screen *s, const abuf *a)
+{
+	if (!a->failed)
+		write_all(s->fd, a->b, a->len);
+}
+
+static void draw_status(screen *s, abuf *a)
+{
+	if (s->status_row < 0)
+		return;
+	abuf_printf(a, "\x1b" "7\x1b[%dH\x1b[7m", s->status_row + 1);
+	/* Count columns as code points (the text is ASCII plus a few symbols). */
+	int width = 0;
+	const char *p = s->status;
+	for (; *p && width < s->cols; p++) {
+		abuf_char(a, *p);
+		if (((unsigned char)*p & 0xc0) != 0x80)
+			width++;
+	}
+	/* Finish a code point cut at the edge. */
+	while (((unsigned char)*p & 0xc0) == 0x80)
+		abuf_char(a, *p++);
+	for (; width < s->cols; width++)
+		abuf_char(a, ' ');
+	abuf_str(a, "\x1b[m\x1b" "8");
+}
+
+/* Clears the screen, sets the scroll region, draws the status line and puts
+ * the cursor on the last row. */
+static void redraw_chrome(screen *s)
+{
+	abuf a;
+	abuf_init(&a);
+	abuf_str(&a, "\x1b[r\x1b[m\x1b[2J");
+	if (s->region_top < s->rows)
+		abuf_printf(&a, "\x1b[%d;%dr", s->region_top + 1, s->rows);
+	abuf_printf(&a, "\x1b[%dH", s->rows);
+	draw_status(s, &a);
+	put(s, &a);
+	abuf_free(&a);
+	if (s->fr)
+		frame_invalidate(s->fr);
+}
+
+bool screen_layout(screen *s, double aspect, bool force)
+{
+	int oc = s->cols, orow = s->rows, ow = s->img_w, oh = s->img_h;
+	double oa = s->aspect;
+	query_size(s);
+	s->aspect = aspect > 0 && isfinite(aspect) ? aspect : 16.0 / 9.0;
+	compute_layout(s);
+	bool changed = oc != s->cols || orow != s->rows || oa != s->aspect;
+	if (changed || force || !s->fr) {
+		if (!s->fr || s->fr->cols != s->cols || s->fr->rows != s->pic_rows) {
+			frame_free(s->fr);
+			s->fr = s->pic_rows > 0 ? frame_new(s->cols, s->pic_rows, s->pal) : NULL;
+		}
+		if (s->fr)
+			frame_clear(s->fr);
+		redraw_chrome(s);
+	}
+	return ow != s->img_w || oh != s->img_h;
+}
+
+bool screen_enter(screen *s, int fd, frame_palette pal, double aspect)
+{
+	memset(s, 0, sizeof *s);
+	s->fd = fd;
+	s->pal = pal;
+	if (!isatty(fd))
+		return false;
+	if (tcgetattr(fd, &saved_modes) == 0)
+		have_modes = 1;
+	restore_fd = fd;
+	crash_handlers(true);
+	write_all(fd, ENTER_SEQ, sizeof ENTER_SEQ - 1);
+	s->active = true;
+	screen_layout(s, aspect, true);
+	return true;
+}
+
+void screen_suspend(screen *s)
+{
+	if (!s->active)
+		return;
+	write_all(s->fd, RESTORE_SEQ, sizeof RESTORE_SEQ - 1);
+}
+
+void screen_resume(screen *s)
+{
+	if (!s->active)
+		return;
+	write_all(s->fd, ENTER_SEQ, sizeof ENTER_SEQ - 1);
+	screen_layout(s, s->aspect, true);
+}
+
+void screen_leave(screen *s)
+{
+	if (!s->active)
+		return;
+	write_all(s->fd, RESTORE_SEQ, sizeof RESTORE_SEQ - 1);
+	crash_handlers(false);
+	restore_fd = -1;
+	s->active = false;
+	frame_free(s->fr);
+	s->fr = NULL;
+}
+
+void screen_status(screen *s, const char *text)
+{
+	snprintf(s->status, sizeof s->status, "%s", text);
+	if (!s->active)
+		return;
+	abuf a;
+	abuf_init(&a);
+	draw_status(s, &a);
+	put(s, &a);
+	abuf_free(&a);
+}
+
+void screen_picture(screen *s, const uint8_t *rgb, int w, int h)
+{
+	if (!s->active || !s->fr || w != s->img_w || h != s->img_h)
+		return;
+	frame_put_image(s->fr, rgb, w, h, s->img_x, s->img_y);
+	const abuf *a = frame_update(s->fr);
+	put(s, a);
+}

@@ -1,0 +1,71 @@
+/* rtsh — the full-screen layout: the picture on top, a status line, and a
+ * scroll region of a few lines at the bottom for the prompt and the output
+ * of commands.
+ *
+ *   row 0 .. pic_rows-1        the picture (half blocks, frame.h)
+ *   row status_row             the status line (reverse video)
+ *   rows region_top .. rows-1  the scroll region (DECSTBM); the cursor lives
+ *                              here, so readline and printf work as usual
+ *
+ * Escape sequences sent here, besides the frame's (frame.h):
+ *   \e[?1049h \e[?1049l   enter / leave the alternate screen
+ *   \e[T;Br  \e[r         set / reset the scroll region
+ *   \e[2J                 clear the screen
+ *   \e[7m                 reverse video (the status line)
+ *   \e[K                  clear to the end of the line
+ *
+ * The terminal is restored on every way out: screen_leave on a normal exit,
+ * and a handler for crash signals (SIGSEGV, SIGBUS, SIGFPE, SIGILL,
+ * SIGABRT) that writes the restore sequence and the saved terminal modes
+ * with async-signal-safe calls only, then lets the signal kill the process.
+ */
+#ifndef RTSH_SCREEN_H
+#define RTSH_SCREEN_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "term/frame.h"
+
+typedef struct screen {
+	int fd;
+	int cols, rows;
+	int pic_rows;      /* 0: no room for a picture */
+	int status_row;    /* 0-based */
+	int region_top;    /* the scroll region is region_top .. rows-1 */
+	frame_palette pal;
+	double aspect;     /* width / height of the image */
+	int img_w, img_h;  /* the preview's size in pixels (0 when no picture) */
+	int img_x, img_y;  /* its place on the cols x 2*pic_rows pixel canvas */
+	frame *fr;         /* the picture area */
+	bool active;
+	char status[512];  /* the status line's text */
+} screen;
+
+/* Saves the terminal modes of fd (call before readline changes them), enters
+ * the alternate screen, lays it out for an image of the given aspect and
+ * installs the crash handlers. False when fd is not a terminal. */
+bool screen_enter(screen *s, int fd, frame_palette pal, double aspect);
+/* Restores the terminal: scroll region, attributes, cursor, main screen.
+ * Safe to call twice. */
+void screen_leave(screen *s);
+/* Reads the terminal size and lays the screen out again for `aspect`;
+ * clears it when anything changed (or `force`), redraws the status line and
+ * puts the cursor on the last row. True when the image size changed. */
+bool screen_layout(screen *s, double aspect, bool force);
+/* Sets and draws the status line. */
+void screen_status(screen *s, const char *text);
+/* Shows an sRGB image of img_w x img_h pixels in the picture area
+ * (letterboxed; only changed cells are sent). */
+void screen_picture(screen *s, const uint8_t *rgb, int w, int h);
+/* Writes the restore sequence and the saved terminal modes (for a process
+ * that is about to stop or be suspended; the screen stays "entered"). */
+void screen_suspend(screen *s);
+/* Enters the alternate screen again after screen_suspend and redraws. */
+void screen_resume(screen *s);
+
+/* The preview size for a picture area of cols x rows cells and an aspect:
+ * letterboxed inside cols x 2*rows pixels, both at least 1. */
+void screen_fit(int cols, int rows, double aspect, bool whole_cells, int *w, int *h);
+
+#endif
