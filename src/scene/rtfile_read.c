@@ -181,6 +181,8 @@ static bool lex_line(parser *p, const char *s, size_t len)
 {
 	p->ntoks = 0;
 	p->endcol = 1;
+	if (len > RT_FILE_MAX)
+		return fail(p, 0, "the line is longer than 1 GiB; expected a shorter line");
 	for (size_t i = 0; i < len; i++) {
 		unsigned char c = (unsigned char)s[i];
 		if ((c < 0x20 && c != '\t') || c == 0x7F) {
@@ -531,7 +533,7 @@ static bool parse_camera(parser *p, const elem_def *e)
 	if (p->single) {
 		if (s->ncams == 0)
 			return scene_add_camera(s, &c, p->err);
-		s->cams[s->cam] = c;
+		s->cams[s->cam < s->ncams ? s->cam : 0] = c;
 		return true;
 	}
 	bool same = false;
