@@ -353,12 +353,14 @@ static bool get_tuple(parser *p, const tok *t, const char *elem, const char *fie
                       const char *shape, const range *r, double *out)
 {
 	int count = 1;
-	for (size_t i = 0; i < t->len; i++)
-		count += t->s[i] == ',';
-	char what[64];
-	for (size_t i = 0; i < t->len; i++)
-		if (t->s[i] == ',' && (i == 0 || i + 1 == t->len || t->s[i + 1] == ','))
+	for (size_t i = 0; i < t->len; i++) {
+		if (t->s[i] != ',')
+			continue;
+		if (i == 0 || i + 1 == t->len || t->s[i + 1] == ',')
 			return fail_tok(p, t, elem, field, "has an empty component", shape);
+		count++;
+	}
+	char what[64];
 	if (count != n) {
 		if (count == 1)
 			snprintf(what, sizeof what, "is not a vector");
@@ -372,24 +374,16 @@ static bool get_tuple(parser *p, const tok *t, const char *elem, const char *fie
 		if (!e)
 			e = end;
 		double v = 0;
-		switch (num_parse(c, (size_t)(e - c), &v)) {
-		case NUM_EMPTY:
-			return fail_tok(p, t, elem, field, "has an empty component", shape);
-		case NUM_BAD:
-			return fail_tok(p, t, elem, field, "has a component that is not a number",
-			                shape);
-		case NUM_BIG:
+		num_status st = num_parse(c, (size_t)(e - c), &v);
+		if (st == NUM_BIG)
 			return fail_tok(p, t, elem, field, "is out of range",
 			                "a magnitude up to " RT_NUM_MAX_TEXT);
-		case NUM_OK:
-			break;
-		}
+		if (st != NUM_OK)
+			return fail_tok(p, t, elem, field, "has a component that is not a number",
+			                shape);
 		const char *bad = range_problem(r, v);
 		if (bad) {
-			if (strcmp(bad, "out of range") == 0)
-				snprintf(what, sizeof what, "is out of range");
-			else
-				snprintf(what, sizeof what, "has a component that is %s", bad);
+			snprintf(what, sizeof what, "has a component that is %s", bad);
 			return fail_tok(p, t, elem, field, what, r->expect);
 		}
 		out[k] = v;

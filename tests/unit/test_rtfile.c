@@ -565,8 +565,8 @@ static const err_case field_errors[] = {
 	 "ambient ratio \"1.5\" is out of range; expected a number in [0,1]"},
 	{"A -0.1 255,255,255\n" CAM, 1, 3, "ambient ratio \"-0.1\" is out of range"},
 	{"A 0.2 256,0,0\n" CAM, 1, 7,
-	 "ambient colour \"256,0,0\" is out of range; expected R,G,B each in [0,255]"},
-	{"A 0.2 0,-1,0\n" CAM, 1, 7, "ambient colour \"0,-1,0\" is out of range"},
+	 "ambient colour \"256,0,0\" has a component that is out of range; expected R,G,B each in [0,255]"},
+	{"A 0.2 0,-1,0\n" CAM, 1, 7, "ambient colour \"0,-1,0\" has a component that is out of range"},
 	{"A 0.2\n" CAM, 1, 6, "ambient: too few fields; expected A RATIO R,G,B"},
 	{"A 0.2 1,1,1 1\n" CAM, 1, 13, "ambient: too many fields; expected A RATIO R,G,B"},
 	{"A 0.2 255,255,255\nA 0.3 255,255,255\n" CAM, 2, 1,
@@ -586,7 +586,7 @@ static const err_case field_errors[] = {
 	{CAM "L 0,0,0 1.2\n", 2, 9, "light ratio \"1.2\" is out of range; expected a number in [0,1]"},
 	{CAM "L 0,0,0\n", 2, 8, "light: too few fields; expected L POSITION RATIO [R,G,B]"},
 	{CAM "l 0,0,0 1 1,1,1 1\n", 2, 17, "light: too many fields"},
-	{CAM "L 0,0,0 1 1,1,300\n", 2, 11, "light colour \"1,1,300\" is out of range"},
+	{CAM "L 0,0,0 1 1,1,300\n", 2, 11, "light colour \"1,1,300\" has a component that is out of range"},
 	/* R */
 	{"R 0 10\n" CAM, 1, 3, "resolution width \"0\" is out of range; expected a whole number in [1,1e9]"},
 	{"R 10 -10\n" CAM, 1, 6, "resolution height \"-10\" is out of range"},
@@ -636,7 +636,7 @@ static const err_case field_errors[] = {
 	{CAM "cu 0,0,0 0,1,0 1 255,0,0\n", 2, 16, "cube scaling \"1\" is not a vector; expected X,Y,Z"},
 	{CAM "di 0,0,0 0,1,0 1,1,1 255,0,0 0.9 0.9 200 0 0,0,0,0,0,0 7\n", 2, 56, "disc: too many fields"},
 	{CAM "di 0,0,0 0,1,0 1,-1,1 255,0,0\n", 2, 16, "disc scaling \"1,-1,1\" has a component that is not positive"},
-	{CAM "rc 0,0,0 0,1,0 1,1,1 300,0,0\n", 2, 22, "rectangle colour \"300,0,0\" is out of range"},
+	{CAM "rc 0,0,0 0,1,0 1,1,1 300,0,0\n", 2, 22, "rectangle colour \"300,0,0\" has a component that is out of range"},
 	/* sq */
 	{CAM "sq 0,0,0 0,0,1 -1 255,0,0\n", 2, 16, "square side \"-1\" is not positive; expected a number > 0"},
 	{CAM "sq 0,0,0 0,0,0 1 255,0,0\n", 2, 10, "square normal is the zero vector"},
@@ -674,7 +674,7 @@ static const err_case field_errors[] = {
 	/* sky */
 	{CAM "sky 0,0,255 255,255,255 -1\n", 2, 25, "sky strength \"-1\" is out of range; expected a number >= 0"},
 	{CAM "sky 0,0,255\n", 2, 12, "sky: too few fields; expected sky ZENITH_R,G,B HORIZON_R,G,B [STRENGTH]"},
-	{CAM "sky 0,0,256 0,0,0\n", 2, 5, "sky zenith colour \"0,0,256\" is out of range"},
+	{CAM "sky 0,0,256 0,0,0\n", 2, 5, "sky zenith colour \"0,0,256\" has a component that is out of range"},
 	{CAM "sky 0,0,0 0,0,0\nsky 1,1,1 0,0,0\n", 3, 1, "sky: a second sky line"},
 	/* set */
 	{CAM "set samples 0\n", 2, 13, "set samples \"0\" is out of range; expected a whole number in [1,1000000]"},
