@@ -214,7 +214,9 @@ static int batch_render(const rtsh_options *o)
 		return 1;
 	}
 	render_settings set = render_settings_default();
-	render_settings_apply_hints(&set, &s->hints);
+	if (render_settings_apply_hints(&set, &s->hints) && !o->quiet)
+		fprintf(stderr, "%s: resolution %dx%d is too large; rendering %dx%d (use -r to choose)\n",
+		        o->scene, s->hints.width, s->hints.height, set.width, set.height);
 	options_apply_settings(o, &set);
 	world *w = world_build(s, &err);
 	scene_free(s);

@@ -35,8 +35,15 @@ typedef struct render_settings {
 } render_settings;
 
 render_settings render_settings_default(void);
-/* Applies the hints of a scene file (R, set lines) over s. */
-void render_settings_apply_hints(render_settings *s, const scene_hints *h);
+/* The largest side a scene file's resolution (R, set resolution) may ask
+ * for: larger ones are scaled down to it, keeping their aspect, as the 42
+ * subject clamps R to the screen. The command line may ask for up to
+ * RENDER_MAX_DIM. */
+#define RENDER_HINT_MAX_DIM 7680
+
+/* Applies the hints of a scene file (R, set lines) over s; true when the
+ * file's resolution had to be scaled down (the caller may warn). */
+bool render_settings_apply_hints(render_settings *s, const scene_hints *h);
 /* The thread count to use: s->threads, or the online CPUs when 0. */
 int render_threads(const render_settings *s);
 

@@ -29,11 +29,18 @@ render_settings render_settings_default(void)
 	};
 }
 
-void render_settings_apply_hints(render_settings *s, const scene_hints *h)
+bool render_settings_apply_hints(render_settings *s, const scene_hints *h)
 {
+	bool clamped = false;
 	if (h->width > 0 && h->height > 0) {
-		s->width = h->width < RENDER_MAX_DIM ? h->width : RENDER_MAX_DIM;
-		s->height = h->height < RENDER_MAX_DIM ? h->height : RENDER_MAX_DIM;
+		double w = h->width, hh = h->height, big = fmax(w, hh);
+		if (big > RENDER_HINT_MAX_DIM) {
+			w = fmax(1.0, round(w * RENDER_HINT_MAX_DIM / big));
+			hh = fmax(1.0, round(hh * RENDER_HINT_MAX_DIM / big));
+			clamped = true;
+		}
+		s->width = (int)w;
+		s->height = (int)hh;
 	}
 	if (h->samples > 0)
 		s->samples = h->samples;
@@ -41,6 +48,7 @@ void render_settings_apply_hints(render_settings *s, const scene_hints *h)
 		s->depth = h->depth;
 	if (h->mode >= 0)
 		s->mode = (render_mode)h->mode;
+	return clamped;
 }
 
 int render_threads(const render_settings *s)
