@@ -1,11 +1,534 @@
-/* rtsh — placeholder until the shell lands (issue 3). */
-#include <stdio.h>
+/* rtsh — the shell: set-up, the scene and its settings, full-resolution
+ * renders, and shell_main, which picks script or interactive mode. */
+#include "shell/shell.h"
 
-#include "shell/options.h"
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "rtsh/settings.h"
+#include "shell/builtin_scene.h"
+#include "term/caps.h"
+
+volatile sig_atomic_t shell_sig_int, shell_sig_term, shell_sig_winch, shell_sig_tstp, shell_sig_cont;
+shell *shell_current;
+
+bool shell_fail(shell *sh, const char *fmt, ...)
+{
+	char buf[SHELL_MSG_MAX];
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(buf, sizeof buf, fmt, ap);
+	va_end(ap);
+	memcpy(sh->err, buf, sizeof buf);
+	return false;
+}
+
+void shell_out(shell *sh, const char *fmt, ...)
+{
+	(void)sh;
+	va_list ap;
+	va_start(ap, fmt);
+	vprintf(fmt, ap);
+	va_end(ap);
+}
+
+void shell_info(shell *sh, const char *fmt, ...)
+{
+	if (sh->opt->quiet)
+		return;
+	va_list ap;
+	va_start(ap, fmt);
+	vprintf(fmt, ap);
+	va_end(ap);
+}
+
+void shell_note(shell *sh, const char *fmt, ...)
+{
+	(void)sh;
+	fflush(stdout);
+	va_list ap;
+	va_start(ap, fmt);
+	vfprintf(stderr, fmt, ap);
+	va_end(ap);
+}
+
+static double now(void)
+{
+	struct timespec t;
+	clock_gettime(CLOCK_MONOTONIC, &t);
+	return (double)t.tv_sec + t.tv_nsec * 1e-9;
+}
+
+char *shell_expand_path(const char *path)
+{
+	const char *home = getenv("HOME");
+	if (path[0] == '~' && (path[1] == '/' || path[1] == '\0') && home && *home) {
+		size_t n = strlen(home) + strlen(path);
+		char *p = malloc(n);
+		if (p)
+			snprintf(p, n, "%s%s", home, path + 1);
+		return p;
+	}
+	return strdup(path);
+}
+
+static void print_warning(void *ctx, const rt_error *w)
+{
+	(void)ctx;
+	char buf[RT_ERROR_MSG_MAX + RT_ERROR_FILE_MAX + 32];
+	rt_error_format(w, buf, sizeof buf);
+	fflush(stdout);
+	fprintf(stderr, "%s (warning)\n", buf);
+}
+
+/* --- settings per scene --- */
+
+/* Defaults, then the scene's hints, then the command line's settings; the
+ * thread count carries over (it is about the machine, not the scene). */
+static render_settings fresh_settings(const shell *sh, bool keep_threads)
+{
+	render_settings s = render_settings_default();
+	render_settings_apply_hints(&s, &editor_scene(sh->ed)->hints);
+	for (int i = 0; i < sh->opt->nsettings; i++)
+		settings_set(&s, sh->opt->settings[i].def, sh->opt->settings[i].value, NULL);
+	if (keep_threads)
+		s.threads = sh->set.threads;
+	return s;
+}
+
+static bool same_str(const char *a, const char *b)
+{
+	return a == b || (a && b && strcmp(a, b) == 0);
+}
+
+static scene_memo *memo_find(shell *sh, const char *label)
+{
+	for (size_t i = 0; i < sh->nmemo; i++)
+		if (same_str(sh->memo[i].label, label))
+			return &sh->memo[i];
+	return NULL;
+}
+
+static void memo_put(shell *sh, const char *label, const render_settings *set)
+{
+	scene_memo *m = memo_find(sh, label);
+	if (m) {
+		m->set = *set;
+		return;
+	}
+	char *l = label ? strdup(label) : NULL;
+	if (label && !l)
+		return;
+	scene_memo *p = realloc(sh->memo, (sh->nmemo + 1) * sizeof *p);
+	if (!p) {
+		free(l);
+		return;
+	}
+	sh->memo = p;
+	sh->memo[sh->nmemo++] = (scene_memo){l, *set};
+}
+
+/* Name and folder from a label: NULL = the built-in scene, "generate:N:S" =
+ * a generated one, anything else = a file path. */
+static void name_from_label(shell *sh)
+{
+	const char *l = sh->label;
+	if (!l) {
+		snprintf(sh->name, sizeof sh->name, "%s", BUILTIN_SCENE_NAME);
+		return;
+	}
+	long n;
+	unsigned long long seed;
+	if (sscanf(l, "generate:%ld:%llu", &n, &seed) == 2) {
+		snprintf(sh->name, sizeof sh->name, "generated: %ld object%s, seed %llu", n, n == 1 ? "" : "s",
+		         seed);
+		return;
+	}
+	const char *slash = strrchr(l, '/');
+	snprintf(sh->name, sizeof sh->name, "%s", slash ? slash + 1 : l);
+	free(sh->dir);
+	sh->dir = slash ? strndup(l, slash == l ? 1 : (size_t)(slash - l)) : strdup(".");
+}
+
+/* Notices that the editor holds another scene (load, undo of a load, ...):
+ * keeps the old scene's settings and takes the new one's. */
+static void sync_scene(shell *sh)
+{
+	const char *l = editor_label(sh->ed);
+	if (same_str(l, sh->label))
+		return;
+	memo_put(sh, sh->label, &sh->set);
+	free(sh->label);
+	sh->label = l ? strdup(l) : NULL;
+	const scene_memo *m = memo_find(sh, sh->label);
+	sh->set = m ? m->set : fresh_settings(sh, true);
+	name_from_label(sh);
+}
+
+/* --- the preview --- */
+
+static double aspect_of(const render_settings *s)
+{
+	return (double)s->width / s->height;
+}
+
+void shell_refresh(shell *sh)
+{
+	if (!sh->scr || !sh->scr->active) {
+		preview_release(sh->pv);
+		return;
+	}
+	screen_layout(sh->scr, aspect_of(&sh->set), false);
+	if (sh->scr->img_w <= 0 || sh->scr->img_h <= 0) {
+		preview_release(sh->pv);
+		return;
+	}
+	preview_request req = {
+		.s = editor_scene(sh->ed),
+		.gen = editor_generation(sh->ed),
+		.set = sh->set,
+		.w = sh->scr->img_w,
+		.h = sh->scr->img_h,
+	};
+	preview_start(sh->pv, &req);
+	sh->redraw = true;
+	if (sh->status_hook)
+		sh->status_hook(sh);
+}
+
+void shell_edit_begin(shell *sh)
+{
+	preview_hold(sh->pv);
+}
+
+void shell_edit_end(shell *sh)
+{
+	sync_scene(sh);
+	shell_refresh(sh);
+}
+
+static void format_seconds(double s, char *buf, size_t size)
+{
+	if (s < 1)
+		snprintf(buf, size, "%.0f ms", s * 1000);
+	else if (s < 60)
+		snprintf(buf, size, "%.2f s", s);
+	else
+		snprintf(buf, size, "%.0fm%02.0fs", floor(s / 60), fmod(s, 60));
+}
+
+void shell_status_text(shell *sh, char *buf, size_t size)
+{
+	const preview_image *im = &sh->img;
+	char samples[RT_ERROR_MSG_MAX + 16], t[32] = "";
+	bool busy = preview_busy(sh->pv);
+	if (im->error[0]) {
+		snprintf(samples, sizeof samples, "error: %s", im->error);
+	} else if (im->w == 0) {
+		snprintf(samples, sizeof samples, "rendering");
+	} else if (im->stopped) {
+		snprintf(samples, sizeof samples, "stopped at %d/%d spp", im->spp, im->target);
+	} else if (im->spp == 0) {
+		snprintf(samples, sizeof samples, "quick pass, 0/%d spp", im->target);
+	} else {
+		snprintf(samples, sizeof samples, "%d/%d spp%s", im->spp, im->target, busy && !im->done ? "…" : "");
+	}
+	if (im->w > 0)
+		format_seconds(im->seconds, t, sizeof t);
+	int th = render_threads(&sh->set);
+	snprintf(buf, size, " %s │ %s │ %s │ depth %d │ %dx%d │ %d thread%s │ %s", sh->name,
+	         render_mode_name(sh->set.mode), samples, sh->set.depth, sh->scr ? sh->scr->img_w : 0,
+	         sh->scr ? sh->scr->img_h : 0, th, th == 1 ? "" : "s", t);
+}
+
+/* --- full-resolution images --- */
+
+typedef struct progress_ctx {
+	shell *sh;
+	double t0;
+	bool shown;
+	int w, h;
+} progress_ctx;
+
+static void on_progress(void *ctx, long done, long total)
+{
+	progress_ctx *p = ctx;
+	double el = now() - p->t0, frac = total ? (double)done / total : 1.0;
+	char bar[32];
+	const int width = 24;
+	int fill = (int)(frac * width + 0.5);
+	for (int i = 0; i < width; i++)
+		bar[i] = i < fill ? '#' : '.';
+	bar[width] = '\0';
+	char left[48] = "";
+	if (done > 0 && done < total)
+		snprintf(left, sizeof left, ", about %.0f s left", el / frac - el);
+	if (p->sh->scr && p->sh->scr->active) {
+		char text[256];
+		snprintf(text, sizeof text, " rendering %dx%d [%s] %3d%%  %.1f s%s  (Ctrl-C stops)", p->w, p->h,
+		         bar, (int)(frac * 100), el, left);
+		screen_status(p->sh->scr, text);
+	} else {
+		fprintf(stderr, "\r[%s] %3d%%  %.1f s%s   ", bar, (int)(frac * 100), el, left);
+		p->shown = true;
+	}
+}
+
+static bool same_image_settings(const render_settings *a, const render_settings *b)
+{
+	return a->width == b->width && a->height == b->height && a->samples == b->samples &&
+	       a->depth == b->depth && a->mode == b->mode && a->seed == b->seed;
+}
+
+const framebuffer *shell_full_image(shell *sh, bool force)
+{
+	uint64_t gen = editor_generation(sh->ed);
+	if (!force && sh->full && sh->full_gen == gen && same_image_settings(&sh->full_set, &sh->set))
+		return sh->full;
+	preview_hold(sh->pv);
+	rt_error err;
+	rt_error_clear(&err);
+	const world *w = preview_world(sh->pv, editor_scene(sh->ed), gen, &err);
+	if (!w) {
+		shell_refresh(sh);
+		shell_fail(sh, "render: %s", err.msg);
+		return NULL;
+	}
+	atomic_store(&sh->cancel, false);
+	progress_ctx p = {sh, now(), false, sh->set.width, sh->set.height};
+	framebuffer *fb = render_image(w, &sh->set, &sh->cancel, sh->progress ? on_progress : NULL, &p, &err);
+	double seconds = now() - p.t0;
+	if (p.shown)
+		fputc('\n', stderr);
+	bool stopped = atomic_load(&sh->cancel);
+	if (stopped)
+		shell_sig_int = 0; /* the Ctrl-C is used up */
+	shell_refresh(sh);
+	if (!fb) {
+		if (stopped)
+			shell_fail(sh, "render: stopped");
+		else
+			shell_fail(sh, "render: %s", err.msg);
+		return NULL;
+	}
+	fb_free(sh->full);
+	sh->full = fb;
+	sh->full_gen = gen;
+	sh->full_set = sh->set;
+	sh->full_seconds = seconds;
+	return fb;
+}
+
+frame *shell_picture_frame(shell *sh, frame_palette pal, int cols)
+{
+	const float *rgb;
+	int w, h;
+	framebuffer *fb = NULL;
+	if (sh->scr && sh->img.w > 0 && sh->img.rgb) {
+		rgb = sh->img.rgb;
+		w = sh->img.w;
+		h = sh->img.h;
+	} else {
+		screen_fit(cols, 1000, aspect_of(&sh->set), pal == PALETTE_NONE, &w, &h);
+		preview_hold(sh->pv);
+		rt_error err;
+		rt_error_clear(&err);
+		const world *wd = preview_world(sh->pv, editor_scene(sh->ed), editor_generation(sh->ed), &err);
+		render_settings s = sh->set;
+		s.width = w;
+		s.height = h;
+		if (wd) {
+			atomic_store(&sh->cancel, false);
+			fb = render_image(wd, &s, &sh->cancel, NULL, NULL, &err);
+		}
+		shell_refresh(sh);
+		if (!fb) {
+			shell_fail(sh, "%s", err.msg);
+			return NULL;
+		}
+		rgb = fb->rgb;
+	}
+	frame *f = frame_new(w, (h + 1) / 2, pal);
+	uint8_t *px = malloc((size_t)w * h * 3);
+	if (!f || !px) {
+		frame_free(f);
+		free(px);
+		fb_free(fb);
+		shell_fail(sh, "out of memory");
+		return NULL;
+	}
+	frame_srgb_from_linear(rgb, (size_t)w * h, sh->set.exposure, px);
+	frame_put_image(f, px, w, h, 0, 0);
+	free(px);
+	fb_free(fb);
+	return f;
+}
+
+/* --- scenes --- */
+
+bool shell_replace_scene(shell *sh, scene *s, const char *label)
+{
+	rt_error err;
+	shell_edit_begin(sh);
+	bool ok = editor_replace(sh->ed, s, label, &err);
+	shell_edit_end(sh);
+	return ok ? true : shell_fail(sh, "%s", err.msg);
+}
+
+bool shell_load(shell *sh, const char *path)
+{
+	char *p = shell_expand_path(path);
+	if (!p)
+		return shell_fail(sh, "out of memory");
+	rt_error err;
+	scene *s = rt_load_file(p, &sh->load_opts, &err);
+	if (!s) {
+		char msg[RT_ERROR_MSG_MAX + RT_ERROR_FILE_MAX + 32];
+		rt_error_format(&err, msg, sizeof msg);
+		free(p);
+		return shell_fail(sh, "load: %s", msg);
+	}
+	/* A file label must not look like a generated scene's. */
+	char *label = p;
+	if (strncmp(p, "generate:", 9) == 0) {
+		size_t n = strlen(p) + 3;
+		label = malloc(n);
+		if (label)
+			snprintf(label, n, "./%s", p);
+	}
+	bool ok = label && shell_replace_scene(sh, s, label);
+	if (!label) {
+		scene_free(s);
+		ok = shell_fail(sh, "out of memory");
+	}
+	if (label != p)
+		free(label);
+	free(p);
+	return ok;
+}
+
+bool shell_init(shell *sh, const rtsh_options *o, int wake_fd)
+{
+	memset(sh, 0, sizeof *sh);
+	sh->opt = o;
+	sh->warn = (rt_warnings){print_warning, sh};
+	sh->load_opts = (rt_load_opts){o->strict, o->quiet ? NULL : &sh->warn};
+	atomic_init(&sh->cancel, false);
+	rt_error err;
+	scene *s;
+	if (o->scene)
+		s = rt_load_file(o->scene, &sh->load_opts, &err);
+	else
+		s = rt_load_string(builtin_scene_text, builtin_scene_len, "showcase.rt", &sh->load_opts, &err);
+	if (!s) {
+		char msg[RT_ERROR_MSG_MAX + RT_ERROR_FILE_MAX + 32];
+		rt_error_format(&err, msg, sizeof msg);
+		fprintf(stderr, "%s\n", msg);
+		return false;
+	}
+	sh->ed = editor_new(s, o->scene);
+	sh->pv = preview_new(wake_fd);
+	if (!sh->ed || !sh->pv) {
+		if (!sh->ed)
+			scene_free(s);
+		fprintf(stderr, "rtsh: out of memory\n");
+		shell_free(sh);
+		return false;
+	}
+	sh->label = o->scene ? strdup(o->scene) : NULL;
+	sh->set = fresh_settings(sh, false);
+	name_from_label(sh);
+	return true;
+}
+
+void shell_free(shell *sh)
+{
+	preview_free(sh->pv);
+	editor_free(sh->ed);
+	fb_free(sh->full);
+	preview_image_free(&sh->img);
+	free(sh->srgb);
+	free(sh->label);
+	free(sh->dir);
+	for (size_t i = 0; i < sh->nmemo; i++)
+		free(sh->memo[i].label);
+	free(sh->memo);
+	memset(sh, 0, sizeof *sh);
+}
+
+/* Scripts: Ctrl-C stops a render and then the script. */
+static void script_sigint(int sig)
+{
+	(void)sig;
+	shell_sig_int = 1;
+	if (shell_current)
+		atomic_store(&shell_current->cancel, true);
+}
 
 int shell_main(const rtsh_options *o)
 {
-	(void)o;
-	fputs("rtsh: the interactive shell is not built yet; use rtsh SCENE.rt -o OUT\n", stderr);
-	return 2;
+	bool tty_in = isatty(STDIN_FILENO);
+	bool script = o->commands || o->file || !tty_in;
+	bool then_interactive = !script || (o->interactive && tty_in);
+	bool screen_ok = then_interactive && caps_screen_ok(STDOUT_FILENO);
+	int wake[2] = {-1, -1};
+	if (then_interactive) {
+		if (pipe(wake) != 0) {
+			fprintf(stderr, "rtsh: cannot make a pipe: %s\n", strerror(errno));
+			return 1;
+		}
+		for (int i = 0; i < 2; i++) {
+			fcntl(wake[i], F_SETFL, fcntl(wake[i], F_GETFL) | O_NONBLOCK);
+			fcntl(wake[i], F_SETFD, FD_CLOEXEC);
+		}
+	}
+	shell sh;
+	if (!shell_init(&sh, o, wake[1])) {
+		if (wake[0] >= 0)
+			close(wake[0]), close(wake[1]);
+		return 1;
+	}
+	shell_current = &sh;
+	sh.pal = caps_palette(o->color, STDOUT_FILENO);
+	int status = 0;
+	if (script) {
+		struct sigaction sa, old;
+		memset(&sa, 0, sizeof sa);
+		sa.sa_handler = script_sigint;
+		sigemptyset(&sa.sa_mask);
+		sigaction(SIGINT, &sa, &old);
+		sh.interactive = false;
+		sh.progress = !o->quiet && isatty(STDERR_FILENO);
+		bool ok;
+		if (o->commands)
+			ok = shell_run_text(&sh, o->commands, "-c", true);
+		else
+			ok = shell_run_file(&sh, o->file ? o->file : "-");
+		if (!ok && !sh.err_reported)
+			fprintf(stderr, "rtsh: %s\n", sh.err);
+		status = ok ? 0 : shell_sig_int ? 130 : 1;
+		sigaction(SIGINT, &old, NULL);
+		if (sh.quit)
+			then_interactive = false;
+	}
+	if (then_interactive) {
+		sh.interactive = true;
+		sh.quit = false;
+		shell_sig_int = 0;
+		int st = shell_interactive(&sh, screen_ok, wake);
+		if (st != 0 || status == 0)
+			status = st;
+	}
+	shell_current = NULL;
+	shell_free(&sh);
+	if (wake[0] >= 0)
+		close(wake[0]), close(wake[1]);
+	return status;
 }

@@ -1,0 +1,267 @@
+/* rtsh — commands that edit the scene: camera, light, object, ambient, add,
+ * delete, undo, redo. Each parses its arguments, then makes one editor call
+ * between shell_edit_begin and shell_edit_end. */
+#include <stdio.h>
+#include <string.h>
+
+#include "rtsh/edit.h"
+#include "rtsh/rtfile.h"
+#include "shell/commands.h"
+
+#define SUBS_CAMERA "pos|dir|lookat|fov|move|turn"
+#define SUBS_LIGHT "pos|move|brightness|color"
+#define SUBS_OBJECT "move|rotate|scale|color"
+
+/* The subcommand `word` among choices, or a message naming them. */
+static int pick_sub(shell *sh, const char *cmd, const char *kind, const char *choices, const char *word)
+{
+	int i = choice_pick(choices, word);
+	if (i < 0) {
+		char list[256];
+		choice_list(choices, list, sizeof list);
+		shell_fail(sh, "%s: \"%s\" is not %s; expected %s", cmd, word, kind, list);
+	}
+	return i;
+}
+
+/* Runs an editor call, reporting its error as "WHAT: message". */
+#define EDIT(sh, what, call)                                             \
+	do {                                                             \
+		rt_error err_;                                           \
+		shell_edit_begin(sh);                                    \
+		bool ok_ = (call);                                       \
+		shell_edit_end(sh);                                      \
+		if (!ok_)                                                \
+			return shell_fail(sh, "%s: %s", what, err_.msg); \
+		return true;                                             \
+	} while (0)
+
+static bool need_value(shell *sh, const char *what, const char *usage, int argc, int want)
+{
+	if (argc != want)
+		return shell_fail(sh, "%s: %s; usage: %s", what, argc < want ? "too few arguments" : "too many arguments",
+		                  usage);
+	return true;
+}
+
+bool cmd_camera(shell *sh, int argc, char **argv, const char *rest)
+{
+	(void)rest;
+	const scene *s = editor_scene(sh->ed);
+	if (argc == 0) {
+		char *a[] = {"cameras"};
+		return cmd_list(sh, 1, a, "");
+	}
+	if (argc == 1 && argv[0][0] >= '0' && argv[0][0] <= '9') {
+		size_t i;
+		if (!arg_index(sh, "camera", argv[0], "camera", s->ncams, &i))
+			return false;
+		EDIT(sh, "camera", editor_select_camera(sh->ed, i, &err_));
+	}
+	int sub = pick_sub(sh, "camera", "a camera command", SUBS_CAMERA, argv[0]);
+	if (sub < 0)
+		return false;
+	static const char *const names[] = {"pos", "dir", "lookat", "fov", "move", "turn"};
+	static const char *const forms[] = {"X,Y,Z", "X,Y,Z", "X,Y,Z", "DEG", "DX,DY,DZ", "YAW,PITCH"};
+	char what[32], usage[64];
+	snprintf(what, sizeof what, "camera %s", names[sub]);
+	snprintf(usage, sizeof usage, "camera %s %s", names[sub], forms[sub]);
+	if (!need_value(sh, what, usage, argc - 1, 1))
+		return false;
+	const char *v = argv[1];
+	vec3 p;
+	double d;
+	switch (sub) {
+	case 0:
+		if (!arg_vec(sh, what, v, "X,Y,Z", &p))
+			return false;
+		EDIT(sh, what, editor_camera_pos(sh->ed, p, &err_));
+	case 1:
+		if (!arg_vec(sh, what, v, "X,Y,Z (not all zero)", &p))
+			return false;
+		EDIT(sh, what, editor_camera_dir(sh->ed, p, &err_));
+	case 2:
+		if (!arg_vec(sh, what, v, "X,Y,Z", &p))
+			return false;
+		EDIT(sh, what, editor_camera_lookat(sh->ed, p, &err_));
+	case 3:
+		if (!parse_number(v, &d) || !(d > 0 && d < 180))
+			return shell_fail(sh, "%s: \"%s\" is not a field of view; expected degrees between 0 and 180",
+			                  what, v);
+		EDIT(sh, what, editor_camera_fov(sh->ed, d, &err_));
+	case 4:
+		if (!arg_vec(sh, what, v, "DX,DY,DZ", &p))
+			return false;
+		EDIT(sh, what, editor_camera_move(sh->ed, p, &err_));
+	default: {
+		double yp[2];
+		char buf[128];
+		char *comma = strchr(v, ',');
+		if (strlen(v) >= sizeof buf || !comma || strchr(comma + 1, ','))
+			return shell_fail(sh, "%s: \"%s\" is not a turn; expected YAW,PITCH in degrees", what, v);
+		snprintf(buf, sizeof buf, "%s", v);
+		buf[comma - v] = '\0';
+		if (!parse_number(buf, &yp[0]) || !parse_number(buf + (comma - v) + 1, &yp[1]))
+			return shell_fail(sh, "%s: \"%s\" is not a turn; expected YAW,PITCH in degrees", what, v);
+		EDIT(sh, what, editor_camera_turn(sh->ed, yp[0], yp[1], &err_));
+	}
+	}
+}
+
+bool cmd_light(shell *sh, int argc, char **argv, const char *rest)
+{
+	(void)rest;
+	const scene *s = editor_scene(sh->ed);
+	if (argc == 0) {
+		char *a[] = {"lights"};
+		return cmd_list(sh, 1, a, "");
+	}
+	size_t i;
+	if (!arg_index(sh, "light", argv[0], "light", s->nlights, &i))
+		return false;
+	if (argc < 3)
+		return shell_fail(sh, "light: too few arguments; usage: light N pos|move|brightness|color VALUE");
+	int sub = pick_sub(sh, "light", "a light command", SUBS_LIGHT, argv[1]);
+	if (sub < 0)
+		return false;
+	static const char *const names[] = {"pos", "move", "brightness", "color"};
+	char what[32];
+	snprintf(what, sizeof what, "light %s", names[sub]);
+	const char *v = argv[2];
+	vec3 p;
+	double d;
+	switch (sub) {
+	case 0:
+		if (!arg_vec(sh, what, v, "X,Y,Z", &p))
+			return false;
+		EDIT(sh, what, editor_light_pos(sh->ed, i, p, &err_));
+	case 1:
+		if (!arg_vec(sh, what, v, "DX,DY,DZ", &p))
+			return false;
+		EDIT(sh, what, editor_light_move(sh->ed, i, p, &err_));
+	case 2:
+		if (!arg_number(sh, what, v, 0, 1, &d))
+			return false;
+		EDIT(sh, what, editor_light_brightness(sh->ed, i, d, &err_));
+	default:
+		if (!arg_color(sh, what, v, &p))
+			return false;
+		EDIT(sh, what, editor_light_color(sh->ed, i, p, &err_));
+	}
+}
+
+bool cmd_object(shell *sh, int argc, char **argv, const char *rest)
+{
+	(void)rest;
+	const scene *s = editor_scene(sh->ed);
+	if (argc == 0) {
+		char *a[] = {"objects"};
+		return cmd_list(sh, 1, a, "");
+	}
+	size_t i;
+	if (!arg_index(sh, "object", argv[0], "object", s->nobjs, &i))
+		return false;
+	if (argc < 3)
+		return shell_fail(sh, "object: too few arguments; usage: object N move|rotate|scale|color VALUE");
+	int sub = pick_sub(sh, "object", "an object command", SUBS_OBJECT, argv[1]);
+	if (sub < 0)
+		return false;
+	static const char *const names[] = {"move", "rotate", "scale", "color"};
+	char what[32];
+	snprintf(what, sizeof what, "object %s", names[sub]);
+	const char *v = argv[2];
+	vec3 p;
+	switch (sub) {
+	case 0:
+		if (!arg_vec(sh, what, v, "DX,DY,DZ", &p))
+			return false;
+		EDIT(sh, what, editor_object_move(sh->ed, i, p, &err_));
+	case 1:
+		if (!arg_vec(sh, what, v, "RX,RY,RZ in degrees", &p))
+			return false;
+		EDIT(sh, what, editor_object_rotate(sh->ed, i, p, &err_));
+	case 2:
+		if (!arg_vec(sh, what, v, "SX,SY,SZ (factors > 0)", &p))
+			return false;
+		if (!(p.x > 0 && p.y > 0 && p.z > 0))
+			return shell_fail(sh, "%s: %s has a factor <= 0; expected SX,SY,SZ with each > 0", what, v);
+		EDIT(sh, what, editor_object_scale(sh->ed, i, p, &err_));
+	default:
+		if (!arg_color(sh, what, v, &p))
+			return false;
+		EDIT(sh, what, editor_object_color(sh->ed, i, p, &err_));
+	}
+}
+
+bool cmd_ambient(shell *sh, int argc, char **argv, const char *rest)
+{
+	(void)rest;
+	const scene *s = editor_scene(sh->ed);
+	ambient a = s->has_ambient ? s->amb : (ambient){0.0, v3(255, 255, 255)};
+	if (argc == 0) {
+		if (s->has_ambient)
+			shell_out(sh, "ambient: A %g %g,%g,%g\n", a.ratio, a.color.x, a.color.y, a.color.z);
+		else
+			shell_out(sh, "ambient: none\n");
+		return true;
+	}
+	int sub = pick_sub(sh, "ambient", "an ambient command", "brightness|color", argv[0]);
+	if (sub < 0)
+		return false;
+	const char *what = sub == 0 ? "ambient brightness" : "ambient color";
+	if (!need_value(sh, what, sub == 0 ? "ambient brightness B" : "ambient color R,G,B", argc - 1, 1))
+		return false;
+	if (sub == 0) {
+		if (!arg_number(sh, what, argv[1], 0, 1, &a.ratio))
+			return false;
+	} else if (!arg_color(sh, what, argv[1], &a.color)) {
+		return false;
+	}
+	EDIT(sh, what, editor_set_ambient(sh->ed, &a, &err_));
+}
+
+bool cmd_add(shell *sh, int argc, char **argv, const char *rest)
+{
+	(void)argc, (void)argv;
+	rt_error err;
+	shell_edit_begin(sh);
+	bool ok = editor_add_line(sh->ed, rest, "add", 0, &sh->load_opts, &err);
+	shell_edit_end(sh);
+	if (!ok) {
+		/* The parser's column counts from the start of LINE. */
+		if (err.col > 0)
+			return shell_fail(sh, "add: column %d: %s", err.col, err.msg);
+		return shell_fail(sh, "add: %s", err.msg);
+	}
+	return true;
+}
+
+bool cmd_delete(shell *sh, int argc, char **argv, const char *rest)
+{
+	(void)argc, (void)rest;
+	const scene *s = editor_scene(sh->ed);
+	int kind = pick_sub(sh, "delete", "something to delete", "object|light|camera", argv[0]);
+	if (kind < 0)
+		return false;
+	static const char *const kinds[] = {"object", "light", "camera"};
+	size_t n = kind == 0 ? s->nobjs : kind == 1 ? s->nlights : s->ncams, i;
+	if (!arg_index(sh, "delete", argv[1], kinds[kind], n, &i))
+		return false;
+	if (kind == 0)
+		EDIT(sh, "delete", editor_delete_object(sh->ed, i, &err_));
+	if (kind == 1)
+		EDIT(sh, "delete", editor_delete_light(sh->ed, i, &err_));
+	EDIT(sh, "delete", editor_delete_camera(sh->ed, i, &err_));
+}
+
+bool cmd_undo(shell *sh, int argc, char **argv, const char *rest)
+{
+	(void)argc, (void)argv, (void)rest;
+	EDIT(sh, "undo", editor_undo(sh->ed, &err_));
+}
+
+bool cmd_redo(shell *sh, int argc, char **argv, const char *rest)
+{
+	(void)argc, (void)argv, (void)rest;
+	EDIT(sh, "redo", editor_redo(sh->ed, &err_));
+}

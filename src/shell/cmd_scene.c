@@ -1,0 +1,382 @@
+/* rtsh — commands about the scene as a whole: load, save, render, set, list,
+ * generate, next/prev, show, source, view. */
+#include <dirent.h>
+#include <errno.h>
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "rtsh/generate.h"
+#include "rtsh/image.h"
+#include "rtsh/rtfile.h"
+#include "rtsh/settings.h"
+#include "shell/commands.h"
+#include "term/caps.h"
+
+/* The generator (src/scene/generate.c) is being written alongside; until it
+ * is in the library, `generate` says so instead of failing to link. */
+#pragma weak scene_generate
+
+bool cmd_load(shell *sh, int argc, char **argv, const char *rest)
+{
+	(void)argc, (void)rest;
+	return shell_load(sh, argv[0]);
+}
+
+static bool has_ext(const char *path, const char *ext)
+{
+	size_t n = strlen(path), e = strlen(ext);
+	return n > e && strcasecmp(path + n - e, ext) == 0;
+}
+
+typedef struct text_ctx {
+	const abuf *a;
+} text_ctx;
+
+static bool write_text(FILE *f, void *ctx, rt_error *err)
+{
+	const text_ctx *t = ctx;
+	if (t->a->len && fwrite(t->a->b, 1, t->a->len, f) != t->a->len)
+		return rt_error_set(err, "cannot write: %s", strerror(errno));
+	return true;
+}
+
+/* The terminal width for pictures printed outside the full screen. */
+static int picture_columns(void)
+{
+	const char *c = getenv("COLUMNS");
+	long v = c ? strtol(c, NULL, 10) : 0;
+	return v >= 8 && v <= 1000 ? (int)v : 80;
+}
+
+bool cmd_save(shell *sh, int argc, char **argv, const char *rest)
+{
+	(void)argc, (void)rest;
+	char *path = shell_expand_path(argv[0]);
+	if (!path)
+		return shell_fail(sh, "out of memory");
+	rt_error err;
+	bool ok = true;
+	if (has_ext(path, ".rt")) {
+		if (!rt_save(editor_scene(sh->ed), path, &err))
+			ok = shell_fail(sh, "save: %s", err.msg);
+		else
+			shell_info(sh, "saved the scene to %s\n", path);
+	} else if (has_ext(path, ".ans")) {
+		frame *f = shell_picture_frame(sh, PALETTE_TRUECOLOR, picture_columns());
+		if (!f) {
+			ok = sh->err[0] ? false : shell_fail(sh, "save: no picture to save");
+		} else {
+			abuf a;
+			abuf_init(&a);
+			frame_text(f, &a);
+			text_ctx t = {&a};
+			if (a.failed)
+				ok = shell_fail(sh, "save: out of memory");
+			else if (!file_write_atomic(path, write_text, &t, &err))
+				ok = shell_fail(sh, "save: %s", err.msg);
+			else
+				shell_info(sh, "saved the %dx%d-cell picture to %s\n", f->cols, f->rows, path);
+			abuf_free(&a);
+			frame_free(f);
+		}
+	} else if (image_format_of(path) != IMAGE_UNKNOWN) {
+		const framebuffer *fb = shell_full_image(sh, false);
+		if (!fb)
+			ok = false;
+		else if (!image_write(path, fb, sh->set.exposure, &err))
+			ok = shell_fail(sh, "save: %s", err.msg);
+		else
+			shell_info(sh, "saved %s (%dx%d, %d sample%s, %s)\n", path, fb->w, fb->h, fb->spp,
+			          fb->spp == 1 ? "" : "s", render_mode_name(sh->full_set.mode));
+	} else {
+		ok = shell_fail(sh, "save: \"%s\" has an unknown type; expected .ppm, .pfm, .png, .ans or .rt",
+		                path);
+	}
+	free(path);
+	return ok;
+}
+
+bool cmd_render(shell *sh, int argc, char **argv, const char *rest)
+{
+	(void)argc, (void)argv, (void)rest;
+	const framebuffer *before = sh->full;
+	const framebuffer *fb = shell_full_image(sh, false);
+	if (!fb)
+		return false;
+	shell_info(sh, "%s %dx%d, %d sample%s, %s, depth %d in %.2f s\n",
+	          fb == before ? "up to date:" : "rendered", fb->w,
+	          fb->h, fb->spp, fb->spp == 1 ? "" : "s", render_mode_name(sh->full_set.mode),
+	          sh->full_set.depth, sh->full_seconds);
+	return true;
+}
+
+bool cmd_set(shell *sh, int argc, char **argv, const char *rest)
+{
+	(void)rest;
+	char val[64];
+	if (argc == 0) {
+		for (size_t i = 0; i < settings_count; i++) {
+			settings_format(&sh->set, &settings_table[i], val, sizeof val);
+			shell_out(sh, "  %-11s %-11s %s\n", settings_table[i].name, val, settings_table[i].help);
+		}
+		return true;
+	}
+	rt_error err;
+	const setting_def *def = settings_find(argv[0], &err);
+	if (!def)
+		return shell_fail(sh, "set: %s", err.msg);
+	if (argc == 1) {
+		settings_format(&sh->set, def, val, sizeof val);
+		shell_out(sh, "%s %s\n", def->name, val);
+		return true;
+	}
+	render_settings s = sh->set;
+	if (!settings_set(&s, def, argv[1], &err))
+		return shell_fail(sh, "set: %s", err.msg);
+	shell_edit_begin(sh);
+	sh->set = s;
+	shell_edit_end(sh);
+	return true;
+}
+
+static void list_cameras(shell *sh, const scene *s)
+{
+	char line[512];
+	if (s->ncams == 0)
+		shell_out(sh, "no camera (the default one is used)\n");
+	for (size_t i = 0; i < s->ncams; i++) {
+		rt_format_camera(&s->cams[i], line, sizeof line);
+		shell_out(sh, "camera %zu%s: %s\n", i + 1, i == s->cam ? " (active)" : "", line);
+	}
+}
+
+static void list_lights(shell *sh, const scene *s)
+{
+	char line[512];
+	if (s->nlights == 0)
+		shell_out(sh, "no lights\n");
+	for (size_t i = 0; i < s->nlights; i++) {
+		rt_format_light(&s->lights[i], line, sizeof line);
+		shell_out(sh, "light %zu: %s\n", i + 1, line);
+	}
+}
+
+static void list_objects(shell *sh, const scene *s)
+{
+	char line[1024];
+	if (s->nobjs == 0)
+		shell_out(sh, "no objects\n");
+	for (size_t i = 0; i < s->nobjs; i++) {
+		rt_format_object(&s->objs[i], line, sizeof line);
+		shell_out(sh, "object %zu: %s\n", i + 1, line);
+	}
+}
+
+bool cmd_list(shell *sh, int argc, char **argv, const char *rest)
+{
+	(void)rest;
+	const scene *s = editor_scene(sh->ed);
+	int which = -1;
+	if (argc == 1) {
+		which = choice_pick("cameras|lights|objects", argv[0]);
+		if (which < 0)
+			return shell_fail(sh, "list: \"%s\" is not a list; expected cameras, lights or objects",
+			                  argv[0]);
+	}
+	if (which < 0 || which == 0)
+		list_cameras(sh, s);
+	if (which < 0) {
+		if (s->has_ambient)
+			shell_out(sh, "ambient: A %g %g,%g,%g\n", s->amb.ratio, s->amb.color.x, s->amb.color.y,
+			          s->amb.color.z);
+		else
+			shell_out(sh, "ambient: none\n");
+		if (s->has_sky)
+			shell_out(sh, "sky: %g,%g,%g %g,%g,%g %g\n", s->sky.zenith.x, s->sky.zenith.y,
+			          s->sky.zenith.z, s->sky.horizon.x, s->sky.horizon.y, s->sky.horizon.z,
+			          s->sky.strength);
+	}
+	if (which < 0 || which == 1)
+		list_lights(sh, s);
+	if (which < 0 || which == 2)
+		list_objects(sh, s);
+	return true;
+}
+
+bool cmd_generate(shell *sh, int argc, char **argv, const char *rest)
+{
+	(void)rest;
+	long n;
+	if (!arg_int(sh, "generate", argv[0], 1, GENERATE_MAX, &n))
+		return false;
+	uint64_t seed;
+	if (argc == 2) {
+		char *end;
+		errno = 0;
+		unsigned long long v = strtoull(argv[1], &end, 10);
+		if (!*argv[1] || *argv[1] == '-' || *end || errno)
+			return shell_fail(sh, "generate: \"%s\" is not a seed; expected a whole number >= 0", argv[1]);
+		seed = v;
+	} else {
+		struct timespec t;
+		clock_gettime(CLOCK_REALTIME, &t);
+		seed = ((uint64_t)t.tv_sec * 1000003u ^ (uint64_t)t.tv_nsec) % 1000000;
+	}
+	rt_error err;
+	if (!scene_generate)
+		return shell_fail(sh, "generate: the scene generator is not in this build");
+	scene *s = scene_generate((size_t)n, seed, NULL, &err);
+	if (!s)
+		return shell_fail(sh, "generate: %s", err.msg);
+	char label[96];
+	snprintf(label, sizeof label, "generate:%ld:%" PRIu64, n, seed);
+	if (!shell_replace_scene(sh, s, label))
+		return false;
+	shell_info(sh, "generated %ld object%s with seed %" PRIu64 "\n", n, n == 1 ? "" : "s", seed);
+	return true;
+}
+
+static int cmp_names(const void *a, const void *b)
+{
+	return strcmp(*(char *const *)a, *(char *const *)b);
+}
+
+/* The .rt files of dir in sorted order; NULL with a message on failure. */
+static char **list_rt_files(shell *sh, const char *what, const char *dir, size_t *count)
+{
+	DIR *d = opendir(dir);
+	if (!d) {
+		shell_fail(sh, "%s: cannot read the folder %s: %s", what, dir, strerror(errno));
+		return NULL;
+	}
+	char **names = NULL;
+	size_t n = 0, cap = 0;
+	struct dirent *e;
+	while ((e = readdir(d))) {
+		size_t len = strlen(e->d_name);
+		if (len < 4 || strcmp(e->d_name + len - 3, ".rt") != 0)
+			continue;
+		if (n == cap) {
+			cap = cap ? cap * 2 : 16;
+			char **p = realloc(names, cap * sizeof *p);
+			if (!p)
+				break;
+			names = p;
+		}
+		names[n] = strdup(e->d_name);
+		if (names[n])
+			n++;
+	}
+	closedir(d);
+	qsort(names, n, sizeof *names, cmp_names);
+	*count = n;
+	if (n == 0) {
+		free(names);
+		shell_fail(sh, "%s: no .rt files in %s", what, dir);
+		return NULL;
+	}
+	return names;
+}
+
+static const char *base_name(const char *path)
+{
+	const char *s = strrchr(path, '/');
+	return s ? s + 1 : path;
+}
+
+/* Opens the .rt file `step` places from the current one (wrapping around),
+ * skipping files that fail to load (with a note). */
+static bool step_scene(shell *sh, int step, const char *what)
+{
+	const char *dir = sh->dir ? sh->dir : ".";
+	size_t n;
+	char **names = list_rt_files(sh, what, dir, &n);
+	if (!names)
+		return false;
+	const char *cur = sh->label && strncmp(sh->label, "generate:", 9) != 0 ? base_name(sh->label) : NULL;
+	long at = -1;
+	for (size_t i = 0; cur && i < n; i++)
+		if (strcmp(names[i], cur) == 0)
+			at = (long)i;
+	if (at < 0)
+		at = step > 0 ? -1 : (long)n;
+	bool ok = false;
+	for (size_t tries = 0; tries < n && !ok; tries++) {
+		at = ((at + step) % (long)n + (long)n) % (long)n;
+		if (cur && strcmp(names[at], cur) == 0 && tries > 0)
+			break;
+		char path[4096];
+		if (strcmp(dir, ".") == 0)
+			snprintf(path, sizeof path, "%s", names[at]);
+		else
+			snprintf(path, sizeof path, "%s/%s", dir, names[at]);
+		ok = shell_load(sh, path);
+		if (!ok && tries + 1 < n) {
+			shell_note(sh, "%s (skipped)\n", sh->err);
+			sh->err[0] = '\0';
+		}
+	}
+	for (size_t i = 0; i < n; i++)
+		free(names[i]);
+	free(names);
+	return ok;
+}
+
+bool cmd_next(shell *sh, int argc, char **argv, const char *rest)
+{
+	(void)argc, (void)argv, (void)rest;
+	return step_scene(sh, 1, "next");
+}
+
+bool cmd_prev(shell *sh, int argc, char **argv, const char *rest)
+{
+	(void)argc, (void)argv, (void)rest;
+	return step_scene(sh, -1, "prev");
+}
+
+bool cmd_show(shell *sh, int argc, char **argv, const char *rest)
+{
+	(void)rest;
+	long cols = picture_columns();
+	if (argc == 1 && !arg_int(sh, "show", argv[0], 8, 1000, &cols))
+		return false;
+	frame *f = shell_picture_frame(sh, sh->pal, (int)cols);
+	if (!f)
+		return sh->err[0] ? false : shell_fail(sh, "show: no picture");
+	abuf a;
+	abuf_init(&a);
+	frame_text(f, &a);
+	fflush(stdout);
+	bool ok = !a.failed && write_all(1, a.b, a.len);
+	abuf_free(&a);
+	frame_free(f);
+	return ok ? true : shell_fail(sh, "show: cannot write the picture");
+}
+
+bool cmd_source(shell *sh, int argc, char **argv, const char *rest)
+{
+	(void)argc, (void)rest;
+	if (sh->depth >= 16)
+		return shell_fail(sh, "source: files nest more than 16 deep; expected no loop of source commands");
+	char *path = shell_expand_path(argv[0]);
+	if (!path)
+		return shell_fail(sh, "out of memory");
+	sh->depth++;
+	bool ok = shell_run_file(sh, path);
+	sh->depth--;
+	free(path);
+	return ok;
+}
+
+/* Key mode (issue 6) plugs in here: replace this body with the call into
+ * it; the shell's editor, preview and screen are in sh. */
+bool cmd_view(shell *sh, int argc, char **argv, const char *rest)
+{
+	(void)argc, (void)argv, (void)rest;
+	return shell_fail(sh, "view: key mode is not available yet in this version of rtsh");
+}

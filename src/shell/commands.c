@@ -1,0 +1,435 @@
+/* rtsh — the command table, lookup, argument parsing and `help`. */
+#include "shell/commands.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define SUBS_CAMERA "pos|dir|lookat|fov|move|turn"
+#define SUBS_LIGHT "pos|move|brightness|color"
+#define SUBS_OBJECT "move|rotate|scale|color"
+
+const command command_table[] = {
+	{"load", NULL, "load FILE", 1, 1, {"@file"},
+	 "replace the scene by a .rt file; on any error the current scene stays", cmd_load},
+	{"save", NULL, "save FILE.ppm|FILE.pfm|FILE.png|FILE.ans|FILE.rt", 1, 1, {"@file"},
+	 "write the image (full resolution, rendered first if needed), the picture as ANSI text, or the scene",
+	 cmd_save},
+	{"render", NULL, "render", 0, 0, {NULL},
+	 "render at full resolution now, with progress; Ctrl-C stops it", cmd_render},
+	{"set", NULL, "set\nset KEY\nset KEY VALUE", 0, 2, {"@setting", "@value"},
+	 "list the settings, or show or change one (resolution WxH, samples, depth, mode, threads, seed, exposure)",
+	 cmd_set},
+	{"list", "ls", "list [cameras|lights|objects]", 0, 1, {"cameras|lights|objects"},
+	 "the cameras, ambient, lights and objects with their numbers and fields", cmd_list},
+	{"camera", "cam",
+	 "camera\ncamera N\ncamera pos X,Y,Z\ncamera dir X,Y,Z\ncamera lookat X,Y,Z\ncamera fov DEG\n"
+	 "camera move DX,DY,DZ\ncamera turn YAW,PITCH",
+	 0, 2, {"@camera|" SUBS_CAMERA},
+	 "list the cameras, switch to camera N, or edit the active one (move and turn: camera axes)",
+	 cmd_camera},
+	{"light", NULL,
+	 "light\nlight N pos X,Y,Z\nlight N move DX,DY,DZ\nlight N brightness B\nlight N color R,G,B", 0, 3,
+	 {"@light", SUBS_LIGHT}, "list the lights, or edit light N", cmd_light},
+	{"object", "obj",
+	 "object\nobject N move DX,DY,DZ\nobject N rotate RX,RY,RZ\nobject N scale SX,SY,SZ\n"
+	 "object N color R,G,B",
+	 0, 3, {"@object", SUBS_OBJECT},
+	 "list the objects, or edit object N (move in world axes, rotate in degrees about X, Y, Z)",
+	 cmd_object},
+	{"ambient", NULL, "ambient\nambient brightness B\nambient color R,G,B", 0, 2, {"brightness|color"},
+	 "show or edit the ambient light", cmd_ambient},
+	{"add", NULL, "add LINE", 1, CMD_ANY, {NULL},
+	 "add an element written as a .rt line (A and C replace theirs, c adds a camera)", cmd_add},
+	{"delete", "del rm", "delete object N\ndelete light N\ndelete camera N", 2, 2,
+	 {"object|light|camera", "@ref"}, "remove an object, a light or a camera", cmd_delete},
+	{"undo", NULL, "undo", 0, 0, {NULL}, "undo the last scene edit", cmd_undo},
+	{"redo", NULL, "redo", 0, 0, {NULL}, "redo the last undone edit", cmd_redo},
+	{"generate", "gen", "generate N [SEED]", 1, 2, {NULL},
+	 "replace the scene with N random objects; the same seed gives the same scene", cmd_generate},
+	{"next", NULL, "next", 0, 0, {NULL},
+	 "open the next .rt file of the scene's folder (settings are remembered per scene)", cmd_next},
+	{"prev", "previous", "prev", 0, 0, {NULL}, "open the previous .rt file of the scene's folder",
+	 cmd_prev},
+	{"view", NULL, "view", 0, 0, {NULL},
+	 "full-screen key mode: arrow keys move things on a fast preview; Esc returns", cmd_view},
+	{"show", NULL, "show [COLUMNS]", 0, 1, {NULL},
+	 "print the picture on standard output (half blocks; plain characters without colour)", cmd_show},
+	{"source", ".", "source FILE", 1, 1, {"@file"}, "run a command file", cmd_source},
+	{"help", "?", "help [COMMAND]", 0, 1, {"@command"}, "the commands, or one command's usage",
+	 cmd_help},
+	{"clear", NULL, "clear", 0, 0, {NULL}, "clear the command area", cmd_clear},
+	{"quit", "exit", "quit", 0, 0, {NULL}, "leave rtsh (Ctrl-D too); the terminal is restored",
+	 cmd_quit},
+};
+const size_t command_count = sizeof command_table / sizeof command_table[0];
+
+/* True when `word` is one of the space-separated names in list. */
+static bool in_list(const char *list, const char *word, size_t len, bool prefix)
+{
+	if (!list)
+		return false;
+	const char *p = list;
+	while (*p) {
+		size_t n = strcspn(p, " ");
+		if (prefix ? (len <= n && strncmp(p, word, len) == 0) : (n == len && strncmp(p, word, n) == 0))
+			return true;
+		p += n;
+		while (*p == ' ')
+			p++;
+	}
+	return false;
+}
+
+const command *command_find(const char *word, char *msg, size_t size)
+{
+	size_t len = strlen(word);
+	for (size_t i = 0; i < command_count; i++)
+		if (strcmp(command_table[i].name, word) == 0 || in_list(command_table[i].aliases, word, len, false))
+			return &command_table[i];
+	const command *found = NULL;
+	char names[512] = "";
+	int n = 0;
+	for (size_t i = 0; len && i < command_count; i++) {
+		const command *c = &command_table[i];
+		if (strncmp(c->name, word, len) == 0 || in_list(c->aliases, word, len, true)) {
+			found = c;
+			n++;
+			size_t l = strlen(names);
+			snprintf(names + l, sizeof names - l, "%s%s", l ? ", " : "", c->name);
+		}
+	}
+	if (n == 1)
+		return found;
+	if (n > 1) {
+		/* "a, b, c" -> "a, b or c" */
+		char *last = strrchr(names, ',');
+		char tail[128];
+		if (last) {
+			snprintf(tail, sizeof tail, "%s", last + 2);
+			snprintf(last, sizeof names - (size_t)(last - names), " or %s", tail);
+		}
+		snprintf(msg, size, "ambiguous command \"%s\"; could be %s", word, names);
+	} else {
+		snprintf(msg, size, "unknown command \"%s\"; type help for the list of commands", word);
+	}
+	return NULL;
+}
+
+int choice_pick(const char *choices, const char *word)
+{
+	size_t len = strlen(word);
+	int idx = 0, found = -1, n = 0;
+	for (const char *p = choices; *p; idx++) {
+		size_t k = strcspn(p, "|");
+		if (k == len && strncmp(p, word, len) == 0)
+			return idx;
+		if (len && len < k && strncmp(p, word, len) == 0) {
+			found = idx;
+			n++;
+		}
+		p += k;
+		if (*p == '|')
+			p++;
+	}
+	return n == 1 ? found : -1;
+}
+
+void choice_list(const char *choices, char *buf, size_t size)
+{
+	size_t count = 1;
+	for (const char *p = choices; *p; p++)
+		count += *p == '|';
+	buf[0] = '\0';
+	size_t i = 0;
+	for (const char *p = choices; *p; i++) {
+		size_t k = strcspn(p, "|"), l = strlen(buf);
+		const char *sep = i == 0 ? "" : i + 1 == count ? " or " : ", ";
+		snprintf(buf + l, size - l, "%s%.*s", sep, (int)k, p);
+		p += k;
+		if (*p == '|')
+			p++;
+	}
+}
+
+int split_words(const char *s, char **argv, int max, char *buf, size_t *rest_at, char *msg, size_t size)
+{
+	int argc = 0;
+	const char *p = s;
+	char *o = buf;
+	*rest_at = strlen(s);
+	for (;;) {
+		while (*p == ' ' || *p == '\t' || *p == '\r' || *p == '\n')
+			p++;
+		if (!*p)
+			break;
+		if (argc == 1)
+			*rest_at = (size_t)(p - s);
+		char *start = o;
+		char quote = 0;
+		while (*p && (quote || !(*p == ' ' || *p == '\t' || *p == '\r' || *p == '\n'))) {
+			if (quote) {
+				if (*p == quote) {
+					quote = 0;
+					p++;
+				} else if (*p == '\\' && quote == '"' && (p[1] == '"' || p[1] == '\\')) {
+					*o++ = p[1];
+					p += 2;
+				} else {
+					*o++ = *p++;
+				}
+			} else if (*p == '\'' || *p == '"') {
+				quote = *p++;
+			} else if (*p == '\\' && p[1]) {
+				*o++ = p[1];
+				p += 2;
+			} else {
+				*o++ = *p++;
+			}
+		}
+		if (quote) {
+			snprintf(msg, size, "unclosed %c quote; expected a closing %c", quote, quote);
+			return -1;
+		}
+		*o++ = '\0';
+		if (argc < max)
+			argv[argc] = start;
+		argc++;
+	}
+	if (argc == 1)
+		*rest_at = strlen(s);
+	return argc > max ? max + 1 : argc;
+}
+
+bool parse_number(const char *s, double *out)
+{
+	const char *p = s;
+	if (*p == '+' || *p == '-')
+		p++;
+	int digits = 0;
+	while (isdigit((unsigned char)*p))
+		p++, digits++;
+	if (*p == '.') {
+		p++;
+		while (isdigit((unsigned char)*p))
+			p++, digits++;
+	}
+	if (!digits)
+		return false;
+	if (*p == 'e' || *p == 'E') {
+		p++;
+		if (*p == '+' || *p == '-')
+			p++;
+		if (!isdigit((unsigned char)*p))
+			return false;
+		while (isdigit((unsigned char)*p))
+			p++;
+	}
+	if (*p)
+		return false;
+	errno = 0;
+	double v = strtod(s, NULL);
+	if (!isfinite(v) || fabs(v) > 1e20)
+		return false;
+	*out = v;
+	return true;
+}
+
+bool arg_number(shell *sh, const char *what, const char *word, double lo, double hi, double *out)
+{
+	double v;
+	if (!parse_number(word, &v))
+		return shell_fail(sh, "%s: \"%s\" is not a number; expected a number in %g..%g", what, word, lo, hi);
+	if (v < lo || v > hi)
+		return shell_fail(sh, "%s: %s is out of range; expected a number in %g..%g", what, word, lo, hi);
+	*out = v;
+	return true;
+}
+
+bool arg_int(shell *sh, const char *what, const char *word, long lo, long hi, long *out)
+{
+	char *end;
+	errno = 0;
+	long v = strtol(word, &end, 10);
+	if (!*word || *end || errno || isspace((unsigned char)*word))
+		return shell_fail(sh, "%s: \"%s\" is not a whole number; expected %ld..%ld", what, word, lo, hi);
+	if (v < lo || v > hi)
+		return shell_fail(sh, "%s: %s is out of range; expected %ld..%ld", what, word, lo, hi);
+	*out = v;
+	return true;
+}
+
+/* Exactly n numbers separated by commas. */
+static bool parse_tuple(const char *word, double *v, int n)
+{
+	char buf[256];
+	if (strlen(word) >= sizeof buf)
+		return false;
+	strcpy(buf, word);
+	char *p = buf;
+	for (int i = 0; i < n; i++) {
+		char *comma = strchr(p, ',');
+		if ((i < n - 1) != (comma != NULL))
+			return false;
+		if (comma)
+			*comma = '\0';
+		if (!parse_number(p, &v[i]))
+			return false;
+		p = comma ? comma + 1 : p;
+	}
+	return true;
+}
+
+bool arg_vec(shell *sh, const char *what, const char *word, const char *expect, vec3 *out)
+{
+	double v[3];
+	if (!parse_tuple(word, v, 3))
+		return shell_fail(sh, "%s: \"%s\" is not a vector; expected %s", what, word, expect);
+	*out = v3(v[0], v[1], v[2]);
+	return true;
+}
+
+bool arg_color(shell *sh, const char *what, const char *word, vec3 *out)
+{
+	double v[3];
+	if (!parse_tuple(word, v, 3))
+		return shell_fail(sh, "%s: \"%s\" is not a colour; expected R,G,B with each in 0..255", what, word);
+	for (int i = 0; i < 3; i++)
+		if (v[i] < 0 || v[i] > 255)
+			return shell_fail(sh, "%s: %s is out of range; expected R,G,B with each in 0..255", what,
+			                  word);
+	*out = v3(v[0], v[1], v[2]);
+	return true;
+}
+
+bool arg_index(shell *sh, const char *what, const char *word, const char *kind, size_t n, size_t *out)
+{
+	char *end;
+	errno = 0;
+	unsigned long long v = strtoull(word, &end, 10);
+	bool ok = *word && isdigit((unsigned char)*word) && !*end && !errno && v >= 1 && v <= n;
+	if (!ok) {
+		if (n == 0)
+			return shell_fail(sh, "%s: \"%s\" is not %s %s number; the scene has no %ss", what, word,
+			                  kind[0] == 'o' ? "an" : "a", kind, kind);
+		return shell_fail(sh, "%s: \"%s\" is not %s %s number; expected 1..%zu", what, word,
+		                  kind[0] == 'o' ? "an" : "a", kind, n);
+	}
+	*out = (size_t)(v - 1);
+	return true;
+}
+
+/* "usage: a | b | c" from the usage lines. */
+static void usage_line(const command *c, char *buf, size_t size)
+{
+	snprintf(buf, size, "usage: ");
+	for (const char *p = c->usage; *p;) {
+		size_t k = strcspn(p, "\n"), l = strlen(buf);
+		snprintf(buf + l, size - l, "%s%.*s", p == c->usage ? "" : " | ", (int)k, p);
+		p += k;
+		if (*p == '\n')
+			p++;
+	}
+}
+
+bool command_run(shell *sh, const char *text)
+{
+	size_t len = strlen(text);
+	char *buf = malloc(len + 1);
+	char *argv[CMD_MAX_ARGS + 1];
+	size_t rest_at;
+	char msg[256];
+	if (!buf)
+		return shell_fail(sh, "out of memory");
+	int argc = split_words(text, argv, CMD_MAX_ARGS, buf, &rest_at, msg, sizeof msg);
+	if (argc < 0) {
+		free(buf);
+		return shell_fail(sh, "%s", msg);
+	}
+	if (argc == 0) {
+		free(buf);
+		return true;
+	}
+	const command *c = command_find(argv[0], msg, sizeof msg);
+	if (!c) {
+		free(buf);
+		return shell_fail(sh, "%s", msg);
+	}
+	int nargs = argc - 1;
+	if (nargs < c->min_args || (c->max_args != CMD_ANY && nargs > c->max_args) || argc > CMD_MAX_ARGS) {
+		char u[512];
+		usage_line(c, u, sizeof u);
+		free(buf);
+		const char *why = nargs < c->min_args ? "too few arguments" : "too many arguments";
+		return shell_fail(sh, "%s: %s; %s", c->name, why, u);
+	}
+	/* The raw text after the name, without trailing blanks. */
+	char *rest = strdup(text + rest_at);
+	if (!rest) {
+		free(buf);
+		return shell_fail(sh, "out of memory");
+	}
+	for (size_t n = strlen(rest); n > 0 && strchr(" \t\r\n", rest[n - 1]); n--)
+		rest[n - 1] = '\0';
+	bool ok = c->run(sh, nargs, argv + 1, rest);
+	free(rest);
+	free(buf);
+	return ok;
+}
+
+bool cmd_help(shell *sh, int argc, char **argv, const char *rest)
+{
+	(void)rest;
+	if (argc == 1) {
+		char msg[256];
+		const command *c = command_find(argv[0], msg, sizeof msg);
+		if (!c)
+			return shell_fail(sh, "help: %s", msg);
+		for (const char *p = c->usage; *p;) {
+			size_t k = strcspn(p, "\n");
+			shell_out(sh, "%s%.*s\n", p == c->usage ? "usage: " : "       ", (int)k, p);
+			p += k;
+			if (*p == '\n')
+				p++;
+		}
+		shell_out(sh, "%s\n", c->help);
+		if (c->aliases)
+			shell_out(sh, "also: %s\n", c->aliases);
+		return true;
+	}
+	shell_out(sh, "commands (a unique prefix is enough; help COMMAND for its usage):\n");
+	for (size_t i = 0; i < command_count; i++) {
+		const command *c = &command_table[i];
+		shell_out(sh, "  %-9s %s\n", c->name, c->help);
+	}
+	shell_out(sh, "vectors X,Y,Z and colours R,G,B (0-255) as in .rt files; objects and lights "
+	              "are numbered from 1 (see list)\n");
+	return true;
+}
+
+bool cmd_quit(shell *sh, int argc, char **argv, const char *rest)
+{
+	(void)argc, (void)argv, (void)rest;
+	sh->quit = true;
+	return true;
+}
+
+bool cmd_clear(shell *sh, int argc, char **argv, const char *rest)
+{
+	(void)argc, (void)argv, (void)rest;
+	if (sh->scr && sh->scr->active) {
+		/* Clear the scroll region only, and start again at its bottom. */
+		fflush(stdout);
+		abuf a;
+		abuf_init(&a);
+		for (int r = sh->scr->region_top; r < sh->scr->rows; r++)
+			abuf_printf(&a, "\x1b[%dH\x1b[K", r + 1);
+		if (!a.failed)
+			write_all(sh->scr->fd, a.b, a.len);
+		abuf_free(&a);
+	}
+	return true;
+}

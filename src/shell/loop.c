@@ -1,0 +1,297 @@
+/* rtsh — the interactive loop: readline's callback interface and select()
+ * on standard input and the wake-up pipe, so typing never waits for a
+ * render. The render thread (preview.c) writes a byte to the pipe when an
+ * image is ready; the signal handlers below set a flag and write a byte
+ * too; everything else happens here, in the main thread, which alone talks
+ * to the terminal.
+ */
+#include <errno.h>
+#include <locale.h>
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/select.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <readline/history.h>
+#include <readline/readline.h>
+
+#include "shell/complete.h"
+#include "shell/history.h"
+#include "shell/shell.h"
+#include "term/caps.h"
+
+/* At most this many frames a second. */
+#define FRAME_INTERVAL 0.1
+#define PROMPT "rtsh> "
+
+static shell *active;     /* the shell readline's line handler runs commands in */
+static int wake_write = -1;
+static shell_history hist;
+
+static double now(void)
+{
+	struct timespec t;
+	clock_gettime(CLOCK_MONOTONIC, &t);
+	return (double)t.tv_sec + t.tv_nsec * 1e-9;
+}
+
+static void poke(void)
+{
+	if (wake_write >= 0) {
+		int saved = errno;
+		ssize_t r = write(wake_write, "s", 1);
+		(void)r;
+		errno = saved;
+	}
+}
+
+static void on_signal(int sig)
+{
+	switch (sig) {
+	case SIGINT:
+		shell_sig_int = 1;
+		if (shell_current)
+			atomic_store(&shell_current->cancel, true);
+		break;
+	case SIGWINCH:
+		shell_sig_winch = 1;
+		break;
+	case SIGTSTP:
+		shell_sig_tstp = 1;
+		break;
+	case SIGCONT:
+		shell_sig_cont = 1;
+		break;
+	default: /* SIGTERM, SIGHUP */
+		shell_sig_term = sig;
+		if (shell_current)
+			atomic_store(&shell_current->cancel, true);
+		break;
+	}
+	poke();
+}
+
+static const int handled[] = {SIGINT, SIGTERM, SIGHUP, SIGWINCH, SIGTSTP, SIGCONT};
+#define NHANDLED (sizeof handled / sizeof handled[0])
+
+static void install_signals(struct sigaction *old)
+{
+	struct sigaction sa;
+	memset(&sa, 0, sizeof sa);
+	sa.sa_handler = on_signal;
+	sigemptyset(&sa.sa_mask);
+	for (size_t i = 0; i < NHANDLED; i++)
+		sigaction(handled[i], &sa, &old[i]);
+}
+
+static void restore_signals(const struct sigaction *old)
+{
+	for (size_t i = 0; i < NHANDLED; i++)
+		sigaction(handled[i], &old[i], NULL);
+}
+
+static void draw_status(shell *sh)
+{
+	if (!sh->scr || !sh->scr->active)
+		return;
+	char text[512];
+	shell_status_text(sh, text, sizeof text);
+	fflush(stdout);
+	screen_status(sh->scr, text);
+}
+
+/* Sends the newest preview image, converted with the exposure. */
+static void draw_picture(shell *sh)
+{
+	sh->redraw = false;
+	screen *scr = sh->scr;
+	const preview_image *im = &sh->img;
+	if (!scr || !scr->active || im->w != scr->img_w || im->h != scr->img_h || !im->rgb)
+		return;
+	size_t n = (size_t)im->w * im->h * 3;
+	if (n > sh->srgb_cap) {
+		uint8_t *p = realloc(sh->srgb, n);
+		if (!p)
+			return;
+		sh->srgb = p;
+		sh->srgb_cap = n;
+	}
+	frame_srgb_from_linear(im->rgb, (size_t)im->w * im->h, sh->set.exposure, sh->srgb);
+	fflush(stdout);
+	screen_picture(scr, sh->srgb, im->w, im->h);
+	sh->last_draw = now();
+}
+
+static void on_line(char *line)
+{
+	shell *sh = active;
+	if (!line) { /* Ctrl-D or end of input */
+		fputs("\n", stdout);
+		sh->quit = true;
+		return;
+	}
+	history_add_line(&hist, line);
+	shell_sig_int = 0;
+	if (!shell_run_line(sh, line))
+		shell_report(sh);
+	free(line);
+	fflush(stdout);
+	shell_sig_int = 0;
+	/* The command may have taken a while: show what came meanwhile. */
+	if (preview_take(sh->pv, &sh->img))
+		sh->redraw = true;
+	draw_status(sh);
+}
+
+/* Ctrl-C at the prompt: stop a render in flight, else clear the line. */
+static void interrupt(shell *sh)
+{
+	atomic_store(&sh->cancel, false);
+	if (preview_stop(sh->pv)) {
+		preview_take(sh->pv, &sh->img);
+		draw_status(sh);
+		return;
+	}
+	rl_callback_sigcleanup();
+	rl_replace_line("", 0);
+	fputs("^C", rl_outstream);
+	rl_crlf();
+	rl_on_new_line();
+	rl_redisplay();
+}
+
+/* Ctrl-Z: give the terminal back, stop, and take it again on SIGCONT. */
+static void suspend(shell *sh)
+{
+	rl_deprep_terminal();
+	if (sh->scr)
+		screen_suspend(sh->scr);
+	struct sigaction sa, old;
+	memset(&sa, 0, sizeof sa);
+	sa.sa_handler = SIG_DFL;
+	sigemptyset(&sa.sa_mask);
+	sigaction(SIGTSTP, &sa, &old);
+	raise(SIGTSTP);
+	/* ... continued. */
+	sigaction(SIGTSTP, &old, NULL);
+	rl_prep_terminal(1);
+	if (sh->scr) {
+		screen_resume(sh->scr);
+		shell_refresh(sh);
+		sh->redraw = true;
+	}
+	rl_forced_update_display();
+}
+
+static void relayout(shell *sh)
+{
+	if (sh->scr) {
+		screen_layout(sh->scr, (double)sh->set.width / sh->set.height, true);
+		rl_set_screen_size(sh->scr->rows - sh->scr->region_top, sh->scr->cols);
+		shell_refresh(sh);
+		sh->redraw = true;
+		draw_status(sh);
+	} else {
+		rl_resize_terminal();
+	}
+	rl_forced_update_display();
+}
+
+int shell_interactive(shell *sh, bool use_screen, const int wake[2])
+{
+	int wake_fd = wake[0];
+	setlocale(LC_CTYPE, "");
+	active = sh;
+	wake_write = -1;
+	struct sigaction old[NHANDLED];
+	shell_sig_int = shell_sig_term = shell_sig_winch = shell_sig_tstp = shell_sig_cont = 0;
+
+	screen scr;
+	if (use_screen && screen_enter(&scr, STDOUT_FILENO, caps_palette(sh->opt->color, STDOUT_FILENO),
+	                               (double)sh->set.width / sh->set.height))
+		sh->scr = &scr;
+	history_setup(&hist, stderr);
+	install_signals(old);
+	wake_write = wake[1]; /* for the signal handlers */
+
+	rl_catch_signals = 0;
+	rl_catch_sigwinch = 0;
+	rl_change_environment = 0;
+	rl_readline_name = "rtsh";
+	if (!sh->scr && !isatty(STDOUT_FILENO))
+		rl_outstream = stderr;
+	complete_install(sh);
+	if (sh->scr)
+		rl_set_screen_size(scr.rows - scr.region_top, scr.cols);
+	sh->status_hook = draw_status;
+	shell_refresh(sh);
+	draw_status(sh);
+	rl_callback_handler_install(PROMPT, on_line);
+
+	int status = 0;
+	while (!sh->quit) {
+		fd_set rd;
+		FD_ZERO(&rd);
+		FD_SET(STDIN_FILENO, &rd);
+		if (wake_fd >= 0)
+			FD_SET(wake_fd, &rd);
+		struct timeval tv, *tvp = NULL;
+		if (sh->redraw) {
+			double wait = sh->last_draw + FRAME_INTERVAL - now();
+			if (wait < 0)
+				wait = 0;
+			tv.tv_sec = (time_t)wait;
+			tv.tv_usec = (suseconds_t)((wait - (double)tv.tv_sec) * 1e6);
+			tvp = &tv;
+		}
+		int n = select((wake_fd > STDIN_FILENO ? wake_fd : STDIN_FILENO) + 1, &rd, NULL, NULL, tvp);
+		if (n < 0 && errno != EINTR)
+			break;
+		if (n > 0 && wake_fd >= 0 && FD_ISSET(wake_fd, &rd)) {
+			char buf[256];
+			while (read(wake_fd, buf, sizeof buf) > 0)
+				;
+		}
+		if (shell_sig_term) {
+			status = 128 + shell_sig_term;
+			break;
+		}
+		if (shell_sig_winch) {
+			shell_sig_winch = 0;
+			relayout(sh);
+		}
+		if (shell_sig_tstp) {
+			shell_sig_tstp = 0;
+			suspend(sh);
+		}
+		shell_sig_cont = 0;
+		if (shell_sig_int) {
+			shell_sig_int = 0;
+			interrupt(sh);
+		}
+		if (preview_take(sh->pv, &sh->img)) {
+			sh->redraw = true;
+			draw_status(sh);
+		}
+		if (sh->redraw && now() - sh->last_draw >= FRAME_INTERVAL)
+			draw_picture(sh);
+		if (n > 0 && FD_ISSET(STDIN_FILENO, &rd))
+			rl_callback_read_char();
+	}
+	rl_callback_handler_remove();
+	history_finish(&hist);
+	sh->status_hook = NULL;
+	preview_hold(sh->pv);
+	if (sh->scr) {
+		screen_leave(sh->scr);
+		sh->scr = NULL;
+	}
+	restore_signals(old);
+	wake_write = -1;
+	active = NULL;
+	return status;
+}

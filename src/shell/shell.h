@@ -1,0 +1,142 @@
+/* rtsh — the shell's state and the helpers its commands share.
+ *
+ * One `shell` lives for the whole run. Commands (commands.h) read and change
+ * it; the scene itself is changed only through the editor (rtsh/edit.h).
+ * The shell runs in one of two ways:
+ *   - interactive (loop.c): readline, the picture and the status line on
+ *     the alternate screen, a background preview; errors are reported and
+ *     the shell goes on;
+ *   - script (script.c): -c, -f, piped standard input; no picture; the
+ *     first error prints "FILE:LINE: message" and stops with status 1.
+ */
+#ifndef RTSH_SHELL_H
+#define RTSH_SHELL_H
+
+#include <signal.h>
+#include <stdatomic.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "rtsh/edit.h"
+#include "rtsh/render.h"
+#include "rtsh/rtfile.h"
+#include "shell/options.h"
+#include "shell/preview.h"
+#include "term/frame.h"
+#include "term/screen.h"
+
+#define SHELL_MSG_MAX 1024
+
+/* Settings remembered per scene file for the session (next, prev, load). */
+typedef struct scene_memo {
+	char *label;
+	render_settings set;
+} scene_memo;
+
+typedef struct shell {
+	const rtsh_options *opt;
+	editor *ed;
+	render_settings set;
+
+	/* The scene's name and origin, from the editor's label. */
+	char *label;           /* copy of editor_label() last seen: a path, or NULL */
+	char name[256];        /* for the status line and messages */
+	char *dir;             /* the folder next/prev walk through */
+	scene_memo *memo;
+	size_t nmemo;
+
+	rt_load_opts load_opts;
+	rt_warnings warn;
+
+	/* Output. */
+	bool interactive;      /* a person types: errors do not stop */
+	bool progress;         /* progress bars for full renders (stderr or status line) */
+	frame_palette pal;     /* for `show` on standard output */
+	screen *scr;           /* NULL: no picture */
+	preview *pv;           /* the world cache, and the background preview */
+	preview_image img;     /* the newest preview image shown */
+	uint8_t *srgb;         /* img as sRGB bytes */
+	size_t srgb_cap;
+	double last_draw;      /* when the picture was last sent */
+	bool redraw;           /* an image waits to be drawn */
+
+	/* The full-resolution image and what it was rendered from. */
+	framebuffer *full;
+	uint64_t full_gen;
+	render_settings full_set;
+	double full_seconds;
+
+	/* Running. */
+	bool quit;
+	atomic_bool cancel;    /* Ctrl-C: stops a full render */
+	char err[SHELL_MSG_MAX];
+	bool err_reported;     /* err was printed already (by a nested source) */
+	int depth;             /* source nesting */
+	void (*status_hook)(struct shell *sh); /* redraws the status line (interactive) */
+} shell;
+
+/* Signals, set by handlers (loop.c, script.c) and read by the loops. */
+extern volatile sig_atomic_t shell_sig_int, shell_sig_term, shell_sig_winch, shell_sig_tstp;
+extern volatile sig_atomic_t shell_sig_cont;
+/* The shell whose cancel flag the SIGINT handler sets. */
+extern shell *shell_current;
+
+/* Records an error message for the command being run; returns false. */
+bool shell_fail(shell *sh, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* Prints to standard output (command results). */
+void shell_out(shell *sh, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* Prints a confirmation ("saved x.png") to standard output, unless -q. */
+void shell_info(shell *sh, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* Prints a note to standard error (warnings, progress text). */
+void shell_note(shell *sh, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* Sets up the shell for the options: loads the scene (or the built-in one)
+ * and applies the settings; the preview wakes wake_fd (-1: none). False
+ * (message printed) when the scene fails. */
+bool shell_init(shell *sh, const rtsh_options *o, int wake_fd);
+void shell_free(shell *sh);
+
+/* Call before changing the scene or the settings: stops the preview. */
+void shell_edit_begin(shell *sh);
+/* Call after: notices a new scene (name, settings) and restarts the preview. */
+void shell_edit_end(shell *sh);
+/* Restarts the preview for the current scene, settings and screen size. */
+void shell_refresh(shell *sh);
+/* The status line's text. */
+void shell_status_text(shell *sh, char *buf, size_t size);
+
+/* The full-resolution image for the current scene and settings, rendered
+ * now if missing or stale (with progress, Ctrl-C stops it); NULL (error
+ * recorded) on failure. */
+const framebuffer *shell_full_image(shell *sh, bool force);
+/* The picture as a frame of cells for `save X.ans` and `show`: the current
+ * preview when there is one, else rendered at `cols` columns. */
+frame *shell_picture_frame(shell *sh, frame_palette pal, int cols);
+
+/* Replaces the scene (load, next, prev, generate). */
+bool shell_replace_scene(shell *sh, scene *s, const char *label);
+/* Loads a scene file (the current scene stays on failure). */
+bool shell_load(shell *sh, const char *path);
+
+/* --- running commands (script.c) --- */
+/* Runs one command line (commands separated by ';'); false on the first
+ * error (recorded in sh->err). */
+bool shell_run_line(shell *sh, const char *line);
+/* Runs text as a command file named `name`; -c uses counts commands
+ * instead of lines. Reports the first error as "NAME:LINE: message" and
+ * returns false. */
+bool shell_run_text(shell *sh, const char *text, const char *name, bool count_commands);
+/* Runs a command file ("-" = standard input). */
+bool shell_run_file(shell *sh, const char *path);
+/* Prints sh->err for an interactive command (not yet reported). */
+void shell_report(shell *sh);
+
+/* The interactive shell (loop.c), full screen when use_screen; wake is the
+ * preview's wake-up pipe (read end, write end). Returns the exit status. */
+int shell_interactive(shell *sh, bool use_screen, const int wake[2]);
+
+/* ~ and ~/ at the start of a path, expanded with $HOME; a new string. */
+char *shell_expand_path(const char *path);
+
+#endif
