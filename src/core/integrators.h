@@ -45,8 +45,9 @@ typedef struct bsdf_sample {
 void bsdf_make(bsdf *b, const mat_lin *m, const hit *h, vec3 wo);
 /* The BSDF value f(wi, wo) of the non-delta lobes (per steradian). */
 vec3 bsdf_eval(const bsdf *b, vec3 wi);
-/* Samples a direction from u1, u2, u3 in [0,1); false when the path is absorbed. */
-bool bsdf_sample_dir(const bsdf *b, double u1, double u2, double u3, bsdf_sample *out);
+/* Samples a lobe and a direction with random numbers from g; false when
+ * the path is absorbed. */
+bool bsdf_sample_dir(const bsdf *b, rng *g, bsdf_sample *out);
 /* The Phong exponent of a mirror lobe of roughness fuzz in (0,1]. */
 double fuzz_exponent(double fuzz);
 

@@ -35,28 +35,52 @@ static void basis(vec3 n, vec3 *t, vec3 *b)
 	*b = v3(c, sign + n.y * n.y * a, -n.y);
 }
 
-/* The direction (sin a cos phi, sin a sin phi, cos a) about axis. */
-static vec3 around(vec3 axis, double cos_a, double phi)
+/* The largest component (plain comparisons: fmax is a library call). */
+static inline double max3(vec3 v)
 {
-	vec3 t, b;
-	basis(axis, &t, &b);
-	double sin_a = sqrt(fmax(0.0, 1.0 - cos_a * cos_a));
-	return v3_add(v3_add(v3_scale(t, sin_a * cos(phi)), v3_scale(b, sin_a * sin(phi))),
-	              v3_scale(axis, cos_a));
+	double m = v.x > v.y ? v.x : v.y;
+	return m > v.z ? m : v.z;
 }
 
-/* Cosine-weighted about n, pdf cos / pi (Malley's method). */
-static vec3 sample_cosine(vec3 n, double u1, double u2)
+/* A uniform point (x, y) of the unit disc, by rejection from the square
+ * (no trigonometry; on average 2.55 random numbers). *r2 = x^2 + y^2 > 0. */
+static void disc_point(rng *g, double *x, double *y, double *r2)
 {
-	return around(n, sqrt(fmax(0.0, 1.0 - u1)), 2.0 * RT_PI * u2);
+	for (;;) {
+		double a = 2.0 * rng_next(g) - 1.0, c = 2.0 * rng_next(g) - 1.0, s = a * a + c * c;
+		if (s < 1.0 && s > 0.0) {
+			*x = a;
+			*y = c;
+			*r2 = s;
+			return;
+		}
+	}
+}
+
+/* Cosine-weighted about n, pdf cos / pi: a uniform point of the unit disc
+ * lifted onto the hemisphere (Malley's method). */
+static vec3 sample_cosine(vec3 n, rng *g)
+{
+	double x, y, r2;
+	disc_point(g, &x, &y, &r2);
+	vec3 t, b;
+	basis(n, &t, &b);
+	return v3_add(v3_add(v3_scale(t, x), v3_scale(b, y)), v3_scale(n, sqrt(1.0 - r2)));
 }
 
 /* Proportional to cos^e of the angle to axis, pdf (e + 1) / (2 pi) cos^e
  * (Lafortune & Willems, "Using the modified Phong reflectance model for
- * physically based rendering", 1994). */
-static vec3 sample_phong(vec3 axis, double e, double u1, double u2)
+ * physically based rendering", 1994). The azimuth is the direction of a
+ * uniform point of the disc. */
+static vec3 sample_phong(vec3 axis, double e, rng *g)
 {
-	return around(axis, pow(u1, 1.0 / (e + 1.0)), 2.0 * RT_PI * u2);
+	double cos_a = pow(rng_next(g), 1.0 / (e + 1.0));
+	double x, y, r2;
+	disc_point(g, &x, &y, &r2);
+	double k = sqrt(fmax(0.0, 1.0 - cos_a * cos_a) / r2);
+	vec3 t, b;
+	basis(axis, &t, &b);
+	return v3_add(v3_add(v3_scale(t, x * k), v3_scale(b, y * k)), v3_scale(axis, cos_a));
 }
 
 /* The normalised Phong lobe (e + 2) / (2 pi) cos^e a: its albedo is 1 at
@@ -113,7 +137,7 @@ void bsdf_make(bsdf *b, const mat_lin *m, const hit *h, vec3 wo)
 		b->kd = v3_scale(albedo, d * k);
 		b->ks = v3_splat(s * k);
 		b->ns = fmax(m->shininess, 0.0);
-		w[0] = v3_max_comp(b->kd);
+		w[0] = max3(b->kd);
 		w[1] = s * k;
 	}
 	if (mirror > 0.0) {
@@ -124,7 +148,7 @@ void bsdf_make(bsdf *b, const mat_lin *m, const hit *h, vec3 wo)
 		double x = 1.0 - b->cos_o, x5 = x * x * x * x * x;
 		b->km = v3_scale(v3_add(f0, v3_scale(v3_sub(v3_splat(1.0), f0), x5)), mirror);
 		b->nm = m->fuzz > 0.0 ? fuzz_exponent(fmin(m->fuzz, 1.0)) : -1.0;
-		w[2] = v3_max_comp(b->km);
+		w[2] = max3(b->km);
 	} else {
 		b->nm = -1.0;
 	}
@@ -150,10 +174,11 @@ vec3 bsdf_eval(const bsdf *b, vec3 wi)
 	return f;
 }
 
-bool bsdf_sample_dir(const bsdf *b, double u0, double u1, double u2, bsdf_sample *out)
+bool bsdf_sample_dir(const bsdf *b, rng *g, bsdf_sample *out)
 {
 	if (!(b->total > 0.0))
 		return false;
+	double u0 = rng_next(g);
 	int lobe = 0;
 	double acc = b->p[0];
 	while (lobe < 3 && (u0 >= acc || b->p[lobe] == 0.0))
@@ -168,7 +193,7 @@ bool bsdf_sample_dir(const bsdf *b, double u0, double u1, double u2, bsdf_sample
 	out->delta = false;
 	switch (lobe) {
 	case 0: /* Lambert: f cos / pdf = (kd / pi) cos / (cos / pi) */
-		out->wi = sample_cosine(b->n, u1, u2);
+		out->wi = sample_cosine(b->n, g);
 		out->weight = v3_scale(b->kd, inv_p);
 		return true;
 	case 1:
@@ -181,7 +206,7 @@ bool bsdf_sample_dir(const bsdf *b, double u0, double u1, double u2, bsdf_sample
 			out->delta = true;
 			return true;
 		}
-		out->wi = sample_phong(r, e, u1, u2);
+		out->wi = sample_phong(r, e, g);
 		double c = v3_dot(out->wi, b->n);
 		if (c <= 0.0)
 			return false; /* below the surface: the lobe's lost energy */
@@ -193,7 +218,7 @@ bool bsdf_sample_dir(const bsdf *b, double u0, double u1, double u2, bsdf_sample
 		double eta = b->front ? b->ior : 1.0 / b->ior, cos_t;
 		double f = fresnel_dielectric(b->cos_o, eta, &cos_t);
 		out->delta = true;
-		if (u1 < f) {
+		if (rng_next(g) < f) {
 			out->wi = r;
 			out->weight = v3_splat(b->wg * inv_p);
 			return true;
@@ -261,9 +286,8 @@ vec3 path_radiance(const world *w, const render_settings *s, ray r, rng *g)
 		if (b.smooth && w->nlights)
 			radiance = v3_add(radiance, v3_mul(thr, direct_light(w, &b, p)));
 
-		double u0 = rng_next(g), u1 = rng_next(g), u2 = rng_next(g);
 		bsdf_sample bs;
-		if (!bsdf_sample_dir(&b, u0, u1, u2, &bs))
+		if (!bsdf_sample_dir(&b, g, &bs))
 			break;
 		thr = v3_mul(thr, v3_scale(bs.weight, bs.radiance_scale));
 		eta_scale /= bs.radiance_scale;
@@ -272,7 +296,8 @@ vec3 path_radiance(const world *w, const render_settings *s, ray r, rng *g)
 		/* Russian roulette after the third bounce: survive with q, weigh
 		 * the survivors by 1 / q. */
 		if (bounce >= 3) {
-			double q = fmin(0.95, v3_max_comp(thr) * eta_scale);
+			double q = max3(thr) * eta_scale;
+			q = q < 0.95 ? q : 0.95;
 			if (!(q > 0.0) || rng_next(g) >= q)
 				break;
 			thr = v3_scale(thr, 1.0 / q);
