@@ -110,8 +110,10 @@ static void draw_picture(shell *sh)
 	sh->redraw = false;
 	screen *scr = sh->scr;
 	const preview_image *im = &sh->img;
-	if (!scr || !scr->active || im->w != scr->img_w || im->h != scr->img_h || !im->rgb)
+	if (!scr || !scr->active || im->w != scr->img_w || im->h != scr->img_h || !im->rgb) {
+		draw_status(sh);
 		return;
+	}
 	size_t n = (size_t)im->w * im->h * 3;
 	if (n > sh->srgb_cap) {
 		uint8_t *p = realloc(sh->srgb, n);
@@ -124,6 +126,7 @@ static void draw_picture(shell *sh)
 	fflush(stdout);
 	screen_picture(scr, sh->srgb, im->w, im->h);
 	sh->last_draw = now();
+	draw_status(sh); /* the status line tells about the picture shown */
 }
 
 static void on_line(char *line)
@@ -273,10 +276,8 @@ int shell_interactive(shell *sh, bool use_screen, const int wake[2])
 			shell_sig_int = 0;
 			interrupt(sh);
 		}
-		if (preview_take(sh->pv, &sh->img)) {
+		if (preview_take(sh->pv, &sh->img))
 			sh->redraw = true;
-			draw_status(sh);
-		}
 		if (sh->redraw && now() - sh->last_draw >= FRAME_INTERVAL)
 			draw_picture(sh);
 		if (n > 0 && FD_ISSET(STDIN_FILENO, &rd))
