@@ -146,13 +146,17 @@ static void redraw_chrome(screen *s)
 
 bool screen_layout(screen *s, double aspect, bool force)
 {
-	int oc = s->cols, orow = s->rows, ow = s->img_w, oh = s->img_h;
+	int oc = s->cols, orow = s->rows, opic = s->pic_rows, ow = s->img_w, oh = s->img_h;
 	double oa = s->aspect;
 	query_size(s);
 	s->aspect = aspect > 0 && isfinite(aspect) ? aspect : 16.0 / 9.0;
 	compute_layout(s);
-	bool changed = oc != s->cols || orow != s->rows || oa != s->aspect;
-	if (changed || force || !s->fr) {
+	bool changed = oc != s->cols || orow != s->rows || opic != s->pic_rows;
+	if (!changed && !force && s->fr && oa != s->aspect) {
+		/* Only the image's shape changed: the next frame update erases
+		 * the old picture; the prompt's lines stay. */
+		frame_clear(s->fr);
+	} else if (changed || force || !s->fr) {
 		if (!s->fr || s->fr->cols != s->cols || s->fr->rows != s->pic_rows) {
 			frame_free(s->fr);
 			s->fr = s->pic_rows > 0 ? frame_new(s->cols, s->pic_rows, s->pal) : NULL;
