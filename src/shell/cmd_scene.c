@@ -273,7 +273,8 @@ static char **list_rt_files(shell *sh, const char *what, const char *dir, size_t
 			n++;
 	}
 	closedir(d);
-	qsort(names, n, sizeof *names, cmp_names);
+	if (n > 0)
+		qsort(names, n, sizeof *names, cmp_names);
 	*count = n;
 	if (n == 0) {
 		free(names);
