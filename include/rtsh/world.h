@@ -25,12 +25,31 @@ typedef struct mat_lin {
 	double fuzz, metal, ior;
 	vec3 emission;     /* emitted radiance (linear) */
 	double checker;    /* squares per unit; 0 = none */
+	int32_t light;     /* index into world.emitters; -1 when not sampled */
 } mat_lin;
 
 typedef struct light_lin {
 	vec3 pos;
 	vec3 radiance; /* ratio x linear colour */
 } light_lin;
+
+/* An emissive surface the path tracer samples directly (path.c): spheres
+ * with a uniform scale and no shear, rectangles, discs and triangles. */
+typedef enum emitter_shape {
+	EMITTER_SPHERE,
+	EMITTER_RECT,     /* c + a u + b v, a and b in [-1,1] */
+	EMITTER_DISC,     /* the same with a^2 + b^2 <= 1 */
+	EMITTER_TRIANGLE, /* c + a u + b v, a, b >= 0, a + b <= 1 */
+} emitter_shape;
+
+typedef struct emitter {
+	uint32_t object; /* the scene object */
+	uint32_t shape;  /* emitter_shape */
+	vec3 c, u, v;    /* sphere: centre; flat shapes: see emitter_shape */
+	vec3 n;          /* flat shapes: unit normal */
+	double r;        /* sphere radius */
+	double area;     /* flat shapes */
+} emitter;
 
 /* Camera axes: forward, right and up are unit and orthogonal; a pixel's
  * ray direction is fwd + u*half_w*right + v*half_h*up with u, v in [-1,1]. */
@@ -71,6 +90,8 @@ typedef struct world {
 	size_t nplanes;
 	mat_lin *mats;   /* indexed by prim.object */
 	size_t nmats;
+	emitter *emitters; /* sampled in path mode; nemitters = 0 turns that off */
+	size_t nemitters;
 	bvh *tree;       /* over prims */
 	box bounds;      /* of the bounded primitives */
 	double eps;      /* self-intersection offset scale for this scene */

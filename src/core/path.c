@@ -3,10 +3,13 @@
  *
  * One path per camera sample. At every vertex the path adds the emission it
  * finds, adds next-event estimation toward every point light (a shadow ray
- * each; point lights cannot be hit by a path, so nothing is counted twice),
- * then picks one lobe of the material and continues in a direction sampled
- * from it. Russian roulette ends paths after the third bounce without bias
- * (Arvo & Kirk, "Particle transport and image synthesis", 1990).
+ * each; point lights cannot be hit by a path, so nothing is counted twice)
+ * and toward one emissive sphere, rectangle, disc or triangle (whose light
+ * the path can also find: the two estimates are weighed by multiple
+ * importance sampling), then picks one lobe of the material and continues
+ * in a direction sampled from it. Russian roulette ends paths after the
+ * third bounce without bias (Arvo & Kirk, "Particle transport and image
+ * synthesis", 1990).
  *
  * Materials are a mix of lobes whose shares never sum above 1 (rtsh(5),
  * "Materials"):
@@ -24,6 +27,8 @@
  * radiance ratio L gives a surface the irradiance pi * L * cos(theta), so a
  * white Lambertian surface facing it sends back exactly L. */
 #include "integrators.h"
+
+#include <stdlib.h>
 
 /* An orthonormal basis (t, b) around the unit vector n (Duff et al.,
  * "Building an orthonormal basis, revisited", JCGT 2017). */
@@ -174,6 +179,27 @@ vec3 bsdf_eval(const bsdf *b, vec3 wi)
 	return f;
 }
 
+/* The density of sample_phong's directions. */
+static double phong_pdf(double cos_a, double e)
+{
+	return cos_a > 0.0 ? (e + 1.0) * (0.5 / RT_PI) * pow(cos_a, e) : 0.0;
+}
+
+double bsdf_pdf(const bsdf *b, vec3 wi)
+{
+	double c = v3_dot(b->n, wi);
+	if (c <= 0.0 || !b->smooth)
+		return 0.0;
+	double pdf = b->p[0] * c / RT_PI;
+	vec3 r = v3_sub(v3_scale(b->n, 2.0 * b->cos_o), b->wo);
+	double cos_r = v3_dot(wi, r);
+	if (b->p[1] > 0.0)
+		pdf += b->p[1] * phong_pdf(cos_r, b->ns);
+	if (b->p[2] > 0.0 && b->nm >= 0.0)
+		pdf += b->p[2] * phong_pdf(cos_r, b->nm);
+	return pdf;
+}
+
 bool bsdf_sample_dir(const bsdf *b, rng *g, bsdf_sample *out)
 {
 	if (!(b->total > 0.0))
@@ -263,6 +289,168 @@ static vec3 direct_light(const world *w, const bsdf *b, vec3 p)
 	return sum;
 }
 
+/* --- emissive surfaces: sampled directly and found by the paths, the two
+ * combined by multiple importance sampling with the power heuristic (Veach
+ * & Guibas, "Optimally combining sampling techniques for Monte Carlo
+ * rendering", SIGGRAPH 1995). */
+
+bool emitters_build(world *w, const scene *s, rt_error *err)
+{
+	w->emitters = NULL;
+	w->nemitters = 0;
+	size_t n = 0;
+	for (size_t pass = 0; pass < 2; pass++) {
+		for (size_t i = 0; i < s->nobjs; i++) {
+			const object *o = &s->objs[i];
+			const mat_lin *m = &w->mats[i];
+			if (!(max3(m->emission) > 0.0))
+				continue;
+			emitter e = {.object = (uint32_t)i};
+			bool plain = true; /* uniform scale, no shear */
+			for (int k = 0; k < 6; k++)
+				plain = plain && o->shear[k] == 0.0;
+			xform x;
+			if (o->kind == OBJ_SPHERE && plain && o->scale.x == o->scale.y &&
+			    o->scale.y == o->scale.z) {
+				e.shape = EMITTER_SPHERE;
+				e.c = o->pos;
+				e.r = 0.5 * o->scale.x;
+			} else if (o->kind == OBJ_TRIANGLE) {
+				e.shape = EMITTER_TRIANGLE;
+				e.c = o->tri[0];
+				e.u = v3_sub(o->tri[1], o->tri[0]);
+				e.v = v3_sub(o->tri[2], o->tri[0]);
+				e.area = 0.5 * v3_len(v3_cross(e.u, e.v));
+			} else if ((o->kind == OBJ_RECT || o->kind == OBJ_DISC) && object_xform(o, &x)) {
+				/* the unit shape's axes X and Z, carried into the world */
+				e.shape = o->kind == OBJ_RECT ? EMITTER_RECT : EMITTER_DISC;
+				e.c = m4_point(&x.m, v3(0, 0, 0));
+				e.u = m4_vector(&x.m, v3(1, 0, 0));
+				e.v = m4_vector(&x.m, v3(0, 0, 1));
+				double a = v3_len(v3_cross(e.u, e.v));
+				e.area = o->kind == OBJ_RECT ? 4.0 * a : RT_PI * a;
+			} else {
+				continue; /* found by the paths only */
+			}
+			if (e.shape != EMITTER_SPHERE) {
+				vec3 nn = v3_cross(e.u, e.v);
+				if (!(e.area > 0.0) || !v3_finite(nn))
+					continue;
+				e.n = v3_norm(nn);
+			} else if (!(e.r > 0.0)) {
+				continue;
+			}
+			if (pass == 1) {
+				w->mats[i].light = (int32_t)w->nemitters;
+				w->emitters[w->nemitters++] = e;
+			} else {
+				n++;
+			}
+		}
+		if (pass == 0) {
+			if (n == 0)
+				return true;
+			w->emitters = calloc(n, sizeof *w->emitters);
+			if (!w->emitters)
+				return rt_error_set(err, "out of memory preparing the scene");
+		}
+	}
+	return true;
+}
+
+/* 1 - cos(theta_max) of the cone that the sphere subtends from a point at
+ * squared distance d2 > r^2, without cancellation for small spheres. */
+static double cone_gap(double r2, double d2)
+{
+	double s2 = r2 / d2;
+	return s2 / (1.0 + sqrt(1.0 - s2));
+}
+
+/* The density (per steradian) with which sample_emitter picks the
+ * direction d (unit) from p towards e, whose surface it meets at distance t
+ * (flat shapes); the choice of the emitter is not included. */
+static double emitter_pdf(const emitter *e, vec3 p, vec3 d, double t)
+{
+	if (e->shape == EMITTER_SPHERE) {
+		double d2 = v3_len2(v3_sub(e->c, p)), r2 = e->r * e->r;
+		return d2 > r2 ? 1.0 / (2.0 * RT_PI * cone_gap(r2, d2)) : 0.0;
+	}
+	double cos_l = fabs(v3_dot(e->n, d));
+	return cos_l > 0.0 ? t * t / (cos_l * e->area) : 0.0;
+}
+
+/* The power heuristic weight of a technique of density a against one of b. */
+static double power_weight(double a, double b)
+{
+	return a * a / (a * a + b * b);
+}
+
+/* Next-event estimation toward one emitter picked uniformly: a direction
+ * from the emitter's solid angle (spheres: the uniform cone they subtend)
+ * or area (flat shapes), the emission if nothing is in between, weighted
+ * against the chance that the bsdf would have picked the same direction.
+ * A vertex on object `self` skips it: a flat or convex surface cannot light
+ * itself, and sampling it from just off its surface would only add noise. */
+static vec3 emitter_light(const world *w, const bsdf *b, vec3 p, uint32_t self, rng *g)
+{
+	size_t k = (size_t)(rng_next(g) * (double)w->nemitters);
+	const emitter *e = &w->emitters[k < w->nemitters ? k : w->nemitters - 1];
+	if (e->object == self)
+		return v3(0, 0, 0);
+	vec3 wi;
+	double pdf, t = 0.0;
+	if (e->shape == EMITTER_SPHERE) {
+		vec3 pc = v3_sub(e->c, p);
+		double d2 = v3_len2(pc), r2 = e->r * e->r;
+		if (!(d2 > r2))
+			return v3(0, 0, 0); /* inside: left to the paths */
+		double gap = cone_gap(r2, d2), cos_a = 1.0 - rng_next(g) * gap;
+		double x, y, rr;
+		disc_point(g, &x, &y, &rr);
+		double k2 = sqrt(fmax(0.0, 1.0 - cos_a * cos_a) / rr);
+		vec3 ax = v3_scale(pc, 1.0 / sqrt(d2)), tu, tv;
+		basis(ax, &tu, &tv);
+		wi = v3_add(v3_add(v3_scale(tu, x * k2), v3_scale(tv, y * k2)), v3_scale(ax, cos_a));
+		pdf = 1.0 / (2.0 * RT_PI * gap);
+	} else {
+		double a, c;
+		if (e->shape == EMITTER_RECT) {
+			a = 2.0 * rng_next(g) - 1.0;
+			c = 2.0 * rng_next(g) - 1.0;
+		} else if (e->shape == EMITTER_DISC) {
+			double rr;
+			disc_point(g, &a, &c, &rr);
+		} else { /* uniform on the triangle (Turk, Graphics Gems 1990) */
+			double su = sqrt(rng_next(g));
+			a = 1.0 - su;
+			c = rng_next(g) * su;
+		}
+		vec3 q = v3_add(e->c, v3_add(v3_scale(e->u, a), v3_scale(e->v, c)));
+		vec3 d = v3_sub(q, p);
+		t = v3_len(d);
+		if (!(t > 0.0))
+			return v3(0, 0, 0);
+		wi = v3_scale(d, 1.0 / t);
+		pdf = emitter_pdf(e, p, wi, t);
+		if (!(pdf > 0.0))
+			return v3(0, 0, 0);
+	}
+	double cos_i = v3_dot(b->n, wi);
+	if (cos_i <= 0.0)
+		return v3(0, 0, 0);
+	vec3 f = bsdf_eval(b, wi);
+	if (f.x <= 0.0 && f.y <= 0.0 && f.z <= 0.0)
+		return v3(0, 0, 0);
+	/* The emitter must be the first thing on the way. */
+	hit h;
+	ray sr = {p, wi};
+	if (!world_intersect(w, &sr, 0.0, INFINITY, &h) || h.object != e->object)
+		return v3(0, 0, 0);
+	double pdf_l = pdf / (double)w->nemitters;
+	double weight = power_weight(pdf_l, bsdf_pdf(b, wi));
+	return v3_mul(f, v3_scale(w->mats[e->object].emission, cos_i * weight / pdf_l));
+}
+
 vec3 path_radiance(const world *w, const render_settings *s, ray r, rng *g)
 {
 	vec3 radiance = v3(0, 0, 0), thr = v3(1, 1, 1);
@@ -270,6 +458,10 @@ vec3 path_radiance(const world *w, const render_settings *s, ray r, rng *g)
 	 * undoes their radiance scaling for Russian roulette (pbrt 4th ed.
 	 * 13.1.5). */
 	double eta_scale = 1.0;
+	/* Where the ray r left and with what density its direction was picked,
+	 * when the emitters were also sampled there (0: weigh emission by 1). */
+	vec3 from = r.o;
+	double from_pdf = 0.0;
 	for (int bounce = 0;; bounce++) {
 		hit h;
 		if (!world_intersect(w, &r, 0.0, INFINITY, &h)) {
@@ -277,7 +469,14 @@ vec3 path_radiance(const world *w, const render_settings *s, ray r, rng *g)
 			break;
 		}
 		const mat_lin *m = &w->mats[h.object];
-		radiance = v3_add(radiance, v3_mul(thr, m->emission));
+		if (m->light >= 0 && from_pdf > 0.0) {
+			double pdf_l = emitter_pdf(&w->emitters[m->light], from, r.d, h.t) /
+			               (double)w->nemitters;
+			radiance = v3_add(radiance, v3_mul(thr, v3_scale(m->emission,
+			                                                 power_weight(from_pdf, pdf_l))));
+		} else {
+			radiance = v3_add(radiance, v3_mul(thr, m->emission));
+		}
 		if (bounce >= s->depth)
 			break;
 		bsdf b;
@@ -285,6 +484,9 @@ vec3 path_radiance(const world *w, const render_settings *s, ray r, rng *g)
 		vec3 p = offset_point(w, h.p, b.n);
 		if (b.smooth && w->nlights)
 			radiance = v3_add(radiance, v3_mul(thr, direct_light(w, &b, p)));
+		bool sample_emitters = b.smooth && w->nemitters;
+		if (sample_emitters)
+			radiance = v3_add(radiance, v3_mul(thr, emitter_light(w, &b, p, h.object, g)));
 
 		bsdf_sample bs;
 		if (!bsdf_sample_dir(&b, g, &bs))
@@ -292,6 +494,8 @@ vec3 path_radiance(const world *w, const render_settings *s, ray r, rng *g)
 		thr = v3_mul(thr, v3_scale(bs.weight, bs.radiance_scale));
 		eta_scale /= bs.radiance_scale;
 		r = (ray){bs.transmit ? offset_point(w, h.p, v3_neg(b.n)) : p, bs.wi};
+		from = r.o;
+		from_pdf = sample_emitters && !bs.delta ? bsdf_pdf(&b, bs.wi) : 0.0;
 
 		/* Russian roulette after the third bounce: survive with q, weigh
 		 * the survivors by 1 / q. */

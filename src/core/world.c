@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "bvh.h"
+#include "integrators.h"
 #include "rtsh/shape.h"
 
 vec3 srgb255_to_linear(vec3 c)
@@ -49,6 +50,7 @@ static mat_lin material_linear(const material *m)
 	l.ior = m->ior;
 	l.emission = v3_scale(l.albedo, m->emission);
 	l.checker = m->checker;
+	l.light = -1; /* set by emitters_build */
 	return l;
 }
 
@@ -159,7 +161,7 @@ world *world_build(const scene *s, rt_error *err)
 	w->eps = 1e-9 * fmax(1.0, extent);
 	w->tree = bvh_build(w->prims, bounds, w->nprims, err);
 	free(bounds);
-	if (!w->tree) {
+	if (!w->tree || !emitters_build(w, s, err)) {
 		world_free(w);
 		return NULL;
 	}
@@ -174,6 +176,7 @@ void world_free(world *w)
 	free(w->mats);
 	free(w->prims);
 	free(w->planes);
+	free(w->emitters);
 	bvh_free(w->tree);
 	free(w);
 }

@@ -424,6 +424,129 @@ static void test_two_sided(void **state)
 	fb_free(fb[1]);
 }
 
+/* --- emitters --------------------------------------------------------------- */
+
+/* Renders a 1x1 image through a very narrow camera at cam looking at the
+ * origin, with `samples` paths at depth 1, the emitters sampled directly
+ * (and weighed against the paths) or left to the paths alone. */
+static double origin_radiance(const scene *s, int samples, bool sample_emitters)
+{
+	world *w = world_build(s, NULL);
+	assert_non_null(w);
+	if (!sample_emitters)
+		w->nemitters = 0;
+	render_settings set = settings(1, 1, samples, 1, 2, 11);
+	framebuffer *fb = render_image(w, &set, NULL, NULL, NULL, NULL);
+	assert_non_null(fb);
+	double v = fb->rgb[1];
+	fb_free(fb);
+	world_free(w);
+	return v;
+}
+
+/* A white Lambertian floor of albedo 0.8 under a lamp, no sky. At the
+ * origin, facing up (Lambert's formulas for the irradiance E from a
+ * uniform emitter of radiance Le; the floor sends back 0.8 E / pi):
+ *   a disc of radius R at height h, parallel, centred above:
+ *     E = pi Le R^2 / (R^2 + h^2)
+ *   a sphere of radius r whose centre is at distance D straight up:
+ *     E = pi Le (r / D)^2
+ * Both the direct sampling of the emitters (with MIS) and the paths alone
+ * must give these. */
+static void test_emitter_irradiance(void **state)
+{
+	(void)state;
+	const double le = 2 * srgb_decode(250); /* emit 2, colour 250 grey */
+	for (int shape = 0; shape < 2; shape++) {
+		scene *s = cam_scene(v3(0, 0.5, -4), v3(0, -0.5, 4), 0.2);
+		object floor = obj(OBJ_PLANE, v3(0, 0, 0), v3(1, 1, 1), v3(255, 255, 255), 0.8);
+		object lamp = obj(shape ? OBJ_SPHERE : OBJ_DISC, v3(0, shape ? 2 : 1, 0),
+		                  v3_splat(1), v3(250, 250, 250), 0);
+		lamp.dir = v3(0, -1, 0);
+		lamp.mat.emission = 2;
+		add(s, &floor);
+		add(s, &lamp);
+		double want = shape ? 0.8 * le * 0.25 * 0.25 : 0.8 * le * 0.25 / 1.25;
+		double mis = origin_radiance(s, 20000, true);
+		double paths = origin_radiance(s, 400000, false);
+		print_message("%s: expected %.5f, sampled %.5f, paths only %.5f\n", shape ? "sphere" : "disc",
+		              want, mis, paths);
+		assert_near(mis, want, 0.005 * want);
+		assert_near(paths, want, 0.01 * want);
+		scene_free(s);
+	}
+}
+
+/* Sampling the emitters directly changes the noise, not the image: every
+ * kind of sampled emitter (sphere, rectangle, disc, triangle), out of the
+ * camera's view, over Lambert, Phong and fuzzy-metal lobes, renders to the
+ * same means with and without it. */
+static void test_emitter_sampling_unbiased(void **state)
+{
+	(void)state;
+	scene *s = cam_scene(v3(0, 3.2, -4.5), v3(0, -0.75, 1), 55);
+	object floor = obj(OBJ_PLANE, v3(0, 0, 0), v3(1, 1, 1), v3(220, 220, 220), 0.6);
+	floor.mat.specular = 0.3;
+	floor.mat.shininess = 20;
+	object a = obj(OBJ_SPHERE, v3(-1.2, 0.6, 0.5), v3_splat(1.2), v3(200, 160, 120), 0);
+	a.mat.reflective = 1;
+	a.mat.metal = 1;
+	a.mat.fuzz = 0.4;
+	object b = obj(OBJ_CUBE, v3(1.2, 0.5, 0.3), v3(1, 1, 1), v3(120, 180, 220), 0.9);
+	b.dir = v3(0.2, 1, 0.1);
+	object l1 = obj(OBJ_SPHERE, v3(-3, 3, 2.5), v3_splat(1.6), v3(255, 220, 180), 0);
+	l1.mat.emission = 1.5;
+	object l2 = obj(OBJ_RECT, v3(1, 3.6, 0), v3(3, 1, 2), v3(200, 220, 255), 0);
+	l2.dir = v3(0.2, -1, 0);
+	l2.mat.emission = 1;
+	object l3 = obj(OBJ_DISC, v3(0, 2.5, 4), v3(2.5, 1, 2.5), v3(255, 255, 255), 0.5);
+	l3.dir = v3(0, -0.5, -1);
+	l3.mat.emission = 1;
+	object l4 = object_make(OBJ_TRIANGLE, v3(255, 180, 120));
+	l4.tri[0] = v3(5, 0, 1);
+	l4.tri[1] = v3(5.5, 3, 3);
+	l4.tri[2] = v3(4.5, 1.5, 4);
+	l4.mat.emission = 1;
+	object objs[] = {floor, a, b, l1, l2, l3, l4};
+	for (size_t i = 0; i < sizeof objs / sizeof objs[0]; i++)
+		add(s, &objs[i]);
+	double mean[2] = {0, 0}, block_diff = 0;
+	framebuffer *fb[2];
+	for (int k = 0; k < 2; k++) {
+		world *w = world_build(s, NULL);
+		assert_non_null(w);
+		assert_int_equal(w->nemitters, 4);
+		if (k)
+			w->nemitters = 0;
+		render_settings set = settings(16, 12, k ? 4096 : 1024, 6, 2, 21 + k);
+		fb[k] = render_image(w, &set, NULL, NULL, NULL, NULL);
+		assert_non_null(fb[k]);
+		for (int i = 0; i < 16 * 12 * 3; i++)
+			mean[k] += fb[k]->rgb[i] / (16 * 12 * 3);
+		world_free(w);
+	}
+	/* the image mean, and the means of its twelve 4x4 blocks */
+	for (int by = 0; by < 3; by++)
+		for (int bx = 0; bx < 4; bx++) {
+			double m[2] = {0, 0};
+			for (int k = 0; k < 2; k++)
+				for (int y = by * 4; y < by * 4 + 4; y++)
+					for (int x = bx * 4; x < bx * 4 + 4; x++) {
+						vec3 c = pixel(fb[k], x, y);
+						m[k] += (c.x + c.y + c.z) / 48;
+					}
+			block_diff = fmax(block_diff, fabs(m[0] - m[1]) / m[1]);
+		}
+	print_message("image mean: sampled %.5f, paths only %.5f; largest 4x4 block difference %.2f%%\n",
+	              mean[0], mean[1], 100 * block_diff);
+	assert_true(mean[1] > 0.04);
+	assert_near(mean[0], mean[1], 0.015 * mean[1]);
+	assert_true(block_diff < 0.08);
+	fb_free(fb[0]);
+	fb_free(fb[1]);
+	scene_free(s);
+}
+
 /* --- convergence ----------------------------------------------------------- */
 
 /* Soft light from the sky gradient, a point light, diffuse surfaces and a
@@ -769,6 +892,8 @@ int main(void)
 		cmocka_unit_test(test_mirror_shows_sky),
 		cmocka_unit_test(test_depth1_equals_whitted_diffuse),
 		cmocka_unit_test(test_two_sided),
+		cmocka_unit_test(test_emitter_irradiance),
+		cmocka_unit_test(test_emitter_sampling_unbiased),
 		cmocka_unit_test(test_convergence),
 		cmocka_unit_test(test_threads_bit_identical),
 		cmocka_unit_test(test_energy_bound),
