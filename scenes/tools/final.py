@@ -5,6 +5,10 @@ spheres (diffuse, metal, glass) on a grid around three large ones.
 
     python3 scenes/tools/final.py [SEED] > scenes/final.rt
 
+rtsh's axes are left-handed (x right, y up, z forward, as in miniRT and
+POV-Ray) and the book's right-handed, so every z is negated: the picture
+then has the book's left and right.
+
 The random numbers come from splitmix64 (Steele, Lea & Flood 2014) seeded by
 SEED (default 1), so the same seed writes the same file with any Python 3.
 """
@@ -47,9 +51,11 @@ def num(x):
 
 
 def sphere(center, radius, rgb, material):
+    """A sphere at the book's (right-handed) centre."""
     d = num(2 * radius)
+    x, y, z = center
     return "sp %s 0,1,0 %s,%s,%s %s %s" % (
-        ",".join(num(c) for c in center), d, d, d, color(rgb), material)
+        ",".join(num(c) for c in (x, y, -z)), d, d, d, color(rgb), material)
 
 
 DIFFUSE = "1 0 1 0"
@@ -74,7 +80,7 @@ def main():
         "R 1200 675",
         # The book's camera: from (13,2,3) towards the origin with a vertical
         # field of 20 degrees at 16:9, i.e. 2 atan(tan(10 deg) 16/9) across.
-        "C 13,2,3 -13,-2,-3 34.84",
+        "C 13,2,-3 -13,-2,3 34.81",
         "sky 188,219,255 255,255,255 1",
         "pl 0,0,0 0,1,0 1,1,1 %s %s" % (color((0.5, 0.5, 0.5)), DIFFUSE),
     ]
