@@ -69,7 +69,9 @@ vec3 hit_albedo(const mat_lin *m, const hit *h);
 /* A point just off the surface on the side of n, for spawning rays. */
 static inline vec3 offset_point(const world *w, vec3 p, vec3 n)
 {
-	double e = w->eps + 1e-12 * v3_max_abs(p);
+	double ax = fabs(p.x), ay = fabs(p.y), az = fabs(p.z); /* not fmax: a library call */
+	double m = ax > ay ? ax : ay;
+	double e = w->eps + 1e-12 * (m > az ? m : az);
 	return v3_madd(p, n, e);
 }
 

@@ -40,6 +40,12 @@ static void basis(vec3 n, vec3 *t, vec3 *b)
 	*b = v3(c, sign + n.y * n.y * a, -n.y);
 }
 
+/* max(v, 0), NaN to 0 (plain comparisons: fmax is a library call). */
+static inline double pos(double v)
+{
+	return v > 0.0 ? v : 0.0;
+}
+
 /* The largest component (plain comparisons: fmax is a library call). */
 static inline double max3(vec3 v)
 {
@@ -82,7 +88,7 @@ static vec3 sample_phong(vec3 axis, double e, rng *g)
 	double cos_a = pow(rng_next(g), 1.0 / (e + 1.0));
 	double x, y, r2;
 	disc_point(g, &x, &y, &r2);
-	double k = sqrt(fmax(0.0, 1.0 - cos_a * cos_a) / r2);
+	double k = sqrt(pos(1.0 - cos_a * cos_a) / r2);
 	vec3 t, b;
 	basis(axis, &t, &b);
 	return v3_add(v3_add(v3_scale(t, x * k), v3_scale(b, y * k)), v3_scale(axis, cos_a));
@@ -127,7 +133,7 @@ void bsdf_make(bsdf *b, const mat_lin *m, const hit *h, vec3 wo)
 	b->n = h->front ? h->n : v3_neg(h->n);
 	b->wo = wo;
 	b->front = h->front;
-	b->cos_o = fmax(0.0, v3_dot(b->n, wo));
+	b->cos_o = pos(v3_dot(b->n, wo));
 	vec3 albedo = hit_albedo(m, h);
 	double mirror = clampd(m->reflective, 0.0, 1.0), rest = 1.0 - mirror;
 	double w[4] = {0, 0, 0, 0};
@@ -141,7 +147,7 @@ void bsdf_make(bsdf *b, const mat_lin *m, const hit *h, vec3 wo)
 		double k = d + s > 1.0 ? rest / (d + s) : rest;
 		b->kd = v3_scale(albedo, d * k);
 		b->ks = v3_splat(s * k);
-		b->ns = fmax(m->shininess, 0.0);
+		b->ns = pos(m->shininess);
 		w[0] = max3(b->kd);
 		w[1] = s * k;
 	}
@@ -152,7 +158,7 @@ void bsdf_make(bsdf *b, const mat_lin *m, const hit *h, vec3 wo)
 		vec3 f0 = v3_lerp(v3_splat(1.0), albedo, clampd(m->metal, 0.0, 1.0));
 		double x = 1.0 - b->cos_o, x5 = x * x * x * x * x;
 		b->km = v3_scale(v3_add(f0, v3_scale(v3_sub(v3_splat(1.0), f0), x5)), mirror);
-		b->nm = m->fuzz > 0.0 ? fuzz_exponent(fmin(m->fuzz, 1.0)) : -1.0;
+		b->nm = m->fuzz > 0.0 ? fuzz_exponent(m->fuzz < 1.0 ? m->fuzz : 1.0) : -1.0;
 		w[2] = max3(b->km);
 	} else {
 		b->nm = -1.0;
@@ -398,7 +404,7 @@ static vec3 emitter_light(const world *w, const bsdf *b, vec3 p, uint32_t self, 
 	if (e->object == self)
 		return v3(0, 0, 0);
 	vec3 wi;
-	double pdf, t = 0.0;
+	double pdf, t;
 	if (e->shape == EMITTER_SPHERE) {
 		vec3 pc = v3_sub(e->c, p);
 		double d2 = v3_len2(pc), r2 = e->r * e->r;
@@ -407,11 +413,14 @@ static vec3 emitter_light(const world *w, const bsdf *b, vec3 p, uint32_t self, 
 		double gap = cone_gap(r2, d2), cos_a = 1.0 - rng_next(g) * gap;
 		double x, y, rr;
 		disc_point(g, &x, &y, &rr);
-		double k2 = sqrt(fmax(0.0, 1.0 - cos_a * cos_a) / rr);
+		double k2 = sqrt(pos(1.0 - cos_a * cos_a) / rr);
 		vec3 ax = v3_scale(pc, 1.0 / sqrt(d2)), tu, tv;
 		basis(ax, &tu, &tv);
 		wi = v3_add(v3_add(v3_scale(tu, x * k2), v3_scale(tv, y * k2)), v3_scale(ax, cos_a));
 		pdf = 1.0 / (2.0 * RT_PI * gap);
+		/* the near side of the sphere along wi: |p + t wi - c| = r */
+		double along = v3_dot(pc, wi);
+		t = along - sqrt(pos(along * along - (d2 - r2)));
 	} else {
 		double a, c;
 		if (e->shape == EMITTER_RECT) {
@@ -441,10 +450,10 @@ static vec3 emitter_light(const world *w, const bsdf *b, vec3 p, uint32_t self, 
 	vec3 f = bsdf_eval(b, wi);
 	if (f.x <= 0.0 && f.y <= 0.0 && f.z <= 0.0)
 		return v3(0, 0, 0);
-	/* The emitter must be the first thing on the way. */
-	hit h;
+	/* Nothing may stand between: an any-hit query that stops just short
+	 * of the emitter's surface. */
 	ray sr = {p, wi};
-	if (!world_intersect(w, &sr, 0.0, INFINITY, &h) || h.object != e->object)
+	if (world_occluded(w, &sr, 0.0, t * (1.0 - 1e-7)))
 		return v3(0, 0, 0);
 	double pdf_l = pdf / (double)w->nemitters;
 	double weight = power_weight(pdf_l, bsdf_pdf(b, wi));
