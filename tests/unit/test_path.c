@@ -216,24 +216,29 @@ static void test_furnace_albedo_one(void **state)
 	scene_free(s);
 }
 
-/* The camera inside a closed sphere of diffuse albedo a = 0.5 that emits
- * E = 1 (emit 1, white): L = E + a L, so every pixel is E / (1 - a) = 2.
- * The rays start inside the shape and see only its inner side. */
+/* The camera inside a closed sphere, cube or cylinder of diffuse albedo
+ * a = 0.5 that emits E = 1 (emit 1, white): L = E + a L, so every pixel is
+ * E / (1 - a) = 2. The rays start inside the shape and see only its inner
+ * side (the seed's "cube as a room" that one-sided shading got wrong). */
 static void test_inside_emitter(void **state)
 {
 	(void)state;
-	scene *s = cam_scene(v3(0.3, -0.2, 0.1), v3(0.2, 0.1, 1), 90);
-	object o = obj(OBJ_SPHERE, v3(0, 0, 0), v3_splat(4), v3(255, 255, 255), 0.5);
-	o.mat.emission = 1;
-	add(s, &o);
-	framebuffer *fb = render(s, 16, 16, 256, 1000);
-	double sum = 0;
-	for (int y = 0; y < 16; y++)
-		for (int x = 0; x < 16; x++)
-			sum += pixel(fb, x, y).x;
-	assert_near(sum / 256, 2.0, 0.02);
-	fb_free(fb);
-	scene_free(s);
+	const obj_kind kinds[] = {OBJ_SPHERE, OBJ_CUBE, OBJ_CYLINDER};
+	for (int k = 0; k < 3; k++) {
+		scene *s = cam_scene(v3(0.3, -0.2, 0.1), v3(0.2, 0.1, 1), 90);
+		object o = obj(kinds[k], v3(0, 0, 0), v3_splat(4), v3(255, 255, 255), 0.5);
+		o.dir = v3(0.1, 1, 0.2);
+		o.mat.emission = 1;
+		add(s, &o);
+		framebuffer *fb = render(s, 16, 16, 256, 1000);
+		double sum = 0;
+		for (int y = 0; y < 16; y++)
+			for (int x = 0; x < 16; x++)
+				sum += pixel(fb, x, y).x;
+		assert_near(sum / 256, 2.0, 0.02);
+		fb_free(fb);
+		scene_free(s);
+	}
 }
 
 /* Clear glass (ior 1.5) reflects F and refracts 1 - F of what falls on it:
