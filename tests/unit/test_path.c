@@ -164,6 +164,7 @@ static void test_white_furnace(void **state)
 	framebuffer *fb = render(s, 32, 32, 256, 5);
 	int n = 0, outside = 0;
 	double mean = mean_inside(fb, cam, fov, v3(0, 0, 0), 1, &n);
+	print_message("furnace: %d sphere pixels, mean %.6f (expected 0.5)\n", n, mean);
 	assert_true(n > 100);
 	assert_near(mean, 0.5, 0.005);
 	for (int y = 0; y < 32; y++)
@@ -211,6 +212,7 @@ static void test_furnace_albedo_one(void **state)
 			sum += p.x + p.y + p.z;
 			assert_near(p.x, 1.0, 0.2); /* 128 samples per pixel */
 		}
+	print_message("albedo-1 furnace: mean %.5f (expected 1)\n", sum / (24 * 24 * 3));
 	assert_near(sum / (24 * 24 * 3), 1.0, 0.01);
 	fb_free(fb);
 	scene_free(s);
@@ -235,6 +237,8 @@ static void test_inside_emitter(void **state)
 		for (int y = 0; y < 16; y++)
 			for (int x = 0; x < 16; x++)
 				sum += pixel(fb, x, y).x;
+		print_message("inside an emitter (%s): mean %.5f (expected 2)\n", obj_kind_name(kinds[k]),
+		              sum / 256);
 		assert_near(sum / 256, 2.0, 0.02);
 		fb_free(fb);
 		scene_free(s);
@@ -261,6 +265,8 @@ static void test_glass_furnace(void **state)
 		framebuffer *fb = render(s, 24, 24, 256, 200);
 		int n = 0;
 		double mean = mean_inside(fb, cam, fov, v3(0, 0, 0), k ? 0.5 : 1, &n);
+		print_message("glass %s in the furnace: mean over it %.5f (expected 1)\n",
+		              k ? "cube" : "sphere", mean);
 		assert_true(n > 10);
 		assert_near(mean, 1.0, 0.01);
 		double all = 0;
