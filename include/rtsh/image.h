@@ -30,7 +30,8 @@ image_format image_format_of(const char *path);
 uint8_t linear_to_srgb8(double v);
 double srgb8_to_linear(double code);
 
-/* Writes the framebuffer; `exposure` is in stops (radiance x 2^exposure). */
+/* Writes the framebuffer. `exposure` (stops: radiance x 2^exposure) applies
+ * to the 8-bit formats; a PFM keeps the linear radiance as rendered. */
 bool image_write(const char *path, const framebuffer *fb, double exposure, rt_error *err);
 
 /* Readers for tests and tools: a new framebuffer with linear values (PPM

@@ -138,7 +138,7 @@ static bool write_pfm(FILE *f, void *vctx, rt_error *err)
 	for (int y = fb->h - 1; y >= 0 && ok; y--) {
 		const float *src = fb->rgb + (size_t)y * fb->w * 3;
 		for (int i = 0; i < fb->w * 3; i++) {
-			float v = (float)(src[i] * c->gain);
+			float v = src[i]; /* linear radiance, exposure not applied */
 			uint32_t bits;
 			memcpy(&bits, &v, 4);
 			uint8_t le[4] = {(uint8_t)bits, (uint8_t)(bits >> 8), (uint8_t)(bits >> 16),
