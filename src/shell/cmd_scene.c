@@ -15,6 +15,7 @@
 #include "rtsh/rtfile.h"
 #include "rtsh/settings.h"
 #include "shell/commands.h"
+#include "shell/keymode.h"
 #include "term/caps.h"
 
 /* The generator (src/scene/generate.c) is being written alongside; until it
@@ -374,10 +375,9 @@ bool cmd_source(shell *sh, int argc, char **argv, const char *rest)
 	return ok;
 }
 
-/* Key mode (issue 6) plugs in here: replace this body with the call into
- * it; the shell's editor, preview and screen are in sh. */
+/* Key mode (keymode.c). */
 bool cmd_view(shell *sh, int argc, char **argv, const char *rest)
 {
 	(void)argc, (void)argv, (void)rest;
-	return shell_fail(sh, "view: key mode is not available yet in this version of rtsh");
+	return keymode_run(sh);
 }

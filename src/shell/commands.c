@@ -8,6 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "shell/keymode.h"
+
 #define SUBS_CAMERA "pos|dir|lookat|fov|move|turn"
 #define SUBS_LIGHT "pos|move|brightness|color"
 #define SUBS_OBJECT "move|rotate|scale|color"
@@ -55,7 +57,8 @@ const command command_table[] = {
 	{"prev", "previous", "prev", 0, 0, {NULL}, "open the previous .rt file of the scene's folder",
 	 cmd_prev},
 	{"view", NULL, "view", 0, 0, {NULL},
-	 "full-screen key mode: arrow keys move things on a fast preview; Esc returns", cmd_view},
+	 "full-screen key mode: arrow keys move the camera or a selected object on a fast preview; Esc returns",
+	 cmd_view},
 	{"show", NULL, "show [COLUMNS]", 0, 1, {NULL},
 	 "print the picture on standard output (half blocks; plain characters without colour)", cmd_show},
 	{"source", ".", "source FILE", 1, 1, {"@file"}, "run a command file", cmd_source},
@@ -66,6 +69,13 @@ const command command_table[] = {
 	 cmd_quit},
 };
 const size_t command_count = sizeof command_table / sizeof command_table[0];
+
+/* More for `help COMMAND` than its usage and one line. */
+static const struct {
+	const char *name, *text;
+} details[] = {
+	{"view", keymode_help},
+};
 
 /* True when `word` is one of the space-separated names in list. */
 static bool in_list(const char *list, const char *word, size_t len, bool prefix)
@@ -396,6 +406,9 @@ bool cmd_help(shell *sh, int argc, char **argv, const char *rest)
 				p++;
 		}
 		shell_out(sh, "%s\n", c->help);
+		for (size_t i = 0; i < sizeof details / sizeof details[0]; i++)
+			if (strcmp(details[i].name, c->name) == 0)
+				shell_out(sh, "%s", details[i].text);
 		if (c->aliases)
 			shell_out(sh, "also: %s\n", c->aliases);
 		return true;

@@ -210,6 +210,8 @@ int shell_interactive(shell *sh, bool use_screen, const int wake[2])
 	setlocale(LC_CTYPE, "");
 	active = sh;
 	wake_write = -1;
+	sh->wake[0] = wake[0];
+	sh->wake[1] = wake[1];
 	struct sigaction old[NHANDLED];
 	shell_sig_int = shell_sig_term = shell_sig_winch = shell_sig_tstp = shell_sig_cont = 0;
 
@@ -237,6 +239,12 @@ int shell_interactive(shell *sh, bool use_screen, const int wake[2])
 
 	int status = 0;
 	while (!sh->quit) {
+		/* A signal may have come while a command ran (key mode drains
+		 * the pipe): leave before waiting. */
+		if (shell_sig_term) {
+			status = 128 + shell_sig_term;
+			break;
+		}
 		fd_set rd;
 		FD_ZERO(&rd);
 		FD_SET(STDIN_FILENO, &rd);
@@ -293,6 +301,7 @@ int shell_interactive(shell *sh, bool use_screen, const int wake[2])
 	}
 	restore_signals(old);
 	wake_write = -1;
+	sh->wake[0] = sh->wake[1] = -1;
 	active = NULL;
 	return status;
 }

@@ -74,6 +74,7 @@ typedef struct shell {
 	bool err_reported;     /* err was printed already (by a nested source) */
 	int depth;             /* source nesting */
 	void (*status_hook)(struct shell *sh); /* redraws the status line (interactive) */
+	int wake[2];           /* the interactive loop's wake-up pipe (read, write); -1: none */
 } shell;
 
 /* Signals, set by handlers (loop.c, script.c) and read by the loops. */

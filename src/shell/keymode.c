@@ -1,0 +1,1618 @@
+/* rtsh — key mode (keymode.h).
+ *
+ * Three parts:
+ *   1. keys to edits: pure functions of the key, the scene and the
+ *      selection (unit-tested without a terminal);
+ *   2. the session: a render thread of its own, the adaptive pixel ratio,
+ *      the picture with the selection marked, the status line and the help
+ *      bar;
+ *   3. the terminal: ncurses for the keys, termios, signals, and giving the
+ *      shell's screen back.
+ *
+ * Escape sequences sent here, besides the frame encoder's (term/frame.h):
+ *   \e[?2026h \e[?2026l   begin / end synchronized update, around each frame
+ *   \e[r                  reset the scroll region (the shell's is restored
+ *                         by screen_layout on the way out)
+ *   \e[2J                 clear the screen
+ *   \e[R;CH               move the cursor
+ *   \e[7m  \e[m           reverse video (the status line) / reset
+ *   \e[K                  clear to the end of the line
+ *   \e[?25l \e[?25h       hide / show the cursor
+ *   smkx / rmkx           terminfo's keypad transmit on / off, so that the
+ *                         arrow keys send what terminfo (and ncurses) expect
+ */
+#include "shell/keymode.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/ioctl.h>
+#include <sys/select.h>
+#include <termios.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <readline/readline.h>
+
+#include "rtsh/settings.h"
+#include "rtsh/shape.h"
+#include "rtsh/world.h"
+#include "shell/commands.h"
+#include "term/abuf.h"
+#include "term/frame.h"
+#include "term/keys.h"
+
+/* The help bar and `help view`. */
+const char keymode_help[] =
+	"keys in view (key mode):\n"
+	"  Up Down Left Right, W S A D  move forward, back, left, right (the camera flies where it\n"
+	"                               looks; a selected object or light moves level with the floor)\n"
+	"  R F                          move up, down\n"
+	"  I K J L, Shift+arrows        turn the camera (pitch, yaw) by 3 degrees\n"
+	"  Tab, Shift+Tab               select the next / previous object or light, then the camera\n"
+	"  [ ]                          turn the selected object about the vertical by 15 degrees\n"
+	"  { }                          roll it about the line of sight by 15 degrees\n"
+	"  - +                          shrink / grow it (x1.1); a light: dimmer / brighter;\n"
+	"                               the camera: zoom out / in (field of view)\n"
+	"  , .                          halve / double the samples per pixel\n"
+	"  < >                          depth one less / one more\n"
+	"  PgUp PgDn                    the previous / next .rt file of the scene's folder\n"
+	"  m                            switch between whitted and path mode\n"
+	"  Space                        stop the render in progress\n"
+	"  u U                          undo / redo (a run of the same key is one step)\n"
+	"  ? F1                         hide / show the help bar;  Ctrl-L F5  repaint\n"
+	"  Esc q                        back to the shell; every change stays (undo, save x.rt)\n"
+	"a movement key moves by 1/40 of the size of the scene (the box around the objects\n"
+	"but planes, the lights and the camera)\n";
+
+static const char help_bar[] =
+	" Esc back │ ←↑↓→ WASD move │ R/F up/down │ IJKL ⇧←↑↓→ turn │ Tab select │ [ ] { } rotate │ -/+ size"
+	" │ ,/. samples │ </> depth │ PgUp/PgDn scene │ m mode │ Space stop │ u/U undo/redo │ ? help";
+
+static double now(void)
+{
+	struct timespec t;
+	clock_gettime(CLOCK_MONOTONIC, &t);
+	return (double)t.tv_sec + t.tv_nsec * 1e-9;
+}
+
+/* ------------------------------------------------------------------ */
+/* 1. Keys to edits                                                    */
+/* ------------------------------------------------------------------ */
+
+double keymode_step(const scene *s)
+{
+	camera c = scene_camera(s);
+	box b = box_point(c.pos);
+	for (size_t i = 0; i < s->nobjs; i++) {
+		if (s->objs[i].kind == OBJ_PLANE)
+			continue;
+		box o = object_bounds(&s->objs[i]);
+		if (!box_is_empty(o) && v3_finite(o.lo) && v3_finite(o.hi))
+			b = box_union(b, o);
+	}
+	for (size_t i = 0; i < s->nlights; i++)
+		b = box_add(b, s->lights[i].pos);
+	double side = v3_max_comp(v3_sub(b.hi, b.lo));
+	if (!(side > 0) || !isfinite(side))
+		side = 1.0;
+	return side * KEYMODE_STEP_FRACTION;
+}
+
+bool keymode_sel_valid(const scene *s, km_sel sel)
+{
+	switch (sel.kind) {
+	case KM_SEL_OBJECT:
+		return sel.index < s->nobjs;
+	case KM_SEL_LIGHT:
+		return sel.index < s->nlights;
+	case KM_SEL_CAMERA:
+		break;
+	}
+	return true;
+}
+
+km_sel keymode_select(const scene *s, km_sel sel, int dir)
+{
+	size_t total = 1 + s->nobjs + s->nlights, at = 0;
+	if (sel.kind == KM_SEL_OBJECT && sel.index < s->nobjs)
+		at = 1 + sel.index;
+	else if (sel.kind == KM_SEL_LIGHT && sel.index < s->nlights)
+		at = 1 + s->nobjs + sel.index;
+	at = dir >= 0 ? (at + 1) % total : (at + total - 1) % total;
+	if (at == 0)
+		return (km_sel){KM_SEL_CAMERA, 0};
+	if (at <= s->nobjs)
+		return (km_sel){KM_SEL_OBJECT, at - 1};
+	return (km_sel){KM_SEL_LIGHT, at - 1 - s->nobjs};
+}
+
+vec3 keymode_axis_euler(vec3 axis, double deg)
+{
+	mat4 r = m4_rotate_axis(v3_norm(axis), deg_to_rad(deg));
+	/* r = Rz(c) Ry(b) Rx(a): r[2][0] = -sin b, r[2][1] = cos b sin a,
+	 * r[2][2] = cos b cos a, r[1][0] = sin c cos b, r[0][0] = cos c cos b. */
+	double sb = clampd(-r.m[2][0], -1.0, 1.0);
+	double a, b = asin(sb), c;
+	if (fabs(sb) < 0.9999999) {
+		a = atan2(r.m[2][1], r.m[2][2]);
+		c = atan2(r.m[1][0], r.m[0][0]);
+	} else {
+		/* Gimbal lock: only a - c (or a + c) is defined; put it all in a. */
+		c = 0.0;
+		a = atan2(-r.m[1][2], r.m[1][1]);
+	}
+	return v3(rad_to_deg(a), rad_to_deg(b), rad_to_deg(c));
+}
+
+static km_action act(km_op op, km_sel sel)
+{
+	km_action a;
+	memset(&a, 0, sizeof a);
+	a.op = op;
+	a.sel = sel;
+	return a;
+}
+
+static km_action move_by(km_sel sel, vec3 dir, double amount)
+{
+	km_action a = act(KM_MOVE, sel);
+	a.d = v3_scale(dir, amount);
+	return a;
+}
+
+km_action keymode_map(int key, const scene *s, km_sel sel, double step)
+{
+	camera c = scene_camera(s);
+	cam_view v = cam_view_make(&c);
+	vec3 fwd = v.fwd, right = v.right, up = v3(0, 1, 0);
+	if (sel.kind != KM_SEL_CAMERA) {
+		/* Objects and lights slide level with the floor. */
+		vec3 flat = v3(v.fwd.x, 0, v.fwd.z);
+		fwd = v3_len(flat) > 1e-6 ? v3_norm(flat) : v3_norm(v3(v.up.x, 0, v.up.z));
+	}
+	km_action a = act(KM_NONE, sel);
+	switch (key) {
+	case KEYS_UP:
+	case 'w':
+	case 'W':
+		return move_by(sel, fwd, step);
+	case KEYS_DOWN:
+	case 's':
+	case 'S':
+		return move_by(sel, fwd, -step);
+	case KEYS_LEFT:
+	case 'a':
+	case 'A':
+		return move_by(sel, right, -step);
+	case KEYS_RIGHT:
+	case 'd':
+	case 'D':
+		return move_by(sel, right, step);
+	case 'r':
+	case 'R':
+		return move_by(sel, up, step);
+	case 'f':
+	case 'F':
+		return move_by(sel, up, -step);
+	case 'j':
+	case 'J':
+	case KEYS_SHIFT_LEFT:
+		a = act(KM_TURN, sel);
+		a.a = -KEYMODE_TURN_DEG;
+		return a;
+	case 'l':
+	case 'L':
+	case KEYS_SHIFT_RIGHT:
+		a = act(KM_TURN, sel);
+		a.a = KEYMODE_TURN_DEG;
+		return a;
+	case 'i':
+	case 'I':
+	case KEYS_SHIFT_UP:
+		a = act(KM_TURN, sel);
+		a.b = KEYMODE_TURN_DEG;
+		return a;
+	case 'k':
+	case 'K':
+	case KEYS_SHIFT_DOWN:
+		a = act(KM_TURN, sel);
+		a.b = -KEYMODE_TURN_DEG;
+		return a;
+	case '[': /* the front turns to the left, as the camera sees it */
+		a = act(KM_ROTATE, sel);
+		a.d = v3(0, KEYMODE_ROTATE_DEG, 0);
+		return a;
+	case ']':
+		a = act(KM_ROTATE, sel);
+		a.d = v3(0, -KEYMODE_ROTATE_DEG, 0);
+		return a;
+	case '{': /* counterclockwise on the screen */
+		a = act(KM_ROTATE, sel);
+		a.d = keymode_axis_euler(v.fwd, KEYMODE_ROTATE_DEG);
+		return a;
+	case '}':
+		a = act(KM_ROTATE, sel);
+		a.d = keymode_axis_euler(v.fwd, -KEYMODE_ROTATE_DEG);
+		return a;
+	case '-':
+	case '_':
+		a = act(KM_SCALE, sel);
+		a.a = 1.0 / KEYMODE_SCALE;
+		return a;
+	case '+':
+	case '=':
+		a = act(KM_SCALE, sel);
+		a.a = KEYMODE_SCALE;
+		return a;
+	case '\t':
+	case KEYS_BACKTAB:
+		a = act(KM_SELECT, keymode_select(s, sel, key == '\t' ? 1 : -1));
+		a.n = key == '\t' ? 1 : -1;
+		return a;
+	case ',':
+	case '.':
+		a = act(KM_SAMPLES, sel);
+		a.n = key == '.' ? 1 : -1;
+		return a;
+	case '<':
+	case '>':
+		a = act(KM_DEPTH, sel);
+		a.n = key == '>' ? 1 : -1;
+		return a;
+	case KEYS_PAGE_UP:
+	case KEYS_PAGE_DOWN:
+		a = act(KM_SCENE, sel);
+		a.n = key == KEYS_PAGE_DOWN ? 1 : -1;
+		return a;
+	case 'm':
+	case 'M':
+		return act(KM_MODE, sel);
+	case ' ':
+		return act(KM_STOP, sel);
+	case 'u':
+		return act(KM_UNDO, sel);
+	case 'U':
+		return act(KM_REDO, sel);
+	case 12: /* Ctrl-L */
+	case KEYS_F(5):
+		return act(KM_REDRAW, sel);
+	case '?':
+	case KEYS_F(1):
+		return act(KM_HELP, sel);
+	case KEYS_ESC:
+	case 'q':
+	case 'Q':
+		return act(KM_QUIT, sel);
+	default:
+		return a;
+	}
+}
+
+bool keymode_is_edit(km_op op)
+{
+	return op == KM_MOVE || op == KM_TURN || op == KM_ROTATE || op == KM_SCALE;
+}
+
+/* The camera turned by yaw degrees about the world's vertical and pitched
+ * by pitch degrees, keeping within 89 degrees of the horizon. */
+static bool turn_camera(editor *ed, double yaw, double pitch, rt_error *err)
+{
+	camera c = scene_camera(editor_scene(ed));
+	vec3 f = v3_norm(c.dir);
+	double elev = asin(clampd(f.y, -1.0, 1.0)), az = atan2(f.x, f.z);
+	double lim = deg_to_rad(89.0);
+	double ne = elev + deg_to_rad(pitch);
+	if (ne > lim)
+		ne = fmax(elev, lim);
+	if (ne < -lim)
+		ne = fmin(elev, -lim);
+	double na = az + deg_to_rad(yaw);
+	if (ne == elev && yaw == 0.0)
+		return true; /* already as far as it goes */
+	if (fabs(f.y) > 0.999999 && yaw != 0.0 && ne == elev) {
+		/* Straight up or down: yaw has no azimuth to turn; turn about the
+		 * camera's own up axis instead. */
+		return editor_camera_turn(ed, yaw, 0.0, err);
+	}
+	vec3 d = v3(cos(ne) * sin(na), sin(ne), cos(ne) * cos(na));
+	return editor_camera_dir(ed, d, err);
+}
+
+bool keymode_apply(editor *ed, const km_action *a, rt_error *err)
+{
+	const scene *s = editor_scene(ed);
+	if (!keymode_sel_valid(s, a->sel))
+		return rt_error_set(err, "the selection is gone; press Tab to select again");
+	size_t i = a->sel.index;
+	switch (a->op) {
+	case KM_MOVE:
+		if (a->sel.kind == KM_SEL_OBJECT)
+			return editor_object_move(ed, i, a->d, err);
+		if (a->sel.kind == KM_SEL_LIGHT)
+			return editor_light_move(ed, i, a->d, err);
+		return editor_camera_pos(ed, v3_add(scene_camera(s).pos, a->d), err);
+	case KM_TURN:
+		return turn_camera(ed, a->a, a->b, err);
+	case KM_ROTATE:
+		if (a->sel.kind != KM_SEL_OBJECT)
+			return rt_error_set(err, "only objects rotate; press Tab to select one");
+		return editor_object_rotate(ed, i, a->d, err);
+	case KM_SCALE:
+		if (a->sel.kind == KM_SEL_OBJECT)
+			return editor_object_scale(ed, i, v3_splat(a->a), err);
+		if (a->sel.kind == KM_SEL_LIGHT) {
+			double r = s->lights[i].ratio + (a->a > 1 ? KEYMODE_BRIGHTNESS : -KEYMODE_BRIGHTNESS);
+			r = clampd(round(r * 1000.0) / 1000.0, 0.0, 1.0);
+			return r == s->lights[i].ratio ? true : editor_light_brightness(ed, i, r, err);
+		} else {
+			double fov = scene_camera(s).fov + (a->a > 1 ? -KEYMODE_FOV_DEG : KEYMODE_FOV_DEG);
+			fov = clampd(fov, 5.0, 170.0);
+			return fov == scene_camera(s).fov ? true : editor_camera_fov(ed, fov, err);
+		}
+	default:
+		return rt_error_set(err, "not a scene edit");
+	}
+}
+
+/* ------------------------------------------------------------------ */
+/* 2. The session                                                      */
+/* ------------------------------------------------------------------ */
+
+/* A render request to the session's thread. */
+typedef struct km_req {
+	uint64_t seq;         /* newer requests have larger numbers */
+	uint64_t gen;         /* the scene generation the world shows */
+	const world *w;
+	render_settings set;  /* samples = the target of a refine */
+	int w_px, h_px;       /* the render size */
+	bool refine;          /* all the samples, in passes that accumulate */
+} km_req;
+
+/* An image the thread published. */
+typedef struct km_img {
+	uint64_t seq;
+	int w, h;
+	float *rgb;
+	size_t cap;
+	int spp, target;
+	bool done, refine;
+	double seconds;       /* the render time of this frame / pass */
+	double px_cost;       /* seconds per pixel and sample it measured */
+} km_img;
+
+typedef struct km_worker {
+	pthread_t thread;
+	bool started;
+	int wake_fd;
+	pthread_mutex_t m; /* guards quit, pending, busy, req */
+	pthread_cond_t work, idle;
+	bool quit, pending, busy;
+	km_req req;
+	atomic_bool cancel;
+
+	pthread_mutex_t im; /* guards img, serial, the cancel report */
+	km_img img;
+	uint64_t serial;
+	/* The last fast frame that was cancelled: how far it got. */
+	uint64_t cut_seq;
+	double cut_seconds, cut_frac;
+
+	/* The thread's own. */
+	framebuffer *fast, *fb;
+	km_req fb_req;     /* what fb holds */
+	long tiles_done, tiles_total;
+} km_worker;
+
+static void wk_wake(km_worker *wk)
+{
+	if (wk->wake_fd >= 0) {
+		ssize_t r = write(wk->wake_fd, "k", 1);
+		(void)r; /* a full pipe already holds a wake-up */
+	}
+}
+
+static void wk_publish(km_worker *wk, const km_req *req, const framebuffer *fb, int target, double seconds,
+                       double px_cost)
+{
+	size_t n = (size_t)fb->w * (size_t)fb->h * 3;
+	pthread_mutex_lock(&wk->im);
+	km_img *img = &wk->img;
+	bool ok = true;
+	if (n > img->cap) {
+		float *p = realloc(img->rgb, n * sizeof *p);
+		if (p) {
+			img->rgb = p;
+			img->cap = n;
+		} else {
+			ok = false;
+		}
+	}
+	if (ok) {
+		memcpy(img->rgb, fb->rgb, n * sizeof *img->rgb);
+		img->seq = req->seq;
+		img->w = fb->w;
+		img->h = fb->h;
+		img->spp = fb->spp;
+		img->target = target;
+		img->done = fb->spp >= target;
+		img->refine = req->refine;
+		img->seconds = seconds;
+		img->px_cost = px_cost;
+		wk->serial++;
+	}
+	pthread_mutex_unlock(&wk->im);
+	if (ok)
+		wk_wake(wk);
+}
+
+static framebuffer *wk_fresh(framebuffer **fb, int w, int h)
+{
+	if (*fb && ((*fb)->w != w || (*fb)->h != h)) {
+		fb_free(*fb);
+		*fb = NULL;
+	}
+	if (!*fb)
+		*fb = fb_new(w, h);
+	if (*fb)
+		fb_clear(*fb);
+	return *fb;
+}
+
+static void wk_progress(void *ctx, long done, long total)
+{
+	km_worker *wk = ctx;
+	wk->tiles_done = done;
+	wk->tiles_total = total;
+}
+
+/* True when fb (rendered for a) can take more samples for b. */
+static bool wk_continues(const km_req *a, const km_req *b)
+{
+	return a->refine && b->refine && a->gen == b->gen && a->w == b->w && a->w_px == b->w_px &&
+	       a->h_px == b->h_px && a->set.mode == b->set.mode && a->set.depth == b->set.depth &&
+	       a->set.seed == b->set.seed && (a->set.samples > 1) == (b->set.samples > 1);
+}
+
+static void wk_run(km_worker *wk, const km_req *req)
+{
+	rt_error err;
+	double t0 = now();
+	render_job job = {
+		.w = req->w,
+		.set = req->set,
+		.cancel = &wk->cancel,
+		.progress = wk_progress,
+		.progress_ctx = wk,
+	};
+	wk->tiles_done = 0;
+	wk->tiles_total = 1;
+	if (!req->refine) {
+		/* A fast frame: one centred sample per pixel. */
+		framebuffer *fb = wk_fresh(&wk->fast, req->w_px, req->h_px);
+		if (!fb)
+			return;
+		job.set.samples = 1;
+		job.fb = fb;
+		job.sample_begin = 0;
+		job.sample_end = 1;
+		render_status st = render_run(&job, &err);
+		double dt = now() - t0;
+		if (st == RENDER_DONE) {
+			wk_publish(wk, req, fb, 1, dt, dt / ((double)fb->w * fb->h));
+		} else if (st == RENDER_CANCELLED) {
+			pthread_mutex_lock(&wk->im);
+			wk->cut_seq = req->seq;
+			wk->cut_seconds = dt;
+			wk->cut_frac = wk->tiles_total > 0 ? (double)wk->tiles_done / (double)wk->tiles_total : 0.0;
+			pthread_mutex_unlock(&wk->im);
+		}
+		return;
+	}
+	/* A refine: go on from the samples fb holds when it shows the same. */
+	framebuffer *fb = wk->fb;
+	bool cont = fb && fb->spp > 0 && fb->spp <= req->set.samples && wk_continues(&wk->fb_req, req);
+	if (!cont)
+		fb = wk_fresh(&wk->fb, req->w_px, req->h_px);
+	if (!fb)
+		return;
+	wk->fb_req = *req;
+	int target = req->set.samples, done = fb->spp, n = 1;
+	if (done >= target) {
+		wk_publish(wk, req, fb, target, 0.0, 0.0);
+		return;
+	}
+	while (done < target) {
+		if (n > target - done)
+			n = target - done;
+		job.fb = fb;
+		job.sample_begin = done;
+		job.sample_end = done + n;
+		double t1 = now();
+		if (render_run(&job, &err) != RENDER_DONE)
+			return;
+		double dt = now() - t1, per = dt / n;
+		done += n;
+		wk_publish(wk, req, fb, target, dt, per / ((double)fb->w * fb->h));
+		/* Passes of about 0.2 s after the first. */
+		n = per > 0 ? (int)(0.2 / per) : 64;
+		if (n < 1)
+			n = 1;
+	}
+}
+
+static void *wk_main(void *arg)
+{
+	km_worker *wk = arg;
+	pthread_mutex_lock(&wk->m);
+	for (;;) {
+		while (!wk->quit && !wk->pending)
+			pthread_cond_wait(&wk->work, &wk->m);
+		if (wk->quit)
+			break;
+		km_req req = wk->req;
+		wk->pending = false;
+		wk->busy = true;
+		pthread_mutex_unlock(&wk->m);
+		wk_run(wk, &req);
+		pthread_mutex_lock(&wk->m);
+		wk->busy = false;
+		pthread_cond_broadcast(&wk->idle);
+	}
+	pthread_mutex_unlock(&wk->m);
+	return NULL;
+}
+
+static void wk_init(km_worker *wk, int wake_fd)
+{
+	memset(wk, 0, sizeof *wk);
+	wk->wake_fd = wake_fd;
+	pthread_mutex_init(&wk->m, NULL);
+	pthread_mutex_init(&wk->im, NULL);
+	pthread_cond_init(&wk->work, NULL);
+	pthread_cond_init(&wk->idle, NULL);
+	atomic_init(&wk->cancel, false);
+}
+
+/* Cancels the render in flight and any request waiting; returns once the
+ * thread no longer uses the world. */
+static void wk_hold(km_worker *wk)
+{
+	pthread_mutex_lock(&wk->m);
+	wk->pending = false;
+	atomic_store(&wk->cancel, true);
+	while (wk->busy)
+		pthread_cond_wait(&wk->idle, &wk->m);
+	atomic_store(&wk->cancel, false);
+	pthread_mutex_unlock(&wk->m);
+}
+
+static bool wk_busy(km_worker *wk)
+{
+	pthread_mutex_lock(&wk->m);
+	bool b = wk->busy || wk->pending;
+	pthread_mutex_unlock(&wk->m);
+	return b;
+}
+
+static bool wk_start(km_worker *wk, const km_req *req)
+{
+	pthread_mutex_lock(&wk->m);
+	wk->req = *req;
+	wk->pending = true;
+	if (!wk->started) {
+		if (pthread_create(&wk->thread, NULL, wk_main, wk) == 0)
+			wk->started = true;
+		else
+			wk->pending = false;
+	}
+	bool ok = wk->pending;
+	pthread_cond_signal(&wk->work);
+	pthread_mutex_unlock(&wk->m);
+	return ok;
+}
+
+static void wk_free(km_worker *wk)
+{
+	if (wk->started) {
+		pthread_mutex_lock(&wk->m);
+		wk->quit = true;
+		atomic_store(&wk->cancel, true);
+		pthread_cond_signal(&wk->work);
+		pthread_mutex_unlock(&wk->m);
+		pthread_join(wk->thread, NULL);
+	}
+	fb_free(wk->fast);
+	fb_free(wk->fb);
+	free(wk->img.rgb);
+	pthread_mutex_destroy(&wk->m);
+	pthread_mutex_destroy(&wk->im);
+	pthread_cond_destroy(&wk->work);
+	pthread_cond_destroy(&wk->idle);
+}
+
+/* The pixel ratios a fast frame may use. */
+static const double ratios[] = {1, 1.5, 2, 3, 4, 6, 8, 12, 16};
+#define NRATIOS ((int)(sizeof ratios / sizeof ratios[0]))
+
+/* A selection outline: gold, drawn just outside the selected pixels. */
+static const uint8_t mark_rgb[3] = {255, 205, 0};
+
+struct keymode {
+	shell *sh;
+	int fd;
+	frame_palette pal;
+	int cols, rows;
+	int pic_rows;          /* the picture's rows; the status line and help bar follow */
+	int img_w, img_h;      /* the picture in pixels ... */
+	int img_x, img_y;      /* ... and its place on the cols x 2*pic_rows canvas */
+	frame *fr;
+	abuf out;
+	bool help;             /* the help bar is shown */
+	double layout_aspect;  /* the image aspect the layout is for */
+	bool repaint;          /* clear the screen before the next frame */
+
+	km_worker wk;
+	const world *w;        /* the preview's world for wgen (NULL: none yet) */
+	uint64_t wgen;
+	double step;
+
+	km_sel sel;
+	bool run_open;         /* an undo group for a run of one key is open */
+	int run_key;
+	km_sel run_sel;
+
+	uint64_t seq;          /* the newest request */
+	km_req cur;
+	bool want_fast, want_refine; /* a render to start */
+	bool refined;          /* the newest request is a refine (or needs none) */
+	bool stopped;
+	double last_key;
+	int ratio_i;
+	double cost;           /* seconds per pixel and sample; 0 = not known */
+	uint64_t cut_seen;
+	uint64_t taken;        /* the thread's image serial last looked at */
+
+	km_img img;            /* the newest image taken */
+	bool have_img, dirty;
+	bool held;             /* a new image waits to be drawn */
+	double last_draw;
+	uint8_t *small, *big, *mask;
+	size_t small_cap, big_cap, mask_cap;
+	bool mask_ok;
+	uint64_t mask_gen;
+	km_sel mask_sel;
+	int mask_w, mask_h;
+	bool sel_visible;
+
+	char msg[256];
+	double msg_until;
+	char status_shown[1024];
+	double fast_times[16]; /* when the last fast frames were drawn */
+	long fast_frames, frames;
+	int edits;
+	bool quit;
+};
+
+/* --- layout --- */
+
+static double km_aspect(const keymode *km)
+{
+	return (double)km->sh->set.width / km->sh->set.height;
+}
+
+static void km_layout(keymode *km)
+{
+	int bars = km->help ? 2 : 1;
+	km->layout_aspect = km_aspect(km);
+	km->pic_rows = km->rows - bars;
+	frame_free(km->fr);
+	km->fr = NULL;
+	km->img_w = km->img_h = 0;
+	if (km->pic_rows < 2 || km->cols < 8) {
+		km->pic_rows = 0;
+	} else {
+		bool whole = km->pal == PALETTE_NONE;
+		screen_fit(km->cols, km->pic_rows, km_aspect(km), whole, &km->img_w, &km->img_h);
+		km->img_x = (km->cols - km->img_w) / 2;
+		km->img_y = (2 * km->pic_rows - km->img_h) / 2;
+		if (whole)
+			km->img_y &= ~1;
+		km->fr = frame_new(km->cols, km->pic_rows, km->pal);
+		if (km->fr)
+			km->fr->sync = false; /* each whole update is bracketed here */
+		else
+			km->img_w = km->img_h = 0;
+	}
+	km->repaint = true;
+	km->status_shown[0] = '\0';
+	km->mask_ok = false;
+}
+
+static void km_message(keymode *km, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void km_message(keymode *km, const char *fmt, ...)
+{
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(km->msg, sizeof km->msg, fmt, ap);
+	va_end(ap);
+	km->msg_until = now() + 3.0;
+	km->dirty = true;
+}
+
+/* --- the world and the requests --- */
+
+/* The world for the editor's scene, built when the scene changed (the
+ * thread must not be rendering). */
+static const world *km_world(keymode *km)
+{
+	uint64_t gen = editor_generation(km->sh->ed);
+	if (km->w && km->wgen == gen)
+		return km->w;
+	preview_hold(km->sh->pv); /* cheap when held: the shell may have released it */
+	rt_error err;
+	rt_error_clear(&err);
+	km->w = preview_world(km->sh->pv, editor_scene(km->sh->ed), gen, &err);
+	km->wgen = gen;
+	if (!km->w)
+		km_message(km, "the scene cannot be shown: %s", err.msg);
+	return km->w;
+}
+
+static int km_pick_ratio(keymode *km)
+{
+	if (!(km->cost > 0))
+		return km->ratio_i > 0 ? km->ratio_i : 2;
+	int loose = NRATIOS - 1, strict = NRATIOS - 1;
+	for (int i = NRATIOS - 1; i >= 0; i--) {
+		double r = ratios[i];
+		double px = ceil(km->img_w / r) * ceil(km->img_h / r);
+		double t = px * km->cost;
+		if (t <= KEYMODE_FRAME_BUDGET)
+			loose = i;
+		if (t <= 0.7 * KEYMODE_FRAME_BUDGET)
+			strict = i;
+	}
+	int i = km->ratio_i;
+	if (i < loose)
+		i = loose;
+	if (i > strict)
+		i = strict;
+	return i;
+}
+
+/* What the last cancelled fast frame says about the cost of a pixel. */
+static void km_learn_from_cut(keymode *km)
+{
+	km_worker *wk = &km->wk;
+	pthread_mutex_lock(&wk->im);
+	uint64_t seq = wk->cut_seq;
+	double sec = wk->cut_seconds, frac = wk->cut_frac;
+	pthread_mutex_unlock(&wk->im);
+	if (seq == km->cut_seen || seq != km->cur.seq || km->cur.refine)
+		return;
+	km->cut_seen = seq;
+	double px = (double)km->cur.w_px * km->cur.h_px;
+	if (px <= 0 || sec < 0.002)
+		return; /* cut at once: says nothing */
+	double c = frac > 0.05 ? sec / (frac * px) : sec / px;
+	if (c > km->cost)
+		km->cost = km->cost > 0 ? 0.5 * (km->cost + c) : c;
+}
+
+static void km_start(keymode *km, bool refine)
+{
+	shell *sh = km->sh;
+	if (km->img_w <= 0 || km->img_h <= 0)
+		return;
+	wk_hold(&km->wk);
+	km_learn_from_cut(km);
+	const world *w = km_world(km);
+	if (!w)
+		return;
+	km_req r;
+	memset(&r, 0, sizeof r);
+	r.seq = ++km->seq;
+	r.gen = km->wgen;
+	r.w = w;
+	r.set = sh->set;
+	r.refine = refine;
+	if (refine) {
+		r.w_px = km->img_w;
+		r.h_px = km->img_h;
+	} else {
+		km->ratio_i = km_pick_ratio(km);
+		double q = ratios[km->ratio_i];
+		r.w_px = (int)ceil(km->img_w / q);
+		r.h_px = (int)ceil(km->img_h / q);
+		if (r.w_px < 1)
+			r.w_px = 1;
+		if (r.h_px < 1)
+			r.h_px = 1;
+	}
+	km->cur = r;
+	km->refined = refine;
+	km->stopped = false;
+	if (!wk_start(&km->wk, &r))
+		km_message(km, "cannot start the render thread");
+}
+
+/* --- drawing --- */
+
+static bool grow(uint8_t **p, size_t *cap, size_t n)
+{
+	if (n <= *cap)
+		return true;
+	uint8_t *q = realloc(*p, n);
+	if (!q)
+		return false;
+	*p = q;
+	*cap = n;
+	return true;
+}
+
+/* Which picture pixels show the selected object (primary rays through the
+ * pixel centres, as the renderer casts them). */
+static void km_mask(keymode *km)
+{
+	uint64_t gen = km->wgen;
+	if (km->mask_ok && km->mask_gen == gen && km->mask_sel.kind == km->sel.kind &&
+	    km->mask_sel.index == km->sel.index && km->mask_w == km->img_w && km->mask_h == km->img_h)
+		return;
+	km->mask_ok = false;
+	km->sel_visible = false;
+	if (km->sel.kind != KM_SEL_OBJECT || !km->w)
+		return;
+	size_t n = (size_t)km->img_w * (size_t)km->img_h;
+	if (!grow(&km->mask, &km->mask_cap, n))
+		return;
+	const world *w = km->w;
+	uint32_t want = (uint32_t)km->sel.index;
+	for (int y = 0; y < km->img_h; y++)
+		for (int x = 0; x < km->img_w; x++) {
+			ray r = cam_ray(&w->cam, x + 0.5, y + 0.5, km->img_w, km->img_h);
+			hit h;
+			bool on = world_intersect(w, &r, 0.0, INFINITY, &h) && h.object == want;
+			km->mask[(size_t)y * km->img_w + x] = on;
+			km->sel_visible |= on;
+		}
+	km->mask_ok = true;
+	km->mask_gen = gen;
+	km->mask_sel = km->sel;
+	km->mask_w = km->img_w;
+	km->mask_h = km->img_h;
+}
+
+static void put_px(uint8_t *img, int w, int h, int x, int y, const uint8_t c[3])
+{
+	if (x < 0 || y < 0 || x >= w || y >= h)
+		return;
+	memcpy(img + ((size_t)y * w + x) * 3, c, 3);
+}
+
+/* Marks the selection on the picture (img_w x img_h sRGB). */
+static void km_mark(keymode *km, uint8_t *img)
+{
+	int w = km->img_w, h = km->img_h;
+	if (km->sel.kind == KM_SEL_OBJECT) {
+		km_mask(km);
+		if (!km->mask_ok)
+			return;
+		const uint8_t *m = km->mask;
+		/* An outline just outside the object's pixels. */
+		for (int y = 0; y < h; y++)
+			for (int x = 0; x < w; x++) {
+				size_t i = (size_t)y * w + x;
+				if (m[i])
+					continue;
+				bool edge = (x > 0 && m[i - 1]) || (x + 1 < w && m[i + 1]) || (y > 0 && m[i - w]) ||
+				            (y + 1 < h && m[i + w]);
+				if (edge)
+					memcpy(img + i * 3, mark_rgb, 3);
+			}
+	} else if (km->sel.kind == KM_SEL_LIGHT && km->w) {
+		const scene *s = editor_scene(km->sh->ed);
+		km->sel_visible = false;
+		if (km->sel.index >= s->nlights)
+			return;
+		const cam_view *c = &km->w->cam;
+		vec3 p = v3_sub(s->lights[km->sel.index].pos, c->pos);
+		double z = v3_dot(p, c->fwd);
+		if (!(z > 0))
+			return;
+		double u = v3_dot(p, c->right) / (z * c->tan_half);
+		double v = v3_dot(p, c->up) / (z * c->tan_half * ((double)h / w));
+		int px = (int)floor((u + 1) * 0.5 * w), py = (int)floor((1 - v) * 0.5 * h);
+		if (px < -2 || py < -2 || px > w + 1 || py > h + 1)
+			return;
+		km->sel_visible = true;
+		static const uint8_t white[3] = {255, 255, 255}, dark[3] = {40, 30, 0};
+		/* A plus of gold arms around a white centre, on a dark ring. */
+		for (int d = -3; d <= 3; d++) {
+			put_px(img, w, h, px + d, py - 1, dark);
+			put_px(img, w, h, px + d, py + 1, dark);
+			put_px(img, w, h, px - 1, py + d, dark);
+			put_px(img, w, h, px + 1, py + d, dark);
+		}
+		for (int d = -3; d <= 3; d++) {
+			put_px(img, w, h, px + d, py, mark_rgb);
+			put_px(img, w, h, px, py + d, mark_rgb);
+		}
+		put_px(img, w, h, px, py, white);
+	}
+}
+
+static const char *km_sel_name(const keymode *km, char *buf, size_t size)
+{
+	const scene *s = editor_scene(km->sh->ed);
+	switch (km->sel.kind) {
+	case KM_SEL_OBJECT:
+		if (km->sel.index < s->nobjs) {
+			snprintf(buf, size, "object %zu %s%s", km->sel.index + 1,
+			         obj_kind_name(s->objs[km->sel.index].kind), km->sel_visible ? "" : " (hidden)");
+			return buf;
+		}
+		break;
+	case KM_SEL_LIGHT:
+		if (km->sel.index < s->nlights) {
+			snprintf(buf, size, "light %zu%s", km->sel.index + 1, km->sel_visible ? "" : " (out of view)");
+			return buf;
+		}
+		break;
+	case KM_SEL_CAMERA:
+		break;
+	}
+	snprintf(buf, size, "camera");
+	return buf;
+}
+
+/* Fast frames a second over the last ones drawn within a second; 0 when
+ * not moving. */
+static double km_fps(const keymode *km)
+{
+	long total = km->fast_frames;
+	double t = now();
+	if (total < 2 || t - km->fast_times[(total - 1) % 16] > 0.5)
+		return 0;
+	double newest = km->fast_times[(total - 1) % 16], oldest = newest;
+	int n = 1;
+	for (long i = total - 2; i >= 0 && i > total - 16; i--) {
+		double ti = km->fast_times[i % 16];
+		if (newest - ti > 1.0)
+			break;
+		oldest = ti;
+		n++;
+	}
+	return n > 1 && newest > oldest ? (n - 1) / (newest - oldest) : 0;
+}
+
+static void km_status_text(keymode *km, char *buf, size_t size)
+{
+	shell *sh = km->sh;
+	char sel[128], spp[64], res[48] = "", fps[32] = "", t[32] = "";
+	km_sel_name(km, sel, sizeof sel);
+	const km_img *im = &km->img;
+	if (!km->have_img)
+		snprintf(spp, sizeof spp, "rendering");
+	else if (!im->refine && !km->refined)
+		snprintf(spp, sizeof spp, "moving");
+	else if (!im->refine)
+		snprintf(spp, sizeof spp, "1/1 spp");
+	else
+		snprintf(spp, sizeof spp, "%d/%d spp%s", im->spp, im->target,
+		         km->stopped ? " stopped" : im->done ? "" : "…");
+	if (km->have_img && !im->refine && ratios[km->ratio_i] > 1)
+		snprintf(res, sizeof res, " (1/%g res)", ratios[km->ratio_i]);
+	double f = km_fps(km);
+	if (f > 0)
+		snprintf(fps, sizeof fps, " │ %.0f fps", f);
+	if (km->have_img)
+		snprintf(t, sizeof t, " │ %.0f ms", im->seconds * 1000);
+	bool msg = km->msg[0] && now() < km->msg_until;
+	snprintf(buf, size, " view │ %s │ %s │ %s │ %s │ depth %d │ %dx%d%s%s%s │ step %.3g%s%s", sh->name, sel,
+	         render_mode_name(sh->set.mode), spp, sh->set.depth, km->img_w, km->img_h, res, fps, t, km->step,
+	         msg ? " │ " : "", msg ? km->msg : "");
+}
+
+/* Appends a line of text at row (0-based), cut to the width. */
+static void put_line(abuf *a, int row, int cols, const char *text, bool reverse)
+{
+	abuf_printf(a, "\x1b[%dH%s", row + 1, reverse ? "\x1b[7m" : "");
+	int width = 0, max = reverse ? cols : cols - 1; /* never the last cell of the last row */
+	const char *p = text;
+	for (; *p && width < max; p++) {
+		abuf_char(a, *p);
+		if (((unsigned char)p[1] & 0xc0) != 0x80)
+			width++;
+	}
+	while (((unsigned char)*p & 0xc0) == 0x80)
+		abuf_char(a, *p++);
+	if (reverse)
+		for (; width < cols; width++)
+			abuf_char(a, ' ');
+	abuf_str(a, "\x1b[m");
+	if (!reverse)
+		abuf_str(a, "\x1b[K");
+}
+
+/* Draws the newest image (scaled up to the picture size), the marker and
+ * the bars, as one write(). */
+static void km_draw(keymode *km)
+{
+	abuf *a = &km->out;
+	abuf_reset(a);
+	abuf_str(a, "\x1b[?2026h");
+	if (km->repaint) {
+		abuf_str(a, "\x1b[r\x1b[m\x1b[2J\x1b[?25l");
+		if (km->fr)
+			frame_invalidate(km->fr);
+		km->status_shown[0] = '\0';
+		if (km->help)
+			put_line(a, km->rows - 1, km->cols, help_bar, false);
+		km->repaint = false;
+	}
+	const km_img *im = &km->img;
+	if (km->fr && km->have_img && im->w > 0 && im->h > 0) {
+		int W = km->img_w, H = km->img_h;
+		size_t n = (size_t)W * H * 3, sn = (size_t)im->w * im->h * 3;
+		if (grow(&km->small, &km->small_cap, sn) && grow(&km->big, &km->big_cap, n)) {
+			frame_srgb_from_linear(im->rgb, (size_t)im->w * im->h, km->sh->set.exposure, km->small);
+			/* Pixel replication up to the picture size. */
+			for (int y = 0; y < H; y++) {
+				int sy = (int)((long)y * im->h / H);
+				const uint8_t *src = km->small + (size_t)sy * im->w * 3;
+				uint8_t *dst = km->big + (size_t)y * W * 3;
+				for (int x = 0; x < W; x++)
+					memcpy(dst + (size_t)x * 3, src + (size_t)((long)x * im->w / W) * 3, 3);
+			}
+			km_mark(km, km->big);
+			frame_put_image(km->fr, km->big, W, H, km->img_x, km->img_y);
+			const abuf *f = frame_update(km->fr);
+			abuf_add(a, f->b, f->len);
+		}
+	}
+	char status[1024];
+	km_status_text(km, status, sizeof status);
+	if (strcmp(status, km->status_shown) != 0 && km->rows >= 1) {
+		put_line(a, km->pic_rows, km->cols, status, true);
+		snprintf(km->status_shown, sizeof km->status_shown, "%s", status);
+	}
+	abuf_str(a, "\x1b[?25l\x1b[?2026l");
+	if (!a->failed)
+		write_all(km->fd, a->b, a->len);
+	km->dirty = false;
+	km->last_draw = now();
+}
+
+/* --- keys --- */
+
+static void km_close_run(keymode *km)
+{
+	if (km->run_open) {
+		editor_group_end(km->sh->ed);
+		km->run_open = false;
+	}
+}
+
+/* After an edit that may have replaced the scene (undo, redo, PgUp/PgDn):
+ * the step, the selection and the layout follow the new scene. */
+static void km_after_replace(keymode *km, const char *label_before)
+{
+	shell *sh = km->sh;
+	const char *label = editor_label(sh->ed);
+	bool same = label == label_before || (label && label_before && strcmp(label, label_before) == 0);
+	if (!same) {
+		km->step = keymode_step(editor_scene(sh->ed));
+		km->cost = 0;
+	}
+	if (!keymode_sel_valid(editor_scene(sh->ed), km->sel))
+		km->sel = (km_sel){KM_SEL_CAMERA, 0};
+	if (km_aspect(km) != km->layout_aspect)
+		km_layout(km);
+}
+
+/* Runs a shell command (next, prev) with its notes on standard error
+ * caught and shown in the status line instead. */
+static bool km_shell_command(keymode *km, cmd_fn fn)
+{
+	shell *sh = km->sh;
+	fflush(stdout);
+	fflush(stderr);
+	FILE *tmp = tmpfile();
+	int saved_err = -1, saved_out = -1;
+	if (tmp) {
+		saved_err = dup(STDERR_FILENO);
+		saved_out = dup(STDOUT_FILENO);
+		dup2(fileno(tmp), STDERR_FILENO);
+		dup2(fileno(tmp), STDOUT_FILENO);
+	}
+	sh->err[0] = '\0';
+	bool ok = fn(sh, 0, NULL, "");
+	fflush(stdout);
+	fflush(stderr);
+	char last[256] = "";
+	if (tmp) {
+		dup2(saved_err, STDERR_FILENO);
+		dup2(saved_out, STDOUT_FILENO);
+		close(saved_err);
+		close(saved_out);
+		rewind(tmp);
+		char line[256];
+		while (fgets(line, sizeof line, tmp))
+			if (line[0] != '\n')
+				snprintf(last, sizeof last, "%s", line);
+		fclose(tmp);
+		last[strcspn(last, "\r\n")] = '\0';
+	}
+	if (!ok)
+		km_message(km, "%s", sh->err);
+	else if (last[0])
+		km_message(km, "%s", last);
+	sh->err[0] = '\0';
+	return ok;
+}
+
+static void km_settings(keymode *km, const km_action *a)
+{
+	shell *sh = km->sh;
+	rt_error err;
+	const setting_def *def;
+	switch (a->op) {
+	case KM_SAMPLES:
+		def = settings_find("samples", &err);
+		if (def) {
+			long v = a->n > 0 ? (long)sh->set.samples * 2 : sh->set.samples / 2;
+			v = v < (long)def->min ? (long)def->min : v > (long)def->max ? (long)def->max : v;
+			if (v == sh->set.samples)
+				km_message(km, "samples: %d is the %s", sh->set.samples, a->n > 0 ? "most" : "least");
+			sh->set.samples = (int)v;
+		}
+		break;
+	case KM_DEPTH:
+		def = settings_find("depth", &err);
+		if (def) {
+			long v = sh->set.depth + a->n;
+			v = v < (long)def->min ? (long)def->min : v > (long)def->max ? (long)def->max : v;
+			if (v == sh->set.depth)
+				km_message(km, "depth: %d is the %s", sh->set.depth, a->n > 0 ? "most" : "least");
+			sh->set.depth = (int)v;
+		}
+		km->cost = 0;
+		break;
+	default: /* KM_MODE */
+		sh->set.mode = sh->set.mode == MODE_PATH ? MODE_WHITTED : MODE_PATH;
+		km->cost = 0;
+		break;
+	}
+	km->want_refine = true;
+	km->want_fast = false;
+}
+
+void keymode_key(keymode *km, int key)
+{
+	if (km->quit)
+		return;
+	shell *sh = km->sh;
+	const scene *s = editor_scene(sh->ed);
+	km_action a = keymode_map(key, s, km->sel, km->step);
+	if (a.op == KM_NONE)
+		return;
+	km->last_key = now();
+	if (keymode_is_edit(a.op)) {
+		if (!(km->run_open && km->run_key == key && km->run_sel.kind == km->sel.kind &&
+		      km->run_sel.index == km->sel.index)) {
+			km_close_run(km);
+			editor_group_begin(sh->ed);
+			km->run_open = true;
+			km->run_key = key;
+			km->run_sel = km->sel;
+		}
+		uint64_t gen = editor_generation(sh->ed);
+		rt_error err;
+		if (!keymode_apply(sh->ed, &a, &err))
+			km_message(km, "%s", err.msg);
+		if (editor_generation(sh->ed) != gen) {
+			km->edits++;
+			km->want_fast = true;
+		}
+		return;
+	}
+	km_close_run(km);
+	uint64_t gen = editor_generation(sh->ed);
+	const char *label = editor_label(sh->ed);
+	char *label_copy = label ? strdup(label) : NULL;
+	rt_error err;
+	switch (a.op) {
+	case KM_SELECT:
+		km->sel = a.sel;
+		km->dirty = true;
+		break;
+	case KM_UNDO:
+	case KM_REDO:
+		shell_edit_begin(sh);
+		if (!(a.op == KM_UNDO ? editor_undo(sh->ed, &err) : editor_redo(sh->ed, &err)))
+			km_message(km, "%s", err.msg);
+		shell_edit_end(sh);
+		km_after_replace(km, label_copy);
+		if (editor_generation(sh->ed) != gen)
+			km->want_fast = true;
+		break;
+	case KM_SCENE:
+		km_shell_command(km, a.n > 0 ? cmd_next : cmd_prev);
+		km_after_replace(km, label_copy);
+		km->want_refine = true;
+		km->want_fast = false;
+		break;
+	case KM_SAMPLES:
+	case KM_DEPTH:
+	case KM_MODE:
+		km_settings(km, &a);
+		break;
+	case KM_STOP:
+		if (wk_busy(&km->wk) || km->want_fast || km->want_refine || !km->refined) {
+			wk_hold(&km->wk);
+			km->want_fast = km->want_refine = false;
+			km->refined = true;
+			km->stopped = true;
+			km_message(km, "stopped; any key that changes the picture renders again");
+		} else {
+			km_message(km, "nothing to stop: the picture is done");
+		}
+		break;
+	case KM_REDRAW:
+		km->repaint = true;
+		km->dirty = true;
+		break;
+	case KM_HELP:
+		km->help = !km->help;
+		km_layout(km);
+		km->want_refine = true;
+		break;
+	case KM_QUIT:
+		km->quit = true;
+		break;
+	default:
+		break;
+	}
+	free(label_copy);
+}
+
+/* Takes the newest image from the thread; true when there is one to show. */
+static bool km_take(keymode *km)
+{
+	km_worker *wk = &km->wk;
+	pthread_mutex_lock(&wk->im);
+	/* Images of an older request are dropped. */
+	bool fresh = wk->serial != km->taken && wk->img.seq == km->cur.seq;
+	km->taken = wk->serial;
+	if (fresh) {
+		size_t n = (size_t)wk->img.w * wk->img.h * 3;
+		if (n > km->img.cap) {
+			float *p = realloc(km->img.rgb, n * sizeof *p);
+			if (!p) {
+				pthread_mutex_unlock(&wk->im);
+				return false;
+			}
+			km->img.rgb = p;
+			km->img.cap = n;
+		}
+		float *keep = km->img.rgb;
+		size_t cap = km->img.cap;
+		km->img = wk->img;
+		km->img.rgb = keep;
+		km->img.cap = cap;
+		memcpy(km->img.rgb, wk->img.rgb, n * sizeof *keep);
+	}
+	pthread_mutex_unlock(&wk->im);
+	if (!fresh)
+		return false;
+	km->have_img = true;
+	/* What a pixel costs, for the next fast frame's ratio. */
+	if (km->img.px_cost > 0)
+		km->cost = km->cost > 0 ? 0.5 * (km->cost + km->img.px_cost) : km->img.px_cost;
+	return true;
+}
+
+int keymode_tick(keymode *km)
+{
+	double t = now();
+	if (km->want_fast) {
+		km->want_fast = false;
+		km->want_refine = false;
+		km_start(km, false);
+	} else if (km->want_refine || (!km->refined && t - km->last_key >= KEYMODE_IDLE)) {
+		km->want_refine = false;
+		/* A fast frame at full resolution with one sample is final. */
+		const km_req *c = &km->cur;
+		bool final = c->seq != 0 && !c->refine && km->ratio_i == 0 && km->sh->set.samples == 1 &&
+		             c->gen == editor_generation(km->sh->ed) && c->set.mode == km->sh->set.mode &&
+		             c->set.depth == km->sh->set.depth && c->w_px == km->img_w && c->h_px == km->img_h;
+		if (final)
+			km->refined = true;
+		else
+			km_start(km, true);
+	}
+	if (km_take(km))
+		km->held = true;
+	/* Fast frames are drawn at once; passes of a refine at most 10 times a
+	 * second (its first and last pass at once). */
+	bool picture = km->held && (!km->img.refine || km->img.done || km->img.spp <= 1 ||
+	                            t - km->last_draw >= 0.1);
+	if (km->msg[0] && t >= km->msg_until) {
+		km->msg[0] = '\0';
+		km->dirty = true;
+	}
+	if (!picture && !km->dirty) {
+		/* The status line alone may have changed (the fps figure). */
+		char status[1024];
+		km_status_text(km, status, sizeof status);
+		km->dirty = strcmp(status, km->status_shown) != 0;
+	}
+	if (picture || km->dirty || km->repaint) {
+		km_draw(km);
+		if (picture) {
+			km->held = false;
+			km->frames++;
+			if (!km->img.refine)
+				km->fast_times[km->fast_frames++ % 16] = km->last_draw;
+			return 1;
+		}
+	}
+	return 0;
+}
+
+double keymode_timeout(const keymode *km)
+{
+	double t = now(), best = -1;
+	if (!km->refined) {
+		double d = km->last_key + KEYMODE_IDLE - t;
+		best = d < 0 ? 0 : d;
+	}
+	if (km->msg[0]) {
+		double d = km->msg_until - t;
+		d = d < 0 ? 0 : d;
+		if (best < 0 || d < best)
+			best = d;
+	}
+	/* A refine pass waiting for its turn to be drawn. */
+	if (km->held) {
+		double d = km->last_draw + 0.1 - t;
+		d = d < 0 ? 0 : d;
+		if (best < 0 || d < best)
+			best = d;
+	}
+	/* Let the fps figure go when keys stop. */
+	if (km->fast_frames > 1 && t - km->fast_times[(km->fast_frames - 1) % 16] < 0.6) {
+		double d = km->fast_times[(km->fast_frames - 1) % 16] + 0.6 - t;
+		if (best < 0 || d < best)
+			best = d < 0 ? 0 : d;
+	}
+	return best;
+}
+
+bool keymode_done(const keymode *km)
+{
+	return km->quit;
+}
+
+int keymode_edits(const keymode *km)
+{
+	return km->edits;
+}
+
+double keymode_ratio(const keymode *km)
+{
+	return ratios[km->ratio_i];
+}
+
+long keymode_frames(const keymode *km)
+{
+	return km->frames;
+}
+
+void keymode_resize(keymode *km, int cols, int rows)
+{
+	km->cols = cols;
+	km->rows = rows;
+	km_layout(km);
+	km->want_refine = true;
+	km->dirty = true;
+}
+
+keymode *keymode_new(shell *sh, int fd, frame_palette pal, int cols, int rows)
+{
+	keymode *km = calloc(1, sizeof *km);
+	if (!km) {
+		shell_fail(sh, "view: out of memory");
+		return NULL;
+	}
+	km->sh = sh;
+	km->fd = fd;
+	km->pal = pal;
+	km->cols = cols;
+	km->rows = rows;
+	km->help = true;
+	abuf_init(&km->out);
+	wk_init(&km->wk, sh->wake[1]);
+	preview_hold(sh->pv);
+	km->step = keymode_step(editor_scene(sh->ed));
+	km->sel = (km_sel){KM_SEL_CAMERA, 0};
+	km_layout(km);
+	km->want_refine = true;
+	km->refined = true;
+	km->dirty = true;
+	return km;
+}
+
+void keymode_free(keymode *km)
+{
+	if (!km)
+		return;
+	wk_hold(&km->wk);
+	wk_free(&km->wk);
+	km_close_run(km);
+	frame_free(km->fr);
+	abuf_free(&km->out);
+	free(km->img.rgb);
+	free(km->small);
+	free(km->big);
+	free(km->mask);
+	free(km);
+}
+
+/* ------------------------------------------------------------------ */
+/* 3. The terminal                                                     */
+/* ------------------------------------------------------------------ */
+
+static void term_size(int fd, int *cols, int *rows)
+{
+	struct winsize ws;
+	if (ioctl(fd, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 0 && ws.ws_row > 0) {
+		*cols = ws.ws_col;
+		*rows = ws.ws_row;
+	} else {
+		*cols = 80;
+		*rows = 24;
+	}
+}
+
+static void put_str(int fd, const char *s)
+{
+	if (s)
+		write_all(fd, s, strlen(s));
+}
+
+/* The terminal modes of key mode: keys one at a time, no echo; Ctrl-C,
+ * Ctrl-Z and Ctrl-\ still send their signals. */
+static void raw_modes(int fd, const struct termios *saved)
+{
+	struct termios t = *saved;
+	t.c_lflag &= ~(tcflag_t)(ICANON | ECHO);
+	t.c_iflag &= ~(tcflag_t)ICRNL;
+	t.c_cc[VMIN] = 1;
+	t.c_cc[VTIME] = 0;
+	tcsetattr(fd, TCSANOW, &t);
+}
+
+/* Ctrl-Z: give the terminal back, stop, and take it again on SIGCONT. */
+static void km_suspend(keymode *km, screen *scr, const keys *k, int in, const struct termios *saved)
+{
+	put_str(km->fd, keys_keypad_off(k));
+	tcsetattr(in, TCSANOW, saved);
+	screen_suspend(scr);
+	struct sigaction sa, old;
+	memset(&sa, 0, sizeof sa);
+	sa.sa_handler = SIG_DFL;
+	sigemptyset(&sa.sa_mask);
+	sigaction(SIGTSTP, &sa, &old);
+	raise(SIGTSTP);
+	/* ... continued. */
+	sigaction(SIGTSTP, &old, NULL);
+	raw_modes(in, saved);
+	screen_resume(scr);
+	put_str(km->fd, keys_keypad_on(k));
+	int cols, rows;
+	term_size(km->fd, &cols, &rows);
+	keymode_resize(km, cols, rows);
+}
+
+bool keymode_run(shell *sh)
+{
+	screen *scr = sh->scr;
+	if (!sh->interactive || !scr || !scr->active || sh->wake[0] < 0 || sh->wake[1] < 0 ||
+	    !isatty(STDIN_FILENO))
+		return shell_fail(sh, "view: key mode needs the full-screen shell on a terminal");
+	int in = STDIN_FILENO, fd = scr->fd;
+	fflush(stdout);
+	struct termios saved;
+	if (tcgetattr(in, &saved) != 0)
+		return shell_fail(sh, "view: cannot read the terminal's modes: %s", strerror(errno));
+	keys *k = keys_open(in, 25);
+	if (!k) {
+		return shell_fail(sh, "view: ncurses cannot read the keys of this terminal (TERM=%s)",
+		                  getenv("TERM") ? getenv("TERM") : "");
+	}
+	/* The shell's screen steps aside: nothing of the shell draws until
+	 * key mode is over. */
+	void (*hook)(shell *) = sh->status_hook;
+	sh->status_hook = NULL;
+	sh->scr = NULL;
+	raw_modes(in, &saved);
+	put_str(fd, keys_keypad_on(k));
+	int cols, rows;
+	term_size(fd, &cols, &rows);
+	keymode *km = keymode_new(sh, fd, scr->pal, cols, rows);
+	bool ok = km != NULL;
+	int wake = sh->wake[0];
+	while (km && !keymode_done(km)) {
+		keymode_tick(km);
+		double to = keymode_timeout(km);
+		fd_set rd;
+		FD_ZERO(&rd);
+		FD_SET(in, &rd);
+		FD_SET(wake, &rd);
+		struct timeval tv, *tvp = NULL;
+		if (to >= 0) {
+			tv.tv_sec = (time_t)to;
+			tv.tv_usec = (suseconds_t)((to - (double)tv.tv_sec) * 1e6);
+			tvp = &tv;
+		}
+		int n = select((in > wake ? in : wake) + 1, &rd, NULL, NULL, tvp);
+		if (n < 0 && errno != EINTR)
+			break;
+		if (n > 0 && FD_ISSET(wake, &rd)) {
+			char buf[256];
+			while (read(wake, buf, sizeof buf) > 0)
+				;
+		}
+		if (shell_sig_term)
+			break;
+		if (shell_sig_int) {
+			/* Ctrl-C leaves key mode (Space stops a render). */
+			shell_sig_int = 0;
+			atomic_store(&sh->cancel, false);
+			break;
+		}
+		if (shell_sig_winch) {
+			shell_sig_winch = 0;
+			term_size(fd, &cols, &rows);
+			keymode_resize(km, cols, rows);
+		}
+		if (shell_sig_tstp) {
+			shell_sig_tstp = 0;
+			km_suspend(km, scr, k, in, &saved);
+		}
+		shell_sig_cont = 0;
+		/* Every key waiting, before the next frame starts. */
+		if (n > 0 && FD_ISSET(in, &rd)) {
+			int c;
+			while (!keymode_done(km) && (c = keys_next(k)) != KEYS_NONE)
+				if (c != KEYS_RESIZE)
+					keymode_key(km, c);
+		}
+	}
+	int edits = km ? keymode_edits(km) : 0;
+	keymode_free(km);
+	/* Give the terminal and the screen back to the shell. */
+	put_str(fd, keys_keypad_off(k));
+	keys_close(k);
+	tcsetattr(in, TCSANOW, &saved);
+	write_all(fd, "\x1b[m\x1b[?25h", 9);
+	sh->scr = scr;
+	sh->status_hook = hook;
+	screen_layout(scr, (double)sh->set.width / sh->set.height, true);
+	rl_set_screen_size(scr->rows - scr->region_top, scr->cols);
+	shell_refresh(sh);
+	sh->redraw = true;
+	if (ok && edits > 0)
+		shell_info(sh, "view: %d edit%s kept; undo takes them back (a run of one key is one step)\n",
+		           edits, edits == 1 ? "" : "s");
+	return ok;
+}

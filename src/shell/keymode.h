@@ -1,0 +1,154 @@
+/* rtsh — key mode (`view`): fly through the scene with the keyboard.
+ *
+ * Key mode takes over the whole terminal the shell is on: the picture fills
+ * it but for a status line and a help bar at the bottom. ncurses only reads
+ * the keys (its output goes to /dev/null); the picture is drawn by the
+ * shell's own frame encoder (term/frame.h), one write() per frame.
+ *
+ * Every key that changes the scene is one editor call (rtsh/edit.h), so
+ * everything done in key mode stays in the shell's undo history; a run of
+ * the same key (holding an arrow down) is one undo step.
+ *
+ * The step rule (documented in rtsh(1), KEY MODE): a movement key moves by
+ * step = L / 40, where L is the longest side of the axis-aligned box around
+ * the bounded objects (planes are left out), the lights and the camera,
+ * measured when key mode starts and when the scene is replaced; L = 1 when
+ * that box is a point. Turning keys turn the camera by 3 degrees; `[` `]`
+ * `{` `}` rotate an object by 15 degrees; `-` `+` scale it by 1/1.1 and 1.1.
+ *
+ * While keys arrive, frames are rendered at a reduced resolution (a pixel
+ * ratio picked from the measured cost of a pixel so that a frame takes at
+ * most KEYMODE_FRAME_BUDGET) and scaled up by pixel replication; 150 ms
+ * after the last key the picture is refined to the full resolution and, in
+ * path mode, accumulates samples. A new key cancels the frame in flight.
+ */
+#ifndef RTSH_KEYMODE_H
+#define RTSH_KEYMODE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "rtsh/edit.h"
+#include "rtsh/scene.h"
+#include "shell/shell.h"
+
+/* The fraction of the scene's size one movement key moves by. */
+#define KEYMODE_STEP_FRACTION (1.0 / 40.0)
+/* Degrees per key: camera turns, object rotations. */
+#define KEYMODE_TURN_DEG 3.0
+#define KEYMODE_ROTATE_DEG 15.0
+/* Object scale factor per key (and its inverse). */
+#define KEYMODE_SCALE 1.1
+/* Light brightness per key; camera field of view per key (degrees). */
+#define KEYMODE_BRIGHTNESS 0.05
+#define KEYMODE_FOV_DEG 5.0
+/* Seconds: the longest a frame may take while keys arrive; the quiet time
+ * after the last key before the picture is refined. */
+#define KEYMODE_FRAME_BUDGET 0.025
+#define KEYMODE_IDLE 0.15
+
+/* What the keys act on: the camera, or an object or a light (0-based). */
+typedef enum km_sel_kind {
+	KM_SEL_CAMERA,
+	KM_SEL_OBJECT,
+	KM_SEL_LIGHT,
+} km_sel_kind;
+
+typedef struct km_sel {
+	km_sel_kind kind;
+	size_t index;
+} km_sel;
+
+/* What a key does. */
+typedef enum km_op {
+	KM_NONE,       /* nothing */
+	KM_MOVE,       /* move the selection by d (world space) */
+	KM_TURN,       /* turn the camera: a = yaw degrees to the right, b = pitch degrees up */
+	KM_ROTATE,     /* rotate the selected object by Euler angles d (degrees, about X, Y, Z) */
+	KM_SCALE,      /* object: scale by a; light: brightness +- KEYMODE_BRIGHTNESS;
+	                  camera: field of view -+ KEYMODE_FOV_DEG (a > 1 zooms in) */
+	KM_SELECT,     /* n = +1 the next element, -1 the previous one */
+	KM_SAMPLES,    /* n = +1 double the samples, -1 halve them */
+	KM_DEPTH,      /* n = +1 / -1 */
+	KM_SCENE,      /* n = +1 the next .rt file of the folder, -1 the previous one */
+	KM_MODE,       /* whitted <-> path */
+	KM_STOP,       /* stop the render in progress */
+	KM_UNDO,
+	KM_REDO,
+	KM_REDRAW,     /* repaint the whole screen */
+	KM_HELP,       /* show or hide the help bar */
+	KM_QUIT,       /* back to the shell */
+} km_op;
+
+typedef struct km_action {
+	km_op op;
+	km_sel sel; /* what it acts on */
+	vec3 d;
+	double a, b;
+	int n;
+} km_action;
+
+/* The movement step for scene s (the rule above). */
+double keymode_step(const scene *s);
+/* The selection dir (+1 / -1) places after sel in the order camera,
+ * objects, lights, camera ... */
+km_sel keymode_select(const scene *s, km_sel sel, int dir);
+/* True when sel names an element of s (the camera always does). */
+bool keymode_sel_valid(const scene *s, km_sel sel);
+/* What `key` (a character or a KEYS_ code, term/keys.h) does with sel selected.
+ * Movement is relative to the active camera: for the camera, forward is
+ * where it looks; for objects and lights, forward is that direction made
+ * horizontal; right is the camera's right; R/F go along world +Y. */
+km_action keymode_map(int key, const scene *s, km_sel sel, double step);
+/* True for the actions that edit the scene (those keymode_apply makes). */
+bool keymode_is_edit(km_op op);
+/* Makes the scene edit of a (KM_MOVE, KM_TURN, KM_ROTATE, KM_SCALE) as
+ * editor calls; false (err set) when it cannot be done. An action that
+ * would change nothing (a light already at full brightness) succeeds
+ * without an edit. */
+bool keymode_apply(editor *ed, const km_action *a, rt_error *err);
+/* Euler angles (degrees; about X, then Y, then Z, as object_rotate takes
+ * them) of the rotation by deg degrees about the unit axis. */
+vec3 keymode_axis_euler(vec3 axis, double deg);
+
+/* --- the session, without a terminal of its own (bench, tests) --- */
+typedef struct keymode keymode;
+
+/* A key-mode session on sh's scene drawing frames of cols x rows cells to
+ * fd in palette pal; the render thread writes a byte to sh->wake[1] when a
+ * frame is ready. The shell's preview is held until keymode_free. NULL (the
+ * shell's error set) on failure. */
+keymode *keymode_new(shell *sh, int fd, frame_palette pal, int cols, int rows);
+/* Ends the session: stops its thread, closes an open undo group, frees it.
+ * The preview stays held (the caller restarts it). */
+void keymode_free(keymode *km);
+/* Handles one key (edits go to the editor at once; renders start in
+ * keymode_tick). */
+void keymode_key(keymode *km, int key);
+/* Starts, cancels and refines renders as needed and draws a finished
+ * frame; returns the number of frames written (0 or 1). */
+int keymode_tick(keymode *km);
+/* Seconds until keymode_tick has something to do with no key and no
+ * wake-up (a refine or a message to clear); < 0 when nothing. */
+double keymode_timeout(const keymode *km);
+/* True once a key asked to leave. */
+bool keymode_done(const keymode *km);
+/* A new terminal size: lays out again and repaints. */
+void keymode_resize(keymode *km, int cols, int rows);
+/* How many scene edits the session made. */
+int keymode_edits(const keymode *km);
+/* The pixel ratio of the last fast frame (1 = full resolution) and the
+ * frames drawn so far. */
+double keymode_ratio(const keymode *km);
+long keymode_frames(const keymode *km);
+
+/* --- the `view` command --- */
+/* Runs key mode on the shell's terminal until Esc or q (or Ctrl-C, SIGTERM,
+ * SIGHUP), then gives the shell's screen back as it was. False (error
+ * recorded) when there is no full-screen terminal. */
+bool keymode_run(shell *sh);
+
+/* The keys, for `help view` (one per line). */
+extern const char keymode_help[];
+
+#endif

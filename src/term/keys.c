@@ -1,0 +1,162 @@
+/* rtsh — the keyboard of key mode (keys.h). */
+#include "term/keys.h"
+
+#include <curses.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <term.h>
+#include <unistd.h>
+
+struct keys {
+	SCREEN *scr;
+	WINDOW *pad;
+	FILE *in, *out;
+	TERMINAL *saved_term; /* readline's (terminfo's current terminal) */
+	char smkx[64], rmkx[64];
+	/* Codes ncurses gives to terminfo's extended shift+arrow keys. */
+	int shift_up, shift_down;
+};
+
+/* Signals ncurses may take over in newterm: the shell's handlers stay. */
+static const int kept[] = {SIGINT, SIGTERM, SIGHUP, SIGWINCH, SIGTSTP, SIGCONT, SIGQUIT, SIGTTIN, SIGTTOU};
+#define NKEPT (sizeof kept / sizeof kept[0])
+
+static void copy_cap(const char *name, char *dst, size_t size)
+{
+	char n[16];
+	snprintf(n, sizeof n, "%s", name);
+	const char *s = tigetstr(n);
+	if (!s || s == (const char *)-1 || strlen(s) >= size)
+		s = "";
+	snprintf(dst, size, "%s", s);
+}
+
+/* The key code ncurses gives to the extended capability `name`, or 0. */
+static int ext_key(const char *name)
+{
+	char n[16];
+	snprintf(n, sizeof n, "%s", name);
+	const char *s = tigetstr(n);
+	if (!s || s == (const char *)-1)
+		return 0;
+	int code = key_defined(s);
+	return code > 0 ? code : 0;
+}
+
+keys *keys_open(int in_fd, int esc_ms)
+{
+	keys *k = calloc(1, sizeof *k);
+	if (!k)
+		return NULL;
+	struct sigaction old[NKEPT];
+	for (size_t i = 0; i < NKEPT; i++)
+		sigaction(kept[i], NULL, &old[i]);
+	k->saved_term = cur_term;
+	int fd = dup(in_fd);
+	k->in = fd >= 0 ? fdopen(fd, "r") : NULL;
+	if (!k->in && fd >= 0)
+		close(fd);
+	k->out = fopen("/dev/null", "w");
+	if (k->in && k->out)
+		k->scr = newterm(NULL, k->out, k->in);
+	for (size_t i = 0; i < NKEPT; i++)
+		sigaction(kept[i], &old[i], NULL);
+	if (k->scr) {
+		set_escdelay(esc_ms);
+		noecho();
+		nonl();
+		k->pad = newpad(1, 1);
+	}
+	if (!k->pad) {
+		keys_close(k);
+		return NULL;
+	}
+	keypad(k->pad, TRUE);
+	nodelay(k->pad, TRUE);
+	copy_cap("smkx", k->smkx, sizeof k->smkx);
+	copy_cap("rmkx", k->rmkx, sizeof k->rmkx);
+	k->shift_up = ext_key("kUP");
+	k->shift_down = ext_key("kDN");
+	return k;
+}
+
+int keys_next(keys *k)
+{
+	int c = wgetch(k->pad);
+	if (c == ERR)
+		return KEYS_NONE;
+	if (c < KEY_MIN)
+		return c;
+	if (c >= KEY_F(1) && c <= KEY_F(63))
+		return KEYS_F(c - KEY_F0);
+	if (c == k->shift_up)
+		return KEYS_SHIFT_UP;
+	if (c == k->shift_down)
+		return KEYS_SHIFT_DOWN;
+	switch (c) {
+	case KEY_UP:
+		return KEYS_UP;
+	case KEY_DOWN:
+		return KEYS_DOWN;
+	case KEY_LEFT:
+		return KEYS_LEFT;
+	case KEY_RIGHT:
+		return KEYS_RIGHT;
+	case KEY_SR: /* scroll backward: shift+up on xterm-like terminals */
+		return KEYS_SHIFT_UP;
+	case KEY_SF:
+		return KEYS_SHIFT_DOWN;
+	case KEY_SLEFT:
+		return KEYS_SHIFT_LEFT;
+	case KEY_SRIGHT:
+		return KEYS_SHIFT_RIGHT;
+	case KEY_PPAGE:
+		return KEYS_PAGE_UP;
+	case KEY_NPAGE:
+		return KEYS_PAGE_DOWN;
+	case KEY_HOME:
+		return KEYS_HOME;
+	case KEY_END:
+		return KEYS_END;
+	case KEY_BTAB:
+		return KEYS_BACKTAB;
+	case KEY_RESIZE:
+		return KEYS_RESIZE;
+	case KEY_ENTER:
+		return '\r';
+	case KEY_BACKSPACE:
+		return 127;
+	default:
+		return KEYS_OTHER;
+	}
+}
+
+const char *keys_keypad_on(const keys *k)
+{
+	return k->smkx;
+}
+
+const char *keys_keypad_off(const keys *k)
+{
+	return k->rmkx;
+}
+
+void keys_close(keys *k)
+{
+	if (!k)
+		return;
+	if (k->scr) {
+		if (k->pad)
+			delwin(k->pad);
+		endwin();
+		delscreen(k->scr);
+	}
+	set_curterm(k->saved_term);
+	if (k->in)
+		fclose(k->in);
+	if (k->out)
+		fclose(k->out);
+	free(k);
+}

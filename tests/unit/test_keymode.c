@@ -1,0 +1,468 @@
+/* rtsh — tests of key mode without a terminal: the step rule, the
+ * selection order, what each key does (keymode_map), the edits it makes
+ * through the editor (keymode_apply), the Euler angles of a roll, and a
+ * whole session drawing into a pipe: a run of one key is one undo step,
+ * frames come, the status line and help bar are drawn. The session part
+ * runs a render thread; `make test` runs it under ThreadSanitizer too. */
+#include "testutil.h"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "rtsh/edit.h"
+#include "rtsh/rtfile.h"
+#include "rtsh/shape.h"
+#include "shell/keymode.h"
+#include "shell/options.h"
+#include "term/keys.h"
+
+/* The box around the objects but the plane, the light and the camera is
+ * x -10..10, y -2..10, z -10..2: its longest side is 20, so step = 0.5. */
+static const char scene_text[] = "A 0.3 255,255,255\n"
+                                 "C 0,0,-10 0,0,1 70\n"
+                                 "L -10,10,-10 0.7 255,255,255\n"
+                                 "sp 0,0,0 4 230,60,50\n"
+                                 "sp 8,0,0 4 60,200,80\n"
+                                 "cu -6,0,0 0,1,0 3,3,3 70,110,235 0.9 0.5 50 0\n"
+                                 "pl 0,-2,0 0,1,0 200,200,200\n";
+
+static scene *load(const char *text)
+{
+	rt_error err;
+	scene *s = rt_load_string(text, strlen(text), "k.rt", NULL, &err);
+	if (!s)
+		fail_msg("%s", err.msg);
+	return s;
+}
+
+static const km_sel camera_sel = {KM_SEL_CAMERA, 0};
+
+static void test_step_rule(void **state)
+{
+	(void)state;
+	scene *s = load(scene_text);
+	assert_near(keymode_step(s), 0.5, 1e-12);
+	scene_free(s);
+	/* Ten times the scene: ten times the step. */
+	s = load("C 0,0,-100 0,0,1 70\nL -100,100,-100 0.7\nsp 0,0,0 40 230,60,50\nsp 80,0,0 40 60,200,80\n");
+	assert_near(keymode_step(s), 5.0, 1e-12);
+	scene_free(s);
+	/* Planes do not count; a scene that is one point steps 1/40. */
+	s = load("C 0,0,0 0,0,1 70\npl 0,-2,0 0,1,0 200,200,200\n");
+	assert_near(keymode_step(s), 1.0 / 40, 1e-12);
+	scene_free(s);
+	/* A far camera makes the step larger. */
+	s = load("C 0,0,-400 0,0,1 70\nsp 0,0,0 2 255,0,0\n");
+	assert_near(keymode_step(s), 401.0 / 40, 1e-12);
+	scene_free(s);
+}
+
+static void test_selection_order(void **state)
+{
+	(void)state;
+	scene *s = load(scene_text); /* 4 objects, 1 light */
+	km_sel sel = camera_sel;
+	const km_sel_kind kinds[] = {KM_SEL_OBJECT, KM_SEL_OBJECT, KM_SEL_OBJECT, KM_SEL_OBJECT, KM_SEL_LIGHT,
+	                             KM_SEL_CAMERA};
+	const size_t idx[] = {0, 1, 2, 3, 0, 0};
+	for (int i = 0; i < 6; i++) {
+		sel = keymode_select(s, sel, 1);
+		assert_int_equal(sel.kind, kinds[i]);
+		assert_int_equal(sel.index, idx[i]);
+	}
+	sel = keymode_select(s, camera_sel, -1);
+	assert_int_equal(sel.kind, KM_SEL_LIGHT);
+	sel = keymode_select(s, sel, -1);
+	assert_int_equal(sel.kind, KM_SEL_OBJECT);
+	assert_int_equal(sel.index, 3);
+	assert_true(keymode_sel_valid(s, (km_sel){KM_SEL_OBJECT, 3}));
+	assert_false(keymode_sel_valid(s, (km_sel){KM_SEL_OBJECT, 4}));
+	assert_false(keymode_sel_valid(s, (km_sel){KM_SEL_LIGHT, 1}));
+	/* Tab through keymode_map does the same. */
+	km_action a = keymode_map('\t', s, camera_sel, 0.5);
+	assert_int_equal(a.op, KM_SELECT);
+	assert_int_equal(a.sel.kind, KM_SEL_OBJECT);
+	assert_int_equal(a.sel.index, 0);
+	a = keymode_map(KEYS_BACKTAB, s, camera_sel, 0.5);
+	assert_int_equal(a.sel.kind, KM_SEL_LIGHT);
+	scene_free(s);
+}
+
+static void assert_move(const scene *s, km_sel sel, int key, vec3 d)
+{
+	km_action a = keymode_map(key, s, sel, 0.5);
+	assert_int_equal(a.op, KM_MOVE);
+	assert_int_equal(a.sel.kind, sel.kind);
+	assert_vec_near(a.d, d, 1e-12);
+}
+
+static void test_movement_keys(void **state)
+{
+	(void)state;
+	scene *s = load(scene_text); /* the camera looks along +z: right is +x */
+	const km_sel obj = {KM_SEL_OBJECT, 0};
+	for (int k = 0; k < 2; k++) {
+		km_sel sel = k ? obj : camera_sel;
+		assert_move(s, sel, KEYS_UP, v3(0, 0, 0.5));
+		assert_move(s, sel, 'w', v3(0, 0, 0.5));
+		assert_move(s, sel, KEYS_DOWN, v3(0, 0, -0.5));
+		assert_move(s, sel, 's', v3(0, 0, -0.5));
+		assert_move(s, sel, KEYS_LEFT, v3(-0.5, 0, 0));
+		assert_move(s, sel, 'a', v3(-0.5, 0, 0));
+		assert_move(s, sel, KEYS_RIGHT, v3(0.5, 0, 0));
+		assert_move(s, sel, 'D', v3(0.5, 0, 0));
+		assert_move(s, sel, 'r', v3(0, 0.5, 0));
+		assert_move(s, sel, 'f', v3(0, -0.5, 0));
+	}
+	scene_free(s);
+	/* The camera looks 45 degrees down: it flies along its view; an object
+	 * slides level with the floor. */
+	s = load("C 0,10,-10 0,-1,1 70\nsp 0,0,0 2 255,0,0\n");
+	double h = 0.5 / sqrt(2.0);
+	assert_move(s, camera_sel, KEYS_UP, v3(0, -h, h));
+	assert_move(s, obj, KEYS_UP, v3(0, 0, 0.5));
+	assert_move(s, obj, 'R', v3(0, 0.5, 0));
+	scene_free(s);
+	/* Straight down: forward for an object is the camera's up. */
+	s = load("C 0,10,0 0,-1,0 70\nsp 0,0,0 2 255,0,0\n");
+	km_action a = keymode_map(KEYS_UP, s, obj, 1.0);
+	assert_near(v3_len(a.d), 1.0, 1e-12);
+	assert_near(a.d.y, 0.0, 1e-12);
+	scene_free(s);
+}
+
+static void test_other_keys(void **state)
+{
+	(void)state;
+	scene *s = load(scene_text);
+	const km_sel obj = {KM_SEL_OBJECT, 2};
+	struct {
+		int key;
+		km_op op;
+		double a, b;
+		int n;
+	} cases[] = {
+		{'j', KM_TURN, -KEYMODE_TURN_DEG, 0, 0},
+		{KEYS_SHIFT_LEFT, KM_TURN, -KEYMODE_TURN_DEG, 0, 0},
+		{'l', KM_TURN, KEYMODE_TURN_DEG, 0, 0},
+		{KEYS_SHIFT_RIGHT, KM_TURN, KEYMODE_TURN_DEG, 0, 0},
+		{'i', KM_TURN, 0, KEYMODE_TURN_DEG, 0},
+		{KEYS_SHIFT_UP, KM_TURN, 0, KEYMODE_TURN_DEG, 0},
+		{'k', KM_TURN, 0, -KEYMODE_TURN_DEG, 0},
+		{KEYS_SHIFT_DOWN, KM_TURN, 0, -KEYMODE_TURN_DEG, 0},
+		{'+', KM_SCALE, KEYMODE_SCALE, 0, 0},
+		{'=', KM_SCALE, KEYMODE_SCALE, 0, 0},
+		{'-', KM_SCALE, 1 / KEYMODE_SCALE, 0, 0},
+		{',', KM_SAMPLES, 0, 0, -1},
+		{'.', KM_SAMPLES, 0, 0, 1},
+		{'<', KM_DEPTH, 0, 0, -1},
+		{'>', KM_DEPTH, 0, 0, 1},
+		{KEYS_PAGE_UP, KM_SCENE, 0, 0, -1},
+		{KEYS_PAGE_DOWN, KM_SCENE, 0, 0, 1},
+		{'m', KM_MODE, 0, 0, 0},
+		{' ', KM_STOP, 0, 0, 0},
+		{'u', KM_UNDO, 0, 0, 0},
+		{'U', KM_REDO, 0, 0, 0},
+		{12, KM_REDRAW, 0, 0, 0},
+		{KEYS_F(5), KM_REDRAW, 0, 0, 0},
+		{'?', KM_HELP, 0, 0, 0},
+		{KEYS_F(1), KM_HELP, 0, 0, 0},
+		{KEYS_ESC, KM_QUIT, 0, 0, 0},
+		{'q', KM_QUIT, 0, 0, 0},
+		{'x', KM_NONE, 0, 0, 0},
+		{KEYS_OTHER, KM_NONE, 0, 0, 0},
+		{KEYS_HOME, KM_NONE, 0, 0, 0},
+	};
+	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+		km_action a = keymode_map(cases[i].key, s, obj, 0.5);
+		if (a.op != cases[i].op)
+			fail_msg("key %d: op %d, expected %d", cases[i].key, a.op, cases[i].op);
+		assert_near(a.a, cases[i].a, 1e-12);
+		assert_near(a.b, cases[i].b, 1e-12);
+		assert_int_equal(a.n, cases[i].n);
+		assert_int_equal(a.sel.index, 2);
+	}
+	/* [ and ] turn about the vertical; { and } roll about the line of
+	 * sight (here +z: a roll about Z). */
+	assert_vec_near(keymode_map('[', s, obj, 0.5).d, v3(0, KEYMODE_ROTATE_DEG, 0), 1e-12);
+	assert_vec_near(keymode_map(']', s, obj, 0.5).d, v3(0, -KEYMODE_ROTATE_DEG, 0), 1e-12);
+	assert_vec_near(keymode_map('{', s, obj, 0.5).d, v3(0, 0, KEYMODE_ROTATE_DEG), 1e-9);
+	assert_vec_near(keymode_map('}', s, obj, 0.5).d, v3(0, 0, -KEYMODE_ROTATE_DEG), 1e-9);
+	assert_true(keymode_is_edit(KM_MOVE) && keymode_is_edit(KM_TURN) && keymode_is_edit(KM_ROTATE) &&
+	            keymode_is_edit(KM_SCALE));
+	assert_false(keymode_is_edit(KM_SELECT) || keymode_is_edit(KM_UNDO) || keymode_is_edit(KM_SCENE));
+	scene_free(s);
+}
+
+/* The Euler angles of a rotation about an axis turn every direction as the
+ * rotation itself does (object_rotate's order: X, then Y, then Z). */
+static void test_axis_euler(void **state)
+{
+	(void)state;
+	test_rng rng = {7};
+	for (int i = 0; i < 500; i++) {
+		vec3 axis = tdir(&rng), v = tdir(&rng);
+		double deg = trange(&rng, -180, 180);
+		if (i % 50 == 0)
+			axis = v3(0, i % 100 ? 1 : -1, 0); /* gimbal lock: a turn about Y by 90 */
+		if (i % 50 == 0)
+			deg = 90;
+		vec3 e = keymode_axis_euler(axis, deg);
+		mat4 q = m4_mul(m4_rotate_z(deg_to_rad(e.z)), m4_mul(m4_rotate_y(deg_to_rad(e.y)), m4_rotate_x(deg_to_rad(e.x))));
+		mat4 r = m4_rotate_axis(axis, deg_to_rad(deg));
+		assert_vec_near(m4_vector(&q, v), m4_vector(&r, v), 1e-9);
+	}
+}
+
+static void test_apply(void **state)
+{
+	(void)state;
+	editor *ed = editor_new(load(scene_text), NULL);
+	const scene *s;
+	rt_error err;
+	const km_sel obj = {KM_SEL_OBJECT, 0}, lamp = {KM_SEL_LIGHT, 0}, cube = {KM_SEL_OBJECT, 2};
+	/* Object: two steps right, then undo one. */
+	for (int i = 0; i < 2; i++) {
+		km_action a = keymode_map(KEYS_RIGHT, editor_scene(ed), obj, 0.5);
+		assert_true(keymode_apply(ed, &a, &err));
+	}
+	s = editor_scene(ed);
+	assert_vec_near(s->objs[0].pos, v3(1, 0, 0), 1e-12);
+	assert_true(editor_undo(ed, &err));
+	assert_vec_near(editor_scene(ed)->objs[0].pos, v3(0.5, 0, 0), 1e-12);
+	/* Camera: forward, up. */
+	km_action a = keymode_map(KEYS_UP, editor_scene(ed), camera_sel, 0.5);
+	assert_true(keymode_apply(ed, &a, &err));
+	a = keymode_map('r', editor_scene(ed), camera_sel, 0.5);
+	assert_true(keymode_apply(ed, &a, &err));
+	assert_vec_near(scene_camera(editor_scene(ed)).pos, v3(0, 0.5, -9.5), 1e-12);
+	/* Light: moves; brightness in steps of 0.05, up to 1 and no further. */
+	a = keymode_map(KEYS_LEFT, editor_scene(ed), lamp, 0.5);
+	assert_true(keymode_apply(ed, &a, &err));
+	assert_vec_near(editor_scene(ed)->lights[0].pos, v3(-10.5, 10, -10), 1e-12);
+	a = keymode_map('+', editor_scene(ed), lamp, 0.5);
+	for (int i = 0; i < 10; i++)
+		assert_true(keymode_apply(ed, &a, &err));
+	assert_near(editor_scene(ed)->lights[0].ratio, 1.0, 1e-12);
+	uint64_t gen = editor_generation(ed);
+	assert_true(keymode_apply(ed, &a, &err));
+	assert_int_equal(editor_generation(ed), gen); /* nothing to change: no edit */
+	a = keymode_map('-', editor_scene(ed), lamp, 0.5);
+	assert_true(keymode_apply(ed, &a, &err));
+	assert_near(editor_scene(ed)->lights[0].ratio, 0.95, 1e-12);
+	/* Objects grow and shrink by 1.1. */
+	a = keymode_map('+', editor_scene(ed), cube, 0.5);
+	assert_true(keymode_apply(ed, &a, &err));
+	assert_vec_near(editor_scene(ed)->objs[2].scale, v3(3.3, 3.3, 3.3), 1e-12);
+	/* The camera zooms: + narrows the field of view by 5 degrees. */
+	a = keymode_map('+', editor_scene(ed), camera_sel, 0.5);
+	assert_true(keymode_apply(ed, &a, &err));
+	assert_near(scene_camera(editor_scene(ed)).fov, 65, 1e-12);
+	/* ] turns the cube's front to the right: -15 degrees about Y, a twist
+	 * for an upright cube. */
+	a = keymode_map(']', editor_scene(ed), cube, 0.5);
+	assert_true(keymode_apply(ed, &a, &err));
+	s = editor_scene(ed);
+	assert_vec_near(v3_norm(s->objs[2].dir), v3(0, 1, 0), 1e-9);
+	assert_near(fmod(s->objs[2].twist + 360.0, 360.0), 345.0, 1e-9);
+	/* } rolls the cube clockwise on the screen: its up axis leans right. */
+	a = keymode_map('}', editor_scene(ed), cube, 0.5);
+	assert_true(keymode_apply(ed, &a, &err));
+	vec3 d = v3_norm(editor_scene(ed)->objs[2].dir);
+	assert_vec_near(d, v3(sin(deg_to_rad(15)), cos(deg_to_rad(15)), 0), 1e-9);
+	/* Only objects rotate. */
+	a = keymode_map('[', editor_scene(ed), camera_sel, 0.5);
+	assert_false(keymode_apply(ed, &a, &err));
+	assert_string_equal(err.msg, "only objects rotate; press Tab to select one");
+	/* A selection that is gone is refused. */
+	a = keymode_map(KEYS_UP, editor_scene(ed), (km_sel){KM_SEL_OBJECT, 9}, 0.5);
+	assert_false(keymode_apply(ed, &a, &err));
+	editor_free(ed);
+}
+
+static void test_turns(void **state)
+{
+	(void)state;
+	editor *ed = editor_new(load(scene_text), NULL);
+	rt_error err;
+	/* 30 turns of 3 degrees to the right: looking along +x. */
+	km_action a = keymode_map('l', editor_scene(ed), camera_sel, 0.5);
+	for (int i = 0; i < 30; i++)
+		assert_true(keymode_apply(ed, &a, &err));
+	assert_vec_near(v3_norm(scene_camera(editor_scene(ed)).dir), v3(1, 0, 0), 1e-9);
+	/* Pitching up stops 89 degrees above the horizon, and the heading stays. */
+	a = keymode_map('i', editor_scene(ed), camera_sel, 0.5);
+	for (int i = 0; i < 40; i++)
+		assert_true(keymode_apply(ed, &a, &err));
+	vec3 d = v3_norm(scene_camera(editor_scene(ed)).dir);
+	assert_near(rad_to_deg(asin(d.y)), 89.0, 1e-9);
+	assert_near(d.z, 0.0, 1e-9);
+	assert_true(d.x > 0);
+	/* Turning while looking up still turns about the vertical. */
+	a = keymode_map('j', editor_scene(ed), camera_sel, 0.5);
+	assert_true(keymode_apply(ed, &a, &err));
+	d = v3_norm(scene_camera(editor_scene(ed)).dir);
+	assert_near(rad_to_deg(asin(d.y)), 89.0, 1e-9);
+	assert_near(rad_to_deg(atan2(d.x, d.z)), 87.0, 1e-9);
+	editor_free(ed);
+}
+
+/* --- a whole session, drawing into a pipe --- */
+
+typedef struct session {
+	char path[64];
+	int wake[2], out; /* frames go to a file (a pipe would fill up) */
+	rtsh_options opt;
+	shell sh;
+	keymode *km;
+	char *text; /* everything drawn */
+	size_t len, cap;
+} session;
+
+static double seconds(void)
+{
+	struct timespec t;
+	clock_gettime(CLOCK_MONOTONIC, &t);
+	return (double)t.tv_sec + t.tv_nsec * 1e-9;
+}
+
+static void drain_output(session *ss)
+{
+	char buf[65536];
+	ssize_t n;
+	while ((n = pread(ss->out, buf, sizeof buf, (off_t)ss->len)) > 0) {
+		if (ss->len + (size_t)n + 1 > ss->cap) {
+			ss->cap = (ss->len + (size_t)n + 1) * 2;
+			ss->text = realloc(ss->text, ss->cap);
+			assert_non_null(ss->text);
+		}
+		memcpy(ss->text + ss->len, buf, (size_t)n);
+		ss->len += (size_t)n;
+		ss->text[ss->len] = '\0';
+	}
+}
+
+/* Ticks the session for `secs` seconds, as keymode_run's loop does. */
+static long run_for(session *ss, double secs)
+{
+	long frames = 0;
+	double end = seconds() + secs;
+	while (seconds() < end) {
+		frames += keymode_tick(ss->km);
+		drain_output(ss);
+		struct pollfd p = {ss->wake[0], POLLIN, 0};
+		poll(&p, 1, 5);
+		char buf[64];
+		while (read(ss->wake[0], buf, sizeof buf) > 0)
+			;
+	}
+	return frames;
+}
+
+static void session_open(session *ss)
+{
+	memset(ss, 0, sizeof *ss);
+	snprintf(ss->path, sizeof ss->path, "/tmp/rtsh-keymode-XXXXXX.rt");
+	int fd = mkstemps(ss->path, 3);
+	assert_true(fd >= 0);
+	assert_int_equal(write(fd, scene_text, sizeof scene_text - 1), (ssize_t)(sizeof scene_text - 1));
+	close(fd);
+	assert_int_equal(pipe(ss->wake), 0);
+	FILE *f = tmpfile();
+	assert_non_null(f);
+	ss->out = dup(fileno(f));
+	fclose(f);
+	for (int i = 0; i < 2; i++)
+		fcntl(ss->wake[i], F_SETFL, O_NONBLOCK);
+	ss->opt.scene = ss->path;
+	ss->opt.quiet = true;
+	assert_true(shell_init(&ss->sh, &ss->opt, ss->wake[1]));
+	ss->sh.wake[0] = ss->wake[0];
+	ss->sh.wake[1] = ss->wake[1];
+	ss->sh.set.threads = 2;
+	ss->km = keymode_new(&ss->sh, ss->out, PALETTE_TRUECOLOR, 160, 48);
+	assert_non_null(ss->km);
+}
+
+static void session_close(session *ss)
+{
+	keymode_free(ss->km);
+	shell_free(&ss->sh);
+	for (int i = 0; i < 2; i++)
+		close(ss->wake[i]);
+	close(ss->out);
+	unlink(ss->path);
+	free(ss->text);
+}
+
+static void test_session(void **state)
+{
+	(void)state;
+	session ss;
+	session_open(&ss);
+	assert_true(run_for(&ss, 0.5) >= 1);
+	assert_non_null(strstr(ss.text, " view │ "));
+	assert_non_null(strstr(ss.text, "Esc back"));
+	assert_null(strstr(ss.text, "\x1b[?1049")); /* never leaves the alternate screen */
+	editor *ed = ss.sh.ed;
+	size_t undo0 = editor_undo_count(ed);
+	/* Tab selects object 1; three Rights are one run: one undo step. */
+	keymode_key(ss.km, '\t');
+	for (int i = 0; i < 3; i++)
+		keymode_key(ss.km, KEYS_RIGHT);
+	assert_vec_near(editor_scene(ed)->objs[0].pos, v3(1.5, 0, 0), 1e-12);
+	assert_true(run_for(&ss, 0.1) >= 1);
+	assert_non_null(strstr(ss.text, "object 1 sphere"));
+	keymode_key(ss.km, KEYS_UP); /* another key: a new run */
+	keymode_key(ss.km, KEYS_RIGHT);
+	assert_int_equal(keymode_edits(ss.km), 5);
+	keymode_key(ss.km, 'u'); /* takes back the last run (one Right) */
+	assert_vec_near(editor_scene(ed)->objs[0].pos, v3(1.5, 0, 0.5), 1e-12);
+	keymode_key(ss.km, 'u'); /* and the Up */
+	assert_vec_near(editor_scene(ed)->objs[0].pos, v3(1.5, 0, 0), 1e-12);
+	keymode_key(ss.km, 'U'); /* redo */
+	assert_vec_near(editor_scene(ed)->objs[0].pos, v3(1.5, 0, 0.5), 1e-12);
+	assert_int_equal(editor_undo_count(ed), undo0 + 2);
+	/* Settings keys change the shell's settings. */
+	int samples = ss.sh.set.samples;
+	keymode_key(ss.km, '.');
+	assert_int_equal(ss.sh.set.samples, samples * 2);
+	keymode_key(ss.km, 'm');
+	assert_int_equal(ss.sh.set.mode, MODE_PATH);
+	keymode_key(ss.km, '>');
+	assert_int_equal(ss.sh.set.depth, 6);
+	/* Keys held down: frames keep coming, none of them stale. */
+	long frames = 0;
+	for (int i = 0; i < 30; i++) {
+		keymode_key(ss.km, 'l');
+		frames += run_for(&ss, 0.02);
+	}
+	assert_true(frames >= 5);
+	/* More samples than take a moment; Space stops them. */
+	for (int i = 0; i < 12; i++)
+		keymode_key(ss.km, '.');
+	run_for(&ss, 0.3);
+	keymode_key(ss.km, ' ');
+	run_for(&ss, 0.1);
+	assert_non_null(strstr(ss.text, "spp stopped"));
+	keymode_key(ss.km, ' ');
+	run_for(&ss, 0.1);
+	assert_non_null(strstr(ss.text, "nothing to stop"));
+	assert_false(keymode_done(ss.km));
+	keymode_key(ss.km, 'q');
+	assert_true(keymode_done(ss.km));
+	session_close(&ss);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_step_rule),     cmocka_unit_test(test_selection_order),
+		cmocka_unit_test(test_movement_keys), cmocka_unit_test(test_other_keys),
+		cmocka_unit_test(test_axis_euler),    cmocka_unit_test(test_apply),
+		cmocka_unit_test(test_turns),         cmocka_unit_test(test_session),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
