@@ -58,22 +58,56 @@ typedef struct cam_view {
 	double tan_half; /* tan(fov / 2), horizontal */
 } cam_view;
 
-/* One traceable primitive (see world.c for the layouts). */
+/* Float or double (measured for issue 5; figures in bench/README.md): rays,
+ * primitives and hits are double, as math.h explains. The BVH (bvh.h) keeps
+ * its boxes as floats rounded outward, and the slab tests run in single
+ * precision with conservative rounding (world.c): a box test in double
+ * measured no faster with double boxes and up to 1.5x slower with float boxes
+ * converted on the fly, while float halves the nodes' memory (64 bytes hold
+ * two child boxes). Far from the origin float boxes grow coarse (at 2^31 a
+ * float step is 256 units): the tree then visits more, but never misses.
+ *
+ * One traceable primitive, 40 bytes (see world.c). A sphere with a uniform
+ * scale and no shear is traced in world space from its centre and radius;
+ * every other shape keeps its world-to-object matrix, and a triangle its
+ * vertex and edges, in the side arrays `shapes` and `tris` (in the order of
+ * the primitives that use them), so that the records the tree walks over
+ * stay small. */
+typedef enum prim_tag {
+	PRIM_SPHERE,   /* u.sph */
+	PRIM_TRIANGLE, /* u.index into world.tris */
+	PRIM_SHAPE,    /* u.index into world.shapes: a unit shape and its matrix */
+} prim_tag;
+
 typedef struct prim {
-	uint32_t kind;   /* obj_kind */
+	uint32_t tag;    /* prim_tag */
 	uint32_t object; /* index into the scene's objects */
 	union {
-		double inv[3][4]; /* world -> object (the last row is 0 0 0 1) */
 		struct {
 			vec3 c;
-			double r2, inv_r;
-		} sph; /* a sphere with uniform scale and no shear, traced in world space */
-		struct {
-			vec3 v0, e1, e2;
-		} tri;
+			double r;
+		} sph;
+		uint32_t index;
 	} u;
-	uint32_t fast_sphere; /* 1 when u.sph is in use */
 } prim;
+
+typedef struct prim_shape {
+	double inv[3][4]; /* world -> object (the last row is 0 0 0 1) */
+	uint32_t kind;    /* obj_kind */
+} prim_shape;
+
+typedef struct prim_tri {
+	vec3 v0, e1, e2;
+} prim_tri;
+
+/* An unbounded plane, tested beside the tree in world space: its object-space
+ * height is y = h[0] x + h[1] y + h[2] z + h[3] (row 1 of its world-to-object
+ * matrix, so the test is bit for bit the unit plane's). */
+typedef struct prim_plane {
+	double h[4];
+	uint32_t object;
+	uint32_t shape; /* its matrix in world.shapes (texture coordinates) */
+} prim_plane;
 
 typedef struct bvh bvh;
 
@@ -86,8 +120,12 @@ typedef struct world {
 	size_t nlights;
 	prim *prims;     /* bounded primitives, in BVH order */
 	size_t nprims;
-	prim *planes;    /* unbounded primitives, tested beside the tree */
+	prim_plane *planes; /* unbounded primitives, tested beside the tree */
 	size_t nplanes;
+	prim_shape *shapes; /* of the PRIM_SHAPE primitives and planes */
+	size_t nshapes;
+	prim_tri *tris;  /* of the PRIM_TRIANGLE primitives */
+	size_t ntris;
 	mat_lin *mats;   /* indexed by prim.object */
 	size_t nmats;
 	emitter *emitters; /* sampled in path mode; nemitters = 0 turns that off */

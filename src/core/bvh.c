@@ -1,180 +1,413 @@
-/* rtsh — binned SAH BVH construction (bvh.h). */
+/* rtsh — binned SAH BVH construction (bvh.h).
+ *
+ * The builder works on 32-byte references (a float box rounded outward) and
+ * a parallel array of primitive indices, rather than on the primitives, so
+ * that partitioning moves little memory; the caller reorders its primitives
+ * once at the end from `order`. Each node bins the centroids of its
+ * references on all three axes in one pass (Wald, "On fast construction of
+ * SAH-based bounding volume hierarchies", 2007; 16 bins per axis, fewer for
+ * small nodes), sweeps the bins for the split of least surface area
+ * heuristic cost (Goldsmith & Salmon 1987; MacDonald & Booth 1990), and
+ * partitions in place, gathering the children's centroid bounds on the way,
+ * so every level costs two passes over its references. The boxes are kept
+ * as four floats (the fourth unused) so that a box union is one SSE min and
+ * one max; a scalar version of each helper serves other machines.
+ */
 #include "bvh.h"
 
 #include <stdlib.h>
 #include <string.h>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #define BINS 16
 #define LEAF_MAX 8
+/* Past this depth nodes are halved by count, which bounds the depth by
+ * BALANCED_DEPTH + log2(n) < BVH_MAX_DEPTH. */
 #define BALANCED_DEPTH 60
-#define COST_TRAVERSE 1.0
+/* SAH costs of a node visit (two box tests) and of a primitive test. */
+#define COST_TRAVERSE 4.0
 #define COST_INTERSECT 1.0
 
+/* A box of floats; lane 3 is unused and kept 0 (no denormal arithmetic). */
+typedef struct fbox {
+	float lo[4], hi[4];
+} fbox;
+
 typedef struct builder {
-	prim *prims;
-	box *bounds;
-	vec3 *centroids;
+	fbox *refs;    /* the primitives' boxes, rounded outward */
+	uint32_t *ids; /* the primitive of each reference */
 	bvh_node *nodes;
-	size_t used;
+	size_t used, cap;
 	int depth;
+	size_t leaves;
 } builder;
 
-static void swap_items(builder *b, size_t i, size_t j)
+static fbox fbox_empty(void)
 {
-	prim tp = b->prims[i];
-	b->prims[i] = b->prims[j];
-	b->prims[j] = tp;
-	box tb = b->bounds[i];
-	b->bounds[i] = b->bounds[j];
-	b->bounds[j] = tb;
-	vec3 tc = b->centroids[i];
-	b->centroids[i] = b->centroids[j];
-	b->centroids[j] = tc;
+	return (fbox){{INFINITY, INFINITY, INFINITY, 0}, {-INFINITY, -INFINITY, -INFINITY, 0}};
 }
 
-static int bin_of(double c, double lo, double scale)
+#if defined(__SSE2__)
+/* a = a u b */
+static inline void fbox_union(fbox *a, const fbox *b)
 {
-	int k = (int)((c - lo) * scale);
-	return k < 0 ? 0 : k >= BINS ? BINS - 1 : k;
+	_mm_storeu_ps(a->lo, _mm_min_ps(_mm_loadu_ps(a->lo), _mm_loadu_ps(b->lo)));
+	_mm_storeu_ps(a->hi, _mm_max_ps(_mm_loadu_ps(a->hi), _mm_loadu_ps(b->hi)));
 }
 
-static void make_leaf(bvh_node *node, size_t begin, size_t end)
+/* c = lo + hi: twice the centroid (the bins only need a consistent scale) */
+static inline void centroid2(const fbox *r, float c[4])
 {
-	node->first_or_right = (uint32_t)begin;
-	node->count = (uint16_t)(end - begin);
-	node->axis = 0;
+	_mm_storeu_ps(c, _mm_add_ps(_mm_loadu_ps(r->lo), _mm_loadu_ps(r->hi)));
 }
 
-static void build(builder *b, size_t ni, size_t begin, size_t end, int depth)
+/* a = a u {p} */
+static inline void fbox_add_point(fbox *a, const float p[4])
 {
-	bvh_node *node = &b->nodes[ni];
-	box nb = box_empty(), cb = box_empty();
+	__m128 v = _mm_loadu_ps(p);
+	_mm_storeu_ps(a->lo, _mm_min_ps(_mm_loadu_ps(a->lo), v));
+	_mm_storeu_ps(a->hi, _mm_max_ps(_mm_loadu_ps(a->hi), v));
+}
+#else
+static inline float fmn(float a, float b) { return a < b ? a : b; }
+static inline float fmx(float a, float b) { return a > b ? a : b; }
+
+static inline void fbox_union(fbox *a, const fbox *b)
+{
+	for (int i = 0; i < 4; i++) {
+		a->lo[i] = fmn(a->lo[i], b->lo[i]);
+		a->hi[i] = fmx(a->hi[i], b->hi[i]);
+	}
+}
+
+static inline void centroid2(const fbox *r, float c[4])
+{
+	for (int i = 0; i < 4; i++)
+		c[i] = r->lo[i] + r->hi[i];
+}
+
+static inline void fbox_add_point(fbox *a, const float p[4])
+{
+	for (int i = 0; i < 4; i++) {
+		a->lo[i] = fmn(a->lo[i], p[i]);
+		a->hi[i] = fmx(a->hi[i], p[i]);
+	}
+}
+#endif
+
+/* Half the surface area, in double (no overflow); 0 when empty. */
+static inline double fbox_half_area(const fbox *b)
+{
+	double e[3];
+	for (int i = 0; i < 3; i++) {
+		e[i] = (double)b->hi[i] - (double)b->lo[i];
+		if (!(e[i] >= 0.0))
+			return 0.0;
+	}
+	return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
+}
+
+/* The nearest floats below and above a double. */
+static float float_down(double v)
+{
+	float f = (float)v;
+	return (double)f > v ? nextafterf(f, -INFINITY) : f;
+}
+
+static float float_up(double v)
+{
+	float f = (float)v;
+	return (double)f < v ? nextafterf(f, INFINITY) : f;
+}
+
+/* Fewer bins for small nodes: most nodes are small, and 16 bins on three
+ * axes would cost more to set up and sweep than the binning itself. */
+static int bins_for(size_t n)
+{
+	return n >= BINS ? BINS : n < 4 ? 4 : (int)n;
+}
+
+/* The bin of each lane of a (doubled) centroid: (c - lo) * scale, clamped to
+ * [0, nbins - 1]; NaN (an infinite box) goes to bin 0. */
+static inline void bin_index(const float c[4], const float lo[4], const float scale[4], int nbins, int k[4])
+{
+#if defined(__SSE2__)
+	__m128 v = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(c), _mm_loadu_ps(lo)), _mm_loadu_ps(scale));
+	/* max(v, 0) is 0 when v is NaN */
+	v = _mm_min_ps(_mm_max_ps(v, _mm_setzero_ps()), _mm_set1_ps((float)(nbins - 1)));
+	_mm_storeu_si128((__m128i *)k, _mm_cvttps_epi32(v));
+#else
+	for (int i = 0; i < 4; i++) {
+		float v = (c[i] - lo[i]) * scale[i];
+		k[i] = !(v > 0.0f) ? 0 : v >= (float)(nbins - 1) ? nbins - 1 : (int)v;
+	}
+#endif
+}
+
+typedef struct split {
+	int axis, at; /* bins [0, at) go left */
+	double cost;  /* SAH: area-weighted counts, not yet divided by the parent's area */
+	fbox lb, rb;  /* the children's boxes */
+} split;
+
+/* The binning of one node: the lower corner and scale of the centroid
+ * bounds per axis (scale 0 on an axis where all centroids are equal). */
+typedef struct binning {
+	float lo[4], scale[4];
+	int nbins;
+	bool usable[3];
+} binning;
+
+static bool binning_make(const fbox *cb, size_t n, binning *bn)
+{
+	bn->nbins = bins_for(n);
+	bool any = false;
+	for (int a = 0; a < 3; a++) {
+		float e = cb->hi[a] - cb->lo[a];
+		bn->lo[a] = cb->lo[a];
+		bn->usable[a] = e > 0.0f && e < INFINITY;
+		bn->scale[a] = bn->usable[a] ? (float)bn->nbins / e : 0.0f;
+		any |= bn->usable[a];
+	}
+	bn->lo[3] = 0.0f;
+	bn->scale[3] = 0.0f;
+	return any;
+}
+
+/* The cheapest binned split of refs[begin, end) with centroid bounds cb;
+ * axis -1 when every centroid is the same point. */
+static split find_split(const builder *b, size_t begin, size_t end, const fbox *cb)
+{
+	split best = {.axis = -1, .cost = INFINITY};
+	binning bn;
+	if (!binning_make(cb, end - begin, &bn))
+		return best;
+	int nbins = bn.nbins;
+	fbox bbox[3][BINS];
+	uint32_t bcount[3][BINS];
+	for (int a = 0; a < 3; a++)
+		for (int k = 0; k < nbins; k++) {
+			bbox[a][k] = fbox_empty();
+			bcount[a][k] = 0;
+		}
 	for (size_t i = begin; i < end; i++) {
-		nb = box_union(nb, b->bounds[i]);
-		cb = box_add(cb, b->centroids[i]);
+		const fbox *r = &b->refs[i];
+		float c[4];
+		int k[4];
+		centroid2(r, c);
+		bin_index(c, bn.lo, bn.scale, nbins, k);
+		for (int a = 0; a < 3; a++) {
+			bcount[a][k[a]]++;
+			fbox_union(&bbox[a][k[a]], r);
+		}
 	}
-	node->b = nb;
-	if (depth > b->depth)
-		b->depth = depth;
-	size_t n = end - begin;
-	if (n <= 1 || (depth >= BALANCED_DEPTH && n <= LEAF_MAX)) {
-		make_leaf(node, begin, end);
-		return;
-	}
-
-	/* Find the cheapest split over the bins of all three axes. */
-	double best_cost = INFINITY;
-	int best_axis = -1, best_split = 0;
-	vec3 ext = v3_sub(cb.hi, cb.lo);
-	/* Past BALANCED_DEPTH only halving by count is used, which bounds the
-	 * depth by BALANCED_DEPTH + log2(n) < BVH_MAX_DEPTH. */
-	for (int axis = 0; axis < 3 && depth < BALANCED_DEPTH; axis++) {
-		double lo = v3_get(cb.lo, axis), e = v3_get(ext, axis);
-		if (!(e > 0.0))
+	for (int a = 0; a < 3; a++) {
+		if (!bn.usable[a])
 			continue;
-		double scale = BINS / e;
-		size_t count[BINS] = {0};
-		box bbox[BINS];
-		for (int k = 0; k < BINS; k++)
-			bbox[k] = box_empty();
-		for (size_t i = begin; i < end; i++) {
-			int k = bin_of(v3_get(b->centroids[i], axis), lo, scale);
-			count[k]++;
-			bbox[k] = box_union(bbox[k], b->bounds[i]);
-		}
-		/* Sweep from the right to get the area and count right of each split. */
+		/* right-to-left sweep: the area and count right of each split */
 		double right_area[BINS];
-		size_t right_count[BINS];
-		box acc = box_empty();
+		size_t right_n[BINS];
+		fbox acc = fbox_empty();
 		size_t cnt = 0;
-		for (int k = BINS - 1; k > 0; k--) {
-			acc = box_union(acc, bbox[k]);
-			cnt += count[k];
-			right_area[k] = box_half_area(acc);
-			right_count[k] = cnt;
+		for (int k = nbins - 1; k > 0; k--) {
+			fbox_union(&acc, &bbox[a][k]);
+			cnt += bcount[a][k];
+			right_area[k] = cnt ? fbox_half_area(&acc) : 0.0;
+			right_n[k] = cnt;
 		}
-		acc = box_empty();
+		acc = fbox_empty();
 		cnt = 0;
-		for (int k = 0; k < BINS - 1; k++) {
-			acc = box_union(acc, bbox[k]);
-			cnt += count[k];
-			if (cnt == 0 || right_count[k + 1] == 0)
+		for (int k = 0; k < nbins - 1; k++) {
+			fbox_union(&acc, &bbox[a][k]);
+			cnt += bcount[a][k];
+			if (cnt == 0 || right_n[k + 1] == 0)
 				continue;
-			double cost = box_half_area(acc) * (double)cnt +
-			              right_area[k + 1] * (double)right_count[k + 1];
-			if (cost < best_cost) {
-				best_cost = cost;
-				best_axis = axis;
-				best_split = k + 1;
+			double cost = fbox_half_area(&acc) * (double)cnt + right_area[k + 1] * (double)right_n[k + 1];
+			if (cost < best.cost) {
+				best.cost = cost;
+				best.axis = a;
+				best.at = k + 1;
 			}
 		}
 	}
+	if (best.axis >= 0) {
+		best.lb = best.rb = fbox_empty();
+		for (int k = 0; k < nbins; k++)
+			fbox_union(k < best.at ? &best.lb : &best.rb, &bbox[best.axis][k]);
+	}
+	return best;
+}
 
-	double parent_area = box_half_area(nb);
-	double leaf_cost = COST_INTERSECT * (double)n;
-	double split_cost = parent_area > 0.0 ? COST_TRAVERSE + COST_INTERSECT * best_cost / parent_area
-	                                      : INFINITY;
-	if (n <= LEAF_MAX && depth < BALANCED_DEPTH && (best_axis < 0 || leaf_cost <= split_cost)) {
-		make_leaf(node, begin, end);
+static inline void swap_refs(builder *b, size_t i, size_t j)
+{
+	fbox t = b->refs[i];
+	b->refs[i] = b->refs[j];
+	b->refs[j] = t;
+	uint32_t id = b->ids[i];
+	b->ids[i] = b->ids[j];
+	b->ids[j] = id;
+}
+
+/* Partitions by the split, returning the middle; *lcb, *rcb: the children's
+ * centroid bounds. The bins are computed exactly as find_split did. */
+static size_t partition(builder *b, size_t begin, size_t end, const fbox *cb, const split *s, fbox *lcb,
+                        fbox *rcb)
+{
+	binning bn;
+	binning_make(cb, end - begin, &bn);
+	int a = s->axis;
+	*lcb = *rcb = fbox_empty();
+	size_t i = begin, j = end;
+	while (i < j) {
+		float c[4];
+		int k[4];
+		centroid2(&b->refs[i], c);
+		bin_index(c, bn.lo, bn.scale, bn.nbins, k);
+		if (k[a] < s->at) {
+			fbox_add_point(lcb, c);
+			i++;
+		} else {
+			fbox_add_point(rcb, c);
+			swap_refs(b, i, --j);
+		}
+	}
+	return i;
+}
+
+/* The box and centroid bounds of refs[begin, end). */
+static void bounds_of(const builder *b, size_t begin, size_t end, fbox *bb, fbox *cb)
+{
+	*bb = *cb = fbox_empty();
+	for (size_t i = begin; i < end; i++) {
+		float c[4];
+		centroid2(&b->refs[i], c);
+		fbox_union(bb, &b->refs[i]);
+		fbox_add_point(cb, c);
+	}
+}
+
+static void set_child_box(bvh_node *node, int k, const fbox *fb)
+{
+	for (int a = 0; a < 3; a++) {
+		node->b[BVH_LO_X + a][k] = fb->lo[a];
+		node->b[BVH_HI_X + a][k] = fb->hi[a];
+	}
+}
+
+/* Builds the subtree over refs[begin, end) (box bb, centroid bounds cb) and
+ * returns its reference in *child, *meta. */
+static void build(builder *b, size_t begin, size_t end, const fbox *bb, const fbox *cb, int depth,
+                  uint32_t *child, uint32_t *meta)
+{
+	size_t n = end - begin;
+	if (depth > b->depth)
+		b->depth = depth;
+	split s = {.axis = -1};
+	if (n > 1 && depth < BALANCED_DEPTH)
+		s = find_split(b, begin, end, cb);
+	bool leaf = n <= 1 || (depth >= BALANCED_DEPTH && n <= LEAF_MAX);
+	if (!leaf && n <= LEAF_MAX && depth < BALANCED_DEPTH) {
+		double area = fbox_half_area(bb);
+		double split_cost = area > 0.0 && s.axis >= 0 ? COST_TRAVERSE + COST_INTERSECT * s.cost / area
+		                                               : INFINITY;
+		leaf = COST_INTERSECT * (double)n <= split_cost;
+	}
+	if (leaf) {
+		*child = (uint32_t)begin;
+		*meta = BVH_LEAF | (uint32_t)n;
+		b->leaves++;
 		return;
 	}
 
-	size_t mid;
-	if (best_axis >= 0) {
-		double lo = v3_get(cb.lo, best_axis), scale = BINS / v3_get(ext, best_axis);
-		size_t i = begin, j = end;
-		while (i < j) {
-			if (bin_of(v3_get(b->centroids[i], best_axis), lo, scale) < best_split)
-				i++;
-			else
-				swap_items(b, i, --j);
-		}
-		mid = i;
-	} else {
-		mid = begin; /* every centroid is the same point */
+	size_t mid = begin;
+	fbox lb, rb, lcb, rcb;
+	if (s.axis >= 0) {
+		mid = partition(b, begin, end, cb, &s, &lcb, &rcb);
+		lb = s.lb;
+		rb = s.rb;
 	}
-	if (mid == begin || mid == end)
-		mid = begin + n / 2; /* no useful split: halve by count */
-
-	node->axis = (uint16_t)(best_axis < 0 ? 0 : best_axis);
-	node->count = 0;
-	size_t left = b->used++;
-	build(b, left, begin, mid, depth + 1);
-	size_t right = b->used++;
-	b->nodes[ni].first_or_right = (uint32_t)right;
-	build(b, right, mid, end, depth + 1);
+	if (mid == begin || mid == end) {
+		/* no useful split (equal centroids, or past BALANCED_DEPTH): halve */
+		mid = begin + n / 2;
+		bounds_of(b, begin, mid, &lb, &lcb);
+		bounds_of(b, mid, end, &rb, &rcb);
+	}
+	size_t ni = b->used++;
+	bvh_node *node = &b->nodes[ni];
+	set_child_box(node, 0, &lb);
+	set_child_box(node, 1, &rb);
+	uint32_t c0, m0, c1, m1;
+	build(b, begin, mid, &lb, &lcb, depth + 1, &c0, &m0);
+	build(b, mid, end, &rb, &rcb, depth + 1, &c1, &m1);
+	node = &b->nodes[ni];
+	node->child[0] = c0;
+	node->meta[0] = m0;
+	node->child[1] = c1;
+	node->meta[1] = m1;
+	*child = (uint32_t)ni;
+	*meta = 0;
 }
 
-bvh *bvh_build(prim *prims, box *bounds, size_t n, rt_error *err)
+bvh *bvh_build(const box *bounds, size_t n, uint32_t *order, rt_error *err)
 {
 	bvh *t = calloc(1, sizeof *t);
 	if (!t) {
 		rt_error_set(err, "out of memory building the BVH");
 		return NULL;
 	}
+	t->root_meta = BVH_LEAF; /* an empty leaf */
 	if (n == 0)
 		return t;
-	if (n > UINT32_MAX / 2) {
+	if (n > BVH_MAX_PRIMS) {
 		free(t);
-		rt_error_set(err, "too many objects (%zu); expected at most %u", n, UINT32_MAX / 2);
+		rt_error_set(err, "too many objects (%zu); expected at most %u", n, BVH_MAX_PRIMS);
 		return NULL;
 	}
-	builder b = {prims, bounds, malloc(n * sizeof(vec3)), malloc((2 * n) * sizeof(bvh_node)), 1, 0};
-	if (!b.centroids || !b.nodes) {
-		free(b.centroids);
+	builder b = {0};
+	b.refs = malloc(n * sizeof *b.refs);
+	b.ids = order; /* partitioned along with the references */
+	b.cap = n > 1 ? n - 1 : 1; /* a binary tree with leaves folded in: < n inner nodes */
+	b.nodes = aligned_alloc(64, b.cap * sizeof *b.nodes);
+	if (!b.refs || !b.nodes) {
+		free(b.refs);
 		free(b.nodes);
 		free(t);
-		rt_error_set(err, "out of memory building the BVH");
+		rt_error_set(err, "out of memory building the BVH (%zu objects)", n);
 		return NULL;
 	}
-	for (size_t i = 0; i < n; i++)
-		b.centroids[i] = box_center(bounds[i]);
-	build(&b, 0, 0, n, 0);
-	free(b.centroids);
-	bvh_node *shrunk = realloc(b.nodes, b.used * sizeof(bvh_node));
-	t->nodes = shrunk ? shrunk : b.nodes;
+	fbox bb = fbox_empty(), cb = fbox_empty();
+	for (size_t i = 0; i < n; i++) {
+		fbox *r = &b.refs[i];
+		const box *x = &bounds[i];
+		*r = (fbox){{float_down(x->lo.x), float_down(x->lo.y), float_down(x->lo.z), 0},
+		            {float_up(x->hi.x), float_up(x->hi.y), float_up(x->hi.z), 0}};
+		b.ids[i] = (uint32_t)i;
+		float c[4];
+		centroid2(r, c);
+		fbox_union(&bb, r);
+		fbox_add_point(&cb, c);
+	}
+	build(&b, 0, n, &bb, &cb, 0, &t->root, &t->root_meta);
+	free(b.refs);
+	if (b.used == 0) {
+		free(b.nodes);
+		b.nodes = NULL;
+	} else if (b.used < b.cap / 2) {
+		/* give back what the tree did not use */
+		bvh_node *fit = aligned_alloc(64, b.used * sizeof *fit);
+		if (fit) {
+			memcpy(fit, b.nodes, b.used * sizeof *fit);
+			free(b.nodes);
+			b.nodes = fit;
+		}
+	}
+	t->nodes = b.nodes;
 	t->nnodes = b.used;
 	t->depth = b.depth;
+	t->leaves = b.leaves;
 	return t;
 }
 

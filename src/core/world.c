@@ -1,6 +1,7 @@
 /* rtsh — preparing a scene for tracing, and the ray queries (world.h). */
 #include "rtsh/world.h"
 
+#include <float.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -66,24 +67,27 @@ static bool is_fast_sphere(const object *o)
 	return o->mat.checker == 0;
 }
 
-static bool make_prim(const object *o, uint32_t index, prim *p, box *b, rt_error *err)
+/* Fills p (and the side record it needs) for object o and its world bounds
+ * *b (planes: see make_plane). */
+static bool make_prim(world *w, const object *o, uint32_t index, prim *p, box *b, rt_error *err)
 {
 	memset(p, 0, sizeof *p);
-	p->kind = o->kind;
 	p->object = index;
 	if (o->kind == OBJ_TRIANGLE) {
-		p->u.tri.v0 = o->tri[0];
-		p->u.tri.e1 = v3_sub(o->tri[1], o->tri[0]);
-		p->u.tri.e2 = v3_sub(o->tri[2], o->tri[0]);
+		p->tag = PRIM_TRIANGLE;
+		p->u.index = (uint32_t)w->ntris;
+		prim_tri *t = &w->tris[w->ntris++];
+		t->v0 = o->tri[0];
+		t->e1 = v3_sub(o->tri[1], o->tri[0]);
+		t->e2 = v3_sub(o->tri[2], o->tri[0]);
 		*b = object_bounds(o);
 		return true;
 	}
 	if (is_fast_sphere(o)) {
 		double r = o->scale.x * 0.5;
-		p->fast_sphere = 1;
+		p->tag = PRIM_SPHERE;
 		p->u.sph.c = o->pos;
-		p->u.sph.r2 = r * r;
-		p->u.sph.inv_r = 1.0 / r;
+		p->u.sph.r = r;
 		*b = (box){v3_sub(o->pos, v3_splat(r)), v3_add(o->pos, v3_splat(r))};
 		return true;
 	}
@@ -91,10 +95,68 @@ static bool make_prim(const object *o, uint32_t index, prim *p, box *b, rt_error
 	if (!object_xform(o, &x))
 		return rt_error_set(err, "object %u (%s) cannot be placed: its transform is not invertible",
 		                    index + 1, obj_kind_name(o->kind));
+	p->tag = PRIM_SHAPE;
+	p->u.index = (uint32_t)w->nshapes;
+	prim_shape *sh = &w->shapes[w->nshapes++];
 	for (int i = 0; i < 3; i++)
 		for (int j = 0; j < 4; j++)
-			p->u.inv[i][j] = x.inv.m[i][j];
+			sh->inv[i][j] = x.inv.m[i][j];
+	sh->kind = o->kind;
 	*b = xf_box(&x, shape_local_bounds(o->kind));
+	return true;
+}
+
+static bool make_plane(world *w, const object *o, uint32_t index, prim_plane *pl, rt_error *err)
+{
+	prim p;
+	box b;
+	if (!make_prim(w, o, index, &p, &b, err))
+		return false;
+	const prim_shape *sh = &w->shapes[p.u.index];
+	for (int j = 0; j < 4; j++)
+		pl->h[j] = sh->inv[1][j];
+	pl->object = index;
+	pl->shape = p.u.index;
+	return true;
+}
+
+/* Puts the primitives in tree order, and the side records in the order of
+ * the primitives that use them (planes first), so that a leaf's data is
+ * contiguous in memory. */
+static bool reorder(world *w, const uint32_t *order)
+{
+	prim *prims = malloc((w->nprims ? w->nprims : 1) * sizeof *prims);
+	prim_shape *shapes = malloc((w->nshapes ? w->nshapes : 1) * sizeof *shapes);
+	prim_tri *tris = malloc((w->ntris ? w->ntris : 1) * sizeof *tris);
+	if (!prims || !shapes || !tris) {
+		free(prims);
+		free(shapes);
+		free(tris);
+		return false;
+	}
+	for (size_t i = 0; i < w->nprims; i++)
+		prims[i] = w->prims[order[i]];
+	size_t ns = 0, nt = 0;
+	for (size_t i = 0; i < w->nplanes; i++) {
+		shapes[ns] = w->shapes[w->planes[i].shape];
+		w->planes[i].shape = (uint32_t)ns++;
+	}
+	for (size_t i = 0; i < w->nprims; i++) {
+		prim *p = &prims[i];
+		if (p->tag == PRIM_SHAPE) {
+			shapes[ns] = w->shapes[p->u.index];
+			p->u.index = (uint32_t)ns++;
+		} else if (p->tag == PRIM_TRIANGLE) {
+			tris[nt] = w->tris[p->u.index];
+			p->u.index = (uint32_t)nt++;
+		}
+	}
+	free(w->prims);
+	free(w->shapes);
+	free(w->tris);
+	w->prims = prims;
+	w->shapes = shapes;
+	w->tris = tris;
 	return true;
 }
 
@@ -114,19 +176,27 @@ world *world_build(const scene *s, rt_error *err)
 		w->sky_zenith = v3_scale(srgb255_to_linear(s->sky.zenith), s->sky.strength);
 		w->sky_horizon = v3_scale(srgb255_to_linear(s->sky.horizon), s->sky.strength);
 	}
-	size_t nplanes = 0;
-	for (size_t i = 0; i < s->nobjs; i++)
-		nplanes += s->objs[i].kind == OBJ_PLANE;
+	size_t nplanes = 0, ntris = 0, nshapes = 0;
+	for (size_t i = 0; i < s->nobjs; i++) {
+		const object *o = &s->objs[i];
+		nplanes += o->kind == OBJ_PLANE;
+		ntris += o->kind == OBJ_TRIANGLE;
+		nshapes += o->kind != OBJ_TRIANGLE && !is_fast_sphere(o);
+	}
 	size_t nbounded = s->nobjs - nplanes;
 	w->lights = calloc(s->nlights ? s->nlights : 1, sizeof *w->lights);
 	w->mats = calloc(s->nobjs ? s->nobjs : 1, sizeof *w->mats);
-	w->prims = calloc(nbounded ? nbounded : 1, sizeof *w->prims);
-	w->planes = calloc(nplanes ? nplanes : 1, sizeof *w->planes);
-	box *bounds = calloc(nbounded ? nbounded : 1, sizeof *bounds);
-	if (!w->lights || !w->mats || !w->prims || !w->planes || !bounds) {
+	w->prims = malloc((nbounded ? nbounded : 1) * sizeof *w->prims);
+	w->planes = malloc((nplanes ? nplanes : 1) * sizeof *w->planes);
+	w->shapes = malloc((nshapes ? nshapes : 1) * sizeof *w->shapes);
+	w->tris = malloc((ntris ? ntris : 1) * sizeof *w->tris);
+	box *bounds = malloc((nbounded ? nbounded : 1) * sizeof *bounds);
+	uint32_t *order = malloc((nbounded ? nbounded : 1) * sizeof *order);
+	if (!w->lights || !w->mats || !w->prims || !w->planes || !w->shapes || !w->tris || !bounds || !order) {
 		free(bounds);
+		free(order);
 		world_free(w);
-		rt_error_set(err, "out of memory preparing the scene");
+		rt_error_set(err, "out of memory preparing the scene (%zu objects)", s->nobjs);
 		return NULL;
 	}
 	w->nlights = s->nlights;
@@ -140,14 +210,16 @@ world *world_build(const scene *s, rt_error *err)
 	for (size_t i = 0; i < s->nobjs; i++) {
 		const object *o = &s->objs[i];
 		w->mats[i] = material_linear(&o->mat);
-		prim *p = o->kind == OBJ_PLANE ? &w->planes[w->nplanes++] : &w->prims[w->nprims];
-		box b;
-		if (!make_prim(o, (uint32_t)i, p, o->kind == OBJ_PLANE ? &b : &bounds[w->nprims], err)) {
+		bool plane = o->kind == OBJ_PLANE;
+		if (plane ? !make_plane(w, o, (uint32_t)i, &w->planes[w->nplanes], err)
+		          : !make_prim(w, o, (uint32_t)i, &w->prims[w->nprims], &bounds[w->nprims], err)) {
 			free(bounds);
+			free(order);
 			world_free(w);
 			return NULL;
 		}
-		if (o->kind == OBJ_PLANE) {
+		if (plane) {
+			w->nplanes++;
 			extent = fmax(extent, v3_max_abs(o->pos));
 		} else {
 			w->bounds = box_union(w->bounds, bounds[w->nprims]);
@@ -159,9 +231,13 @@ world *world_build(const scene *s, rt_error *err)
 	for (size_t i = 0; i < s->nlights; i++)
 		extent = fmax(extent, v3_max_abs(s->lights[i].pos));
 	w->eps = 1e-9 * fmax(1.0, extent);
-	w->tree = bvh_build(w->prims, bounds, w->nprims, err);
+	w->tree = bvh_build(bounds, w->nprims, order, err);
 	free(bounds);
-	if (!w->tree || !emitters_build(w, s, err)) {
+	bool ok = w->tree && reorder(w, order);
+	free(order);
+	if (w->tree && !ok)
+		rt_error_set(err, "out of memory preparing the scene (%zu objects)", s->nobjs);
+	if (!ok || !emitters_build(w, s, err)) {
 		world_free(w);
 		return NULL;
 	}
@@ -176,6 +252,8 @@ void world_free(world *w)
 	free(w->mats);
 	free(w->prims);
 	free(w->planes);
+	free(w->shapes);
+	free(w->tris);
 	free(w->emitters);
 	bvh_free(w->tree);
 	free(w);
@@ -183,74 +261,142 @@ void world_free(world *w)
 
 /* --- primitive tests --- */
 
-/* The nearest hit of one primitive in (tmin, tmax): *t and the unnormalised
- * normal in the primitive's own space (*nl). */
-static inline bool prim_hit(const prim *p, const ray *r, double tmin, double tmax, double *t, vec3 *nl)
+/* The ray in the object space of a shape (its direction not renormalised,
+ * so t is the same in both spaces). */
+static inline void to_object(const prim_shape *sh, const ray *r, vec3 *o, vec3 *d)
 {
-	if (p->fast_sphere) {
-		vec3 oc = v3_sub(r->o, p->u.sph.c);
-		double b = v3_dot(oc, r->d), a = v3_dot(r->d, r->d);
-		double c = v3_dot(oc, oc) - p->u.sph.r2;
-		double disc = b * b - a * c;
-		if (disc < 0.0)
-			return false;
-		double q = -(b + copysign(sqrt(disc), b));
-		double t0 = q / a, t1 = q != 0.0 ? c / q : t0;
-		if (t0 > t1) {
-			double tmp = t0;
-			t0 = t1;
-			t1 = tmp;
-		}
-		double tt = t0 > tmin ? t0 : t1;
-		if (!(tt > tmin && tt < tmax))
-			return false;
-		*t = tt;
-		return true;
-	}
-	if (p->kind == OBJ_TRIANGLE)
-		return tri_intersect(p->u.tri.v0, p->u.tri.e1, p->u.tri.e2, r->o, r->d, tmin, tmax, t);
-	const double(*m)[4] = p->u.inv;
-	vec3 o = {m[0][0] * r->o.x + m[0][1] * r->o.y + m[0][2] * r->o.z + m[0][3],
-	          m[1][0] * r->o.x + m[1][1] * r->o.y + m[1][2] * r->o.z + m[1][3],
-	          m[2][0] * r->o.x + m[2][1] * r->o.y + m[2][2] * r->o.z + m[2][3]};
-	vec3 d = {m[0][0] * r->d.x + m[0][1] * r->d.y + m[0][2] * r->d.z,
-	          m[1][0] * r->d.x + m[1][1] * r->d.y + m[1][2] * r->d.z,
-	          m[2][0] * r->d.x + m[2][1] * r->d.y + m[2][2] * r->d.z};
-	return shape_table[p->kind].intersect(o, d, tmin, tmax, t, nl);
+	const double(*m)[4] = sh->inv;
+	*o = (vec3){m[0][0] * r->o.x + m[0][1] * r->o.y + m[0][2] * r->o.z + m[0][3],
+	            m[1][0] * r->o.x + m[1][1] * r->o.y + m[1][2] * r->o.z + m[1][3],
+	            m[2][0] * r->o.x + m[2][1] * r->o.y + m[2][2] * r->o.z + m[2][3]};
+	*d = (vec3){m[0][0] * r->d.x + m[0][1] * r->d.y + m[0][2] * r->d.z,
+	            m[1][0] * r->d.x + m[1][1] * r->d.y + m[1][2] * r->d.z,
+	            m[2][0] * r->d.x + m[2][1] * r->d.y + m[2][2] * r->d.z};
 }
 
-static inline bool prim_occluded(const prim *p, const ray *r, double tmin, double tmax)
+/* The nearest hit of a world-space sphere in (tmin, tmax); the stable
+ * quadratic of Numerical Recipes 5.6. */
+static inline bool sphere_hit(const prim *p, const ray *r, double tmin, double tmax, double *t)
 {
-	if (p->fast_sphere || p->kind == OBJ_TRIANGLE) {
-		double t;
-		vec3 n;
-		return prim_hit(p, r, tmin, tmax, &t, &n);
+	vec3 oc = v3_sub(r->o, p->u.sph.c);
+	double b = v3_dot(oc, r->d), a = v3_dot(r->d, r->d);
+	double c = v3_dot(oc, oc) - p->u.sph.r * p->u.sph.r;
+	double disc = b * b - a * c;
+	if (disc < 0.0)
+		return false;
+	double q = -(b + copysign(sqrt(disc), b));
+	double t0 = q / a, t1 = q != 0.0 ? c / q : t0;
+	if (t0 > t1) {
+		double tmp = t0;
+		t0 = t1;
+		t1 = tmp;
 	}
-	const double(*m)[4] = p->u.inv;
-	vec3 o = {m[0][0] * r->o.x + m[0][1] * r->o.y + m[0][2] * r->o.z + m[0][3],
-	          m[1][0] * r->o.x + m[1][1] * r->o.y + m[1][2] * r->o.z + m[1][3],
-	          m[2][0] * r->o.x + m[2][1] * r->o.y + m[2][2] * r->o.z + m[2][3]};
-	vec3 d = {m[0][0] * r->d.x + m[0][1] * r->d.y + m[0][2] * r->d.z,
-	          m[1][0] * r->d.x + m[1][1] * r->d.y + m[1][2] * r->d.z,
-	          m[2][0] * r->d.x + m[2][1] * r->d.y + m[2][2] * r->d.z};
-	return shape_table[p->kind].occluded(o, d, tmin, tmax);
+	double tt = t0 > tmin ? t0 : t1;
+	if (!(tt > tmin && tt < tmax))
+		return false;
+	*t = tt;
+	return true;
+}
+
+/* A triangle or a transformed shape (spheres are tested inline): *t and,
+ * for a shape, the unnormalised normal in its object space (*nl). */
+static bool other_hit(const world *w, const prim *p, const ray *r, double tmin, double tmax, double *t,
+                      vec3 *nl)
+{
+	if (p->tag == PRIM_TRIANGLE) {
+		const prim_tri *tr = &w->tris[p->u.index];
+		return tri_intersect(tr->v0, tr->e1, tr->e2, r->o, r->d, tmin, tmax, t);
+	}
+	const prim_shape *sh = &w->shapes[p->u.index];
+	vec3 o, d;
+	to_object(sh, r, &o, &d);
+	return shape_table[sh->kind].intersect(o, d, tmin, tmax, t, nl);
+}
+
+static bool other_occluded(const world *w, const prim *p, const ray *r, double tmin, double tmax)
+{
+	if (p->tag == PRIM_TRIANGLE) {
+		double t;
+		const prim_tri *tr = &w->tris[p->u.index];
+		return tri_intersect(tr->v0, tr->e1, tr->e2, r->o, r->d, tmin, tmax, &t);
+	}
+	const prim_shape *sh = &w->shapes[p->u.index];
+	vec3 o, d;
+	to_object(sh, r, &o, &d);
+	return shape_table[sh->kind].occluded(o, d, tmin, tmax);
+}
+
+/* The nearest hit of one primitive in (tmin, tmax). */
+static inline bool prim_hit(const world *w, const prim *p, const ray *r, double tmin, double tmax, double *t,
+                            vec3 *nl)
+{
+	if (p->tag == PRIM_SPHERE)
+		return sphere_hit(p, r, tmin, tmax, t);
+	return other_hit(w, p, r, tmin, tmax, t, nl);
+}
+
+static inline bool prim_occluded(const world *w, const prim *p, const ray *r, double tmin, double tmax)
+{
+	double t;
+	if (p->tag == PRIM_SPHERE)
+		return sphere_hit(p, r, tmin, tmax, &t);
+	return other_occluded(w, p, r, tmin, tmax);
+}
+
+/* A plane: the unit plane's test (plane.c) with the ray's object-space
+ * height and slope computed from row 1 of the matrix only. */
+static inline bool plane_hit(const prim_plane *pl, const ray *r, double tmin, double tmax, double *t)
+{
+	const double *h = pl->h;
+	double oy = h[0] * r->o.x + h[1] * r->o.y + h[2] * r->o.z + h[3];
+	double dy = h[0] * r->d.x + h[1] * r->d.y + h[2] * r->d.z;
+	if (dy == 0.0)
+		return false;
+	double tt = -oy / dy;
+	if (!(tt > tmin && tt < tmax))
+		return false;
+	*t = tt;
+	return true;
+}
+
+/* The hit record of a plane. */
+static void finish_plane(const world *w, const prim_plane *pl, const ray *r, double t, hit *h)
+{
+	const prim_shape *sh = &w->shapes[pl->shape];
+	const double(*m)[4] = sh->inv;
+	h->t = t;
+	h->p = ray_at(*r, t);
+	h->object = pl->object;
+	vec3 q = h->p;
+	h->local = (vec3){m[0][0] * q.x + m[0][1] * q.y + m[0][2] * q.z + m[0][3],
+	                  m[1][0] * q.x + m[1][1] * q.y + m[1][2] * q.z + m[1][3],
+	                  m[2][0] * q.x + m[2][1] * q.y + m[2][2] * q.z + m[2][3]};
+	vec3 n = v3_norm(v3(m[1][0], m[1][1], m[1][2]));
+	h->front = v3_dot(n, r->d) < 0.0;
+	h->n = n;
 }
 
 /* Fills the hit record for the primitive found nearest. */
-static void finish_hit(const prim *p, const ray *r, double t, vec3 nl, hit *h)
+static void finish_hit(const world *w, const prim *p, const ray *r, double t, vec3 nl, hit *h)
 {
 	h->t = t;
 	h->p = ray_at(*r, t);
 	h->object = p->object;
 	vec3 n;
-	if (p->fast_sphere) {
-		n = v3_scale(v3_sub(h->p, p->u.sph.c), p->u.sph.inv_r);
+	if (p->tag == PRIM_SPHERE) {
+		n = v3_norm(v3_sub(h->p, p->u.sph.c));
 		h->local = n;
-	} else if (p->kind == OBJ_TRIANGLE) {
-		n = v3_cross(p->u.tri.e1, p->u.tri.e2);
+		h->front = v3_dot(n, r->d) < 0.0;
+		h->n = n;
+		return;
+	}
+	if (p->tag == PRIM_TRIANGLE) {
+		const prim_tri *tr = &w->tris[p->u.index];
+		n = v3_cross(tr->e1, tr->e2);
 		h->local = h->p;
 	} else {
-		const double(*m)[4] = p->u.inv;
+		const prim_shape *sh = &w->shapes[p->u.index];
+		const double(*m)[4] = sh->inv;
 		n = (vec3){m[0][0] * nl.x + m[1][0] * nl.y + m[2][0] * nl.z,
 		           m[0][1] * nl.x + m[1][1] * nl.y + m[2][1] * nl.z,
 		           m[0][2] * nl.x + m[1][2] * nl.y + m[2][2] * nl.z};
@@ -266,141 +412,257 @@ static void finish_hit(const prim *p, const ray *r, double t, vec3 nl, hit *h)
 
 /* --- the tree walk --- */
 
-static inline double mn(double a, double b) { return a < b ? a : b; }
-static inline double mx(double a, double b) { return a > b ? a : b; }
+static _Thread_local uint64_t rays_traced;
 
-static inline bool slab(const box *b, vec3 o, vec3 inv, double tmin, double tmax)
+void world_rays_reset(void)
 {
-	double tx0 = (b->lo.x - o.x) * inv.x, tx1 = (b->hi.x - o.x) * inv.x;
-	double ty0 = (b->lo.y - o.y) * inv.y, ty1 = (b->hi.y - o.y) * inv.y;
-	double tz0 = (b->lo.z - o.z) * inv.z, tz1 = (b->hi.z - o.z) * inv.z;
-	/* Plain comparisons, not fmin/fmax: those are library calls on x86-64. */
-	double lo = mx(mx(mn(tx0, tx1), mn(ty0, ty1)), mx(mn(tz0, tz1), tmin));
-	double hi = mn(mn(mx(tx0, tx1), mx(ty0, ty1)), mn(mx(tz0, tz1), tmax));
-	return lo <= hi;
+	rays_traced = 0;
 }
 
-static vec3 inverse_dir(vec3 d)
+uint64_t world_rays_traced(void)
 {
-	return v3(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
+	return rays_traced;
 }
+
+size_t world_memory(const world *w)
+{
+	size_t n = w->nlights * sizeof *w->lights + w->nprims * sizeof *w->prims +
+	           w->nplanes * sizeof *w->planes + w->nshapes * sizeof *w->shapes +
+	           w->ntris * sizeof *w->tris + w->nmats * sizeof *w->mats +
+	           w->nemitters * sizeof *w->emitters;
+	if (w->tree)
+		n += sizeof *w->tree + w->tree->nnodes * sizeof *w->tree->nodes;
+	return n;
+}
+
+/* What the slab tests need of a ray, computed once per ray. The tests run in
+ * single precision on the nodes' float boxes (see world.h for why) and must
+ * never miss a box the exact ray enters:
+ *   - each axis reads its near and far planes from the rows of bvh_node.b
+ *     chosen by the direction's sign, so no min/max per axis is needed
+ *     (Williams et al., "An efficient and robust ray-box intersection
+ *     algorithm", 2005);
+ *   - the origin is rounded to float in the direction that can only move
+ *     the near plane's distance down and the far plane's up;
+ *   - the far distance is then scaled by 1 + 2 gamma(3) for the rounding of
+ *     the subtraction, the product and the inverse (Ize, "Robust BVH ray
+ *     traversal", JCGT 2013), and so is tmax where the walk prunes. */
+typedef struct ray_pre {
+	float on[3], of[3]; /* origin, rounded for the near / far planes */
+	float inv[3];
+	int near[3], far[3]; /* rows of bvh_node.b */
+} ray_pre;
+
+#define SLAB_SLACK (1.0f + 2.0f * (3.0f * 0x1p-24f) / (1.0f - 3.0f * 0x1p-24f))
+
+/* A float <= v and a float >= v (a step of |f| 2^-23 covers the rounding;
+ * cheaper than nextafterf, which is a library call). */
+static inline float to_float_down(double v)
+{
+	float f = (float)v;
+	if ((double)f <= v)
+		return f;
+	return f == INFINITY ? FLT_MAX : f - (fabsf(f) * 0x1p-23f + 0x1p-149f);
+}
+
+static inline float to_float_up(double v)
+{
+	float f = (float)v;
+	if ((double)f >= v)
+		return f;
+	return f == -INFINITY ? -FLT_MAX : f + (fabsf(f) * 0x1p-23f + 0x1p-149f);
+}
+
+static inline void ray_prepare(const ray *r, ray_pre *q)
+{
+	double o[3] = {r->o.x, r->o.y, r->o.z}, d[3] = {r->d.x, r->d.y, r->d.z};
+	for (int a = 0; a < 3; a++) {
+		q->inv[a] = (float)(1.0 / d[a]);
+		bool neg = signbit(q->inv[a]);
+		q->near[a] = (neg ? BVH_HI_X : BVH_LO_X) + a;
+		q->far[a] = (neg ? BVH_LO_X : BVH_HI_X) + a;
+		float up = to_float_up(o[a]), down = to_float_down(o[a]);
+		q->on[a] = neg ? down : up;
+		q->of[a] = neg ? up : down;
+	}
+}
+
+/* Slab tests of both children of n against [tmin, tmax]: bit k of the
+ * result is set when child k may be hit, and tn[k] is (about) where the ray
+ * enters it. 0 x inf = NaN (a ray in a slab's plane) is dropped by the order
+ * of the comparisons, which keeps the box. */
+static inline unsigned slab2(const bvh_node *n, const ray_pre *q, float tmin, float tmax, float tn[2])
+{
+	float t0[2] = {tmin, tmin}, t1[2] = {tmax, tmax};
+	for (int a = 0; a < 3; a++) {
+		const float *nb = n->b[q->near[a]], *fb = n->b[q->far[a]];
+		for (int k = 0; k < 2; k++) {
+			float tnear = (nb[k] - q->on[a]) * q->inv[a];
+			float tfar = (fb[k] - q->of[a]) * q->inv[a];
+			t0[k] = tnear > t0[k] ? tnear : t0[k];
+			t1[k] = tfar < t1[k] ? tfar : t1[k];
+		}
+	}
+	tn[0] = t0[0];
+	tn[1] = t0[1];
+	return (unsigned)(t0[0] <= t1[0] * SLAB_SLACK) | (unsigned)(t0[1] <= t1[1] * SLAB_SLACK) << 1;
+}
+
+typedef struct walk_entry {
+	uint32_t child, meta; /* a node or a leaf, as in bvh_node */
+	float t;              /* where the ray enters its box */
+	uint32_t pad;
+} walk_entry;
 
 bool world_intersect(const world *w, const ray *r, double tmin, double tmax, hit *h)
 {
 	const prim *best = NULL;
+	const prim_plane *best_plane = NULL;
 	vec3 best_n = {0, 0, 0};
 	double t;
 	vec3 nl;
+	rays_traced++;
 	for (size_t i = 0; i < w->nplanes; i++)
-		if (prim_hit(&w->planes[i], r, tmin, tmax, &t, &nl)) {
+		if (plane_hit(&w->planes[i], r, tmin, tmax, &t)) {
 			tmax = t;
-			best = &w->planes[i];
-			best_n = nl;
+			best_plane = &w->planes[i];
 		}
 	if (w->nprims) {
-		const bvh_node *nodes = w->tree->nodes;
-		vec3 inv = inverse_dir(r->d);
-		int neg[3] = {r->d.x < 0, r->d.y < 0, r->d.z < 0};
-		uint32_t stack[BVH_MAX_DEPTH + 2];
+		const bvh *tree = w->tree;
+		ray_pre q;
+		ray_prepare(r, &q);
+		float ftmin = to_float_down(tmin), ftmax = to_float_up(tmax);
+		walk_entry stack[BVH_MAX_DEPTH + 2];
 		int sp = 0;
-		uint32_t ni = 0;
+		uint32_t child = tree->root, meta = tree->root_meta;
 		for (;;) {
-			const bvh_node *n = &nodes[ni];
-			if (slab(&n->b, r->o, inv, tmin, tmax)) {
-				if (n->count) {
-					const prim *p = &w->prims[n->first_or_right];
-					for (unsigned k = 0; k < n->count; k++)
-						if (prim_hit(&p[k], r, tmin, tmax, &t, &nl)) {
-							tmax = t;
-							best = &p[k];
-							best_n = nl;
-						}
-				} else {
-					/* Visit the child on the ray's near side first. */
-					if (neg[n->axis]) {
-						stack[sp++] = ni + 1;
-						ni = n->first_or_right;
-					} else {
-						stack[sp++] = n->first_or_right;
-						ni = ni + 1;
+			if (meta) {
+				const prim *p = &w->prims[child];
+				uint32_t count = meta & ~BVH_LEAF;
+				for (uint32_t k = 0; k < count; k++)
+					if (prim_hit(w, &p[k], r, tmin, tmax, &t, &nl)) {
+						tmax = t;
+						ftmax = to_float_up(tmax);
+						best = &p[k];
+						best_n = nl;
 					}
+			} else {
+				const bvh_node *n = &tree->nodes[child];
+				float tn[2];
+				unsigned m = slab2(n, &q, ftmin, ftmax, tn);
+				if (m == 3) {
+					/* both: the nearer now, the other later */
+					unsigned f = tn[1] < tn[0];
+					stack[sp++] = (walk_entry){n->child[!f], n->meta[!f], tn[!f], 0};
+					child = n->child[f];
+					meta = n->meta[f];
+					continue;
+				}
+				if (m) {
+					child = n->child[m >> 1];
+					meta = n->meta[m >> 1];
 					continue;
 				}
 			}
+			/* the next entry that a nearer hit has not ruled out */
+			while (sp > 0 && stack[sp - 1].t > (double)SLAB_SLACK * tmax)
+				sp--;
 			if (sp == 0)
 				break;
-			ni = stack[--sp];
+			sp--;
+			child = stack[sp].child;
+			meta = stack[sp].meta;
 		}
 	}
-	if (!best)
-		return false;
-	finish_hit(best, r, tmax, best_n, h);
-	return true;
+	/* a primitive hit after the planes is nearer than all of them */
+	if (best)
+		finish_hit(w, best, r, tmax, best_n, h);
+	else if (best_plane)
+		finish_plane(w, best_plane, r, tmax, h);
+	return best || best_plane;
 }
 
 bool world_occluded(const world *w, const ray *r, double tmin, double tmax)
 {
+	rays_traced++;
+	double t;
 	for (size_t i = 0; i < w->nplanes; i++)
-		if (prim_occluded(&w->planes[i], r, tmin, tmax))
+		if (plane_hit(&w->planes[i], r, tmin, tmax, &t))
 			return true;
 	if (!w->nprims)
 		return false;
-	const bvh_node *nodes = w->tree->nodes;
-	vec3 inv = inverse_dir(r->d);
-	uint32_t stack[BVH_MAX_DEPTH + 2];
+	const bvh *tree = w->tree;
+	ray_pre q;
+	ray_prepare(r, &q);
+	float ftmin = to_float_down(tmin), ftmax = to_float_up(tmax);
+	walk_entry stack[BVH_MAX_DEPTH + 2];
 	int sp = 0;
-	uint32_t ni = 0;
+	uint32_t child = tree->root, meta = tree->root_meta;
 	for (;;) {
-		const bvh_node *n = &nodes[ni];
-		if (slab(&n->b, r->o, inv, tmin, tmax)) {
-			if (n->count) {
-				const prim *p = &w->prims[n->first_or_right];
-				for (unsigned k = 0; k < n->count; k++)
-					if (prim_occluded(&p[k], r, tmin, tmax))
-						return true;
-			} else {
-				stack[sp++] = n->first_or_right;
-				ni = ni + 1;
+		if (meta) {
+			const prim *p = &w->prims[child];
+			uint32_t count = meta & ~BVH_LEAF;
+			for (uint32_t k = 0; k < count; k++)
+				if (prim_occluded(w, &p[k], r, tmin, tmax))
+					return true;
+		} else {
+			const bvh_node *n = &tree->nodes[child];
+			float tn[2];
+			unsigned m = slab2(n, &q, ftmin, ftmax, tn);
+			if (m == 3) {
+				unsigned f = tn[1] < tn[0];
+				stack[sp++] = (walk_entry){n->child[!f], n->meta[!f], tn[!f], 0};
+				child = n->child[f];
+				meta = n->meta[f];
+				continue;
+			}
+			if (m) {
+				child = n->child[m >> 1];
+				meta = n->meta[m >> 1];
 				continue;
 			}
 		}
 		if (sp == 0)
 			return false;
-		ni = stack[--sp];
+		sp--;
+		child = stack[sp].child;
+		meta = stack[sp].meta;
 	}
 }
 
 bool world_intersect_brute(const world *w, const ray *r, double tmin, double tmax, hit *h)
 {
 	const prim *best = NULL;
+	const prim_plane *best_plane = NULL;
 	vec3 best_n = {0, 0, 0};
 	double t;
 	vec3 nl;
 	for (size_t i = 0; i < w->nplanes; i++)
-		if (prim_hit(&w->planes[i], r, tmin, tmax, &t, &nl)) {
+		if (plane_hit(&w->planes[i], r, tmin, tmax, &t)) {
 			tmax = t;
-			best = &w->planes[i];
-			best_n = nl;
+			best_plane = &w->planes[i];
 		}
 	for (size_t i = 0; i < w->nprims; i++)
-		if (prim_hit(&w->prims[i], r, tmin, tmax, &t, &nl)) {
+		if (prim_hit(w, &w->prims[i], r, tmin, tmax, &t, &nl)) {
 			tmax = t;
 			best = &w->prims[i];
 			best_n = nl;
 		}
-	if (!best)
-		return false;
-	finish_hit(best, r, tmax, best_n, h);
-	return true;
+	if (best)
+		finish_hit(w, best, r, tmax, best_n, h);
+	else if (best_plane)
+		finish_plane(w, best_plane, r, tmax, h);
+	return best || best_plane;
 }
 
 bool world_occluded_brute(const world *w, const ray *r, double tmin, double tmax)
 {
+	double t;
 	for (size_t i = 0; i < w->nplanes; i++)
-		if (prim_occluded(&w->planes[i], r, tmin, tmax))
+		if (plane_hit(&w->planes[i], r, tmin, tmax, &t))
 			return true;
 	for (size_t i = 0; i < w->nprims; i++)
-		if (prim_occluded(&w->prims[i], r, tmin, tmax))
+		if (prim_occluded(w, &w->prims[i], r, tmin, tmax))
 			return true;
 	return false;
 }

@@ -1,0 +1,613 @@
+/* rtsh — the benchmark (`make bench`, `make bench-quick`).
+ *
+ * Prints one table and writes it as TSV (--out FILE): scene, mode,
+ * resolution, samples, threads, runs, the median wall time over the runs,
+ * Mrays/s and a note. Rows:
+ *   grid.rt at 1920x1080, 1 sample, 1 and 2 threads, and POV-Ray 3.7 on its
+ *     twin bench/grid.pov in the same run (interleaved) when `povray` is
+ *     installed;
+ *   primary rays on the grid (camera rays and world_intersect only, 1
+ *     thread), the same by brute force, and Embree 3's rtcIntersect1 on the
+ *     same rays when bench/embree_primary was built;
+ *   generated spheres-only scenes of 10, 1k, 100k and 1M spheres at one view,
+ *     1 and 2 threads; their world_build time and memory per object; the
+ *     load time of the 1M scene saved as .rt;
+ *   the Whitted preview frame (160x96 pixels, showcase.rt) and the bytes of
+ *     the terminal frame that shows it.
+ * A render row's Mrays/s counts every ray the integrator traced (camera,
+ * shadow and reflection rays, counted in one extra 1-thread pass); the
+ * primary-ray rows count camera rays only. Times are medians: the machine is
+ * shared, so compare rows of the same run. --quick runs small sizes once, as
+ * a smoke test for CI. Nothing here asserts a time.
+ */
+#include <errno.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "core/bvh.h"
+#include "rtsh/generate.h"
+#include "rtsh/render.h"
+#include "rtsh/rtfile.h"
+#include "rtsh/world.h"
+#include "term/frame.h"
+
+#define MAX_RUNS 101
+#define MAX_ROWS 64
+
+typedef struct row {
+	char scene[48];
+	char mode[24];
+	char res[16];
+	int samples, threads, runs;
+	double seconds; /* median; < 0: none */
+	double mrays;   /* < 0: none */
+	char note[120];
+} row;
+
+static row rows[MAX_ROWS];
+static int nrows;
+static bool quick;
+static int runs = 5;
+static const char *bench_dir = "build/bench"; /* where embree_primary lives */
+
+static double now(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+	double x = *(const double *)a, y = *(const double *)b;
+	return x < y ? -1 : x > y;
+}
+
+static double median(double *v, int n)
+{
+	if (n <= 0)
+		return -1;
+	qsort(v, (size_t)n, sizeof *v, cmp_double);
+	return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+static row *add_row(const char *name, const char *mode, int w, int h, int samples, int threads, int nruns,
+                    double seconds, double mrays)
+{
+	if (nrows == MAX_ROWS)
+		return &rows[MAX_ROWS - 1];
+	row *r = &rows[nrows++];
+	memset(r, 0, sizeof *r);
+	snprintf(r->scene, sizeof r->scene, "%s", name);
+	snprintf(r->mode, sizeof r->mode, "%s", mode);
+	if (w > 0)
+		snprintf(r->res, sizeof r->res, "%dx%d", w, h);
+	else
+		snprintf(r->res, sizeof r->res, "-");
+	r->samples = samples;
+	r->threads = threads;
+	r->runs = nruns;
+	r->seconds = seconds;
+	r->mrays = mrays;
+	fprintf(stderr, "  %-22s %-16s %-10s %2d thr  %10.4f s  %8.2f Mrays/s\n", name, mode, r->res, threads,
+	        seconds, mrays);
+	return r;
+}
+
+static void fail(const char *what, const rt_error *err)
+{
+	fprintf(stderr, "bench: %s: %s\n", what, err ? err->msg : strerror(errno));
+	exit(1);
+}
+
+static scene *load(const char *path)
+{
+	rt_error err;
+	scene *s = rt_load_file(path, NULL, &err);
+	if (!s) {
+		char buf[RT_ERROR_MSG_MAX + RT_ERROR_FILE_MAX + 32];
+		rt_error_format(&err, buf, sizeof buf);
+		fprintf(stderr, "bench: %s\n", buf);
+		exit(1);
+	}
+	return s;
+}
+
+static world *build(const scene *s)
+{
+	rt_error err;
+	world *w = world_build(s, &err);
+	if (!w)
+		fail("world_build", &err);
+	return w;
+}
+
+static render_settings settings(int w, int h, int threads)
+{
+	render_settings set = render_settings_default();
+	set.width = w;
+	set.height = h;
+	set.samples = 1;
+	set.threads = threads;
+	return set;
+}
+
+/* One render of every pixel into fb (cleared first); seconds. */
+static double render_once(const world *w, const render_settings *set, framebuffer *fb)
+{
+	fb_clear(fb);
+	render_job job = {.w = w, .set = *set, .fb = fb, .sample_begin = 0, .sample_end = set->samples};
+	rt_error err;
+	double t0 = now();
+	if (render_run(&job, &err) != RENDER_DONE)
+		fail("render", &err);
+	return now() - t0;
+}
+
+/* Every ray one render traces: a 1-thread render runs in this thread, whose
+ * counter world_rays_traced reads. */
+static uint64_t count_rays(const world *w, render_settings set, framebuffer *fb)
+{
+	set.threads = 1;
+	world_rays_reset();
+	render_once(w, &set, fb);
+	return world_rays_traced();
+}
+
+/* --- POV-Ray and Embree, as child processes --- */
+
+static bool have_povray(void)
+{
+	return system("command -v povray >/dev/null 2>&1") == 0;
+}
+
+/* Runs POV-Ray on bench/grid.pov; *trace = its own "Trace Time". Wall
+ * seconds of the process, < 0 on failure. */
+static double run_povray(int w, int h, int threads, double *trace)
+{
+	char cmd[512];
+	snprintf(cmd, sizeof cmd,
+	         "povray +Ibench/grid.pov -F -D -A +W%d +H%d +WT%d 2>&1", w, h, threads);
+	double t0 = now();
+	FILE *p = popen(cmd, "r");
+	if (!p)
+		return -1;
+	char line[256];
+	*trace = -1;
+	bool in_trace = false;
+	while (fgets(line, sizeof line, p)) {
+		if (strstr(line, "Trace Time:"))
+			in_trace = true;
+		char *paren = strchr(line, '(');
+		if (in_trace && paren && *trace < 0)
+			*trace = strtod(paren + 1, NULL);
+	}
+	int rc = pclose(p);
+	double t = now() - t0;
+	return rc == 0 ? t : -1;
+}
+
+/* Runs the Embree harness once; Mrays/s of its timed pass, < 0 if absent. */
+static double run_embree(const char *scene_path, int w, int h, double *seconds)
+{
+	char exe[512], cmd[1200];
+	snprintf(exe, sizeof exe, "%s/embree_primary", bench_dir);
+	if (access(exe, X_OK) != 0)
+		return -1;
+	snprintf(cmd, sizeof cmd, "%s %s %d %d 2>&1", exe, scene_path, w, h);
+	FILE *p = popen(cmd, "r");
+	if (!p)
+		return -1;
+	char line[256];
+	double mrays = -1;
+	while (fgets(line, sizeof line, p)) {
+		double m, s;
+		if (sscanf(line, "mrays %lf seconds %lf", &m, &s) == 2) {
+			mrays = m;
+			*seconds = s;
+		}
+	}
+	return pclose(p) == 0 ? mrays : -1;
+}
+
+/* --- the rows --- */
+
+/* grid.rt, 1 and 2 threads, with POV-Ray interleaved in the same loop. */
+static void bench_grid(void)
+{
+	const char *path = "scenes/grid.rt";
+	int w = quick ? 320 : 1920, h = quick ? 180 : 1080;
+	scene *s = load(path);
+	world *wd = build(s);
+	framebuffer *fb = fb_new(w, h);
+	if (!fb)
+		fail("framebuffer", NULL);
+	render_settings set1 = settings(w, h, 1), set2 = settings(w, h, 2);
+	uint64_t rays = count_rays(wd, set1, fb);
+	bool pov = !quick && have_povray();
+	double t1[MAX_RUNS], t2[MAX_RUNS], p1[MAX_RUNS], p2[MAX_RUNS], pt1[MAX_RUNS], pt2[MAX_RUNS];
+	int np1 = 0, np2 = 0;
+	for (int i = 0; i < runs; i++) {
+		t1[i] = render_once(wd, &set1, fb);
+		if (pov) {
+			double tr, t = run_povray(w, h, 1, &tr);
+			if (t > 0) {
+				p1[np1] = t;
+				pt1[np1++] = tr;
+			}
+		}
+		t2[i] = render_once(wd, &set2, fb);
+		if (pov) {
+			double tr, t = run_povray(w, h, 2, &tr);
+			if (t > 0) {
+				p2[np2] = t;
+				pt2[np2++] = tr;
+			}
+		}
+	}
+	double m1 = median(t1, runs), m2 = median(t2, runs);
+	row *r = add_row("grid.rt", "whitted", w, h, 1, 1, runs, m1, (double)rays / m1 * 1e-6);
+	snprintf(r->note, sizeof r->note, "%.2f rays/pixel", (double)rays / ((double)w * h));
+	r = add_row("grid.rt", "whitted", w, h, 1, 2, runs, m2, (double)rays / m2 * 1e-6);
+	snprintf(r->note, sizeof r->note, "%.2fx one thread", m1 / m2);
+	if (pov && np1 && np2) {
+		double w1 = median(p1, np1), w2 = median(p2, np2);
+		double tr1 = median(pt1, np1), tr2 = median(pt2, np2);
+		r = add_row("grid.pov", "povray-process", w, h, 1, 1, np1, w1, -1);
+		snprintf(r->note, sizeof r->note, "rtsh %.2fx faster (render vs process)", w1 / m1);
+		r = add_row("grid.pov", "povray-process", w, h, 1, 2, np2, w2, -1);
+		snprintf(r->note, sizeof r->note, "rtsh %.2fx faster (render vs process)", w2 / m2);
+		r = add_row("grid.pov", "povray-trace", w, h, 1, 1, np1, tr1, -1);
+		snprintf(r->note, sizeof r->note, "rtsh %.2fx faster (render vs POV trace time)", tr1 / m1);
+		r = add_row("grid.pov", "povray-trace", w, h, 1, 2, np2, tr2, -1);
+		snprintf(r->note, sizeof r->note, "rtsh %.2fx faster (render vs POV trace time)", tr2 / m2);
+	} else if (!quick) {
+		r = add_row("grid.pov", "povray", w, h, 1, 1, 0, -1, -1);
+		snprintf(r->note, sizeof r->note, "povray not installed: no comparison");
+	}
+	fb_free(fb);
+	world_free(wd);
+	scene_free(s);
+}
+
+/* The camera rays of a w x h image through pixel centres: nearest hits. */
+static double primary_pass(const world *wd, int w, int h, bool brute, long *hits)
+{
+	double t0 = now();
+	long n = 0;
+	hit hh;
+	for (int y = 0; y < h; y++)
+		for (int x = 0; x < w; x++) {
+			ray r = cam_ray(&wd->cam, x + 0.5, y + 0.5, w, h);
+			n += brute ? world_intersect_brute(wd, &r, 0.0, INFINITY, &hh)
+			           : world_intersect(wd, &r, 0.0, INFINITY, &hh);
+		}
+	*hits = n;
+	return now() - t0;
+}
+
+static void bench_primary(void)
+{
+	const char *path = "scenes/grid.rt";
+	int w = quick ? 320 : 1920, h = quick ? 180 : 1080;
+	scene *s = load(path);
+	world *wd = build(s);
+	double t[MAX_RUNS], tb[MAX_RUNS], te[MAX_RUNS], em[MAX_RUNS];
+	int ne = 0;
+	long hits;
+	primary_pass(wd, w, h, false, &hits); /* warm up */
+	for (int i = 0; i < runs; i++) {
+		t[i] = primary_pass(wd, w, h, false, &hits);
+		tb[i] = primary_pass(wd, w, h, true, &hits);
+		double sec = 0, m = quick ? -1 : run_embree(path, w, h, &sec);
+		if (m > 0) {
+			em[ne] = m;
+			te[ne++] = sec;
+		}
+	}
+	double rays = (double)w * h * 1e-6;
+	double m = median(t, runs), mb = median(tb, runs);
+	row *r = add_row("grid.rt", "primary", w, h, 1, 1, runs, m, rays / m);
+	snprintf(r->note, sizeof r->note, "camera rays only, %.0f%% hit", 100.0 * (double)hits / ((double)w * h));
+	r = add_row("grid.rt", "primary-brute", w, h, 1, 1, runs, mb, rays / mb);
+	snprintf(r->note, sizeof r->note, "every primitive tested");
+	if (ne) {
+		double me = median(em, ne), se = median(te, ne);
+		r = add_row("grid.rt", "embree-primary", w, h, 1, 1, ne, se, me);
+		snprintf(r->note, sizeof r->note, "Embree 3 rtcIntersect1; rtsh %.2fx Embree", (rays / m) / me);
+	} else if (!quick) {
+		r = add_row("grid.rt", "embree-primary", w, h, 1, 1, 0, -1, -1);
+		snprintf(r->note, sizeof r->note, "no %s/embree_primary (needs embree3/rtcore.h)", bench_dir);
+	}
+	world_free(wd);
+	scene_free(s);
+}
+
+static void bench_spheres(void)
+{
+	static const size_t full[] = {10, 1000, 100000, 1000000};
+	static const size_t small[] = {10, 1000};
+	const size_t *sizes = quick ? small : full;
+	int nsizes = quick ? 2 : 4;
+	int w = quick ? 320 : 1920, h = quick ? 180 : 1080;
+	framebuffer *fb = fb_new(w, h);
+	if (!fb)
+		fail("framebuffer", NULL);
+	double base = -1;
+	for (int k = 0; k < nsizes; k++) {
+		size_t n = sizes[k];
+		gen_opts o = {.spheres_only = true};
+		rt_error err;
+		scene *s = scene_generate(n, 1, &o, &err);
+		if (!s)
+			fail("generate", &err);
+		char name[48];
+		snprintf(name, sizeof name, "spheres-%zu", n);
+		/* world_build: the BVH rebuild after an edit, on one core */
+		int bruns = n >= 1000000 ? (runs < 3 ? runs : 3) : runs;
+		double tb[MAX_RUNS];
+		world *wd = NULL;
+		for (int i = 0; i < bruns; i++) {
+			world_free(wd);
+			double t0 = now();
+			wd = build(s);
+			tb[i] = now() - t0;
+		}
+		row *r = add_row(name, "world_build", -1, -1, 0, 1, bruns, median(tb, bruns), -1);
+		snprintf(r->note, sizeof r->note, "%zu B/object: model %zu + world %zu; %zu BVH nodes", 
+		         (s->nobjs * sizeof(object) + world_memory(wd)) / s->nobjs, sizeof(object),
+		         world_memory(wd) / s->nobjs, wd->tree->nnodes);
+		render_settings set1 = settings(w, h, 1), set2 = settings(w, h, 2);
+		uint64_t rays = count_rays(wd, set1, fb);
+		double t1[MAX_RUNS], t2[MAX_RUNS];
+		for (int i = 0; i < runs; i++) {
+			t1[i] = render_once(wd, &set1, fb);
+			t2[i] = render_once(wd, &set2, fb);
+		}
+		double m1 = median(t1, runs), m2 = median(t2, runs);
+		if (n == 1000)
+			base = m1;
+		r = add_row(name, "whitted", w, h, 1, 1, runs, m1, (double)rays / m1 * 1e-6);
+		snprintf(r->note, sizeof r->note, "%zu lights, %.2f rays/pixel", s->nlights,
+		         (double)rays / ((double)w * h));
+		if (base > 0 && n > 1000)
+			snprintf(r->note + strlen(r->note), sizeof r->note - strlen(r->note), "; %.2fx the 1k time",
+			         m1 / base);
+		r = add_row(name, "whitted", w, h, 1, 2, runs, m2, (double)rays / m2 * 1e-6);
+		snprintf(r->note, sizeof r->note, "%.2fx one thread", m1 / m2);
+		world_free(wd);
+		scene_free(s);
+	}
+	fb_free(fb);
+}
+
+/* The 1M-sphere scene saved as .rt and loaded back. */
+static void bench_load(void)
+{
+	size_t n = quick ? 10000 : 1000000;
+	gen_opts o = {.spheres_only = true};
+	rt_error err;
+	scene *s = scene_generate(n, 1, &o, &err);
+	if (!s)
+		fail("generate", &err);
+	char path[] = "/tmp/rtsh-bench-XXXXXX";
+	int fd = mkstemp(path);
+	if (fd < 0)
+		fail("temporary file", NULL);
+	close(fd);
+	double t0 = now();
+	if (!rt_save(s, path, &err))
+		fail("save", &err);
+	double tsave = now() - t0;
+	struct stat st;
+	stat(path, &st);
+	int lruns = quick ? 1 : 3;
+	double tl[MAX_RUNS];
+	for (int i = 0; i < lruns; i++) {
+		t0 = now();
+		scene *back = rt_load_file(path, NULL, &err);
+		tl[i] = now() - t0;
+		if (!back)
+			fail("load", &err);
+		if (i == 0 && !scene_equal(s, back))
+			fprintf(stderr, "bench: the saved scene did not load back identical\n");
+		scene_free(back);
+	}
+	unlink(path);
+	char name[48];
+	snprintf(name, sizeof name, "spheres-%zu.rt", n);
+	row *r = add_row(name, "load", -1, -1, 0, 1, lruns, median(tl, lruns), -1);
+	snprintf(r->note, sizeof r->note, "%.1f MB file; rt_save took %.2f s", (double)st.st_size / 1e6, tsave);
+	scene_free(s);
+}
+
+/* The Whitted preview frame and the terminal frame that shows it. */
+static void bench_preview(void)
+{
+	const char *path = "scenes/showcase.rt";
+	int w = 160, h = 96;
+	scene *s = load(path);
+	framebuffer *fb = fb_new(w, h);
+	if (!fb)
+		fail("framebuffer", NULL);
+	int pruns = quick ? 3 : 31;
+	for (int threads = 1; threads <= 2; threads++) {
+		render_settings set = settings(w, h, threads);
+		double t[MAX_RUNS];
+		uint64_t rays = 0;
+		for (int i = 0; i < pruns; i++) {
+			double t0 = now();
+			world *wd = build(s); /* an edit rebuilds the world */
+			render_once(wd, &set, fb);
+			t[i] = now() - t0;
+			if (i == 0)
+				rays = count_rays(wd, set, fb);
+			world_free(wd);
+		}
+		double m = median(t, pruns);
+		row *r = add_row("showcase.rt", "preview", w, h, 1, threads, pruns, m, (double)rays / m * 1e-6);
+		snprintf(r->note, sizeof r->note, "world_build + render, depth %d; target < 15 ms (2 threads)",
+		         set.depth);
+	}
+
+	/* The frame: every cell first, then the update after the camera turns
+	 * by one degree (what an arrow key in `view` sends). */
+	static const struct {
+		frame_palette pal;
+		const char *name;
+	} pals[] = {{PALETTE_TRUECOLOR, "truecolor"}, {PALETTE_256, "256"}};
+	uint8_t *rgb = malloc((size_t)w * h * 3);
+	if (!rgb)
+		fail("memory", NULL);
+	render_settings set = settings(w, h, 2);
+	world *wd = build(s);
+	render_once(wd, &set, fb);
+	world_free(wd);
+	scene *turned = scene_clone(s);
+	if (!turned)
+		fail("memory", NULL);
+	camera *c = &turned->cams[turned->cam];
+	vec3 d = v3_norm(c->dir);
+	double a = deg_to_rad(1.0);
+	c->dir = v3(d.x * cos(a) + d.z * sin(a), d.y, -d.x * sin(a) + d.z * cos(a));
+	framebuffer *fb2 = fb_new(w, h);
+	if (!fb2)
+		fail("framebuffer", NULL);
+	wd = build(turned);
+	render_once(wd, &set, fb2);
+	world_free(wd);
+	for (size_t k = 0; k < sizeof pals / sizeof pals[0]; k++) {
+		double t[MAX_RUNS];
+		size_t full = 0, update = 0;
+		for (int i = 0; i < pruns; i++) {
+			frame *f = frame_new(w, h / 2, pals[k].pal);
+			if (!f)
+				fail("frame", NULL);
+			double t0 = now();
+			frame_srgb_from_linear(fb->rgb, (size_t)w * h, 0.0, rgb);
+			frame_put_image(f, rgb, w, h, 0, 0);
+			full = frame_update(f)->len;
+			t[i] = now() - t0;
+			frame_srgb_from_linear(fb2->rgb, (size_t)w * h, 0.0, rgb);
+			frame_put_image(f, rgb, w, h, 0, 0);
+			update = frame_update(f)->len;
+			frame_free(f);
+		}
+		char mode[24];
+		snprintf(mode, sizeof mode, "frame-%s", pals[k].name);
+		row *r = add_row("showcase.rt", mode, w, h, 1, 1, pruns, median(t, pruns), -1);
+		snprintf(r->note, sizeof r->note, "%zu bytes full frame, %zu after a 1-degree turn (%dx%d cells)",
+		         full, update, w, h / 2);
+	}
+	fb_free(fb2);
+	scene_free(turned);
+	free(rgb);
+	fb_free(fb);
+	scene_free(s);
+}
+
+static void print_table(FILE *f, bool tsv)
+{
+	if (tsv)
+		fprintf(f, "scene\tmode\tresolution\tsamples\tthreads\truns\tmedian_s\tmrays_s\tnote\n");
+	else
+		fprintf(f, "%-20s %-15s %-10s %3s %3s %4s %11s %8s  %s\n", "scene", "mode", "resolution", "spp",
+		        "thr", "runs", "median", "Mrays/s", "note");
+	for (int i = 0; i < nrows; i++) {
+		const row *r = &rows[i];
+		char sec[32], mr[32];
+		if (r->seconds < 0)
+			snprintf(sec, sizeof sec, "-");
+		else if (tsv)
+			snprintf(sec, sizeof sec, "%.6f", r->seconds);
+		else if (r->seconds < 1)
+			snprintf(sec, sizeof sec, "%.2f ms", r->seconds * 1e3);
+		else
+			snprintf(sec, sizeof sec, "%.3f s", r->seconds);
+		if (r->mrays < 0)
+			snprintf(mr, sizeof mr, "-");
+		else
+			snprintf(mr, sizeof mr, "%.2f", r->mrays);
+		if (tsv)
+			fprintf(f, "%s\t%s\t%s\t%d\t%d\t%d\t%s\t%s\t%s\n", r->scene, r->mode, r->res, r->samples,
+			        r->threads, r->runs, sec, mr, r->note);
+		else
+			fprintf(f, "%-20s %-15s %-10s %3d %3d %4d %11s %8s  %s\n", r->scene, r->mode, r->res, r->samples,
+			        r->threads, r->runs, sec, mr, r->note);
+	}
+}
+
+static void usage(void)
+{
+	fputs("usage: bench [--quick] [--runs N] [--out FILE.tsv] [--only grid|primary|spheres|load|preview]\n",
+	      stderr);
+	exit(2);
+}
+
+int main(int argc, char **argv)
+{
+	const char *out = NULL, *only = NULL;
+	for (int i = 1; i < argc; i++) {
+		if (strcmp(argv[i], "--quick") == 0)
+			quick = true;
+		else if (strcmp(argv[i], "--runs") == 0 && i + 1 < argc)
+			runs = atoi(argv[++i]);
+		else if (strcmp(argv[i], "--out") == 0 && i + 1 < argc)
+			out = argv[++i];
+		else if (strcmp(argv[i], "--only") == 0 && i + 1 < argc)
+			only = argv[++i];
+		else
+			usage();
+	}
+	if (quick && runs == 5)
+		runs = 1;
+	if (runs < 1 || runs > MAX_RUNS)
+		usage();
+	/* The Embree harness is built beside this program. */
+	static char dir[1024];
+	snprintf(dir, sizeof dir, "%s", argv[0]);
+	char *slash = strrchr(dir, '/');
+	if (slash) {
+		*slash = '\0';
+		bench_dir = dir;
+	}
+	double load1, load5, load15;
+	FILE *la = fopen("/proc/loadavg", "r");
+	if (la && fscanf(la, "%lf %lf %lf", &load1, &load5, &load15) == 3)
+		fprintf(stderr, "bench: %s, %d runs per row; load average %.2f %.2f %.2f\n",
+		        quick ? "quick" : "full", runs, load1, load5, load15);
+	if (la)
+		fclose(la);
+	double t0 = now();
+	if (!only || strcmp(only, "grid") == 0)
+		bench_grid();
+	if (!only || strcmp(only, "primary") == 0)
+		bench_primary();
+	if (!only || strcmp(only, "spheres") == 0)
+		bench_spheres();
+	if (!only || strcmp(only, "load") == 0)
+		bench_load();
+	if (!only || strcmp(only, "preview") == 0)
+		bench_preview();
+	la = fopen("/proc/loadavg", "r");
+	if (la && fscanf(la, "%lf %lf %lf", &load1, &load5, &load15) == 3)
+		fprintf(stderr, "bench: done in %.0f s; load average %.2f %.2f %.2f\n", now() - t0, load1, load5,
+		        load15);
+	if (la)
+		fclose(la);
+	print_table(stdout, false);
+	if (out) {
+		FILE *f = fopen(out, "w");
+		if (!f)
+			fail(out, NULL);
+		print_table(f, true);
+		if (fclose(f) != 0)
+			fail(out, NULL);
+	}
+	return 0;
+}

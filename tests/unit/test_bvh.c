@@ -1,0 +1,368 @@
+/* rtsh — the BVH against brute force: on random rays over random seeded
+ * scenes of every shape kind (transformed, sheared, planes beside the tree),
+ * world_intersect must find the same object at the same t as
+ * world_intersect_brute, and world_occluded must agree with
+ * world_occluded_brute. Also: an edit followed by world_build sees the new
+ * geometry, and the degenerate trees (no object, one object, every centroid
+ * in one point, huge coordinates, rays in the planes of the boxes). */
+#include "testutil.h"
+
+#include "core/bvh.h"
+#include "rtsh/generate.h"
+#include "rtsh/world.h"
+
+static double urand(test_rng *g, double lo, double hi)
+{
+	return lo + (hi - lo) * trand(g);
+}
+
+static vec3 vrand(test_rng *g, double lo, double hi)
+{
+	return v3(urand(g, lo, hi), urand(g, lo, hi), urand(g, lo, hi));
+}
+
+/* A unit vector, uniform on the sphere; now and then along an axis, where
+ * the inverse direction has infinities. */
+static vec3 dir_rand(test_rng *g)
+{
+	if (trand(g) < 0.1) {
+		vec3 d = v3(0, 0, 0);
+		int a = (int)(trand(g) * 3) % 3;
+		double s = trand(g) < 0.5 ? -1 : 1;
+		return a == 0 ? v3(s, 0, 0) : a == 1 ? v3(0, s, 0) : (d.z = s, d);
+	}
+	for (;;) {
+		vec3 d = vrand(g, -1, 1);
+		double l = v3_len(d);
+		if (l > 0.1 && l <= 1)
+			return v3_scale(d, 1 / l);
+	}
+}
+
+/* A random object of kind k near c, of about size s. */
+static object random_object(test_rng *g, obj_kind k, vec3 c, double s)
+{
+	object o = object_make(k, v3(urand(g, 0, 255), urand(g, 0, 255), urand(g, 0, 255)));
+	if (k == OBJ_TRIANGLE) {
+		for (;;) {
+			for (int i = 0; i < 3; i++)
+				o.tri[i] = v3_add(c, vrand(g, -s, s));
+			if (object_validate(&o, NULL))
+				return o;
+		}
+	}
+	o.pos = c;
+	o.dir = dir_rand(g);
+	o.twist = trand(g) < 0.5 ? urand(g, 0, 360) : 0;
+	double u = urand(g, 0.2, 1) * s;
+	o.scale = trand(g) < 0.5 ? v3(u, u, u) : v3_scale(vrand(g, 0.2, 1), s);
+	if (k != OBJ_PLANE && trand(g) < 0.3) {
+		for (int i = 0; i < 6; i++)
+			o.shear[i] = urand(g, -0.3, 0.3);
+		if (!object_validate(&o, NULL))
+			memset(o.shear, 0, sizeof o.shear);
+	}
+	return o;
+}
+
+static scene *random_scene(uint64_t seed, size_t n, double region, double size, int planes)
+{
+	test_rng g = {seed};
+	scene *s = scene_new();
+	camera cam = {v3(0, 0, -3 * region), v3(0, 0, 1), 60};
+	assert_true(scene_add_camera(s, &cam, NULL));
+	for (size_t i = 0; i < n; i++) {
+		obj_kind k = (obj_kind)(i % OBJ_KIND_COUNT);
+		if (k == OBJ_PLANE)
+			k = OBJ_SPHERE; /* half the spheres fast, half turned or sheared */
+		object o = random_object(&g, k, vrand(&g, -region, region), size);
+		assert_true(object_validate(&o, NULL));
+		assert_true(scene_add_object(s, &o, NULL));
+	}
+	for (int i = 0; i < planes; i++) {
+		object p = random_object(&g, OBJ_PLANE, vrand(&g, -region * 1.5, region * 1.5), 1);
+		assert_true(scene_add_object(s, &p, NULL));
+	}
+	return s;
+}
+
+static world *build(const scene *s)
+{
+	rt_error err;
+	world *w = world_build(s, &err);
+	if (!w)
+		fail_msg("world_build: %s", err.msg);
+	return w;
+}
+
+/* A ray from somewhere in or around the region; half aimed at an object. */
+static ray random_ray(test_rng *g, const scene *s, double region)
+{
+	ray r;
+	r.o = vrand(g, -2 * region, 2 * region);
+	if (s->nobjs && trand(g) < 0.5) {
+		const object *o = &s->objs[(size_t)(trand(g) * (double)s->nobjs) % s->nobjs];
+		vec3 to = v3_sub(v3_add(object_center(o), vrand(g, -0.3, 0.3)), r.o);
+		r.d = v3_len(to) > 1e-9 ? v3_norm(to) : dir_rand(g);
+	} else {
+		r.d = dir_rand(g);
+	}
+	return r;
+}
+
+static int compared, hits;
+
+/* One ray, both queries, tree against brute force. */
+static void check_ray(const world *w, const ray *r, double tmin, double tmax)
+{
+	hit a, b;
+	bool ha = world_intersect(w, r, tmin, tmax, &a);
+	bool hb = world_intersect_brute(w, r, tmin, tmax, &b);
+	compared++;
+	if (ha != hb)
+		fail_msg("ray o=(%.17g,%.17g,%.17g) d=(%.17g,%.17g,%.17g) [%g,%g]: tree %s, brute %s (object %u t=%.17g)",
+		         r->o.x, r->o.y, r->o.z, r->d.x, r->d.y, r->d.z, tmin, tmax, ha ? "hit" : "missed",
+		         hb ? "hit" : "missed", ha ? a.object + 1 : b.object + 1, ha ? a.t : b.t);
+	if (ha) {
+		hits++;
+		if (a.object != b.object || !(fabs(a.t - b.t) <= 1e-9 * fabs(b.t)))
+			fail_msg("ray o=(%.17g,%.17g,%.17g) d=(%.17g,%.17g,%.17g): tree object %u t=%.17g, brute object %u t=%.17g",
+			         r->o.x, r->o.y, r->o.z, r->d.x, r->d.y, r->d.z, a.object + 1, a.t, b.object + 1, b.t);
+		assert_true(v3_eq(a.n, b.n));
+	}
+	bool oa = world_occluded(w, r, tmin, tmax), ob = world_occluded_brute(w, r, tmin, tmax);
+	if (oa != ob)
+		fail_msg("ray o=(%.17g,%.17g,%.17g) d=(%.17g,%.17g,%.17g) [%g,%g]: occluded tree %d, brute %d", r->o.x,
+		         r->o.y, r->o.z, r->d.x, r->d.y, r->d.z, tmin, tmax, oa, ob);
+	/* any-hit agrees with the nearest hit */
+	assert_int_equal(oa, hb);
+}
+
+static void check_scene(const scene *s, double region, uint64_t seed, int nrays)
+{
+	world *w = build(s);
+	test_rng g = {seed};
+	for (int i = 0; i < nrays; i++) {
+		ray r = random_ray(&g, s, region);
+		double u = trand(&g);
+		/* unbounded, a segment (shadow ray), and a ray starting inside */
+		double tmax = u < 0.5 ? INFINITY : urand(&g, 0, 3 * region);
+		double tmin = u > 0.9 ? urand(&g, 0, region) : 0;
+		check_ray(w, &r, tmin, tmax);
+	}
+	world_free(w);
+}
+
+static void test_random_scenes(void **state)
+{
+	(void)state;
+	compared = hits = 0;
+	static const size_t sizes[] = {2, 7, 40, 300, 2000};
+	for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++)
+		for (uint64_t seed = 1; seed <= 4; seed++) {
+			double region = 10;
+			/* dense (overlapping) and sparse scenes, with and without planes */
+			double size = seed % 2 ? 4.0 : 0.5;
+			scene *s = random_scene(seed * 1000 + k, sizes[k], region, size, (int)(seed % 3));
+			check_scene(s, region, seed, 2000);
+			scene_free(s);
+		}
+	assert_true(hits > compared / 5);
+}
+
+static void test_generated_scenes(void **state)
+{
+	(void)state;
+	for (int spheres = 0; spheres < 2; spheres++) {
+		gen_opts o = {.spheres_only = spheres};
+		scene *s = scene_generate(4000, 9, &o, NULL);
+		assert_non_null(s);
+		check_scene(s, 6, 77, 3000);
+		scene_free(s);
+	}
+}
+
+/* Rays along the axes through a grid of unit cubes, starting on the planes
+ * of the boxes: (box - origin) x inf = 0 x inf = NaN in the slab tests. */
+static void test_rays_in_box_planes(void **state)
+{
+	(void)state;
+	scene *s = scene_new();
+	camera cam = {v3(0, 0, -10), v3(0, 0, 1), 60};
+	assert_true(scene_add_camera(s, &cam, NULL));
+	for (int x = 0; x < 6; x++)
+		for (int y = 0; y < 6; y++) {
+			object o = object_make(x % 2 ? OBJ_CUBE : OBJ_SPHERE, v3(200, 200, 200));
+			o.pos = v3(2 * x, 2 * y, 0);
+			o.scale = v3(1, 1, 1);
+			assert_true(scene_add_object(s, &o, NULL));
+		}
+	world *w = build(s);
+	for (int i = -2; i <= 24; i++)
+		for (int j = -2; j <= 24; j++) {
+			double a = i * 0.5, b = j * 0.5;
+			ray rays[] = {
+				{v3(a, b, -5), v3(0, 0, 1)},  {v3(a, -5, b - 6), v3(0, 1, 0)},
+				{v3(-5, a, b - 6), v3(1, 0, 0)}, {v3(a, b, 5), v3(0, 0, -1)},
+				{v3(a, 20, b - 6), v3(0, -1, 0)}, {v3(20, a, b - 6), v3(-1, 0, 0)},
+			};
+			for (size_t k = 0; k < sizeof rays / sizeof rays[0]; k++)
+				check_ray(w, &rays[k], 0, INFINITY);
+		}
+	world_free(w);
+	scene_free(s);
+}
+
+/* An edit followed by world_build: the moved sphere is hit where it went and
+ * no longer where it was. */
+static void test_edit_then_build(void **state)
+{
+	(void)state;
+	scene *s = random_scene(5, 500, 10, 0.5, 1);
+	object probe = object_make(OBJ_SPHERE, v3(255, 0, 0));
+	probe.pos = v3(100, 100, 100);
+	assert_true(scene_add_object(s, &probe, NULL));
+	size_t idx = s->nobjs - 1;
+	ray r = {v3(100, 100, 90), v3(0, 0, 1)};
+	world *w = build(s);
+	hit h;
+	assert_true(world_intersect(w, &r, 0, INFINITY, &h));
+	assert_int_equal(h.object, idx);
+	assert_near(h.t, 9.5, 1e-12);
+	world_free(w);
+
+	object_move(&s->objs[idx], v3(0, 50, 0));
+	w = build(s);
+	ray r2 = {v3(100, 150, 90), v3(0, 0, 1)};
+	assert_true(world_intersect(w, &r2, 0, INFINITY, &h));
+	assert_int_equal(h.object, idx);
+	assert_false(world_intersect(w, &r, 0, INFINITY, &h) && h.object == idx);
+	assert_true(world_occluded(w, &r2, 0, 20));
+	world_free(w);
+
+	/* a new object after the others is found too */
+	object late = object_make(OBJ_CUBE, v3(0, 255, 0));
+	late.pos = v3(-100, 0, 0);
+	assert_true(scene_add_object(s, &late, NULL));
+	w = build(s);
+	ray r3 = {v3(-100, 0, -20), v3(0, 0, 1)};
+	assert_true(world_intersect(w, &r3, 0, INFINITY, &h));
+	assert_int_equal(h.object, s->nobjs - 1);
+	assert_near(h.t, 19.5, 1e-12);
+	world_free(w);
+	scene_free(s);
+}
+
+static void test_no_objects(void **state)
+{
+	(void)state;
+	scene *s = scene_new();
+	world *w = build(s);
+	ray r = {v3(0, 0, 0), v3(0, 0, 1)};
+	hit h;
+	assert_false(world_intersect(w, &r, 0, INFINITY, &h));
+	assert_false(world_occluded(w, &r, 0, INFINITY));
+	world_free(w);
+	/* a plane alone: beside the tree, which is empty */
+	object p = object_make(OBJ_PLANE, v3(1, 1, 1));
+	p.pos = v3(0, -1, 0);
+	assert_true(scene_add_object(s, &p, NULL));
+	w = build(s);
+	ray down = {v3(0, 0, 0), v3(0, -1, 0)};
+	assert_true(world_intersect(w, &down, 0, INFINITY, &h));
+	assert_near(h.t, 1, 1e-12);
+	assert_vec_near(h.n, v3(0, 1, 0), 1e-12);
+	assert_true(world_occluded(w, &down, 0, 2));
+	assert_false(world_occluded(w, &down, 0, 0.5));
+	world_free(w);
+	scene_free(s);
+}
+
+static void test_one_object(void **state)
+{
+	(void)state;
+	for (int k = 0; k < OBJ_KIND_COUNT; k++) {
+		if (k == OBJ_PLANE)
+			continue;
+		scene *s = random_scene(42 + (uint64_t)k, 0, 1, 1, 0);
+		test_rng g = {(uint64_t)k};
+		object o = random_object(&g, (obj_kind)k, v3(0.1, -0.2, 0.3), 1);
+		assert_true(scene_add_object(s, &o, NULL));
+		check_scene(s, 2, (uint64_t)k, 3000);
+		world *w = build(s);
+		assert_int_equal(w->nprims, 1);
+		world_free(w);
+		scene_free(s);
+	}
+}
+
+/* Every centroid in one point: concentric spheres and cubes; the builder
+ * can only halve by count. */
+static void test_same_centroid(void **state)
+{
+	(void)state;
+	scene *s = random_scene(3, 0, 1, 1, 0);
+	for (int i = 0; i < 200; i++) {
+		object o = object_make(i % 3 ? OBJ_SPHERE : OBJ_CUBE, v3(9, 9, 9));
+		o.pos = v3(1, 2, 3);
+		double d = 0.05 * (i + 1);
+		o.scale = v3(d, d, d);
+		assert_true(scene_add_object(s, &o, NULL));
+	}
+	check_scene(s, 5, 11, 3000);
+	world *w = build(s);
+	/* a ray from outside meets the largest shape first */
+	ray r = {v3(1, 2, -100), v3(0, 0, 1)};
+	hit h;
+	assert_true(world_intersect(w, &r, 0, INFINITY, &h));
+	assert_true(h.object == 198 || h.object == 199);
+	assert_true(w->tree->depth < BVH_MAX_DEPTH);
+	world_free(w);
+	scene_free(s);
+}
+
+/* Coordinates far from the origin (float boxes are coarse there, but must
+ * still contain their objects). */
+static void test_huge_coordinates(void **state)
+{
+	(void)state;
+	static const double offsets[] = {1e6, 2147483648.0, 1e12};
+	for (size_t k = 0; k < sizeof offsets / sizeof offsets[0]; k++) {
+		double off = offsets[k];
+		scene *s = random_scene(7, 0, 1, 1, 0);
+		test_rng g = {k + 1};
+		for (int i = 0; i < 300; i++) {
+			obj_kind kind = (obj_kind)(i % OBJ_KIND_COUNT);
+			if (kind == OBJ_PLANE)
+				kind = OBJ_CUBE;
+			object o = random_object(&g, kind, v3_add(v3(off, -off, off), vrand(&g, -50, 50)), 3);
+			assert_true(scene_add_object(s, &o, NULL));
+		}
+		world *w = build(s);
+		for (int i = 0; i < 3000; i++) {
+			ray r;
+			const object *o = &s->objs[(size_t)i % s->nobjs];
+			r.o = v3_add(v3(off, -off, off), vrand(&g, -200, 200));
+			vec3 to = v3_sub(v3_add(object_center(o), vrand(&g, -1, 1)), r.o);
+			r.d = v3_norm(to);
+			check_ray(w, &r, 0, INFINITY);
+		}
+		world_free(w);
+		scene_free(s);
+	}
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_random_scenes),
+		cmocka_unit_test(test_generated_scenes),
+		cmocka_unit_test(test_rays_in_box_planes),
+		cmocka_unit_test(test_edit_then_build),
+		cmocka_unit_test(test_no_objects),
+		cmocka_unit_test(test_one_object),
+		cmocka_unit_test(test_same_centroid),
+		cmocka_unit_test(test_huge_coordinates),
+	};
+	return cmocka_run_group_tests_name("bvh", tests, NULL, NULL);
+}
