@@ -13,7 +13,9 @@
  *     1 and 2 threads; their world_build time and memory per object; the
  *     load time of the 1M scene saved as .rt;
  *   the Whitted preview frame (160x96 pixels, showcase.rt) and the bytes of
- *     the terminal frame that shows it.
+ *     the terminal frame that shows it;
+ *   key mode (`view`): the time from a key to the first updated frame on
+ *     showcase.rt at 160x48 cells (bench_keymode).
  * A render row's Mrays/s counts every ray the integrator traced (camera,
  * shadow and reflection rays, counted in one extra 1-thread pass); the
  * primary-ray rows count camera rays only. Times are medians: the machine is
@@ -21,6 +23,8 @@
  * a smoke test for CI. Nothing here asserts a time.
  */
 #include <errno.h>
+#include <fcntl.h>
+#include <poll.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -34,7 +38,10 @@
 #include "rtsh/render.h"
 #include "rtsh/rtfile.h"
 #include "rtsh/world.h"
+#include "shell/keymode.h"
+#include "shell/options.h"
 #include "term/frame.h"
+#include "term/keys.h"
 
 #define MAX_RUNS 101
 #define MAX_ROWS 64
@@ -511,6 +518,80 @@ static void bench_preview(void)
 	scene_free(s);
 }
 
+/* --- key mode (issue 6, src/shell/keymode.c) ---------------------------
+ * The time from a key to the first updated frame: a key-mode session on
+ * showcase.rt of 160x48 cells drawing into /dev/null. Each run waits until
+ * the picture is refined, sends an arrow key through keymode_key (the
+ * camera strafes) and ticks the session as its loop does until a frame is
+ * written: the edit, the world build, the render at the adaptive pixel
+ * ratio, the frame encoding and the write. The note gives the frames a
+ * second drawn while a key repeats at 30 Hz. */
+static long keymode_pump(keymode *km, int wake, double seconds, bool until_frame)
+{
+	long frames = 0;
+	double end = now() + seconds;
+	while (now() < end) {
+		frames += keymode_tick(km);
+		if (until_frame && frames)
+			break;
+		struct pollfd p = {wake, POLLIN, 0};
+		double left = end - now();
+		poll(&p, 1, left > 0 ? (int)(left * 1000) + 1 : 0);
+		char buf[64];
+		while (read(wake, buf, sizeof buf) > 0)
+			;
+	}
+	return frames;
+}
+
+static void bench_keymode(void)
+{
+	rtsh_options o;
+	memset(&o, 0, sizeof o);
+	o.scene = "scenes/showcase.rt";
+	o.quiet = true;
+	int p[2], out = open("/dev/null", O_WRONLY);
+	if (pipe(p) != 0 || out < 0)
+		fail("pipe", NULL);
+	for (int i = 0; i < 2; i++)
+		fcntl(p[i], F_SETFL, O_NONBLOCK);
+	static shell sh;
+	if (!shell_init(&sh, &o, p[1]))
+		fail("shell_init", NULL);
+	sh.wake[0] = p[0];
+	sh.wake[1] = p[1];
+	keymode *km = keymode_new(&sh, out, PALETTE_TRUECOLOR, 160, 48);
+	if (!km)
+		fail("keymode_new", NULL);
+	int kruns = quick ? 5 : 41;
+	double t[MAX_RUNS];
+	keymode_pump(km, p[0], 0.5, false);
+	for (int i = 0; i < kruns; i++) {
+		keymode_pump(km, p[0], 0.25, false);
+		double t0 = now();
+		keymode_key(km, i % 2 ? KEYS_LEFT : KEYS_RIGHT);
+		if (!keymode_pump(km, p[0], 5.0, true))
+			fail("key mode drew no frame", NULL);
+		t[i] = now() - t0;
+	}
+	double m = median(t, kruns);
+	/* A key held down: 30 repeats a second for 2 s. */
+	long frames = 0;
+	for (int i = 0; i < 60; i++) {
+		keymode_key(km, i % 2 ? KEYS_LEFT : KEYS_RIGHT);
+		frames += keymode_pump(km, p[0], 1.0 / 30, false);
+	}
+	row *r = add_row("showcase.rt", "key-to-frame", 160, 90, 1, render_threads(&sh.set), kruns, m, -1);
+	snprintf(r->note, sizeof r->note,
+	         "view at 160x48 cells: key to first frame; %.0f frames/s at 30 Hz repeat; target < 50 ms",
+	         frames / 2.0);
+	keymode_free(km);
+	shell_free(&sh);
+	close(out);
+	close(p[0]);
+	close(p[1]);
+}
+
 static void print_table(FILE *f, bool tsv)
 {
 	if (tsv)
@@ -544,7 +625,7 @@ static void print_table(FILE *f, bool tsv)
 
 static void usage(void)
 {
-	fputs("usage: bench [--quick] [--runs N] [--out FILE.tsv] [--only grid|primary|spheres|load|preview]\n",
+	fputs("usage: bench [--quick] [--runs N] [--out FILE.tsv] [--only grid|primary|spheres|load|preview|keymode]\n",
 	      stderr);
 	exit(2);
 }
@@ -594,6 +675,8 @@ int main(int argc, char **argv)
 		bench_load();
 	if (!only || strcmp(only, "preview") == 0)
 		bench_preview();
+	if (!only || strcmp(only, "keymode") == 0)
+		bench_keymode();
 	la = fopen("/proc/loadavg", "r");
 	if (la && fscanf(la, "%lf %lf %lf", &load1, &load5, &load15) == 3)
 		fprintf(stderr, "bench: done in %.0f s; load average %.2f %.2f %.2f\n", now() - t0, load1, load5,
