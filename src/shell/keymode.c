@@ -51,11 +51,11 @@
 
 /* The help bar and `help view`. */
 const char keymode_help[] =
-	"keys in view (key mode):\n"
-	"  Up Down Left Right, W S A D  move forward, back, left, right (the camera flies where it\n"
+	"keys in view (key mode; letters in either case but u and U):\n"
+	"  Up Down Left Right, w s a d  move forward, back, left, right (the camera flies where it\n"
 	"                               looks; a selected object or light moves level with the floor)\n"
-	"  R F                          move up, down\n"
-	"  I K J L, Shift+arrows        turn the camera (pitch, yaw) by 3 degrees\n"
+	"  r f                          move up, down\n"
+	"  i k j l, Shift+arrows        turn the camera (pitch, yaw) by 3 degrees\n"
 	"  Tab, Shift+Tab               select the next / previous object or light, then the camera\n"
 	"  [ ]                          turn the selected object about the vertical by 15 degrees\n"
 	"  { }                          roll it about the line of sight by 15 degrees\n"
@@ -70,11 +70,16 @@ const char keymode_help[] =
 	"  ? F1                         hide / show the help bar;  Ctrl-L F5  repaint\n"
 	"  Esc q                        back to the shell; every change stays (undo, save x.rt)\n"
 	"a movement key moves by 1/40 of the size of the scene (the box around the objects\n"
-	"but planes, the lights and the camera)\n";
+	"but planes, the lights and the camera); see KEY MODE in rtsh(1)\n";
 
-static const char help_bar[] =
-	" Esc back │ ←↑↓→ WASD move │ R/F up/down │ IJKL ⇧←↑↓→ turn │ Tab select │ [ ] { } rotate │ -/+ size"
-	" │ ,/. samples │ </> depth │ PgUp/PgDn scene │ m mode │ Space stop │ u/U undo/redo │ ? help";
+/* The help bar: keys (in bold) and what they do, as many as fit. */
+static const struct {
+	const char *keys, *what;
+} help_bar[] = {
+	{"Esc", "back"}, {"←↑↓→ wasd", "move"}, {"r f", "up/down"}, {"ijkl ⇧←↑↓→", "turn"}, {"Tab", "select"},
+	{"[ ] { }", "rotate"}, {"- +", "size"}, {"u", "undo"}, {"m", "mode"}, {", .", "spp"}, {"< >", "depth"},
+	{"PgUp PgDn", "scene"}, {"Space", "stop"}, {"?", "hide this"},
+};
 
 static double now(void)
 {
@@ -691,6 +696,7 @@ struct keymode {
 	km_sel mask_sel;
 	int mask_w, mask_h;
 	bool sel_visible;
+	bool light_behind;     /* the selected light is behind the camera */
 
 	char msg[256];
 	double msg_until;
@@ -925,15 +931,28 @@ static void km_mark(keymode *km, uint8_t *img)
 		const cam_view *c = &km->w->cam;
 		vec3 p = v3_sub(s->lights[km->sel.index].pos, c->pos);
 		double z = v3_dot(p, c->fwd);
-		if (!(z > 0))
-			return;
+		km->light_behind = !(z > 0);
+		if (km->light_behind)
+			return; /* the status line says so */
 		double u = v3_dot(p, c->right) / (z * c->tan_half);
 		double v = v3_dot(p, c->up) / (z * c->tan_half * ((double)h / w));
-		int px = (int)floor((u + 1) * 0.5 * w), py = (int)floor((1 - v) * 0.5 * h);
-		if (px < -2 || py < -2 || px > w + 1 || py > h + 1)
-			return;
-		km->sel_visible = true;
+		double fx = (u + 1) * 0.5 * w, fy = (1 - v) * 0.5 * h;
 		static const uint8_t white[3] = {255, 255, 255}, dark[3] = {40, 30, 0};
+		if (!(fx >= 0 && fy >= 0 && fx < w && fy < h)) {
+			/* Off the picture but ahead: a gold bar on the edge it lies
+			 * beyond, at the nearest point. */
+			int px = (int)clampd(floor(fx), 0, w - 1), py = (int)clampd(floor(fy), 0, h - 1);
+			bool horizontal = fy < 0 || fy >= h;
+			for (int d = -3; d <= 3; d++)
+				for (int k = 0; k < 2; k++) {
+					int x = horizontal ? px + d : px == 0 ? k : w - 1 - k;
+					int y = horizontal ? (py == 0 ? k : h - 1 - k) : py + d;
+					put_px(img, w, h, x, y, k ? dark : mark_rgb);
+				}
+			return;
+		}
+		int px = (int)fx, py = (int)fy;
+		km->sel_visible = true;
 		/* A plus of gold arms around a white centre, on a dark ring. */
 		for (int d = -3; d <= 3; d++) {
 			put_px(img, w, h, px + d, py - 1, dark);
@@ -962,7 +981,8 @@ static const char *km_sel_name(const keymode *km, char *buf, size_t size)
 		break;
 	case KM_SEL_LIGHT:
 		if (km->sel.index < s->nlights) {
-			snprintf(buf, size, "light %zu%s", km->sel.index + 1, km->sel_visible ? "" : " (out of view)");
+			snprintf(buf, size, "light %zu%s", km->sel.index + 1,
+			         km->sel_visible ? "" : km->light_behind ? " (behind the camera)" : " (out of view: the gold bar)");
 			return buf;
 		}
 		break;
@@ -1042,6 +1062,29 @@ static void put_line(abuf *a, int row, int cols, const char *text, bool reverse)
 		abuf_str(a, "\x1b[K");
 }
 
+/* Code points in s (the bars hold single-width characters only). */
+static int text_width(const char *s)
+{
+	int n = 0;
+	for (; *s; s++)
+		n += ((unsigned char)*s & 0xc0) != 0x80;
+	return n;
+}
+
+static void put_help(abuf *a, int row, int cols)
+{
+	abuf_printf(a, "\x1b[%dH", row + 1);
+	int used = 0;
+	for (size_t i = 0; i < sizeof help_bar / sizeof help_bar[0]; i++) {
+		int w = 2 + text_width(help_bar[i].keys) + 1 + text_width(help_bar[i].what);
+		if (used + w > cols - 1) /* never the last cell of the last row */
+			break;
+		abuf_printf(a, "  \x1b[1m%s\x1b[22m %s", help_bar[i].keys, help_bar[i].what);
+		used += w;
+	}
+	abuf_str(a, "\x1b[K");
+}
+
 /* Draws the newest image (scaled up to the picture size), the marker and
  * the bars, as one write(). */
 static void km_draw(keymode *km)
@@ -1055,7 +1098,7 @@ static void km_draw(keymode *km)
 			frame_invalidate(km->fr);
 		km->status_shown[0] = '\0';
 		if (km->help)
-			put_line(a, km->rows - 1, km->cols, help_bar, false);
+			put_help(a, km->rows - 1, km->cols);
 		km->repaint = false;
 	}
 	const km_img *im = &km->img;
