@@ -42,6 +42,9 @@ TEST_SRC  := $(sort $(wildcard tests/unit/test_*.c))
 TEST_BIN  := $(TEST_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 BENCH_SRC := bench/bench.c
 BENCH_BIN := $(BUILD)/bench/bench
+# Optional: Embree 3's single-ray speed on the same rays, built by `make bench`
+# only when embree3/rtcore.h is installed (apt-get install libembree-dev).
+EMBREE_BIN := $(BUILD)/bench/embree_primary
 
 # The binary: ./rtsh for the default build, $(BUILD)/rtsh for variants.
 ifeq ($(BUILD),build)
@@ -108,7 +111,14 @@ test-unit: $(BIN) $(TEST_BIN)
 test-scripts: $(BIN)
 	@sh tests/run-scripts.sh ./$(BIN)
 
+$(EMBREE_BIN): bench/embree_primary.c $(LIB)
+	@mkdir -p $(@D)
+	$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -o $@ $< $(LIB) -lembree3 $(LDLIBS_CORE)
+
 bench: all $(BENCH_BIN)
+	@if printf '#include <embree3/rtcore.h>\n' | $(CC) -E -x c - >/dev/null 2>&1; then \
+		$(MAKE) --no-print-directory $(EMBREE_BIN); \
+	else echo "bench: no embree3/rtcore.h, so no Embree row (apt-get install libembree-dev)"; fi
 	./$(BENCH_BIN) --out $(BUILD)/bench.tsv
 
 bench-quick: all $(BENCH_BIN)
