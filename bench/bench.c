@@ -58,7 +58,7 @@ typedef struct row {
 
 static row rows[MAX_ROWS];
 static int nrows;
-static bool quick;
+static bool quick, no_povray;
 static int runs = 5;
 static const char *bench_dir = "build/bench"; /* where embree_primary lives */
 
@@ -236,7 +236,7 @@ static void bench_grid(void)
 		fail("framebuffer", NULL);
 	render_settings set1 = settings(w, h, 1), set2 = settings(w, h, 2);
 	uint64_t rays = count_rays(wd, set1, fb);
-	bool pov = !quick && have_povray();
+	bool pov = !quick && !no_povray && have_povray();
 	double t1[MAX_RUNS], t2[MAX_RUNS], p1[MAX_RUNS], p2[MAX_RUNS], pt1[MAX_RUNS], pt2[MAX_RUNS];
 	int np1 = 0, np2 = 0;
 	for (int i = 0; i < runs; i++) {
@@ -273,7 +273,7 @@ static void bench_grid(void)
 		snprintf(r->note, sizeof r->note, "rtsh %.2fx faster (render vs POV trace time)", tr1 / m1);
 		r = add_row("grid.pov", "povray-trace", w, h, 1, 2, np2, tr2, -1);
 		snprintf(r->note, sizeof r->note, "rtsh %.2fx faster (render vs POV trace time)", tr2 / m2);
-	} else if (!quick) {
+	} else if (!quick && !no_povray) {
 		r = add_row("grid.pov", "povray", w, h, 1, 1, 0, -1, -1);
 		snprintf(r->note, sizeof r->note, "povray not installed: no comparison");
 	}
@@ -642,6 +642,8 @@ int main(int argc, char **argv)
 			out = argv[++i];
 		else if (strcmp(argv[i], "--only") == 0 && i + 1 < argc)
 			only = argv[++i];
+		else if (strcmp(argv[i], "--no-povray") == 0)
+			no_povray = true;
 		else
 			usage();
 	}

@@ -98,10 +98,14 @@ void fb_clear(framebuffer *fb)
 vec3 render_sample(const world *w, const render_settings *s, int px, int py, int fw, int fh, int sample)
 {
 	uint64_t pixel = (uint64_t)py * (uint64_t)fw + (uint64_t)px;
-	rng g = rng_for(s->seed, pixel, (uint64_t)sample);
 	double u = 0.5, v = 0.5;
-	if (s->samples > 1)
-		pixel_offset((uint32_t)sample, rng_u64(&g), &u, &v);
+	rng g = {0};
+	/* one Whitted sample at the pixel centre needs no random numbers */
+	if (s->samples > 1 || s->mode == MODE_PATH) {
+		g = rng_for(s->seed, pixel, (uint64_t)sample);
+		if (s->samples > 1)
+			pixel_offset((uint32_t)sample, rng_u64(&g), &u, &v);
+	}
 	ray r = cam_ray(&w->cam, px + u, py + v, fw, fh);
 	vec3 c = s->mode == MODE_PATH ? path_radiance(w, s, r, &g) : whitted_radiance(w, s, r);
 	/* A NaN or infinity from a degenerate case must not poison the pixel. */
@@ -110,13 +114,16 @@ vec3 render_sample(const world *w, const render_settings *s, int px, int py, int
 	return c;
 }
 
+/* The counters every thread writes have a cache line each, apart from the
+ * fields every tile reads, so that taking a tile does not evict the job
+ * from the other threads' caches (false sharing). */
 typedef struct shared {
 	render_job *job;
 	int tiles_x;
 	long tiles;
-	atomic_long next;
-	atomic_long done;
-	atomic_int running;
+	_Alignas(64) atomic_long next;
+	_Alignas(64) atomic_long done;
+	_Alignas(64) atomic_int running;
 	pthread_mutex_t lock;
 	pthread_cond_t finished;
 } shared;
