@@ -1152,8 +1152,10 @@ static void km_after_replace(keymode *km, const char *label_before)
 	const char *label = editor_label(sh->ed);
 	bool same = label == label_before || (label && label_before && strcmp(label, label_before) == 0);
 	if (!same) {
+		/* Another scene: its own step, and the camera selected. */
 		km->step = keymode_step(editor_scene(sh->ed));
 		km->cost = 0;
+		km->sel = (km_sel){KM_SEL_CAMERA, 0};
 	}
 	if (!keymode_sel_valid(editor_scene(sh->ed), km->sel))
 		km->sel = (km_sel){KM_SEL_CAMERA, 0};
@@ -1655,7 +1657,7 @@ bool keymode_run(shell *sh)
 	shell_refresh(sh);
 	sh->redraw = true;
 	if (ok && edits > 0)
-		shell_info(sh, "view: %d edit%s kept; undo takes them back (a run of one key is one step)\n",
-		           edits, edits == 1 ? "" : "s");
+		shell_info(sh, "view: %d edit%s kept; %s\n", edits, edits == 1 ? "" : "s",
+		           edits == 1 ? "undo takes it back" : "undo takes them back, a run of one key at a time");
 	return ok;
 }

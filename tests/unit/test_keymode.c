@@ -404,7 +404,7 @@ static void test_session(void **state)
 	session_open(&ss);
 	assert_true(run_for(&ss, 0.5) >= 1);
 	assert_non_null(strstr(ss.text, " view │ "));
-	assert_non_null(strstr(ss.text, "Esc back"));
+	assert_non_null(strstr(ss.text, "\x1b[1mEsc\x1b[22m back")); /* the help bar */
 	assert_null(strstr(ss.text, "\x1b[?1049")); /* never leaves the alternate screen */
 	editor *ed = ss.sh.ed;
 	size_t undo0 = editor_undo_count(ed);
