@@ -836,8 +836,9 @@ static void km_start(keymode *km, bool refine)
 	} else {
 		km->ratio_i = km_pick_ratio(km);
 		double q = ratios[km->ratio_i];
+		/* The picture's aspect kept, so the pixels stay square. */
 		r.w_px = (int)ceil(km->img_w / q);
-		r.h_px = (int)ceil(km->img_h / q);
+		r.h_px = (int)lround((double)r.w_px * km->img_h / km->img_w);
 		if (r.w_px < 1)
 			r.w_px = 1;
 		if (r.h_px < 1)
@@ -1593,6 +1594,7 @@ bool keymode_run(shell *sh)
 	put_str(fd, keys_keypad_on(k));
 	int cols, rows;
 	term_size(fd, &cols, &rows);
+	size_t undo0 = editor_undo_count(sh->ed);
 	keymode *km = keymode_new(sh, fd, scr->pal, cols, rows);
 	bool ok = km != NULL;
 	int wake = sh->wake[0];
@@ -1643,8 +1645,9 @@ bool keymode_run(shell *sh)
 					keymode_key(km, c);
 		}
 	}
-	int edits = km ? keymode_edits(km) : 0;
 	keymode_free(km);
+	size_t steps = editor_undo_count(sh->ed);
+	steps = steps > undo0 ? steps - undo0 : 0;
 	/* Give the terminal and the screen back to the shell. */
 	put_str(fd, keys_keypad_off(k));
 	keys_close(k);
@@ -1656,8 +1659,8 @@ bool keymode_run(shell *sh)
 	rl_set_screen_size(scr->rows - scr->region_top, scr->cols);
 	shell_refresh(sh);
 	sh->redraw = true;
-	if (ok && edits > 0)
-		shell_info(sh, "view: %d edit%s kept; %s\n", edits, edits == 1 ? "" : "s",
-		           edits == 1 ? "undo takes it back" : "undo takes them back, a run of one key at a time");
+	if (ok && steps > 0)
+		shell_info(sh, "view: %zu change%s kept; undo takes %s back (a run of one key is one change)\n", steps,
+		           steps == 1 ? "" : "s", steps == 1 ? "it" : "them");
 	return ok;
 }

@@ -86,7 +86,7 @@ wait_for "│ path │" "m did not switch to path mode"
 keys m
 wait_for "│ whitted │" "m did not switch back"
 tmux send-keys -t "$s" Escape
-wait_for "view: 6 edits kept" "no summary after Esc"
+wait_for "view: 3 changes kept" "no summary after Esc"
 wait_for "rtsh>" "no prompt after key mode"
 case $(screen) in *"Esc back"*) fail "the help bar stayed after Esc" ;; esac
 [ "$(tmux display -p -t "$s" '#{alternate_on}')" = 1 ] || fail "the shell's alternate screen was left"
