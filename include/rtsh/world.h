@@ -61,10 +61,10 @@ typedef struct cam_view {
 /* Float or double (measured for issue 5; figures in bench/README.md): rays,
  * primitives and hits are double, as math.h explains. The BVH (bvh.h) keeps
  * its boxes as floats rounded outward, and the slab tests run in single
- * precision with conservative rounding (world.c): a box test in double
- * measured no faster with double boxes and up to 1.5x slower with float boxes
- * converted on the fly, while float halves the nodes' memory (64 bytes hold
- * two child boxes). Far from the origin float boxes grow coarse (at 2^31 a
+ * precision with conservative rounding (world.c), four children at a time in
+ * one SSE register: with double math the same walk was 10-50% slower (the
+ * float-to-double conversions, or twice the node memory), and float halves
+ * the tree's memory. Far from the origin float boxes grow coarse (at 2^31 a
  * float step is 256 units): the tree then visits more, but never misses.
  *
  * One traceable primitive, 40 bytes (see world.c). A sphere with a uniform

@@ -11,7 +11,8 @@
  * partitions in place, gathering the children's centroid bounds on the way,
  * so every level costs two passes over its references. The boxes are kept
  * as four floats (the fourth unused) so that a box union is one SSE min and
- * one max; a scalar version of each helper serves other machines.
+ * one max; a scalar version of each helper serves other machines. The binary
+ * tree is then collapsed into 4-wide nodes (collapse, bvh.h).
  */
 #include "bvh.h"
 
@@ -36,10 +37,16 @@ typedef struct fbox {
 	float lo[4], hi[4];
 } fbox;
 
+/* A node of the binary tree, before the collapse to 4-wide nodes. */
+typedef struct node2 {
+	fbox box[2];
+	uint32_t child[2], meta[2];
+} node2;
+
 typedef struct builder {
 	fbox *refs;    /* the primitives' boxes, rounded outward */
 	uint32_t *ids; /* the primitive of each reference */
-	bvh_node *nodes;
+	node2 *nodes;
 	size_t used, cap;
 	int depth;
 	size_t leaves;
@@ -289,14 +296,6 @@ static void bounds_of(const builder *b, size_t begin, size_t end, fbox *bb, fbox
 	}
 }
 
-static void set_child_box(bvh_node *node, int k, const fbox *fb)
-{
-	for (int a = 0; a < 3; a++) {
-		node->b[BVH_LO_X + a][k] = fb->lo[a];
-		node->b[BVH_HI_X + a][k] = fb->hi[a];
-	}
-}
-
 /* Builds the subtree over refs[begin, end) (box bb, centroid bounds cb) and
  * returns its reference in *child, *meta. */
 static void build(builder *b, size_t begin, size_t end, const fbox *bb, const fbox *cb, int depth,
@@ -336,9 +335,9 @@ static void build(builder *b, size_t begin, size_t end, const fbox *bb, const fb
 		bounds_of(b, mid, end, &rb, &rcb);
 	}
 	size_t ni = b->used++;
-	bvh_node *node = &b->nodes[ni];
-	set_child_box(node, 0, &lb);
-	set_child_box(node, 1, &rb);
+	node2 *node = &b->nodes[ni];
+	node->box[0] = lb;
+	node->box[1] = rb;
 	uint32_t c0, m0, c1, m1;
 	build(b, begin, mid, &lb, &lcb, depth + 1, &c0, &m0);
 	build(b, mid, end, &rb, &rcb, depth + 1, &c1, &m1);
@@ -349,6 +348,52 @@ static void build(builder *b, size_t begin, size_t end, const fbox *bb, const fb
 	node->meta[1] = m1;
 	*child = (uint32_t)ni;
 	*meta = 0;
+}
+
+/* A child of a 4-wide node being collected from the binary tree. */
+typedef struct slot {
+	fbox box;
+	uint32_t child, meta;
+} slot;
+
+/* Makes the 4-wide node for binary node n2 (and, depth first, the nodes
+ * below it) in out[*used ...]; returns its index. */
+static uint32_t collapse(const builder *b, uint32_t n2, bvh_node *out, size_t *used)
+{
+	const node2 *src = &b->nodes[n2];
+	slot s[BVH_WIDTH] = {{src->box[0], src->child[0], src->meta[0]}, {src->box[1], src->child[1], src->meta[1]}};
+	int cnt = 2;
+	while (cnt < BVH_WIDTH) {
+		/* open the inner child of largest area (the likeliest to be hit) */
+		int best = -1;
+		double best_area = -1.0;
+		for (int i = 0; i < cnt; i++)
+			if (s[i].meta == 0 && fbox_half_area(&s[i].box) > best_area) {
+				best_area = fbox_half_area(&s[i].box);
+				best = i;
+			}
+		if (best < 0)
+			break;
+		const node2 *c = &b->nodes[s[best].child];
+		s[best] = (slot){c->box[0], c->child[0], c->meta[0]};
+		s[cnt++] = (slot){c->box[1], c->child[1], c->meta[1]};
+	}
+	uint32_t ni = (uint32_t)(*used)++;
+	for (int k = 0; k < BVH_WIDTH; k++) {
+		fbox fb = k < cnt ? s[k].box : fbox_empty();
+		for (int a = 0; a < 3; a++) {
+			out[ni].b[BVH_LO_X + a][k] = fb.lo[a];
+			out[ni].b[BVH_HI_X + a][k] = fb.hi[a];
+		}
+		if (k >= cnt) {
+			out[ni].child[k] = 0;
+			out[ni].meta[k] = BVH_LEAF; /* empty: its empty box is never entered */
+		} else {
+			out[ni].meta[k] = s[k].meta;
+			out[ni].child[k] = s[k].meta ? s[k].child : collapse(b, s[k].child, out, used);
+		}
+	}
+	return ni;
 }
 
 bvh *bvh_build(const box *bounds, size_t n, uint32_t *order, rt_error *err)
@@ -370,7 +415,7 @@ bvh *bvh_build(const box *bounds, size_t n, uint32_t *order, rt_error *err)
 	b.refs = malloc(n * sizeof *b.refs);
 	b.ids = order; /* partitioned along with the references */
 	b.cap = n > 1 ? n - 1 : 1; /* a binary tree with leaves folded in: < n inner nodes */
-	b.nodes = aligned_alloc(64, b.cap * sizeof *b.nodes);
+	b.nodes = malloc(b.cap * sizeof *b.nodes);
 	if (!b.refs || !b.nodes) {
 		free(b.refs);
 		free(b.nodes);
@@ -390,24 +435,40 @@ bvh *bvh_build(const box *bounds, size_t n, uint32_t *order, rt_error *err)
 		fbox_union(&bb, r);
 		fbox_add_point(&cb, c);
 	}
-	build(&b, 0, n, &bb, &cb, 0, &t->root, &t->root_meta);
+	uint32_t root2, meta2;
+	build(&b, 0, n, &bb, &cb, 0, &root2, &meta2);
 	free(b.refs);
-	if (b.used == 0) {
-		free(b.nodes);
-		b.nodes = NULL;
-	} else if (b.used < b.cap / 2) {
-		/* give back what the tree did not use */
-		bvh_node *fit = aligned_alloc(64, b.used * sizeof *fit);
-		if (fit) {
-			memcpy(fit, b.nodes, b.used * sizeof *fit);
-			free(b.nodes);
-			b.nodes = fit;
-		}
-	}
-	t->nodes = b.nodes;
-	t->nnodes = b.used;
 	t->depth = b.depth;
 	t->leaves = b.leaves;
+	if (meta2) {
+		/* one leaf: no node at all */
+		t->root = root2;
+		t->root_meta = meta2;
+		free(b.nodes);
+		return t;
+	}
+	/* each 4-wide node takes at least one binary node */
+	size_t bytes = (b.used * sizeof(bvh_node) + 63) / 64 * 64;
+	bvh_node *wide = aligned_alloc(64, bytes);
+	if (!wide) {
+		free(b.nodes);
+		free(t);
+		rt_error_set(err, "out of memory building the BVH (%zu objects)", n);
+		return NULL;
+	}
+	size_t used = 0;
+	t->root = collapse(&b, root2, wide, &used);
+	t->root_meta = 0;
+	free(b.nodes);
+	bytes = (used * sizeof(bvh_node) + 63) / 64 * 64;
+	bvh_node *fit = aligned_alloc(64, bytes);
+	if (fit) {
+		memcpy(fit, wide, used * sizeof *fit);
+		free(wide);
+		wide = fit;
+	}
+	t->nodes = wide;
+	t->nnodes = used;
 	return t;
 }
 

@@ -6,6 +6,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "bvh.h"
 #include "integrators.h"
 #include "rtsh/shape.h"
@@ -470,14 +474,22 @@ size_t world_memory(const world *w)
  *     the near plane's distance down and the far plane's up;
  *   - the far distance is then scaled by 1 + 2 gamma(3) for the rounding of
  *     the subtraction, the product and the inverse (Ize, "Robust BVH ray
- *     traversal", JCGT 2013), and so is tmax where the walk prunes. */
+ *     traversal", JCGT 2013), and so is tmax where the walk prunes;
+ *   - 0 x inf = NaN (a ray in the plane of a slab) is dropped by the order
+ *     of the min/max operands, which keeps the box.
+ * On x86-64 the four children are tested at once in SSE registers; the
+ * scalar loop is the same test for other machines (GCC 12 vectorises it,
+ * but the explicit version measured faster). */
+#define SLAB_SLACK (1.0f + 2.0f * (3.0f * 0x1p-24f) / (1.0f - 3.0f * 0x1p-24f))
+
 typedef struct ray_pre {
-	float on[3], of[3]; /* origin, rounded for the near / far planes */
-	float inv[3];
+#if defined(__SSE2__)
+	__m128 on[3], of[3], inv[3];
+#else
+	float on[3], of[3], inv[3]; /* origin, rounded for the near / far planes */
+#endif
 	int near[3], far[3]; /* rows of bvh_node.b */
 } ray_pre;
-
-#define SLAB_SLACK (1.0f + 2.0f * (3.0f * 0x1p-24f) / (1.0f - 3.0f * 0x1p-24f))
 
 /* A float <= v and a float >= v (a step of |f| 2^-23 covers the rounding;
  * cheaper than nextafterf, which is a library call). */
@@ -501,35 +513,53 @@ static inline void ray_prepare(const ray *r, ray_pre *q)
 {
 	double o[3] = {r->o.x, r->o.y, r->o.z}, d[3] = {r->d.x, r->d.y, r->d.z};
 	for (int a = 0; a < 3; a++) {
-		q->inv[a] = (float)(1.0 / d[a]);
-		bool neg = signbit(q->inv[a]);
+		float inv = (float)(1.0 / d[a]);
+		bool neg = signbit(inv);
 		q->near[a] = (neg ? BVH_HI_X : BVH_LO_X) + a;
 		q->far[a] = (neg ? BVH_LO_X : BVH_HI_X) + a;
 		float up = to_float_up(o[a]), down = to_float_down(o[a]);
+#if defined(__SSE2__)
+		q->on[a] = _mm_set1_ps(neg ? down : up);
+		q->of[a] = _mm_set1_ps(neg ? up : down);
+		q->inv[a] = _mm_set1_ps(inv);
+#else
 		q->on[a] = neg ? down : up;
 		q->of[a] = neg ? up : down;
+		q->inv[a] = inv;
+#endif
 	}
 }
 
-/* Slab tests of both children of n against [tmin, tmax]: bit k of the
+/* Slab tests of the four children of n against [tmin, tmax]: bit k of the
  * result is set when child k may be hit, and tn[k] is (about) where the ray
- * enters it. 0 x inf = NaN (a ray in a slab's plane) is dropped by the order
- * of the comparisons, which keeps the box. */
-static inline unsigned slab2(const bvh_node *n, const ray_pre *q, float tmin, float tmax, float tn[2])
+ * enters it. */
+static inline unsigned slab4(const bvh_node *n, const ray_pre *q, float tmin, float tmax, float tn[4])
 {
-	float t0[2] = {tmin, tmin}, t1[2] = {tmax, tmax};
+#if defined(__SSE2__)
+	__m128 t0 = _mm_set1_ps(tmin), t1 = _mm_set1_ps(tmax);
 	for (int a = 0; a < 3; a++) {
-		const float *nb = n->b[q->near[a]], *fb = n->b[q->far[a]];
-		for (int k = 0; k < 2; k++) {
-			float tnear = (nb[k] - q->on[a]) * q->inv[a];
-			float tfar = (fb[k] - q->of[a]) * q->inv[a];
-			t0[k] = tnear > t0[k] ? tnear : t0[k];
-			t1[k] = tfar < t1[k] ? tfar : t1[k];
-		}
+		__m128 nb = _mm_load_ps(n->b[q->near[a]]), fb = _mm_load_ps(n->b[q->far[a]]);
+		/* max(x, acc) and min(x, acc) return acc when x is NaN */
+		t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(nb, q->on[a]), q->inv[a]), t0);
+		t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(fb, q->of[a]), q->inv[a]), t1);
 	}
-	tn[0] = t0[0];
-	tn[1] = t0[1];
-	return (unsigned)(t0[0] <= t1[0] * SLAB_SLACK) | (unsigned)(t0[1] <= t1[1] * SLAB_SLACK) << 1;
+	_mm_storeu_ps(tn, t0);
+	return (unsigned)_mm_movemask_ps(_mm_cmple_ps(t0, _mm_mul_ps(t1, _mm_set1_ps(SLAB_SLACK))));
+#else
+	unsigned m = 0;
+	for (int k = 0; k < BVH_WIDTH; k++) {
+		float t0 = tmin, t1 = tmax;
+		for (int a = 0; a < 3; a++) {
+			float tnear = (n->b[q->near[a]][k] - q->on[a]) * q->inv[a];
+			float tfar = (n->b[q->far[a]][k] - q->of[a]) * q->inv[a];
+			t0 = tnear > t0 ? tnear : t0;
+			t1 = tfar < t1 ? tfar : t1;
+		}
+		tn[k] = t0;
+		m |= (unsigned)(t0 <= t1 * SLAB_SLACK) << k;
+	}
+	return m;
+#endif
 }
 
 typedef struct walk_entry {
@@ -537,6 +567,27 @@ typedef struct walk_entry {
 	float t;              /* where the ray enters its box */
 	uint32_t pad;
 } walk_entry;
+
+/* The children of node n that mask m says are hit, pushed farthest first so
+ * that the nearest is on top (an insertion sort of at most four); returns
+ * the new stack height. */
+static inline int push_hits(const bvh_node *n, unsigned m, const float tn[4], walk_entry *stack, int sp)
+{
+	int idx[BVH_WIDTH], c = 0;
+	for (int k = 0; k < BVH_WIDTH; k++) {
+		if (!(m >> k & 1))
+			continue;
+		int j = c++;
+		while (j > 0 && tn[idx[j - 1]] < tn[k]) {
+			idx[j] = idx[j - 1];
+			j--;
+		}
+		idx[j] = k;
+	}
+	for (int i = 0; i < c; i++)
+		stack[sp++] = (walk_entry){n->child[idx[i]], n->meta[idx[i]], tn[idx[i]], 0};
+	return sp;
+}
 
 bool world_intersect(const world *w, const ray *r, double tmin, double tmax, hit *h)
 {
@@ -553,10 +604,11 @@ bool world_intersect(const world *w, const ray *r, double tmin, double tmax, hit
 		}
 	if (w->nprims) {
 		const bvh *tree = w->tree;
+		const bvh_node *nodes = tree->nodes;
 		ray_pre q;
 		ray_prepare(r, &q);
 		float ftmin = to_float_down(tmin), ftmax = to_float_up(tmax);
-		walk_entry stack[BVH_MAX_DEPTH + 2];
+		walk_entry stack[BVH_STACK];
 		int sp = 0;
 		uint32_t child = tree->root, meta = tree->root_meta;
 		for (;;) {
@@ -571,20 +623,19 @@ bool world_intersect(const world *w, const ray *r, double tmin, double tmax, hit
 						best_n = nl;
 					}
 			} else {
-				const bvh_node *n = &tree->nodes[child];
-				float tn[2];
-				unsigned m = slab2(n, &q, ftmin, ftmax, tn);
-				if (m == 3) {
-					/* both: the nearer now, the other later */
-					unsigned f = tn[1] < tn[0];
-					stack[sp++] = (walk_entry){n->child[!f], n->meta[!f], tn[!f], 0};
-					child = n->child[f];
-					meta = n->meta[f];
-					continue;
-				}
+				const bvh_node *n = &nodes[child];
+				float tn[BVH_WIDTH];
+				unsigned m = slab4(n, &q, ftmin, ftmax, tn);
 				if (m) {
-					child = n->child[m >> 1];
-					meta = n->meta[m >> 1];
+					if (m & (m - 1)) {
+						/* several: the nearest now, the others later */
+						sp = push_hits(n, m, tn, stack, sp) - 1;
+					} else {
+						int k = __builtin_ctz(m);
+						stack[sp] = (walk_entry){n->child[k], n->meta[k], 0, 0};
+					}
+					child = stack[sp].child;
+					meta = stack[sp].meta;
 					continue;
 				}
 			}
@@ -616,10 +667,11 @@ bool world_occluded(const world *w, const ray *r, double tmin, double tmax)
 	if (!w->nprims)
 		return false;
 	const bvh *tree = w->tree;
+	const bvh_node *nodes = tree->nodes;
 	ray_pre q;
 	ray_prepare(r, &q);
 	float ftmin = to_float_down(tmin), ftmax = to_float_up(tmax);
-	walk_entry stack[BVH_MAX_DEPTH + 2];
+	walk_entry stack[BVH_STACK];
 	int sp = 0;
 	uint32_t child = tree->root, meta = tree->root_meta;
 	for (;;) {
@@ -630,19 +682,18 @@ bool world_occluded(const world *w, const ray *r, double tmin, double tmax)
 				if (prim_occluded(w, &p[k], r, tmin, tmax))
 					return true;
 		} else {
-			const bvh_node *n = &tree->nodes[child];
-			float tn[2];
-			unsigned m = slab2(n, &q, ftmin, ftmax, tn);
-			if (m == 3) {
-				unsigned f = tn[1] < tn[0];
-				stack[sp++] = (walk_entry){n->child[!f], n->meta[!f], tn[!f], 0};
-				child = n->child[f];
-				meta = n->meta[f];
-				continue;
-			}
+			const bvh_node *n = &nodes[child];
+			float tn[BVH_WIDTH];
+			unsigned m = slab4(n, &q, ftmin, ftmax, tn);
 			if (m) {
-				child = n->child[m >> 1];
-				meta = n->meta[m >> 1];
+				/* any hit will do: no sorting, the first child now */
+				int k = __builtin_ctz(m);
+				for (unsigned rest = m & (m - 1); rest; rest &= rest - 1) {
+					int j = __builtin_ctz(rest);
+					stack[sp++] = (walk_entry){n->child[j], n->meta[j], tn[j], 0};
+				}
+				child = n->child[k];
+				meta = n->meta[k];
 				continue;
 			}
 		}
