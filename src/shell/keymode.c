@@ -1282,6 +1282,9 @@ void keymode_key(keymode *km, int key)
 		break;
 	case KM_UNDO:
 	case KM_REDO:
+		/* The shell's calls below hold and release its preview: nothing
+		 * of ours may be rendering then. */
+		wk_hold(&km->wk);
 		shell_edit_begin(sh);
 		if (!(a.op == KM_UNDO ? editor_undo(sh->ed, &err) : editor_redo(sh->ed, &err)))
 			km_message(km, "%s", err.msg);
@@ -1289,8 +1292,11 @@ void keymode_key(keymode *km, int key)
 		km_after_replace(km, label_copy);
 		if (editor_generation(sh->ed) != gen)
 			km->want_fast = true;
+		else if (!km->stopped)
+			km->want_refine = true; /* the render held above goes on */
 		break;
 	case KM_SCENE:
+		wk_hold(&km->wk);
 		km_shell_command(km, a.n > 0 ? cmd_next : cmd_prev);
 		km_after_replace(km, label_copy);
 		km->want_refine = true;

@@ -91,7 +91,12 @@ wait_for "rtsh>" "no prompt after key mode"
 case $(screen) in *"Esc back"*) fail "the help bar stayed after Esc" ;; esac
 [ "$(tmux display -p -t "$s" '#{alternate_on}')" = 1 ] || fail "the shell's alternate screen was left"
 screen | grep -q '^ k\.rt │ whitted │' || fail "no shell status line after key mode"
-n=$(tmux capture-pane -t "$s" -p -e | grep -o '▀\|▄' | wc -l)
+# The shell's picture comes back (its preview renders again).
+for i in $(seq 1 50); do
+	n=$(tmux capture-pane -t "$s" -p -e | grep -o '▀\|▄' | wc -l)
+	[ "$n" -gt 1000 ] && break
+	sleep 0.1
+done
 [ "$n" -gt 1000 ] || fail "only $n half blocks after key mode"
 
 tmux send-keys -t "$s" "save $TMP/x.rt" Enter
