@@ -1036,10 +1036,11 @@ static void km_status_text(keymode *km, char *buf, size_t size)
 		snprintf(fps, sizeof fps, " │ %.0f fps", f);
 	if (km->have_img)
 		snprintf(t, sizeof t, " │ %.0f ms", im->seconds * 1000);
+	/* A message goes right after the selection, where it is not cut off. */
 	bool msg = km->msg[0] && now() < km->msg_until;
-	snprintf(buf, size, " view │ %s │ %s │ %s │ %s │ depth %d │ %dx%d%s%s%s │ step %.3g%s%s", sh->name, sel,
-	         render_mode_name(sh->set.mode), spp, sh->set.depth, km->img_w, km->img_h, res, fps, t, km->step,
-	         msg ? " │ " : "", msg ? km->msg : "");
+	snprintf(buf, size, " view │ %s │ %s%s%s │ %s │ %s │ depth %d │ %dx%d%s%s%s │ step %.3g", sh->name, sel,
+	         msg ? " │ " : "", msg ? km->msg : "", render_mode_name(sh->set.mode), spp, sh->set.depth,
+	         km->img_w, km->img_h, res, fps, t, km->step);
 }
 
 /* Appends a line of text at row (0-based), cut to the width. */
