@@ -18,10 +18,6 @@
 #include "shell/keymode.h"
 #include "term/caps.h"
 
-/* The generator (src/scene/generate.c) is being written alongside; until it
- * is in the library, `generate` says so instead of failing to link. */
-#pragma weak scene_generate
-
 bool cmd_load(shell *sh, int argc, char **argv, const char *rest)
 {
 	(void)argc, (void)rest;
@@ -229,8 +225,6 @@ bool cmd_generate(shell *sh, int argc, char **argv, const char *rest)
 		seed = ((uint64_t)t.tv_sec * 1000003u ^ (uint64_t)t.tv_nsec) % 1000000;
 	}
 	rt_error err;
-	if (!scene_generate)
-		return shell_fail(sh, "generate: the scene generator is not in this build");
 	scene *s = scene_generate((size_t)n, seed, NULL, &err);
 	if (!s)
 		return shell_fail(sh, "generate: %s", err.msg);
