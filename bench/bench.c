@@ -61,6 +61,8 @@ static int nrows;
 static bool quick, no_povray;
 static int runs = 5;
 static const char *bench_dir = "build/bench"; /* where embree_primary lives */
+static char rtsh_bin[1100] = "./rtsh";         /* the binary of this build */
+static char out_ppm[64];                        /* images of the process rows */
 
 static double now(void)
 {
@@ -173,13 +175,14 @@ static bool have_povray(void)
 	return system("command -v povray >/dev/null 2>&1") == 0;
 }
 
-/* Runs POV-Ray on bench/grid.pov; *trace = its own "Trace Time". Wall
- * seconds of the process, < 0 on failure. */
+/* Runs POV-Ray on bench/grid.pov, writing a PPM as `rtsh -o x.ppm` does;
+ * *trace = its own "Trace Time". Wall seconds of the process, < 0 on
+ * failure. */
 static double run_povray(int w, int h, int threads, double *trace)
 {
 	char cmd[512];
 	snprintf(cmd, sizeof cmd,
-	         "povray +Ibench/grid.pov -F -D -A +W%d +H%d +WT%d 2>&1", w, h, threads);
+	         "povray +Ibench/grid.pov +FP +O%s -D -A +W%d +H%d +WT%d 2>&1", out_ppm, w, h, threads);
 	double t0 = now();
 	FILE *p = popen(cmd, "r");
 	if (!p)
@@ -195,6 +198,19 @@ static double run_povray(int w, int h, int threads, double *trace)
 			*trace = strtod(paren + 1, NULL);
 	}
 	int rc = pclose(p);
+	double t = now() - t0;
+	return rc == 0 ? t : -1;
+}
+
+/* Runs the rtsh binary end to end (read, prepare, render, write the PPM),
+ * as POV-Ray is run. Wall seconds, < 0 when it cannot. */
+static double run_rtsh(const char *scene_path, int w, int h, int threads)
+{
+	char cmd[1400];
+	snprintf(cmd, sizeof cmd, "%s %s -o %s -q -r %dx%d -s 1 -t %d >/dev/null 2>&1", rtsh_bin, scene_path,
+	         out_ppm, w, h, threads);
+	double t0 = now();
+	int rc = system(cmd);
 	double t = now() - t0;
 	return rc == 0 ? t : -1;
 }
@@ -224,7 +240,9 @@ static double run_embree(const char *scene_path, int w, int h, double *seconds)
 
 /* --- the rows --- */
 
-/* grid.rt, 1 and 2 threads, with POV-Ray interleaved in the same loop. */
+/* grid.rt, 1 and 2 threads: the render in this process, the rtsh binary
+ * end to end, and POV-Ray end to end, interleaved in one loop so that they
+ * share the machine's load. */
 static void bench_grid(void)
 {
 	const char *path = "scenes/grid.rt";
@@ -234,47 +252,52 @@ static void bench_grid(void)
 	framebuffer *fb = fb_new(w, h);
 	if (!fb)
 		fail("framebuffer", NULL);
-	render_settings set1 = settings(w, h, 1), set2 = settings(w, h, 2);
-	uint64_t rays = count_rays(wd, set1, fb);
 	bool pov = !quick && !no_povray && have_povray();
-	double t1[MAX_RUNS], t2[MAX_RUNS], p1[MAX_RUNS], p2[MAX_RUNS], pt1[MAX_RUNS], pt2[MAX_RUNS];
-	int np1 = 0, np2 = 0;
-	for (int i = 0; i < runs; i++) {
-		t1[i] = render_once(wd, &set1, fb);
-		if (pov) {
-			double tr, t = run_povray(w, h, 1, &tr);
-			if (t > 0) {
-				p1[np1] = t;
-				pt1[np1++] = tr;
+	bool cli = !quick && access(rtsh_bin, X_OK) == 0;
+	double t[2][MAX_RUNS], c[2][MAX_RUNS], pw[2][MAX_RUNS], pt[2][MAX_RUNS];
+	int nc[2] = {0, 0}, np[2] = {0, 0};
+	uint64_t rays = count_rays(wd, settings(w, h, 1), fb);
+	for (int i = 0; i < runs; i++)
+		for (int k = 0; k < 2; k++) {
+			render_settings set = settings(w, h, k + 1);
+			t[k][i] = render_once(wd, &set, fb);
+			if (cli) {
+				double x = run_rtsh(path, w, h, k + 1);
+				if (x > 0)
+					c[k][nc[k]++] = x;
+			}
+			if (pov) {
+				double tr, x = run_povray(w, h, k + 1, &tr);
+				if (x > 0) {
+					pw[k][np[k]] = x;
+					pt[k][np[k]++] = tr;
+				}
 			}
 		}
-		t2[i] = render_once(wd, &set2, fb);
-		if (pov) {
-			double tr, t = run_povray(w, h, 2, &tr);
-			if (t > 0) {
-				p2[np2] = t;
-				pt2[np2++] = tr;
-			}
-		}
+	double m[2], mc[2] = {-1, -1};
+	for (int k = 0; k < 2; k++) {
+		m[k] = median(t[k], runs);
+		row *r = add_row("grid.rt", "whitted", w, h, 1, k + 1, runs, m[k], (double)rays / m[k] * 1e-6);
+		if (k == 0)
+			snprintf(r->note, sizeof r->note, "render only; %.2f rays/pixel", (double)rays / ((double)w * h));
+		else
+			snprintf(r->note, sizeof r->note, "render only; %.2fx one thread", m[0] / m[1]);
 	}
-	double m1 = median(t1, runs), m2 = median(t2, runs);
-	row *r = add_row("grid.rt", "whitted", w, h, 1, 1, runs, m1, (double)rays / m1 * 1e-6);
-	snprintf(r->note, sizeof r->note, "%.2f rays/pixel", (double)rays / ((double)w * h));
-	r = add_row("grid.rt", "whitted", w, h, 1, 2, runs, m2, (double)rays / m2 * 1e-6);
-	snprintf(r->note, sizeof r->note, "%.2fx one thread", m1 / m2);
-	if (pov && np1 && np2) {
-		double w1 = median(p1, np1), w2 = median(p2, np2);
-		double tr1 = median(pt1, np1), tr2 = median(pt2, np2);
-		r = add_row("grid.pov", "povray-process", w, h, 1, 1, np1, w1, -1);
-		snprintf(r->note, sizeof r->note, "rtsh %.2fx faster (render vs process)", w1 / m1);
-		r = add_row("grid.pov", "povray-process", w, h, 1, 2, np2, w2, -1);
-		snprintf(r->note, sizeof r->note, "rtsh %.2fx faster (render vs process)", w2 / m2);
-		r = add_row("grid.pov", "povray-trace", w, h, 1, 1, np1, tr1, -1);
-		snprintf(r->note, sizeof r->note, "rtsh %.2fx faster (render vs POV trace time)", tr1 / m1);
-		r = add_row("grid.pov", "povray-trace", w, h, 1, 2, np2, tr2, -1);
-		snprintf(r->note, sizeof r->note, "rtsh %.2fx faster (render vs POV trace time)", tr2 / m2);
-	} else if (!quick && !no_povray) {
-		r = add_row("grid.pov", "povray", w, h, 1, 1, 0, -1, -1);
+	for (int k = 0; k < 2 && cli; k++) {
+		mc[k] = median(c[k], nc[k]);
+		row *r = add_row("grid.rt", "rtsh-process", w, h, 1, k + 1, nc[k], mc[k], -1);
+		snprintf(r->note, sizeof r->note, "rtsh grid.rt -o x.ppm: read, prepare, render, write");
+	}
+	for (int k = 0; k < 2 && pov && np[0] && np[1]; k++) {
+		double mw = median(pw[k], np[k]), mt = median(pt[k], np[k]);
+		row *r = add_row("grid.pov", "povray-process", w, h, 1, k + 1, np[k], mw, -1);
+		if (mc[k] > 0)
+			snprintf(r->note, sizeof r->note, "+FP: rtsh-process %.2fx faster", mw / mc[k]);
+		r = add_row("grid.pov", "povray-trace", w, h, 1, k + 1, np[k], mt, -1);
+		snprintf(r->note, sizeof r->note, "POV's own Trace Time: rtsh render %.2fx faster", mt / m[k]);
+	}
+	if (!pov && !quick && !no_povray) {
+		row *r = add_row("grid.pov", "povray", w, h, 1, 1, 0, -1, -1);
 		snprintf(r->note, sizeof r->note, "povray not installed: no comparison");
 	}
 	fb_free(fb);
@@ -659,6 +682,11 @@ int main(int argc, char **argv)
 		*slash = '\0';
 		bench_dir = dir;
 	}
+	/* the rtsh of this build: $(BUILD)/rtsh, or ./rtsh for the default build */
+	snprintf(rtsh_bin, sizeof rtsh_bin, "%s/../rtsh", bench_dir);
+	if (access(rtsh_bin, X_OK) != 0)
+		snprintf(rtsh_bin, sizeof rtsh_bin, "./rtsh");
+	snprintf(out_ppm, sizeof out_ppm, "/tmp/rtsh-bench-%ld.ppm", (long)getpid());
 	double load1, load5, load15;
 	FILE *la = fopen("/proc/loadavg", "r");
 	if (la && fscanf(la, "%lf %lf %lf", &load1, &load5, &load15) == 3)
@@ -685,6 +713,7 @@ int main(int argc, char **argv)
 		        load15);
 	if (la)
 		fclose(la);
+	unlink(out_ppm);
 	print_table(stdout, false);
 	if (out) {
 		FILE *f = fopen(out, "w");

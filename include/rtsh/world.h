@@ -105,6 +105,7 @@ typedef struct prim_tri {
  * matrix, so the test is bit for bit the unit plane's). */
 typedef struct prim_plane {
 	double h[4];
+	vec3 n;         /* the unit normal */
 	uint32_t object;
 	uint32_t shape; /* its matrix in world.shapes (texture coordinates) */
 } prim_plane;

@@ -143,6 +143,7 @@ static bool make_plane(world *w, const object *o, uint32_t index, prim_plane *pl
 	const prim_shape *sh = &w->shapes[p.u.index];
 	for (int j = 0; j < 4; j++)
 		pl->h[j] = sh->inv[1][j];
+	pl->n = v3_norm(v3(pl->h[0], pl->h[1], pl->h[2]));
 	pl->object = index;
 	pl->shape = p.u.index;
 	return true;
@@ -399,9 +400,8 @@ static void finish_plane(const world *w, const prim_plane *pl, const ray *r, dou
 	h->local = (vec3){m[0][0] * q.x + m[0][1] * q.y + m[0][2] * q.z + m[0][3],
 	                  m[1][0] * q.x + m[1][1] * q.y + m[1][2] * q.z + m[1][3],
 	                  m[2][0] * q.x + m[2][1] * q.y + m[2][2] * q.z + m[2][3]};
-	vec3 n = v3_norm(v3(m[1][0], m[1][1], m[1][2]));
-	h->front = v3_dot(n, r->d) < 0.0;
-	h->n = n;
+	h->front = v3_dot(pl->n, r->d) < 0.0;
+	h->n = pl->n;
 }
 
 /* Fills the hit record for the primitive found nearest. */
