@@ -51,12 +51,13 @@ struct bvh {
 	size_t leaves;
 };
 
-/* Builds the tree over n primitives with world bounds bounds[0..n): binned
- * SAH (Wald, "On fast construction of SAH-based bounding volume hierarchies",
- * 2007). order[i] receives the primitive that goes to place i of tree order
- * (leaves index primitives in that order). NULL (err set) when out of memory
- * or n is too large. */
-bvh *bvh_build(const box *bounds, size_t n, uint32_t *order, rt_error *err);
+/* Builds the tree over n primitives with world bounds bounds[0..n) and
+ * intersection costs costs[0..n) (relative to a world-space sphere; NULL:
+ * all 1): binned SAH (Wald, "On fast construction of SAH-based bounding
+ * volume hierarchies", 2007). order[i] receives the primitive that goes to
+ * place i of tree order (leaves index primitives in that order). NULL (err
+ * set) when out of memory or n is too large. */
+bvh *bvh_build(const box *bounds, const float *costs, size_t n, uint32_t *order, rt_error *err);
 void bvh_free(bvh *t);
 
 /* For the benchmark (bench/bench.c): the rays world_intersect and
