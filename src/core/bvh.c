@@ -197,14 +197,14 @@ static split find_split(const builder *b, size_t begin, size_t end, const fbox *
 	if (!binning_make(cb, end - begin, &bn))
 		return best;
 	int nbins = bn.nbins;
+	/* per bin: the box and the summed cost (every cost is >= 1, so a
+	 * bin is empty when its cost is 0; float sums are exact to 2^24) */
 	fbox bbox[3][BINS];
-	uint32_t bcount[3][BINS];
-	double bcost[3][BINS];
+	float bcost[3][BINS];
 	for (int a = 0; a < 3; a++)
 		for (int k = 0; k < nbins; k++) {
 			bbox[a][k] = fbox_empty();
-			bcount[a][k] = 0;
-			bcost[a][k] = 0.0;
+			bcost[a][k] = 0.0f;
 		}
 	for (size_t i = begin; i < end; i++) {
 		const fbox *r = &b->refs[i];
@@ -213,7 +213,6 @@ static split find_split(const builder *b, size_t begin, size_t end, const fbox *
 		centroid2(r, c);
 		bin_index(c, bn.lo, bn.scale, nbins, k);
 		for (int a = 0; a < 3; a++) {
-			bcount[a][k[a]]++;
 			bcost[a][k[a]] += r->lo[3];
 			fbox_union(&bbox[a][k[a]], r);
 		}
@@ -224,28 +223,22 @@ static split find_split(const builder *b, size_t begin, size_t end, const fbox *
 	for (int a = 0; a < 3; a++) {
 		if (!bn.usable[a])
 			continue;
-		/* right-to-left sweep: the area, count and cost right of each split */
+		/* right-to-left sweep: the area and cost right of each split */
 		double right_area[BINS], right_cost[BINS];
-		size_t right_n[BINS];
 		fbox acc = fbox_empty();
-		size_t cnt = 0;
 		double sum = 0.0;
 		for (int k = nbins - 1; k > 0; k--) {
 			fbox_union(&acc, &bbox[a][k]);
-			cnt += bcount[a][k];
 			sum += bcost[a][k];
-			right_area[k] = cnt ? fbox_half_area(&acc) : 0.0;
-			right_n[k] = cnt;
+			right_area[k] = sum > 0.0 ? fbox_half_area(&acc) : 0.0;
 			right_cost[k] = sum;
 		}
 		acc = fbox_empty();
-		cnt = 0;
 		sum = 0.0;
 		for (int k = 0; k < nbins - 1; k++) {
 			fbox_union(&acc, &bbox[a][k]);
-			cnt += bcount[a][k];
 			sum += bcost[a][k];
-			if (cnt == 0 || right_n[k + 1] == 0)
+			if (sum == 0.0 || right_cost[k + 1] == 0.0)
 				continue;
 			double cost = fbox_half_area(&acc) * sum + right_area[k + 1] * right_cost[k + 1];
 			if (cost < best.cost) {
@@ -319,10 +312,18 @@ static void build(builder *b, size_t begin, size_t end, const fbox *bb, const fb
 	size_t n = end - begin;
 	if (depth > b->depth)
 		b->depth = depth;
-	split s = {.axis = -1};
-	if (n > 1 && depth < BALANCED_DEPTH)
-		s = find_split(b, begin, end, cb);
 	bool leaf = n <= 1 || (depth >= BALANCED_DEPTH && n <= LEAF_MAX);
+	if (!leaf && n <= LEAF_MAX) {
+		/* A split costs at least COST_TRAVERSE: a node that costs no more
+		 * to test whole is a leaf without binning (most small nodes). */
+		double total = 0.0;
+		for (size_t i = begin; i < end; i++)
+			total += b->refs[i].lo[3];
+		leaf = total <= COST_TRAVERSE;
+	}
+	split s = {.axis = -1};
+	if (!leaf && depth < BALANCED_DEPTH)
+		s = find_split(b, begin, end, cb);
 	if (!leaf && n <= LEAF_MAX && depth < BALANCED_DEPTH) {
 		double area = fbox_half_area(bb);
 		double split_cost = area > 0.0 && s.axis >= 0 ? COST_TRAVERSE + s.cost / area : INFINITY;
