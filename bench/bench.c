@@ -457,6 +457,56 @@ static void bench_load(void)
 }
 
 /* The Whitted preview frame and the terminal frame that shows it. */
+/* --- path tracing (issue 4): paths per second --- */
+
+/* A path-traced scene at the resolution, samples and depth of a reference
+ * renderer's own benchmark, 1 and 2 threads: Ray Tracing in One Weekend's
+ * final scene (400x225, 50 samples, depth 50) and smallpt's Cornell box
+ * (256x192, 256 samples). Paths/s counts camera samples. */
+static void bench_path_scene(const char *path, const char *name, int w, int h, int spp, int depth,
+                             const char *reference)
+{
+	if (quick) {
+		w /= 4;
+		h /= 4;
+		spp = 4;
+	}
+	scene *s = load(path);
+	world *wd = build(s);
+	framebuffer *fb = fb_new(w, h);
+	if (!fb)
+		fail("framebuffer", NULL);
+	double t[2][MAX_RUNS];
+	for (int i = 0; i < runs; i++)
+		for (int k = 0; k < 2; k++) {
+			render_settings set = settings(w, h, k + 1);
+			set.mode = MODE_PATH;
+			set.samples = spp;
+			set.depth = depth;
+			t[k][i] = render_once(wd, &set, fb);
+		}
+	double m[2];
+	for (int k = 0; k < 2; k++) {
+		m[k] = median(t[k], runs);
+		row *r = add_row(name, "path", w, h, spp, k + 1, runs, m[k], -1);
+		double mpaths = (double)w * h * spp / m[k] * 1e-6;
+		if (k == 0)
+			snprintf(r->note, sizeof r->note, "%.2f Mpaths/s; depth %d; %s", mpaths, depth, reference);
+		else
+			snprintf(r->note, sizeof r->note, "%.2f Mpaths/s; %.2fx one thread", mpaths, m[0] / m[1]);
+	}
+	fb_free(fb);
+	world_free(wd);
+	scene_free(s);
+}
+
+static void bench_path(void)
+{
+	bench_path_scene("scenes/final.rt", "final.rt", 400, 225, 50, 50,
+	                 "RTOW's own code, one core: 39 s (book 1), 7.5 s (book 2)");
+	bench_path_scene("scenes/cornell.rt", "cornell.rt", 256, 192, 256, 12, "smallpt, one core: 21 s");
+}
+
 static void bench_preview(void)
 {
 	const char *path = "scenes/showcase.rt";
@@ -648,7 +698,7 @@ static void print_table(FILE *f, bool tsv)
 
 static void usage(void)
 {
-	fputs("usage: bench [--quick] [--runs N] [--out FILE.tsv] [--only grid|primary|spheres|load|preview|keymode]\n",
+	fputs("usage: bench [--quick] [--runs N] [--out FILE.tsv] [--only grid|primary|spheres|load|path|preview|keymode]\n",
 	      stderr);
 	exit(2);
 }
@@ -703,6 +753,8 @@ int main(int argc, char **argv)
 		bench_spheres();
 	if (!only || strcmp(only, "load") == 0)
 		bench_load();
+	if (!only || strcmp(only, "path") == 0)
+		bench_path();
 	if (!only || strcmp(only, "preview") == 0)
 		bench_preview();
 	if (!only || strcmp(only, "keymode") == 0)
