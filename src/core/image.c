@@ -5,6 +5,7 @@
 #include <fcntl.h>
 #include <math.h>
 #include <png.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
@@ -26,16 +27,44 @@ image_format image_format_of(const char *path)
 	return IMAGE_UNKNOWN;
 }
 
-/* The 8-bit code whose sRGB decoding is nearest to v: the encoding
- * (IEC 61966-2-1) rounded to nearest. */
+/* The 8-bit code of a linear value is the sRGB encoding (IEC 61966-2-1)
+ * rounded to nearest: code k covers the linear values from
+ * threshold[k] = decode((k - 0.5) / 255) up to threshold[k + 1]. A table of
+ * buckets over [0,1) gives the code at the start of each bucket, and at most
+ * a step or two up the thresholds finds the code: no pow() per pixel, which
+ * matters for every terminal frame. */
+#define SRGB_BUCKETS 4096
+
+static double srgb_threshold[257];
+static uint8_t srgb_bucket[SRGB_BUCKETS];
+static pthread_once_t srgb_once = PTHREAD_ONCE_INIT;
+
+static void srgb_tables(void)
+{
+	srgb_threshold[0] = -INFINITY;
+	for (int k = 1; k < 256; k++)
+		srgb_threshold[k] = srgb8_to_linear(k - 0.5);
+	srgb_threshold[256] = INFINITY;
+	int code = 0;
+	for (int b = 0; b < SRGB_BUCKETS; b++) {
+		double v = (double)b / SRGB_BUCKETS;
+		while (v >= srgb_threshold[code + 1])
+			code++;
+		srgb_bucket[b] = (uint8_t)code;
+	}
+}
+
 uint8_t linear_to_srgb8(double v)
 {
 	if (!(v > 0.0))
 		return 0;
 	if (v >= 1.0)
 		return 255;
-	double s = v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
-	return (uint8_t)(s * 255.0 + 0.5);
+	pthread_once(&srgb_once, srgb_tables);
+	int code = srgb_bucket[(int)(v * SRGB_BUCKETS)];
+	while (v >= srgb_threshold[code + 1])
+		code++;
+	return (uint8_t)code;
 }
 
 double srgb8_to_linear(double code)

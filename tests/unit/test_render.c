@@ -262,6 +262,16 @@ static void test_srgb(void **state)
 	assert_int_equal(linear_to_srgb8(-1), 0);
 	assert_int_equal(linear_to_srgb8(7), 255);
 	assert_int_equal(linear_to_srgb8(NAN), 0);
+	/* for any value, the code is the encoding rounded to nearest (values
+	 * within 1e-9 of a rounding boundary may go either way) */
+	test_rng r = {3};
+	for (int i = 0; i < 200000; i++) {
+		double v = i < 100000 ? trand(&r) : trand(&r) * 0.01;
+		double e = (v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1 / 2.4) - 0.055) * 255 + 0.5;
+		if (fabs(e - floor(e + 0.5)) < 1e-9)
+			continue;
+		assert_int_equal(linear_to_srgb8(v), (int)floor(e));
+	}
 	/* the world decodes .rt colours the same way */
 	vec3 l = srgb255_to_linear(v3(0, 128, 255));
 	assert_near(l.x, 0, 0);
