@@ -95,9 +95,12 @@ bool editor_light_move(editor *ed, size_t i, vec3 d, rt_error *err);
 bool editor_light_brightness(editor *ed, size_t i, double ratio, rt_error *err);
 bool editor_light_color(editor *ed, size_t i, vec3 rgb, rt_error *err);
 /* The active camera. move: by d along the camera's own right, up and
- * forward axes (cam_view_make). turn: yaw degrees towards the right, then
- * pitch degrees up, in the camera's own frame; the new direction is unit.
+ * forward axes (cam_view_make). turn: yaw degrees to the right about the
+ * world's vertical, then pitch degrees up, keeping the view within
+ * EDIT_PITCH_LIMIT degrees of the horizon (the camera has no roll); the new
+ * direction is unit; a turn that changes nothing records no edit.
  * lookat: aim at a point (which must differ from the position). */
+#define EDIT_PITCH_LIMIT 89.0
 bool editor_camera_pos(editor *ed, vec3 p, rt_error *err);
 bool editor_camera_dir(editor *ed, vec3 d, rt_error *err);
 bool editor_camera_lookat(editor *ed, vec3 target, rt_error *err);

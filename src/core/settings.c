@@ -76,7 +76,7 @@ bool settings_set(render_settings *s, const setting_def *def, const char *value,
 	switch (def->type) {
 	case SETTING_INT:
 		if (!parse_long(value, def->min, def->max, &a))
-			return rt_error_set(err, "%s \"%s\" is not valid; expected a whole number in %g..%g",
+			return rt_error_set(err, "%s \"%s\" is not valid; expected a whole number in %.0f..%.0f",
 			                    def->name, value, def->min, def->max);
 		*(int *)field(s, def) = (int)a;
 		return true;
@@ -109,7 +109,7 @@ bool settings_set(render_settings *s, const setting_def *def, const char *value,
 		wbuf[x - value] = '\0';
 		if (!parse_long(wbuf, def->min, def->max, &a) || !parse_long(x + 1, def->min, def->max, &b))
 			return rt_error_set(err, "resolution \"%s\" is not valid; expected WxH with each of W "
-			                         "and H in %g..%g",
+			                         "and H in %.0f..%.0f",
 			                    value, def->min, def->max);
 		s->width = (int)a;
 		s->height = (int)b;

@@ -772,10 +772,32 @@ bool editor_camera_turn(editor *ed, double yaw_deg, double pitch_deg, rt_error *
 		return rt_error_set(err, "turn angles are not finite; expected degrees");
 	camera c;
 	size_t i = active_camera(ed, &c);
-	cam_view v = cam_view_make(&c);
-	double y = deg_to_rad(yaw_deg), p = deg_to_rad(pitch_deg);
-	vec3 f = v3_add(v3_scale(v.fwd, cos(y)), v3_scale(v.right, sin(y)));
-	f = v3_add(v3_scale(f, cos(p)), v3_scale(v.up, sin(p)));
-	c.dir = v3_norm(f);
+	/* Yaw turns about the world's vertical and pitch tilts towards the
+	 * camera's up, as in a first-person view: the camera has no roll, so
+	 * the elevation stays within EDIT_PITCH_LIMIT of the horizon (a camera
+	 * loaded beyond it may only come back). */
+	vec3 f = v3_norm(c.dir);
+	double elev = asin(clampd(f.y, -1.0, 1.0)), lim = deg_to_rad(EDIT_PITCH_LIMIT);
+	double ne = elev + deg_to_rad(pitch_deg);
+	if (ne > lim)
+		ne = fmax(elev, lim);
+	if (ne < -lim)
+		ne = fmin(elev, -lim);
+	double az;
+	if (fabs(f.y) > 0.999999) {
+		/* Straight up or down: the heading is where the top of the
+		 * picture points (looking up) or its bottom (looking down). */
+		cam_view v = cam_view_make(&c);
+		az = f.y > 0 ? atan2(-v.up.x, -v.up.z) : atan2(v.up.x, v.up.z);
+	} else {
+		az = atan2(f.x, f.z);
+	}
+	double na = az + deg_to_rad(yaw_deg);
+	vec3 d = v3(cos(ne) * sin(na), sin(ne), cos(ne) * cos(na));
+	if (ne == elev && fabs(f.y) > 0.999999)
+		d = f; /* vertical, and staying so: a heading means nothing */
+	if (v3_eq(d, f) || (ne == elev && yaw_deg == 0.0))
+		return true; /* already as far as it goes: no edit */
+	c.dir = d;
 	return editor_set_camera(ed, i, &c, err);
 }

@@ -18,6 +18,14 @@
 #include "shell/keymode.h"
 #include "term/caps.h"
 
+/* A failed save, with the file it names ("save: FILE: what is wrong"). */
+static bool save_failed(shell *sh, const rt_error *err)
+{
+	char msg[RT_ERROR_MSG_MAX + RT_ERROR_FILE_MAX + 32];
+	rt_error_format(err, msg, sizeof msg);
+	return shell_fail(sh, "save: %s", msg);
+}
+
 bool cmd_load(shell *sh, int argc, char **argv, const char *rest)
 {
 	(void)argc, (void)rest;
@@ -60,7 +68,7 @@ bool cmd_save(shell *sh, int argc, char **argv, const char *rest)
 	bool ok = true;
 	if (has_ext(path, ".rt")) {
 		if (!rt_save(editor_scene(sh->ed), path, &err))
-			ok = shell_fail(sh, "save: %s", err.msg);
+			ok = save_failed(sh, &err);
 		else
 			shell_info(sh, "saved the scene to %s\n", path);
 	} else if (has_ext(path, ".ans")) {
@@ -75,7 +83,7 @@ bool cmd_save(shell *sh, int argc, char **argv, const char *rest)
 			if (a.failed)
 				ok = shell_fail(sh, "save: out of memory");
 			else if (!file_write_atomic(path, write_text, &t, &err))
-				ok = shell_fail(sh, "save: %s", err.msg);
+				ok = save_failed(sh, &err);
 			else
 				shell_info(sh, "saved the %dx%d-cell picture to %s\n", f->cols, f->rows, path);
 			abuf_free(&a);
@@ -86,7 +94,7 @@ bool cmd_save(shell *sh, int argc, char **argv, const char *rest)
 		if (!fb)
 			ok = false;
 		else if (!image_write(path, fb, sh->set.exposure, &err))
-			ok = shell_fail(sh, "save: %s", err.msg);
+			ok = save_failed(sh, &err);
 		else
 			shell_info(sh, "saved %s (%dx%d, %d sample%s, %s)\n", path, fb->w, fb->h, fb->spp,
 			          fb->spp == 1 ? "" : "s", render_mode_name(sh->full_set.mode));

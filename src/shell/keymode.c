@@ -306,31 +306,6 @@ bool keymode_is_edit(km_op op)
 	return op == KM_MOVE || op == KM_TURN || op == KM_ROTATE || op == KM_SCALE;
 }
 
-/* The camera turned by yaw degrees about the world's vertical and pitched
- * by pitch degrees, keeping within 89 degrees of the horizon. */
-static bool turn_camera(editor *ed, double yaw, double pitch, rt_error *err)
-{
-	camera c = scene_camera(editor_scene(ed));
-	vec3 f = v3_norm(c.dir);
-	double elev = asin(clampd(f.y, -1.0, 1.0)), az = atan2(f.x, f.z);
-	double lim = deg_to_rad(89.0);
-	double ne = elev + deg_to_rad(pitch);
-	if (ne > lim)
-		ne = fmax(elev, lim);
-	if (ne < -lim)
-		ne = fmin(elev, -lim);
-	double na = az + deg_to_rad(yaw);
-	if (ne == elev && yaw == 0.0)
-		return true; /* already as far as it goes */
-	if (fabs(f.y) > 0.999999 && yaw != 0.0 && ne == elev) {
-		/* Straight up or down: yaw has no azimuth to turn; turn about the
-		 * camera's own up axis instead. */
-		return editor_camera_turn(ed, yaw, 0.0, err);
-	}
-	vec3 d = v3(cos(ne) * sin(na), sin(ne), cos(ne) * cos(na));
-	return editor_camera_dir(ed, d, err);
-}
-
 bool keymode_apply(editor *ed, const km_action *a, rt_error *err)
 {
 	const scene *s = editor_scene(ed);
@@ -345,7 +320,7 @@ bool keymode_apply(editor *ed, const km_action *a, rt_error *err)
 			return editor_light_move(ed, i, a->d, err);
 		return editor_camera_pos(ed, v3_add(scene_camera(s).pos, a->d), err);
 	case KM_TURN:
-		return turn_camera(ed, a->a, a->b, err);
+		return editor_camera_turn(ed, a->a, a->b, err);
 	case KM_ROTATE:
 		if (a->sel.kind != KM_SEL_OBJECT)
 			return rt_error_set(err, "only objects rotate; press Tab to select one");

@@ -158,6 +158,30 @@ static void test_camera_verbs_by_hand(void **state)
 	editor_free(ed);
 }
 
+/* Pitching up 60 then 60 degrees more stops at 89 degrees above the horizon
+ * (elevation asin(y) = 89 deg, heading kept along +Z); yaw then turns about
+ * the vertical, keeping the elevation. A camera loaded straight down comes
+ * back up towards the top of its picture (+Z, see cam_view_make). */
+static void test_camera_pitch_stops_short_of_vertical(void **state)
+{
+	(void)state;
+	editor *ed = new_editor();
+	rt_error err;
+	double e = deg_to_rad(89.0);
+	assert_true(editor_camera_turn(ed, 0, 60, &err));
+	assert_true(editor_camera_turn(ed, 0, 60, &err));
+	camera c = scene_camera(editor_scene(ed));
+	assert_vec_near(c.dir, v3(0, sin(e), cos(e)), 1e-12);
+	assert_true(editor_camera_turn(ed, 90, 0, &err));
+	c = scene_camera(editor_scene(ed));
+	assert_vec_near(c.dir, v3(cos(e), sin(e), 0), 1e-12);
+	assert_true(editor_camera_dir(ed, v3(0, -3, 0), &err));
+	assert_true(editor_camera_turn(ed, 0, 90 - 30, &err));
+	c = scene_camera(editor_scene(ed));
+	assert_vec_near(c.dir, v3(0, -sin(RT_PI / 6), cos(RT_PI / 6)), 1e-12);
+	editor_free(ed);
+}
+
 static void test_groups_and_limits(void **state)
 {
 	(void)state;
@@ -220,6 +244,7 @@ int main(void)
 		cmocka_unit_test(test_undo_redo_restore_every_state),
 		cmocka_unit_test(test_invalid_edits_change_nothing),
 		cmocka_unit_test(test_camera_verbs_by_hand),
+		cmocka_unit_test(test_camera_pitch_stops_short_of_vertical),
 		cmocka_unit_test(test_groups_and_limits),
 		cmocka_unit_test(test_big_scene_edits_are_cheap),
 	};
