@@ -520,6 +520,12 @@ int shell_main(const rtsh_options *o)
 			then_interactive = false;
 	}
 	if (then_interactive) {
+		if (!screen_ok && isatty(STDOUT_FILENO)) {
+			const char *t = getenv("TERM");
+			fprintf(stderr, "rtsh: this terminal (TERM=%s) cannot show the picture; commands work, "
+			                "and save writes images\n",
+			        t && *t ? t : "unset");
+		}
 		sh.interactive = true;
 		sh.quit = false;
 		shell_sig_int = 0;
