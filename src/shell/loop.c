@@ -21,7 +21,9 @@
 
 #include "shell/complete.h"
 #include "shell/history.h"
+#include "shell/pager.h"
 #include "shell/shell.h"
+#include "term/abuf.h"
 #include "term/caps.h"
 
 /* At most this many frames a second. */
@@ -129,6 +131,25 @@ static void draw_picture(shell *sh)
 	draw_status(sh); /* the status line tells about the picture shown */
 }
 
+static void relayout_screen(shell *sh);
+
+/* Prints a command's output in the command area, or pages it when it would
+ * scroll out of sight there. */
+static void show_output(shell *sh, const abuf *out)
+{
+	screen *scr = sh->scr;
+	int area = scr->rows - scr->region_top; /* the command area, prompt included */
+	if (pager_rows(out->b, out->len, scr->cols) < area) {
+		fwrite(out->b, 1, out->len, stdout);
+		return;
+	}
+	fflush(stdout);
+	write_all(scr->fd, "\x1b[r\x1b[2J", 9);
+	pager_show(STDIN_FILENO, scr->fd, out->b, out->len, scr->cols, scr->rows);
+	/* Readline draws the prompt again when the command returns. */
+	relayout_screen(sh);
+}
+
 static void on_line(char *line)
 {
 	shell *sh = active;
@@ -139,9 +160,20 @@ static void on_line(char *line)
 	}
 	history_add_line(&hist, line);
 	shell_sig_int = 0;
-	if (!shell_run_line(sh, line))
-		shell_report(sh);
+	/* With a picture on screen, the output is held back: if it is longer
+	 * than the command area, the pager shows it over the whole screen. */
+	abuf out;
+	abuf_init(&out);
+	if (sh->scr && sh->scr->active)
+		sh->capture = &out;
+	bool ok = shell_run_line(sh, line);
+	sh->capture = NULL;
 	free(line);
+	if (out.len && !out.failed)
+		show_output(sh, &out);
+	abuf_free(&out);
+	if (!ok)
+		shell_report(sh);
 	fflush(stdout);
 	shell_sig_int = 0;
 	/* The command may have taken a while: show what came meanwhile. */
@@ -190,17 +222,23 @@ static void suspend(shell *sh)
 	rl_forced_update_display();
 }
 
+/* Lays the screen out again and asks for the picture (after a resize or
+ * the pager). */
+static void relayout_screen(shell *sh)
+{
+	screen_layout(sh->scr, (double)sh->set.width / sh->set.height, true);
+	rl_set_screen_size(sh->scr->rows - sh->scr->region_top, sh->scr->cols);
+	shell_refresh(sh);
+	sh->redraw = true;
+	draw_status(sh);
+}
+
 static void relayout(shell *sh)
 {
-	if (sh->scr) {
-		screen_layout(sh->scr, (double)sh->set.width / sh->set.height, true);
-		rl_set_screen_size(sh->scr->rows - sh->scr->region_top, sh->scr->cols);
-		shell_refresh(sh);
-		sh->redraw = true;
-		draw_status(sh);
-	} else {
+	if (sh->scr)
+		relayout_screen(sh);
+	else
 		rl_resize_terminal();
-	}
 	rl_forced_update_display();
 }
 

@@ -30,12 +30,38 @@ bool shell_fail(shell *sh, const char *fmt, ...)
 	return false;
 }
 
+/* Command output goes to standard output, or to the pager's buffer while
+ * an interactive command runs. */
+static void out_v(shell *sh, const char *fmt, va_list ap)
+{
+	if (!sh->capture) {
+		vprintf(fmt, ap);
+		return;
+	}
+	char small[512];
+	va_list copy;
+	va_copy(copy, ap);
+	int n = vsnprintf(small, sizeof small, fmt, copy);
+	va_end(copy);
+	if (n < 0)
+		return;
+	if ((size_t)n < sizeof small) {
+		abuf_add(sh->capture, small, (size_t)n);
+		return;
+	}
+	char *big = malloc((size_t)n + 1);
+	if (!big)
+		return;
+	vsnprintf(big, (size_t)n + 1, fmt, ap);
+	abuf_add(sh->capture, big, (size_t)n);
+	free(big);
+}
+
 void shell_out(shell *sh, const char *fmt, ...)
 {
-	(void)sh;
 	va_list ap;
 	va_start(ap, fmt);
-	vprintf(fmt, ap);
+	out_v(sh, fmt, ap);
 	va_end(ap);
 }
 
@@ -45,7 +71,7 @@ void shell_info(shell *sh, const char *fmt, ...)
 		return;
 	va_list ap;
 	va_start(ap, fmt);
-	vprintf(fmt, ap);
+	out_v(sh, fmt, ap);
 	va_end(ap);
 }
 

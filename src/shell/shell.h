@@ -24,6 +24,7 @@
 #include "shell/options.h"
 #include "shell/preview.h"
 #include "term/frame.h"
+#include "term/abuf.h"
 #include "term/screen.h"
 
 #define SHELL_MSG_MAX 1024
@@ -54,6 +55,7 @@ typedef struct shell {
 	bool progress;         /* progress bars for full renders (stderr or status line) */
 	frame_palette pal;     /* for `show` on standard output */
 	screen *scr;           /* NULL: no picture */
+	abuf *capture;         /* when set, shell_out/shell_info append here (the pager) */
 	preview *pv;           /* the world cache, and the background preview */
 	preview_image img;     /* the newest preview image shown */
 	uint8_t *srgb;         /* img as sRGB bytes */

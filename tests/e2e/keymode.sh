@@ -107,6 +107,14 @@ tmux send-keys -t "$s" "save $TMP/y.rt" Enter
 wait_for "saved the scene to $TMP/y.rt" "save y.rt"
 tmux send-keys -t "$s" "help view" Enter
 wait_for "back to the shell; every change stays" "help view does not list the keys"
+# Output longer than the command area comes in the pager: q leaves it.
+if tmux capture-pane -t "$s" -p | grep -q "Space next page"; then
+	tmux send-keys -t "$s" q
+	for i in $(seq 1 30); do
+		sleep 0.1
+		tmux capture-pane -t "$s" -p | grep -q "Space next page" || break
+	done
+fi
 tmux send-keys -t "$s" quit Enter
 for i in $(seq 1 50); do
 	sleep 0.1

@@ -46,6 +46,28 @@ tmux capture-pane -t "$s" -p | tail -n 2 | grep -q '^rtsh> *$' || fail "Ctrl-C d
 tmux send-keys -t "$s" 'object 99 move 1,0,0' Enter
 sleep 0.3
 tmux capture-pane -t "$s" -p | grep -q 'object: "99" is not an object number' || fail "no error message"
+# Output longer than the command area (help: about 25 lines, the area about
+# 10) comes in a pager over the whole screen; q gives the picture back.
+tmux send-keys -t "$s" 'help' Enter
+paged=
+for i in $(seq 1 30); do
+	sleep 0.1
+	tmux capture-pane -t "$s" -p | grep -q 'Space next page' && paged=1 && break
+done
+[ -n "$paged" ] || fail "help was not paged:
+$(tmux capture-pane -t "$s" -p | tail -n 5)"
+tmux capture-pane -t "$s" -p | head -n 1 | grep -q '^commands (a unique prefix' || fail "the pager does not start at the first line"
+tmux capture-pane -t "$s" -p | grep -q '^  quit ' || fail "the pager does not show the whole help"
+tmux send-keys -t "$s" q
+back=
+for i in $(seq 1 50); do
+	sleep 0.1
+	screen=$(tmux capture-pane -t "$s" -p -e)
+	n=$(echo "$screen" | grep -o '▀\|▄' | wc -l)
+	[ "$n" -gt 1000 ] && back=1 && break
+done
+[ -n "$back" ] || fail "the picture did not come back after the pager"
+tmux capture-pane -t "$s" -p | tail -n 2 | grep -q '^rtsh> *$' || fail "no prompt after the pager"
 tmux send-keys -t "$s" 'quit' Enter
 for i in $(seq 1 50); do
 	sleep 0.1

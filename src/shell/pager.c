@@ -1,0 +1,168 @@
+/* rtsh — the pager (pager.h). */
+#include "shell/pager.h"
+
+#include <errno.h>
+#include <poll.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/ioctl.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include "term/abuf.h"
+
+/* One display row: a slice of the text. */
+typedef struct slice {
+	const char *p;
+	size_t n;
+} slice;
+
+/* Length of the escape sequence at p (CSI ... final byte), or 0. */
+static size_t escape_len(const char *p, const char *end)
+{
+	if (p + 1 >= end || p[0] != '\x1b' || p[1] != '[')
+		return 0;
+	const char *q = p + 2;
+	while (q < end && !(*q >= 0x40 && *q <= 0x7e))
+		q++;
+	return q < end ? (size_t)(q - p) + 1 : (size_t)(end - p);
+}
+
+/* Splits text into display rows of at most cols columns; returns the count
+ * and, when out is not NULL, fills it. */
+static int split(const char *text, size_t len, int cols, slice *out)
+{
+	int n = 0;
+	const char *p = text, *end = text + len;
+	if (cols < 1)
+		cols = 1;
+	while (p < end) {
+		const char *start = p;
+		int width = 0;
+		while (p < end && *p != '\n') {
+			size_t e = escape_len(p, end);
+			if (e) {
+				p += e;
+				continue;
+			}
+			bool lead = ((unsigned char)*p & 0xc0) != 0x80;
+			if (lead && width == cols)
+				break;
+			width += lead;
+			p++;
+		}
+		if (out)
+			out[n] = (slice){start, (size_t)(p - start)};
+		n++;
+		if (p < end && *p == '\n')
+			p++;
+	}
+	return n;
+}
+
+int pager_rows(const char *text, size_t len, int cols)
+{
+	return split(text, len, cols, NULL);
+}
+
+static void draw(int fd, const slice *rows, int nrows, int top, int page, int cols)
+{
+	abuf a;
+	abuf_init(&a);
+	abuf_str(&a, "\x1b[?25l\x1b[m");
+	for (int r = 0; r < page; r++) {
+		abuf_printf(&a, "\x1b[%d;1H\x1b[m\x1b[K", r + 1);
+		if (top + r < nrows)
+			abuf_add(&a, rows[top + r].p, rows[top + r].n);
+	}
+	int last = top + page < nrows ? top + page : nrows;
+	char keys[160];
+	snprintf(keys, sizeof keys, " lines %d-%d of %d%s  Space next page  b back  Up/Down a line  q quit ",
+	         top + 1, last, nrows, last == nrows ? " (end)" : "");
+	abuf_printf(&a, "\x1b[%d;1H\x1b[m\x1b[7m", page + 1);
+	int w = 0;
+	for (const char *k = keys; *k && w < cols; k++, w++)
+		abuf_char(&a, *k);
+	for (; w < cols; w++)
+		abuf_char(&a, ' ');
+	abuf_str(&a, "\x1b[m");
+	if (!a.failed)
+		write_all(fd, a.b, a.len);
+	abuf_free(&a);
+}
+
+/* Reads one key: a byte, or an escape sequence read as a whole (waiting
+ * briefly for the rest of it on a slow link). 0 on end of input or error. */
+static int read_key(int fd, char *seq, size_t size)
+{
+	ssize_t n = read(fd, seq, 1);
+	if (n <= 0)
+		return 0;
+	size_t len = 1;
+	if (seq[0] == '\x1b') {
+		struct pollfd pf = {fd, POLLIN, 0};
+		while (len < size - 1 && poll(&pf, 1, 40) > 0) {
+			if (read(fd, seq + len, 1) != 1)
+				break;
+			len++;
+			char c = seq[len - 1];
+			if (len > 2 && ((c >= 'A' && c <= 'Z') || c == '~'))
+				break;
+		}
+	}
+	seq[len] = '\0';
+	return (int)len;
+}
+
+void pager_show(int fd_in, int fd_out, const char *text, size_t len, int cols, int rows)
+{
+	struct termios saved, raw;
+	bool have_tty = tcgetattr(fd_in, &saved) == 0;
+	if (have_tty) {
+		raw = saved;
+		raw.c_lflag &= ~(tcflag_t)(ICANON | ECHO);
+		raw.c_cc[VMIN] = 1;
+		raw.c_cc[VTIME] = 0;
+		tcsetattr(fd_in, TCSADRAIN, &raw);
+	}
+	int nrows = split(text, len, cols, NULL);
+	slice *sl = malloc((size_t)(nrows ? nrows : 1) * sizeof *sl);
+	if (sl) {
+		split(text, len, cols, sl);
+		int page = rows > 1 ? rows - 1 : 1;
+		int top = 0;
+		for (;;) {
+			int max_top = nrows > page ? nrows - page : 0;
+			top = top < 0 ? 0 : top > max_top ? max_top : top;
+			draw(fd_out, sl, nrows, top, page, cols);
+			char k[16];
+			if (!read_key(fd_in, k, sizeof k))
+				break;
+			if (strcmp(k, " ") == 0 || strcmp(k, "f") == 0 || strcmp(k, "\x1b[6~") == 0) {
+				if (top >= max_top && k[0] == ' ')
+					break;
+				top += page;
+			} else if (strcmp(k, "b") == 0 || strcmp(k, "\x1b[5~") == 0) {
+				top -= page;
+			} else if (strcmp(k, "\r") == 0 || strcmp(k, "\n") == 0 || strcmp(k, "j") == 0 ||
+			           strcmp(k, "\x1b[B") == 0 || strcmp(k, "\x1bOB") == 0) {
+				top++;
+			} else if (strcmp(k, "k") == 0 || strcmp(k, "\x1b[A") == 0 || strcmp(k, "\x1bOA") == 0) {
+				top--;
+			} else if (strcmp(k, "g") == 0 || strcmp(k, "\x1b[H") == 0 || strcmp(k, "\x1b[1~") == 0) {
+				top = 0;
+			} else if (strcmp(k, "G") == 0 || strcmp(k, "\x1b[F") == 0 || strcmp(k, "\x1b[4~") == 0) {
+				top = max_top;
+			} else if (strcmp(k, "q") == 0 || strcmp(k, "Q") == 0 || strcmp(k, "\x1b") == 0 ||
+			           k[0] == 3 /* Ctrl-C when ISIG is off */) {
+				break;
+			}
+		}
+		free(sl);
+	}
+	if (have_tty)
+		tcsetattr(fd_in, TCSADRAIN, &saved);
+	write_all(fd_out, "\x1b[?25h", 6);
+}
