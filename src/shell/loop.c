@@ -26,8 +26,12 @@
 #include "term/abuf.h"
 #include "term/caps.h"
 
-/* At most this many frames a second. */
+/* At most ten frames a second; and on a slow link (an SSH session whose
+ * writes block while the bytes drain), a frame at most every third of the
+ * time, so that the link stays free for typing and the prompt. */
 #define FRAME_INTERVAL 0.1
+#define FRAME_LINK_SHARE 3.0
+#define FRAME_GAP_MAX 5.0
 #define PROMPT "rtsh> "
 
 static shell *active;     /* the shell readline's line handler runs commands in */
@@ -126,8 +130,10 @@ static void draw_picture(shell *sh)
 	}
 	frame_srgb_from_linear(im->rgb, (size_t)im->w * im->h, sh->set.exposure, sh->srgb);
 	fflush(stdout);
+	double t0 = now();
 	screen_picture(scr, sh->srgb, im->w, im->h);
 	sh->last_draw = now();
+	sh->frame_cost = sh->last_draw - t0;
 	draw_status(sh); /* the status line tells about the picture shown */
 }
 
@@ -148,6 +154,13 @@ static void show_output(shell *sh, const abuf *out)
 	pager_show(STDIN_FILENO, scr->fd, out->b, out->len, scr->cols, scr->rows);
 	/* Readline draws the prompt again when the command returns. */
 	relayout_screen(sh);
+}
+
+/* The time to leave between two frames. */
+static double frame_gap(const shell *sh)
+{
+	double g = FRAME_LINK_SHARE * sh->frame_cost;
+	return g < FRAME_INTERVAL ? FRAME_INTERVAL : g > FRAME_GAP_MAX ? FRAME_GAP_MAX : g;
 }
 
 static void on_line(char *line)
@@ -290,7 +303,7 @@ int shell_interactive(shell *sh, bool use_screen, const int wake[2])
 			FD_SET(wake_fd, &rd);
 		struct timeval tv, *tvp = NULL;
 		if (sh->redraw) {
-			double wait = sh->last_draw + FRAME_INTERVAL - now();
+			double wait = sh->last_draw + frame_gap(sh) - now();
 			if (wait < 0)
 				wait = 0;
 			tv.tv_sec = (time_t)wait;
@@ -324,7 +337,7 @@ int shell_interactive(shell *sh, bool use_screen, const int wake[2])
 		}
 		if (preview_take(sh->pv, &sh->img))
 			sh->redraw = true;
-		if (sh->redraw && now() - sh->last_draw >= FRAME_INTERVAL)
+		if (sh->redraw && now() - sh->last_draw >= frame_gap(sh))
 			draw_picture(sh);
 		if (n > 0 && FD_ISSET(STDIN_FILENO, &rd))
 			rl_callback_read_char();

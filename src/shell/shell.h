@@ -61,6 +61,7 @@ typedef struct shell {
 	uint8_t *srgb;         /* img as sRGB bytes */
 	size_t srgb_cap;
 	double last_draw;      /* when the picture was last sent */
+	double frame_cost;     /* how long the last frame's write() took */
 	bool redraw;           /* an image waits to be drawn */
 
 	/* The full-resolution image and what it was rendered from. */
