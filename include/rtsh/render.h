@@ -49,7 +49,8 @@ int render_threads(const render_settings *s);
 
 /* A linear-light image. rgb holds w*h*3 floats, rows top to bottom: the mean
  * of the samples so far. sum holds the running per-pixel sums (double) and
- * spp how many samples they contain. */
+ * spp how many samples they contain; it is NULL in an image made in one
+ * pass (render_image), which cannot take further passes. */
 typedef struct framebuffer {
 	int w, h;
 	float *rgb;
@@ -80,7 +81,7 @@ typedef struct render_job {
 	const world *w;
 	render_settings set;   /* mode, depth, seed, threads, samples (= total target) */
 	framebuffer *fb;       /* the image size is fb->w x fb->h */
-	int sample_begin;      /* must equal fb->spp: passes are added in order */
+	int sample_begin;      /* 0 starts afresh; else must equal fb->spp (passes in order) */
 	int sample_end;        /* <= set.samples */
 	atomic_bool *cancel;   /* optional: set to stop; checked per tile */
 	render_progress_fn progress; /* optional */

@@ -91,7 +91,8 @@ void fb_clear(framebuffer *fb)
 {
 	size_t n = (size_t)fb->w * (size_t)fb->h * 3;
 	memset(fb->rgb, 0, n * sizeof *fb->rgb);
-	memset(fb->sum, 0, n * sizeof *fb->sum);
+	if (fb->sum)
+		memset(fb->sum, 0, n * sizeof *fb->sum);
 	fb->spp = 0;
 }
 
@@ -139,16 +140,25 @@ static void render_tile(shared *sh, long t)
 	for (int y = y0; y < y1; y++)
 		for (int x = x0; x < x1; x++) {
 			size_t i = ((size_t)y * (size_t)fb->w + (size_t)x) * 3;
-			double r = fb->sum[i], g = fb->sum[i + 1], b = fb->sum[i + 2];
+			/* A first pass starts from zero whatever the sums hold (a
+			 * cancelled pass leaves them half done). */
+			double r = 0.0, g = 0.0, b = 0.0;
+			if (job->sample_begin > 0) {
+				r = fb->sum[i];
+				g = fb->sum[i + 1];
+				b = fb->sum[i + 2];
+			}
 			for (int s = job->sample_begin; s < job->sample_end; s++) {
 				vec3 c = render_sample(job->w, &job->set, x, y, fb->w, fb->h, s);
 				r += c.x;
 				g += c.y;
 				b += c.z;
 			}
-			fb->sum[i] = r;
-			fb->sum[i + 1] = g;
-			fb->sum[i + 2] = b;
+			if (fb->sum) {
+				fb->sum[i] = r;
+				fb->sum[i + 1] = g;
+				fb->sum[i + 2] = b;
+			}
 			fb->rgb[i] = (float)(r * inv);
 			fb->rgb[i + 1] = (float)(g * inv);
 			fb->rgb[i + 2] = (float)(b * inv);
@@ -190,7 +200,8 @@ static void report(render_job *job, shared *sh)
 render_status render_run(render_job *job, rt_error *err)
 {
 	framebuffer *fb = job->fb;
-	if (job->sample_begin != fb->spp || job->sample_end <= job->sample_begin) {
+	if ((job->sample_begin > 0 && (job->sample_begin != fb->spp || !fb->sum)) ||
+	    job->sample_end <= job->sample_begin) {
 		rt_error_set(err, "render pass %d..%d does not follow the %d samples done",
 		             job->sample_begin, job->sample_end, fb->spp);
 		return RENDER_FAILED;
@@ -279,6 +290,9 @@ framebuffer *render_image(const world *w, const render_settings *s, atomic_bool 
 		             s->width, s->height, RENDER_MAX_DIM);
 		return NULL;
 	}
+	/* One pass makes the whole image: no running sums are needed. */
+	free(fb->sum);
+	fb->sum = NULL;
 	render_job job = {
 		.w = w,
 		.set = *s,

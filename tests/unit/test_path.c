@@ -676,7 +676,7 @@ static void test_threads_bit_identical(void **state)
 		framebuffer *fb = render_image(w, &set, NULL, NULL, NULL, NULL);
 		assert_non_null(fb);
 		assert_memory_equal(one->rgb, fb->rgb, sizeof(float) * 37 * 23 * 3);
-		assert_memory_equal(one->sum, fb->sum, sizeof(double) * 37 * 23 * 3);
+		assert_null(fb->sum); /* an image made in one pass keeps no sums */
 		fb_free(fb);
 	}
 	/* passes of 1, 2 and 3 samples on 7 threads: the same image again */
