@@ -221,6 +221,16 @@ static void test_progressive_equals_batch(void **state)
 	}
 	assert_int_equal(prog->spp, 4);
 	assert_memory_equal(batch->rgb, prog->rgb, sizeof(float) * 40 * 30 * 3);
+	/* a first pass ignores whatever the sums hold (a cancelled pass leaves
+	 * them half done): garbage in the sums, then passes from 0 */
+	for (int i = 0; i < 40 * 30 * 3; i++)
+		prog->sum[i] = 1e6 + i;
+	prog->spp = 0;
+	for (int k = 0; k < 4; k += 2) {
+		render_job job = {.w = w, .set = set, .fb = prog, .sample_begin = k, .sample_end = k + 2};
+		assert_int_equal(render_run(&job, NULL), RENDER_DONE);
+	}
+	assert_memory_equal(batch->rgb, prog->rgb, sizeof(float) * 40 * 30 * 3);
 	/* a pass that does not follow the samples done is refused */
 	render_job bad = {.w = w, .set = set, .fb = prog, .sample_begin = 2, .sample_end = 3};
 	rt_error err;
