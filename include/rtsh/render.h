@@ -63,6 +63,9 @@ framebuffer *fb_new(int w, int h);
 void fb_free(framebuffer *fb);
 /* Clears to black with no samples. */
 void fb_clear(framebuffer *fb);
+/* A cleared framebuffer of w x h in *fb, reusing the one there when it has
+ * that size (else freeing it); NULL when out of memory. */
+framebuffer *fb_reuse(framebuffer **fb, int w, int h);
 
 #define RENDER_MAX_DIM 16384
 #define RENDER_TILE 16

@@ -96,6 +96,19 @@ void fb_clear(framebuffer *fb)
 	fb->spp = 0;
 }
 
+framebuffer *fb_reuse(framebuffer **fb, int w, int h)
+{
+	if (*fb && ((*fb)->w != w || (*fb)->h != h || !(*fb)->sum)) {
+		fb_free(*fb);
+		*fb = NULL;
+	}
+	if (!*fb)
+		*fb = fb_new(w, h);
+	if (*fb)
+		fb_clear(*fb);
+	return *fb;
+}
+
 vec3 render_sample(const world *w, const render_settings *s, int px, int py, int fw, int fh, int sample)
 {
 	uint64_t pixel = (uint64_t)py * (uint64_t)fw + (uint64_t)px;

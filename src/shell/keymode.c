@@ -433,19 +433,6 @@ static void wk_publish(km_worker *wk, const km_req *req, const framebuffer *fb, 
 		wk_wake(wk);
 }
 
-static framebuffer *wk_fresh(framebuffer **fb, int w, int h)
-{
-	if (*fb && ((*fb)->w != w || (*fb)->h != h)) {
-		fb_free(*fb);
-		*fb = NULL;
-	}
-	if (!*fb)
-		*fb = fb_new(w, h);
-	if (*fb)
-		fb_clear(*fb);
-	return *fb;
-}
-
 static void wk_progress(void *ctx, long done, long total)
 {
 	km_worker *wk = ctx;
@@ -476,7 +463,7 @@ static void wk_run(km_worker *wk, const km_req *req)
 	wk->tiles_total = 1;
 	if (!req->refine) {
 		/* A fast frame: one centred sample per pixel. */
-		framebuffer *fb = wk_fresh(&wk->fast, req->w_px, req->h_px);
+		framebuffer *fb = fb_reuse(&wk->fast, req->w_px, req->h_px);
 		if (!fb)
 			return;
 		job.set.samples = 1;
@@ -500,7 +487,7 @@ static void wk_run(km_worker *wk, const km_req *req)
 	framebuffer *fb = wk->fb;
 	bool cont = fb && fb->spp > 0 && fb->spp <= req->set.samples && wk_continues(&wk->fb_req, req);
 	if (!cont)
-		fb = wk_fresh(&wk->fb, req->w_px, req->h_px);
+		fb = fb_reuse(&wk->fb, req->w_px, req->h_px);
 	if (!fb)
 		return;
 	wk->fb_req = *req;

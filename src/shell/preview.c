@@ -166,19 +166,6 @@ static void publish(preview *pv, const framebuffer *fb, int w, int h, const prev
 }
 
 /* A framebuffer of w x h with no samples, reusing *fb when it fits. */
-static framebuffer *fresh_fb(framebuffer **fb, int w, int h)
-{
-	if (*fb && ((*fb)->w != w || (*fb)->h != h)) {
-		fb_free(*fb);
-		*fb = NULL;
-	}
-	if (!*fb)
-		*fb = fb_new(w, h);
-	if (*fb)
-		fb_clear(*fb);
-	return *fb;
-}
-
 /* Renders one request; true when every sample is in. */
 static bool run(preview *pv, const preview_request *req)
 {
@@ -203,8 +190,8 @@ static bool run(preview *pv, const preview_request *req)
 
 	/* The quick pass: half the width and height, one sample. */
 	int qw = req->w / 2 > 0 ? req->w / 2 : 1, qh = req->h / 2 > 0 ? req->h / 2 : 1;
-	framebuffer *q = fresh_fb(&pv->qfb, qw, qh);
-	framebuffer *fb = fresh_fb(&pv->fb, req->w, req->h);
+	framebuffer *q = fb_reuse(&pv->qfb, qw, qh);
+	framebuffer *fb = fb_reuse(&pv->fb, req->w, req->h);
 	if (!q || !fb) {
 		snprintf(meta.error, sizeof meta.error, "out of memory for a %dx%d preview", req->w, req->h);
 		publish(pv, NULL, 0, 0, &meta);
