@@ -1522,14 +1522,7 @@ static void km_suspend(keymode *km, screen *scr, const keys *k, int in, const st
 	put_str(km->fd, keys_keypad_off(k));
 	tcsetattr(in, TCSANOW, saved);
 	screen_suspend(scr);
-	struct sigaction sa, old;
-	memset(&sa, 0, sizeof sa);
-	sa.sa_handler = SIG_DFL;
-	sigemptyset(&sa.sa_mask);
-	sigaction(SIGTSTP, &sa, &old);
-	raise(SIGTSTP);
-	/* ... continued. */
-	sigaction(SIGTSTP, &old, NULL);
+	screen_stop_self();
 	raw_modes(in, saved);
 	screen_resume(scr);
 	put_str(km->fd, keys_keypad_on(k));

@@ -218,14 +218,7 @@ static void suspend(shell *sh)
 	rl_deprep_terminal();
 	if (sh->scr)
 		screen_suspend(sh->scr);
-	struct sigaction sa, old;
-	memset(&sa, 0, sizeof sa);
-	sa.sa_handler = SIG_DFL;
-	sigemptyset(&sa.sa_mask);
-	sigaction(SIGTSTP, &sa, &old);
-	raise(SIGTSTP);
-	/* ... continued. */
-	sigaction(SIGTSTP, &old, NULL);
+	screen_stop_self();
 	rl_prep_terminal(1);
 	if (sh->scr) {
 		screen_resume(sh->scr);

@@ -15,32 +15,12 @@
 #include "shell/commands.h"
 #include "shell/shell.h"
 
-/* Cuts a comment off line (in place). */
-static void strip_comment(char *line)
+/* The first character of s, outside quotes and not escaped, that `stop`
+ * accepts; the terminating NUL when there is none. */
+static char *scan(char *s, bool (*stop)(const char *s, const char *p))
 {
 	char quote = 0;
-	for (char *p = line; *p; p++) {
-		if (quote) {
-			if (*p == '\\' && quote == '"' && p[1])
-				p++;
-			else if (*p == quote)
-				quote = 0;
-		} else if (*p == '\\' && p[1]) {
-			p++;
-		} else if (*p == '\'' || *p == '"') {
-			quote = *p;
-		} else if (*p == '#' && (p == line || p[-1] == ' ' || p[-1] == '\t')) {
-			*p = '\0';
-			return;
-		}
-	}
-}
-
-/* The end of the command starting at p: the next ';' outside quotes, or
- * the end of the string. */
-static char *command_end(char *p)
-{
-	char quote = 0;
+	char *p = s;
 	for (; *p; p++) {
 		if (quote) {
 			if (*p == '\\' && quote == '"' && p[1])
@@ -51,11 +31,36 @@ static char *command_end(char *p)
 			p++;
 		} else if (*p == '\'' || *p == '"') {
 			quote = *p;
-		} else if (*p == ';') {
-			return p;
+		} else if (stop(s, p)) {
+			break;
 		}
 	}
 	return p;
+}
+
+/* '#' at the start of a word. */
+static bool comment_start(const char *s, const char *p)
+{
+	return *p == '#' && (p == s || p[-1] == ' ' || p[-1] == '\t');
+}
+
+static bool semicolon(const char *s, const char *p)
+{
+	(void)s;
+	return *p == ';';
+}
+
+/* Cuts a comment off line (in place). */
+static void strip_comment(char *line)
+{
+	*scan(line, comment_start) = '\0';
+}
+
+/* The end of the command starting at p: the next ';' outside quotes, or
+ * the end of the string. */
+static char *command_end(char *p)
+{
+	return scan(p, semicolon);
 }
 
 static bool blank(const char *s)

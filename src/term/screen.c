@@ -232,3 +232,15 @@ void screen_picture(screen *s, const uint8_t *rgb, int w, int h)
 	const abuf *a = frame_update(s->fr);
 	put(s, a);
 }
+
+void screen_stop_self(void)
+{
+	struct sigaction sa, old;
+	memset(&sa, 0, sizeof sa);
+	sa.sa_handler = SIG_DFL;
+	sigemptyset(&sa.sa_mask);
+	sigaction(SIGTSTP, &sa, &old);
+	raise(SIGTSTP);
+	/* ... continued. */
+	sigaction(SIGTSTP, &old, NULL);
+}

@@ -63,6 +63,10 @@ void screen_picture(screen *s, const uint8_t *rgb, int w, int h);
 void screen_suspend(screen *s);
 /* Enters the alternate screen again after screen_suspend and redraws. */
 void screen_resume(screen *s);
+/* Stops the process as Ctrl-Z does (SIGTSTP with its default action) and
+ * returns once it is continued; call between screen_suspend and
+ * screen_resume. */
+void screen_stop_self(void);
 
 /* The preview size for a picture area of cols x rows cells and an aspect:
  * letterboxed inside cols x 2*rows pixels, both at least 1. */
