@@ -34,6 +34,7 @@
 #include <unistd.h>
 
 #include "core/bvh.h"
+#include "rtsh/denoise.h"
 #include "rtsh/generate.h"
 #include "rtsh/render.h"
 #include "rtsh/rtfile.h"
@@ -591,6 +592,53 @@ static void bench_preview(void)
 	scene_free(s);
 }
 
+/* --- the denoiser (issue 12, src/core/denoise.c) -----------------------
+ * denoise_image alone on a path preview of cornell.rt at 160x96 (8 samples,
+ * features recorded), 1 and 2 threads; and what recording the features
+ * costs the render. */
+static void bench_denoise(void)
+{
+	const char *path = "scenes/cornell.rt";
+	int w = 160, h = 96;
+	scene *s = load(path);
+	world *wd = build(s);
+	framebuffer *fb = fb_new(w, h), *plain = fb_new(w, h);
+	float *out = malloc((size_t)w * h * 3 * sizeof *out);
+	if (!fb || !plain || !out || !denoise_prepare(fb))
+		fail("memory", NULL);
+	render_settings set = settings(w, h, 2);
+	set.mode = MODE_PATH;
+	set.samples = 8;
+	set.depth = 12;
+	int druns = quick ? 3 : 31;
+	double tf[MAX_RUNS], tp[MAX_RUNS];
+	for (int i = 0; i < (quick ? 1 : 5); i++) {
+		tf[i] = render_once(wd, &set, fb);
+		tp[i] = render_once(wd, &set, plain);
+	}
+	int rruns = quick ? 1 : 5;
+	double mf = median(tf, rruns), mp = median(tp, rruns);
+	for (int threads = 1; threads <= 2; threads++) {
+		double t[MAX_RUNS];
+		for (int i = 0; i < druns; i++) {
+			double t0 = now();
+			if (!denoise_image(fb, out, threads))
+				fail("denoise", NULL);
+			t[i] = now() - t0;
+		}
+		row *r = add_row("cornell.rt", "denoise", w, h, 8, threads, druns, median(t, druns), -1);
+		snprintf(r->note, sizeof r->note, "denoise_image alone; target <= 5 ms (2 threads)");
+	}
+	row *r = add_row("cornell.rt", "path+features", w, h, 8, 2, rruns, mf, -1);
+	snprintf(r->note, sizeof r->note, "render recording the features: %.2fx the plain render (%.1f ms)",
+	         mf / mp, mp * 1e3);
+	free(out);
+	fb_free(plain);
+	fb_free(fb);
+	world_free(wd);
+	scene_free(s);
+}
+
 /* --- key mode (issue 6, src/shell/keymode.c) ---------------------------
  * The time from a key to the first updated frame: a key-mode session on
  * showcase.rt of 160x48 cells drawing into /dev/null. Each run waits until
@@ -698,7 +746,7 @@ static void print_table(FILE *f, bool tsv)
 
 static void usage(void)
 {
-	fputs("usage: bench [--quick] [--runs N] [--out FILE.tsv] [--only grid|primary|spheres|load|path|preview|keymode]\n",
+	fputs("usage: bench [--quick] [--runs N] [--out FILE.tsv] [--only grid|primary|spheres|load|path|preview|denoise|keymode]\n",
 	      stderr);
 	exit(2);
 }
@@ -757,6 +805,8 @@ int main(int argc, char **argv)
 		bench_path();
 	if (!only || strcmp(only, "preview") == 0)
 		bench_preview();
+	if (!only || strcmp(only, "denoise") == 0)
+		bench_denoise();
 	if (!only || strcmp(only, "keymode") == 0)
 		bench_keymode();
 	la = fopen("/proc/loadavg", "r");

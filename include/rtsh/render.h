@@ -24,6 +24,13 @@ typedef enum render_mode {
 
 const char *render_mode_name(render_mode m);
 
+/* When path-mode images are denoised (denoise.h). */
+typedef enum denoise_mode {
+	DENOISE_AUTO, /* the shell's previews only (the default) */
+	DENOISE_ON,   /* every path-mode image: previews, save, batch output */
+	DENOISE_OFF,
+} denoise_mode;
+
 typedef struct render_settings {
 	int width, height; /* full resolution */
 	int samples;       /* per pixel */
@@ -32,6 +39,7 @@ typedef struct render_settings {
 	render_mode mode;
 	uint64_t seed;
 	double exposure;   /* stops; output = radiance x 2^exposure */
+	int denoise;       /* denoise_mode */
 } render_settings;
 
 render_settings render_settings_default(void);
@@ -56,6 +64,8 @@ typedef struct framebuffer {
 	float *rgb;
 	double *sum;
 	int spp;
+	float *feat;  /* optional: the first hit's features for the denoiser
+	               * (denoise.h), recorded by path-mode jobs; NULL: none */
 } framebuffer;
 
 /* NULL when out of memory or the size is not in 1..RENDER_MAX_DIM. */

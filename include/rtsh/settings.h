@@ -17,6 +17,7 @@ typedef enum setting_type {
 	SETTING_DOUBLE,
 	SETTING_RESOLUTION, /* WxH */
 	SETTING_MODE,       /* whitted|path */
+	SETTING_DENOISE,    /* auto|on|off (denoise_mode) */
 } setting_type;
 
 typedef struct setting_def {

@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "integrators.h"
+#include "rtsh/denoise.h"
 
 const char *render_mode_name(render_mode m)
 {
@@ -26,6 +27,7 @@ render_settings render_settings_default(void)
 		.mode = MODE_WHITTED,
 		.seed = 1,
 		.exposure = 0.0,
+		.denoise = DENOISE_AUTO,
 	};
 }
 
@@ -84,6 +86,7 @@ void fb_free(framebuffer *fb)
 		return;
 	free(fb->rgb);
 	free(fb->sum);
+	free(fb->feat);
 	free(fb);
 }
 
@@ -93,6 +96,8 @@ void fb_clear(framebuffer *fb)
 	memset(fb->rgb, 0, n * sizeof *fb->rgb);
 	if (fb->sum)
 		memset(fb->sum, 0, n * sizeof *fb->sum);
+	if (fb->feat)
+		memset(fb->feat, 0, n / 3 * DENOISE_FEATURES * sizeof *fb->feat);
 	fb->spp = 0;
 }
 
@@ -161,11 +166,14 @@ static void render_tile(shared *sh, long t)
 				g = fb->sum[i + 1];
 				b = fb->sum[i + 2];
 			}
+			double sq = 0.0; /* the squared brightness of the samples, for the denoiser */
 			for (int s = job->sample_begin; s < job->sample_end; s++) {
 				vec3 c = render_sample(job->w, &job->set, x, y, fb->w, fb->h, s);
 				r += c.x;
 				g += c.y;
 				b += c.z;
+				if (fb->feat)
+					sq += denoise_sq(c);
 			}
 			if (fb->sum) {
 				fb->sum[i] = r;
@@ -175,6 +183,9 @@ static void render_tile(shared *sh, long t)
 			fb->rgb[i] = (float)(r * inv);
 			fb->rgb[i + 1] = (float)(g * inv);
 			fb->rgb[i + 2] = (float)(b * inv);
+			if (fb->feat && job->set.mode == MODE_PATH)
+				denoise_features(job->w, x, y, fb->w, fb->h, job->sample_begin,
+				                 job->sample_end, sq, fb->feat + i / 3 * DENOISE_FEATURES);
 		}
 }
 
@@ -306,6 +317,13 @@ framebuffer *render_image(const world *w, const render_settings *s, atomic_bool 
 	/* One pass makes the whole image: no running sums are needed. */
 	free(fb->sum);
 	fb->sum = NULL;
+	bool denoise = s->mode == MODE_PATH && s->denoise == DENOISE_ON;
+	if (denoise && !denoise_prepare(fb)) {
+		rt_error_set(err, "out of memory for the denoiser's features of a %dx%d image",
+		             s->width, s->height);
+		fb_free(fb);
+		return NULL;
+	}
 	render_job job = {
 		.w = w,
 		.set = *s,
@@ -320,6 +338,11 @@ framebuffer *render_image(const world *w, const render_settings *s, atomic_bool 
 	if (st != RENDER_DONE) {
 		if (st == RENDER_CANCELLED)
 			rt_error_set(err, "render stopped");
+		fb_free(fb);
+		return NULL;
+	}
+	if (denoise && !denoise_image(fb, fb->rgb, render_threads(s))) {
+		rt_error_set(err, "out of memory denoising a %dx%d image", s->width, s->height);
 		fb_free(fb);
 		return NULL;
 	}

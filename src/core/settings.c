@@ -8,6 +8,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The names of the denoise_mode values, in order. */
+static const char *const denoise_names[] = {"auto", "on", "off"};
+
 const setting_def settings_table[] = {
 #define AT(field) offsetof(render_settings, field)
 	{"resolution", SETTING_RESOLUTION, 1, RENDER_MAX_DIM, AT(width), "full-resolution image size, WxH"},
@@ -17,6 +20,8 @@ const setting_def settings_table[] = {
 	{"threads", SETTING_INT, 0, 256, AT(threads), "render threads; 0 = one per online CPU"},
 	{"seed", SETTING_U64, 0, 0, AT(seed), "random seed of the sampler"},
 	{"exposure", SETTING_DOUBLE, -20, 20, AT(exposure), "exposure in stops: output = radiance x 2^exposure"},
+	{"denoise", SETTING_DENOISE, 0, 2, AT(denoise),
+	 "path mode: denoise auto (previews only), on (saved images too) or off"},
 #undef AT
 };
 const size_t settings_count = sizeof settings_table / sizeof settings_table[0];
@@ -123,6 +128,13 @@ bool settings_set(render_settings *s, const setting_def *def, const char *value,
 		else
 			return rt_error_set(err, "mode \"%s\" is not valid; expected whitted or path", value);
 		return true;
+	case SETTING_DENOISE:
+		for (int i = 0; i < 3; i++)
+			if (strcmp(value, denoise_names[i]) == 0) {
+				s->denoise = i;
+				return true;
+			}
+		return rt_error_set(err, "denoise \"%s\" is not valid; expected auto, on or off", value);
 	}
 	return rt_error_set(err, "internal: setting %s has no type", def->name);
 }
@@ -144,6 +156,9 @@ void settings_format(const render_settings *s, const setting_def *def, char *buf
 		return;
 	case SETTING_MODE:
 		snprintf(buf, size, "%s", render_mode_name(s->mode));
+		return;
+	case SETTING_DENOISE:
+		snprintf(buf, size, "%s", denoise_names[s->denoise >= 0 && s->denoise < 3 ? s->denoise : 0]);
 		return;
 	}
 }

@@ -1,0 +1,530 @@
+/* rtsh — tests of the denoiser (denoise.c). Expected values come from a
+ * reference render or from definitions:
+ *   - on scenes/cornell.rt, 8 samples denoised are closer to a 4096-sample
+ *     reference than 64 samples without (RMS error in linear radiance, the
+ *     lamp's pixels left out);
+ *   - an edge between two flat regions keeps its width (10%-90% rise);
+ *   - a picture without noise (piecewise constant, features agreeing) comes
+ *     out unchanged; a constant one too, however noisy its neighbours;
+ *   - the features seen through a mirror are the reflected wall's, at the
+ *     distance of the whole path;
+ *   - the result is identical for any thread count; whitted mode is never
+ *     touched; the setting parses auto, on and off. */
+#include "testutil.h"
+
+#include <errno.h>
+#include <sys/stat.h>
+
+#include "rtsh/denoise.h"
+#include "rtsh/image.h"
+#include "rtsh/render.h"
+#include "rtsh/rtfile.h"
+#include "rtsh/scene.h"
+#include "rtsh/settings.h"
+#include "rtsh/world.h"
+
+/* The renders of the quality tests are too slow under ThreadSanitizer;
+ * test_threads covers the denoiser's threads there. */
+#if defined(__SANITIZE_THREAD__)
+#define SKIP_UNDER_TSAN()                                                              \
+	do {                                                                           \
+		print_message("skipped under TSan: too slow there (test_threads runs)\n"); \
+		skip();                                                                \
+	} while (0)
+#else
+#define SKIP_UNDER_TSAN() ((void)0)
+#endif
+
+static render_settings path_settings(int w, int h, int samples, int depth, uint64_t seed)
+{
+	render_settings set = render_settings_default();
+	set.width = w;
+	set.height = h;
+	set.samples = samples;
+	set.depth = depth;
+	set.threads = 2;
+	set.mode = MODE_PATH;
+	set.seed = seed;
+	set.denoise = DENOISE_OFF;
+	return set;
+}
+
+static framebuffer *render_with(const world *w, render_settings set, int denoise)
+{
+	set.denoise = denoise;
+	framebuffer *fb = render_image(w, &set, NULL, NULL, NULL, NULL);
+	assert_non_null(fb);
+	return fb;
+}
+
+/* True when any of 4x4 rays through pixel (x, y) meets an emitter. */
+static bool sees_lamp(const world *w, int x, int y, int fw, int fh)
+{
+	for (int j = 0; j < 4; j++)
+		for (int i = 0; i < 4; i++) {
+			ray r = cam_ray(&w->cam, x + (i + 0.5) / 4, y + (j + 0.5) / 4, fw, fh);
+			hit h;
+			if (world_intersect(w, &r, 0.0, INFINITY, &h)) {
+				vec3 e = w->mats[h.object].emission;
+				if (e.x + e.y + e.z > 0.0)
+					return true;
+			}
+		}
+	return false;
+}
+
+/* RMS error of a against ref over the pixels where mask is 0. */
+static double rms(const framebuffer *a, const framebuffer *ref, const unsigned char *mask)
+{
+	double sum = 0;
+	long n = 0;
+	for (int i = 0; i < a->w * a->h; i++) {
+		if (mask[i])
+			continue;
+		for (int k = 0; k < 3; k++) {
+			double d = (double)a->rgb[i * 3 + k] - ref->rgb[i * 3 + k];
+			sum += d * d;
+		}
+		n += 3;
+	}
+	return sqrt(sum / (double)n);
+}
+
+/* FNV-1a over bytes, to name the cached reference. */
+static uint64_t fnv(uint64_t h, const void *p, size_t n)
+{
+	const unsigned char *b = p;
+	for (size_t i = 0; i < n; i++)
+		h = (h ^ b[i]) * 0x100000001b3ULL;
+	return h;
+}
+
+/* The 4096-sample reference of cornell.rt, cached in build/test-cache under
+ * a name that hashes the scene file and a small probe render with the same
+ * settings: any change to the renderer that changes its pixels renders the
+ * reference again (about 15 s on two cores). */
+static framebuffer *cornell_reference(const world *w, render_settings set, const char *scene_path)
+{
+	uint64_t h = 0xcbf29ce484222325ULL;
+	FILE *f = fopen(scene_path, "rb");
+	assert_non_null(f);
+	char buf[4096];
+	size_t n;
+	while ((n = fread(buf, 1, sizeof buf, f)) > 0)
+		h = fnv(h, buf, n);
+	fclose(f);
+	render_settings probe = set;
+	probe.width = 16;
+	probe.height = 9;
+	probe.samples = 4;
+	framebuffer *pf = render_with(w, probe, DENOISE_OFF);
+	h = fnv(h, pf->rgb, (size_t)pf->w * pf->h * 3 * sizeof *pf->rgb);
+	h = fnv(h, &set.width, sizeof set.width);
+	h = fnv(h, &set.height, sizeof set.height);
+	h = fnv(h, &set.samples, sizeof set.samples);
+	h = fnv(h, &set.depth, sizeof set.depth);
+	h = fnv(h, &set.seed, sizeof set.seed);
+	fb_free(pf);
+	char path[256];
+	snprintf(path, sizeof path, "build/test-cache/cornell-%dx%d-%d-%016llx.pfm", set.width, set.height,
+	         set.samples, (unsigned long long)h);
+	rt_error err;
+	framebuffer *ref = image_read_pfm(path, &err);
+	if (ref && ref->w == set.width && ref->h == set.height) {
+		print_message("reference: %s (cached)\n", path);
+		return ref;
+	}
+	fb_free(ref);
+	ref = render_with(w, set, DENOISE_OFF);
+	if (mkdir("build", 0777) == 0 || errno == EEXIST)
+		if (mkdir("build/test-cache", 0777) == 0 || errno == EEXIST)
+			if (image_write(path, ref, 0.0, &err))
+				print_message("reference: %s (rendered and cached)\n", path);
+	return ref;
+}
+
+/* The test of issue 12: cornell.rt, 8 samples denoised against 64 without,
+ * both against 4096 samples with another seed, at 160x90 (at the scene's
+ * own depth 12). */
+static void test_cornell_rmse(void **state)
+{
+	(void)state;
+	SKIP_UNDER_TSAN();
+	rt_error err;
+	const char *path = "scenes/cornell.rt";
+	scene *s = rt_load_file(path, NULL, &err);
+	if (!s) {
+		print_message("skipped: %s\n", err.msg);
+		skip();
+	}
+	world *w = world_build(s, &err);
+	assert_non_null(w);
+	const int W = 160, H = 90, depth = 12;
+	framebuffer *ref = cornell_reference(w, path_settings(W, H, 4096, depth, 4242), path);
+	unsigned char *mask = calloc((size_t)W * H, 1);
+	assert_non_null(mask);
+	int lamp = 0;
+	for (int y = 0; y < H; y++)
+		for (int x = 0; x < W; x++)
+			lamp += mask[y * W + x] = sees_lamp(w, x, y, W, H);
+	assert_true(lamp > 0 && lamp < W * H / 10);
+	framebuffer *raw64 = render_with(w, path_settings(W, H, 64, depth, 1), DENOISE_OFF);
+	framebuffer *raw8 = render_with(w, path_settings(W, H, 8, depth, 2), DENOISE_OFF);
+	framebuffer *dn8 = render_with(w, path_settings(W, H, 8, depth, 2), DENOISE_ON);
+	double e64 = rms(raw64, ref, mask), e8 = rms(raw8, ref, mask), d8 = rms(dn8, ref, mask);
+	print_message("cornell.rt %dx%d, the lamp's %d pixels left out, RMS error against 4096 spp: "
+	              "8 spp %.5f, 64 spp %.5f, 8 spp denoised %.5f (%.2fx the 64 spp error)\n",
+	              W, H, lamp, e8, e64, d8, d8 / e64);
+	assert_true(d8 < e64);
+	fb_free(dn8);
+	fb_free(raw8);
+	fb_free(raw64);
+	free(mask);
+	fb_free(ref);
+	world_free(w);
+	scene_free(s);
+}
+
+/* --- edges ----------------------------------------------------------------- */
+
+static scene *load_text(const char *text)
+{
+	rt_error err;
+	scene *s = rt_load_string(text, strlen(text), "test", NULL, &err);
+	if (!s)
+		fail_msg("%s", err.msg);
+	return s;
+}
+
+/* The mean of the image along rows (vertical = false: a profile across x)
+ * or along columns (vertical = true: across y), of the luminance. */
+static void profile(const framebuffer *fb, bool vertical, double *p)
+{
+	int n = vertical ? fb->h : fb->w, m = vertical ? fb->w : fb->h;
+	for (int i = 0; i < n; i++) {
+		double sum = 0;
+		for (int j = 0; j < m; j++) {
+			const float *c = fb->rgb + ((size_t)(vertical ? i * fb->w + j : j * fb->w + i)) * 3;
+			sum += 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+		}
+		p[i] = sum / m;
+	}
+}
+
+/* The width in pixels of the step of profile p (n values) around index
+ * mid: the distance between its 10% and 90% crossings between the plateau
+ * means lo (before) and hi (after), linearly interpolated between pixel
+ * centres. */
+static double edge_width(const double *p, int n, int mid)
+{
+	double a = 0, b = 0;
+	for (int i = mid - 8; i < mid - 4; i++)
+		a += p[i] / 4;
+	for (int i = mid + 4; i < mid + 8; i++)
+		b += p[i] / 4;
+	double cross[2];
+	const double level[2] = {0.1, 0.9};
+	for (int k = 0; k < 2; k++) {
+		double t = a + level[k] * (b - a);
+		cross[k] = NAN;
+		for (int i = mid - 4; i < mid + 4 && i + 1 < n; i++)
+			if ((p[i] - t) * (p[i + 1] - t) <= 0 && p[i] != p[i + 1]) {
+				cross[k] = i + (t - p[i]) / (p[i + 1] - p[i]);
+				break;
+			}
+	}
+	return fabs(cross[1] - cross[0]);
+}
+
+/* The RMS difference in luminance from ref over a plateau: rows y0..y1,
+ * columns x0..x1 (exclusive). */
+static double plateau_noise(const framebuffer *fb, const framebuffer *ref, int x0, int x1, int y0, int y1)
+{
+	double s2 = 0;
+	int n = 0;
+	for (int y = y0; y < y1; y++)
+		for (int x = x0; x < x1; x++) {
+			const float *c = fb->rgb + ((size_t)y * fb->w + x) * 3;
+			const float *r = ref->rgb + ((size_t)y * fb->w + x) * 3;
+			double d = 0.2126 * (c[0] - r[0]) + 0.7152 * (c[1] - r[1]) + 0.0722 * (c[2] - r[2]);
+			s2 += d * d;
+			n++;
+		}
+	return sqrt(s2 / n);
+}
+
+/* An edge between two flat regions stays as sharp as in the reference: a
+ * change of albedo (two squares side by side, a vertical edge at the middle
+ * column boundary) and a shadow (a point light above, cut off by a shelf
+ * out of view, a horizontal edge at the middle row boundary). Lit by a lamp
+ * and a uniform sky, so the flat regions are noisy at 8 samples. */
+static void test_edges(void **state)
+{
+	(void)state;
+	SKIP_UNDER_TSAN();
+	const char *albedo_scene = "C 0,0,-4 0,0,1 40\n"
+	                           "A 0.3 255,255,255\n"
+	                           "rc -1,0,0 0,0,-1 2,1,2 222,222,222 1 0 1 0\n"
+	                           "rc 1,0,0 0,0,-1 2,1,2 60,60,60 1 0 1 0\n"
+	                           "rc 0,3,-2 0,-1,0 2,1,2 255,255,255 0 0 1 0 emit=3\n";
+	/* The light at (0,5,-1) passes the shelf's edge at z = -0.4, y = 2,
+	 * and meets the wall z = 0 at y = 0. */
+	const char *shadow_scene = "C 0,0,-4 0,0,1 40\n"
+	                           "A 0.3 255,255,255\n"
+	                           "L 0,5,-1 0.8 255,255,255\n"
+	                           "rc 0,0,0 0,0,-1 6,1,6 222,222,222 1 0 1 0\n"
+	                           "rc 0,2,-1.7 0,1,0 6,1,2.6 222,222,222 1 0 1 0\n";
+	const struct {
+		const char *name, *text;
+		bool vertical;
+	} cases[] = {{"albedo edge", albedo_scene, false}, {"shadow edge", shadow_scene, true}};
+	const int W = 64, H = 36;
+	for (size_t c = 0; c < 2; c++) {
+		scene *s = load_text(cases[c].text);
+		world *w = world_build(s, NULL);
+		assert_non_null(w);
+		framebuffer *ref = render_with(w, path_settings(W, H, 1024, 5, 7), DENOISE_OFF);
+		framebuffer *raw = render_with(w, path_settings(W, H, 8, 5, 8), DENOISE_OFF);
+		framebuffer *dn = render_with(w, path_settings(W, H, 8, 5, 8), DENOISE_ON);
+		int n = cases[c].vertical ? H : W, mid = n / 2;
+		double p[64];
+		profile(ref, cases[c].vertical, p);
+		double wref = edge_width(p, n, mid);
+		profile(raw, cases[c].vertical, p);
+		double wraw = edge_width(p, n, mid);
+		profile(dn, cases[c].vertical, p);
+		double wdn = edge_width(p, n, mid);
+		/* the noise of one flat region, away from the edge */
+		int x0 = 4, x1 = cases[c].vertical ? W - 4 : mid - 4;
+		int y0 = 4, y1 = cases[c].vertical ? mid - 4 : H - 4;
+		double nraw = plateau_noise(raw, ref, x0, x1, y0, y1), ndn = plateau_noise(dn, ref, x0, x1, y0, y1);
+		print_message("%s: width (10%%-90%%) %.2f px in the 1024-spp reference, %.2f px at 8 spp, "
+		              "%.2f px at 8 spp denoised; a flat region's RMS error %.4f -> %.4f\n",
+		              cases[c].name, wref, wraw, wdn, nraw, ndn);
+		assert_true(wref < 1.5);
+		assert_true(wdn <= wref + 0.5);
+		assert_true(ndn < 0.5 * nraw);
+		fb_free(dn);
+		fb_free(raw);
+		fb_free(ref);
+		world_free(w);
+		scene_free(s);
+	}
+}
+
+/* --- definitions ----------------------------------------------------------- */
+
+/* A framebuffer of w x h with the given features everywhere, spp samples
+ * and no noise (the mean of the squares is the square of the mean). */
+static framebuffer *flat_fb(int w, int h, int spp)
+{
+	framebuffer *fb = fb_new(w, h);
+	assert_non_null(fb);
+	assert_true(denoise_prepare(fb));
+	fb->spp = spp;
+	for (int i = 0; i < w * h; i++) {
+		float *f = fb->feat + (size_t)i * DENOISE_FEATURES;
+		f[0] = f[1] = f[2] = 0.5f;
+		f[3] = 0;
+		f[4] = 0;
+		f[5] = -1;
+		f[6] = 3;
+	}
+	return fb;
+}
+
+static void set_pixel(framebuffer *fb, int i, float r, float g, float b)
+{
+	fb->rgb[i * 3] = r;
+	fb->rgb[i * 3 + 1] = g;
+	fb->rgb[i * 3 + 2] = b;
+	double l = 0.2126 * r + 0.7152 * g + 0.0722 * b;
+	fb->feat[(size_t)i * DENOISE_FEATURES + 7] = (float)(l * l);
+}
+
+/* Without noise nothing changes: a constant picture, and a picture of two
+ * colours on one surface (a shadow's edge the features do not see) whose
+ * samples all agree. */
+static void test_no_noise_no_change(void **state)
+{
+	(void)state;
+	const int W = 40, H = 30;
+	framebuffer *fb = flat_fb(W, H, 16);
+	for (int i = 0; i < W * H; i++)
+		set_pixel(fb, i, 0.3f, 0.2f, 0.1f);
+	float *out = malloc(sizeof(float) * W * H * 3);
+	assert_non_null(out);
+	assert_true(denoise_image(fb, out, 2));
+	for (int i = 0; i < W * H * 3; i++)
+		assert_near(out[i], fb->rgb[i], 1e-6 * fb->rgb[i]);
+	for (int y = 0; y < H; y++)
+		for (int x = 0; x < W; x++)
+			if (x * 3 + y > 50)
+				set_pixel(fb, y * W + x, 0.05f, 0.04f, 0.03f);
+	assert_true(denoise_image(fb, out, 2));
+	for (int i = 0; i < W * H * 3; i++)
+		assert_near(out[i], fb->rgb[i], 1e-6 * fb->rgb[i]);
+	/* out may be the picture itself */
+	float keep = fb->rgb[0];
+	assert_true(denoise_image(fb, fb->rgb, 3));
+	assert_near(fb->rgb[0], keep, 1e-6 * keep);
+	free(out);
+	fb_free(fb);
+}
+
+/* The same picture for 1, 2, 3 and 7 threads, byte for byte. */
+static void test_threads(void **state)
+{
+	(void)state;
+	scene *s = load_text("C 0,1,-4 0,-0.2,1 60\nA 0.5 200,220,255\n"
+	                     "pl 0,0,0 0,1,0 200,200,200\nsp 0,1,0 2 220,60,50\n"
+	                     "sp 1.5,0.5,-1 0,1,0 1,1,1 255,255,255 0 0 1 1\n");
+	world *w = world_build(s, NULL);
+	assert_non_null(w);
+	render_settings set = path_settings(53, 31, 4, 4, 3);
+	framebuffer *fb = fb_new(53, 31);
+	assert_non_null(fb);
+	assert_true(denoise_prepare(fb));
+	render_job job = {.w = w, .set = set, .fb = fb, .sample_begin = 0, .sample_end = 4};
+	assert_int_equal(render_run(&job, NULL), RENDER_DONE);
+	size_t n = (size_t)fb->w * fb->h * 3;
+	float *one = malloc(n * sizeof *one), *many = malloc(n * sizeof *many);
+	assert_non_null(one);
+	assert_non_null(many);
+	assert_true(denoise_image(fb, one, 1));
+	const int threads[] = {2, 3, 7};
+	for (int k = 0; k < 3; k++) {
+		assert_true(denoise_image(fb, many, threads[k]));
+		assert_memory_equal(one, many, n * sizeof *one);
+	}
+	free(one);
+	free(many);
+	fb_free(fb);
+	world_free(w);
+	scene_free(s);
+}
+
+/* The features through a mirror are those of the surface seen in it: the
+ * camera at the origin looks along +z at a mirror at z = 2; behind the
+ * camera a wall at z = -3 faces it. The centre pixel sees the wall's
+ * albedo, its normal (0,0,1) and the depth 2 + 5 = 7; without the mirror
+ * (a white wall at z = 2) the features are that wall's at depth 2. */
+static void test_features_through_mirror(void **state)
+{
+	(void)state;
+	const char *texts[2] = {
+		"C 0,0,0 0,0,1 10\npl 0,0,2 0,0,-1 1,1,1 255,255,255 0 0 1 1\n"
+		"pl 0,0,-3 0,0,1 1,1,1 180,100,50 1 0 1 0\n",
+		"C 0,0,0 0,0,1 10\npl 0,0,2 0,0,-1 1,1,1 255,255,255 1 0 1 0\n",
+	};
+	vec3 albedo[2] = {srgb255_to_linear(v3(180, 100, 50)), v3(1, 1, 1)};
+	const double normal_z[2] = {1, -1}, depth[2] = {7, 2};
+	for (int c = 0; c < 2; c++) {
+		scene *s = load_text(texts[c]);
+		world *w = world_build(s, NULL);
+		assert_non_null(w);
+		float f[DENOISE_FEATURES] = {0};
+		denoise_features(w, 4, 4, 9, 9, 0, 1, 0.0, f);
+		assert_near(f[0], albedo[c].x, 1e-5);
+		assert_near(f[1], albedo[c].y, 1e-5);
+		assert_near(f[2], albedo[c].z, 1e-5);
+		assert_near(f[5], normal_z[c], 1e-3);
+		assert_near(f[6], depth[c], 1e-3);
+		world_free(w);
+		scene_free(s);
+	}
+}
+
+/* Features recorded in passes equal those of one pass, and mean the first
+ * DENOISE_FEATURE_SAMPLES samples; the mean square covers every sample. */
+static void test_features_in_passes(void **state)
+{
+	(void)state;
+	scene *s = load_text("C 0,1,-4 0,-0.2,1 60\nA 0.5 200,220,255\n"
+	                     "pl 0,0,0 0,1,0 200,200,200\nsp 0,1,0 2 220,60,50\n");
+	world *w = world_build(s, NULL);
+	assert_non_null(w);
+	render_settings set = path_settings(17, 11, 20, 3, 5);
+	framebuffer *a = fb_new(17, 11), *b = fb_new(17, 11);
+	assert_true(a && b && denoise_prepare(a) && denoise_prepare(b));
+	render_job job = {.w = w, .set = set, .fb = a, .sample_begin = 0, .sample_end = 20};
+	assert_int_equal(render_run(&job, NULL), RENDER_DONE);
+	const int cut[] = {0, 1, 3, 9, 20};
+	job.fb = b;
+	for (int k = 0; k + 1 < 5; k++) {
+		job.sample_begin = cut[k];
+		job.sample_end = cut[k + 1];
+		assert_int_equal(render_run(&job, NULL), RENDER_DONE);
+	}
+	for (int i = 0; i < 17 * 11 * DENOISE_FEATURES; i++)
+		assert_near(a->feat[i], b->feat[i], 1e-5 * (1 + fabsf(a->feat[i])));
+	fb_free(a);
+	fb_free(b);
+	world_free(w);
+	scene_free(s);
+}
+
+/* Whitted images are never touched, whatever the setting; path images only
+ * with denoise on (render_image is what save and batch use). */
+static void test_modes(void **state)
+{
+	(void)state;
+	scene *s = load_text("C 0,1,-4 0,-0.2,1 60\nA 0.5 200,220,255\nL 2,4,-2 0.7 255,255,255\n"
+	                     "pl 0,0,0 0,1,0 200,200,200\nsp 0,1,0 2 220,60,50\n");
+	world *w = world_build(s, NULL);
+	assert_non_null(w);
+	render_settings set = path_settings(24, 16, 4, 3, 9);
+	set.mode = MODE_WHITTED;
+	framebuffer *off = render_with(w, set, DENOISE_OFF), *on = render_with(w, set, DENOISE_ON);
+	assert_null(on->feat);
+	assert_memory_equal(off->rgb, on->rgb, sizeof(float) * 24 * 16 * 3);
+	fb_free(off);
+	fb_free(on);
+	set.mode = MODE_PATH;
+	off = render_with(w, set, DENOISE_OFF);
+	framebuffer *aut = render_with(w, set, DENOISE_AUTO);
+	on = render_with(w, set, DENOISE_ON);
+	assert_memory_equal(off->rgb, aut->rgb, sizeof(float) * 24 * 16 * 3);
+	assert_memory_not_equal(off->rgb, on->rgb, sizeof(float) * 24 * 16 * 3);
+	fb_free(off);
+	fb_free(aut);
+	fb_free(on);
+	world_free(w);
+	scene_free(s);
+}
+
+static void test_setting(void **state)
+{
+	(void)state;
+	render_settings set = render_settings_default();
+	assert_int_equal(set.denoise, DENOISE_AUTO);
+	rt_error err;
+	const setting_def *d = settings_find("denoise", &err);
+	assert_non_null(d);
+	const char *names[] = {"auto", "on", "off"};
+	for (int i = 0; i < 3; i++) {
+		assert_true(settings_set(&set, d, names[i], &err));
+		assert_int_equal(set.denoise, i);
+		char buf[16];
+		settings_format(&set, d, buf, sizeof buf);
+		assert_string_equal(buf, names[i]);
+	}
+	assert_false(settings_set(&set, d, "yes", &err));
+	assert_string_equal(err.msg, "denoise \"yes\" is not valid; expected auto, on or off");
+	assert_int_equal(set.denoise, DENOISE_OFF);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_cornell_rmse),
+		cmocka_unit_test(test_edges),
+		cmocka_unit_test(test_no_noise_no_change),
+		cmocka_unit_test(test_threads),
+		cmocka_unit_test(test_features_through_mirror),
+		cmocka_unit_test(test_features_in_passes),
+		cmocka_unit_test(test_modes),
+		cmocka_unit_test(test_setting),
+	};
+	return cmocka_run_group_tests_name("denoise", tests, NULL, NULL);
+}
