@@ -28,6 +28,7 @@ static void usage(FILE *f)
 	      "  -d N             depth               -t N   threads (0 = all CPUs)\n"
 	      "  -m whitted|path  render mode         --seed N  random seed\n"
 	      "  --color auto|truecolor|256|16|none   colour output (default auto)\n"
+	      "  --denoise        denoise path-mode images, batch output too (set denoise on)\n"
 	      "  -q               no progress output\n"
 	      "  --strict         validate scenes by the 42 subject's rules\n"
 	      "  -h, --help       this help           -V, --version  version\n"
@@ -115,6 +116,10 @@ static int parse_args(int argc, char **argv, rtsh_options *o)
 		} else if (strcmp(a, "--seed") == 0) {
 			NEED_ARG();
 			rc = add_setting(o, "seed", next);
+		} else if (strcmp(a, "--denoise") == 0) {
+			rc = add_setting(o, "denoise", "on");
+		} else if (strncmp(a, "--denoise=", 10) == 0) {
+			rc = add_setting(o, "denoise", a + 10);
 		} else if (strcmp(a, "--color") == 0 || strncmp(a, "--color=", 8) == 0) {
 			const char *v = a[7] == '=' ? a + 8 : next;
 			if (a[7] != '=')

@@ -23,7 +23,8 @@ const command command_table[] = {
 	{"render", NULL, "render", 0, 0, {NULL},
 	 "render at full resolution now, with progress; Ctrl-C stops it", cmd_render},
 	{"set", NULL, "set\nset KEY\nset KEY VALUE", 0, 2, {"@setting", "@value"},
-	 "list the settings, or show or change one (resolution WxH, samples, depth, mode, threads, seed, exposure)",
+	 "list the settings, or show or change one (resolution WxH, samples, depth, mode, threads, seed, exposure,\n"
+	 "denoise auto|on|off: auto denoises path previews only, on also saved images)",
 	 cmd_set},
 	{"list", "ls", "list [cameras|lights|objects]", 0, 1, {"cameras|lights|objects"},
 	 "the cameras, ambient, lights and objects with their numbers and fields", cmd_list},

@@ -9,6 +9,8 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "rtsh/denoise.h"
+
 /* Aim for passes of about this long, so the picture refreshes steadily. */
 #define PASS_SECONDS 0.2
 
@@ -205,9 +207,15 @@ static bool run(preview *pv, const preview_request *req)
 		.sample_end = 1,
 		.cancel = &pv->cancel,
 	};
+	/* Path previews are denoised unless `set denoise off`; each pass
+	 * rewrites rgb from the sums, so the filter may work in place. */
+	bool denoise = req->set.mode == MODE_PATH && req->set.denoise != DENOISE_OFF &&
+	               denoise_prepare(q) && denoise_prepare(fb);
+	int threads = render_threads(&req->set);
 	if (req->w >= 8 && req->h >= 8) {
 		if (render_run(&job, &err) != RENDER_DONE)
 			return false;
+		meta.denoised = denoise && denoise_image(q, q->rgb, threads);
 		meta.seconds = now() - t0;
 		publish(pv, q, req->w, req->h, &meta);
 	}
@@ -224,6 +232,7 @@ static bool run(preview *pv, const preview_request *req)
 		if (render_run(&job, &err) != RENDER_DONE)
 			return false;
 		double per = (now() - t1) / n;
+		meta.denoised = denoise && denoise_image(fb, fb->rgb, threads);
 		done += n;
 		meta.spp = done;
 		meta.done = done == req->set.samples;
@@ -291,7 +300,7 @@ static bool same_request(const preview_request *a, const preview_request *b)
 {
 	return a->gen == b->gen && a->w == b->w && a->h == b->h && a->set.samples == b->set.samples &&
 	       a->set.depth == b->set.depth && a->set.mode == b->set.mode && a->set.seed == b->set.seed &&
-	       a->set.threads == b->set.threads;
+	       a->set.threads == b->set.threads && a->set.denoise == b->set.denoise;
 }
 
 void preview_start(preview *pv, const preview_request *req)

@@ -48,6 +48,7 @@ typedef struct preview_image {
 	int spp, target;     /* samples per pixel done / wanted (spp 0: the quick pass) */
 	bool done;           /* all the samples are in */
 	bool stopped;        /* preview_stop ended it early */
+	bool denoised;       /* passed through the denoiser (path mode, set denoise) */
 	double seconds;      /* from the request to this image */
 	uint64_t gen;        /* the scene generation it shows */
 	char error[RT_ERROR_MSG_MAX]; /* not empty: the world could not be built */
