@@ -7,6 +7,7 @@
 #include "rtsh/edit.h"
 #include "rtsh/rtfile.h"
 #include "shell/commands.h"
+#include "shell/suggest.h"
 
 #define SUBS_CAMERA "pos|dir|lookat|fov|move|turn"
 #define SUBS_LIGHT "pos|move|brightness|color"
@@ -18,8 +19,13 @@ static int pick_sub(shell *sh, const char *cmd, const char *kind, const char *ch
 	int i = choice_pick(choices, word);
 	if (i < 0) {
 		char list[256];
+		char near[64];
 		choice_list(choices, list, sizeof list);
-		shell_fail(sh, "%s: \"%s\" is not %s; expected %s", cmd, word, kind, list);
+		if (suggest_choice(choices, word, near, sizeof near))
+			shell_fail(sh, "%s: \"%s\" is not %s; did you mean \"%s\"? (expected %s)", cmd, word,
+			           kind, near, list);
+		else
+			shell_fail(sh, "%s: \"%s\" is not %s; expected %s", cmd, word, kind, list);
 	}
 	return i;
 }

@@ -16,6 +16,7 @@
 #include "rtsh/settings.h"
 #include "shell/commands.h"
 #include "shell/keymode.h"
+#include "shell/suggest.h"
 #include "term/caps.h"
 
 /* A failed save, with the file it names ("save: FILE: what is wrong"). */
@@ -133,16 +134,25 @@ bool cmd_set(shell *sh, int argc, char **argv, const char *rest)
 	}
 	rt_error err;
 	const setting_def *def = settings_find(argv[0], &err);
-	if (!def)
+	if (!def) {
+		const char *near = suggest_setting(argv[0]);
+		if (near && strncmp(err.msg, "unknown", 7) == 0)
+			return shell_fail(sh, "set: unknown setting \"%s\"; did you mean \"%s\"?", argv[0], near);
 		return shell_fail(sh, "set: %s", err.msg);
+	}
 	if (argc == 1) {
 		settings_format(&sh->set, def, val, sizeof val);
 		shell_out(sh, "%s %s\n", def->name, val);
 		return true;
 	}
 	render_settings s = sh->set;
-	if (!settings_set(&s, def, argv[1], &err))
+	if (!settings_set(&s, def, argv[1], &err)) {
+		char near[32];
+		if (def->type == SETTING_MODE && suggest_choice("whitted|path", argv[1], near, sizeof near))
+			return shell_fail(sh, "set: mode \"%s\" is not valid; did you mean \"%s\"? (expected "
+			                  "whitted or path)", argv[1], near);
 		return shell_fail(sh, "set: %s", err.msg);
+	}
 	shell_edit_begin(sh);
 	sh->set = s;
 	shell_edit_end(sh);
@@ -189,6 +199,9 @@ bool cmd_list(shell *sh, int argc, char **argv, const char *rest)
 	int which = -1;
 	if (argc == 1) {
 		which = choice_pick("cameras|lights|objects", argv[0]);
+		char near[32];
+		if (which < 0 && suggest_choice("cameras|lights|objects", argv[0], near, sizeof near))
+			return shell_fail(sh, "list: \"%s\" is not a list; did you mean \"%s\"?", argv[0], near);
 		if (which < 0)
 			return shell_fail(sh, "list: \"%s\" is not a list; expected cameras, lights or objects",
 			                  argv[0]);

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "shell/keymode.h"
+#include "shell/suggest.h"
 
 #define SUBS_CAMERA "pos|dir|lookat|fov|move|turn"
 #define SUBS_LIGHT "pos|move|brightness|color"
@@ -123,6 +124,8 @@ const command *command_find(const char *word, char *msg, size_t size)
 			snprintf(last, sizeof names - (size_t)(last - names), " or %s", tail);
 		}
 		snprintf(msg, size, "ambiguous command \"%s\"; could be %s", word, names);
+	} else if (suggest_command(word, names, sizeof names)) {
+		snprintf(msg, size, "unknown command \"%s\"; did you mean \"%s\"?", word, names);
 	} else {
 		snprintf(msg, size, "unknown command \"%s\"; type help for the list of commands", word);
 	}
@@ -413,7 +416,8 @@ bool cmd_help(shell *sh, int argc, char **argv, const char *rest)
 			shell_out(sh, "also: %s\n", c->aliases);
 		return true;
 	}
-	shell_out(sh, "commands (a unique prefix is enough; help COMMAND for its usage):\n");
+	shell_out(sh, "commands (a unique prefix is enough, a typo gets a suggestion; help COMMAND for its "
+	              "usage):\n");
 	for (size_t i = 0; i < command_count; i++) {
 		const command *c = &command_table[i];
 		shell_out(sh, "  %-9s %s\n", c->name, c->help);
