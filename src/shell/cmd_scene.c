@@ -14,6 +14,7 @@
 #include "rtsh/image.h"
 #include "rtsh/rtfile.h"
 #include "rtsh/settings.h"
+#include "shell/answer.h"
 #include "shell/commands.h"
 #include "shell/keymode.h"
 #include "shell/suggest.h"
@@ -30,7 +31,11 @@ static bool save_failed(shell *sh, const rt_error *err)
 bool cmd_load(shell *sh, int argc, char **argv, const char *rest)
 {
 	(void)argc, (void)rest;
-	return shell_load(sh, argv[0]);
+	render_settings before = sh->set;
+	if (!shell_load(sh, argv[0]))
+		return false;
+	answer_loaded(sh, "loaded", &before);
+	return true;
 }
 
 static bool has_ext(const char *path, const char *ext)
@@ -153,9 +158,17 @@ bool cmd_set(shell *sh, int argc, char **argv, const char *rest)
 			                  "whitted or path)", argv[1], near);
 		return shell_fail(sh, "set: %s", err.msg);
 	}
+	char was[64];
+	settings_format(&sh->set, def, was, sizeof was);
 	shell_edit_begin(sh);
 	sh->set = s;
 	shell_edit_end(sh);
+	size_t bit = (size_t)(def - settings_table);
+	if (bit < sizeof sh->hand_set * 8)
+		sh->hand_set |= 1u << bit;
+	settings_format(&sh->set, def, val, sizeof val);
+	shell_info(sh, "%s %s%s%s%s\n", def->name, val, strcmp(was, val) ? " (was " : "",
+	           strcmp(was, val) ? was : "", strcmp(was, val) ? ")" : "");
 	return true;
 }
 
@@ -347,13 +360,21 @@ static bool step_scene(shell *sh, int step, const char *what)
 bool cmd_next(shell *sh, int argc, char **argv, const char *rest)
 {
 	(void)argc, (void)argv, (void)rest;
-	return step_scene(sh, 1, "next");
+	render_settings before = sh->set;
+	if (!step_scene(sh, 1, "next"))
+		return false;
+	answer_loaded(sh, "opened", &before);
+	return true;
 }
 
 bool cmd_prev(shell *sh, int argc, char **argv, const char *rest)
 {
 	(void)argc, (void)argv, (void)rest;
-	return step_scene(sh, -1, "prev");
+	render_settings before = sh->set;
+	if (!step_scene(sh, -1, "prev"))
+		return false;
+	answer_loaded(sh, "opened", &before);
+	return true;
 }
 
 bool cmd_show(shell *sh, int argc, char **argv, const char *rest)
