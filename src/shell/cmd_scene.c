@@ -17,6 +17,7 @@
 #include "shell/answer.h"
 #include "shell/commands.h"
 #include "shell/keymode.h"
+#include "shell/save_rt.h"
 #include "shell/suggest.h"
 #include "term/caps.h"
 
@@ -73,7 +74,7 @@ bool cmd_save(shell *sh, int argc, char **argv, const char *rest)
 	rt_error err;
 	bool ok = true;
 	if (has_ext(path, ".rt")) {
-		if (!rt_save(editor_scene(sh->ed), path, &err))
+		if (!save_rt(sh, path, &err))
 			ok = save_failed(sh, &err);
 		else
 			shell_info(sh, "saved the scene to %s\n", path);
