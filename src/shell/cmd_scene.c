@@ -16,6 +16,7 @@
 #include "rtsh/settings.h"
 #include "shell/answer.h"
 #include "shell/commands.h"
+#include "shell/complete_files.h"
 #include "shell/keymode.h"
 #include "shell/save_rt.h"
 #include "shell/suggest.h"
@@ -106,8 +107,13 @@ bool cmd_save(shell *sh, int argc, char **argv, const char *rest)
 			shell_info(sh, "saved %s (%dx%d, %d sample%s, %s)\n", path, fb->w, fb->h, fb->spp,
 			          fb->spp == 1 ? "" : "s", render_mode_name(sh->full_set.mode));
 	} else {
-		ok = shell_fail(sh, "save: \"%s\" has an unknown type; expected .ppm, .pfm, .png, .ans or .rt",
-		                path);
+		char exts[256] = "";
+		const char *const *x = output_extensions();
+		for (size_t i = 0; x[i]; i++) {
+			size_t l = strlen(exts);
+			snprintf(exts + l, sizeof exts - l, "%s%s", i == 0 ? "" : x[i + 1] ? ", " : " or ", x[i]);
+		}
+		ok = shell_fail(sh, "save: \"%s\" has an unknown type; expected %s", path, exts);
 	}
 	free(path);
 	return ok;
