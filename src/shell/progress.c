@@ -18,17 +18,23 @@ void progress_duration(double s, char *buf, size_t size)
 		snprintf(buf, size, "%.0fm%02.0fs", floor(s / 60), floor(fmod(s, 60)));
 }
 
-void progress_text(const progress_state *p, char *buf, size_t size)
+void progress_text(const progress_state *p, int bar, char *buf, size_t size)
 {
 	double frac = p->total > 0 ? (double)p->done / (double)p->total : 1.0;
 	if (frac > 1)
 		frac = 1;
-	char bar[32];
-	const int width = 20;
-	int fill = (int)(frac * width + 0.5);
-	for (int i = 0; i < width; i++)
-		bar[i] = i < fill ? '#' : '.';
-	bar[width] = '\0';
+	char bars[64] = "";
+	if (bar > 0) {
+		if (bar > 60)
+			bar = 60;
+		int fill = (int)(frac * bar + 0.5);
+		bars[0] = '[';
+		for (int i = 0; i < bar; i++)
+			bars[1 + i] = i < fill ? '#' : '.';
+		bars[bar + 1] = ']';
+		bars[bar + 2] = ' ';
+		bars[bar + 3] = '\0';
+	}
 	char el[32], left[48] = "", speed[32] = "";
 	progress_duration(p->elapsed, el, sizeof el);
 	if (p->done > 0 && p->done < p->total) {
@@ -38,9 +44,9 @@ void progress_text(const progress_state *p, char *buf, size_t size)
 	}
 	double rays = frac * (double)p->w * (double)p->h * (double)p->samples;
 	if (p->done > 0 && p->elapsed > 0)
-		snprintf(speed, sizeof speed, "  %.1f Mrays/s", rays / p->elapsed / 1e6);
+		snprintf(speed, sizeof speed, " %.1f Mrays/s", rays / p->elapsed / 1e6);
 	/* Samples per pixel done, on average: whole numbers while counting. */
 	double spp = frac * p->samples;
-	snprintf(buf, size, "[%s] %3d%%  %d/%d spp  %s%s%s", bar, (int)(frac * 100), (int)spp, p->samples, el, left,
+	snprintf(buf, size, "%s%d%% %d/%d spp %s%s%s", bars, (int)(frac * 100), (int)spp, p->samples, el, left,
 	         speed);
 }

@@ -15,8 +15,9 @@ typedef struct progress_state {
 	double elapsed;  /* seconds since the start */
 } progress_state;
 
-/* "[#####.......]  42%  27/64 spp  2.3 s, 3.1 s left  12.5 Mrays/s" */
-void progress_text(const progress_state *p, char *buf, size_t size);
+/* "[#####.......] 42% 27/64 spp 2.3 s, 3.1 s left 12.5 Mrays/s", with a bar
+ * of `bar` characters (0: none). */
+void progress_text(const progress_state *p, int bar, char *buf, size_t size);
 /* "950 ms", "12 s", "2m05s": a duration for the status line. */
 void progress_duration(double seconds, char *buf, size_t size);
 

@@ -290,7 +290,7 @@ static void on_progress(void *ctx, long done, long total)
 	progress_ctx *p = ctx;
 	char prog[192];
 	progress_state ps = {p->w, p->h, p->sh->set.samples, done, total, now() - p->t0};
-	progress_text(&ps, prog, sizeof prog);
+	progress_text(&ps, 20, prog, sizeof prog);
 	if (p->sh->scr && p->sh->scr->active) {
 		if (shell_sig_cont && !p->repainted) {
 			/* Continued after Ctrl-Z in the middle of a render: the
@@ -299,7 +299,13 @@ static void on_progress(void *ctx, long done, long total)
 			screen_resume(p->sh->scr);
 		}
 		char text[256];
-		snprintf(text, sizeof text, " rendering %dx%d %s  (Ctrl-C stops)", p->w, p->h, prog);
+		/* A bar only where it fits. */
+		for (int bar = 20; bar >= 0; bar -= 10) {
+			progress_text(&ps, bar, prog, sizeof prog);
+			snprintf(text, sizeof text, " rendering %dx%d %s (Ctrl-C stops)", p->w, p->h, prog);
+			if ((int)strlen(text) <= p->sh->scr->cols)
+				break;
+		}
 		screen_status(p->sh->scr, text);
 	} else {
 		fprintf(stderr, "\r%s   ", prog);
