@@ -295,8 +295,12 @@ static void after_probe(shell *sh)
 	if (!asked_color)
 		return;
 	if (termout_truecolor(o) == 1) {
+		/* The same picture in other colours: drawn again, not rendered
+		 * again. */
 		screen_set_palette(sh->scr, PALETTE_TRUECOLOR);
-		relayout(sh);
+		sh->redraw = true;
+		draw_status(sh);
+		rl_forced_update_display();
 	} else {
 		shell_notice(sh, "%s colours: the terminal did not say it has 24-bit colour (rtsh --color truecolor if it does)",
 		             sh->scr->pal == PALETTE_256 ? "256" : "16");

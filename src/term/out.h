@@ -41,7 +41,7 @@
 #include "term/abuf.h"
 #include "term/encoder.h"
 
-#define TERMOUT_SLICE_SECONDS 0.1
+#define TERMOUT_SLICE_SECONDS 0.08
 #define TERMOUT_PROBE_TIMEOUT 2.0
 
 typedef struct termout termout;
