@@ -279,7 +279,7 @@ void shell_status_text(shell *sh, char *buf, size_t size)
 		snprintf(samples, sizeof samples, "%d/%d spp%s", im->spp, im->target, busy && !im->done ? "…" : "");
 	}
 	if (im->denoised && !im->error[0])
-		strncat(samples, " denoised", sizeof samples - strlen(samples) - 1);
+		strncat(samples, " │ denoised", sizeof samples - strlen(samples) - 1);
 	if (im->w > 0)
 		format_seconds(im->seconds, t, sizeof t);
 	int th = render_threads(&sh->set);
