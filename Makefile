@@ -23,7 +23,7 @@ CPPFLAGS += -Iinclude -Isrc -I$(BUILD) -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOUR
 CFLAGS  ?= $(OPT) -g
 CFLAGS  += $(CSTD) $(WARN) -pthread -MMD -MP
 LDLIBS_CORE := -lpng -lm -pthread
-LDLIBS_FRONT := -lreadline -lncursesw $(LDLIBS_CORE)
+LDLIBS_FRONT := -lreadline -lncursesw -lsixel -lz $(LDLIBS_CORE)
 
 ifneq ($(SAN),)
 CFLAGS  += -fsanitize=$(SAN) -fno-omit-frame-pointer -fno-sanitize-recover=all

@@ -43,6 +43,7 @@
 #include "shell/options.h"
 #include "term/frame.h"
 #include "term/keys.h"
+#include "term/pixels.h"
 
 #define MAX_RUNS 101
 #define MAX_ROWS 64
@@ -645,6 +646,65 @@ static void bench_denoise(void)
 	scene_free(s);
 }
 
+/* --- real pixels (issue 12, src/term/pixels*.c) ---------------------------
+ * One full frame of the showcase at 1600x900 pixels in each protocol: the
+ * bytes sent and the time to encode them (1 thread); and, for comparison,
+ * the half-block frame of the same screen area at 8x16-pixel cells (200x56
+ * cells, a 200x112 picture). */
+static void bench_pixels(void)
+{
+	int w = 1600, h = 900;
+	scene *s = load("scenes/showcase.rt");
+	world *wd = build(s);
+	framebuffer *fb = fb_new(w, h), *small = fb_new(200, 112);
+	uint8_t *rgb = malloc((size_t)w * h * 3);
+	if (!fb || !small || !rgb)
+		fail("memory", NULL);
+	render_settings set = settings(w, h, 2);
+	render_once(wd, &set, fb);
+	frame_srgb_from_linear(fb->rgb, (size_t)w * h, 0.0, rgb);
+	int pruns = quick ? 1 : 5;
+	const pixels_mode modes[] = {PIXELS_KITTY, PIXELS_SIXEL, PIXELS_ITERM};
+	for (size_t k = 0; k < 3; k++) {
+		double t[MAX_RUNS];
+		size_t bytes = 0;
+		for (int i = 0; i < pruns; i++) {
+			abuf a;
+			abuf_init(&a);
+			double t0 = now();
+			if (!pixels_encode(modes[k], &a, rgb, w, h, 200, 56))
+				fail("pixels", NULL);
+			t[i] = now() - t0;
+			bytes = a.len;
+			abuf_free(&a);
+		}
+		char mode[32];
+		snprintf(mode, sizeof mode, "pixels-%s", pixels_mode_name(modes[k]));
+		row *r = add_row("showcase.rt", mode, w, h, 1, 1, pruns, median(t, pruns), -1);
+		snprintf(r->note, sizeof r->note, "%zu bytes a full frame (%.2f bytes a pixel)", bytes,
+		         (double)bytes / ((double)w * h));
+	}
+	render_settings sset = settings(200, 112, 2);
+	render_once(wd, &sset, small);
+	uint8_t *srgb = malloc((size_t)200 * 112 * 3);
+	frame *f = frame_new(200, 56, PALETTE_TRUECOLOR);
+	if (!srgb || !f)
+		fail("memory", NULL);
+	frame_srgb_from_linear(small->rgb, (size_t)200 * 112, 0.0, srgb);
+	frame_put_image(f, srgb, 200, 112, 0, 0);
+	double t0 = now();
+	size_t hb = frame_update(f)->len;
+	row *r = add_row("showcase.rt", "pixels-off", 200, 112, 1, 1, 1, now() - t0, -1);
+	snprintf(r->note, sizeof r->note, "half blocks, the same area at 8x16-pixel cells: %zu bytes", hb);
+	frame_free(f);
+	free(srgb);
+	free(rgb);
+	fb_free(small);
+	fb_free(fb);
+	world_free(wd);
+	scene_free(s);
+}
+
 /* --- key mode (issue 6, src/shell/keymode.c) ---------------------------
  * The time from a key to the first updated frame: a key-mode session on
  * showcase.rt of 160x48 cells drawing into /dev/null. Each run waits until
@@ -752,7 +812,7 @@ static void print_table(FILE *f, bool tsv)
 
 static void usage(void)
 {
-	fputs("usage: bench [--quick] [--runs N] [--out FILE.tsv] [--only grid|primary|spheres|load|path|preview|denoise|keymode]\n",
+	fputs("usage: bench [--quick] [--runs N] [--out FILE.tsv] [--only grid|primary|spheres|load|path|preview|denoise|pixels|keymode]\n",
 	      stderr);
 	exit(2);
 }
@@ -813,6 +873,8 @@ int main(int argc, char **argv)
 		bench_preview();
 	if (!only || strcmp(only, "denoise") == 0)
 		bench_denoise();
+	if (!only || strcmp(only, "pixels") == 0)
+		bench_pixels();
 	if (!only || strcmp(only, "keymode") == 0)
 		bench_keymode();
 	la = fopen("/proc/loadavg", "r");

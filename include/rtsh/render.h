@@ -40,6 +40,8 @@ typedef struct render_settings {
 	uint64_t seed;
 	double exposure;   /* stops; output = radiance x 2^exposure */
 	int denoise;       /* denoise_mode */
+	int pixels;        /* the shell's picture: off (half blocks), kitty, sixel,
+	                    * iterm, auto (term/pixels.h, pixels_mode) */
 } render_settings;
 
 render_settings render_settings_default(void);

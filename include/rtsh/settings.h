@@ -18,6 +18,7 @@ typedef enum setting_type {
 	SETTING_RESOLUTION, /* WxH */
 	SETTING_MODE,       /* whitted|path */
 	SETTING_DENOISE,    /* auto|on|off (denoise_mode) */
+	SETTING_PIXELS,     /* off|kitty|sixel|iterm|auto (pixels_mode) */
 } setting_type;
 
 typedef struct setting_def {

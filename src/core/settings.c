@@ -10,6 +10,8 @@
 
 /* The names of the denoise_mode values, in order. */
 static const char *const denoise_names[] = {"auto", "on", "off"};
+/* The names of term/pixels.h's pixels_mode values, in order. */
+static const char *const pixels_names[] = {"off", "kitty", "sixel", "iterm", "auto"};
 
 const setting_def settings_table[] = {
 #define AT(field) offsetof(render_settings, field)
@@ -22,6 +24,8 @@ const setting_def settings_table[] = {
 	{"exposure", SETTING_DOUBLE, -20, 20, AT(exposure), "exposure in stops: output = radiance x 2^exposure"},
 	{"denoise", SETTING_DENOISE, 0, 2, AT(denoise),
 	 "path mode: denoise auto (previews only), on (saved images too) or off"},
+	{"pixels", SETTING_PIXELS, 0, 4, AT(pixels),
+	 "the picture in real pixels: off (half blocks), kitty, sixel, iterm, or auto (ask the terminal)"},
 #undef AT
 };
 const size_t settings_count = sizeof settings_table / sizeof settings_table[0];
@@ -135,6 +139,14 @@ bool settings_set(render_settings *s, const setting_def *def, const char *value,
 				return true;
 			}
 		return rt_error_set(err, "denoise \"%s\" is not valid; expected auto, on or off", value);
+	case SETTING_PIXELS:
+		for (int i = 0; i < 5; i++)
+			if (strcmp(value, pixels_names[i]) == 0) {
+				s->pixels = i;
+				return true;
+			}
+		return rt_error_set(err, "pixels \"%s\" is not valid; expected off, kitty, sixel, iterm or auto",
+		                    value);
 	}
 	return rt_error_set(err, "internal: setting %s has no type", def->name);
 }
@@ -159,6 +171,9 @@ void settings_format(const render_settings *s, const setting_def *def, char *buf
 		return;
 	case SETTING_DENOISE:
 		snprintf(buf, size, "%s", denoise_names[s->denoise >= 0 && s->denoise < 3 ? s->denoise : 0]);
+		return;
+	case SETTING_PIXELS:
+		snprintf(buf, size, "%s", pixels_names[s->pixels >= 0 && s->pixels < 5 ? s->pixels : 0]);
 		return;
 	}
 }

@@ -1534,6 +1534,8 @@ bool keymode_run(shell *sh)
 		return shell_fail(sh, "view: ncurses cannot read the keys of this terminal (TERM=%s)",
 		                  getenv("TERM") ? getenv("TERM") : "");
 	}
+	/* kitty images float over text: none may stay under key mode's. */
+	screen_clear_all(scr);
 	/* The shell's screen steps aside: nothing of the shell draws until
 	 * key mode is over. */
 	void (*hook)(shell *) = sh->status_hook;

@@ -292,6 +292,13 @@ static void after_probe(shell *sh)
 	if (probe_seen || termout_get_state(o) == TERMOUT_PROBING)
 		return;
 	probe_seen = true;
+	if (sh->set.pixels != PIXELS_OFF && screen_set_pixels(sh->scr, sh->set.pixels)) {
+		/* The answers told the cell size or, for auto, the protocol: the
+		 * screen was laid out again for it. */
+		shell_refresh(sh);
+		draw_status(sh);
+		rl_forced_update_display();
+	}
 	if (!asked_color)
 		return;
 	if (termout_truecolor(o) == 1) {
@@ -345,8 +352,10 @@ int shell_interactive(shell *sh, bool use_screen, const int wake[2])
 	draw_status(sh);
 	rl_callback_handler_install(PROMPT, on_line);
 	/* After readline turned echo off, so the answers are not echoed. */
-	if (sh->scr && !getenv("RTSH_NO_PACING"))
+	if (sh->scr && !getenv("RTSH_NO_PACING")) {
+		termout_ask_pixels(scr.out, sh->set.pixels != PIXELS_OFF);
 		termout_probe(scr.out, asked_color, now());
+	}
 
 	int status = 0;
 	while (!sh->quit) {

@@ -223,7 +223,10 @@ void shell_refresh(shell *sh)
 		preview_release(sh->pv);
 		return;
 	}
-	screen_layout(sh->scr, aspect_of(&sh->set), false);
+	/* A new pixels setting takes effect here; what the terminal answered
+	 * later, in the loop's after_probe. */
+	if (sh->set.pixels == sh->scr->pixels || !screen_set_pixels(sh->scr, sh->set.pixels))
+		screen_layout(sh->scr, aspect_of(&sh->set), false);
 	if (sh->scr->img_w <= 0 || sh->scr->img_h <= 0) {
 		preview_release(sh->pv);
 		return;

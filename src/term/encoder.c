@@ -5,6 +5,9 @@
 
 const encoder_ops *const encoder_table[] = {
 	&encoder_halfblock,
+	&encoder_kitty,
+	&encoder_sixel,
+	&encoder_iterm,
 	NULL,
 };
 

@@ -63,6 +63,9 @@ struct encoder {
 
 /* The half-block encoder (term/frame.h underneath). */
 extern const encoder_ops encoder_halfblock;
+/* Real pixels (term/pixels.h; enc_pixels.c): the canvas is the area at the
+ * terminal's pixel size (geom.cell_w, cell_h must be known). */
+extern const encoder_ops encoder_kitty, encoder_sixel, encoder_iterm;
 
 /* The encoders by name ("halfblock", ...), NULL-terminated. */
 extern const encoder_ops *const encoder_table[];

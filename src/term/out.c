@@ -48,6 +48,8 @@ struct termout {
 	double hold_since;
 
 	int truecolor;
+	bool ask_pixels;   /* the pixel questions go with the probe */
+	pixels_caps pix;   /* their answers */
 	bool notice_given;
 	const char *notice;
 	termout_stats st;
@@ -107,6 +109,16 @@ static void say(termout *o, const char *msg)
 	}
 }
 
+void termout_ask_pixels(termout *o, bool on)
+{
+	o->ask_pixels = on;
+}
+
+const pixels_caps *termout_pixels(const termout *o)
+{
+	return &o->pix;
+}
+
 void termout_probe(termout *o, bool ask_color, double now)
 {
 	abuf *a = &o->buf;
@@ -116,6 +128,8 @@ void termout_probe(termout *o, bool ask_color, double now)
 		push_query(o, Q_RQSS, now, 0);
 		push_query(o, Q_TCAP, now, 0);
 	}
+	if (o->ask_pixels)
+		pixels_questions(a); /* answered before DA1, or never */
 	abuf_str(a, DA1_QUERY);
 	push_query(o, Q_DA1, now, 0);
 	o->probe_sent = now;
@@ -253,6 +267,21 @@ static size_t parse(termout *o, const char *p, size_t n, double now, abuf *keys)
 			abuf_add(keys, p + i, j - i);
 			i = j;
 			continue;
+		}
+		if (o->ask_pixels) {
+			size_t k = pixels_answer(&o->pix, p + i, n - i);
+			if (k) {
+				i += k;
+				continue;
+			}
+			/* the kitty answer (an APC) cut short: hold it */
+			if (n - i >= 2 && p[i + 1] == '_' && o->qlen > 0 && n - i < HOLD_MAX) {
+				bool end = false;
+				for (size_t j = i + 2; j + 1 < n && !end; j++)
+					end = p[j] == '\x1b' && p[j + 1] == '\\';
+				if (!end)
+					return i;
+			}
 		}
 		int kind;
 		size_t len = scan_seq(o, p + i, n - i, &kind);

@@ -40,6 +40,7 @@
 
 #include "term/abuf.h"
 #include "term/encoder.h"
+#include "term/pixels.h"
 
 #define TERMOUT_SLICE_SECONDS 0.08
 #define TERMOUT_PROBE_TIMEOUT 2.0
@@ -74,6 +75,12 @@ void termout_set_picture(termout *o, encoder *e);
  * what it shows. */
 void termout_drop_picture(termout *o);
 
+/* Also asks, in the next termout_probe, what pixels the terminal shows
+ * (term/pixels.h: the kitty graphics query, XTSMGRAPHICS, the cell size);
+ * the answers are kept for termout_pixels. */
+void termout_ask_pixels(termout *o, bool on);
+/* What the terminal said about pixels (all false/0 until it answered). */
+const pixels_caps *termout_pixels(const termout *o);
 /* Sends the start-up questions (the truecolor ones when ask_color) and
  * the DA1 fence; pacing starts when the fence is answered. */
 void termout_probe(termout *o, bool ask_color, double now);

@@ -23,6 +23,10 @@
  * screen_keypad (the handlers live in shell/signals.c). */
 static volatile sig_atomic_t restore_fd = -1;
 static volatile sig_atomic_t keypad_on;
+/* kitty images were shown: they float over the text, so every way out and
+ * every full clear deletes them. */
+static volatile sig_atomic_t kitty_shown;
+#define KITTY_DELETE_ALL "\x1b_Ga=d,d=A,q=2\x1b\\"
 static char keypad_on_seq[64], keypad_off_seq[64];
 
 static void put_raw(int fd, const char *s, size_t n)
@@ -45,6 +49,8 @@ void screen_restore_async(void)
 		return;
 	if (keypad_on && keypad_off_seq[0])
 		put_raw(fd, keypad_off_seq, strlen(keypad_off_seq));
+	if (kitty_shown)
+		put_raw(fd, KITTY_DELETE_ALL, sizeof KITTY_DELETE_ALL - 1);
 	put_raw(fd, RESTORE_SEQ, sizeof RESTORE_SEQ - 1);
 }
 
@@ -95,6 +101,10 @@ static void query_size(screen *s)
 	if (ioctl(s->fd, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 0 && ws.ws_row > 0) {
 		s->cols = ws.ws_col;
 		s->rows = ws.ws_row;
+		if (ws.ws_xpixel > 0 && ws.ws_ypixel > 0) {
+			s->cell_w = ws.ws_xpixel / ws.ws_col;
+			s->cell_h = ws.ws_ypixel / ws.ws_row;
+		}
 	} else {
 		s->cols = 80;
 		s->rows = 24;
@@ -119,6 +129,21 @@ static void compute_layout(screen *s)
 	s->pic_rows = need < avail ? need : avail;
 	s->status_row = s->pic_rows;
 	s->region_top = s->pic_rows + 1;
+	if (s->pix_ops) {
+		/* Real pixels: the picture area at the terminal's pixel size. */
+		int cw = s->cols * s->cell_w, ch = s->pic_rows * s->cell_h;
+		s->img_w = cw;
+		s->img_h = (int)lround(cw / s->aspect);
+		if (s->img_h > ch) {
+			s->img_h = ch;
+			s->img_w = (int)lround(ch * s->aspect);
+		}
+		s->img_w = s->img_w < 1 ? 1 : s->img_w > cw ? cw : s->img_w;
+		s->img_h = s->img_h < 1 ? 1 : s->img_h;
+		s->img_x = (cw - s->img_w) / 2;
+		s->img_y = (ch - s->img_h) / 2;
+		return;
+	}
 	screen_fit(s->cols, s->pic_rows, s->aspect, s->pal == PALETTE_NONE, &s->img_w, &s->img_h);
 	s->img_x = (s->cols - s->img_w) / 2;
 	s->img_y = (2 * s->pic_rows - s->img_h) / 2;
@@ -139,11 +164,25 @@ static void put(screen *s, const abuf *a)
 /* A new picture encoder for the layout (none when there is no room). */
 static void open_encoder(screen *s)
 {
+	if (kitty_shown && s->enc) {
+		/* The old layout's images go with it (kitty's float over text). */
+		abuf a;
+		abuf_init(&a);
+		abuf_str(&a, KITTY_DELETE_ALL);
+		put(s, &a);
+		abuf_free(&a);
+	}
 	encoder_close(s->enc);
 	s->enc = NULL;
 	if (s->pic_rows > 0) {
-		encoder_geom g = {.cols = s->cols, .rows = s->pic_rows, .pal = s->pal};
-		s->enc = encoder_halfblock.open(&g);
+		encoder_geom g = {.cols = s->cols, .rows = s->pic_rows, .pal = s->pal,
+		                  .cell_w = s->cell_w, .cell_h = s->cell_h};
+		if (s->pix_ops)
+			s->enc = s->pix_ops->open(&g);
+		if (s->pix_ops == &encoder_kitty)
+			kitty_shown = 1;
+		if (!s->enc)
+			s->enc = encoder_halfblock.open(&g);
 	}
 	if (s->out)
 		termout_set_picture(s->out, s->enc);
@@ -201,7 +240,8 @@ bool screen_layout(screen *s, double aspect, bool force)
 		s->enc->ops->clear(s->enc);
 	} else if (changed || force || !s->enc) {
 		if (!s->enc || s->enc->geom.cols != s->cols || s->enc->geom.rows != s->pic_rows ||
-		    s->enc->geom.pal != s->pal)
+		    s->enc->geom.pal != s->pal || s->enc->geom.cell_w != s->cell_w ||
+		    s->enc->geom.cell_h != s->cell_h)
 			open_encoder(s);
 		if (s->enc)
 			s->enc->ops->clear(s->enc);
@@ -250,6 +290,14 @@ void screen_leave(screen *s)
 void screen_clear_all(screen *s)
 {
 	static const char seq[] = "\x1b[r\x1b[2J";
+	if (kitty_shown) {
+		if (s->out)
+			termout_text(s->out, KITTY_DELETE_ALL, sizeof KITTY_DELETE_ALL - 1);
+		else
+			write_all(s->fd, KITTY_DELETE_ALL, sizeof KITTY_DELETE_ALL - 1);
+		if (s->enc)
+			s->enc->ops->invalidate(s->enc);
+	}
 	if (s->out)
 		termout_text(s->out, seq, sizeof seq - 1);
 	else
@@ -263,6 +311,37 @@ void screen_set_palette(screen *s, frame_palette pal)
 	s->pal = pal;
 	if (s->active)
 		screen_layout(s, s->aspect, true);
+}
+
+bool screen_set_pixels(screen *s, int mode)
+{
+	s->pixels = mode;
+	const pixels_caps *c = s->out ? termout_pixels(s->out) : NULL;
+	if (mode == PIXELS_AUTO)
+		mode = c ? pixels_choose(c) : PIXELS_OFF;
+	bool cell = false;
+	if (c && c->cell_w > 0 && c->cell_h > 0 && (c->cell_w != s->cell_w || c->cell_h != s->cell_h)) {
+		s->cell_w = c->cell_w;
+		s->cell_h = c->cell_h;
+		cell = true;
+	}
+	const encoder_ops *ops = mode == PIXELS_KITTY   ? &encoder_kitty
+	                         : mode == PIXELS_SIXEL ? &encoder_sixel
+	                         : mode == PIXELS_ITERM ? &encoder_iterm
+	                                                : NULL;
+	if (s->cell_w <= 0 || s->cell_h <= 0)
+		ops = NULL;
+	if (ops == s->pix_ops && !(ops && cell))
+		return false;
+	s->pix_ops = ops;
+	if (s->active) {
+		if (kitty_shown)
+			screen_clear_all(s);
+		encoder_close(s->enc);
+		s->enc = NULL;
+		screen_layout(s, s->aspect, true);
+	}
+	return true;
 }
 
 void screen_status(screen *s, const char *text)

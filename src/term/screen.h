@@ -13,6 +13,8 @@
  *   \e[2J                 clear the screen
  *   \e[7m                 reverse video (the status line)
  *   \e[K                  clear to the end of the line
+ *   \e_Ga=d,d=A,q=2\e\\     kitty: delete the images (when the picture used
+ *                         them: before a full clear, a new layout, the way out)
  *
  *   \e[?2026l \e[?25h \e[?2004l \e[?1000l \e[?1002l \e[?1003l \e[?1006l
  *   \e[?1l \e>           on the way out: every mode rtsh or readline may
@@ -43,6 +45,9 @@ typedef struct screen {
 	int img_w, img_h;  /* the preview's size in pixels (0 when no picture) */
 	int img_x, img_y;  /* its place on the cols x 2*pic_rows pixel canvas */
 	encoder *enc;      /* the picture area's encoder */
+	int pixels;        /* pixels_mode asked for (screen_set_pixels) */
+	const encoder_ops *pix_ops; /* the pixel encoder in use; NULL: half blocks */
+	int cell_w, cell_h; /* a cell in pixels (0: not known) */
 	termout *out;      /* every byte of the screen goes out through it */
 	bool active;
 	char status[512];  /* the status line's text */
@@ -64,6 +69,11 @@ void screen_clear_all(screen *s);
 /* Another palette (the terminal said it has truecolor): lays out and
  * clears the screen again. */
 void screen_set_palette(screen *s, frame_palette pal);
+/* Real pixels (term/pixels.h): mode off, kitty, sixel, iterm or auto (what
+ * the terminal said in the start-up probe; half blocks when it said
+ * nothing, or the cell size in pixels is not known). Lays the screen out
+ * again when the encoder changes; true then. */
+bool screen_set_pixels(screen *s, int mode);
 /* Sets and draws the status line. */
 void screen_status(screen *s, const char *text);
 /* Puts an sRGB image of img_w x img_h pixels in the picture area

@@ -1,0 +1,238 @@
+/* rtsh — the pixel encoders (encoder.h): kitty, sixel and iTerm2 behind the
+ * encoder interface.
+ *
+ * The canvas is the picture area at the terminal's own pixel size (cols x
+ * cell_w by rows x cell_h). It is sent in strips of STRIP_ROWS cell rows,
+ * each a picture of its own placed at its first cell (kitty: its own image
+ * id, replaced in place), so that every part of an update stands alone
+ * and a slow link carries one strip at a time: a newer picture is never
+ * queued behind an older one, the strips still to send simply come from
+ * it. A strip whose pixels the terminal already shows is not sent (a hash
+ * of its bytes is kept), so an unchanged frame costs nothing.
+ *
+ * Clearing for kitty deletes the images (they float above the text and
+ * would survive a cleared screen); sixel and iTerm2 pictures live in the
+ * cells and go with them, so a cleared canvas is sent as background. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "term/encoder.h"
+#include "term/pixels.h"
+
+/* Cell rows per strip. */
+#define STRIP_ROWS 2
+
+typedef struct pix_enc {
+	encoder base;
+	pixels_mode mode;
+	int w, h;          /* the canvas in pixels */
+	uint8_t *rgb;      /* w*h*3, sRGB */
+	int nstrips;
+	uint64_t *want;    /* the hash of each strip of the canvas */
+	uint64_t *shown;   /* the hash of what the terminal shows there; 0: not known */
+	bool *stale;       /* given up by keep_shown: the terminal shows an older picture */
+	int next;          /* the strip to look at first (round robin) */
+	bool erase;        /* kitty: delete the images before anything else */
+	int kitty_used;    /* kitty: image ids used so far (from PIXELS_KITTY_ID) */
+} pix_enc;
+
+static void pix_canvas(const encoder_geom *g, int *w, int *h)
+{
+	*w = g->cols * g->cell_w;
+	*h = g->rows * g->cell_h;
+}
+
+static uint64_t strip_hash(const pix_enc *e, int k)
+{
+	int sh = STRIP_ROWS * e->base.geom.cell_h;
+	int y0 = k * sh, y1 = y0 + sh < e->h ? y0 + sh : e->h;
+	const uint8_t *p = e->rgb + (size_t)y0 * e->w * 3, *end = e->rgb + (size_t)y1 * e->w * 3;
+	uint64_t x = 0xcbf29ce484222325ULL; /* FNV-1a */
+	for (; p < end; p++)
+		x = (x ^ *p) * 0x100000001b3ULL;
+	return x | 1; /* never 0, which means "not known" */
+}
+
+static encoder *pix_open_mode(const encoder_geom *g, const encoder_ops *ops, pixels_mode mode)
+{
+	int w, h;
+	pix_canvas(g, &w, &h);
+	if (w < 1 || h < 1 || g->cell_h < 1)
+		return NULL;
+	pix_enc *e = calloc(1, sizeof *e);
+	if (!e)
+		return NULL;
+	e->base.ops = ops;
+	e->base.geom = *g;
+	e->mode = mode;
+	e->w = w;
+	e->h = h;
+	e->nstrips = (g->rows + STRIP_ROWS - 1) / STRIP_ROWS;
+	e->rgb = calloc((size_t)w * h * 3, 1);
+	e->want = calloc((size_t)e->nstrips, sizeof *e->want);
+	e->shown = calloc((size_t)e->nstrips, sizeof *e->shown);
+	e->stale = calloc((size_t)e->nstrips, sizeof *e->stale);
+	if (!e->rgb || !e->want || !e->shown || !e->stale) {
+		free(e->rgb);
+		free(e->want);
+		free(e->shown);
+		free(e->stale);
+		free(e);
+		return NULL;
+	}
+	/* The terminal shows the background (the screen was cleared). */
+	for (int k = 0; k < e->nstrips; k++)
+		e->shown[k] = e->want[k] = strip_hash(e, k);
+	return &e->base;
+}
+
+static void pix_close(encoder *b)
+{
+	pix_enc *e = (pix_enc *)b;
+	free(e->rgb);
+	free(e->want);
+	free(e->shown);
+	free(e->stale);
+	free(e);
+}
+
+static void pix_put(encoder *b, const uint8_t *rgb, int w, int h, int ox, int oy)
+{
+	pix_enc *e = (pix_enc *)b;
+	int x0 = ox < 0 ? 0 : ox, y0 = oy < 0 ? 0 : oy;
+	int x1 = ox + w < e->w ? ox + w : e->w, y1 = oy + h < e->h ? oy + h : e->h;
+	if (x1 <= x0 || y1 <= y0)
+		return;
+	for (int y = y0; y < y1; y++)
+		memcpy(e->rgb + ((size_t)y * e->w + x0) * 3, rgb + ((size_t)(y - oy) * w + (x0 - ox)) * 3,
+		       (size_t)(x1 - x0) * 3);
+	int sh = STRIP_ROWS * e->base.geom.cell_h;
+	for (int k = y0 / sh; k <= (y1 - 1) / sh && k < e->nstrips; k++) {
+		e->want[k] = strip_hash(e, k);
+		if (e->stale[k]) {
+			e->shown[k] = 0;
+			e->stale[k] = false;
+		}
+	}
+}
+
+static void pix_clear(encoder *b)
+{
+	pix_enc *e = (pix_enc *)b;
+	memset(e->rgb, 0, (size_t)e->w * e->h * 3);
+	for (int k = 0; k < e->nstrips; k++)
+		e->want[k] = strip_hash(e, k);
+	if (e->mode == PIXELS_KITTY) {
+		/* Deleting the images shows the background again. */
+		e->erase = e->kitty_used > 0;
+		memcpy(e->shown, e->want, (size_t)e->nstrips * sizeof *e->shown);
+	}
+}
+
+static void pix_invalidate(encoder *b)
+{
+	pix_enc *e = (pix_enc *)b;
+	memset(e->shown, 0, (size_t)e->nstrips * sizeof *e->shown);
+	memset(e->stale, 0, (size_t)e->nstrips * sizeof *e->stale);
+}
+
+/* Appends strip k, placed at its cell with the cursor saved and restored. */
+static bool send_strip(pix_enc *e, int k, abuf *out)
+{
+	const encoder_geom *g = &e->base.geom;
+	int rows = g->rows - k * STRIP_ROWS < STRIP_ROWS ? g->rows - k * STRIP_ROWS : STRIP_ROWS;
+	int y0 = k * STRIP_ROWS * g->cell_h, h = rows * g->cell_h;
+	size_t len0 = out->len;
+	abuf_printf(out, "\x1b" "7\x1b[%d;%dH", g->y0 + k * STRIP_ROWS + 1, g->x0 + 1);
+	const uint8_t *p = e->rgb + (size_t)y0 * e->w * 3;
+	bool ok;
+	if (e->mode == PIXELS_KITTY) {
+		ok = k < PIXELS_KITTY_IDS && pixels_kitty(out, p, e->w, h, g->cols, rows, PIXELS_KITTY_ID + k);
+		if (ok && k + 1 > e->kitty_used)
+			e->kitty_used = k + 1;
+	} else {
+		ok = pixels_encode(e->mode, out, p, e->w, h, g->cols, rows);
+	}
+	abuf_str(out, "\x1b" "8");
+	if (!ok || out->failed) {
+		out->len = len0;
+		return false;
+	}
+	return true;
+}
+
+static bool pix_update(encoder *b, abuf *out, size_t budget)
+{
+	pix_enc *e = (pix_enc *)b;
+	size_t start = out->len;
+	if (e->erase) {
+		for (int k = 0; k < e->kitty_used; k++)
+			pixels_kitty_delete(out, PIXELS_KITTY_ID + k);
+		e->kitty_used = 0;
+		e->erase = false;
+	}
+	for (int i = 0; i < e->nstrips; i++) {
+		int k = (e->next + i) % e->nstrips;
+		if (e->want[k] == e->shown[k])
+			continue;
+		if (out->len > start && out->len - start >= budget) {
+			e->next = k;
+			return true;
+		}
+		if (send_strip(e, k, out))
+			e->shown[k] = e->want[k];
+		else
+			e->shown[k] = e->want[k]; /* out of memory: give this picture up */
+		e->next = (k + 1) % e->nstrips;
+	}
+	return false;
+}
+
+static bool pix_dirty(const encoder *b)
+{
+	const pix_enc *e = (const pix_enc *)b;
+	if (e->erase)
+		return true;
+	for (int k = 0; k < e->nstrips; k++)
+		if (e->want[k] != e->shown[k])
+			return true;
+	return false;
+}
+
+static void pix_keep_shown(encoder *b)
+{
+	pix_enc *e = (pix_enc *)b;
+	/* What the terminal shows stays: the strips not sent are given up
+	 * until the next picture, which sends them whatever it holds. */
+	for (int k = 0; k < e->nstrips; k++)
+		if (e->shown[k] != e->want[k]) {
+			e->shown[k] = e->want[k];
+			e->stale[k] = true;
+		}
+}
+
+static encoder *kitty_open(const encoder_geom *g)
+{
+	return pix_open_mode(g, &encoder_kitty, PIXELS_KITTY);
+}
+
+static encoder *sixel_open(const encoder_geom *g)
+{
+	return pix_open_mode(g, &encoder_sixel, PIXELS_SIXEL);
+}
+
+static encoder *iterm_open(const encoder_geom *g)
+{
+	return pix_open_mode(g, &encoder_iterm, PIXELS_ITERM);
+}
+
+#define PIXEL_OPS(NAME, OPEN)                                                                      \
+	{                                                                                          \
+		.name = NAME, .canvas = pix_canvas, .open = OPEN, .close = pix_close, .put = pix_put, \
+		.clear = pix_clear, .invalidate = pix_invalidate, .update = pix_update,            \
+		.dirty = pix_dirty, .keep_shown = pix_keep_shown,                                  \
+	}
+
+const encoder_ops encoder_kitty = PIXEL_OPS("kitty", kitty_open);
+const encoder_ops encoder_sixel = PIXEL_OPS("sixel", sixel_open);
+const encoder_ops encoder_iterm = PIXEL_OPS("iterm", iterm_open);
