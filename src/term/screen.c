@@ -9,6 +9,7 @@
 #include <termios.h>
 #include <unistd.h>
 
+#include "rtsh/atomic.h"
 #include "term/abuf.h"
 
 #define ENTER_SEQ "\x1b[?1049h"
@@ -21,6 +22,7 @@ static volatile sig_atomic_t have_modes;
 
 static void crash_handler(int sig)
 {
+	atomic_cleanup_on_signal(); /* a save in progress leaves no temporary file */
 	if (restore_fd >= 0) {
 		ssize_t r = write(restore_fd, RESTORE_SEQ, sizeof RESTORE_SEQ - 1);
 		(void)r;
