@@ -127,11 +127,8 @@ static void guard_off(guard *g)
 static void split(const char *path, char *dir, size_t dsize, const char **base)
 {
 	const char *slash = strrchr(path, '/');
-	size_t n = slash ? (size_t)(slash - path) + 1 : 0;
-	if (n >= dsize)
-		n = dsize - 1;
-	memcpy(dir, path, n);
-	dir[n] = '\0';
+	int n = slash ? (int)(slash - path) + 1 : 0;
+	snprintf(dir, dsize, "%.*s", n, path);
 	*base = slash ? slash + 1 : path;
 }
 
