@@ -5,6 +5,7 @@
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/ioctl.h>
 #include <unistd.h>
@@ -317,8 +318,15 @@ bool screen_set_pixels(screen *s, int mode)
 {
 	s->pixels = mode;
 	const pixels_caps *c = s->out ? termout_pixels(s->out) : NULL;
-	if (mode == PIXELS_AUTO)
-		mode = c ? pixels_choose(c) : PIXELS_OFF;
+	if (mode == PIXELS_AUTO) {
+		/* What the terminal answered, and what the environment says
+		 * (iTerm2 has no query of its own). */
+		pixels_caps all = {0};
+		if (c)
+			all = *c;
+		pixels_caps_env(&all, getenv("TERM_PROGRAM"), getenv("LC_TERMINAL"), getenv("TMUX"));
+		mode = pixels_choose(&all);
+	}
 	bool cell = false;
 	if (c && c->cell_w > 0 && c->cell_h > 0 && (c->cell_w != s->cell_w || c->cell_h != s->cell_h)) {
 		s->cell_w = c->cell_w;
