@@ -1535,7 +1535,7 @@ bool keymode_run(shell *sh)
 		                  getenv("TERM") ? getenv("TERM") : "");
 	}
 	/* kitty images float over text: none may stay under key mode's. */
-	screen_clear_all(scr);
+	screen_drop_images(scr);
 	/* The shell's screen steps aside: nothing of the shell draws until
 	 * key mode is over. */
 	void (*hook)(shell *) = sh->status_hook;

@@ -288,17 +288,22 @@ void screen_leave(screen *s)
 	s->out = NULL;
 }
 
+void screen_drop_images(screen *s)
+{
+	if (!kitty_shown)
+		return;
+	if (s->out)
+		termout_text(s->out, KITTY_DELETE_ALL, sizeof KITTY_DELETE_ALL - 1);
+	else
+		write_all(s->fd, KITTY_DELETE_ALL, sizeof KITTY_DELETE_ALL - 1);
+	if (s->enc)
+		s->enc->ops->invalidate(s->enc);
+}
+
 void screen_clear_all(screen *s)
 {
 	static const char seq[] = "\x1b[r\x1b[2J";
-	if (kitty_shown) {
-		if (s->out)
-			termout_text(s->out, KITTY_DELETE_ALL, sizeof KITTY_DELETE_ALL - 1);
-		else
-			write_all(s->fd, KITTY_DELETE_ALL, sizeof KITTY_DELETE_ALL - 1);
-		if (s->enc)
-			s->enc->ops->invalidate(s->enc);
-	}
+	screen_drop_images(s);
 	if (s->out)
 		termout_text(s->out, seq, sizeof seq - 1);
 	else

@@ -74,6 +74,9 @@ void screen_set_palette(screen *s, frame_palette pal);
  * nothing, or the cell size in pixels is not known). Lays the screen out
  * again when the encoder changes; true then. */
 bool screen_set_pixels(screen *s, int mode);
+/* Deletes the picture's kitty images now, if it showed any (they float
+ * over text): before something else draws on the screen (key mode). */
+void screen_drop_images(screen *s);
 /* Sets and draws the status line. */
 void screen_status(screen *s, const char *text);
 /* Puts an sRGB image of img_w x img_h pixels in the picture area
