@@ -15,6 +15,7 @@
 #include "testutil.h"
 
 #include "core/sampler.h"
+#include "core/warp.h"
 #include "rtsh/render.h"
 #include "rtsh/scene.h"
 #include "rtsh/world.h"
