@@ -36,7 +36,9 @@
 #include "rtsh/rtfile.h"
 #include "rtsh/world.h"
 
+#ifndef QDIR
 #define QDIR "build/quality"
+#endif
 
 static FILE *tsv;
 
