@@ -28,6 +28,9 @@ struct emitter {
 	vec3 n;          /* flat shapes: unit normal */
 	double r;        /* sphere radius */
 	double area;     /* flat shapes */
+	double reach2;   /* flat shapes: sampled by solid angle from points closer
+	                  * to c than sqrt(reach2), by area beyond (0: always by
+	                  * area) */
 };
 
 /* Fills w->emitters with the scene's emissive spheres, rectangles, discs
