@@ -16,7 +16,7 @@
  *          columns are still measured and the Cycles ones say why not.
  * preview  the shell's progressive preview of scenes/cornell.rt at 160x96
  *          (all threads, passes of 1, 1, 2, 4, ... samples): the RMS error
- *          of the picture after each pass against a 16384-sample reference,
+ *          of the picture after each pass against a 4096-sample reference,
  *          and the time it takes to reach given errors.
  *
  * Times are CPU seconds of the render (the rendering thread for one thread,
@@ -333,13 +333,13 @@ static void bench_preview(void)
 	world *w = world_build(s, &err);
 	if (!w)
 		die("world_build", &err);
-	framebuffer *ref = reference(w, path_settings(W, H, 16384, depth, 0, 4242),
+	framebuffer *ref = reference(w, path_settings(W, H, 4096, depth, 0, 4242),
 	                             QDIR "/cornell-preview-ref.pfm");
 	static const double targets[] = {0.05, 0.03, 0.02};
 	const int nt = 3;
 	double reach[3] = {-1, -1, -1}, prev_t = 0, prev_e = 0;
 	printf("\ncornell.rt preview, %dx%d, all threads, passes 1, 1, 2, 4, ... samples; RMS error of "
-	       "the displayed sRGB picture against a 16384-sample reference\n",
+	       "the displayed sRGB picture against a 4096-sample reference\n",
 	       W, H);
 	printf("%6s %10s %10s\n", "spp", "cpu s", "rms");
 	framebuffer *fb = fb_new(W, H);

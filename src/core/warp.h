@@ -32,14 +32,17 @@ static inline double max3(vec3 v)
 }
 
 /* cos and sin of x in [-pi/4, pi/4] by their Taylor series to x^12, error
- * below 1e-11. */
+ * below 1e-11; the polynomials in x^2 evaluated in pairs (Estrin's scheme)
+ * for a short chain of dependent operations. */
 static inline void sincos_small(double x, double *c, double *s)
 {
-	double x2 = x * x;
-	*s = x * (1.0 + x2 * (-1.0 / 6 + x2 * (1.0 / 120 + x2 * (-1.0 / 5040 + x2 * (1.0 / 362880 +
-	                                                         x2 * (-1.0 / 39916800))))));
-	*c = 1.0 + x2 * (-0.5 + x2 * (1.0 / 24 + x2 * (-1.0 / 720 + x2 * (1.0 / 40320 + x2 * (
-	                                               -1.0 / 3628800 + x2 * (1.0 / 479001600))))));
+	double x2 = x * x, x4 = x2 * x2, x8 = x4 * x4;
+	double s01 = 1.0 - x2 * (1.0 / 6), s23 = 1.0 / 120 - x2 * (1.0 / 5040);
+	double s45 = 1.0 / 362880 - x2 * (1.0 / 39916800);
+	*s = x * (s01 + x4 * s23 + x8 * s45);
+	double c01 = 1.0 - x2 * 0.5, c23 = 1.0 / 24 - x2 * (1.0 / 720);
+	double c45 = 1.0 / 40320 - x2 * (1.0 / 3628800), c6 = 1.0 / 479001600;
+	*c = c01 + x4 * c23 + x8 * (c45 + x4 * c6);
 }
 
 /* The point at angle 2 pi t of the unit circle (t in [0, 1]). */
