@@ -1,7 +1,8 @@
 /* rtsh — equal-quality benchmarks (`make bench` runs them after the speed
  * table; bench/README.md explains the rows):
  *
- *   quality [--only cycles|preview] [--out FILE.tsv] [--no-cycles]
+ *   quality [--only cycles|preview] [--scene cornell|glass-sky] [--out FILE.tsv]
+ *           [--no-cycles]
  *
  * cycles   rtsh's path mode against Blender's Cycles on the same scenes
  *          (scenes/cornell.rt and bench/glass-sky.rt, rebuilt in Cycles by
@@ -324,6 +325,33 @@ static double rms_display(const framebuffer *a, const framebuffer *ref)
 	return sqrt(s / n);
 }
 
+/* The RMS error of the linear radiance. */
+static double rms_linear(const framebuffer *a, const framebuffer *ref)
+{
+	double s = 0;
+	long n = (long)a->w * a->h * 3;
+	for (long i = 0; i < n; i++) {
+		double d = (double)a->rgb[i] - ref->rgb[i];
+		s += d * d;
+	}
+	return sqrt(s / n);
+}
+
+/* Updates reach[k], the time target k was first met, from the errors
+ * (prev_t, prev_e) and (t, e) of two passes, interpolated in log-log. */
+static void crossing(const double *targets, int nt, double *reach, double prev_t, double prev_e, double t,
+                     double e)
+{
+	for (int k = 0; k < nt; k++)
+		if (reach[k] < 0 && e <= targets[k]) {
+			if (prev_t > 0 && prev_e > e)
+				reach[k] = exp(log(prev_t) + (log(targets[k]) - log(prev_e)) / (log(e) - log(prev_e)) *
+				                                 (log(t) - log(prev_t)));
+			else
+				reach[k] = t;
+		}
+}
+
 static void bench_preview(void)
 {
 	const int W = 160, H = 96, MAX = 256;
@@ -337,11 +365,12 @@ static void bench_preview(void)
 	                             QDIR "/cornell-preview-ref.pfm");
 	static const double targets[] = {0.05, 0.03, 0.02};
 	const int nt = 3;
-	double reach[3] = {-1, -1, -1}, prev_t = 0, prev_e = 0;
-	printf("\ncornell.rt preview, %dx%d, all threads, passes 1, 1, 2, 4, ... samples; RMS error of "
-	       "the displayed sRGB picture against a 4096-sample reference\n",
+	double reach[2][3] = {{-1, -1, -1}, {-1, -1, -1}}, prev_t = 0, prev_e[2] = {0, 0};
+	printf("\ncornell.rt preview, %dx%d, all threads, passes 1, 1, 2, 4, ... samples; RMS error "
+	       "against a 4096-sample reference, of the displayed sRGB picture (codes / 255) and of the "
+	       "linear radiance\n",
 	       W, H);
-	printf("%6s %10s %10s\n", "spp", "cpu s", "rms");
+	printf("%6s %10s %10s %10s\n", "spp", "cpu s", "rms sRGB", "rms linear");
 	framebuffer *fb = fb_new(W, H);
 	render_settings set = path_settings(W, H, MAX, depth, 0, 3);
 	double t = 0;
@@ -351,28 +380,25 @@ static void bench_preview(void)
 		if (render_run(&job, &err) != RENDER_DONE)
 			die("render", &err);
 		t += cpu_now(CLOCK_PROCESS_CPUTIME_ID) - t0;
-		double e = rms_display(fb, ref);
-		printf("%6d %10.4f %10.5f\n", done + n, t, e);
-		/* the time a target is crossed, interpolated in log-log */
-		for (int k = 0; k < nt; k++)
-			if (reach[k] < 0 && e <= targets[k]) {
-				if (prev_t > 0 && prev_e > e)
-					reach[k] = exp(log(prev_t) + (log(targets[k]) - log(prev_e)) /
-					                                 (log(e) - log(prev_e)) * (log(t) - log(prev_t)));
-				else
-					reach[k] = t;
-			}
+		double e[2] = {rms_display(fb, ref), rms_linear(fb, ref)};
+		printf("%6d %10.4f %10.5f %10.5f\n", done + n, t, e[0], e[1]);
+		for (int m = 0; m < 2; m++) {
+			crossing(targets, nt, reach[m], prev_t, prev_e[m], t, e[m]);
+			prev_e[m] = e[m];
+		}
 		prev_t = t;
-		prev_e = e;
 	}
-	for (int k = 0; k < nt; k++) {
-		if (reach[k] > 0)
-			printf("RMS %.3f reached after %.3f CPU s\n", targets[k], reach[k]);
-		else
-			printf("RMS %.3f not reached in %d samples\n", targets[k], MAX);
-		if (tsv)
-			fprintf(tsv, "cornell.rt\tpreview-rms\t%.3f\t%.4f\n", targets[k], reach[k]);
-	}
+	for (int m = 0; m < 2; m++)
+		for (int k = 0; k < nt; k++) {
+			const char *space = m ? "linear" : "sRGB";
+			if (reach[m][k] > 0)
+				printf("RMS %s %.3f reached after %.3f CPU s\n", space, targets[k], reach[m][k]);
+			else
+				printf("RMS %s %.3f not reached in %d samples\n", space, targets[k], MAX);
+			if (tsv)
+				fprintf(tsv, "cornell.rt\tpreview-rms-%s\t%.3f\t%.4f\n", space, targets[k],
+				        reach[m][k]);
+		}
 	fb_free(fb);
 	fb_free(ref);
 	world_free(w);
@@ -381,7 +407,7 @@ static void bench_preview(void)
 
 int main(int argc, char **argv)
 {
-	const char *only = NULL, *out = NULL;
+	const char *only = NULL, *out = NULL, *one = NULL;
 	bool cycles = true;
 	for (int i = 1; i < argc; i++) {
 		if (strcmp(argv[i], "--only") == 0 && i + 1 < argc)
@@ -390,8 +416,12 @@ int main(int argc, char **argv)
 			out = argv[++i];
 		else if (strcmp(argv[i], "--no-cycles") == 0)
 			cycles = false;
+		else if (strcmp(argv[i], "--scene") == 0 && i + 1 < argc)
+			one = argv[++i];
 		else {
-			fputs("usage: quality [--only cycles|preview] [--out FILE.tsv] [--no-cycles]\n", stderr);
+			fputs("usage: quality [--only cycles|preview] [--scene cornell|glass-sky] [--out FILE.tsv] "
+			      "[--no-cycles]\n",
+			      stderr);
 			return 2;
 		}
 	}
@@ -400,8 +430,10 @@ int main(int argc, char **argv)
 	if (out && !(tsv = fopen(out, "w")))
 		die(out, NULL);
 	if (!only || strcmp(only, "cycles") == 0) {
-		bench_cycles_scene("scenes/cornell.rt", "cornell", cycles);
-		bench_cycles_scene("bench/glass-sky.rt", "glass-sky", cycles);
+		if (!one || strcmp(one, "cornell") == 0)
+			bench_cycles_scene("scenes/cornell.rt", "cornell", cycles);
+		if (!one || strcmp(one, "glass-sky") == 0)
+			bench_cycles_scene("bench/glass-sky.rt", "glass-sky", cycles);
 	}
 	if (!only || strcmp(only, "preview") == 0)
 		bench_preview();
