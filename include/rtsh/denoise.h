@@ -38,7 +38,7 @@
  * (denoise_sq), from which the noise of the pixel is estimated. */
 #define DENOISE_FEATURES 8
 /* The features are the mean of at most this many samples per pixel. */
-#define DENOISE_FEATURE_SAMPLES 4
+#define DENOISE_FEATURE_SAMPLES 8
 
 /* Gives fb its feature buffer (cleared) if it has none, so that path-mode
  * render jobs into it record features; false when out of memory. */
