@@ -22,7 +22,7 @@ WARN    := -Wall -Wextra -Wpedantic -Werror -Wshadow -Wstrict-prototypes -Wmissi
 CPPFLAGS += -Iinclude -Isrc -I$(BUILD) -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -DRTSH_VERSION=\"$(VERSION)\"
 CFLAGS  ?= $(OPT) -g
 CFLAGS  += $(CSTD) $(WARN) -pthread -MMD -MP
-LDLIBS_CORE := -lpng -lm -pthread
+LDLIBS_CORE := -lpng -lassimp -lXpm -lstb -lm -pthread
 LDLIBS_FRONT := -lreadline -lncursesw $(LDLIBS_CORE)
 
 ifneq ($(SAN),)

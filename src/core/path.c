@@ -477,7 +477,7 @@ vec3 path_radiance(const world *w, const render_settings *s, ray r, rng *g)
 			radiance = v3_add(radiance, v3_mul(thr, world_background(w, r.d, MODE_PATH)));
 			break;
 		}
-		const mat_lin *m = &w->mats[h.object];
+		const mat_lin *m = &w->mats[h.mat];
 		if (m->light >= 0 && from_pdf > 0.0) {
 			double pdf_l = emitter_pdf(&w->emitters[m->light], from, r.d, h.t) /
 			               (double)w->nemitters;
