@@ -1317,6 +1317,8 @@ fail:
 
 scene *rt_load_file(const char *path, const rt_load_opts *opts, rt_error *err)
 {
+	if (mesh_format_known(path) && !(opts && opts->strict))
+		return rt_load_model(path, opts, err);
 	if (opts && opts->strict && !has_rt_extension(path)) {
 		rt_error_at(err, path, 0, 0,
 		            "the file name does not end in .rt; expected a .rt file (strict mode)");
