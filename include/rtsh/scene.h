@@ -112,6 +112,8 @@ typedef struct sky {
 	vec3 zenith;     /* sRGB 0..255 */
 	vec3 horizon;    /* sRGB 0..255 */
 	double strength; /* radiance scale, >= 0 */
+	const char *file; /* sky FILE [STRENGTH [ROTATION]]: an HDR image (rt_intern'ed), or NULL */
+	double rotation;  /* degrees about +Y */
 } sky;
 
 /* Per-scene render hints from the file (`R`, `set` lines). scene_new sets

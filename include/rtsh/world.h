@@ -134,6 +134,7 @@ typedef struct world {
 	vec3 ambient;   /* linear ambient radiance (ratio x colour) */
 	bool has_sky;
 	vec3 sky_zenith, sky_horizon; /* linear, already x strength */
+	const struct envmap *env; /* an HDR sky (envmap.h), or NULL */
 	light_lin *lights;
 	size_t nlights;
 	prim *prims;     /* bounded primitives, in BVH order */

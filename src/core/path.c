@@ -27,6 +27,7 @@
  * radiance ratio L gives a surface the irradiance pi * L * cos(theta), so a
  * white Lambertian surface facing it sends back exactly L. */
 #include "integrators.h"
+#include "envmap.h"
 
 #include <stdlib.h>
 
@@ -471,10 +472,16 @@ vec3 path_radiance(const world *w, const render_settings *s, ray r, rng *g)
 	 * when the emitters were also sampled there (0: weigh emission by 1). */
 	vec3 from = r.o;
 	double from_pdf = 0.0;
+	double env_from_pdf = 0.0; /* the same for the HDR sky (envmap.c) */
 	for (int bounce = 0;; bounce++) {
 		hit h;
 		if (!world_intersect(w, &r, 0.0, INFINITY, &h)) {
-			radiance = v3_add(radiance, v3_mul(thr, world_background(w, r.d, MODE_PATH)));
+			vec3 bg = world_background(w, r.d, MODE_PATH);
+			if (w->env && env_from_pdf > 0.0) {
+				double pe = envmap_pdf(w->env, r.d);
+				bg = v3_scale(bg, env_from_pdf * env_from_pdf / (env_from_pdf * env_from_pdf + pe * pe));
+			}
+			radiance = v3_add(radiance, v3_mul(thr, bg));
 			break;
 		}
 		const mat_lin *m = &w->mats[h.mat];
@@ -496,6 +503,8 @@ vec3 path_radiance(const world *w, const render_settings *s, ray r, rng *g)
 		bool sample_emitters = b.smooth && w->nemitters;
 		if (sample_emitters)
 			radiance = v3_add(radiance, v3_mul(thr, emitter_light(w, &b, p, h.object, g)));
+		if (b.smooth && w->env)
+			radiance = v3_add(radiance, v3_mul(thr, envmap_light(w, &b, p, g)));
 
 		bsdf_sample bs;
 		if (!bsdf_sample_dir(&b, g, &bs))
@@ -505,6 +514,7 @@ vec3 path_radiance(const world *w, const render_settings *s, ray r, rng *g)
 		r = (ray){bs.transmit ? offset_point(w, h.p, v3_neg(b.n)) : p, bs.wi};
 		from = r.o;
 		from_pdf = sample_emitters && !bs.delta ? bsdf_pdf(&b, bs.wi) : 0.0;
+		env_from_pdf = b.smooth && w->env && !bs.delta ? bsdf_pdf(&b, bs.wi) : 0.0;
 
 		/* Russian roulette after the third bounce: survive with q, weigh
 		 * the survivors by 1 / q. */

@@ -1,9 +1,12 @@
 /* rtsh — shading helpers shared by the integrators. */
 #include "integrators.h"
+#include "envmap.h"
 #include "rtsh/texture.h"
 
 vec3 world_background(const world *w, vec3 dir, render_mode mode)
 {
+	if (w->env)
+		return envmap_eval(w->env, dir);
 	if (w->has_sky) {
 		/* The height gradient of the path-tracer seed: horizon at and
 		 * below y = 0, zenith straight up. */

@@ -12,6 +12,7 @@
 
 #include "bvh.h"
 #include "integrators.h"
+#include "envmap.h"
 #include "surface.h"
 #include "rtsh/shape.h"
 
@@ -204,7 +205,14 @@ world *world_build(const scene *s, rt_error *err)
 	if (s->has_ambient)
 		w->ambient = v3_scale(srgb255_to_linear(s->amb.color), s->amb.ratio);
 	w->has_sky = s->has_sky;
-	if (s->has_sky) {
+	if (s->has_sky && s->sky.file) {
+		envmap *env = envmap_new(s->sky.file, s->sky.strength, s->sky.rotation, err);
+		if (!env) {
+			world_free(w);
+			return NULL;
+		}
+		w->env = env;
+	} else if (s->has_sky) {
 		w->sky_zenith = v3_scale(srgb255_to_linear(s->sky.zenith), s->sky.strength);
 		w->sky_horizon = v3_scale(srgb255_to_linear(s->sky.horizon), s->sky.strength);
 	}
@@ -313,6 +321,7 @@ void world_free(world *w)
 	free(w->tris);
 	free(w->emitters);
 	surf_free(w);
+	envmap_free((envmap *)w->env);
 	bvh_free(w->tree);
 	free(w);
 }
@@ -507,7 +516,7 @@ size_t world_memory(const world *w)
 	           w->nemitters * sizeof *w->emitters;
 	if (w->tree)
 		n += sizeof *w->tree + w->tree->nnodes * sizeof *w->tree->nodes;
-	return n + surf_memory(w);
+	return n + surf_memory(w) + (w->env ? envmap_memory(w->env) : 0);
 }
 
 /* What the slab tests need of a ray, computed once per ray. The tests run in

@@ -616,18 +616,30 @@ static bool parse_resolution(parser *p, const elem_def *e)
 	return r >= 0;
 }
 
+static bool get_file(parser *p, const tok *t, const char *name, size_t n, const rt_key *key,
+                     const char **out);
+
 static bool parse_sky(parser *p, const elem_def *e)
 {
 	sky k = {.strength = 1};
-	if (!no_keys(p, e) || !count_ok(p, e, 2, 3, e->usage) ||
+	if (p->np >= 1 && (p->toks[1].quoted || !memchr(p->toks[1].s, ',', p->toks[1].len))) {
+		/* sky FILE [STRENGTH [ROTATION]]: an HDR image */
+		if (!no_keys(p, e) || !count_ok(p, e, 1, 3, e->usage) ||
+		    !get_file(p, &p->toks[1], p->toks[1].s, p->toks[1].len, NULL, &k.file))
+			return false;
+		if (p->np >= 2 && !get_num(p, &p->toks[2], e->name, "strength", &R_NONNEG, &k.strength))
+			return false;
+		if (p->np >= 3 && !get_num(p, &p->toks[3], e->name, "rotation", &R_ANY, &k.rotation))
+			return false;
+	} else if (!no_keys(p, e) || !count_ok(p, e, 2, 3, e->usage) ||
 	    !get_color(p, &p->toks[1], e->name, "zenith colour", &k.zenith) ||
 	    !get_color(p, &p->toks[2], e->name, "horizon colour", &k.horizon))
 		return false;
-	if (p->np == 3 && !get_num(p, &p->toks[3], e->name, "strength", &R_NONNEG, &k.strength))
+	else if (p->np == 3 && !get_num(p, &p->toks[3], e->name, "strength", &R_NONNEG, &k.strength))
 		return false;
 	const sky *o = &p->s->sky;
 	bool same = p->s->has_sky && v3_eq(o->zenith, k.zenith) && v3_eq(o->horizon, k.horizon) &&
-	            o->strength == k.strength;
+	            o->strength == k.strength && o->file == k.file && o->rotation == k.rotation;
 	int r = once(p, e, "sky", &p->line_sky, same);
 	if (r > 0) {
 		p->s->has_sky = true;
@@ -749,8 +761,9 @@ static bool get_file(parser *p, const tok *t, const char *name, size_t n, const 
 	rt_error ferr;
 	rt_error_clear(&ferr);
 	bool ok = true;
-	if (key) {
-		texture *tx = texture_cache_get(full, strcmp(key->name, "texture") == 0, &ferr);
+	bool image = key || strcmp(p->toks[0].s, "sky") == 0;
+	if (image) {
+		texture *tx = texture_cache_get(full, key && strcmp(key->name, "texture") == 0, &ferr);
 		ok = tx != NULL;
 		texture_cache_put(tx);
 	} else if (!mesh_format_known(full)) {
@@ -759,7 +772,8 @@ static bool get_file(parser *p, const tok *t, const char *name, size_t n, const 
 	if (!ok) {
 		char msg[RT_ERROR_MSG_MAX];
 		rt_error_format(&ferr, msg, sizeof msg);
-		return fail(p, t->col, "%s \"%s\": %s", key ? key->name : "mesh file", quoted(p, t), msg);
+		return fail(p, t->col, "%s \"%s\": %s", key ? key->name : image ? "sky file" : "mesh file",
+		            quoted(p, t), msg);
 	}
 	*out = rt_intern(full, strlen(full));
 	if (!*out)
@@ -1101,7 +1115,7 @@ static const elem_def elements[] = {
 	 "tr P1 P2 P3 R,G,B [DIFFUSE SPECULAR SHININESS REFLECTIVE]", NULL},
 	{"mesh", "mesh", OBJ_MESH, false, parse_mesh,
 	 "mesh FILE POSITION DIRECTION SIZE [R,G,B [DIFFUSE SPECULAR SHININESS REFLECTIVE]]", NULL},
-	{"sky", "sky", -1, false, parse_sky, "sky ZENITH_R,G,B HORIZON_R,G,B [STRENGTH]", NULL},
+	{"sky", "sky", -1, false, parse_sky, "sky ZENITH_R,G,B HORIZON_R,G,B [STRENGTH] or sky FILE.hdr [STRENGTH [ROTATION]]", NULL},
 	{"set", "set", -1, false, parse_set, "set samples|depth|mode|resolution VALUE", NULL},
 };
 #define NELEMENTS (sizeof elements / sizeof elements[0])

@@ -328,7 +328,15 @@ static void write_scene(const scene *s, FILE *f)
 		fmt_light(&b, &s->lights[i]);
 		put_line(f, &b);
 	}
-	if (s->has_sky) {
+	if (s->has_sky && s->sky.file) {
+		sb_put(&b, "sky ");
+		sb_file(&b, s->sky.file);
+		if (s->sky.strength != 1 || s->sky.rotation != 0)
+			sb_field(&b, s->sky.strength);
+		if (s->sky.rotation != 0)
+			sb_field(&b, s->sky.rotation);
+		put_line(f, &b);
+	} else if (s->has_sky) {
 		sb_put(&b, "sky");
 		sb_vec(&b, s->sky.zenith);
 		sb_vec(&b, s->sky.horizon);

@@ -151,7 +151,8 @@ bool scene_equal(const scene *a, const scene *b)
 		return false;
 	if (a->has_sky && (!v3_eq(a->sky.zenith, b->sky.zenith) ||
 	                   !v3_eq(a->sky.horizon, b->sky.horizon) ||
-	                   a->sky.strength != b->sky.strength))
+	                   a->sky.strength != b->sky.strength || a->sky.file != b->sky.file ||
+	                   a->sky.rotation != b->sky.rotation))
 		return false;
 	if (memcmp(&a->hints, &b->hints, sizeof a->hints) != 0)
 		return false;
