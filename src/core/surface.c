@@ -254,7 +254,7 @@ static void perturb(const world *w, hit *h)
 	if (m->nmap) {
 		vec3 c = texture_lookup(m->nmap, h->u, h->v, 0);
 		double tx = 2 * c.x - 1, ty = 2 * c.y - 1, tz = 2 * c.z - 1;
-		const double flat = 1.0 / 255 + 1e-9;
+		const double flat = 1.0 / 255 + 1e-6; /* the codes 127 and 128, as floats */
 		if (fabs(tx) <= flat)
 			tx = 0;
 		if (fabs(ty) <= flat)
