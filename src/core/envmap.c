@@ -12,6 +12,8 @@
  */
 #include "envmap.h"
 
+#include "integrators.h"
+
 #include <stdlib.h>
 #include <string.h>
 

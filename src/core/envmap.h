@@ -3,7 +3,10 @@
 #ifndef RTSH_ENVMAP_H
 #define RTSH_ENVMAP_H
 
-#include "integrators.h"
+#include "rtsh/world.h"
+
+struct bsdf;
+struct rng;
 
 typedef struct envmap envmap;
 
@@ -20,7 +23,7 @@ double envmap_pdf(const envmap *e, vec3 d);
 vec3 envmap_sample(const envmap *e, double u1, double u2, double *pdf);
 /* Next-event estimation toward the sky from p (path mode), weighted by the
  * power heuristic against the bsdf's own sampling. */
-vec3 envmap_light(const world *w, const bsdf *b, vec3 p, rng *g);
+vec3 envmap_light(const world *w, const struct bsdf *b, vec3 p, struct rng *g);
 size_t envmap_memory(const envmap *e);
 
 #endif

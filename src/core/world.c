@@ -11,7 +11,7 @@
 #endif
 
 #include "bvh.h"
-#include "integrators.h"
+#include "emitters.h"
 #include "envmap.h"
 #include "surface.h"
 #include "rtsh/shape.h"

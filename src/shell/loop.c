@@ -1,14 +1,13 @@
 /* rtsh — the interactive loop: readline's callback interface and select()
  * on standard input and the wake-up pipe, so typing never waits for a
  * render. The render thread (preview.c) writes a byte to the pipe when an
- * image is ready; the signal handlers below set a flag and write a byte
- * too; everything else happens here, in the main thread, which alone talks
+ * image is ready; the signal handlers (signals.c) set a flag and write a
+ * byte too; everything else happens here, in the main thread, which alone talks
  * to the terminal.
  */
 #include <errno.h>
 #include <locale.h>
 #include <math.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -22,6 +21,7 @@
 #include "shell/complete.h"
 #include "shell/history.h"
 #include "shell/pager.h"
+#include "shell/signals.h"
 #include "shell/shell.h"
 #include "term/abuf.h"
 #include "term/caps.h"
@@ -35,7 +35,6 @@
 #define PROMPT "rtsh> "
 
 static shell *active;     /* the shell readline's line handler runs commands in */
-static int wake_write = -1;
 static shell_history hist;
 
 static double now(void)
@@ -43,61 +42,6 @@ static double now(void)
 	struct timespec t;
 	clock_gettime(CLOCK_MONOTONIC, &t);
 	return (double)t.tv_sec + t.tv_nsec * 1e-9;
-}
-
-static void poke(void)
-{
-	if (wake_write >= 0) {
-		int saved = errno;
-		ssize_t r = write(wake_write, "s", 1);
-		(void)r;
-		errno = saved;
-	}
-}
-
-static void on_signal(int sig)
-{
-	switch (sig) {
-	case SIGINT:
-		shell_sig_int = 1;
-		if (shell_current)
-			atomic_store(&shell_current->cancel, true);
-		break;
-	case SIGWINCH:
-		shell_sig_winch = 1;
-		break;
-	case SIGTSTP:
-		shell_sig_tstp = 1;
-		break;
-	case SIGCONT:
-		shell_sig_cont = 1;
-		break;
-	default: /* SIGTERM, SIGHUP */
-		shell_sig_term = sig;
-		if (shell_current)
-			atomic_store(&shell_current->cancel, true);
-		break;
-	}
-	poke();
-}
-
-static const int handled[] = {SIGINT, SIGTERM, SIGHUP, SIGWINCH, SIGTSTP, SIGCONT};
-#define NHANDLED (sizeof handled / sizeof handled[0])
-
-static void install_signals(struct sigaction *old)
-{
-	struct sigaction sa;
-	memset(&sa, 0, sizeof sa);
-	sa.sa_handler = on_signal;
-	sigemptyset(&sa.sa_mask);
-	for (size_t i = 0; i < NHANDLED; i++)
-		sigaction(handled[i], &sa, &old[i]);
-}
-
-static void restore_signals(const struct sigaction *old)
-{
-	for (size_t i = 0; i < NHANDLED; i++)
-		sigaction(handled[i], &old[i], NULL);
 }
 
 static void draw_status(shell *sh)
@@ -212,22 +156,6 @@ static void interrupt(shell *sh)
 	rl_redisplay();
 }
 
-/* Ctrl-Z: give the terminal back, stop, and take it again on SIGCONT. */
-static void suspend(shell *sh)
-{
-	rl_deprep_terminal();
-	if (sh->scr)
-		screen_suspend(sh->scr);
-	screen_stop_self();
-	rl_prep_terminal(1);
-	if (sh->scr) {
-		screen_resume(sh->scr);
-		shell_refresh(sh);
-		sh->redraw = true;
-	}
-	rl_forced_update_display();
-}
-
 /* Lays the screen out again and asks for the picture (after a resize or
  * the pager). */
 static void relayout_screen(shell *sh)
@@ -253,19 +181,15 @@ int shell_interactive(shell *sh, bool use_screen, const int wake[2])
 	int wake_fd = wake[0];
 	setlocale(LC_CTYPE, "");
 	active = sh;
-	wake_write = -1;
 	sh->wake[0] = wake[0];
 	sh->wake[1] = wake[1];
-	struct sigaction old[NHANDLED];
-	shell_sig_int = shell_sig_term = shell_sig_winch = shell_sig_tstp = shell_sig_cont = 0;
 
 	screen scr;
 	if (use_screen && screen_enter(&scr, STDOUT_FILENO, caps_palette(sh->opt->color, STDOUT_FILENO),
 	                               (double)sh->set.width / sh->set.height))
 		sh->scr = &scr;
 	history_setup(&hist, stderr);
-	install_signals(old);
-	wake_write = wake[1]; /* for the signal handlers */
+	signals_interactive_begin(STDIN_FILENO, wake[1]);
 
 	rl_catch_signals = 0;
 	rl_catch_sigwinch = 0;
@@ -319,11 +243,14 @@ int shell_interactive(shell *sh, bool use_screen, const int wake[2])
 			shell_sig_winch = 0;
 			relayout(sh);
 		}
-		if (shell_sig_tstp) {
-			shell_sig_tstp = 0;
-			suspend(sh);
+		if (shell_sig_cont) {
+			/* Continued after Ctrl-Z: the handler gave the screen back;
+			 * draw it all again. */
+			shell_sig_cont = 0;
+			if (sh->scr)
+				screen_resume(sh->scr);
+			relayout(sh);
 		}
-		shell_sig_cont = 0;
 		if (shell_sig_int) {
 			shell_sig_int = 0;
 			interrupt(sh);
@@ -343,8 +270,7 @@ int shell_interactive(shell *sh, bool use_screen, const int wake[2])
 		screen_leave(sh->scr);
 		sh->scr = NULL;
 	}
-	restore_signals(old);
-	wake_write = -1;
+	signals_interactive_end();
 	sh->wake[0] = sh->wake[1] = -1;
 	active = NULL;
 	return status;

@@ -23,6 +23,7 @@
 #include "rtsh/rtfile.h"
 #include "shell/options.h"
 #include "shell/preview.h"
+#include "shell/signals.h"
 #include "term/frame.h"
 #include "term/abuf.h"
 #include "term/screen.h"
@@ -76,14 +77,12 @@ typedef struct shell {
 	char err[SHELL_MSG_MAX];
 	bool err_reported;     /* err was printed already (by a nested source) */
 	int depth;             /* source nesting */
+	unsigned hand_set;     /* bit i: settings_table[i] was changed by `set` (answer.c) */
 	void (*status_hook)(struct shell *sh); /* redraws the status line (interactive) */
 	int wake[2];           /* the interactive loop's wake-up pipe (read, write); -1: none */
 } shell;
 
-/* Signals, set by handlers (loop.c, script.c) and read by the loops. */
-extern volatile sig_atomic_t shell_sig_int, shell_sig_term, shell_sig_winch, shell_sig_tstp;
-extern volatile sig_atomic_t shell_sig_cont;
-/* The shell whose cancel flag the SIGINT handler sets. */
+/* The shell of shell_main (the signal flags are in signals.h). */
 extern shell *shell_current;
 
 /* Records an error message for the command being run; returns false. */

@@ -1,48 +1,74 @@
 /* rtsh — the full-screen layout (screen.h). */
 #include "term/screen.h"
 
+#include <errno.h>
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/ioctl.h>
-#include <termios.h>
 #include <unistd.h>
 
 #include "term/abuf.h"
 
 #define ENTER_SEQ "\x1b[?1049h"
-#define RESTORE_SEQ "\x1b[r\x1b[m\x1b[?2026l\x1b[?25h\x1b[?1049l"
+/* Every mode rtsh (or readline) may have set, back to the terminal's
+ * default: synchronized output, scroll region, attributes, cursor shown,
+ * bracketed paste, mouse reporting (1000 1002 1003 1006), cursor keys and
+ * keypad in normal mode (DECCKM, DECKPNM), then the main screen. */
+#define RESTORE_SEQ "\x1b[?2026l\x1b[r\x1b[m\x1b[?25h\x1b[?2004l\x1b[?1000l\x1b[?1002l\x1b[?1003l\x1b[?1006l" \
+                    "\x1b[?1l\x1b>\x1b[?1049l"
 
-/* What the crash handler needs, set before it is installed. */
-static int restore_fd = -1;
-static struct termios saved_modes;
-static volatile sig_atomic_t have_modes;
+/* What the signal-time restore needs, set by screen_enter and
+ * screen_keypad (the handlers live in shell/signals.c). */
+static volatile sig_atomic_t restore_fd = -1;
+static volatile sig_atomic_t keypad_on;
+static char keypad_on_seq[64], keypad_off_seq[64];
 
-static void crash_handler(int sig)
+static void put_raw(int fd, const char *s, size_t n)
 {
-	if (restore_fd >= 0) {
-		ssize_t r = write(restore_fd, RESTORE_SEQ, sizeof RESTORE_SEQ - 1);
-		(void)r;
-		if (have_modes)
-			tcsetattr(restore_fd, TCSANOW, &saved_modes);
+	while (n > 0) {
+		ssize_t w = write(fd, s, n);
+		if (w < 0 && errno == EINTR)
+			continue;
+		if (w <= 0)
+			return;
+		s += w;
+		n -= (size_t)w;
 	}
-	/* SA_RESETHAND made the action the default again: the signal kills us
-	 * (with a core dump) once this handler returns. */
-	raise(sig);
 }
 
-static const int crash_signals[] = {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT};
-
-static void crash_handlers(bool on)
+void screen_restore_async(void)
 {
-	struct sigaction sa;
-	memset(&sa, 0, sizeof sa);
-	sigemptyset(&sa.sa_mask);
-	sa.sa_handler = on ? crash_handler : SIG_DFL;
-	sa.sa_flags = on ? SA_RESETHAND : 0;
-	for (size_t i = 0; i < sizeof crash_signals / sizeof crash_signals[0]; i++)
-		sigaction(crash_signals[i], &sa, NULL);
+	int fd = restore_fd;
+	if (fd < 0)
+		return;
+	if (keypad_on && keypad_off_seq[0])
+		put_raw(fd, keypad_off_seq, strlen(keypad_off_seq));
+	put_raw(fd, RESTORE_SEQ, sizeof RESTORE_SEQ - 1);
+}
+
+void screen_reenter_async(void)
+{
+	int fd = restore_fd;
+	if (fd < 0)
+		return;
+	put_raw(fd, ENTER_SEQ, sizeof ENTER_SEQ - 1);
+	if (keypad_on && keypad_on_seq[0])
+		put_raw(fd, keypad_on_seq, strlen(keypad_on_seq));
+}
+
+void screen_keypad(int fd, const char *on_seq, const char *off_seq, bool on)
+{
+	if (on) {
+		snprintf(keypad_on_seq, sizeof keypad_on_seq, "%s", on_seq ? on_seq : "");
+		snprintf(keypad_off_seq, sizeof keypad_off_seq, "%s", off_seq ? off_seq : "");
+		put_raw(fd, keypad_on_seq, strlen(keypad_on_seq));
+		keypad_on = 1;
+	} else {
+		keypad_on = 0;
+		put_raw(fd, keypad_off_seq, strlen(keypad_off_seq));
+	}
 }
 
 void screen_fit(int cols, int rows, double aspect, bool whole_cells, int *w, int *h)
@@ -175,28 +201,17 @@ bool screen_enter(screen *s, int fd, frame_palette pal, double aspect)
 	s->pal = pal;
 	if (!isatty(fd))
 		return false;
-	if (tcgetattr(fd, &saved_modes) == 0)
-		have_modes = 1;
 	restore_fd = fd;
-	crash_handlers(true);
 	write_all(fd, ENTER_SEQ, sizeof ENTER_SEQ - 1);
 	s->active = true;
 	screen_layout(s, aspect, true);
 	return true;
 }
 
-void screen_suspend(screen *s)
-{
-	if (!s->active)
-		return;
-	write_all(s->fd, RESTORE_SEQ, sizeof RESTORE_SEQ - 1);
-}
-
 void screen_resume(screen *s)
 {
 	if (!s->active)
 		return;
-	write_all(s->fd, ENTER_SEQ, sizeof ENTER_SEQ - 1);
 	screen_layout(s, s->aspect, true);
 }
 
@@ -204,8 +219,7 @@ void screen_leave(screen *s)
 {
 	if (!s->active)
 		return;
-	write_all(s->fd, RESTORE_SEQ, sizeof RESTORE_SEQ - 1);
-	crash_handlers(false);
+	screen_restore_async();
 	restore_fd = -1;
 	s->active = false;
 	frame_free(s->fr);
@@ -231,16 +245,4 @@ void screen_picture(screen *s, const uint8_t *rgb, int w, int h)
 	frame_put_image(s->fr, rgb, w, h, s->img_x, s->img_y);
 	const abuf *a = frame_update(s->fr);
 	put(s, a);
-}
-
-void screen_stop_self(void)
-{
-	struct sigaction sa, old;
-	memset(&sa, 0, sizeof sa);
-	sa.sa_handler = SIG_DFL;
-	sigemptyset(&sa.sa_mask);
-	sigaction(SIGTSTP, &sa, &old);
-	raise(SIGTSTP);
-	/* ... continued. */
-	sigaction(SIGTSTP, &old, NULL);
 }
