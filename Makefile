@@ -45,6 +45,7 @@ BENCH_BIN := $(BUILD)/bench/bench
 # Optional: Embree 3's single-ray speed on the same rays, built by `make bench`
 # only when embree3/rtcore.h is installed (apt-get install libembree-dev).
 EMBREE_BIN := $(BUILD)/bench/embree_primary
+EMBREE_MESH_BIN := $(BUILD)/bench/embree_mesh
 
 # The binary: ./rtsh for the default build, $(BUILD)/rtsh for variants.
 ifeq ($(BUILD),build)
@@ -115,9 +116,13 @@ $(EMBREE_BIN): bench/embree_primary.c $(LIB)
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -o $@ $< $(LIB) -lembree3 $(LDLIBS_CORE)
 
+$(EMBREE_MESH_BIN): bench/embree_mesh.c bench/mesh_rays.h $(LIB)
+	@mkdir -p $(@D)
+	$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -o $@ $< $(LIB) -lembree3 $(LDLIBS_CORE)
+
 bench: all $(BENCH_BIN)
 	@if printf '#include <embree3/rtcore.h>\n' | $(CC) -E -x c - >/dev/null 2>&1; then \
-		$(MAKE) --no-print-directory $(EMBREE_BIN); \
+		$(MAKE) --no-print-directory $(EMBREE_BIN) $(EMBREE_MESH_BIN); \
 	else echo "bench: no embree3/rtcore.h, so no Embree row (apt-get install libembree-dev)"; fi
 	./$(BENCH_BIN) --out $(BUILD)/bench.tsv
 
