@@ -17,7 +17,9 @@
 #include "rtsh/settings.h"
 #include "shell/answer.h"
 #include "shell/commands.h"
+#include "shell/complete_files.h"
 #include "shell/keymode.h"
+#include "shell/save_rt.h"
 #include "shell/suggest.h"
 #include "term/caps.h"
 
@@ -74,7 +76,7 @@ bool cmd_save(shell *sh, int argc, char **argv, const char *rest)
 	rt_error err;
 	bool ok = true;
 	if (has_ext(path, ".rt")) {
-		if (!rt_save(editor_scene(sh->ed), path, &err))
+		if (!save_rt(sh, path, &err))
 			ok = save_failed(sh, &err);
 		else
 			shell_info(sh, "saved the scene to %s\n", path);
@@ -106,8 +108,13 @@ bool cmd_save(shell *sh, int argc, char **argv, const char *rest)
 			shell_info(sh, "saved %s (%dx%d, %d sample%s, %s)\n", path, fb->w, fb->h, fb->spp,
 			          fb->spp == 1 ? "" : "s", render_mode_name(sh->full_set.mode));
 	} else {
-		ok = shell_fail(sh, "save: \"%s\" has an unknown type; expected .ppm, .pfm, .png, .ans or .rt",
-		                path);
+		char exts[256] = "";
+		const char *const *x = output_extensions();
+		for (size_t i = 0; x[i]; i++) {
+			size_t l = strlen(exts);
+			snprintf(exts + l, sizeof exts - l, "%s%s", i == 0 ? "" : x[i + 1] ? ", " : " or ", x[i]);
+		}
+		ok = shell_fail(sh, "save: \"%s\" has an unknown type; expected %s", path, exts);
 	}
 	free(path);
 	return ok;
