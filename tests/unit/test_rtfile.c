@@ -1141,7 +1141,7 @@ static scene *rand_scene(test_rng *r)
 	}
 	if (trand(r) < 0.3) {
 		s->has_sky = true;
-		s->sky = (sky){rand_color(r), rand_color(r), trand(r) < 0.5 ? 1 : trange(r, 0, 5)};
+		s->sky = (sky){.zenith = rand_color(r), .horizon = rand_color(r), .strength = trand(r) < 0.5 ? 1 : trange(r, 0, 5)};
 	}
 	if (trand(r) < 0.3) {
 		s->hints.width = 1 + (int)trange(r, 0, 4000);

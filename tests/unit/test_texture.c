@@ -100,6 +100,7 @@ static void test_ppm_pfm_xpm(void **state)
 	} bad[] = {
 		{"z.ppm", "P6 0 4 255\n", "is 0x4 pixels"},
 		{"t.ppm", "P6 4 4 255\nabc", "ends early"},
+		{"h.ppm", "P6 2 2 255", "ends after the header"},
 		{"c.png", "\x89PNG\r\n\x1a\ngarbage", "cannot decode"},
 		{"c.xpm", "/* XPM */\nstatic char *x[] = {\n\"1 1 1 1\",\n\"a c #GG0000\",\n\"a\"};\n", "XPM colour 1"},
 		{"u.gif2", "x", "unknown image format"},

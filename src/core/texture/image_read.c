@@ -172,6 +172,11 @@ static float *read_ppm(const char *path, const unsigned char *buf, size_t len, b
 	int comp = color ? 3 : 1, bps = maxv > 255 ? 2 : 1;
 	size_t n = (size_t)x * (size_t)y;
 	if (binary) {
+		if (p.s >= p.end) {
+			rt_error_set(err, "%s: byte %zu: the file ends after the header (truncated?); expected pixel data",
+			             path, len);
+			return NULL;
+		}
 		p.s++; /* the one blank after maxval */
 		if ((size_t)(p.end - p.s) / ((size_t)comp * (size_t)bps) < n) {
 			rt_error_set(err, "%s: byte %zu: the pixel data ends early (truncated?); expected %zu bytes",
