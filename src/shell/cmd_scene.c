@@ -395,7 +395,7 @@ bool cmd_prev(shell *sh, int argc, char **argv, const char *rest)
 bool cmd_show(shell *sh, int argc, char **argv, const char *rest)
 {
 	(void)rest;
-	long cols = picture_columns();
+	long cols = sh->capture && sh->scr ? sh->scr->cols : picture_columns();
 	if (argc == 1 && !arg_int(sh, "show", argv[0], 8, 1000, &cols))
 		return false;
 	frame *f = shell_picture_frame(sh, sh->pal, (int)cols);
@@ -404,8 +404,15 @@ bool cmd_show(shell *sh, int argc, char **argv, const char *rest)
 	abuf a;
 	abuf_init(&a);
 	frame_text(f, &a);
-	fflush(stdout);
-	bool ok = !a.failed && write_all(1, a.b, a.len);
+	bool ok = !a.failed;
+	if (ok && sh->capture) {
+		/* On the full screen: through the pager, like help and list, when
+		 * it is taller than the command area. */
+		abuf_add(sh->capture, a.b, a.len);
+	} else if (ok) {
+		fflush(stdout);
+		ok = write_all(1, a.b, a.len);
+	}
 	abuf_free(&a);
 	frame_free(f);
 	return ok ? true : shell_fail(sh, "show: cannot write the picture");

@@ -14,6 +14,7 @@
 
 #include "rtsh/settings.h"
 #include "shell/builtin_scene.h"
+#include "shell/progress.h"
 #include "shell/signals.h"
 #include "term/caps.h"
 
@@ -287,16 +288,9 @@ typedef struct progress_ctx {
 static void on_progress(void *ctx, long done, long total)
 {
 	progress_ctx *p = ctx;
-	double el = now() - p->t0, frac = total ? (double)done / total : 1.0;
-	char bar[32];
-	const int width = 24;
-	int fill = (int)(frac * width + 0.5);
-	for (int i = 0; i < width; i++)
-		bar[i] = i < fill ? '#' : '.';
-	bar[width] = '\0';
-	char left[48] = "";
-	if (done > 0 && done < total)
-		snprintf(left, sizeof left, ", about %.0f s left", el / frac - el);
+	char prog[192];
+	progress_state ps = {p->w, p->h, p->sh->set.samples, done, total, now() - p->t0};
+	progress_text(&ps, 20, prog, sizeof prog);
 	if (p->sh->scr && p->sh->scr->active) {
 		if (shell_sig_cont && !p->repainted) {
 			/* Continued after Ctrl-Z in the middle of a render: the
@@ -305,11 +299,16 @@ static void on_progress(void *ctx, long done, long total)
 			screen_resume(p->sh->scr);
 		}
 		char text[256];
-		snprintf(text, sizeof text, " rendering %dx%d [%s] %3d%%  %.1f s%s  (Ctrl-C stops)", p->w, p->h,
-		         bar, (int)(frac * 100), el, left);
+		/* A bar only where it fits. */
+		for (int bar = 20; bar >= 0; bar -= 10) {
+			progress_text(&ps, bar, prog, sizeof prog);
+			snprintf(text, sizeof text, " rendering %dx%d %s (Ctrl-C stops)", p->w, p->h, prog);
+			if ((int)strlen(text) <= p->sh->scr->cols)
+				break;
+		}
 		screen_status(p->sh->scr, text);
 	} else {
-		fprintf(stderr, "\r[%s] %3d%%  %.1f s%s   ", bar, (int)(frac * 100), el, left);
+		fprintf(stderr, "\r%s   ", prog);
 		p->shown = true;
 	}
 }
