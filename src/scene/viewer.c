@@ -4,7 +4,7 @@
  * a ground plane (its bounding box centred over the origin, longest side 2
  * units, +Y up), a camera that frames its bounding sphere from the front,
  * a little above and to the right, a key light above the camera's left
- * shoulder, a soft ambient and a sky. `save x.rt` writes it out with a mesh
+ * shoulder, a soft ambient and a sky. The model keeps its own materials. `save x.rt` writes it out with a mesh
  * line that references the model.
  */
 #include <stdio.h>
@@ -44,7 +44,7 @@ scene *rt_load_model(const char *path, const rt_load_opts *opts, rt_error *err)
 	                 "L %.6g,%.6g,%.6g 0.8 255,250,240\n"
 	                 "sky 110,150,210 235,235,240 1\n"
 	                 "pl 0,0,0 0,1,0 180,180,180\n"
-	                 "mesh %s%s%s 0,%.6g,0 0,1,0 2 255,255,255\n"
+	                 "mesh %s%s%s 0,%.6g,0 0,1,0 2\n"
 	                 "set samples 4\n",
 	                 base, cam.x, cam.y, cam.z, dir.x, dir.y, dir.z, fov, lamp.x, lamp.y, lamp.z,
 	                 quote ? "\"" : "", base, quote ? "\"" : "", e.y / 2);
