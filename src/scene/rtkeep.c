@@ -25,9 +25,11 @@
 
 _Thread_local const char *rt_keep_source;
 /* The largest middle part matched by dynamic programming (cells of 4 bytes);
- * beyond it the leftovers pair up in order, which is exact for edits in
- * place and still correct, if less tidy, for the rest. */
+ * beyond it a walk with a bounded look-ahead matches them (exact for edits
+ * in place and for runs of up to LOOKAHEAD deletions or insertions). */
 #define LCS_MAX_CELLS ((uint64_t)1 << 21)
+/* How far the walk of long lists looks for an element that moved. */
+#define LOOKAHEAD 64
 /* Formatted lines are shorter than this. */
 #define BODY_MAX 4096
 
@@ -143,20 +145,15 @@ static bool tok_is(const char *s, const ltok *t, const char *word)
 	return t->len == strlen(word) && memcmp(s + t->at, word, t->len) == 0;
 }
 
-/* True when an object line is in the 42 short form (the reader's own test:
- * a plain number where the extended form has a vector). */
+/* True when an object line is in a short form: the extended form is the one
+ * whose position, rotation, scaling and colour are all vectors (a short
+ * form has a plain size among them, or only three fields, as a plane). */
 static bool short_form(const char *s, const lline *l)
 {
-	if (l->n == 0)
-		return false;
-	const ltok *id = &l->t[0];
-	if (tok_is(s, id, "sp"))
-		return l->np >= 2 && !l->t[2].comma;
-	if (tok_is(s, id, "pl"))
-		return l->np <= 3;
-	if (tok_is(s, id, "cy") || tok_is(s, id, "co"))
-		return l->np >= 3 && l->n > 3 && !l->t[3].comma;
-	return tok_is(s, id, "sq");
+	(void)s;
+	if (l->n < 5)
+		return true;
+	return !(l->np >= 4 && l->t[1].comma && l->t[2].comma && l->t[3].comma && l->t[4].comma);
 }
 
 /* --- what the source says --- */
@@ -434,6 +431,35 @@ static bool align(const char *O, size_t n, const char *S, size_t m, size_t size,
 		}
 #undef AT
 		free(L);
+	} else if (a > 0 && b > 0) {
+		/* Too long for the table: walk both lists, taking a run of
+		 * deletions or insertions when the element looked for comes back
+		 * within a few places, else an edit in place. */
+		size_t i = p, j = p, iend = n - q, jend = m - q;
+		while (i < iend && j < jend) {
+			if (same(O + i * size, S + j * size)) {
+				out->o2s[i] = j;
+				out->s2o[j] = i;
+				i++, j++;
+				continue;
+			}
+			size_t d = 1;
+			for (; d <= LOOKAHEAD; d++) {
+				if (i + d < iend && same(O + (i + d) * size, S + j * size)) {
+					i += d; /* O[i, i+d) deleted */
+					break;
+				}
+				if (j + d < jend && same(O + i * size, S + (j + d) * size)) {
+					j += d; /* S[j, j+d) new */
+					break;
+				}
+			}
+			if (d > LOOKAHEAD) {
+				out->o2s[i] = j; /* edited in place */
+				out->s2o[j] = i;
+				i++, j++;
+			}
+		}
 	}
 	/* Between two matches, the leftovers pair up in order: edits. */
 	size_t i = 0, j = 0;

@@ -429,6 +429,8 @@ bool cmd_source(shell *sh, int argc, char **argv, const char *rest)
 	sh->depth++;
 	bool ok = shell_run_file(sh, path);
 	sh->depth--;
+	if (ok)
+		shell_info(sh, "ran %s\n", path);
 	free(path);
 	return ok;
 }

@@ -274,6 +274,41 @@ static void test_default_camera(void **state)
 	scene_free(s);
 }
 
+/* Lists too long for the table (about 2490 x 2490 cells left between the
+ * common head and tail, more than 2^21): a deletion and an edit far apart
+ * still touch one line each. */
+static void test_long_lists(void **state)
+{
+	(void)state;
+	enum { N = 3000 };
+	size_t cap = (size_t)N * 40 + 64;
+	char *src = malloc(cap), *want = malloc(cap);
+	size_t len = (size_t)snprintf(src, cap, "C 0,0,-5 0,0,1 70\n"), wl = len;
+	memcpy(want, src, len);
+	for (int i = 0; i < N; i++) {
+		char line[64];
+		/* "1.0": a rewritten line would read "1", so only the edited one may. */
+		int n = snprintf(line, sizeof line, "sp %d,0,0 1.0 %d,0,0\n", i, i % 256);
+		memcpy(src + len, line, (size_t)n + 1);
+		len += (size_t)n;
+		if (i == 10)
+			continue; /* deleted */
+		if (i == 2500)
+			n = snprintf(line, sizeof line, "sp %d,5,0 1 %d,0,0\n", i, i % 256);
+		memcpy(want + wl, line, (size_t)n + 1);
+		wl += (size_t)n;
+	}
+	scene *s = load(src);
+	s->objs[2500].pos.y = 5;
+	scene_remove_object(s, 10);
+	char *t = keep(s, src);
+	assert_string_equal(t, want);
+	free(t);
+	scene_free(s);
+	free(src);
+	free(want);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -282,6 +317,7 @@ int main(void)
 		cmocka_unit_test(test_one_edit_one_line),
 		cmocka_unit_test(test_delete_add_and_hints),
 		cmocka_unit_test(test_default_camera),
+		cmocka_unit_test(test_long_lists),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
