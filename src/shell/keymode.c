@@ -1521,6 +1521,14 @@ bool keymode_run(shell *sh)
 	struct termios saved;
 	if (tcgetattr(in, &saved) != 0)
 		return shell_fail(sh, "view: cannot read the terminal's modes: %s", strerror(errno));
+	/* The answers the terminal owes the shell's output scheduler come in
+	 * before ncurses reads the keys (keys typed meanwhile are dropped). */
+	if (scr->out) {
+		abuf junk;
+		abuf_init(&junk);
+		termout_settle(scr->out, in, 1.0, &junk);
+		abuf_free(&junk);
+	}
 	keys *k = keys_open(in, 25);
 	if (!k) {
 		return shell_fail(sh, "view: ncurses cannot read the keys of this terminal (TERM=%s)",

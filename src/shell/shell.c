@@ -93,6 +93,17 @@ static double now(void)
 	return (double)t.tv_sec + t.tv_nsec * 1e-9;
 }
 
+void shell_notice(shell *sh, const char *fmt, ...)
+{
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(sh->notice, sizeof sh->notice, fmt, ap);
+	va_end(ap);
+	sh->notice_until = now() + 15.0;
+	if (sh->status_hook)
+		sh->status_hook(sh);
+}
+
 char *shell_expand_path(const char *path)
 {
 	const char *home = getenv("HOME");
@@ -270,8 +281,9 @@ void shell_status_text(shell *sh, char *buf, size_t size)
 	if (im->w > 0)
 		format_seconds(im->seconds, t, sizeof t);
 	int th = render_threads(&sh->set);
-	snprintf(buf, size, " %s │ %s │ %s │ depth %d │ %dx%d │ %d thread%s │ %s", sh->name,
-	         render_mode_name(sh->set.mode), samples, sh->set.depth, sh->scr ? sh->scr->img_w : 0,
+	bool note = sh->notice[0] && now() < sh->notice_until;
+	snprintf(buf, size, " %s%s%s │ %s │ %s │ depth %d │ %dx%d │ %d thread%s │ %s", sh->name, note ? " │ " : "",
+	         note ? sh->notice : "", render_mode_name(sh->set.mode), samples, sh->set.depth, sh->scr ? sh->scr->img_w : 0,
 	         sh->scr ? sh->scr->img_h : 0, th, th == 1 ? "" : "s", t);
 }
 

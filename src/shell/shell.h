@@ -75,6 +75,8 @@ typedef struct shell {
 	bool quit;
 	atomic_bool cancel;    /* Ctrl-C: stops a full render */
 	char err[SHELL_MSG_MAX];
+	char notice[256];      /* said once in the status line (until notice_until) */
+	double notice_until;
 	bool err_reported;     /* err was printed already (by a nested source) */
 	int depth;             /* source nesting */
 	unsigned hand_set;     /* bit i: settings_table[i] was changed by `set` (answer.c) */
@@ -91,6 +93,9 @@ bool shell_fail(shell *sh, const char *fmt, ...) __attribute__((format(printf, 2
 void shell_out(shell *sh, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 /* Prints a confirmation ("saved x.png") to standard output, unless -q. */
 void shell_info(shell *sh, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* A message for the status line, shown for a while (said once: the
+ * caller's business). */
+void shell_notice(shell *sh, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 /* Prints a note to standard error (warnings, progress text). */
 void shell_note(shell *sh, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 

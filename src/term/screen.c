@@ -128,8 +128,25 @@ static void compute_layout(screen *s)
 
 static void put(screen *s, const abuf *a)
 {
-	if (!a->failed)
+	if (a->failed)
+		return;
+	if (s->out)
+		termout_text(s->out, a->b, a->len);
+	else
 		write_all(s->fd, a->b, a->len);
+}
+
+/* A new picture encoder for the layout (none when there is no room). */
+static void open_encoder(screen *s)
+{
+	encoder_close(s->enc);
+	s->enc = NULL;
+	if (s->pic_rows > 0) {
+		encoder_geom g = {.cols = s->cols, .rows = s->pic_rows, .pal = s->pal};
+		s->enc = encoder_halfblock.open(&g);
+	}
+	if (s->out)
+		termout_set_picture(s->out, s->enc);
 }
 
 static void draw_status(screen *s, abuf *a)
@@ -166,8 +183,8 @@ static void redraw_chrome(screen *s)
 	draw_status(s, &a);
 	put(s, &a);
 	abuf_free(&a);
-	if (s->fr)
-		frame_invalidate(s->fr);
+	if (s->enc)
+		s->enc->ops->invalidate(s->enc);
 }
 
 bool screen_layout(screen *s, double aspect, bool force)
@@ -178,17 +195,16 @@ bool screen_layout(screen *s, double aspect, bool force)
 	s->aspect = aspect > 0 && isfinite(aspect) ? aspect : 16.0 / 9.0;
 	compute_layout(s);
 	bool changed = oc != s->cols || orow != s->rows || opic != s->pic_rows;
-	if (!changed && !force && s->fr && oa != s->aspect) {
+	if (!changed && !force && s->enc && oa != s->aspect) {
 		/* Only the image's shape changed: the next frame update erases
 		 * the old picture; the prompt's lines stay. */
-		frame_clear(s->fr);
-	} else if (changed || force || !s->fr) {
-		if (!s->fr || s->fr->cols != s->cols || s->fr->rows != s->pic_rows) {
-			frame_free(s->fr);
-			s->fr = s->pic_rows > 0 ? frame_new(s->cols, s->pic_rows, s->pal) : NULL;
-		}
-		if (s->fr)
-			frame_clear(s->fr);
+		s->enc->ops->clear(s->enc);
+	} else if (changed || force || !s->enc) {
+		if (!s->enc || s->enc->geom.cols != s->cols || s->enc->geom.rows != s->pic_rows ||
+		    s->enc->geom.pal != s->pal)
+			open_encoder(s);
+		if (s->enc)
+			s->enc->ops->clear(s->enc);
 		redraw_chrome(s);
 	}
 	return ow != s->img_w || oh != s->img_h;
@@ -200,6 +216,9 @@ bool screen_enter(screen *s, int fd, frame_palette pal, double aspect)
 	s->fd = fd;
 	s->pal = pal;
 	if (!isatty(fd))
+		return false;
+	s->out = termout_new(fd);
+	if (!s->out)
 		return false;
 	restore_fd = fd;
 	write_all(fd, ENTER_SEQ, sizeof ENTER_SEQ - 1);
@@ -222,8 +241,28 @@ void screen_leave(screen *s)
 	screen_restore_async();
 	restore_fd = -1;
 	s->active = false;
-	frame_free(s->fr);
-	s->fr = NULL;
+	encoder_close(s->enc);
+	s->enc = NULL;
+	termout_free(s->out);
+	s->out = NULL;
+}
+
+void screen_clear_all(screen *s)
+{
+	static const char seq[] = "\x1b[r\x1b[2J";
+	if (s->out)
+		termout_text(s->out, seq, sizeof seq - 1);
+	else
+		write_all(s->fd, seq, sizeof seq - 1);
+}
+
+void screen_set_palette(screen *s, frame_palette pal)
+{
+	if (pal == s->pal)
+		return;
+	s->pal = pal;
+	if (s->active)
+		screen_layout(s, s->aspect, true);
 }
 
 void screen_status(screen *s, const char *text)
@@ -240,9 +279,7 @@ void screen_status(screen *s, const char *text)
 
 void screen_picture(screen *s, const uint8_t *rgb, int w, int h)
 {
-	if (!s->active || !s->fr || w != s->img_w || h != s->img_h)
+	if (!s->active || !s->enc || w != s->img_w || h != s->img_h)
 		return;
-	frame_put_image(s->fr, rgb, w, h, s->img_x, s->img_y);
-	const abuf *a = frame_update(s->fr);
-	put(s, a);
+	encoder_put(s->enc, rgb, w, h, s->img_x, s->img_y);
 }

@@ -28,7 +28,9 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "term/encoder.h"
 #include "term/frame.h"
+#include "term/out.h"
 
 typedef struct screen {
 	int fd;
@@ -40,7 +42,8 @@ typedef struct screen {
 	double aspect;     /* width / height of the image */
 	int img_w, img_h;  /* the preview's size in pixels (0 when no picture) */
 	int img_x, img_y;  /* its place on the cols x 2*pic_rows pixel canvas */
-	frame *fr;         /* the picture area */
+	encoder *enc;      /* the picture area's encoder */
+	termout *out;      /* every byte of the screen goes out through it */
 	bool active;
 	char status[512];  /* the status line's text */
 } screen;
@@ -55,10 +58,17 @@ void screen_leave(screen *s);
  * clears it when anything changed (or `force`), redraws the status line and
  * puts the cursor on the last row. True when the image size changed. */
 bool screen_layout(screen *s, double aspect, bool force);
+/* Clears the whole screen and resets the scroll region (before the pager
+ * takes the screen; screen_layout gives it back). */
+void screen_clear_all(screen *s);
+/* Another palette (the terminal said it has truecolor): lays out and
+ * clears the screen again. */
+void screen_set_palette(screen *s, frame_palette pal);
 /* Sets and draws the status line. */
 void screen_status(screen *s, const char *text);
-/* Shows an sRGB image of img_w x img_h pixels in the picture area
- * (letterboxed; only changed cells are sent). */
+/* Puts an sRGB image of img_w x img_h pixels in the picture area
+ * (letterboxed); the output scheduler (s->out, termout_pump) sends the
+ * cells that changed. */
 void screen_picture(screen *s, const uint8_t *rgb, int w, int h);
 /* Lays the screen out again and redraws it after the process was stopped
  * and continued (the signal handler entered the alternate screen again). */
