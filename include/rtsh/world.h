@@ -26,12 +26,16 @@ typedef struct mat_lin {
 	vec3 emission;     /* emitted radiance (linear) */
 	double checker;    /* squares per unit; 0 = none */
 	int32_t light;     /* index into world.emitters; -1 when not sampled */
-	/* textures (texture.h; NULL = none), held by the world */
+	const struct mat_tex *tx; /* textures, or NULL (most materials): 8 bytes here */
+} mat_lin;
+
+/* The textures of a material (texture.h; NULL = none), held by the world. */
+typedef struct mat_tex {
 	const struct texture *tex, *nmap, *bump;
-	bool tex_tint;     /* tex x albedo (texture= with a colour); else tex alone */
+	bool tint;         /* tex x albedo (texture= with a colour); else tex alone */
 	double bumpscale;
 	double uvs[2], uvo[2]; /* uv x uvs + uvo */
-} mat_lin;
+} mat_tex;
 
 typedef struct light_lin {
 	vec3 pos;
@@ -136,6 +140,8 @@ typedef struct world {
 	size_t nmeshes;
 	struct texture **texs; /* the textures the materials use (held) */
 	size_t ntexs;
+	mat_tex *mtex;   /* what mat_lin.tx points to */
+	size_t nmtex;
 	mat_lin *mats;   /* indexed by prim.object */
 	size_t nmats;
 	emitter *emitters; /* sampled in path mode; nemitters = 0 turns that off */

@@ -18,12 +18,12 @@ vec3 world_background(const world *w, vec3 dir, render_mode mode)
 
 vec3 hit_albedo(const mat_lin *m, const hit *h)
 {
-	if (m->tex && h->has_uv) {
+	if (m->tx && m->tx->tex && h->has_uv) {
 		/* the footprint of a pixel at this distance, in u units */
 		double du = v3_len(h->dpdu);
 		double width = du > 0 ? h->t * texture_pixel_angle() / du : 0;
-		vec3 c = texture_lookup(m->tex, h->u, h->v, width);
-		return m->tex_tint ? v3_mul(c, m->albedo) : c;
+		vec3 c = texture_lookup(m->tx->tex, h->u, h->v, width);
+		return m->tx->tint ? v3_mul(c, m->albedo) : c;
 	}
 	if (m->checker <= 0.0)
 		return m->albedo;

@@ -50,9 +50,16 @@ static bool hold_texture(world *w, const char *path, bool srgb, const struct tex
 
 bool surf_begin(world *w, const scene *s, rt_error *err)
 {
-	size_t n = 0;
-	for (size_t i = 0; i < s->nobjs; i++)
+	size_t n = 0, ntx = 0;
+	for (size_t i = 0; i < s->nobjs; i++) {
+		const material *om = &s->objs[i].mat;
 		n += s->objs[i].kind == OBJ_MESH;
+		ntx += om->texture || om->normalmap || om->bump;
+	}
+	w->mtex = NULL;
+	w->nmtex = 0;
+	if (ntx && !(w->mtex = calloc(ntx, sizeof *w->mtex)))
+		return rt_error_set(err, "out of memory preparing the textures");
 	if (n == 0)
 		return true;
 	w->insts = calloc(n, sizeof *w->insts);
@@ -83,6 +90,13 @@ bool surf_begin(world *w, const scene *s, rt_error *err)
 		if (o->file_colors)
 			extra += m->nmats;
 	}
+	/* each of a model's own materials may have textures */
+	if (extra) {
+		mat_tex *t = realloc(w->mtex, (ntx + extra) * sizeof *t);
+		if (!t)
+			return rt_error_set(err, "out of memory preparing the textures");
+		w->mtex = t;
+	}
 	w->ninsts = 0; /* surf_make_inst counts them again */
 	if (extra) {
 		mat_lin *mats = realloc(w->mats, (s->nobjs + extra) * sizeof *mats);
@@ -97,15 +111,16 @@ bool surf_material(world *w, const object *o, uint32_t i, rt_error *err)
 {
 	mat_lin *m = &w->mats[i];
 	const material *om = &o->mat;
-	m->bumpscale = om->bumpscale;
-	m->uvs[0] = om->uvscale[0] ? om->uvscale[0] : 1;
-	m->uvs[1] = om->uvscale[1] ? om->uvscale[1] : 1;
-	m->uvo[0] = om->uvoffset[0];
-	m->uvo[1] = om->uvoffset[1];
-	m->tex_tint = true;
-	if (!hold_texture(w, om->texture, true, &m->tex, err) || !hold_texture(w, om->normalmap, false, &m->nmap, err) ||
-	    !hold_texture(w, om->bump, false, &m->bump, err))
+	m->tx = NULL;
+	mat_tex own = {.tint = true, .bumpscale = om->bumpscale, .uvs = {om->uvscale[0] ? om->uvscale[0] : 1,
+	               om->uvscale[1] ? om->uvscale[1] : 1}, .uvo = {om->uvoffset[0], om->uvoffset[1]}};
+	if (!hold_texture(w, om->texture, true, &own.tex, err) || !hold_texture(w, om->normalmap, false, &own.nmap, err) ||
+	    !hold_texture(w, om->bump, false, &own.bump, err))
 		return false;
+	if (own.tex || own.nmap || own.bump) {
+		w->mtex[w->nmtex] = own;
+		m->tx = &w->mtex[w->nmtex++];
+	}
 	if (o->kind != OBJ_MESH || !o->file_colors)
 		return true;
 	/* the model's own materials, after the object's: its keys (fuzz,
@@ -122,18 +137,24 @@ bool surf_material(world *w, const object *o, uint32_t i, rt_error *err)
 		if (v3_max_comp(ke) > 0)
 			l.emission = ke;
 		l.light = -1;
+		mat_tex t = own;
 		if (mm->map_kd) {
-			if (!hold_texture(w, mm->map_kd, true, &l.tex, err))
+			if (!hold_texture(w, mm->map_kd, true, &t.tex, err))
 				return false;
-			l.tex_tint = false;
+			t.tint = false;
 		}
-		if (mm->map_norm && !hold_texture(w, mm->map_norm, false, &l.nmap, err))
+		if (mm->map_norm && !hold_texture(w, mm->map_norm, false, &t.nmap, err))
 			return false;
 		if (mm->map_bump) {
-			if (!hold_texture(w, mm->map_bump, false, &l.bump, err))
+			if (!hold_texture(w, mm->map_bump, false, &t.bump, err))
 				return false;
 			/* an MTL -bm is in model units: roughly right for scenes */
-			l.bumpscale = mm->bump_scale * 0.01;
+			t.bumpscale = mm->bump_scale * 0.01;
+		}
+		l.tx = NULL;
+		if (t.tex || t.nmap || t.bump) {
+			w->mtex[w->nmtex] = t;
+			l.tx = &w->mtex[w->nmtex++];
 		}
 		w->mats[w->nmats++] = l;
 	}
@@ -233,8 +254,8 @@ static double luminance(vec3 c)
 /* Normal and bump maps: h->n from the textures of h's material. */
 static void perturb(const world *w, hit *h)
 {
-	const mat_lin *m = &w->mats[h->mat];
-	if (!h->has_uv || (!m->nmap && !m->bump))
+	const mat_tex *m = w->mats[h->mat].tx;
+	if (!h->has_uv || !m || (!m->nmap && !m->bump))
 		return;
 	vec3 n = h->n;
 	if (m->bump) {
@@ -279,7 +300,7 @@ static void perturb(const world *w, hit *h)
 
 static void apply_uv(const world *w, hit *h, double u, double v, vec3 dpdu, vec3 dpdv)
 {
-	const mat_lin *m = &w->mats[h->mat];
+	const mat_tex *m = w->mats[h->mat].tx;
 	h->has_uv = true;
 	h->u = u * m->uvs[0] + m->uvo[0];
 	h->v = v * m->uvs[1] + m->uvo[1];
@@ -290,8 +311,7 @@ static void apply_uv(const world *w, hit *h, double u, double v, vec3 dpdu, vec3
 
 static bool wants_uv(const world *w, const hit *h)
 {
-	const mat_lin *m = &w->mats[h->mat];
-	return m->tex || m->nmap || m->bump;
+	return w->mats[h->mat].tx != NULL;
 }
 
 void surf_inst_finish(const world *w, const prim *p, const ray *r, vec3 nl, hit *h)
@@ -416,12 +436,13 @@ void surf_free(world *w)
 		texture_cache_put(w->texs[i]);
 	free(w->meshes);
 	free(w->texs);
+	free(w->mtex);
 	free(w->insts);
 }
 
 size_t surf_memory(const world *w)
 {
-	size_t n = w->ninsts * sizeof *w->insts + w->nmeshes * sizeof *w->meshes;
+	size_t n = w->ninsts * sizeof *w->insts + w->nmeshes * sizeof *w->meshes + w->nmtex * sizeof *w->mtex;
 	for (size_t i = 0; i < w->nmeshes; i++)
 		n += mesh_memory(w->meshes[i]);
 	return n;

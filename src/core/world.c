@@ -82,6 +82,7 @@ static mat_lin material_linear(const material *m)
 	l.emission = v3_scale(l.albedo, m->emission);
 	l.checker = m->checker;
 	l.light = -1; /* set by emitters_build */
+	l.tx = NULL;  /* set by surf_material */
 	return l;
 }
 

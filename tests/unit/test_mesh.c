@@ -210,6 +210,46 @@ static void test_ply_faces_and_strips(void **state)
 	expect_error(mesh_parse_ply("x.ply", "plx\n", 4, &err), &err, "x.ply:1", "not a PLY file");
 }
 
+/* glTF 2.0 and STL through assimp: a square of two triangles under a node
+ * that moves it by 5 along X and doubles it; one STL facet. */
+static void test_gltf_and_stl(void **state)
+{
+	(void)state;
+	const char *gltf =
+	    "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
+	    "\"nodes\":[{\"mesh\":0,\"translation\":[5,0,0],\"scale\":[2,2,2]}],"
+	    "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":0}]}],"
+	    "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.25,0.5,0.75,1]}}],"
+	    "\"buffers\":[{\"byteLength\":60,\"uri\":\"data:application/octet-stream;base64,"
+	    "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAACAPwAAgD8AAAAAAAAAAAAAgD8AAAAAAAABAAIAAAACAAMA\"}],"
+	    "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},"
+	    "{\"buffer\":0,\"byteOffset\":48,\"byteLength\":12}],"
+	    "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+	    "\"min\":[0,0,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5123,\"count\":6,"
+	    "\"type\":\"SCALAR\"}]}";
+	rt_error err = {0};
+	mesh *m = mesh_load(tmp_text("sq.gltf", gltf), &err);
+	if (!m)
+		fail_msg("%s", err.msg);
+	assert_int_equal(m->ntris, 2);
+	assert_vec_near(m->bounds.lo, v3(5, 0, 0), 1e-6);
+	assert_vec_near(m->bounds.hi, v3(7, 2, 0), 1e-6);
+	mesh_surf sf;
+	float b[3] = {1.0f / 3, 1.0f / 3, 1.0f / 3};
+	mesh_surface(m, 0, b, &sf);
+	assert_true(sf.mat >= 0);
+	assert_near(m->mats[sf.mat].kd[0], 0.25, 1e-6);
+	assert_near(m->mats[sf.mat].kd[2], 0.75, 1e-6);
+	mesh_free(m);
+	m = mesh_load(tmp_text("t.stl", "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 2 0 0\n"
+	                                "vertex 0 3 0\nendloop\nendfacet\nendsolid t\n"), &err);
+	assert_non_null(m);
+	assert_int_equal(m->ntris, 1);
+	assert_vec_near(m->bounds.hi, v3(2, 3, 0), 0);
+	mesh_free(m);
+	expect_error(mesh_load(tmp_text("bad.gltf", "garbage"), &err), &err, "bad.gltf", "cannot read the model");
+}
+
 /* --- the tree and the watertight test --- */
 
 static mesh *sphere_mesh(int nu, int nv)
@@ -523,6 +563,7 @@ int main(void)
 		cmocka_unit_test(test_obj_welds_uv_corners),
 		cmocka_unit_test(test_obj_bad_input),
 		cmocka_unit_test(test_ply_faces_and_strips),
+		cmocka_unit_test(test_gltf_and_stl),
 		cmocka_unit_test(test_tree_matches_brute_force),
 		cmocka_unit_test(test_watertight),
 		cmocka_unit_test(test_cube_obj_silhouette_is_cu),

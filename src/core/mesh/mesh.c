@@ -418,6 +418,43 @@ bool mesh_prepare(mesh *m, bool smooth, double crease_deg, rt_error *err)
 	free(m->tmat);
 	m->tri = tri;
 	m->tmat = tmat;
+	/* vertices in the order the tree's leaves first use them, so that a
+	 * leaf's triangles find theirs close together in memory */
+	uint32_t *newid = malloc((size_t)m->nverts * sizeof *newid);
+	float(*p)[3] = malloc((size_t)m->nverts * sizeof *p);
+	float(*n)[3] = m->n ? malloc((size_t)m->nverts * sizeof *n) : NULL;
+	float(*uv)[2] = m->uv ? malloc((size_t)m->nverts * sizeof *uv) : NULL;
+	if (newid && p && (!m->n || n) && (!m->uv || uv)) {
+		memset(newid, 0xff, (size_t)m->nverts * sizeof *newid);
+		uint32_t next = 0;
+		for (uint32_t t = 0; t < m->ntris; t++)
+			for (int k = 0; k < 3; k++) {
+				uint32_t v = m->tri[t][k];
+				if (newid[v] == UINT32_MAX)
+					newid[v] = next++;
+				m->tri[t][k] = newid[v];
+			}
+		for (uint32_t v = 0; v < m->nverts; v++) {
+			if (newid[v] == UINT32_MAX)
+				newid[v] = next++; /* unused by any triangle */
+			memcpy(p[newid[v]], m->p[v], sizeof *p);
+			if (n)
+				memcpy(n[newid[v]], m->n[v], sizeof *n);
+			if (uv)
+				memcpy(uv[newid[v]], m->uv[v], sizeof *uv);
+		}
+		free(m->p);
+		free(m->n);
+		free(m->uv);
+		m->p = p;
+		m->n = n;
+		m->uv = uv;
+	} else {
+		free(p);
+		free(n);
+		free(uv);
+	}
+	free(newid);
 	double ext = fmax(v3_max_abs(m->bounds.lo), v3_max_abs(m->bounds.hi));
 	m->eps = (float)(ext * 0x1p-19);
 	return true;

@@ -418,6 +418,18 @@ mesh *mesh_parse_ply(const char *name, const char *buf, size_t len, rt_error *er
 	r.line++;
 	for (int i = 0; i < nelems; i++) {
 		const elem *e = &elems[i];
+		if (strcmp(e->name, "vertex") == 0 && e->count > 0) {
+			int xyz = 0;
+			for (int p = 0; p < e->nprops; p++)
+				xyz += e->props[p].role >= P_X && e->props[p].role <= P_Z;
+			if (xyz != 3) {
+				rt_error_set(err, "%s: the vertex element has %d of the properties x, y, z; expected all three",
+				             name, xyz);
+				goto fail;
+			}
+		}
+		if (e->nprops == 0)
+			continue; /* records of nothing: nothing to read */
 		/* counts larger than the file: refuse before allocating anything */
 		size_t min = 0;
 		for (int p = 0; p < e->nprops; p++)

@@ -48,7 +48,7 @@ void mesh_ray_make(mesh_ray *r, vec3 o, vec3 d)
 
 /* The watertight test of triangle t: t in (tmin, *tmax) sets *tmax and the
  * barycentric weights. */
-static inline bool tri_test(const mesh *m, const mesh_ray *r, uint32_t t, float tmin, float *tmax, float b[3])
+static inline __attribute__((always_inline)) bool tri_test(const mesh *m, const mesh_ray *r, uint32_t t, float tmin, float *tmax, float b[3])
 {
 	const uint32_t *i = m->tri[t];
 	const float *pa = m->p[i[0]], *pb = m->p[i[1]], *pc = m->p[i[2]];

@@ -334,6 +334,29 @@ static bool xpm_color(const char *s, float rgb[3], bool srgb)
 static float *read_xpm(const char *path, const unsigned char *buf, size_t len, bool srgb, int *w, int *h,
                        rt_error *err)
 {
+	/* the values line ("W H NCOLORS CPP"), checked against the file's size
+	 * before libXpm allocates what it promises */
+	const unsigned char *q = memchr(buf, '"', len);
+	long v[4] = {0, 0, 0, 0};
+	const char *vc = q ? (const char *)q + 1 : NULL, *end = (const char *)buf + len;
+	for (int k = 0; vc && k < 4; k++) {
+		while (vc < end && (*vc == ' ' || *vc == '\t'))
+			vc++;
+		if (!scan_long(&vc, end, &v[k]))
+			vc = NULL;
+	}
+	if (!vc) {
+		rt_error_set(err, "%s: no XPM values line; expected \"WIDTH HEIGHT NCOLORS CHARS_PER_PIXEL\"", path);
+		return NULL;
+	}
+	if (!size_ok(path, v[0], v[1], err))
+		return NULL;
+	if (v[3] < 1 || v[3] > 8 || v[2] < 1 || (size_t)v[2] > len / ((size_t)v[3] + 4) ||
+	    (size_t)v[0] * (size_t)v[1] > len / (size_t)v[3]) {
+		rt_error_set(err, "%s: the XPM values line promises %ldx%ld pixels, %ld colours, %ld characters "
+		             "per pixel: more than the file holds", path, v[0], v[1], v[2], v[3]);
+		return NULL;
+	}
 	char *text = malloc(len + 1);
 	if (!text) {
 		rt_error_set(err, "%s: out of memory", path);
@@ -346,6 +369,7 @@ static float *read_xpm(const char *path, const unsigned char *buf, size_t len, b
 	int rc = XpmCreateXpmImageFromBuffer(text, &img, NULL);
 	free(text);
 	if (rc != XpmSuccess) {
+		XpmFreeXpmImage(&img); /* what libXpm left allocated (it may leave some) */
 		rt_error_set(err, "%s: cannot read the XPM image: %s", path, XpmGetErrorString(rc));
 		return NULL;
 	}
