@@ -187,10 +187,11 @@ static double power_w(double a, double b)
 	return a * a / (a * a + b * b);
 }
 
-vec3 envmap_light(const world *w, const bsdf *b, vec3 p, rng *g)
+vec3 envmap_light(const world *w, const bsdf *b, vec3 p, sampler *g)
 {
 	const envmap *e = w->env;
-	double u1 = rng_next(g), u2 = rng_next(g), pdf;
+	double u1, u2, pdf;
+	samp_2d(g, &u1, &u2);
 	vec3 wi = envmap_sample(e, u1, u2, &pdf);
 	if (!(pdf > 0))
 		return v3(0, 0, 0);

@@ -6,7 +6,7 @@
 #include "rtsh/world.h"
 
 struct bsdf;
-struct rng;
+struct sampler;
 
 typedef struct envmap envmap;
 
@@ -23,7 +23,7 @@ double envmap_pdf(const envmap *e, vec3 d);
 vec3 envmap_sample(const envmap *e, double u1, double u2, double *pdf);
 /* Next-event estimation toward the sky from p (path mode), weighted by the
  * power heuristic against the bsdf's own sampling. */
-vec3 envmap_light(const world *w, const struct bsdf *b, vec3 p, struct rng *g);
+vec3 envmap_light(const world *w, const struct bsdf *b, vec3 p, struct sampler *g);
 size_t envmap_memory(const envmap *e);
 
 #endif

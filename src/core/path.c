@@ -358,8 +358,12 @@ vec3 path_radiance(const world *w, const render_settings *s, ray r, sampler *g)
 		bool sample_emitters = b.smooth && w->nemitters;
 		if (sample_emitters)
 			radiance = v3_add(radiance, v3_mul(thr, emitter_light(w, &b, p, h.object, g)));
-		if (b.smooth && w->env)
+		if (b.smooth && w->env) {
+			/* the sky's two numbers: hashed dimensions of their own, far
+			 * from the bounces' (envmap.c) */
+			g->dim = (1u << 20) + 2u * (uint32_t)bounce;
 			radiance = v3_add(radiance, v3_mul(thr, envmap_light(w, &b, p, g)));
+		}
 
 		g->dim = dim0 + 6u * (uint32_t)bounce + 2u;
 		double u[3];
