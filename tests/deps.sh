@@ -9,6 +9,9 @@ have_header() {
 have_header png.h || missing="$missing libpng-dev"
 have_header readline/readline.h || missing="$missing libreadline-dev"
 have_header ncurses.h || missing="$missing libncurses-dev"
+have_header assimp/cimport.h || missing="$missing libassimp-dev"
+have_header stb/stb_image.h || missing="$missing libstb-dev"
+have_header X11/xpm.h || missing="$missing libxpm-dev"
 have_header sixel/sixel.h || missing="$missing libsixel-dev"
 have_header zlib.h || missing="$missing zlib1g-dev"
 printf '#include <stdarg.h>\n#include <stddef.h>\n#include <setjmp.h>\n#include <cmocka.h>\n' |
