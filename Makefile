@@ -25,7 +25,9 @@ CPPFLAGS += -Iinclude -Isrc -I$(BUILD) -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOUR
 CFLAGS  ?= $(OPT) -g
 CFLAGS  += $(CSTD) $(WARN) -pthread -MMD -MP
 LDLIBS_CORE := -lpng -lassimp -lXpm -lstb -lm -pthread
-LDLIBS_FRONT := -lreadline -lncursesw -lsixel -lz $(LDLIBS_CORE)
+# libsixel carries its own copy of stb_image: libstb (in LDLIBS_CORE) must come first
+# so that the scene loader's stbi_* calls reach libstb, not libsixel's.
+LDLIBS_FRONT := -lreadline -lncursesw $(LDLIBS_CORE) -lsixel -lz
 
 ifneq ($(SAN),)
 CFLAGS  += -fsanitize=$(SAN) -fno-omit-frame-pointer -fno-sanitize-recover=all
