@@ -42,6 +42,12 @@ scene *rt_load_string(const char *text, size_t len, const char *name, const rt_l
 bool rt_parse_line(scene *s, const char *line, const char *name, int lineno,
                    const rt_load_opts *opts, rt_error *err);
 
+/* The i-th element the reader knows, in the order of its messages (A C c L
+ * l R, then the shape kinds' identifiers from shape.h, then sky set): its
+ * identifier, and in *usage every form it is read in. NULL past the last.
+ * `help add` and completion list them from here. */
+const char *rt_element(size_t i, const char **usage);
+
 /* Writes the scene as .rt text; load(write(s)) is equal to s (scene_equal). */
 bool rt_write(const scene *s, FILE *f, rt_error *err);
 /* Writes the scene to path atomically. */

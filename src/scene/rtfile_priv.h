@@ -25,14 +25,20 @@ typedef struct rt_key {
 	size_t offset;      /* of the field in struct object */
 	bool is_int;        /* an int field (else double) */
 	bool triangles;     /* allowed on triangles */
+	unsigned needs;     /* a KIND_* flag the kind must have (0: any kind) */
+	bool in_short;      /* the short form says it already: written in the extended form only */
 	double min, max;    /* inclusive range */
 	double def;         /* the value that means "absent"; not written */
 	bool (*extra)(double v); /* a further rule within [min,max], or NULL */
 	const char *expect; /* what a valid value is, for messages */
+	const char *help;   /* one line for `help` */
 } rt_key;
 
 extern const rt_key rt_keys[];
 extern const size_t rt_nkeys;
+
+/* Whether key k may be given on an object of kind kind. */
+bool rt_key_applies(const rt_key *k, obj_kind kind);
 
 /* The key's value in o, as a double. */
 double rt_key_get(const rt_key *k, const object *o);

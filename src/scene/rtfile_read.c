@@ -19,6 +19,7 @@
 
 #include "rtsh/render.h"
 #include "rtsh/rtfile.h"
+#include "rtsh/shape.h"
 #include "scene/rtfile_priv.h"
 
 /* Files larger than this are refused rather than read. */
@@ -32,20 +33,35 @@
 /* --- the key=value table (shared with the writer) --- */
 
 static bool ior_rule(double v) { return v == 0.0 || v >= 1.0; }
+static bool positive(double v) { return v > 0.0; }
 
+/* name, field, int, on triangles, kinds, in the short form, min, max, default, rule,
+ * expected, help */
 const rt_key rt_keys[] = {
-	{"twist", offsetof(object, twist), false, false, -RT_NUM_MAX, RT_NUM_MAX, 0, NULL,
-	 "twist in degrees"},
-	{"fuzz", offsetof(object, mat.fuzz), false, true, 0, 1, 0, NULL, "fuzz in [0,1]"},
-	{"metal", offsetof(object, mat.metal), false, true, 0, 1, 0, NULL, "metal in [0,1]"},
-	{"ior", offsetof(object, mat.ior), false, true, 0, 10, 0, ior_rule,
-	 "ior 0 (opaque) or a refractive index in [1,10]"},
-	{"emit", offsetof(object, mat.emission), false, true, 0, 1e6, 0, NULL,
-	 "emit in [0,1e6]"},
-	{"checker", offsetof(object, mat.checker), true, true, 0, 1000, 0, NULL,
-	 "checker a whole number in [0,1000]"},
+	{"twist", offsetof(object, twist), false, false, 0, false, -RT_NUM_MAX, RT_NUM_MAX, 0, NULL,
+	 "twist in degrees", "turn about the object's own axis, degrees"},
+	{"fuzz", offsetof(object, mat.fuzz), false, true, 0, false, 0, 1, 0, NULL, "fuzz in [0,1]",
+	 "roughness of the mirror lobe (0 sharp, 1 broad)"},
+	{"metal", offsetof(object, mat.metal), false, true, 0, false, 0, 1, 0, NULL, "metal in [0,1]",
+	 "how much reflections take the object's colour"},
+	{"ior", offsetof(object, mat.ior), false, true, 0, false, 0, 10, 0, ior_rule,
+	 "ior 0 (opaque) or a refractive index in [1,10]", "glass: refractive index (0 opaque)"},
+	{"emit", offsetof(object, mat.emission), false, true, 0, false, 0, 1e6, 0, NULL,
+	 "emit in [0,1e6]", "emitted radiance, times the colour (path mode)"},
+	{"checker", offsetof(object, mat.checker), true, true, 0, false, 0, 1000, 0, NULL,
+	 "checker a whole number in [0,1000]", "checker texture: squares per unit (0 none)"},
+	{"tube", offsetof(object, tube), false, false, KIND_TUBE, true, 0, 100, 0.5, positive,
+	 "tube a ratio in (0,100]", "torus: tube diameter / ring diameter"},
 };
 const size_t rt_nkeys = sizeof rt_keys / sizeof rt_keys[0];
+
+bool rt_key_applies(const rt_key *k, obj_kind kind)
+{
+	unsigned f = obj_kind_flags(kind);
+	if ((f & KIND_VERTICES) && !k->triangles)
+		return false;
+	return !k->needs || (f & k->needs);
+}
 
 double rt_key_get(const rt_key *k, const object *o)
 {
@@ -107,6 +123,7 @@ typedef struct parser {
 	char *text;
 	size_t cap_text;
 	char quote[96];   /* a token shortened for a message */
+	char usage[256], usage42[128]; /* an object element's usage lines */
 } parser;
 
 typedef struct elem_def elem_def;
@@ -118,6 +135,7 @@ struct elem_def {
 	bool (*parse)(parser *p, const elem_def *e);
 	const char *usage;  /* every accepted form */
 	const char *usage42; /* the 42 subject's form, or NULL */
+	const shape_form *form; /* objects: the form of the kind it reads */
 };
 
 static bool fail(parser *p, int col, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
@@ -709,17 +727,16 @@ static bool parse_keys(parser *p, const elem_def *e, object *o)
 		while (k < rt_nkeys &&
 		       !(strlen(rt_keys[k].name) == nlen && memcmp(rt_keys[k].name, t->s, nlen) == 0))
 			k++;
-		bool tri = o->kind == OBJ_TRIANGLE;
-		if (k == rt_nkeys || (tri && !rt_keys[k].triangles)) {
+		if (k == rt_nkeys || !rt_key_applies(&rt_keys[k], o->kind)) {
 			char list[256] = "";
 			size_t used = 0;
 			for (size_t j = 0; j < rt_nkeys; j++)
-				if (!tri || rt_keys[j].triangles)
+				if (rt_key_applies(&rt_keys[j], o->kind))
 					used += (size_t)snprintf(list + used, sizeof list - used, "%s%s=",
 					                         used ? " " : "", rt_keys[j].name);
-			return fail_tok(p, t, e->name, "key",
-			                k == rt_nkeys ? "is unknown" : "does not apply to triangles",
-			                list);
+			char what[64];
+			snprintf(what, sizeof what, "does not apply to %ss", e->name);
+			return fail_tok(p, t, e->name, "key", k == rt_nkeys ? "is unknown" : what, list);
 		}
 		const rt_key *key = &rt_keys[k];
 		if (seen & (1u << k))
@@ -846,73 +863,48 @@ static object short_object(const elem_def *e, vec3 pos, vec3 dir, vec3 scale, ve
 
 static bool plain_number(const tok *t) { return !memchr(t->s, ',', t->len); }
 
-static bool parse_sphere(parser *p, const elem_def *e)
+/* The short form of e->form: its fields (shape.h), then R,G,B; the
+ * extended form instead when the form has one and the line is not short:
+ * when the first size field is missing or not a plain number, or (no size
+ * field) when there are more fields than the short form's. */
+static bool parse_form(parser *p, const elem_def *e)
 {
-	if (p->np < 2 || !plain_number(&p->toks[2]))
-		return parse_extended(p, e);
-	vec3 c, color;
-	double d;
+	const shape_form *f = e->form;
+	size_t nf = (size_t)f->nfields;
+	if (f->extended) {
+		const char *sz = strchr(f->types, 's');
+		size_t k = sz ? (size_t)(sz - f->types) + 1 : 0;
+		if (k ? p->np < k || !plain_number(&p->toks[k]) : p->np > nf + 1)
+			return parse_extended(p, e);
+	}
+	if (!count_ok(p, e, nf + 1, nf + 1 + (f->material ? 4 : 0), usage_of(p, e)) ||
+	    !group_ok(p, e, nf + 1))
+		return false;
+	vec3 pos = v3(0, 0, 0), dir = v3(0, 1, 0), color;
+	double sizes[4] = {0, 0, 0, 0};
+	size_t ns = 0;
 	zero_size zero = {0};
-	if (!count_ok(p, e, 3, 3, usage_of(p, e)) ||
-	    !get_vec(p, &p->toks[1], e->name, "center", &R_ANY, &c) ||
-	    !get_size(p, &p->toks[2], e->name, "diameter", &d, &zero) ||
-	    !get_color(p, &p->toks[3], e->name, "colour", &color))
+	for (size_t i = 0; i < nf; i++) {
+		const tok *t = &p->toks[1 + i];
+		bool ok = f->types[i] == 'p'   ? get_vec(p, t, e->name, f->fields[i], &R_ANY, &pos)
+		          : f->types[i] == 'd' ? get_dir(p, t, e->name, f->fields[i], &dir)
+		                               : get_size(p, t, e->name, f->fields[i], &sizes[ns++], &zero);
+		if (!ok)
+			return false;
+	}
+	if (!get_color(p, &p->toks[nf + 1], e->name, "colour", &color))
 		return false;
-	object o = short_object(e, c, v3(0, 1, 0), v3_splat(d), color);
-	return add_object(p, e, &o, &zero);
-}
-
-static bool parse_plane(parser *p, const elem_def *e)
-{
-	if (p->np > 3)
-		return parse_extended(p, e);
-	vec3 pt, n, color;
-	if (!count_ok(p, e, 3, 3, usage_of(p, e)) ||
-	    !get_vec(p, &p->toks[1], e->name, "point", &R_ANY, &pt) ||
-	    !get_dir(p, &p->toks[2], e->name, "normal", &n) ||
-	    !get_color(p, &p->toks[3], e->name, "colour", &color))
+	object o = short_object(e, pos, dir, v3_splat(1), color);
+	if (p->np == nf + 5 && !get_material(p, e, nf + 2, &o.mat))
 		return false;
-	object o = short_object(e, pt, n, v3_splat(1), color);
-	return add_object(p, e, &o, NULL);
-}
-
-/* cy and co */
-static bool parse_tube(parser *p, const elem_def *e)
-{
-	if (p->np < 3 || !plain_number(&p->toks[3]))
-		return parse_extended(p, e);
-	vec3 c, axis, color;
-	double d, h;
-	zero_size zero = {0};
-	if (!count_ok(p, e, 5, 5, usage_of(p, e)) ||
-	    !get_vec(p, &p->toks[1], e->name, "center", &R_ANY, &c) ||
-	    !get_dir(p, &p->toks[2], e->name, "axis", &axis) ||
-	    !get_size(p, &p->toks[3], e->name, "diameter", &d, &zero) ||
-	    !get_size(p, &p->toks[4], e->name, "height", &h, &zero) ||
-	    !get_color(p, &p->toks[5], e->name, "colour", &color))
-		return false;
-	object o = short_object(e, c, axis, v3(d, h, d), color);
-	return add_object(p, e, &o, &zero);
-}
-
-static bool parse_square(parser *p, const elem_def *e)
-{
-	vec3 c, n, color;
-	double side;
-	zero_size zero = {0};
-	if (!count_ok(p, e, 4, 4, e->usage) ||
-	    !get_vec(p, &p->toks[1], e->name, "center", &R_ANY, &c) ||
-	    !get_dir(p, &p->toks[2], e->name, "normal", &n) ||
-	    !get_size(p, &p->toks[3], e->name, "side", &side, &zero) ||
-	    !get_color(p, &p->toks[4], e->name, "colour", &color))
-		return false;
-	object o = short_object(e, c, n, v3(side, 1, side), color);
+	if (!zero.t)
+		f->read(&o, sizes);
 	return add_object(p, e, &o, &zero);
 }
 
 static bool parse_triangle(parser *p, const elem_def *e)
 {
-	static const char *const names[3] = {"first point", "second point", "third point"};
+	const char *const *names = e->form->fields;
 	vec3 v[3], color;
 	if (!count_ok(p, e, 4, 8, e->usage) || !group_ok(p, e, 4))
 		return false;
@@ -921,7 +913,7 @@ static bool parse_triangle(parser *p, const elem_def *e)
 			return false;
 	if (!get_color(p, &p->toks[4], e->name, "colour", &color))
 		return false;
-	object o = object_make(OBJ_TRIANGLE, color);
+	object o = object_make((obj_kind)e->kind, color);
 	if (p->np == 8 && !get_material(p, e, 5, &o.mat))
 		return false;
 	vec3 n = v3_cross(v3_sub(v[1], v[0]), v3_sub(v[2], v[0]));
@@ -935,48 +927,115 @@ static bool parse_triangle(parser *p, const elem_def *e)
 
 #define EXT_TAIL " POS ROT SCALE R,G,B [DIFFUSE SPECULAR SHININESS REFLECTIVE [SHEAR]]"
 
-static const elem_def elements[] = {
-	{"A", "ambient", -1, true, parse_ambient, "A RATIO R,G,B", NULL},
-	{"C", "camera", -1, true, parse_camera, "C POSITION DIRECTION FOV", NULL},
-	{"c", "camera", -1, false, parse_camera, "c POSITION DIRECTION FOV", NULL},
-	{"L", "light", -1, true, parse_light, "L POSITION RATIO [R,G,B]", "L POSITION RATIO R,G,B"},
-	{"l", "light", -1, false, parse_light, "l POSITION RATIO [R,G,B]", NULL},
-	{"R", "resolution", -1, false, parse_resolution, "R WIDTH HEIGHT", NULL},
-	{"sp", "sphere", OBJ_SPHERE, true, parse_sphere,
-	 "sp CENTER DIAMETER R,G,B" " or sp" EXT_TAIL, "sp CENTER DIAMETER R,G,B"},
-	{"pl", "plane", OBJ_PLANE, true, parse_plane,
-	 "pl POINT NORMAL R,G,B" " or pl" EXT_TAIL, "pl POINT NORMAL R,G,B"},
-	{"cy", "cylinder", OBJ_CYLINDER, true, parse_tube,
-	 "cy CENTER AXIS DIAMETER HEIGHT R,G,B" " or cy" EXT_TAIL,
-	 "cy CENTER AXIS DIAMETER HEIGHT R,G,B"},
-	{"co", "cone", OBJ_CONE, false, parse_tube,
-	 "co CENTER AXIS DIAMETER HEIGHT R,G,B" " or co" EXT_TAIL, NULL},
-	{"cu", "cube", OBJ_CUBE, false, parse_extended, "cu" EXT_TAIL, NULL},
-	{"di", "disc", OBJ_DISC, false, parse_extended, "di" EXT_TAIL, NULL},
-	{"rc", "rectangle", OBJ_RECT, false, parse_extended, "rc" EXT_TAIL, NULL},
-	{"sq", "square", OBJ_RECT, false, parse_square, "sq CENTER NORMAL SIDE R,G,B", NULL},
-	{"tr", "triangle", OBJ_TRIANGLE, false, parse_triangle,
-	 "tr P1 P2 P3 R,G,B [DIFFUSE SPECULAR SHININESS REFLECTIVE]", NULL},
-	{"sky", "sky", -1, false, parse_sky, "sky ZENITH_R,G,B HORIZON_R,G,B [STRENGTH]", NULL},
-	{"set", "set", -1, false, parse_set, "set samples|depth|mode|resolution VALUE", NULL},
+/* The elements before the objects and after them; the objects' come from
+ * the shape kinds (shape.h, kinds.def), in the order of the kinds, each
+ * kind's own identifier and then its alias. */
+static const elem_def elements_head[] = {
+	{"A", "ambient", -1, true, parse_ambient, "A RATIO R,G,B", NULL, NULL},
+	{"C", "camera", -1, true, parse_camera, "C POSITION DIRECTION FOV", NULL, NULL},
+	{"c", "camera", -1, false, parse_camera, "c POSITION DIRECTION FOV", NULL, NULL},
+	{"L", "light", -1, true, parse_light, "L POSITION RATIO [R,G,B]", "L POSITION RATIO R,G,B", NULL},
+	{"l", "light", -1, false, parse_light, "l POSITION RATIO [R,G,B]", NULL, NULL},
+	{"R", "resolution", -1, false, parse_resolution, "R WIDTH HEIGHT", NULL, NULL},
 };
-#define NELEMENTS (sizeof elements / sizeof elements[0])
+static const elem_def elements_tail[] = {
+	{"sky", "sky", -1, false, parse_sky, "sky ZENITH_R,G,B HORIZON_R,G,B [STRENGTH]", NULL, NULL},
+	{"set", "set", -1, false, parse_set, "set samples|depth|mode|resolution VALUE", NULL, NULL},
+};
+#define NHEAD (sizeof elements_head / sizeof elements_head[0])
+#define NTAIL (sizeof elements_tail / sizeof elements_tail[0])
+
+/* The element of an object's form, its usage lines written into p. */
+static elem_def object_element(parser *p, obj_kind k, const shape_form *f)
+{
+	char *u = p->usage, *u42 = p->usage42;
+	size_t n = sizeof p->usage;
+	int used = 0;
+	if (f->nfields)
+		used = snprintf(u, n, "%s %s R,G,B%s", f->id, f->usage,
+		                f->material ? " [DIFFUSE SPECULAR SHININESS REFLECTIVE]" : "");
+	if (f->extended)
+		snprintf(u + used, n - (size_t)used, "%s%s" EXT_TAIL, used ? " or " : "", f->id);
+	if (f->strict && f->nfields)
+		snprintf(u42, sizeof p->usage42, "%s %s R,G,B", f->id, f->usage);
+	bool (*parse)(parser *, const elem_def *) =
+	    obj_kind_flags(k) & KIND_VERTICES ? parse_triangle : f->nfields ? parse_form : parse_extended;
+	return (elem_def){f->id, f->name, (int)k, f->strict, parse, u, f->strict && f->nfields ? u42 : NULL,
+	                  f};
+}
+
+const char *rt_element(size_t i, const char **usage)
+{
+	if (i < NHEAD) {
+		*usage = elements_head[i].usage;
+		return elements_head[i].id;
+	}
+	i -= NHEAD;
+	/* one parser's usage buffers per call: static, so one caller at a time */
+	static parser p;
+	for (int k = 0; k < OBJ_KIND_COUNT; k++) {
+		const shape_kind *d = shape_kinds[k];
+		for (int a = 0; a < 2; a++) {
+			const shape_form *f = a ? &d->alias : &d->form;
+			if (!f->id)
+				continue;
+			if (i-- == 0) {
+				elem_def e = object_element(&p, (obj_kind)k, f);
+				*usage = e.usage;
+				return e.id;
+			}
+		}
+	}
+	if (i < NTAIL) {
+		*usage = elements_tail[i].usage;
+		return elements_tail[i].id;
+	}
+	return NULL;
+}
+
+/* Every element identifier, in order, for messages (strict: only those
+ * strict mode allows). */
+static void element_list(const parser *p, char *list, size_t size)
+{
+	size_t used = 0;
+	list[0] = '\0';
+#define ADD(id, ok) \
+	if (!p->strict || (ok)) \
+		used += (size_t)snprintf(list + used, used < size ? size - used : 0, " %s", id)
+	for (size_t i = 0; i < NHEAD; i++)
+		ADD(elements_head[i].id, elements_head[i].strict);
+	for (int k = 0; k < OBJ_KIND_COUNT; k++) {
+		const shape_kind *d = shape_kinds[k];
+		ADD(d->form.id, d->form.strict);
+		if (d->alias.id)
+			ADD(d->alias.id, d->alias.strict);
+	}
+	for (size_t i = 0; i < NTAIL; i++)
+		ADD(elements_tail[i].id, elements_tail[i].strict);
+#undef ADD
+}
 
 /* Parses the tokens of one line (at least one). */
 static bool parse_tokens(parser *p)
 {
 	const tok *id = &p->toks[0];
 	const elem_def *e = NULL;
-	for (size_t i = 0; i < NELEMENTS && !e; i++)
-		if (strcmp(elements[i].id, id->s) == 0)
-			e = &elements[i];
+	elem_def obj;
+	for (size_t i = 0; i < NHEAD && !e; i++)
+		if (strcmp(elements_head[i].id, id->s) == 0)
+			e = &elements_head[i];
+	for (size_t i = 0; i < NTAIL && !e; i++)
+		if (strcmp(elements_tail[i].id, id->s) == 0)
+			e = &elements_tail[i];
+	obj_kind k;
+	const shape_form *f;
+	if (!e && shape_kind_find(id->s, &k, &f)) {
+		obj = object_element(p, k, f);
+		e = &obj;
+	}
 	if (!e || (p->strict && !e->strict)) {
-		char list[128] = "";
-		size_t used = 0;
-		for (size_t i = 0; i < NELEMENTS; i++)
-			if (!p->strict || elements[i].strict)
-				used += (size_t)snprintf(list + used, sizeof list - used, " %s",
-				                         elements[i].id);
+		char list[256];
+		element_list(p, list, sizeof list);
 		return fail(p, id->col, "%s element \"%s\"; expected one of%s%s",
 		            e ? "strict mode does not allow the" : "unknown", quoted(p, id), list,
 		            p->strict ? " (strict mode)" : "");

@@ -16,6 +16,7 @@
 #include "rtsh/image.h"
 #include "rtsh/render.h"
 #include "rtsh/rtfile.h"
+#include "rtsh/shape.h"
 #include "scene/rtfile_priv.h"
 
 /* A bounded string builder: output is cut at size - 1 bytes, always
@@ -92,25 +93,17 @@ static bool has_shear(const object *o)
 	return false;
 }
 
-/* True when the object is exactly what its 42 (or 2019) short form reads to. */
-static bool short_form_ok(const object *o)
+/* The sizes of o's short form f, when f reads back to exactly o: no twist,
+ * shear or material beyond the default, a direction only if f has one,
+ * and sizes the form can say (shape.h). */
+static bool short_form_ok(const object *o, const shape_form *f, double *sizes)
 {
-	if (o->twist != 0 || has_shear(o) || !base_material_default(&o->mat))
+	if (!f->id || !f->nfields || o->twist != 0 || has_shear(o) ||
+	    (!f->material && !base_material_default(&o->mat)))
 		return false;
-	vec3 s = o->scale;
-	switch (o->kind) {
-	case OBJ_SPHERE:
-		return v3_eq(o->dir, v3(0, 1, 0)) && s.x == s.y && s.y == s.z;
-	case OBJ_PLANE:
-		return v3_eq(s, v3_splat(1));
-	case OBJ_CYLINDER:
-	case OBJ_CONE:
-		return s.x == s.z;
-	case OBJ_RECT:
-		return s.x == s.z && s.y == 1;
-	default:
+	if (!strchr(f->types, 'd') && !v3_eq(o->dir, v3(0, 1, 0)))
 		return false;
-	}
+	return f->write(o, sizes);
 }
 
 static void fmt_material(sbuf *b, const material *m)
@@ -121,12 +114,12 @@ static void fmt_material(sbuf *b, const material *m)
 	sb_field(b, m->reflective);
 }
 
-static void fmt_keys(sbuf *b, const object *o)
+static void fmt_keys(sbuf *b, const object *o, bool short_form)
 {
 	for (size_t i = 0; i < rt_nkeys; i++) {
 		const rt_key *k = &rt_keys[i];
 		double v = rt_key_get(k, o);
-		if (v == k->def || (o->kind == OBJ_TRIANGLE && !k->triangles))
+		if (v == k->def || !rt_key_applies(k, o->kind) || (short_form && k->in_short))
 			continue;
 		sb_put(b, " ");
 		sb_put(b, k->name);
@@ -138,37 +131,33 @@ static void fmt_keys(sbuf *b, const object *o)
 static void fmt_object(sbuf *b, const object *o)
 {
 	const material *m = &o->mat;
-	if (o->kind == OBJ_TRIANGLE) {
-		sb_put(b, "tr");
+	const shape_kind *d = shape_kinds[o->kind];
+	double sizes[4];
+	const shape_form *f = NULL;
+	if (obj_kind_flags(o->kind) & KIND_VERTICES) {
+		sb_put(b, d->form.id);
 		for (int i = 0; i < 3; i++)
 			sb_vec(b, o->tri[i]);
 		sb_vec(b, m->color);
 		if (!base_material_default(m))
 			fmt_material(b, m);
-	} else if (short_form_ok(o)) {
-		vec3 s = o->scale;
-		sb_put(b, o->kind == OBJ_RECT ? "sq" : obj_kind_id(o->kind));
-		sb_vec(b, o->pos);
-		switch (o->kind) {
-		case OBJ_SPHERE:
-			sb_field(b, s.x);
-			break;
-		case OBJ_PLANE:
-			sb_vec(b, o->dir);
-			break;
-		case OBJ_RECT:
-			sb_vec(b, o->dir);
-			sb_field(b, s.x);
-			break;
-		default: /* cylinder, cone */
-			sb_vec(b, o->dir);
-			sb_field(b, s.x);
-			sb_field(b, s.y);
-			break;
+	} else if (short_form_ok(o, f = &d->form, sizes) || short_form_ok(o, f = &d->alias, sizes)) {
+		sb_put(b, f->id);
+		size_t ns = 0;
+		for (int i = 0; i < f->nfields; i++) {
+			if (f->types[i] == 'p')
+				sb_vec(b, o->pos);
+			else if (f->types[i] == 'd')
+				sb_vec(b, o->dir);
+			else
+				sb_field(b, sizes[ns++]);
 		}
 		sb_vec(b, m->color);
+		if (f->material && !base_material_default(m))
+			fmt_material(b, m);
 	} else {
-		sb_put(b, o->kind == OBJ_RECT ? "rc" : obj_kind_id(o->kind));
+		f = NULL;
+		sb_put(b, d->form.extended ? d->form.id : d->alias.id);
 		sb_vec(b, o->pos);
 		sb_vec(b, o->dir);
 		sb_vec(b, o->scale);
@@ -183,7 +172,7 @@ static void fmt_object(sbuf *b, const object *o)
 			}
 		}
 	}
-	fmt_keys(b, o);
+	fmt_keys(b, o, f != NULL);
 }
 
 static void fmt_light(sbuf *b, const light *l)

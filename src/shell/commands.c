@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rtsh/rtfile.h"
 #include "shell/answer.h"
 #include "shell/keymode.h"
 #include "shell/suggest.h"
@@ -46,7 +47,7 @@ const command command_table[] = {
 	 cmd_object},
 	{"ambient", NULL, "ambient\nambient brightness B\nambient color R,G,B", 0, 2, {"brightness|color"},
 	 "show or edit the ambient light", cmd_ambient},
-	{"add", NULL, "add LINE", 1, CMD_ANY, {NULL},
+	{"add", NULL, "add LINE", 1, CMD_ANY, {"@element"},
 	 "add an element written as a .rt line (A and C replace theirs, c adds a camera)", cmd_add},
 	{"delete", "del rm", "delete object N\ndelete light N\ndelete camera N", 1, 2,
 	 {"object|light|camera", "@ref"}, "remove an object, a light or a camera", cmd_delete},
@@ -416,6 +417,12 @@ bool cmd_help(shell *sh, int argc, char **argv, const char *rest)
 		for (size_t i = 0; i < sizeof details / sizeof details[0]; i++)
 			if (strcmp(details[i].name, c->name) == 0)
 				shell_out(sh, "%s", details[i].text);
+		if (c->run == cmd_add) { /* the elements, from the reader's table */
+			const char *usage;
+			shell_out(sh, "elements (rtsh(5)):\n");
+			for (size_t i = 0; rt_element(i, &usage); i++)
+				shell_out(sh, "  %s\n", usage);
+		}
 		if (c->aliases)
 			shell_out(sh, "also: %s\n", c->aliases);
 		return true;

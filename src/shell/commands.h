@@ -30,8 +30,9 @@ typedef struct command {
 	int min_args, max_args;/* words after the name; CMD_ANY: no limit */
 	/* What to complete for the first words after the name: alternatives
 	 * separated by '|'; "@file", "@command", "@setting", "@value" (of the
-	 * setting before), "@object", "@light", "@camera" (their numbers) and
-	 * "@ref" (numbers of the kind named by the word before). */
+	 * setting before), "@object", "@light", "@camera" (their numbers),
+	 * "@element" (the .rt elements, rtfile.h) and "@ref" (numbers of the
+	 * kind named by the word before). */
 	const char *complete[3];
 	const char *help;      /* one line */
 	cmd_fn run;
