@@ -10,9 +10,10 @@
 /* The fingerprint of generate(1000, 12345). Changed by issue 16: the sizes
  * are drawn x, y, z in that order (before, v3(part(..), part(..), part(..))
  * drew them in the compiler's argument order: right to left with gcc, so
- * clang builds generated other scenes). The old value 0xd27d0d74b8d35693
- * was reproduced by the table-driven generator drawing z, y, x. */
-#define GENERATE_PIN 0x47c1ab9a98699f97ULL
+ * clang builds generated other scenes; the old value 0xd27d0d74b8d35693 was
+ * reproduced by the table-driven generator drawing z, y, x), then 0x47c1...
+ * became this when the torus joined the kinds the generator draws from. */
+#define GENERATE_PIN 0xffe0e2b28f5a87a7ULL
 
 static scene *gen(size_t n, uint64_t seed, bool spheres)
 {
