@@ -54,6 +54,9 @@ bool rt_write(const scene *s, FILE *f, rt_error *err);
 bool rt_save(const scene *s, const char *path, rt_error *err);
 /* The one .rt line for an element (no newline), as `list` shows it. */
 void rt_format_object(const object *o, char *buf, size_t size);
+/* The same in the extended form whatever the short form could say
+ * (triangles: their only form). */
+void rt_format_object_extended(const object *o, char *buf, size_t size);
 void rt_format_light(const light *l, char *buf, size_t size);
 void rt_format_camera(const camera *c, char *buf, size_t size);
 

@@ -128,7 +128,7 @@ static void fmt_keys(sbuf *b, const object *o, bool short_form)
 	}
 }
 
-static void fmt_object(sbuf *b, const object *o)
+static void fmt_object(sbuf *b, const object *o, bool extended)
 {
 	const material *m = &o->mat;
 	const shape_kind *d = shape_kinds[o->kind];
@@ -141,7 +141,8 @@ static void fmt_object(sbuf *b, const object *o)
 		sb_vec(b, m->color);
 		if (!base_material_default(m))
 			fmt_material(b, m);
-	} else if (short_form_ok(o, f = &d->form, sizes) || short_form_ok(o, f = &d->alias, sizes)) {
+	} else if (!extended &&
+	           (short_form_ok(o, f = &d->form, sizes) || short_form_ok(o, f = &d->alias, sizes))) {
 		sb_put(b, f->id);
 		size_t ns = 0;
 		for (int i = 0; i < f->nfields; i++) {
@@ -196,7 +197,16 @@ void rt_format_object(const object *o, char *buf, size_t size)
 	rt_numloc loc;
 	rt_numloc_enter(&loc);
 	sbuf b = sb_make(buf, size);
-	fmt_object(&b, o);
+	fmt_object(&b, o, false);
+	rt_numloc_leave(&loc);
+}
+
+void rt_format_object_extended(const object *o, char *buf, size_t size)
+{
+	rt_numloc loc;
+	rt_numloc_enter(&loc);
+	sbuf b = sb_make(buf, size);
+	fmt_object(&b, o, true);
 	rt_numloc_leave(&loc);
 }
 
@@ -265,7 +275,7 @@ static void write_scene(const scene *s, FILE *f)
 		put_line(f, &b);
 	}
 	for (size_t i = 0; i < s->nobjs; i++) {
-		fmt_object(&b, &s->objs[i]);
+		fmt_object(&b, &s->objs[i], false);
 		put_line(f, &b);
 	}
 }
