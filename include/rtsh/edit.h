@@ -26,6 +26,7 @@
 
 #include "rtsh/error.h"
 #include "rtsh/rtfile.h"
+#include "rtsh/rules.h"
 #include "rtsh/scene.h"
 
 /* How many undo steps are kept (older ones are forgotten). */
@@ -128,11 +129,6 @@ const char *editor_redo_note(const editor *ed);
 void editor_group_begin(editor *ed);
 void editor_group_end(editor *ed);
 
-/* --- validation, shared with the front ends --- */
-bool light_validate(const light *l, rt_error *err);
-bool camera_validate(const camera *c, rt_error *err);
-bool ambient_validate(const ambient *a, rt_error *err);
-/* A colour with each channel in 0..255. */
-bool color_validate(vec3 rgb, const char *what, rt_error *err);
+/* Validation, shared with the reader and the front ends: rules.h. */
 
 #endif

@@ -12,13 +12,9 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "rtsh/rules.h"
 #include "rtsh/scene.h"
 
-/* Numbers in .rt files never exceed this magnitude. Scenes in the wild use
- * coordinates up to 1.5e18 (and -2^31 is common); 1e20 keeps every product
- * the renderer forms far from overflow. */
-#define RT_NUM_MAX 1e20
-#define RT_NUM_MAX_TEXT "1e20"
 
 typedef struct rt_key {
 	const char *name;   /* as written before '=' */

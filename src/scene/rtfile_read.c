@@ -17,6 +17,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "rtsh/num.h"
 #include "rtsh/render.h"
 #include "rtsh/rtfile.h"
 #include "rtsh/shape.h"
@@ -26,9 +27,6 @@
 #define RT_FILE_MAX ((size_t)1 << 30)
 /* --strict: a direction is unit length when |length - 1| <= this. */
 #define STRICT_UNIT_TOL 1e-2
-/* The renderable ends of the field of view, for fov 0 and 180. */
-#define FOV_MIN 0.01
-#define FOV_MAX 179.99
 
 /* --- the key=value table (shared with the writer) --- */
 
@@ -253,66 +251,11 @@ static bool lex_line(parser *p, const char *s, size_t len)
 
 /* --- numbers --- */
 
-static bool is_digit(char c) { return c >= '0' && c <= '9'; }
-
-/* The end of the decimal number that starts at s, or NULL if none does:
- * [+-] (digits [. digits] | . digits) [(e|E) [+-] digits]. */
-static const char *scan_decimal(const char *s, const char *end)
-{
-	const char *q = s;
-	if (q < end && (*q == '+' || *q == '-'))
-		q++;
-	size_t ndig = 0;
-	while (q < end && is_digit(*q)) {
-		q++;
-		ndig++;
-	}
-	if (q < end && *q == '.') {
-		q++;
-		while (q < end && is_digit(*q)) {
-			q++;
-			ndig++;
-		}
-	}
-	if (ndig == 0)
-		return NULL;
-	if (q < end && (*q == 'e' || *q == 'E')) {
-		q++;
-		if (q < end && (*q == '+' || *q == '-'))
-			q++;
-		const char *e0 = q;
-		while (q < end && is_digit(*q))
-			q++;
-		if (q == e0)
-			return NULL;
-	}
-	return q;
-}
-
-typedef enum num_status { NUM_OK, NUM_EMPTY, NUM_BAD, NUM_BIG } num_status;
-
-/* Reads s[0..len), which must be followed by ',', 'x' or NUL. */
+/* Reads s[0..len), which must be followed by ',', 'x' or NUL: the one
+ * scanner of num.h, within RT_NUM_MAX. */
 static num_status num_parse(const char *s, size_t len, double *out)
 {
-	if (len == 0)
-		return NUM_EMPTY;
-	if (scan_decimal(s, s + len) != s + len)
-		return NUM_BAD;
-	/* The syntax is checked: strtod reads exactly these bytes, except that
-	 * "0x" would start a hexadecimal number, so copy the short ones. */
-	char buf[64];
-	double v;
-	if (len < sizeof buf) {
-		memcpy(buf, s, len);
-		buf[len] = '\0';
-		v = strtod(buf, NULL);
-	} else {
-		v = strtod(s, NULL);
-	}
-	if (!(fabs(v) <= RT_NUM_MAX))
-		return NUM_BIG;
-	*out = v;
-	return NUM_OK;
+	return num_scan(s, len, RT_NUM_MAX, out);
 }
 
 /* A field's range: lo..hi (lo excluded when lo_open), whole numbers only
@@ -531,14 +474,14 @@ static bool parse_camera(parser *p, const elem_def *e)
 	    !get_dir(p, &p->toks[2], e->name, "direction", &c.dir) ||
 	    !get_num(p, &p->toks[3], e->name, "fov", &R_FOV, &c.fov))
 		return false;
-	if (c.fov < FOV_MIN || c.fov > FOV_MAX) {
-		double to = c.fov < FOV_MIN ? FOV_MIN : FOV_MAX;
+	bool clamped;
+	if (!fov_rule(&c.fov, &clamped, p->err)) /* R_FOV has checked [0,180] */
+		return false;
+	if (clamped)
 		rt_warn(p->warn, p->name, p->line, p->toks[3].col,
 		        "camera fov \"%s\" is clamped to %g degrees; expected an angle strictly "
 		        "between 0 and 180",
-		        quoted(p, &p->toks[3]), to);
-		c.fov = to;
-	}
+		        quoted(p, &p->toks[3]), c.fov);
 	scene *s = p->s;
 	if (strcmp(e->id, "C") != 0)
 		return scene_add_camera(s, &c, p->err);
@@ -794,7 +737,7 @@ static bool add_object(parser *p, const elem_def *e, object *o, const zero_size 
 	}
 	rt_error verr;
 	rt_error_clear(&verr);
-	if (!object_validate(o, &verr))
+	if (!object_rules(o, &verr)) /* the editor's rules too */
 		return fail(p, p->toks[0].col, "%s: %s", e->name, verr.msg);
 	return scene_add_object(p->s, o, p->err);
 }

@@ -313,9 +313,14 @@ bool object_validate(const object *o, rt_error *err)
 	if (!(obj_kind_flags(o->kind) & KIND_UNBOUNDED) && !(o->scale.x > 0 && o->scale.y > 0 && o->scale.z > 0))
 		return rt_error_set(err, "%s scaling has a component <= 0; expected sizes > 0", name);
 	xform x;
-	if (!object_xform(o, &x))
-		return rt_error_set(err, "%s transform is not invertible (check the shear); "
-		                         "expected a shear that keeps the shape solid", name);
+	if (!object_xform(o, &x)) {
+		if (has_shear(o))
+			return rt_error_set(err, "%s transform is not invertible (check the shear); "
+			                         "expected a shear that keeps the shape solid", name);
+		return rt_error_set(err, "%s scaling %g,%g,%g is too small or too uneven to place; "
+		                         "expected sizes whose product is far from 0",
+		                    name, o->scale.x, o->scale.y, o->scale.z);
+	}
 	return true;
 }
 

@@ -93,8 +93,8 @@ bool cmd_camera(shell *sh, int argc, char **argv, const char *rest)
 			return false;
 		EDIT(sh, what, editor_camera_lookat(sh->ed, p, &err_));
 	case 3:
-		if (!parse_number(v, &d) || !(d > 0 && d < 180))
-			return shell_fail(sh, "%s: \"%s\" is not a field of view; expected degrees between 0 and 180",
+		if (!parse_number(v, &d)) /* the range is the editor's, as in files (rules.h) */
+			return shell_fail(sh, "%s: \"%s\" is not a field of view; expected degrees in [0,180]",
 			                  what, v);
 		EDIT(sh, what, editor_camera_fov(sh->ed, d, &err_));
 	case 4:

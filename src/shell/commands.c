@@ -3,11 +3,13 @@
 
 #include <ctype.h>
 #include <errno.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "rtsh/num.h"
 #include "rtsh/rtfile.h"
 #include "shell/answer.h"
 #include "shell/keymode.h"
@@ -221,36 +223,7 @@ int split_words(const char *s, char **argv, int max, char *buf, size_t *rest_at,
 
 bool parse_number(const char *s, double *out)
 {
-	const char *p = s;
-	if (*p == '+' || *p == '-')
-		p++;
-	int digits = 0;
-	while (isdigit((unsigned char)*p))
-		p++, digits++;
-	if (*p == '.') {
-		p++;
-		while (isdigit((unsigned char)*p))
-			p++, digits++;
-	}
-	if (!digits)
-		return false;
-	if (*p == 'e' || *p == 'E') {
-		p++;
-		if (*p == '+' || *p == '-')
-			p++;
-		if (!isdigit((unsigned char)*p))
-			return false;
-		while (isdigit((unsigned char)*p))
-			p++;
-	}
-	if (*p)
-		return false;
-	errno = 0;
-	double v = strtod(s, NULL);
-	if (!isfinite(v) || fabs(v) > 1e20)
-		return false;
-	*out = v;
-	return true;
+	return num_scan_str(s, 1e20, out) == NUM_OK; /* the .rt reader's numbers (num.h) */
 }
 
 bool arg_number(shell *sh, const char *what, const char *word, double lo, double hi, double *out)
@@ -266,12 +239,11 @@ bool arg_number(shell *sh, const char *what, const char *word, double lo, double
 
 bool arg_int(shell *sh, const char *what, const char *word, long lo, long hi, long *out)
 {
-	char *end;
-	errno = 0;
-	long v = strtol(word, &end, 10);
-	if (!*word || *end || errno || isspace((unsigned char)*word))
+	long v = 0;
+	num_status st = num_scan_long(word, LONG_MIN, LONG_MAX, &v);
+	if (st == NUM_EMPTY || st == NUM_BAD)
 		return shell_fail(sh, "%s: \"%s\" is not a whole number; expected %ld..%ld", what, word, lo, hi);
-	if (v < lo || v > hi)
+	if (st != NUM_OK || v < lo || v > hi)
 		return shell_fail(sh, "%s: %s is out of range; expected %ld..%ld", what, word, lo, hi);
 	*out = v;
 	return true;
@@ -322,10 +294,8 @@ bool arg_color(shell *sh, const char *what, const char *word, vec3 *out)
 
 bool arg_index(shell *sh, const char *what, const char *word, const char *kind, size_t n, size_t *out)
 {
-	char *end;
-	errno = 0;
-	unsigned long long v = strtoull(word, &end, 10);
-	bool ok = *word && isdigit((unsigned char)*word) && !*end && !errno && v >= 1 && v <= n;
+	unsigned long long v = 0;
+	bool ok = num_scan_u64(word, &v) == NUM_OK && v >= 1 && v <= n; /* num.h */
 	if (!ok) {
 		if (n == 0)
 			return shell_fail(sh, "%s: \"%s\" is not %s %s number; the scene has no %ss", what, word,

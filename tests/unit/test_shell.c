@@ -126,8 +126,10 @@ static void test_arguments_and_messages(void **state)
 	assert_false(command_run(sh, "undo"));
 	assert_string_equal(sh->err, "undo: nothing to undo");
 	assert_false(command_run(sh, "set samples lots"));
-	assert_false(command_run(sh, "camera fov 180"));
-	assert_string_equal(sh->err, "camera fov: \"180\" is not a field of view; expected degrees between 0 and 180");
+	/* fov 180 is clamped as in files (issue 14: one rule); 181 is refused */
+	assert_false(command_run(sh, "camera fov 181"));
+	assert_string_equal(sh->err, "camera fov: camera field of view 181 is out of range; expected degrees "
+	                             "in [0,180] (the ends are clamped to 0.01 and 179.99)");
 	/* Good commands change the scene and undo brings it back. */
 	scene *before = scene_clone(editor_scene(sh->ed));
 	assert_true(command_run(sh, "obj 1 mo 1,0,0"));
