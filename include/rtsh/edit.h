@@ -90,6 +90,9 @@ bool editor_object_move(editor *ed, size_t i, vec3 d, rt_error *err);
 bool editor_object_rotate(editor *ed, size_t i, vec3 deg, rt_error *err);
 bool editor_object_scale(editor *ed, size_t i, vec3 factor, rt_error *err);
 bool editor_object_color(editor *ed, size_t i, vec3 rgb, rt_error *err);
+/* One key=value field ("ior=1.5"), read and checked as the reader does
+ * (the same table, scanner and rules). */
+bool editor_object_set_key(editor *ed, size_t i, const char *assignment, rt_error *err);
 /* Light i. */
 bool editor_light_pos(editor *ed, size_t i, vec3 p, rt_error *err);
 bool editor_light_move(editor *ed, size_t i, vec3 d, rt_error *err);

@@ -10,7 +10,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rtsh/num.h"
 #include "rtsh/world.h"
+#include "scene/rtfile_priv.h"
 
 typedef enum rec_kind {
 	REC_OBJECT,        /* replace object idx by u.obj */
@@ -656,6 +658,36 @@ bool editor_object_color(editor *ed, size_t i, vec3 rgb, rt_error *err)
 	if (!get_object(ed, i, &o, err))
 		return false;
 	o.mat.color = rgb;
+	return editor_set_object(ed, i, &o, err);
+}
+
+bool editor_object_set_key(editor *ed, size_t i, const char *assignment, rt_error *err)
+{
+	object o;
+	if (!get_object(ed, i, &o, err))
+		return false;
+	const char *eq = strchr(assignment, '=');
+	size_t nlen = eq ? (size_t)(eq - assignment) : strlen(assignment);
+	const rt_key *k = NULL;
+	for (size_t j = 0; j < rt_nkeys && !k; j++)
+		if (strlen(rt_keys[j].name) == nlen && strncmp(rt_keys[j].name, assignment, nlen) == 0)
+			k = &rt_keys[j];
+	if (!k || !eq || !rt_key_applies(k, o.kind)) {
+		char list[256] = "";
+		size_t used = 0;
+		for (size_t j = 0; j < rt_nkeys; j++)
+			if (rt_key_applies(&rt_keys[j], o.kind))
+				used += (size_t)snprintf(list + used, sizeof list - used, "%s%s=",
+				                         used ? " " : "", rt_keys[j].name);
+		return rt_error_set(err, "\"%s\" is %s; expected KEY=VALUE with one of %s", assignment,
+		                    !eq ? "not KEY=VALUE" : !k ? "an unknown key" : "a key this object does not take",
+		                    list);
+	}
+	double v;
+	if (num_scan_str(eq + 1, RT_NUM_MAX, &v) != NUM_OK || v < k->min || v > k->max ||
+	    (k->is_int && v != floor(v)) || (k->extra && !k->extra(v)))
+		return rt_error_set(err, "\"%s\" is out of range; expected %s", assignment, k->expect);
+	rt_key_set(k, &o, v);
 	return editor_set_object(ed, i, &o, err);
 }
 

@@ -53,6 +53,14 @@ const rt_key rt_keys[] = {
 };
 const size_t rt_nkeys = sizeof rt_keys / sizeof rt_keys[0];
 
+const char *rt_key_info(size_t i, const char **help)
+{
+	if (i >= rt_nkeys)
+		return NULL;
+	*help = rt_keys[i].help;
+	return rt_keys[i].name;
+}
+
 bool rt_key_applies(const rt_key *k, obj_kind kind)
 {
 	unsigned f = obj_kind_flags(kind);

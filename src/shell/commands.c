@@ -17,7 +17,7 @@
 
 #define SUBS_CAMERA "pos|dir|lookat|fov|move|turn"
 #define SUBS_LIGHT "pos|move|brightness|color"
-#define SUBS_OBJECT "move|rotate|scale|color"
+#define SUBS_OBJECT "move|rotate|scale|color|set"
 
 const command command_table[] = {
 	{"load", NULL, "load FILE", 1, 1, {"@scene"},
@@ -43,8 +43,8 @@ const command command_table[] = {
 	 0, 3, {"@light", SUBS_LIGHT}, "list the lights, show light N, or edit it", cmd_light},
 	{"object", "obj",
 	 "object\nobject N\nobject N move DX,DY,DZ\nobject N rotate RX,RY,RZ\nobject N scale SX,SY,SZ\n"
-	 "object N color R,G,B",
-	 0, 3, {"@object", SUBS_OBJECT},
+	 "object N color R,G,B\nobject N set KEY=VALUE",
+	 0, 3, {"@object", SUBS_OBJECT, "@key"},
 	 "list the objects, show object N, or edit it (move in world axes, rotate in degrees about X, Y, Z)",
 	 cmd_object},
 	{"ambient", NULL, "ambient\nambient brightness B\nambient color R,G,B", 0, 2, {"brightness|color"},
@@ -392,6 +392,12 @@ bool cmd_help(shell *sh, int argc, char **argv, const char *rest)
 			shell_out(sh, "elements (rtsh(5)):\n");
 			for (size_t i = 0; rt_element(i, &usage); i++)
 				shell_out(sh, "  %s\n", usage);
+		}
+		if (c->run == cmd_add || c->run == cmd_object) { /* the keys, from the reader's table */
+			const char *name, *kh;
+			shell_out(sh, "object keys (KEY=VALUE after the fields, or object N set KEY=VALUE):\n");
+			for (size_t i = 0; (name = rt_key_info(i, &kh)); i++)
+				shell_out(sh, "  %-8s %s\n", name, kh);
 		}
 		if (c->aliases)
 			shell_out(sh, "also: %s\n", c->aliases);

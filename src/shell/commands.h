@@ -32,7 +32,8 @@ typedef struct command {
 	 * separated by '|'; "@file" (any), "@scene" (what load reads),
 	 * "@output" (what save writes), "@command", "@setting", "@value" (of the
 	 * setting before), "@object", "@light", "@camera" (their numbers),
-	 * "@element" (the .rt elements, rtfile.h) and "@ref" (numbers of the
+	 * "@element" (the .rt elements, rtfile.h), "@key" (after "set": the
+	 * object keys, rtfile.h) and "@ref" (numbers of the
 	 * kind named by the word before). */
 	const char *complete[3];
 	const char *help;      /* one line */

@@ -68,6 +68,26 @@ static void test_issue_repros(void **state)
 	editor_free(ed);
 }
 
+/* object N set KEY=VALUE: the reader's table, scanner and ranges. */
+static void test_set_key(void **state)
+{
+	(void)state;
+	rt_error err;
+	editor *ed = editor_new(load("sp 0,0,0 1 255,0,0\nto 0,0,0 0,1,0 2 1 0,0,255\n"), "t");
+	assert_true(editor_object_set_key(ed, 0, "ior=1.5", &err));
+	assert_near(editor_scene(ed)->objs[0].mat.ior, 1.5, 0);
+	assert_true(editor_object_set_key(ed, 1, "tube=0.25", &err));
+	assert_near(editor_scene(ed)->objs[1].tube, 0.25, 0);
+	static const char *const bad[] = {"ior=0.5", "ior=0x1", "ior", "glow=1", "tube=2", "checker=1.5",
+	                                  "emit=-1", "fuzz=1e400"};
+	for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++)
+		if (editor_object_set_key(ed, 0, bad[i], &err))
+			fail_msg("object 1 set %s was accepted", bad[i]);
+	assert_false(editor_object_set_key(ed, 1, "tube=0", &err));
+	expect_round_trip(ed, "object set");
+	editor_free(ed);
+}
+
 /* Arguments spread over every magnitude, with some odd ones. */
 static double wild(test_rng *g)
 {
@@ -154,6 +174,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_issue_repros),
+		cmocka_unit_test(test_set_key),
 		cmocka_unit_test(test_random_edit_sequences),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);

@@ -117,7 +117,7 @@ static void test_arguments_and_messages(void **state)
 	assert_string_equal(sh->err, "light color: 300,0,0 is out of range; expected R,G,B with each in 0..255");
 	assert_false(command_run(sh, "object 1 spin 1,2,3"));
 	assert_string_equal(sh->err,
-	                    "object: \"spin\" is not an object command; expected move, rotate, scale or color");
+	                    "object: \"spin\" is not an object command; expected move, rotate, scale, color or set");
 	assert_false(command_run(sh, "delete"));
 	assert_string_equal(sh->err, "delete: too few arguments; usage: delete object N | delete light N | "
 	                             "delete camera N");
@@ -173,7 +173,11 @@ static void test_completion(void **state)
 	assert_candidates(complete_at_end(sh, "set sa", &files), "samples");
 	assert_candidates(complete_at_end(sh, "set mode ", &files), "whitted path");
 	assert_candidates(complete_at_end(sh, "set m", &files), "mode");
-	assert_candidates(complete_at_end(sh, "object 1 ", &files), "move rotate scale color");
+	assert_candidates(complete_at_end(sh, "object 1 ", &files), "move rotate scale color set");
+	/* the keys after set come from the reader's table (rtfile.h) */
+	assert_candidates(complete_at_end(sh, "object 1 set ", &files),
+	                  "twist= fuzz= metal= ior= emit= checker= tube=");
+	assert_candidates(complete_at_end(sh, "object 1 move ", &files), "");
 	assert_candidates(complete_at_end(sh, "obj 2 r", &files), "rotate");
 	assert_candidates(complete_at_end(sh, "light ", &files), "1 2 3");
 	assert_candidates(complete_at_end(sh, "delete li", &files), "light");
