@@ -15,6 +15,7 @@
  * tree is then collapsed into 4-wide nodes (collapse, bvh.h).
  */
 #include "bvh.h"
+#include "prims.h"
 
 #include <stdlib.h>
 #include <string.h>

@@ -11,6 +11,7 @@
 #endif
 
 #include "bvh.h"
+#include "prims.h"
 #include "emitters.h"
 #include "rtsh/shape.h"
 
