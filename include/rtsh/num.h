@@ -21,7 +21,9 @@ typedef enum num_status {
 	NUM_BIG,   /* a number, but its magnitude is above the limit (or overflows) */
 } num_status;
 
-/* The decimal number s[0..len), |v| <= max. */
+/* The decimal number s[0..len), |v| <= max. A text of 64 bytes or more is
+ * read in place: the byte after it must be readable and must not continue a
+ * number (the reader's tokens end in ',', 'x' or NUL). */
 num_status num_scan(const char *s, size_t len, double max, double *out);
 /* The same for a NUL-terminated string. */
 num_status num_scan_str(const char *s, double max, double *out);

@@ -59,19 +59,24 @@ num_status num_scan(const char *s, size_t len, double max, double *out)
 	if (scan_decimal(s, s + len) != s + len)
 		return NUM_BAD;
 	/* The syntax is checked: strtod reads exactly these bytes (in the "C"
-	 * locale), from a copy that ends where the number does. */
-	char small[64], *buf = len < sizeof small ? small : malloc(len + 1);
-	if (!buf)
-		return NUM_BAD;
-	memcpy(buf, s, len);
-	buf[len] = '\0';
+	 * locale). Short ones from a copy ("0" before an 'x' would start a hex
+	 * number); long ones in place, where the text after them (',', 'x',
+	 * NUL: see num.h) ends the number, which the end pointer confirms. */
+	char small[64];
+	const char *from = s;
+	if (len < sizeof small) {
+		memcpy(small, s, len);
+		small[len] = '\0';
+		from = small;
+	}
 	pthread_once(&c_once, c_locale_init);
 	locale_t old = c_locale ? uselocale(c_locale) : (locale_t)0;
-	double v = strtod(buf, NULL);
+	char *end;
+	double v = strtod(from, &end);
 	if (c_locale)
 		uselocale(old);
-	if (buf != small)
-		free(buf);
+	if (end != from + len)
+		return NUM_BAD;
 	if (!(fabs(v) <= max))
 		return NUM_BIG;
 	*out = v;
