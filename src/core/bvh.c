@@ -15,7 +15,6 @@
  * tree is then collapsed into 4-wide nodes (collapse, bvh.h).
  */
 #include "bvh.h"
-#include "prims.h"
 
 #include <stdlib.h>
 #include <string.h>

@@ -683,6 +683,10 @@ bool editor_object_set_key(editor *ed, size_t i, const char *assignment, rt_erro
 		                    !eq ? "not KEY=VALUE" : !k ? "an unknown key" : "a key this object does not take",
 		                    list);
 	}
+	if (k->type != RT_KEY_NUM)
+		return rt_error_set(err, "\"%s\": %s= takes a file or U,V; expected it on the object's line "
+		                         "(add, or edit the .rt file)",
+		                    assignment, k->name);
 	double v;
 	if (num_scan_str(eq + 1, RT_NUM_MAX, &v) != NUM_OK || v < k->min || v > k->max ||
 	    (k->is_int && v != floor(v)) || (k->extra && !k->extra(v)))

@@ -122,8 +122,8 @@ bool object_rules(const object *o, rt_error *err)
 		                    name, m->diffuse, m->specular, m->shininess, m->reflective);
 	for (size_t i = 0; i < rt_nkeys; i++) {
 		const rt_key *k = &rt_keys[i];
-		if (!rt_key_applies(k, o->kind))
-			continue;
+		if (!rt_key_applies(k, o->kind) || k->type != RT_KEY_NUM)
+			continue; /* files and U,V pairs are checked where they are read */
 		double v = rt_key_get(k, o);
 		if (v == k->def)
 			continue;

@@ -154,7 +154,7 @@ static void test_random_edit_sequences(void **state)
 				ok = editor_camera_pos(ed, wild_vec(&g), &err);
 				break;
 			default:
-				ok = editor_set_sky(ed, true, &(sky){v3(1, 2, 3), v3(4, 5, 6), wild(&g)}, &err);
+				ok = editor_set_sky(ed, true, &(sky){.zenith = v3(1, 2, 3), .horizon = v3(4, 5, 6), .strength = wild(&g)}, &err);
 				break;
 			}
 			accepted += ok;

@@ -176,7 +176,8 @@ static void test_completion(void **state)
 	assert_candidates(complete_at_end(sh, "object 1 ", &files), "move rotate scale color set");
 	/* the keys after set come from the reader's table (rtfile.h) */
 	assert_candidates(complete_at_end(sh, "object 1 set ", &files),
-	                  "twist= fuzz= metal= ior= emit= checker= tube=");
+	                  "twist= fuzz= metal= ior= emit= checker= tube= texture= normalmap= bump= bumpscale= "
+	                  "uvscale= uvoffset= smooth= crease=");
 	assert_candidates(complete_at_end(sh, "object 1 move ", &files), "");
 	assert_candidates(complete_at_end(sh, "obj 2 r", &files), "rotate");
 	assert_candidates(complete_at_end(sh, "light ", &files), "1 2 3");
