@@ -4,7 +4,9 @@
 #   make run        build and open the shell on the built-in showcase scene
 #   make test       build and run every test, then again under ASan+UBSan, and
 #                   the threaded tests under TSan
-#   make bench      build and run the benchmark (writes build/bench.tsv)
+#   make bench      build and run the benchmark (writes build/bench.tsv), then
+#                   bench-quality: rtsh against Cycles at equal noise (skipped
+#                   without blender) and the preview's time to an error
 #   make fuzz       build the libFuzzer targets (clang) and run each for
 #                   FUZZ_SECONDS (default 60) on tests/fuzz/corpus
 #   make install    PREFIX=/usr/local DESTDIR=  (binary, man pages, scenes)
