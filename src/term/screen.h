@@ -77,6 +77,9 @@ bool screen_set_pixels(screen *s, int mode);
 /* Deletes the picture's kitty images now, if it showed any (they float
  * over text): before something else draws on the screen (key mode). */
 void screen_drop_images(screen *s);
+/* text fitted to exactly cols terminal columns (cut on a character, padded
+ * with spaces), counted by wcwidth in the current locale: the status line. */
+void screen_fit_text(abuf *a, const char *text, int cols);
 /* Sets and draws the status line. */
 void screen_status(screen *s, const char *text);
 /* Puts an sRGB image of img_w x img_h pixels in the picture area
