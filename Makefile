@@ -5,6 +5,8 @@
 #   make test       build and run every test, then again under ASan+UBSan, and
 #                   the threaded tests under TSan
 #   make bench      build and run the benchmark (writes build/bench.tsv)
+#   make mpi        build ./rtsh-mpi, the Open MPI renderer (`make` builds it
+#                   too when mpicc is installed)
 #   make install    PREFIX=/usr/local DESTDIR=  (binary, man pages, scenes)
 #
 # Variants build in their own folder: `make BUILD=build/asan SAN=address,undefined`.
@@ -53,10 +55,28 @@ else
 BIN := $(BUILD)/rtsh
 endif
 
-.PHONY: all run test test-bins test-unit test-scripts bench bench-quick install uninstall \
-        clean deps check-man
+# rtsh-mpi: only its own objects are compiled with mpicc; rtsh never links MPI.
+MPICC    ?= mpicc
+MPI_SRC  := $(sort $(wildcard src/mpi/*.c))
+MPI_OBJ  := $(MPI_SRC:%.c=$(BUILD)/%.o)
+MPI_BIN  := $(patsubst %rtsh,%rtsh-mpi,$(BIN))
+HAVE_MPI := $(shell command -v $(MPICC) 2>/dev/null)
 
-all: deps $(BIN)
+.PHONY: all run test test-bins test-unit test-scripts bench bench-quick install uninstall \
+        clean deps check-man mpi
+
+all: deps $(BIN) $(if $(HAVE_MPI),$(MPI_BIN))
+
+mpi: deps $(MPI_BIN)
+
+$(MPI_BIN): $(MPI_OBJ) $(FRONTLIB) $(LIB)
+	@echo "  LD      $@"
+	@$(MPICC) $(LDFLAGS) -o $@ $^ $(LDLIBS_CORE)
+
+$(BUILD)/src/mpi/%.o: src/mpi/%.c
+	@mkdir -p $(@D)
+	@echo "  MPICC   $<"
+	@$(MPICC) $(CPPFLAGS) $(CFLAGS) -c -o $@ $<
 
 deps:
 	@sh tests/deps.sh
@@ -145,6 +165,6 @@ uninstall:
 	rm -rf $(DESTDIR)$(PREFIX)/share/rtsh
 
 clean:
-	rm -rf build rtsh
+	rm -rf build rtsh rtsh-mpi
 
--include $(CORE_OBJ:.o=.d) $(FRONT_OBJ:.o=.d) $(MAIN_OBJ:.o=.d)
+-include $(CORE_OBJ:.o=.d) $(FRONT_OBJ:.o=.d) $(MAIN_OBJ:.o=.d) $(MPI_OBJ:.o=.d)

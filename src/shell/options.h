@@ -36,6 +36,13 @@ typedef struct rtsh_options {
 	int nsettings;
 } rtsh_options;
 
+/* Parses argv into o (zeroed by the caller); returns -1 to go on, or an
+ * exit status (0 after --help or --version, 2 after a usage error, whose
+ * message it has printed). */
+int options_parse(int argc, char **argv, rtsh_options *o);
+/* Prints "PROG: " fmt (with arg) and the --help hint; returns 2. */
+int options_usage_error(const char *fmt, const char *arg);
+
 /* Applies the command line's settings over s (after the scene's hints).
  * They were validated when parsed, so this cannot fail. */
 void options_apply_settings(const rtsh_options *o, render_settings *s);

@@ -1,0 +1,370 @@
+/* rtsh-mpi — one image rendered by many processes: `mpirun -n N rtsh-mpi
+ * SCENE -o OUT [options]` writes the same bytes as `rtsh SCENE -o OUT
+ * [options]`.
+ *
+ * Rank 0 reads the command line, the scene and every file it references,
+ * and broadcasts the settings and the files' bytes (fileset.h); every rank
+ * builds the same world from them. Rank 0 then serves tiles from one queue
+ * while rendering too, the others render the tiles they are given with all
+ * their threads (farm.h), and rank 0 assembles the image and writes it
+ * atomically. Every rank ends with the same exit status.
+ */
+#include <mpi.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include <fcntl.h>
+
+#include "mpi/farm.h"
+#include "mpi/fileset.h"
+#include "rtsh/image.h"
+#include "rtsh/render.h"
+#include "rtsh/rtfile.h"
+#include "rtsh/settings.h"
+#include "rtsh/world.h"
+#include "shell/options.h"
+
+#define MSG_MAX (RT_ERROR_MSG_MAX + RT_ERROR_FILE_MAX + 32)
+/* MPI counts are ints: large buffers go in pieces of 1 GiB. */
+#define BCAST_PIECE (1 << 30)
+
+/* What rank 0 tells every rank before the render. */
+typedef struct job_config {
+	int32_t status;   /* -1: render; else every rank exits with it */
+	int32_t verbose, progress, strict;
+	int32_t tile, prefetch, delay_us;
+	render_settings set;
+	uint64_t files;   /* bytes of the packed file set */
+} job_config;
+
+static void usage(FILE *f)
+{
+	fputs("usage: mpirun -n N [--hostfile HOSTS] rtsh-mpi SCENE.rt -o OUT [OPTIONS]\n"
+	      "Renders SCENE.rt to OUT (.ppm .pfm .png) across the ranks of an MPI job; the\n"
+	      "output is the same, byte for byte, as `rtsh SCENE.rt -o OUT [OPTIONS]`.\n"
+	      "options (as rtsh's batch mode):\n"
+	      "  -r WxH           resolution          -s N   samples per pixel\n"
+	      "  -d N             depth               -t N   threads per rank\n"
+	      "                                       (0 = the node's CPUs shared among its ranks)\n"
+	      "  -m whitted|path  render mode         --seed N  random seed\n"
+	      "  -q               no progress output  --strict  the 42 subject's rules\n"
+	      "  -v               per-rank figures at the end: tiles, seconds, Mrays/s, bytes sent\n"
+	      "  -h, --help       this help           -V, --version  version\n"
+	      "See rtsh-mpi(1).\n",
+	      f);
+}
+
+static void print_warning(void *ctx, const rt_error *w)
+{
+	(void)ctx;
+	char buf[MSG_MAX];
+	rt_error_format(w, buf, sizeof buf);
+	fprintf(stderr, "%s (warning)\n", buf);
+}
+
+/* A whole number in lo..hi from the environment variable, or def when it is
+ * unset; -1 (message printed) when it is not valid. */
+static long env_number(const char *name, long def, long lo, long hi)
+{
+	const char *v = getenv(name);
+	if (!v || !*v)
+		return def;
+	char *end;
+	long n = strtol(v, &end, 10);
+	if (*end || n < lo || n > hi) {
+		fprintf(stderr, "rtsh-mpi: %s=\"%s\" is not valid; expected a whole number in %ld..%ld\n",
+		        name, v, lo, hi);
+		return -1;
+	}
+	return n;
+}
+
+/* Under mpirun, standard error is a pipe to mpirun even when the user
+ * watches a terminal: then the job's controlling terminal says so. */
+static bool watched(void)
+{
+	if (isatty(STDERR_FILENO))
+		return true;
+	if (!getenv("OMPI_COMM_WORLD_SIZE"))
+		return false;
+	int fd = open("/dev/tty", O_WRONLY | O_NOCTTY);
+	if (fd < 0)
+		return false;
+	close(fd);
+	return true;
+}
+
+/* Rank 0: the command line, the scene and its files, the world, the image.
+ * Sets c->status to an exit status when the job must not render. */
+static void setup(int argc, char **argv, job_config *c, fileset *files, world **w,
+                  framebuffer **fb, const char **output)
+{
+	char msg[MSG_MAX];
+	rt_error err;
+	c->status = 2;
+	/* rtsh-mpi's own options: -v, and its own help and version */
+	char **args = calloc((size_t)argc + 1, sizeof *args);
+	if (!args) {
+		fputs("rtsh-mpi: out of memory\n", stderr);
+		c->status = 1;
+		return;
+	}
+	int n = 0;
+	bool dashdash = false;
+	for (int i = 0; i < argc; i++) {
+		const char *a = argv[i];
+		if (i > 0 && !dashdash && strcmp(a, "-v") == 0) {
+			c->verbose = 1;
+			continue;
+		}
+		if (i > 0 && !dashdash && (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0)) {
+			usage(stdout);
+			c->status = 0;
+			goto out;
+		}
+		if (i > 0 && !dashdash && (strcmp(a, "-V") == 0 || strcmp(a, "--version") == 0)) {
+			printf("rtsh-mpi %s\n", RTSH_VERSION);
+			c->status = 0;
+			goto out;
+		}
+		if (strcmp(a, "--") == 0)
+			dashdash = true;
+		args[n++] = argv[i];
+	}
+	rtsh_options o;
+	memset(&o, 0, sizeof o);
+	int rc = options_parse(n, args, &o);
+	if (rc >= 0) {
+		c->status = rc;
+		goto out;
+	}
+	if (o.commands || o.file || o.interactive) {
+		c->status = options_usage_error("-c, -f and -i are rtsh's shell%s; rtsh-mpi only renders SCENE -o OUT", "");
+		goto out;
+	}
+	if (!o.output) {
+		c->status = options_usage_error("no output given%s; expected SCENE.rt -o OUT", "");
+		goto out;
+	}
+	if (image_format_of(o.output) == IMAGE_UNKNOWN) {
+		c->status = options_usage_error("output \"%s\" has an unknown type; expected .ppm, .pfm or .png", o.output);
+		goto out;
+	}
+	if (!o.scene) {
+		c->status = options_usage_error("-o needs a scene file%s", "");
+		goto out;
+	}
+	long tile = env_number("RTSH_MPI_TILE", 32, 4, 1024);
+	long prefetch = env_number("RTSH_MPI_PREFETCH", 2, 0, 1024);
+	long delay = env_number("RTSH_MPI_DELAY_US", 0, 0, 10000000);
+	if (tile < 0 || prefetch < 0 || delay < 0)
+		goto out;
+	c->tile = (int32_t)tile;
+	c->prefetch = (int32_t)prefetch;
+	c->delay_us = (int32_t)delay;
+	c->strict = o.strict;
+
+	c->status = 1;
+	rt_warnings warn = {print_warning, NULL};
+	rt_load_opts lo = {.strict = o.strict, .warn = o.quiet ? NULL : &warn,
+	                   .read = fileset_record, .read_ctx = files};
+	scene *s = rt_load_file(o.scene, &lo, &err);
+	if (!s) {
+		rt_error_format(&err, msg, sizeof msg);
+		fprintf(stderr, "%s\n", msg);
+		goto out;
+	}
+	c->set = render_settings_default();
+	if (render_settings_apply_hints(&c->set, &s->hints) && !o.quiet)
+		fprintf(stderr, "%s: resolution %dx%d is too large; rendering %dx%d (use -r to choose)\n",
+		        o.scene, s->hints.width, s->hints.height, c->set.width, c->set.height);
+	options_apply_settings(&o, &c->set);
+	*w = world_build(s, &err);
+	scene_free(s);
+	if (!*w) {
+		rt_error_format(&err, msg, sizeof msg);
+		fprintf(stderr, "%s: %s\n", o.scene, msg);
+		goto out;
+	}
+	*fb = fb_new(c->set.width, c->set.height);
+	if (!*fb) {
+		fprintf(stderr, "%s: cannot make a %dx%d image; expected 1..%d pixels a side, and memory\n",
+		        o.scene, c->set.width, c->set.height, RENDER_MAX_DIM);
+		goto out;
+	}
+	free((*fb)->sum); /* one pass: no running sums, as render_image */
+	(*fb)->sum = NULL;
+	c->progress = !o.quiet && watched();
+	*output = o.output;
+	c->status = -1;
+out:
+	free(args);
+}
+
+/* Broadcasts size bytes from rank 0 in pieces an int can count. */
+static void bcast_bytes(char *buf, uint64_t size)
+{
+	for (uint64_t at = 0; at < size; at += BCAST_PIECE) {
+		uint64_t left = size - at;
+		MPI_Bcast(buf + at, (int)(left < BCAST_PIECE ? left : BCAST_PIECE), MPI_BYTE, 0,
+		          MPI_COMM_WORLD);
+	}
+}
+
+/* The render threads of this rank: -t, or the node's CPUs shared among the
+ * ranks on the node. */
+static int rank_threads(const render_settings *s)
+{
+	if (s->threads > 0)
+		return s->threads;
+	MPI_Comm node;
+	int here = 1;
+	if (MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node) ==
+	    MPI_SUCCESS) {
+		MPI_Comm_size(node, &here);
+		MPI_Comm_free(&node);
+	}
+	int cpus = render_threads(s);
+	return cpus / here > 1 ? cpus / here : 1;
+}
+
+/* Ends the whole job from any rank with one message. */
+static void die(int rank, const char *host, const char *what, const rt_error *err)
+{
+	char msg[MSG_MAX];
+	rt_error_format(err, msg, sizeof msg);
+	fprintf(stderr, "rtsh-mpi: rank %d on %s: %s%s%s\n", rank, host, what, *what ? ": " : "", msg);
+	fflush(stderr);
+	MPI_Abort(MPI_COMM_WORLD, 1);
+}
+
+static void print_figures(const farm_stats *st, int size, const job_config *c, double total)
+{
+	double tiles = 0, rays = 0, bytes = 0;
+	fprintf(stderr, "%-5s %-16s %7s %7s %8s %8s %9s %11s %9s\n", "rank", "host", "threads",
+	        "tiles", "seconds", "busy", "Mrays/s", "bytes sent", "rtt (us)");
+	for (int r = 0; r < size; r++) {
+		const farm_stats *f = &st[r];
+		double cap = f->seconds * f->threads;
+		fprintf(stderr, "%-5d %-16.16s %7d %7.0f %8.2f %7.0f%% %9.2f %11.0f %9.0f\n", r, f->host,
+		        f->threads, f->tiles, f->seconds, cap > 0 ? 100.0 * f->busy / cap : 0.0,
+		        f->seconds > 0 ? f->rays / f->seconds * 1e-6 : 0.0, f->bytes, f->rtt * 1e6);
+		tiles += f->tiles;
+		rays += f->rays;
+		bytes += f->bytes;
+	}
+	fprintf(stderr, "all   %d ranks, %.0f tiles of %dx%d, %.2f s, %.2f Mrays/s, %.0f bytes sent\n",
+	        size, tiles, c->tile, c->tile, total, total > 0 ? rays / total * 1e-6 : 0.0, bytes);
+}
+
+int main(int argc, char **argv)
+{
+	int provided, rank, size;
+	MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+	MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+	MPI_Comm_size(MPI_COMM_WORLD, &size);
+	char host[64] = "?";
+	int hl;
+	char name[MPI_MAX_PROCESSOR_NAME];
+	if (MPI_Get_processor_name(name, &hl) == MPI_SUCCESS)
+		snprintf(host, sizeof host, "%.63s", name);
+
+	job_config c;
+	memset(&c, 0, sizeof c);
+	fileset files = {0};
+	world *w = NULL;
+	framebuffer *fb = NULL;
+	const char *output = NULL;
+	char *packed = NULL;
+	size_t packed_size = 0;
+	if (rank == 0) {
+		setup(argc, argv, &c, &files, &w, &fb, &output);
+		if (c.status < 0) {
+			packed = fileset_pack(&files, &packed_size);
+			if (!packed) {
+				fputs("rtsh-mpi: out of memory packing the scene's files\n", stderr);
+				c.status = 1;
+			}
+			c.files = packed_size;
+		}
+	}
+	MPI_Bcast(&c, (int)sizeof c, MPI_BYTE, 0, MPI_COMM_WORLD);
+	if (c.status >= 0) {
+		/* a usage or scene error: rank 0 said it once; all end alike */
+		world_free(w);
+		fb_free(fb);
+		fileset_free(&files);
+		MPI_Finalize();
+		return c.status;
+	}
+	double t0 = MPI_Wtime();
+	rt_error err;
+	if (rank != 0) {
+		packed = malloc(c.files ? c.files : 1);
+		if (!packed) {
+			rt_error_set(&err, "out of memory for the scene's %llu bytes",
+			             (unsigned long long)c.files);
+			die(rank, host, "", &err);
+		}
+	}
+	bcast_bytes(packed, c.files);
+	if (rank != 0) {
+		rt_load_opts lo = {.strict = c.strict, .read = fileset_serve, .read_ctx = &files};
+		if (!fileset_unpack(&files, packed, c.files) || files.n == 0) {
+			rt_error_set(&err, "the scene's files arrived damaged or memory ran out");
+			die(rank, host, "", &err);
+		}
+		scene *s = rt_load_file(files.files[0].path, &lo, &err);
+		if (!s)
+			die(rank, host, "loading the scene rank 0 sent", &err);
+		w = world_build(s, &err);
+		scene_free(s);
+		if (!w)
+			die(rank, host, "building the world", &err);
+	}
+	free(packed);
+	fileset_free(&files);
+
+	farm_opts fo = {
+		.tile = c.tile,
+		.prefetch = c.prefetch,
+		.delay_us = c.delay_us,
+		.threads = rank_threads(&c.set),
+		.progress = c.progress != 0,
+	};
+	farm_stats st;
+	bool ok = rank == 0 ? farm_serve(w, &c.set, &fo, fb, &st, &err)
+	                    : farm_work(w, &c.set, &fo, &st, &err);
+	if (!ok)
+		die(rank, host, "", &err);
+	memcpy(st.host, host, sizeof st.host);
+	if (rank == 0)
+		st.bytes += (double)c.files * (size > 1);
+	world_free(w);
+	farm_stats *all = rank == 0 ? calloc((size_t)size, sizeof *all) : NULL;
+	MPI_Gather(&st, (int)sizeof st, MPI_BYTE, all, (int)sizeof st, MPI_BYTE, 0, MPI_COMM_WORLD);
+
+	int status = 0;
+	if (rank == 0) {
+		double rendered = MPI_Wtime() - t0;
+		if (!image_write(output, fb, c.set.exposure, &err)) {
+			char msg[MSG_MAX];
+			rt_error_format(&err, msg, sizeof msg);
+			fprintf(stderr, "%s\n", msg);
+			status = 1;
+		}
+		if (c.verbose && all)
+			print_figures(all, size, &c, rendered);
+		if (status == 0 && c.progress)
+			fprintf(stderr, "wrote %s (%dx%d, %d samples, %s) on %d ranks in %.2fs\n", output,
+			        c.set.width, c.set.height, c.set.samples, render_mode_name(c.set.mode), size,
+			        MPI_Wtime() - t0);
+	}
+	free(all);
+	fb_free(fb);
+	MPI_Bcast(&status, 1, MPI_INT, 0, MPI_COMM_WORLD);
+	MPI_Finalize();
+	return status;
+}
