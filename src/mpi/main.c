@@ -9,7 +9,9 @@
  * their threads (farm.h), and rank 0 assembles the image and writes it
  * atomically. Every rank ends with the same exit status.
  */
+#include <errno.h>
 #include <mpi.h>
+#include <signal.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -94,6 +96,24 @@ static bool watched(void)
 		return false;
 	close(fd);
 	return true;
+}
+
+/* Whether a file can be created in path's folder (as image_write will). */
+static bool folder_writable(const char *path, rt_error *err)
+{
+	const char *slash = strrchr(path, '/');
+	char dir[4096];
+	if (!slash)
+		snprintf(dir, sizeof dir, ".");
+	else if (slash == path)
+		snprintf(dir, sizeof dir, "/");
+	else
+		snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+	if (access(dir, W_OK | X_OK) == 0)
+		return true;
+	return rt_error_at(err, path, 0, 0,
+	                   "cannot create a file in that folder (%s); expected a writable folder",
+	                   strerror(errno));
 }
 
 /* Rank 0: the command line, the scene and its files, the world, the image.
@@ -188,6 +208,13 @@ static void setup(int argc, char **argv, job_config *c, fileset *files, world **
 		fprintf(stderr, "%s: %s\n", o.scene, msg);
 		goto out;
 	}
+	/* An hour's render must not end in a folder that cannot take the file:
+	 * check it now, in the words the final write would use. */
+	if (!folder_writable(o.output, &err)) {
+		rt_error_format(&err, msg, sizeof msg);
+		fprintf(stderr, "%s\n", msg);
+		goto out;
+	}
 	*fb = fb_new(c->set.width, c->set.height);
 	if (!*fb) {
 		fprintf(stderr, "%s: cannot make a %dx%d image; expected 1..%d pixels a side, and memory\n",
@@ -228,6 +255,52 @@ static int rank_threads(const render_settings *s)
 	}
 	int cpus = render_threads(s);
 	return cpus / here > 1 ? cpus / here : 1;
+}
+
+/* Rank 0 catches the launcher's SIGTERM (after another rank died, or
+ * Ctrl-C on mpirun) and SIGINT, to say why no image was written. */
+static volatile sig_atomic_t stop_signal;
+
+static void on_stop(int sig)
+{
+	stop_signal = sig;
+}
+
+/* Who each rank is, for messages about a rank that ended. */
+typedef struct rank_id {
+	int32_t pid;
+	char host[64];
+} rank_id;
+
+typedef struct stop_ctx {
+	const rank_id *ids;
+	int size;
+	const char *output;
+} stop_ctx;
+
+/* Rank 0 after a stop: names the ranks on its own host that are gone (others
+ * it cannot see), then ends by the signal that stopped it. */
+static void report_stop(void *ctx)
+{
+	const stop_ctx *sc = ctx;
+	const rank_id *ids = sc->ids;
+	int size = sc->size;
+	const char *output = sc->output;
+	int named = 0;
+	for (int r = 1; r < size && ids; r++)
+		if (strcmp(ids[r].host, ids[0].host) == 0 && kill(ids[r].pid, 0) != 0 && errno == ESRCH) {
+			fprintf(stderr, "rtsh-mpi: rank %d on %s ended before the image was complete\n", r,
+			        ids[r].host);
+			named++;
+		}
+	if (!named)
+		fputs("rtsh-mpi: the job was stopped before the image was complete (interrupted, or a rank on another host ended)\n",
+		      stderr);
+	fprintf(stderr, "rtsh-mpi: %s not written\n", output);
+	fflush(stderr);
+	int sig = stop_signal ? stop_signal : SIGTERM;
+	signal(sig, SIG_DFL);
+	raise(sig);
 }
 
 /* Ends the whole job from any rank with one message. */
@@ -301,6 +374,17 @@ int main(int argc, char **argv)
 	}
 	double t0 = MPI_Wtime();
 	rt_error err;
+	rank_id me = {(int32_t)getpid(), {0}}, *ids = rank == 0 ? calloc((size_t)size, sizeof *ids) : NULL;
+	memcpy(me.host, host, sizeof me.host);
+	MPI_Gather(&me, (int)sizeof me, MPI_BYTE, ids, (int)sizeof me, MPI_BYTE, 0, MPI_COMM_WORLD);
+	if (rank == 0) {
+		struct sigaction sa;
+		memset(&sa, 0, sizeof sa);
+		sa.sa_handler = on_stop;
+		sigemptyset(&sa.sa_mask);
+		sigaction(SIGTERM, &sa, NULL);
+		sigaction(SIGINT, &sa, NULL);
+	}
 	if (rank != 0) {
 		packed = malloc(c.files ? c.files : 1);
 		if (!packed) {
@@ -327,12 +411,16 @@ int main(int argc, char **argv)
 	free(packed);
 	fileset_free(&files);
 
+	stop_ctx sc = {ids, size, output};
 	farm_opts fo = {
 		.tile = c.tile,
 		.prefetch = c.prefetch,
 		.delay_us = c.delay_us,
 		.threads = rank_threads(&c.set),
 		.progress = c.progress != 0,
+		.stop = &stop_signal,
+		.stopped = report_stop,
+		.stopped_ctx = &sc,
 	};
 	farm_stats st;
 	bool ok = rank == 0 ? farm_serve(w, &c.set, &fo, fb, &st, &err)
@@ -363,6 +451,7 @@ int main(int argc, char **argv)
 			        MPI_Wtime() - t0);
 	}
 	free(all);
+	free(ids);
 	fb_free(fb);
 	MPI_Bcast(&status, 1, MPI_INT, 0, MPI_COMM_WORLD);
 	MPI_Finalize();
