@@ -148,7 +148,7 @@ check-man:
 	@for m in man/rtsh.1 man/rtsh.5; do \
 		out=$$(LC_ALL=C.UTF-8 MANWIDTH=80 groff -man -ww -z $$m 2>&1); \
 		if [ -n "$$out" ]; then echo "$$m: $$out"; exit 1; fi; \
-		if command -v mandoc >/dev/null 2>&1; then mandoc -Tlint -W warning $$m || exit 1; fi; \
+		if command -v mandoc >/dev/null 2>&1; then out=$$(mandoc -Tlint -W style $$m 2>&1); if [ -n "$$out" ]; then echo "$$out"; exit 1; fi; fi; \
 	done; echo "man pages clean"
 
 install: all

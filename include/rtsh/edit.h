@@ -115,6 +115,14 @@ bool editor_undo(editor *ed, rt_error *err);
 bool editor_redo(editor *ed, rt_error *err);
 size_t editor_undo_count(const editor *ed);
 size_t editor_redo_count(const editor *ed);
+/* Names the step on top of the undo stack ("object 3 move 0.5,0,0"), for
+ * the front end to say what undo and redo do; the note travels with the step.
+ * A step named already keeps its name (false then, or with no step or no
+ * memory). */
+bool editor_note(editor *ed, const char *text);
+/* The name of the step that undo / redo would apply next, or NULL. */
+const char *editor_undo_note(const editor *ed);
+const char *editor_redo_note(const editor *ed);
 /* Edits between begin and end undo as one step (key mode: one drag). Groups
  * nest; only the outermost counts. */
 void editor_group_begin(editor *ed);

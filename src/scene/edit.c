@@ -32,6 +32,7 @@ typedef enum rec_kind {
 typedef struct record {
 	rec_kind kind;
 	uint64_t group;
+	char *note;    /* what the step did, for "undone: ..." (editor_note); or NULL */
 	size_t idx;
 	size_t active;
 	bool has;
@@ -92,6 +93,8 @@ editor *editor_new(scene *s, const char *label)
 
 static void record_release(record *r)
 {
+	free(r->note);
+	r->note = NULL;
 	if (r->kind == REC_SCENE) {
 		scene_free(r->u.sc.s);
 		free(r->u.sc.label);
@@ -383,6 +386,37 @@ static bool commit(editor *ed, record *r, rt_error *err)
 	while (editor_undo_count(ed) > EDITOR_MAX_UNDO || scenes_held(&ed->undo) > EDITOR_MAX_SCENES)
 		drop_oldest(&ed->undo);
 	return true;
+}
+
+/* The note of the group on top of st, or NULL. */
+static const char *top_note(const stack *st)
+{
+	if (st->n == 0)
+		return NULL;
+	uint64_t g = st->r[st->n - 1].group;
+	for (size_t i = st->n; i > 0 && st->r[i - 1].group == g; i--)
+		if (st->r[i - 1].note)
+			return st->r[i - 1].note;
+	return NULL;
+}
+
+bool editor_note(editor *ed, const char *text)
+{
+	if (ed->undo.n == 0 || top_note(&ed->undo))
+		return false;
+	record *r = &ed->undo.r[ed->undo.n - 1];
+	r->note = strdup(text);
+	return r->note != NULL;
+}
+
+const char *editor_undo_note(const editor *ed)
+{
+	return top_note(&ed->undo);
+}
+
+const char *editor_redo_note(const editor *ed)
+{
+	return top_note(&ed->redo);
 }
 
 /* Moves one group from `from` to `to`, applying each record. */

@@ -2,11 +2,14 @@
  * delete, undo, redo. Each parses its arguments, then makes one editor call
  * between shell_edit_begin and shell_edit_end. */
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "rtsh/edit.h"
 #include "rtsh/rtfile.h"
+#include "shell/answer.h"
 #include "shell/commands.h"
+#include "shell/suggest.h"
 
 #define SUBS_CAMERA "pos|dir|lookat|fov|move|turn"
 #define SUBS_LIGHT "pos|move|brightness|color"
@@ -18,8 +21,13 @@ static int pick_sub(shell *sh, const char *cmd, const char *kind, const char *ch
 	int i = choice_pick(choices, word);
 	if (i < 0) {
 		char list[256];
+		char near[64];
 		choice_list(choices, list, sizeof list);
-		shell_fail(sh, "%s: \"%s\" is not %s; expected %s", cmd, word, kind, list);
+		if (suggest_choice(choices, word, near, sizeof near))
+			shell_fail(sh, "%s: \"%s\" is not %s; did you mean \"%s\"? (expected %s)", cmd, word,
+			           kind, near, list);
+		else
+			shell_fail(sh, "%s: \"%s\" is not %s; expected %s", cmd, word, kind, list);
 	}
 	return i;
 }
@@ -49,8 +57,8 @@ bool cmd_camera(shell *sh, int argc, char **argv, const char *rest)
 	(void)rest;
 	const scene *s = editor_scene(sh->ed);
 	if (argc == 0) {
-		char *a[] = {"cameras"};
-		return cmd_list(sh, 1, a, "");
+		answer_camera_fields(sh, s->cam < s->ncams ? s->cam : 0);
+		return true;
 	}
 	if (argc == 1 && argv[0][0] >= '0' && argv[0][0] <= '9') {
 		size_t i;
@@ -119,6 +127,10 @@ bool cmd_light(shell *sh, int argc, char **argv, const char *rest)
 	size_t i;
 	if (!arg_index(sh, "light", argv[0], "light", s->nlights, &i))
 		return false;
+	if (argc == 1) {
+		answer_light_fields(sh, i);
+		return true;
+	}
 	if (argc < 3)
 		return shell_fail(sh, "light: too few arguments; usage: light N pos|move|brightness|color VALUE");
 	int sub = pick_sub(sh, "light", "a light command", SUBS_LIGHT, argv[1]);
@@ -161,6 +173,10 @@ bool cmd_object(shell *sh, int argc, char **argv, const char *rest)
 	size_t i;
 	if (!arg_index(sh, "object", argv[0], "object", s->nobjs, &i))
 		return false;
+	if (argc == 1) {
+		answer_object_fields(sh, i);
+		return true;
+	}
 	if (argc < 3)
 		return shell_fail(sh, "object: too few arguments; usage: object N move|rotate|scale|color VALUE");
 	int sub = pick_sub(sh, "object", "an object command", SUBS_OBJECT, argv[1]);
@@ -224,6 +240,8 @@ bool cmd_add(shell *sh, int argc, char **argv, const char *rest)
 {
 	(void)argc, (void)argv;
 	rt_error err;
+	const scene *s = editor_scene(sh->ed);
+	size_t nobjs = s->nobjs, nlights = s->nlights, ncams = s->ncams;
 	shell_edit_begin(sh);
 	bool ok = editor_add_line(sh->ed, rest, "add", 0, &sh->load_opts, &err);
 	shell_edit_end(sh);
@@ -233,35 +251,73 @@ bool cmd_add(shell *sh, int argc, char **argv, const char *rest)
 			return shell_fail(sh, "add: column %d: %s", err.col, err.msg);
 		return shell_fail(sh, "add: %s", err.msg);
 	}
+	s = editor_scene(sh->ed);
+	if (s->nobjs > nobjs)
+		shell_info(sh, "added object %zu (%s)\n", s->nobjs, obj_kind_name(s->objs[s->nobjs - 1].kind));
+	else if (s->nlights > nlights)
+		shell_info(sh, "added light %zu\n", s->nlights);
+	else if (s->ncams > ncams)
+		shell_info(sh, "added camera %zu\n", s->ncams);
+	else
+		shell_info(sh, "replaced: %s\n", rest);
 	return true;
 }
 
 bool cmd_delete(shell *sh, int argc, char **argv, const char *rest)
 {
-	(void)argc, (void)rest;
+	(void)rest;
+	static const char usage[] = "usage: delete object N | delete light N | delete camera N";
 	const scene *s = editor_scene(sh->ed);
+	if (argc == 1 && argv[0][0] >= '0' && argv[0][0] <= '9')
+		return shell_fail(sh, "delete: object or light? %s", usage);
 	int kind = pick_sub(sh, "delete", "something to delete", "object|light|camera", argv[0]);
 	if (kind < 0)
 		return false;
 	static const char *const kinds[] = {"object", "light", "camera"};
 	size_t n = kind == 0 ? s->nobjs : kind == 1 ? s->nlights : s->ncams, i;
+	if (argc == 1)
+		return shell_fail(sh, "delete: which %s? expected delete %s N with N in 1..%zu", kinds[kind],
+		                  kinds[kind], n);
 	if (!arg_index(sh, "delete", argv[1], kinds[kind], n, &i))
 		return false;
+	char what[80] = "";
 	if (kind == 0)
-		EDIT(sh, "delete", editor_delete_object(sh->ed, i, &err_));
-	if (kind == 1)
-		EDIT(sh, "delete", editor_delete_light(sh->ed, i, &err_));
-	EDIT(sh, "delete", editor_delete_camera(sh->ed, i, &err_));
+		snprintf(what, sizeof what, " (%s)", obj_kind_name(s->objs[i].kind));
+	rt_error err;
+	shell_edit_begin(sh);
+	bool ok = kind == 0   ? editor_delete_object(sh->ed, i, &err)
+	          : kind == 1 ? editor_delete_light(sh->ed, i, &err)
+	                      : editor_delete_camera(sh->ed, i, &err);
+	shell_edit_end(sh);
+	if (!ok)
+		return shell_fail(sh, "delete: %s", err.msg);
+	shell_info(sh, "deleted %s %zu%s\n", kinds[kind], i + 1, what);
+	return true;
+}
+
+/* Undo or redo one step, saying which. */
+static bool undo_redo(shell *sh, bool redo)
+{
+	const char *note = redo ? editor_redo_note(sh->ed) : editor_undo_note(sh->ed);
+	char *copy = note ? strdup(note) : NULL;
+	rt_error err;
+	shell_edit_begin(sh);
+	bool ok = redo ? editor_redo(sh->ed, &err) : editor_undo(sh->ed, &err);
+	shell_edit_end(sh);
+	if (ok)
+		answer_undo(sh, redo ? "redone" : "undone", copy);
+	free(copy);
+	return ok ? true : shell_fail(sh, "%s: %s", redo ? "redo" : "undo", err.msg);
 }
 
 bool cmd_undo(shell *sh, int argc, char **argv, const char *rest)
 {
 	(void)argc, (void)argv, (void)rest;
-	EDIT(sh, "undo", editor_undo(sh->ed, &err_));
+	return undo_redo(sh, false);
 }
 
 bool cmd_redo(shell *sh, int argc, char **argv, const char *rest)
 {
 	(void)argc, (void)argv, (void)rest;
-	EDIT(sh, "redo", editor_redo(sh->ed, &err_));
+	return undo_redo(sh, true);
 }

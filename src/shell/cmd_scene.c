@@ -14,8 +14,10 @@
 #include "rtsh/image.h"
 #include "rtsh/rtfile.h"
 #include "rtsh/settings.h"
+#include "shell/answer.h"
 #include "shell/commands.h"
 #include "shell/keymode.h"
+#include "shell/suggest.h"
 #include "term/caps.h"
 
 /* A failed save, with the file it names ("save: FILE: what is wrong"). */
@@ -29,7 +31,11 @@ static bool save_failed(shell *sh, const rt_error *err)
 bool cmd_load(shell *sh, int argc, char **argv, const char *rest)
 {
 	(void)argc, (void)rest;
-	return shell_load(sh, argv[0]);
+	render_settings before = sh->set;
+	if (!shell_load(sh, argv[0]))
+		return false;
+	answer_loaded(sh, "loaded", &before);
+	return true;
 }
 
 static bool has_ext(const char *path, const char *ext)
@@ -133,19 +139,36 @@ bool cmd_set(shell *sh, int argc, char **argv, const char *rest)
 	}
 	rt_error err;
 	const setting_def *def = settings_find(argv[0], &err);
-	if (!def)
+	if (!def) {
+		const char *near = suggest_setting(argv[0]);
+		if (near && strncmp(err.msg, "unknown", 7) == 0)
+			return shell_fail(sh, "set: unknown setting \"%s\"; did you mean \"%s\"?", argv[0], near);
 		return shell_fail(sh, "set: %s", err.msg);
+	}
 	if (argc == 1) {
 		settings_format(&sh->set, def, val, sizeof val);
 		shell_out(sh, "%s %s\n", def->name, val);
 		return true;
 	}
 	render_settings s = sh->set;
-	if (!settings_set(&s, def, argv[1], &err))
+	if (!settings_set(&s, def, argv[1], &err)) {
+		char near[32];
+		if (def->type == SETTING_MODE && suggest_choice("whitted|path", argv[1], near, sizeof near))
+			return shell_fail(sh, "set: mode \"%s\" is not valid; did you mean \"%s\"? (expected "
+			                  "whitted or path)", argv[1], near);
 		return shell_fail(sh, "set: %s", err.msg);
+	}
+	char was[64];
+	settings_format(&sh->set, def, was, sizeof was);
 	shell_edit_begin(sh);
 	sh->set = s;
 	shell_edit_end(sh);
+	size_t bit = (size_t)(def - settings_table);
+	if (bit < sizeof sh->hand_set * 8)
+		sh->hand_set |= 1u << bit;
+	settings_format(&sh->set, def, val, sizeof val);
+	shell_info(sh, "%s %s%s%s%s\n", def->name, val, strcmp(was, val) ? " (was " : "",
+	           strcmp(was, val) ? was : "", strcmp(was, val) ? ")" : "");
 	return true;
 }
 
@@ -189,6 +212,9 @@ bool cmd_list(shell *sh, int argc, char **argv, const char *rest)
 	int which = -1;
 	if (argc == 1) {
 		which = choice_pick("cameras|lights|objects", argv[0]);
+		char near[32];
+		if (which < 0 && suggest_choice("cameras|lights|objects", argv[0], near, sizeof near))
+			return shell_fail(sh, "list: \"%s\" is not a list; did you mean \"%s\"?", argv[0], near);
 		if (which < 0)
 			return shell_fail(sh, "list: \"%s\" is not a list; expected cameras, lights or objects",
 			                  argv[0]);
@@ -334,13 +360,21 @@ static bool step_scene(shell *sh, int step, const char *what)
 bool cmd_next(shell *sh, int argc, char **argv, const char *rest)
 {
 	(void)argc, (void)argv, (void)rest;
-	return step_scene(sh, 1, "next");
+	render_settings before = sh->set;
+	if (!step_scene(sh, 1, "next"))
+		return false;
+	answer_loaded(sh, "opened", &before);
+	return true;
 }
 
 bool cmd_prev(shell *sh, int argc, char **argv, const char *rest)
 {
 	(void)argc, (void)argv, (void)rest;
-	return step_scene(sh, -1, "prev");
+	render_settings before = sh->set;
+	if (!step_scene(sh, -1, "prev"))
+		return false;
+	answer_loaded(sh, "opened", &before);
+	return true;
 }
 
 bool cmd_show(shell *sh, int argc, char **argv, const char *rest)

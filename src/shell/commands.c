@@ -8,7 +8,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "shell/answer.h"
 #include "shell/keymode.h"
+#include "shell/suggest.h"
 
 #define SUBS_CAMERA "pos|dir|lookat|fov|move|turn"
 #define SUBS_LIGHT "pos|move|brightness|color"
@@ -31,22 +33,22 @@ const command command_table[] = {
 	 "camera\ncamera N\ncamera pos X,Y,Z\ncamera dir X,Y,Z\ncamera lookat X,Y,Z\ncamera fov DEG\n"
 	 "camera move DX,DY,DZ\ncamera turn YAW,PITCH",
 	 0, 2, {"@camera|" SUBS_CAMERA},
-	 "list the cameras, switch to camera N, or edit the active one (move and turn: camera axes)",
+	 "show the active camera, switch to camera N, or edit the active one (move and turn: camera axes)",
 	 cmd_camera},
 	{"light", NULL,
-	 "light\nlight N pos X,Y,Z\nlight N move DX,DY,DZ\nlight N brightness B\nlight N color R,G,B", 0, 3,
-	 {"@light", SUBS_LIGHT}, "list the lights, or edit light N", cmd_light},
+	 "light\nlight N\nlight N pos X,Y,Z\nlight N move DX,DY,DZ\nlight N brightness B\nlight N color R,G,B",
+	 0, 3, {"@light", SUBS_LIGHT}, "list the lights, show light N, or edit it", cmd_light},
 	{"object", "obj",
-	 "object\nobject N move DX,DY,DZ\nobject N rotate RX,RY,RZ\nobject N scale SX,SY,SZ\n"
+	 "object\nobject N\nobject N move DX,DY,DZ\nobject N rotate RX,RY,RZ\nobject N scale SX,SY,SZ\n"
 	 "object N color R,G,B",
 	 0, 3, {"@object", SUBS_OBJECT},
-	 "list the objects, or edit object N (move in world axes, rotate in degrees about X, Y, Z)",
+	 "list the objects, show object N, or edit it (move in world axes, rotate in degrees about X, Y, Z)",
 	 cmd_object},
 	{"ambient", NULL, "ambient\nambient brightness B\nambient color R,G,B", 0, 2, {"brightness|color"},
 	 "show or edit the ambient light", cmd_ambient},
 	{"add", NULL, "add LINE", 1, CMD_ANY, {NULL},
 	 "add an element written as a .rt line (A and C replace theirs, c adds a camera)", cmd_add},
-	{"delete", "del rm", "delete object N\ndelete light N\ndelete camera N", 2, 2,
+	{"delete", "del rm", "delete object N\ndelete light N\ndelete camera N", 1, 2,
 	 {"object|light|camera", "@ref"}, "remove an object, a light or a camera", cmd_delete},
 	{"undo", NULL, "undo", 0, 0, {NULL}, "undo the last scene edit", cmd_undo},
 	{"redo", NULL, "redo", 0, 0, {NULL}, "redo the last undone edit", cmd_redo},
@@ -123,6 +125,8 @@ const command *command_find(const char *word, char *msg, size_t size)
 			snprintf(last, sizeof names - (size_t)(last - names), " or %s", tail);
 		}
 		snprintf(msg, size, "ambiguous command \"%s\"; could be %s", word, names);
+	} else if (suggest_command(word, names, sizeof names)) {
+		snprintf(msg, size, "unknown command \"%s\"; did you mean \"%s\"?", word, names);
 	} else {
 		snprintf(msg, size, "unknown command \"%s\"; type help for the list of commands", word);
 	}
@@ -384,7 +388,10 @@ bool command_run(shell *sh, const char *text)
 	}
 	for (size_t n = strlen(rest); n > 0 && strchr(" \t\r\n", rest[n - 1]); n--)
 		rest[n - 1] = '\0';
+	uint64_t gen0 = editor_generation(sh->ed);
 	bool ok = c->run(sh, nargs, argv + 1, rest);
+	if (ok)
+		answer_after_command(sh, c, rest, gen0);
 	free(rest);
 	free(buf);
 	return ok;
@@ -413,7 +420,8 @@ bool cmd_help(shell *sh, int argc, char **argv, const char *rest)
 			shell_out(sh, "also: %s\n", c->aliases);
 		return true;
 	}
-	shell_out(sh, "commands (a unique prefix is enough; help COMMAND for its usage):\n");
+	shell_out(sh, "commands (a unique prefix is enough, a typo gets a suggestion; help COMMAND for its "
+	              "usage):\n");
 	for (size_t i = 0; i < command_count; i++) {
 		const command *c = &command_table[i];
 		shell_out(sh, "  %-9s %s\n", c->name, c->help);

@@ -76,6 +76,7 @@ typedef struct shell {
 	char err[SHELL_MSG_MAX];
 	bool err_reported;     /* err was printed already (by a nested source) */
 	int depth;             /* source nesting */
+	unsigned hand_set;     /* bit i: settings_table[i] was changed by `set` (answer.c) */
 	void (*status_hook)(struct shell *sh); /* redraws the status line (interactive) */
 	int wake[2];           /* the interactive loop's wake-up pipe (read, write); -1: none */
 } shell;
