@@ -244,15 +244,6 @@ bool farm_serve(const world *w, const render_settings *s, const farm_opts *o, fr
 	if (started == 0)
 		world_rays_reset();
 	while (ok && (active > 0 || atomic_load(&sv.done) < sv.t.count)) {
-		if (o->stop && *o->stop) {
-			if (o->progress)
-				fputc('\n', stderr);
-			if (o->stopped)
-				o->stopped(o->stopped_ctx);
-			ok = rt_error_set(err, "stopped");
-			atomic_store(&sv.next, sv.t.count);
-			break;
-		}
 		int flag = 0;
 		MPI_Status ms;
 		MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &ms);
@@ -286,8 +277,7 @@ bool farm_serve(const world *w, const render_settings *s, const farm_opts *o, fr
 	for (int i = 0; i < started; i++)
 		pthread_join(tid[i], NULL);
 	if (o->progress) {
-		if (ok)
-			show_progress(atomic_load(&sv.done), sv.t.count, now() - t0);
+		show_progress(atomic_load(&sv.done), sv.t.count, now() - t0);
 		fputc('\n', stderr);
 	}
 	if (started == 0)

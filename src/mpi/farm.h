@@ -15,7 +15,6 @@
 #ifndef RTSH_MPI_FARM_H
 #define RTSH_MPI_FARM_H
 
-#include <signal.h>
 #include <stdbool.h>
 #include <stdint.h>
 
@@ -27,11 +26,6 @@ typedef struct farm_opts {
 	int delay_us;   /* test mode: each result waits this long before it is sent */
 	int threads;    /* render threads on this rank */
 	bool progress;  /* rank 0: a progress line on standard error */
-	volatile sig_atomic_t *stop; /* rank 0: set (by a signal) to stop early */
-	/* rank 0: called at once when *stop is set, before waiting for the
-	 * threads (the launcher may follow with SIGKILL); may not return */
-	void (*stopped)(void *ctx);
-	void *stopped_ctx;
 } farm_opts;
 
 /* One rank's figures (gathered on rank 0 for -v). */
@@ -47,8 +41,7 @@ typedef struct farm_stats {
 } farm_stats;
 
 /* Both return false (err set) when a message breaks the protocol or memory
- * runs out, and farm_serve when *o->stop is set; the caller then ends the
- * job. */
+ * runs out; the caller then ends the job. */
 /* Rank 0: renders the image into fb (s->width x s->height, rgb only) with
  * the workers of MPI_COMM_WORLD. */
 bool farm_serve(const world *w, const render_settings *s, const farm_opts *o, framebuffer *fb,

@@ -12,6 +12,7 @@
 #include <errno.h>
 #include <mpi.h>
 #include <signal.h>
+#include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -257,48 +258,76 @@ static int rank_threads(const render_settings *s)
 	return cpus / here > 1 ? cpus / here : 1;
 }
 
-/* Rank 0 catches the launcher's SIGTERM (after another rank died, or
- * Ctrl-C on mpirun) and SIGINT, to say why no image was written. */
-static volatile sig_atomic_t stop_signal;
-
-static void on_stop(int sig)
-{
-	stop_signal = sig;
-}
-
-/* Who each rank is, for messages about a rank that ended. */
+/* Who each rank is, for the message about a rank that ended. */
 typedef struct rank_id {
 	int32_t pid;
 	char host[64];
 } rank_id;
 
-typedef struct stop_ctx {
-	const rank_id *ids;
-	int size;
-	const char *output;
-} stop_ctx;
+/* What rank 0's SIGTERM/SIGINT handler reads: set before it is installed
+ * (output) or published once complete (ids, by the atomic store). */
+static const char *stop_output;
+static rank_id *stop_ids;
+static _Atomic int stop_nids;
+static _Atomic int stop_progress; /* a progress line is open: end it first */
 
-/* Rank 0 after a stop: names the ranks on its own host that are gone (others
- * it cannot see), then ends by the signal that stopped it. */
-static void report_stop(void *ctx)
+static void put(char *buf, size_t *n, size_t cap, const char *s)
 {
-	const stop_ctx *sc = ctx;
-	const rank_id *ids = sc->ids;
-	int size = sc->size;
-	const char *output = sc->output;
-	int named = 0;
-	for (int r = 1; r < size && ids; r++)
-		if (strcmp(ids[r].host, ids[0].host) == 0 && kill(ids[r].pid, 0) != 0 && errno == ESRCH) {
-			fprintf(stderr, "rtsh-mpi: rank %d on %s ended before the image was complete\n", r,
-			        ids[r].host);
+	while (*s && *n < cap)
+		buf[(*n)++] = *s++;
+}
+
+static void put_int(char *buf, size_t *n, size_t cap, int v)
+{
+	char d[16];
+	int k = 0;
+	do
+		d[k++] = (char)('0' + v % 10);
+	while ((v /= 10) > 0 && k < 15);
+	while (k > 0 && *n < cap)
+		buf[(*n)++] = d[--k];
+}
+
+/* Rank 0, on the launcher's SIGTERM (sent to every rank when one dies, and
+ * on Ctrl-C at mpirun) or SIGINT: says which ranks on its host are gone
+ * (those on other hosts it cannot see) and that no image was written, then
+ * ends by the signal. The launcher follows with SIGKILL within about a
+ * second and rank 0 may be inside a blocking MPI call, so this is done here,
+ * with async-signal-safe calls only (kill, write, strcmp, raise). */
+static _Atomic int stop_rank = -1; /* this process's rank once known */
+
+static void on_stop(int sig)
+{
+	if (atomic_load(&stop_rank) != 0) {
+		/* another rank, or MPI not started yet: end quietly */
+		signal(sig, SIG_DFL);
+		raise(sig);
+		return;
+	}
+	char buf[4096];
+	size_t n = 0, cap = sizeof buf;
+	if (atomic_load(&stop_progress))
+		put(buf, &n, cap, "\n");
+	int named = 0, nids = atomic_load(&stop_nids);
+	for (int r = 1; r < nids; r++)
+		if (strcmp(stop_ids[r].host, stop_ids[0].host) == 0 && kill(stop_ids[r].pid, 0) != 0 &&
+		    errno == ESRCH) {
+			put(buf, &n, cap, "rtsh-mpi: rank ");
+			put_int(buf, &n, cap, r);
+			put(buf, &n, cap, " on ");
+			put(buf, &n, cap, stop_ids[r].host);
+			put(buf, &n, cap, " ended before the image was complete\n");
 			named++;
 		}
 	if (!named)
-		fputs("rtsh-mpi: the job was stopped before the image was complete (interrupted, or a rank on another host ended)\n",
-		      stderr);
-	fprintf(stderr, "rtsh-mpi: %s not written\n", output);
-	fflush(stderr);
-	int sig = stop_signal ? stop_signal : SIGTERM;
+		put(buf, &n, cap, sig == SIGINT ? "rtsh-mpi: interrupted before the image was complete\n"
+		                                : "rtsh-mpi: stopped before the image was complete "
+		                                  "(interrupted, or a rank on another host ended)\n");
+	put(buf, &n, cap, "rtsh-mpi: ");
+	put(buf, &n, cap, stop_output ? stop_output : "the image");
+	put(buf, &n, cap, " not written\n");
+	ssize_t wr = write(STDERR_FILENO, buf, n);
+	(void)wr;
 	signal(sig, SIG_DFL);
 	raise(sig);
 }
@@ -335,8 +364,15 @@ static void print_figures(const farm_stats *st, int size, const job_config *c, d
 int main(int argc, char **argv)
 {
 	int provided, rank, size;
+	struct sigaction sa;
+	memset(&sa, 0, sizeof sa);
+	sa.sa_handler = on_stop;
+	sigemptyset(&sa.sa_mask);
+	sigaction(SIGTERM, &sa, NULL);
+	sigaction(SIGINT, &sa, NULL);
 	MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
 	MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+	atomic_store(&stop_rank, rank);
 	MPI_Comm_size(MPI_COMM_WORLD, &size);
 	char host[64] = "?";
 	int hl;
@@ -354,6 +390,8 @@ int main(int argc, char **argv)
 	size_t packed_size = 0;
 	if (rank == 0) {
 		setup(argc, argv, &c, &files, &w, &fb, &output);
+		stop_output = output;
+		atomic_store(&stop_progress, c.progress);
 		if (c.status < 0) {
 			packed = fileset_pack(&files, &packed_size);
 			if (!packed) {
@@ -365,7 +403,9 @@ int main(int argc, char **argv)
 	}
 	MPI_Bcast(&c, (int)sizeof c, MPI_BYTE, 0, MPI_COMM_WORLD);
 	if (c.status >= 0) {
-		/* a usage or scene error: rank 0 said it once; all end alike */
+		/* a usage or scene error: rank 0 said it once; all end alike (and
+		 * the launcher may stop the last ones: quietly) */
+		atomic_store(&stop_rank, -1);
 		world_free(w);
 		fb_free(fb);
 		fileset_free(&files);
@@ -377,13 +417,9 @@ int main(int argc, char **argv)
 	rank_id me = {(int32_t)getpid(), {0}}, *ids = rank == 0 ? calloc((size_t)size, sizeof *ids) : NULL;
 	memcpy(me.host, host, sizeof me.host);
 	MPI_Gather(&me, (int)sizeof me, MPI_BYTE, ids, (int)sizeof me, MPI_BYTE, 0, MPI_COMM_WORLD);
-	if (rank == 0) {
-		struct sigaction sa;
-		memset(&sa, 0, sizeof sa);
-		sa.sa_handler = on_stop;
-		sigemptyset(&sa.sa_mask);
-		sigaction(SIGTERM, &sa, NULL);
-		sigaction(SIGINT, &sa, NULL);
+	if (rank == 0 && ids) {
+		stop_ids = ids;
+		atomic_store(&stop_nids, size);
 	}
 	if (rank != 0) {
 		packed = malloc(c.files ? c.files : 1);
@@ -411,20 +447,17 @@ int main(int argc, char **argv)
 	free(packed);
 	fileset_free(&files);
 
-	stop_ctx sc = {ids, size, output};
 	farm_opts fo = {
 		.tile = c.tile,
 		.prefetch = c.prefetch,
 		.delay_us = c.delay_us,
 		.threads = rank_threads(&c.set),
 		.progress = c.progress != 0,
-		.stop = &stop_signal,
-		.stopped = report_stop,
-		.stopped_ctx = &sc,
 	};
 	farm_stats st;
 	bool ok = rank == 0 ? farm_serve(w, &c.set, &fo, fb, &st, &err)
 	                    : farm_work(w, &c.set, &fo, &st, &err);
+	atomic_store(&stop_progress, 0);
 	if (!ok)
 		die(rank, host, "", &err);
 	memcpy(st.host, host, sizeof st.host);
@@ -451,9 +484,11 @@ int main(int argc, char **argv)
 			        MPI_Wtime() - t0);
 	}
 	free(all);
+	atomic_store(&stop_nids, 0);
 	free(ids);
 	fb_free(fb);
 	MPI_Bcast(&status, 1, MPI_INT, 0, MPI_COMM_WORLD);
+	atomic_store(&stop_rank, -1); /* all said: the launcher may stop us quietly */
 	MPI_Finalize();
 	return status;
 }
