@@ -42,6 +42,8 @@ FRONTLIB  := $(BUILD)/librtsh-front.a
 
 TEST_SRC  := $(sort $(wildcard tests/unit/test_*.c))
 TEST_BIN  := $(TEST_SRC:tests/unit/%.c=$(BUILD)/tests/%)
+# The link simulator (tests/link): a program on a pty behind a slow wire.
+LINKSIM   := $(BUILD)/tests/linksim
 BENCH_SRC := bench/bench.c
 BENCH_BIN := $(BUILD)/bench/bench
 # Optional: Embree 3's single-ray speed on the same rays, built by `make bench`
@@ -118,7 +120,12 @@ $(BENCH_BIN): $(BENCH_SRC) $(FRONTLIB) $(LIB)
 run: all
 	./$(BIN)
 
-test-bins: $(TEST_BIN)
+test-bins: $(TEST_BIN) $(LINKSIM)
+
+$(LINKSIM): tests/link/linksim.c
+	@mkdir -p $(@D)
+	@echo "  CC      $@"
+	@$(CC) $(CFLAGS) $(LDFLAGS) -o $@ $< -lutil
 
 # The whole suite: plain build, tmux end to end, then ASan+UBSan, then TSan on
 # the threaded tests; the last line is "N passed, N failed".

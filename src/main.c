@@ -1,4 +1,5 @@
-/* rtsh — the command line: options, then a batch render or the shell. */
+/* rtsh — the command line (shell/args.h), then a batch render or the shell. */
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -10,7 +11,15 @@
 #include "rtsh/rtfile.h"
 #include "rtsh/settings.h"
 #include "rtsh/world.h"
-#include "shell/options.h"
+#include "shell/args.h"
+
+static int usage_error(const char *fmt, const char *arg)
+{
+	fputs("rtsh: ", stderr);
+	fprintf(stderr, fmt, arg);
+	fputs("\nTry 'rtsh --help' for more information.\n", stderr);
+	return 2;
+}
 
 typedef struct progress_state {
 	struct timespec start;
@@ -56,9 +65,9 @@ static int batch_render(const rtsh_options *o)
 	rt_error err;
 	char msg[RT_ERROR_MSG_MAX + RT_ERROR_FILE_MAX + 32];
 	if (image_format_of(o->output) == IMAGE_UNKNOWN)
-		return options_usage_error("output \"%s\" has an unknown type; expected .ppm, .pfm or .png", o->output);
+		return usage_error("output \"%s\" has an unknown type; expected .ppm, .pfm or .png", o->output);
 	if (!o->scene)
-		return options_usage_error("-o needs a scene file%s", "");
+		return usage_error("-o needs a scene file%s", "");
 	rt_warnings warn = {print_warning, NULL};
 	rt_load_opts lo = {.strict = o->strict, .warn = o->quiet ? NULL : &warn};
 	scene *s = rt_load_file(o->scene, &lo, &err);
@@ -107,8 +116,7 @@ static int batch_render(const rtsh_options *o)
 int main(int argc, char **argv)
 {
 	rtsh_options o;
-	memset(&o, 0, sizeof o);
-	int rc = options_parse(argc, argv, &o);
+	int rc = args_parse(argc, argv, ARGS_RTSH, "rtsh", &o);
 	if (rc >= 0)
 		return rc;
 	if (o.output)

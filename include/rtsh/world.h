@@ -33,23 +33,8 @@ typedef struct light_lin {
 	vec3 radiance; /* ratio x linear colour */
 } light_lin;
 
-/* An emissive surface the path tracer samples directly (path.c): spheres
- * with a uniform scale and no shear, rectangles, discs and triangles. */
-typedef enum emitter_shape {
-	EMITTER_SPHERE,
-	EMITTER_RECT,     /* c + a u + b v, a and b in [-1,1] */
-	EMITTER_DISC,     /* the same with a^2 + b^2 <= 1 */
-	EMITTER_TRIANGLE, /* c + a u + b v, a, b >= 0, a + b <= 1 */
-} emitter_shape;
-
-typedef struct emitter {
-	uint32_t object; /* the scene object */
-	uint32_t shape;  /* emitter_shape */
-	vec3 c, u, v;    /* sphere: centre; flat shapes: see emitter_shape */
-	vec3 n;          /* flat shapes: unit normal */
-	double r;        /* sphere radius */
-	double area;     /* flat shapes */
-} emitter;
+/* An emissive surface the path tracer samples directly (emitters.h). */
+typedef struct emitter emitter;
 
 /* Camera axes: forward, right and up are unit and orthogonal; a pixel's
  * ray direction is fwd + u*half_w*right + v*half_h*up with u, v in [-1,1]. */

@@ -54,10 +54,6 @@ double fuzz_exponent(double fuzz);
 /* The mixed density with which bsdf_sample_dir picks the direction wi
  * through a smooth lobe (per steradian; delta lobes are left out). */
 double bsdf_pdf(const bsdf *b, vec3 wi);
-/* Fills w->emitters with the scene's emissive spheres, rectangles, discs
- * and triangles and points their materials at them (world_build calls it
- * last). False (err set) when out of memory. */
-bool emitters_build(world *w, const scene *s, rt_error *err);
 
 /* What a ray that leaves the scene sees: the sky if the scene has one, else
  * black (whitted) or the ambient colour as a uniform sky (path). */

@@ -28,45 +28,10 @@
  * white Lambertian surface facing it sends back exactly L. */
 #include "integrators.h"
 
+#include "emitters.h"
+#include "warp.h"
+
 #include <stdlib.h>
-
-/* An orthonormal basis (t, b) around the unit vector n (Duff et al.,
- * "Building an orthonormal basis, revisited", JCGT 2017). */
-static void basis(vec3 n, vec3 *t, vec3 *b)
-{
-	double sign = copysign(1.0, n.z);
-	double a = -1.0 / (sign + n.z), c = n.x * n.y * a;
-	*t = v3(1.0 + sign * n.x * n.x * a, sign * c, -sign * n.x);
-	*b = v3(c, sign + n.y * n.y * a, -n.y);
-}
-
-/* max(v, 0), NaN to 0 (plain comparisons: fmax is a library call). */
-static inline double pos(double v)
-{
-	return v > 0.0 ? v : 0.0;
-}
-
-/* The largest component (plain comparisons: fmax is a library call). */
-static inline double max3(vec3 v)
-{
-	double m = v.x > v.y ? v.x : v.y;
-	return m > v.z ? m : v.z;
-}
-
-/* A uniform point (x, y) of the unit disc, by rejection from the square
- * (no trigonometry; on average 2.55 random numbers). *r2 = x^2 + y^2 > 0. */
-static void disc_point(rng *g, double *x, double *y, double *r2)
-{
-	for (;;) {
-		double a = 2.0 * rng_next(g) - 1.0, c = 2.0 * rng_next(g) - 1.0, s = a * a + c * c;
-		if (s < 1.0 && s > 0.0) {
-			*x = a;
-			*y = c;
-			*r2 = s;
-			return;
-		}
-	}
-}
 
 /* Cosine-weighted about n, pdf cos / pi: a uniform point of the unit disc
  * lifted onto the hemisphere (Malley's method). */
@@ -295,96 +260,6 @@ static vec3 direct_light(const world *w, const bsdf *b, vec3 p)
 	return sum;
 }
 
-/* --- emissive surfaces: sampled directly and found by the paths, the two
- * combined by multiple importance sampling with the power heuristic (Veach
- * & Guibas, "Optimally combining sampling techniques for Monte Carlo
- * rendering", SIGGRAPH 1995). */
-
-bool emitters_build(world *w, const scene *s, rt_error *err)
-{
-	w->emitters = NULL;
-	w->nemitters = 0;
-	size_t n = 0;
-	for (size_t pass = 0; pass < 2; pass++) {
-		for (size_t i = 0; i < s->nobjs; i++) {
-			const object *o = &s->objs[i];
-			const mat_lin *m = &w->mats[i];
-			if (!(max3(m->emission) > 0.0))
-				continue;
-			emitter e = {.object = (uint32_t)i};
-			bool plain = true; /* uniform scale, no shear */
-			for (int k = 0; k < 6; k++)
-				plain = plain && o->shear[k] == 0.0;
-			xform x;
-			if (o->kind == OBJ_SPHERE && plain && o->scale.x == o->scale.y &&
-			    o->scale.y == o->scale.z) {
-				e.shape = EMITTER_SPHERE;
-				e.c = o->pos;
-				e.r = 0.5 * o->scale.x;
-			} else if (o->kind == OBJ_TRIANGLE) {
-				e.shape = EMITTER_TRIANGLE;
-				e.c = o->tri[0];
-				e.u = v3_sub(o->tri[1], o->tri[0]);
-				e.v = v3_sub(o->tri[2], o->tri[0]);
-				e.area = 0.5 * v3_len(v3_cross(e.u, e.v));
-			} else if ((o->kind == OBJ_RECT || o->kind == OBJ_DISC) && object_xform(o, &x)) {
-				/* the unit shape's axes X and Z, carried into the world */
-				e.shape = o->kind == OBJ_RECT ? EMITTER_RECT : EMITTER_DISC;
-				e.c = m4_point(&x.m, v3(0, 0, 0));
-				e.u = m4_vector(&x.m, v3(1, 0, 0));
-				e.v = m4_vector(&x.m, v3(0, 0, 1));
-				double a = v3_len(v3_cross(e.u, e.v));
-				e.area = o->kind == OBJ_RECT ? 4.0 * a : RT_PI * a;
-			} else {
-				continue; /* found by the paths only */
-			}
-			if (e.shape != EMITTER_SPHERE) {
-				vec3 nn = v3_cross(e.u, e.v);
-				if (!(e.area > 0.0) || !v3_finite(nn))
-					continue;
-				e.n = v3_norm(nn);
-			} else if (!(e.r > 0.0)) {
-				continue;
-			}
-			if (pass == 1) {
-				w->mats[i].light = (int32_t)w->nemitters;
-				w->emitters[w->nemitters++] = e;
-			} else {
-				n++;
-			}
-		}
-		if (pass == 0) {
-			if (n == 0)
-				return true;
-			w->emitters = calloc(n, sizeof *w->emitters);
-			if (!w->emitters)
-				return rt_error_set(err, "out of memory preparing the scene");
-		}
-	}
-	return true;
-}
-
-/* 1 - cos(theta_max) of the cone that the sphere subtends from a point at
- * squared distance d2 > r^2, without cancellation for small spheres. */
-static double cone_gap(double r2, double d2)
-{
-	double s2 = r2 / d2;
-	return s2 / (1.0 + sqrt(1.0 - s2));
-}
-
-/* The density (per steradian) with which sample_emitter picks the
- * direction d (unit) from p towards e, whose surface it meets at distance t
- * (flat shapes); the choice of the emitter is not included. */
-static double emitter_pdf(const emitter *e, vec3 p, vec3 d, double t)
-{
-	if (e->shape == EMITTER_SPHERE) {
-		double d2 = v3_len2(v3_sub(e->c, p)), r2 = e->r * e->r;
-		return d2 > r2 ? 1.0 / (2.0 * RT_PI * cone_gap(r2, d2)) : 0.0;
-	}
-	double cos_l = fabs(v3_dot(e->n, d));
-	return cos_l > 0.0 ? t * t / (cos_l * e->area) : 0.0;
-}
-
 /* The power heuristic weight of a technique of density a against one of b. */
 static double power_weight(double a, double b)
 {
@@ -405,45 +280,8 @@ static vec3 emitter_light(const world *w, const bsdf *b, vec3 p, uint32_t self, 
 		return v3(0, 0, 0);
 	vec3 wi;
 	double pdf, t;
-	if (e->shape == EMITTER_SPHERE) {
-		vec3 pc = v3_sub(e->c, p);
-		double d2 = v3_len2(pc), r2 = e->r * e->r;
-		if (!(d2 > r2))
-			return v3(0, 0, 0); /* inside: left to the paths */
-		double gap = cone_gap(r2, d2), cos_a = 1.0 - rng_next(g) * gap;
-		double x, y, rr;
-		disc_point(g, &x, &y, &rr);
-		double k2 = sqrt(pos(1.0 - cos_a * cos_a) / rr);
-		vec3 ax = v3_scale(pc, 1.0 / sqrt(d2)), tu, tv;
-		basis(ax, &tu, &tv);
-		wi = v3_add(v3_add(v3_scale(tu, x * k2), v3_scale(tv, y * k2)), v3_scale(ax, cos_a));
-		pdf = 1.0 / (2.0 * RT_PI * gap);
-		/* the near side of the sphere along wi: |p + t wi - c| = r */
-		double along = v3_dot(pc, wi);
-		t = along - sqrt(pos(along * along - (d2 - r2)));
-	} else {
-		double a, c;
-		if (e->shape == EMITTER_RECT) {
-			a = 2.0 * rng_next(g) - 1.0;
-			c = 2.0 * rng_next(g) - 1.0;
-		} else if (e->shape == EMITTER_DISC) {
-			double rr;
-			disc_point(g, &a, &c, &rr);
-		} else { /* uniform on the triangle (Turk, Graphics Gems 1990) */
-			double su = sqrt(rng_next(g));
-			a = 1.0 - su;
-			c = rng_next(g) * su;
-		}
-		vec3 q = v3_add(e->c, v3_add(v3_scale(e->u, a), v3_scale(e->v, c)));
-		vec3 d = v3_sub(q, p);
-		t = v3_len(d);
-		if (!(t > 0.0))
-			return v3(0, 0, 0);
-		wi = v3_scale(d, 1.0 / t);
-		pdf = emitter_pdf(e, p, wi, t);
-		if (!(pdf > 0.0))
-			return v3(0, 0, 0);
-	}
+	if (!emitter_sample(e, p, g, &wi, &pdf, &t))
+		return v3(0, 0, 0);
 	double cos_i = v3_dot(b->n, wi);
 	if (cos_i <= 0.0)
 		return v3(0, 0, 0);

@@ -11,7 +11,7 @@
 #endif
 
 #include "bvh.h"
-#include "integrators.h"
+#include "emitters.h"
 #include "rtsh/shape.h"
 
 /* sRGB code (0..255, not necessarily whole) to linear, IEC 61966-2-1. */

@@ -27,7 +27,7 @@
 #include "rtsh/rtfile.h"
 #include "rtsh/settings.h"
 #include "rtsh/world.h"
-#include "shell/options.h"
+#include "shell/args.h"
 
 #define MSG_MAX (RT_ERROR_MSG_MAX + RT_ERROR_FILE_MAX + 32)
 /* MPI counts are ints: large buffers go in pieces of 1 GiB. */
@@ -47,16 +47,14 @@ static void usage(FILE *f)
 	fputs("usage: mpirun -n N [--hostfile HOSTS] rtsh-mpi SCENE.rt -o OUT [OPTIONS]\n"
 	      "Renders SCENE.rt to OUT (.ppm .pfm .png) across the ranks of an MPI job; the\n"
 	      "output is the same, byte for byte, as `rtsh SCENE.rt -o OUT [OPTIONS]`.\n"
-	      "options (as rtsh's batch mode):\n"
-	      "  -r WxH           resolution          -s N   samples per pixel\n"
-	      "  -d N             depth               -t N   threads per rank\n"
-	      "                                       (0 = the node's CPUs shared among its ranks)\n"
-	      "  -m whitted|path  render mode         --seed N  random seed\n"
-	      "  -q               no progress output  --strict  the 42 subject's rules\n"
-	      "  -v               per-rank figures at the end: tiles, seconds, Mrays/s, bytes sent\n"
-	      "  -h, --help       this help           -V, --version  version\n"
-	      "See rtsh-mpi(1).\n",
+	      "  -v, --verbose                per-rank figures at the end: tiles, seconds,\n"
+	      "                               Mrays/s, bytes sent\n"
+	      "  -t N                         render threads per rank (0: the node's CPUs\n"
+	      "                               shared among its ranks)\n"
+	      "and rtsh's batch options:\n",
 	      f);
+	args_usage(f, ARGS_BATCH, "rtsh-mpi");
+	fputs("See rtsh-mpi(1).\n", f);
 }
 
 static void print_warning(void *ctx, const rt_error *w)
@@ -125,7 +123,7 @@ static void setup(int argc, char **argv, job_config *c, fileset *files, world **
 	char msg[MSG_MAX];
 	rt_error err;
 	c->status = 2;
-	/* rtsh-mpi's own options: -v, and its own help and version */
+	/* rtsh-mpi's own option -v, and its own help; the rest are rtsh's */
 	char **args = calloc((size_t)argc + 1, sizeof *args);
 	if (!args) {
 		fputs("rtsh-mpi: out of memory\n", stderr);
@@ -136,7 +134,7 @@ static void setup(int argc, char **argv, job_config *c, fileset *files, world **
 	bool dashdash = false;
 	for (int i = 0; i < argc; i++) {
 		const char *a = argv[i];
-		if (i > 0 && !dashdash && strcmp(a, "-v") == 0) {
+		if (i > 0 && !dashdash && (strcmp(a, "-v") == 0 || strcmp(a, "--verbose") == 0)) {
 			c->verbose = 1;
 			continue;
 		}
@@ -145,36 +143,19 @@ static void setup(int argc, char **argv, job_config *c, fileset *files, world **
 			c->status = 0;
 			goto out;
 		}
-		if (i > 0 && !dashdash && (strcmp(a, "-V") == 0 || strcmp(a, "--version") == 0)) {
-			printf("rtsh-mpi %s\n", RTSH_VERSION);
-			c->status = 0;
-			goto out;
-		}
 		if (strcmp(a, "--") == 0)
 			dashdash = true;
 		args[n++] = argv[i];
 	}
 	rtsh_options o;
-	memset(&o, 0, sizeof o);
-	int rc = options_parse(n, args, &o);
+	int rc = args_parse(n, args, ARGS_BATCH, "rtsh-mpi", &o);
 	if (rc >= 0) {
 		c->status = rc;
 		goto out;
 	}
-	if (o.commands || o.file || o.interactive) {
-		c->status = options_usage_error("-c, -f and -i are rtsh's shell%s; rtsh-mpi only renders SCENE -o OUT", "");
-		goto out;
-	}
-	if (!o.output) {
-		c->status = options_usage_error("no output given%s; expected SCENE.rt -o OUT", "");
-		goto out;
-	}
 	if (image_format_of(o.output) == IMAGE_UNKNOWN) {
-		c->status = options_usage_error("output \"%s\" has an unknown type; expected .ppm, .pfm or .png", o.output);
-		goto out;
-	}
-	if (!o.scene) {
-		c->status = options_usage_error("-o needs a scene file%s", "");
+		fprintf(stderr, "rtsh-mpi: output \"%s\" has an unknown type; expected .ppm, .pfm or .png\n"
+		        "Try 'rtsh-mpi --help' for more information.\n", o.output);
 		goto out;
 	}
 	long tile = env_number("RTSH_MPI_TILE", 32, 4, 1024);

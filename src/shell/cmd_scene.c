@@ -16,7 +16,9 @@
 #include "rtsh/settings.h"
 #include "shell/answer.h"
 #include "shell/commands.h"
+#include "shell/complete_files.h"
 #include "shell/keymode.h"
+#include "shell/save_rt.h"
 #include "shell/suggest.h"
 #include "term/caps.h"
 
@@ -73,7 +75,7 @@ bool cmd_save(shell *sh, int argc, char **argv, const char *rest)
 	rt_error err;
 	bool ok = true;
 	if (has_ext(path, ".rt")) {
-		if (!rt_save(editor_scene(sh->ed), path, &err))
+		if (!save_rt(sh, path, &err))
 			ok = save_failed(sh, &err);
 		else
 			shell_info(sh, "saved the scene to %s\n", path);
@@ -105,8 +107,13 @@ bool cmd_save(shell *sh, int argc, char **argv, const char *rest)
 			shell_info(sh, "saved %s (%dx%d, %d sample%s, %s)\n", path, fb->w, fb->h, fb->spp,
 			          fb->spp == 1 ? "" : "s", render_mode_name(sh->full_set.mode));
 	} else {
-		ok = shell_fail(sh, "save: \"%s\" has an unknown type; expected .ppm, .pfm, .png, .ans or .rt",
-		                path);
+		char exts[256] = "";
+		const char *const *x = output_extensions();
+		for (size_t i = 0; x[i]; i++) {
+			size_t l = strlen(exts);
+			snprintf(exts + l, sizeof exts - l, "%s%s", i == 0 ? "" : x[i + 1] ? ", " : " or ", x[i]);
+		}
+		ok = shell_fail(sh, "save: \"%s\" has an unknown type; expected %s", path, exts);
 	}
 	free(path);
 	return ok;
@@ -380,7 +387,7 @@ bool cmd_prev(shell *sh, int argc, char **argv, const char *rest)
 bool cmd_show(shell *sh, int argc, char **argv, const char *rest)
 {
 	(void)rest;
-	long cols = picture_columns();
+	long cols = sh->capture && sh->scr ? sh->scr->cols : picture_columns();
 	if (argc == 1 && !arg_int(sh, "show", argv[0], 8, 1000, &cols))
 		return false;
 	frame *f = shell_picture_frame(sh, sh->pal, (int)cols);
@@ -389,8 +396,15 @@ bool cmd_show(shell *sh, int argc, char **argv, const char *rest)
 	abuf a;
 	abuf_init(&a);
 	frame_text(f, &a);
-	fflush(stdout);
-	bool ok = !a.failed && write_all(1, a.b, a.len);
+	bool ok = !a.failed;
+	if (ok && sh->capture) {
+		/* On the full screen: through the pager, like help and list, when
+		 * it is taller than the command area. */
+		abuf_add(sh->capture, a.b, a.len);
+	} else if (ok) {
+		fflush(stdout);
+		ok = write_all(1, a.b, a.len);
+	}
 	abuf_free(&a);
 	frame_free(f);
 	return ok ? true : shell_fail(sh, "show: cannot write the picture");
@@ -407,6 +421,8 @@ bool cmd_source(shell *sh, int argc, char **argv, const char *rest)
 	sh->depth++;
 	bool ok = shell_run_file(sh, path);
 	sh->depth--;
+	if (ok)
+		shell_info(sh, "ran %s\n", path);
 	free(path);
 	return ok;
 }

@@ -17,9 +17,9 @@
 #define SUBS_OBJECT "move|rotate|scale|color"
 
 const command command_table[] = {
-	{"load", NULL, "load FILE", 1, 1, {"@file"},
+	{"load", NULL, "load FILE", 1, 1, {"@scene"},
 	 "replace the scene by a .rt file; on any error the current scene stays", cmd_load},
-	{"save", NULL, "save FILE.ppm|FILE.pfm|FILE.png|FILE.ans|FILE.rt", 1, 1, {"@file"},
+	{"save", NULL, "save FILE.ppm|FILE.pfm|FILE.png|FILE.ans|FILE.rt", 1, 1, {"@output"},
 	 "write the image (full resolution, rendered first if needed), the picture as ANSI text, or the scene",
 	 cmd_save},
 	{"render", NULL, "render", 0, 0, {NULL},

@@ -29,7 +29,8 @@ typedef struct command {
 	const char *usage;     /* the forms, one per line, with the name */
 	int min_args, max_args;/* words after the name; CMD_ANY: no limit */
 	/* What to complete for the first words after the name: alternatives
-	 * separated by '|'; "@file", "@command", "@setting", "@value" (of the
+	 * separated by '|'; "@file" (any), "@scene" (what load reads),
+	 * "@output" (what save writes), "@command", "@setting", "@value" (of the
 	 * setting before), "@object", "@light", "@camera" (their numbers) and
 	 * "@ref" (numbers of the kind named by the word before). */
 	const char *complete[3];

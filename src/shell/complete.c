@@ -10,6 +10,7 @@
 
 #include "rtsh/settings.h"
 #include "shell/commands.h"
+#include "shell/complete_files.h"
 
 /* Numbers beyond this many are not offered (a million objects...). */
 #define MAX_CANDIDATES 1000
@@ -46,6 +47,12 @@ static void add(list *l, const char *s, const char *text)
 	l->v[l->n] = NULL;
 }
 
+static void add_file(void *ctx, const char *s)
+{
+	list *l = ctx;
+	add(l, s, "");
+}
+
 static void add_numbers(list *l, size_t n, const char *text)
 {
 	char buf[32];
@@ -70,6 +77,10 @@ static void add_alternative(list *l, const shell *sh, const char *alt, size_t le
 	snprintf(a, sizeof a, "%.*s", (int)len, alt);
 	if (strcmp(a, "@file") == 0) {
 		*files = true;
+	} else if (strcmp(a, "@scene") == 0) {
+		complete_files(text, FILES_SCENE, add_file, l);
+	} else if (strcmp(a, "@output") == 0) {
+		complete_files(text, FILES_OUTPUT, add_file, l);
 	} else if (strcmp(a, "@command") == 0) {
 		add_commands(l, text);
 	} else if (strcmp(a, "@setting") == 0) {
@@ -167,6 +178,9 @@ static char **attempt(const char *text, int start, int end)
 	if (!pending)
 		return NULL;
 	char **m = rl_completion_matches(text, next_candidate);
+	/* A folder is not finished: no space after it. */
+	if (m && !m[1] && m[0][0] && m[0][strlen(m[0]) - 1] == '/')
+		rl_completion_append_character = '\0';
 	/* Candidates not handed to readline are ours to free. */
 	for (size_t i = pending_at; pending[i]; i++)
 		free(pending[i]);

@@ -1498,12 +1498,6 @@ static void term_size(int fd, int *cols, int *rows)
 	}
 }
 
-static void put_str(int fd, const char *s)
-{
-	if (s)
-		write_all(fd, s, strlen(s));
-}
-
 /* The terminal modes of key mode: keys one at a time, no echo; Ctrl-C,
  * Ctrl-Z and Ctrl-\ still send their signals. */
 static void raw_modes(int fd, const struct termios *saved)
@@ -1514,21 +1508,6 @@ static void raw_modes(int fd, const struct termios *saved)
 	t.c_cc[VMIN] = 1;
 	t.c_cc[VTIME] = 0;
 	tcsetattr(fd, TCSANOW, &t);
-}
-
-/* Ctrl-Z: give the terminal back, stop, and take it again on SIGCONT. */
-static void km_suspend(keymode *km, screen *scr, const keys *k, int in, const struct termios *saved)
-{
-	put_str(km->fd, keys_keypad_off(k));
-	tcsetattr(in, TCSANOW, saved);
-	screen_suspend(scr);
-	screen_stop_self();
-	raw_modes(in, saved);
-	screen_resume(scr);
-	put_str(km->fd, keys_keypad_on(k));
-	int cols, rows;
-	term_size(km->fd, &cols, &rows);
-	keymode_resize(km, cols, rows);
 }
 
 bool keymode_run(shell *sh)
@@ -1542,6 +1521,14 @@ bool keymode_run(shell *sh)
 	struct termios saved;
 	if (tcgetattr(in, &saved) != 0)
 		return shell_fail(sh, "view: cannot read the terminal's modes: %s", strerror(errno));
+	/* The answers the terminal owes the shell's output scheduler come in
+	 * before ncurses reads the keys (keys typed meanwhile are dropped). */
+	if (scr->out) {
+		abuf junk;
+		abuf_init(&junk);
+		termout_settle(scr->out, in, 1.0, &junk);
+		abuf_free(&junk);
+	}
 	keys *k = keys_open(in, 25);
 	if (!k) {
 		return shell_fail(sh, "view: ncurses cannot read the keys of this terminal (TERM=%s)",
@@ -1553,7 +1540,7 @@ bool keymode_run(shell *sh)
 	sh->status_hook = NULL;
 	sh->scr = NULL;
 	raw_modes(in, &saved);
-	put_str(fd, keys_keypad_on(k));
+	screen_keypad(fd, keys_keypad_on(k), keys_keypad_off(k), true);
 	int cols, rows;
 	term_size(fd, &cols, &rows);
 	size_t undo0 = editor_undo_count(sh->ed);
@@ -1594,11 +1581,13 @@ bool keymode_run(shell *sh)
 			term_size(fd, &cols, &rows);
 			keymode_resize(km, cols, rows);
 		}
-		if (shell_sig_tstp) {
-			shell_sig_tstp = 0;
-			km_suspend(km, scr, k, in, &saved);
+		if (shell_sig_cont) {
+			/* Continued after Ctrl-Z (signals.c gave the terminal back
+			 * and took it again): paint it all. */
+			shell_sig_cont = 0;
+			term_size(fd, &cols, &rows);
+			keymode_resize(km, cols, rows);
 		}
-		shell_sig_cont = 0;
 		/* Every key waiting, before the next frame starts. */
 		if (n > 0 && FD_ISSET(in, &rd)) {
 			int c;
@@ -1611,7 +1600,7 @@ bool keymode_run(shell *sh)
 	size_t steps = editor_undo_count(sh->ed);
 	steps = steps > undo0 ? steps - undo0 : 0;
 	/* Give the terminal and the screen back to the shell. */
-	put_str(fd, keys_keypad_off(k));
+	screen_keypad(fd, NULL, NULL, false);
 	keys_close(k);
 	tcsetattr(in, TCSANOW, &saved);
 	write_all(fd, "\x1b[m\x1b[?25h", 9);

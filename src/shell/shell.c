@@ -14,9 +14,10 @@
 
 #include "rtsh/settings.h"
 #include "shell/builtin_scene.h"
+#include "shell/progress.h"
+#include "shell/signals.h"
 #include "term/caps.h"
 
-volatile sig_atomic_t shell_sig_int, shell_sig_term, shell_sig_winch, shell_sig_tstp, shell_sig_cont;
 shell *shell_current;
 
 bool shell_fail(shell *sh, const char *fmt, ...)
@@ -90,6 +91,17 @@ static double now(void)
 	struct timespec t;
 	clock_gettime(CLOCK_MONOTONIC, &t);
 	return (double)t.tv_sec + t.tv_nsec * 1e-9;
+}
+
+void shell_notice(shell *sh, const char *fmt, ...)
+{
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(sh->notice, sizeof sh->notice, fmt, ap);
+	va_end(ap);
+	sh->notice_until = now() + 15.0;
+	if (sh->status_hook)
+		sh->status_hook(sh);
 }
 
 char *shell_expand_path(const char *path)
@@ -269,8 +281,9 @@ void shell_status_text(shell *sh, char *buf, size_t size)
 	if (im->w > 0)
 		format_seconds(im->seconds, t, sizeof t);
 	int th = render_threads(&sh->set);
-	snprintf(buf, size, " %s │ %s │ %s │ depth %d │ %dx%d │ %d thread%s │ %s", sh->name,
-	         render_mode_name(sh->set.mode), samples, sh->set.depth, sh->scr ? sh->scr->img_w : 0,
+	bool note = sh->notice[0] && now() < sh->notice_until;
+	snprintf(buf, size, " %s%s%s │ %s │ %s │ depth %d │ %dx%d │ %d thread%s │ %s", sh->name, note ? " │ " : "",
+	         note ? sh->notice : "", render_mode_name(sh->set.mode), samples, sh->set.depth, sh->scr ? sh->scr->img_w : 0,
 	         sh->scr ? sh->scr->img_h : 0, th, th == 1 ? "" : "s", t);
 }
 
@@ -280,29 +293,34 @@ typedef struct progress_ctx {
 	shell *sh;
 	double t0;
 	bool shown;
+	bool repainted; /* after a stop and a continue */
 	int w, h;
 } progress_ctx;
 
 static void on_progress(void *ctx, long done, long total)
 {
 	progress_ctx *p = ctx;
-	double el = now() - p->t0, frac = total ? (double)done / total : 1.0;
-	char bar[32];
-	const int width = 24;
-	int fill = (int)(frac * width + 0.5);
-	for (int i = 0; i < width; i++)
-		bar[i] = i < fill ? '#' : '.';
-	bar[width] = '\0';
-	char left[48] = "";
-	if (done > 0 && done < total)
-		snprintf(left, sizeof left, ", about %.0f s left", el / frac - el);
+	char prog[192];
+	progress_state ps = {p->w, p->h, p->sh->set.samples, done, total, now() - p->t0};
+	progress_text(&ps, 20, prog, sizeof prog);
 	if (p->sh->scr && p->sh->scr->active) {
+		if (shell_sig_cont && !p->repainted) {
+			/* Continued after Ctrl-Z in the middle of a render: the
+			 * screen's frame now, the picture and prompt after it. */
+			p->repainted = true;
+			screen_resume(p->sh->scr);
+		}
 		char text[256];
-		snprintf(text, sizeof text, " rendering %dx%d [%s] %3d%%  %.1f s%s  (Ctrl-C stops)", p->w, p->h,
-		         bar, (int)(frac * 100), el, left);
+		/* A bar only where it fits. */
+		for (int bar = 20; bar >= 0; bar -= 10) {
+			progress_text(&ps, bar, prog, sizeof prog);
+			snprintf(text, sizeof text, " rendering %dx%d %s (Ctrl-C stops)", p->w, p->h, prog);
+			if ((int)strlen(text) <= p->sh->scr->cols)
+				break;
+		}
 		screen_status(p->sh->scr, text);
 	} else {
-		fprintf(stderr, "\r[%s] %3d%%  %.1f s%s   ", bar, (int)(frac * 100), el, left);
+		fprintf(stderr, "\r%s   ", prog);
 		p->shown = true;
 	}
 }
@@ -328,7 +346,7 @@ const framebuffer *shell_full_image(shell *sh, bool force)
 		return NULL;
 	}
 	atomic_store(&sh->cancel, false);
-	progress_ctx p = {sh, now(), false, sh->set.width, sh->set.height};
+	progress_ctx p = {sh, now(), false, false, sh->set.width, sh->set.height};
 	framebuffer *fb = render_image(w, &sh->set, &sh->cancel, sh->progress ? on_progress : NULL, &p, &err);
 	double seconds = now() - p.t0;
 	if (p.shown)
@@ -490,15 +508,6 @@ void shell_free(shell *sh)
 	memset(sh, 0, sizeof *sh);
 }
 
-/* Scripts: Ctrl-C stops a render and then the script. */
-static void script_sigint(int sig)
-{
-	(void)sig;
-	shell_sig_int = 1;
-	if (shell_current)
-		atomic_store(&shell_current->cancel, true);
-}
-
 int shell_main(const rtsh_options *o)
 {
 	bool tty_in = isatty(STDIN_FILENO);
@@ -523,14 +532,11 @@ int shell_main(const rtsh_options *o)
 		return 1;
 	}
 	shell_current = &sh;
+	signals_set_cancel(&sh.cancel);
 	sh.pal = caps_palette(o->color, STDOUT_FILENO);
 	int status = 0;
 	if (script) {
-		struct sigaction sa, old;
-		memset(&sa, 0, sizeof sa);
-		sa.sa_handler = script_sigint;
-		sigemptyset(&sa.sa_mask);
-		sigaction(SIGINT, &sa, &old);
+		signals_script_begin();
 		sh.interactive = false;
 		sh.progress = !o->quiet && isatty(STDERR_FILENO);
 		bool ok;
@@ -541,7 +547,7 @@ int shell_main(const rtsh_options *o)
 		if (!ok && !sh.err_reported)
 			fprintf(stderr, "rtsh: %s\n", sh.err);
 		status = ok ? 0 : shell_sig_int ? 130 : 1;
-		sigaction(SIGINT, &old, NULL);
+		signals_script_end();
 		if (sh.quit)
 			then_interactive = false;
 	}
@@ -553,6 +559,7 @@ int shell_main(const rtsh_options *o)
 			        t && *t ? t : "unset");
 		}
 		sh.interactive = true;
+		sh.progress = !o->quiet; /* `render` shows its progress in the status line */
 		sh.quit = false;
 		shell_sig_int = 0;
 		int st = shell_interactive(&sh, screen_ok, wake);
@@ -560,6 +567,7 @@ int shell_main(const rtsh_options *o)
 			status = st;
 	}
 	shell_current = NULL;
+	signals_set_cancel(NULL);
 	shell_free(&sh);
 	if (wake[0] >= 0)
 		close(wake[0]), close(wake[1]);

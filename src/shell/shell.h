@@ -23,6 +23,7 @@
 #include "rtsh/rtfile.h"
 #include "shell/options.h"
 #include "shell/preview.h"
+#include "shell/signals.h"
 #include "term/frame.h"
 #include "term/abuf.h"
 #include "term/screen.h"
@@ -74,6 +75,8 @@ typedef struct shell {
 	bool quit;
 	atomic_bool cancel;    /* Ctrl-C: stops a full render */
 	char err[SHELL_MSG_MAX];
+	char notice[256];      /* said once in the status line (until notice_until) */
+	double notice_until;
 	bool err_reported;     /* err was printed already (by a nested source) */
 	int depth;             /* source nesting */
 	unsigned hand_set;     /* bit i: settings_table[i] was changed by `set` (answer.c) */
@@ -81,10 +84,7 @@ typedef struct shell {
 	int wake[2];           /* the interactive loop's wake-up pipe (read, write); -1: none */
 } shell;
 
-/* Signals, set by handlers (loop.c, script.c) and read by the loops. */
-extern volatile sig_atomic_t shell_sig_int, shell_sig_term, shell_sig_winch, shell_sig_tstp;
-extern volatile sig_atomic_t shell_sig_cont;
-/* The shell whose cancel flag the SIGINT handler sets. */
+/* The shell of shell_main (the signal flags are in signals.h). */
 extern shell *shell_current;
 
 /* Records an error message for the command being run; returns false. */
@@ -93,6 +93,9 @@ bool shell_fail(shell *sh, const char *fmt, ...) __attribute__((format(printf, 2
 void shell_out(shell *sh, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 /* Prints a confirmation ("saved x.png") to standard output, unless -q. */
 void shell_info(shell *sh, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* A message for the status line, shown for a while (said once: the
+ * caller's business). */
+void shell_notice(shell *sh, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 /* Prints a note to standard error (warnings, progress text). */
 void shell_note(shell *sh, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 

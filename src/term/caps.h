@@ -4,8 +4,16 @@
 
 #include <stdbool.h>
 
-#include "shell/options.h"
 #include "term/frame.h"
+
+/* The colour output asked for on the command line (--color). */
+typedef enum color_mode {
+	COLOR_AUTO,
+	COLOR_TRUECOLOR,
+	COLOR_256,
+	COLOR_16,
+	COLOR_NONE,
+} color_mode;
 
 /* The palette for output on fd. A forced --color wins (even when fd is not
  * a terminal); `auto` gives PALETTE_NONE when fd is not a terminal, NO_COLOR

@@ -404,61 +404,143 @@ static void cursor_to(abuf *a, int row, int col)
 	abuf_char(a, 'H');
 }
 
+/* A value no real cell takes: "the terminal's cell is not known". */
+static const frame_cell unknown_cell = {0xfffffffeu, 0xfffffffeu};
+
+static void forget_shown(frame *f)
+{
+	size_t n = (size_t)f->cols * (size_t)f->rows;
+	for (size_t i = 0; i < n; i++)
+		f->shown[i] = unknown_cell;
+	f->have_shown = true;
+}
+
+/* The state of one update as it is built. */
+typedef struct update_state {
+	abuf *out;
+	size_t start;    /* out->len when the update began */
+	sgr s;
+	int row, col;    /* where the cursor is, in frame cells */
+} update_state;
+
+static void update_begin(const frame *f, update_state *u, abuf *out)
+{
+	u->out = out;
+	u->start = out->len;
+	u->s = (sgr){UNKNOWN, UNKNOWN};
+	u->row = u->col = -1;
+	(void)f;
+}
+
+/* Appends the changed runs of row y; true when it sent anything. The row
+ * then counts as shown. */
+static bool update_row(frame *f, update_state *u, int y)
+{
+	abuf *out = u->out;
+	const frame_cell *row = f->cur + (size_t)y * f->cols;
+	frame_cell *old = f->shown + (size_t)y * f->cols;
+	bool sent = false;
+	int x = 0;
+	for (;;) {
+		while (x < f->cols && cell_eq(row[x], old[x]))
+			x++;
+		if (x >= f->cols)
+			break;
+		/* A run from x: extend over changed cells and short gaps. */
+		int end = x + 1;
+		for (int k = end; k < f->cols; k++) {
+			if (!cell_eq(row[k], old[k]))
+				end = k + 1;
+			else if (k - end >= GAP_FILL)
+				break;
+		}
+		if (out->len == u->start) {
+			if (f->sync)
+				abuf_str(out, "\x1b[?2026h");
+			abuf_str(out, "\x1b" "7\x1b[?25l");
+		}
+		if (u->row == y && u->col < x) {
+			abuf_str(out, "\x1b[");
+			if (x - u->col > 1)
+				abuf_uint(out, (unsigned)(x - u->col));
+			abuf_char(out, 'C');
+		} else if (u->row != y || u->col != x) {
+			cursor_to(out, f->y0 + y, f->x0 + x);
+		}
+		emit_run(f->pal, out, row, x, end, &u->s);
+		u->row = y;
+		u->col = end;
+		x = end;
+		sent = true;
+	}
+	memcpy(old, row, sizeof *row * (size_t)f->cols);
+	return sent;
+}
+
+static void update_end(const frame *f, update_state *u)
+{
+	if (u->out->len > u->start) {
+		abuf_str(u->out, "\x1b[m\x1b" "8\x1b[?25h");
+		if (f->sync)
+			abuf_str(u->out, "\x1b[?2026l");
+	}
+}
+
 const abuf *frame_update(frame *f)
 {
 	abuf *out = &f->out;
 	abuf_reset(out);
-	sgr s = {UNKNOWN, UNKNOWN};
-	int cur_row = -1, cur_col = -1; /* where the cursor is, in frame cells */
-	for (int y = 0; y < f->rows; y++) {
-		const frame_cell *row = f->cur + (size_t)y * f->cols;
-		const frame_cell *old = f->shown + (size_t)y * f->cols;
-		int x = 0;
-		for (;;) {
-			while (x < f->cols && f->have_shown && cell_eq(row[x], old[x]))
-				x++;
-			if (x >= f->cols)
-				break;
-			/* A run from x: extend over changed cells and short gaps. */
-			int end = x + 1;
-			for (int k = end; k < f->cols; k++) {
-				if (!f->have_shown || !cell_eq(row[k], old[k]))
-					end = k + 1;
-				else if (k - end >= GAP_FILL)
-					break;
-			}
-			if (out->len == 0) {
-				if (f->sync)
-					abuf_str(out, "\x1b[?2026h");
-				abuf_str(out, "\x1b" "7\x1b[?25l");
-			}
-			if (cur_row == y && cur_col < x) {
-				abuf_str(out, "\x1b[");
-				if (x - cur_col > 1)
-					abuf_uint(out, (unsigned)(x - cur_col));
-				abuf_char(out, 'C');
-			} else if (cur_row != y || cur_col != x) {
-				cursor_to(out, f->y0 + y, f->x0 + x);
-			}
-			emit_run(f->pal, out, row, x, end, &s);
-			cur_row = y;
-			cur_col = end;
-			x = end;
-		}
-	}
-	if (out->len > 0) {
-		abuf_str(out, "\x1b[m\x1b" "8\x1b[?25h");
-		if (f->sync)
-			abuf_str(out, "\x1b[?2026l");
-	}
-	if (!out->failed) {
-		memcpy(f->shown, f->cur, sizeof *f->cur * (size_t)f->cols * (size_t)f->rows);
-		f->have_shown = true;
-	} else {
+	if (!f->have_shown)
+		forget_shown(f);
+	update_state u;
+	update_begin(f, &u, out);
+	for (int y = 0; y < f->rows; y++)
+		update_row(f, &u, y);
+	update_end(f, &u);
+	f->next_row = 0;
+	if (out->failed) {
 		abuf_reset(out);
 		f->have_shown = false;
 	}
 	return out;
+}
+
+bool frame_dirty(const frame *f)
+{
+	if (!f->have_shown)
+		return true;
+	size_t n = (size_t)f->cols * (size_t)f->rows;
+	for (size_t i = 0; i < n; i++)
+		if (!cell_eq(f->cur[i], f->shown[i]))
+			return true;
+	return false;
+}
+
+bool frame_update_part(frame *f, abuf *out, size_t budget)
+{
+	if (!f->have_shown)
+		forget_shown(f);
+	update_state u;
+	update_begin(f, &u, out);
+	int y = f->next_row % f->rows;
+	for (int i = 0; i < f->rows && out->len - u.start < budget; i++) {
+		update_row(f, &u, y);
+		y = (y + 1) % f->rows;
+	}
+	f->next_row = y;
+	update_end(f, &u);
+	if (out->failed) {
+		f->have_shown = false;
+		return true;
+	}
+	return frame_dirty(f);
+}
+
+void frame_keep_shown(frame *f)
+{
+	if (!f->have_shown)
+		return;
+	memcpy(f->cur, f->shown, sizeof *f->cur * (size_t)f->cols * (size_t)f->rows);
 }
 
 void frame_text(const frame *f, abuf *out)

@@ -51,6 +51,7 @@ typedef struct frame {
 	frame_cell *cur;   /* what the next update shows: cols x rows */
 	frame_cell *shown; /* what the terminal shows */
 	bool have_shown;   /* false: the next update sends every cell */
+	int next_row;      /* where the next frame_update_part starts */
 	abuf out;
 } frame;
 
@@ -72,6 +73,18 @@ void frame_put_image(frame *f, const uint8_t *rgb, int w, int h, int ox, int oy)
  * one buffer for one write(); empty (len 0) when nothing changed. The
  * current cells then count as shown. */
 const abuf *frame_update(frame *f);
+/* Appends to out the next part of the update: rows with changes, from the
+ * row after the last part's (round robin, so that every row gets its turn
+ * while the picture keeps changing), until about `budget` bytes are out
+ * (whole rows; at least one). Each part stands alone (cursor saved and
+ * restored, attributes reset, its own synchronized-update bracket) and the
+ * rows it holds count as shown. True when cells that differ remain. */
+bool frame_update_part(frame *f, abuf *out, size_t budget);
+/* True when some cell differs from what the terminal shows. */
+bool frame_dirty(const frame *f);
+/* Takes what the terminal shows as the current cells (the changes not yet
+ * sent are dropped). */
+void frame_keep_shown(frame *f);
 /* The current cells as ANSI text for a file or a pipe: every row, each
  * ended by "\e[m\n" (PALETTE_NONE: plain text lines). */
 void frame_text(const frame *f, abuf *out);

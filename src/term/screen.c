@@ -1,48 +1,74 @@
 /* rtsh — the full-screen layout (screen.h). */
 #include "term/screen.h"
 
+#include <errno.h>
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/ioctl.h>
-#include <termios.h>
 #include <unistd.h>
 
 #include "term/abuf.h"
 
 #define ENTER_SEQ "\x1b[?1049h"
-#define RESTORE_SEQ "\x1b[r\x1b[m\x1b[?2026l\x1b[?25h\x1b[?1049l"
+/* Every mode rtsh (or readline) may have set, back to the terminal's
+ * default: synchronized output, scroll region, attributes, cursor shown,
+ * bracketed paste, mouse reporting (1000 1002 1003 1006), cursor keys and
+ * keypad in normal mode (DECCKM, DECKPNM), then the main screen. */
+#define RESTORE_SEQ "\x1b[?2026l\x1b[r\x1b[m\x1b[?25h\x1b[?2004l\x1b[?1000l\x1b[?1002l\x1b[?1003l\x1b[?1006l" \
+                    "\x1b[?1l\x1b>\x1b[?1049l"
 
-/* What the crash handler needs, set before it is installed. */
-static int restore_fd = -1;
-static struct termios saved_modes;
-static volatile sig_atomic_t have_modes;
+/* What the signal-time restore needs, set by screen_enter and
+ * screen_keypad (the handlers live in shell/signals.c). */
+static volatile sig_atomic_t restore_fd = -1;
+static volatile sig_atomic_t keypad_on;
+static char keypad_on_seq[64], keypad_off_seq[64];
 
-static void crash_handler(int sig)
+static void put_raw(int fd, const char *s, size_t n)
 {
-	if (restore_fd >= 0) {
-		ssize_t r = write(restore_fd, RESTORE_SEQ, sizeof RESTORE_SEQ - 1);
-		(void)r;
-		if (have_modes)
-			tcsetattr(restore_fd, TCSANOW, &saved_modes);
+	while (n > 0) {
+		ssize_t w = write(fd, s, n);
+		if (w < 0 && errno == EINTR)
+			continue;
+		if (w <= 0)
+			return;
+		s += w;
+		n -= (size_t)w;
 	}
-	/* SA_RESETHAND made the action the default again: the signal kills us
-	 * (with a core dump) once this handler returns. */
-	raise(sig);
 }
 
-static const int crash_signals[] = {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT};
-
-static void crash_handlers(bool on)
+void screen_restore_async(void)
 {
-	struct sigaction sa;
-	memset(&sa, 0, sizeof sa);
-	sigemptyset(&sa.sa_mask);
-	sa.sa_handler = on ? crash_handler : SIG_DFL;
-	sa.sa_flags = on ? SA_RESETHAND : 0;
-	for (size_t i = 0; i < sizeof crash_signals / sizeof crash_signals[0]; i++)
-		sigaction(crash_signals[i], &sa, NULL);
+	int fd = restore_fd;
+	if (fd < 0)
+		return;
+	if (keypad_on && keypad_off_seq[0])
+		put_raw(fd, keypad_off_seq, strlen(keypad_off_seq));
+	put_raw(fd, RESTORE_SEQ, sizeof RESTORE_SEQ - 1);
+}
+
+void screen_reenter_async(void)
+{
+	int fd = restore_fd;
+	if (fd < 0)
+		return;
+	put_raw(fd, ENTER_SEQ, sizeof ENTER_SEQ - 1);
+	if (keypad_on && keypad_on_seq[0])
+		put_raw(fd, keypad_on_seq, strlen(keypad_on_seq));
+}
+
+void screen_keypad(int fd, const char *on_seq, const char *off_seq, bool on)
+{
+	if (on) {
+		snprintf(keypad_on_seq, sizeof keypad_on_seq, "%s", on_seq ? on_seq : "");
+		snprintf(keypad_off_seq, sizeof keypad_off_seq, "%s", off_seq ? off_seq : "");
+		put_raw(fd, keypad_on_seq, strlen(keypad_on_seq));
+		keypad_on = 1;
+	} else {
+		keypad_on = 0;
+		put_raw(fd, keypad_off_seq, strlen(keypad_off_seq));
+	}
 }
 
 void screen_fit(int cols, int rows, double aspect, bool whole_cells, int *w, int *h)
@@ -102,8 +128,25 @@ static void compute_layout(screen *s)
 
 static void put(screen *s, const abuf *a)
 {
-	if (!a->failed)
+	if (a->failed)
+		return;
+	if (s->out)
+		termout_text(s->out, a->b, a->len);
+	else
 		write_all(s->fd, a->b, a->len);
+}
+
+/* A new picture encoder for the layout (none when there is no room). */
+static void open_encoder(screen *s)
+{
+	encoder_close(s->enc);
+	s->enc = NULL;
+	if (s->pic_rows > 0) {
+		encoder_geom g = {.cols = s->cols, .rows = s->pic_rows, .pal = s->pal};
+		s->enc = encoder_halfblock.open(&g);
+	}
+	if (s->out)
+		termout_set_picture(s->out, s->enc);
 }
 
 static void draw_status(screen *s, abuf *a)
@@ -140,8 +183,8 @@ static void redraw_chrome(screen *s)
 	draw_status(s, &a);
 	put(s, &a);
 	abuf_free(&a);
-	if (s->fr)
-		frame_invalidate(s->fr);
+	if (s->enc)
+		s->enc->ops->invalidate(s->enc);
 }
 
 bool screen_layout(screen *s, double aspect, bool force)
@@ -152,17 +195,16 @@ bool screen_layout(screen *s, double aspect, bool force)
 	s->aspect = aspect > 0 && isfinite(aspect) ? aspect : 16.0 / 9.0;
 	compute_layout(s);
 	bool changed = oc != s->cols || orow != s->rows || opic != s->pic_rows;
-	if (!changed && !force && s->fr && oa != s->aspect) {
+	if (!changed && !force && s->enc && oa != s->aspect) {
 		/* Only the image's shape changed: the next frame update erases
 		 * the old picture; the prompt's lines stay. */
-		frame_clear(s->fr);
-	} else if (changed || force || !s->fr) {
-		if (!s->fr || s->fr->cols != s->cols || s->fr->rows != s->pic_rows) {
-			frame_free(s->fr);
-			s->fr = s->pic_rows > 0 ? frame_new(s->cols, s->pic_rows, s->pal) : NULL;
-		}
-		if (s->fr)
-			frame_clear(s->fr);
+		s->enc->ops->clear(s->enc);
+	} else if (changed || force || !s->enc) {
+		if (!s->enc || s->enc->geom.cols != s->cols || s->enc->geom.rows != s->pic_rows ||
+		    s->enc->geom.pal != s->pal)
+			open_encoder(s);
+		if (s->enc)
+			s->enc->ops->clear(s->enc);
 		redraw_chrome(s);
 	}
 	return ow != s->img_w || oh != s->img_h;
@@ -175,28 +217,20 @@ bool screen_enter(screen *s, int fd, frame_palette pal, double aspect)
 	s->pal = pal;
 	if (!isatty(fd))
 		return false;
-	if (tcgetattr(fd, &saved_modes) == 0)
-		have_modes = 1;
+	s->out = termout_new(fd);
+	if (!s->out)
+		return false;
 	restore_fd = fd;
-	crash_handlers(true);
 	write_all(fd, ENTER_SEQ, sizeof ENTER_SEQ - 1);
 	s->active = true;
 	screen_layout(s, aspect, true);
 	return true;
 }
 
-void screen_suspend(screen *s)
-{
-	if (!s->active)
-		return;
-	write_all(s->fd, RESTORE_SEQ, sizeof RESTORE_SEQ - 1);
-}
-
 void screen_resume(screen *s)
 {
 	if (!s->active)
 		return;
-	write_all(s->fd, ENTER_SEQ, sizeof ENTER_SEQ - 1);
 	screen_layout(s, s->aspect, true);
 }
 
@@ -204,12 +238,31 @@ void screen_leave(screen *s)
 {
 	if (!s->active)
 		return;
-	write_all(s->fd, RESTORE_SEQ, sizeof RESTORE_SEQ - 1);
-	crash_handlers(false);
+	screen_restore_async();
 	restore_fd = -1;
 	s->active = false;
-	frame_free(s->fr);
-	s->fr = NULL;
+	encoder_close(s->enc);
+	s->enc = NULL;
+	termout_free(s->out);
+	s->out = NULL;
+}
+
+void screen_clear_all(screen *s)
+{
+	static const char seq[] = "\x1b[r\x1b[2J";
+	if (s->out)
+		termout_text(s->out, seq, sizeof seq - 1);
+	else
+		write_all(s->fd, seq, sizeof seq - 1);
+}
+
+void screen_set_palette(screen *s, frame_palette pal)
+{
+	if (pal == s->pal)
+		return;
+	s->pal = pal;
+	if (s->active)
+		screen_layout(s, s->aspect, true);
 }
 
 void screen_status(screen *s, const char *text)
@@ -226,21 +279,7 @@ void screen_status(screen *s, const char *text)
 
 void screen_picture(screen *s, const uint8_t *rgb, int w, int h)
 {
-	if (!s->active || !s->fr || w != s->img_w || h != s->img_h)
+	if (!s->active || !s->enc || w != s->img_w || h != s->img_h)
 		return;
-	frame_put_image(s->fr, rgb, w, h, s->img_x, s->img_y);
-	const abuf *a = frame_update(s->fr);
-	put(s, a);
-}
-
-void screen_stop_self(void)
-{
-	struct sigaction sa, old;
-	memset(&sa, 0, sizeof sa);
-	sa.sa_handler = SIG_DFL;
-	sigemptyset(&sa.sa_mask);
-	sigaction(SIGTSTP, &sa, &old);
-	raise(SIGTSTP);
-	/* ... continued. */
-	sigaction(SIGTSTP, &old, NULL);
+	encoder_put(s->enc, rgb, w, h, s->img_x, s->img_y);
 }

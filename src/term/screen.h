@@ -14,10 +14,13 @@
  *   \e[7m                 reverse video (the status line)
  *   \e[K                  clear to the end of the line
  *
- * The terminal is restored on every way out: screen_leave on a normal exit,
- * and a handler for crash signals (SIGSEGV, SIGBUS, SIGFPE, SIGILL,
- * SIGABRT) that writes the restore sequence and the saved terminal modes
- * with async-signal-safe calls only, then lets the signal kill the process.
+ *   \e[?2026l \e[?25h \e[?2004l \e[?1000l \e[?1002l \e[?1003l \e[?1006l
+ *   \e[?1l \e>           on the way out: every mode rtsh or readline may
+ *                         have set, back to its default (screen_restore_async)
+ *
+ * The terminal is restored on every way out: screen_leave on a normal exit;
+ * the signal handlers (shell/signals.c) call screen_restore_async, which
+ * uses async-signal-safe calls only.
  */
 #ifndef RTSH_SCREEN_H
 #define RTSH_SCREEN_H
@@ -25,7 +28,9 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "term/encoder.h"
 #include "term/frame.h"
+#include "term/out.h"
 
 typedef struct screen {
 	int fd;
@@ -37,14 +42,14 @@ typedef struct screen {
 	double aspect;     /* width / height of the image */
 	int img_w, img_h;  /* the preview's size in pixels (0 when no picture) */
 	int img_x, img_y;  /* its place on the cols x 2*pic_rows pixel canvas */
-	frame *fr;         /* the picture area */
+	encoder *enc;      /* the picture area's encoder */
+	termout *out;      /* every byte of the screen goes out through it */
 	bool active;
 	char status[512];  /* the status line's text */
 } screen;
 
-/* Saves the terminal modes of fd (call before readline changes them), enters
- * the alternate screen, lays it out for an image of the given aspect and
- * installs the crash handlers. False when fd is not a terminal. */
+/* Enters the alternate screen of fd and lays it out for an image of the
+ * given aspect. False when fd is not a terminal. */
 bool screen_enter(screen *s, int fd, frame_palette pal, double aspect);
 /* Restores the terminal: scroll region, attributes, cursor, main screen.
  * Safe to call twice. */
@@ -53,20 +58,32 @@ void screen_leave(screen *s);
  * clears it when anything changed (or `force`), redraws the status line and
  * puts the cursor on the last row. True when the image size changed. */
 bool screen_layout(screen *s, double aspect, bool force);
+/* Clears the whole screen and resets the scroll region (before the pager
+ * takes the screen; screen_layout gives it back). */
+void screen_clear_all(screen *s);
+/* Another palette (the terminal said it has truecolor): lays out and
+ * clears the screen again. */
+void screen_set_palette(screen *s, frame_palette pal);
 /* Sets and draws the status line. */
 void screen_status(screen *s, const char *text);
-/* Shows an sRGB image of img_w x img_h pixels in the picture area
- * (letterboxed; only changed cells are sent). */
+/* Puts an sRGB image of img_w x img_h pixels in the picture area
+ * (letterboxed); the output scheduler (s->out, termout_pump) sends the
+ * cells that changed. */
 void screen_picture(screen *s, const uint8_t *rgb, int w, int h);
-/* Writes the restore sequence and the saved terminal modes (for a process
- * that is about to stop or be suspended; the screen stays "entered"). */
-void screen_suspend(screen *s);
-/* Enters the alternate screen again after screen_suspend and redraws. */
+/* Lays the screen out again and redraws it after the process was stopped
+ * and continued (the signal handler entered the alternate screen again). */
 void screen_resume(screen *s);
-/* Stops the process as Ctrl-Z does (SIGTSTP with its default action) and
- * returns once it is continued; call between screen_suspend and
- * screen_resume. */
-void screen_stop_self(void);
+
+/* --- for signal handlers: async-signal-safe --- */
+/* Writes the sequence that gives the terminal back (keypad off when
+ * screen_keypad turned it on, every mode reset, main screen); nothing when
+ * no screen is entered. */
+void screen_restore_async(void);
+/* Enters the alternate screen again, with the keypad mode it had. */
+void screen_reenter_async(void);
+/* Sends terminfo's keypad transmit string on_seq (on) or off_seq (off) to
+ * fd and remembers the state for the two functions above. */
+void screen_keypad(int fd, const char *on_seq, const char *off_seq, bool on);
 
 /* The preview size for a picture area of cols x rows cells and an aspect:
  * letterboxed inside cols x 2*rows pixels, both at least 1. */

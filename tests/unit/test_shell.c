@@ -181,10 +181,11 @@ static void test_completion(void **state)
 	assert_candidates(complete_at_end(sh, "undo; re", &files), "render redo");
 	assert_candidates(complete_at_end(sh, "object 1 move ", &files), "");
 	assert_false(files);
-	assert_null(complete_at_end(sh, "load sc", &files));
+	assert_null(complete_at_end(sh, "source sc", &files));
 	assert_true(files);
-	assert_null(complete_at_end(sh, "save ", &files));
-	assert_true(files);
+	/* load and save complete by file type (test_complete_files). */
+	assert_candidates(complete_at_end(sh, "load scenes/basic.", &files), "scenes/basic.rt");
+	assert_false(files);
 	/* Object numbers follow the scene. */
 	size_t n = editor_scene(sh->ed)->nobjs;
 	char **c = complete_at_end(sh, "object ", &files);

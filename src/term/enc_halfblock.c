@@ -1,0 +1,84 @@
+/* rtsh — the half-block encoder (encoder.h): two pixels a cell, drawn by
+ * the frame module (frame.h), which keeps the cells the terminal shows and
+ * sends the changed ones, a few rows per part. */
+#include <stdlib.h>
+
+#include "term/encoder.h"
+
+typedef struct halfblock {
+	encoder base;
+	frame *fr;
+} halfblock;
+
+static void hb_canvas(const encoder_geom *g, int *w, int *h)
+{
+	*w = g->cols;
+	*h = 2 * g->rows;
+}
+
+static encoder *hb_open(const encoder_geom *g)
+{
+	halfblock *e = calloc(1, sizeof *e);
+	if (!e)
+		return NULL;
+	e->base.ops = &encoder_halfblock;
+	e->base.geom = *g;
+	e->fr = frame_new(g->cols, g->rows, g->pal);
+	if (!e->fr) {
+		free(e);
+		return NULL;
+	}
+	e->fr->x0 = g->x0;
+	e->fr->y0 = g->y0;
+	return &e->base;
+}
+
+static void hb_close(encoder *e)
+{
+	halfblock *h = (halfblock *)e;
+	frame_free(h->fr);
+	free(h);
+}
+
+static void hb_put(encoder *e, const uint8_t *rgb, int w, int h, int ox, int oy)
+{
+	frame_put_image(((halfblock *)e)->fr, rgb, w, h, ox, oy);
+}
+
+static void hb_clear(encoder *e)
+{
+	frame_clear(((halfblock *)e)->fr);
+}
+
+static void hb_invalidate(encoder *e)
+{
+	frame_invalidate(((halfblock *)e)->fr);
+}
+
+static bool hb_update(encoder *e, abuf *out, size_t budget)
+{
+	return frame_update_part(((halfblock *)e)->fr, out, budget);
+}
+
+static bool hb_dirty(const encoder *e)
+{
+	return frame_dirty(((const halfblock *)e)->fr);
+}
+
+static void hb_keep_shown(encoder *e)
+{
+	frame_keep_shown(((halfblock *)e)->fr);
+}
+
+const encoder_ops encoder_halfblock = {
+	.name = "halfblock",
+	.canvas = hb_canvas,
+	.open = hb_open,
+	.close = hb_close,
+	.put = hb_put,
+	.clear = hb_clear,
+	.invalidate = hb_invalidate,
+	.update = hb_update,
+	.dirty = hb_dirty,
+	.keep_shown = hb_keep_shown,
+};

@@ -1,0 +1,91 @@
+/* rtsh — picture encoders: how an RGB picture becomes bytes for the
+ * terminal. Half blocks (enc_halfblock.c) are the first; other protocols
+ * (kitty, sixel, iTerm2) are one file each behind the same interface, and
+ * one line in encoder_table (encoder.c).
+ *
+ * An encoder owns a rectangle of character cells on the screen. The front
+ * end puts sRGB pictures on its pixel canvas (encoder_put, as often as it
+ * likes: a newer picture overtakes one not yet sent) and the output
+ * scheduler (out.h) asks for the bytes in parts of about a given size
+ * (encoder_update), each part standing alone, so that the bytes in flight
+ * to a slow terminal stay bounded. An encoder keeps what the terminal was
+ * last sent and sends only what differs from it ("damage").
+ */
+#ifndef RTSH_ENCODER_H
+#define RTSH_ENCODER_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "term/abuf.h"
+#include "term/frame.h"
+
+/* Where the picture goes and what the terminal is like. */
+typedef struct encoder_geom {
+	int cols, rows;      /* the picture area in cells */
+	int x0, y0;          /* its top-left cell on the screen, 0-based */
+	int cell_w, cell_h;  /* a cell in pixels, 0 when not known */
+	frame_palette pal;   /* the colours the terminal takes */
+} encoder_geom;
+
+typedef struct encoder encoder;
+
+typedef struct encoder_ops {
+	const char *name;
+	/* The pixel canvas of an area: half blocks give cols x 2*rows. */
+	void (*canvas)(const encoder_geom *g, int *w, int *h);
+	/* A new encoder, every cell at the default background; NULL when
+	 * out of memory or the area is empty. */
+	encoder *(*open)(const encoder_geom *g);
+	void (*close)(encoder *e);
+	/* Puts w x h sRGB pixels (3 bytes each, rows top down) at (ox, oy) of
+	 * the canvas; pixels outside keep their value. */
+	void (*put)(encoder *e, const uint8_t *rgb, int w, int h, int ox, int oy);
+	/* Every pixel to the default background. */
+	void (*clear)(encoder *e);
+	/* Forgets what the terminal shows (after the screen was cleared). */
+	void (*invalidate)(encoder *e);
+	/* Appends the next part of the update to out, about `budget` bytes
+	 * (SIZE_MAX: all of it); true when more remains to send. */
+	bool (*update)(encoder *e, abuf *out, size_t budget);
+	/* True when the terminal does not show the newest picture yet. */
+	bool (*dirty)(const encoder *e);
+	/* Drops the part not yet sent: what the terminal shows stays. */
+	void (*keep_shown)(encoder *e);
+} encoder_ops;
+
+/* Every encoder starts with this. */
+struct encoder {
+	const encoder_ops *ops;
+	encoder_geom geom;
+};
+
+/* The half-block encoder (term/frame.h underneath). */
+extern const encoder_ops encoder_halfblock;
+
+/* The encoders by name ("halfblock", ...), NULL-terminated. */
+extern const encoder_ops *const encoder_table[];
+/* The encoder called name, or NULL. */
+const encoder_ops *encoder_find(const char *name);
+
+/* Shorthands for e->ops->... */
+static inline void encoder_close(encoder *e)
+{
+	if (e)
+		e->ops->close(e);
+}
+static inline void encoder_put(encoder *e, const uint8_t *rgb, int w, int h, int ox, int oy)
+{
+	e->ops->put(e, rgb, w, h, ox, oy);
+}
+static inline bool encoder_update(encoder *e, abuf *out, size_t budget)
+{
+	return e->ops->update(e, out, budget);
+}
+static inline bool encoder_dirty(const encoder *e)
+{
+	return e->ops->dirty(e);
+}
+
+#endif

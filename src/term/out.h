@@ -1,0 +1,110 @@
+/* rtsh — the output scheduler: the bytes rtsh's screen sends to the
+ * terminal, paced by the terminal's own answers.
+ *
+ * Text (the status line, the screen's frame, messages) is written at once.
+ * The picture is an encoder (encoder.h) whose damage is sent in slices:
+ * after each slice a Device Status Report query, CSI 5 n, which the
+ * terminal answers with CSI 0 n once it has read everything before it. The
+ * next slice goes only after the answer, so at most about one slice is in
+ * flight however deep the buffers between rtsh and the terminal are (sshd,
+ * the network). Slices are sized to about SLICE_SECONDS of the link, from
+ * the throughput and round-trip time measured on the answers; text never
+ * waits behind more than the slice in flight. A picture that changes while
+ * slices are out is not finished: the next slice starts from what the
+ * terminal really shows (the encoder's damage).
+ *
+ * At start the scheduler asks (termout_probe): DECRQSS of a 24-bit SGR and
+ * XTGETTCAP of RGB and Tc (is there truecolor?), then DA1 (CSI c), which
+ * every terminal answers, as the fence: once DA1's answer is in, the
+ * questions before it were answered or never will be. No picture is sent
+ * before that. A terminal that answers nothing within PROBE_TIMEOUT (or a
+ * slice within its timeout) gets today's unpaced output, and the
+ * scheduler says so once (termout_notice).
+ *
+ * The answers come in on the terminal's input, mixed with keys:
+ * termout_input takes them out and gives back the keys alone.
+ *
+ * Escape sequences sent here:
+ *   \e[5n                  DSR: status report (answer \e[0n)
+ *   \e[c                   DA1: primary device attributes (answer \e[?...c)
+ *   \e7 \e[48;2;1;2;3m \eP$qm\e\\ \e[m \e8
+ *                          DECRQSS of the SGR with a 24-bit background
+ *                          (answer \eP1$r...48:2:...1:2:3m\e\\ when kept)
+ *   \eP+q524742;5463\e\\   XTGETTCAP of RGB and Tc (answer \eP1+r...\e\\)
+ */
+#ifndef RTSH_OUT_H
+#define RTSH_OUT_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "term/abuf.h"
+#include "term/encoder.h"
+
+#define TERMOUT_SLICE_SECONDS 0.08
+#define TERMOUT_PROBE_TIMEOUT 2.0
+
+typedef struct termout termout;
+
+typedef enum termout_state {
+	TERMOUT_IDLE,     /* no probe sent: unpaced */
+	TERMOUT_PROBING,  /* waiting for the start-up answers */
+	TERMOUT_PACED,    /* slices wait for the terminal's answers */
+	TERMOUT_UNPACED,  /* the terminal did not answer: whole updates */
+} termout_state;
+
+/* Figures for tests and the status of a session. */
+typedef struct termout_stats {
+	double rtt;        /* seconds, the smallest round trip seen (0: none yet) */
+	double bps;        /* bytes a second the link carries (0: not known) */
+	long slices;       /* picture slices sent */
+	long answers;      /* answers taken out of the input */
+	size_t in_flight;  /* picture bytes sent and not yet answered */
+} termout_stats;
+
+/* A scheduler writing to fd; NULL when out of memory. */
+termout *termout_new(int fd);
+void termout_free(termout *o);
+
+/* Writes text now (it goes ahead of every picture slice not yet sent). */
+void termout_text(termout *o, const void *b, size_t n);
+/* The picture to send (NULL: none); the scheduler does not own it. */
+void termout_set_picture(termout *o, encoder *e);
+/* Drops the picture's changes not yet sent (Ctrl-C): the terminal keeps
+ * what it shows. */
+void termout_drop_picture(termout *o);
+
+/* Sends the start-up questions (the truecolor ones when ask_color) and
+ * the DA1 fence; pacing starts when the fence is answered. */
+void termout_probe(termout *o, bool ask_color, double now);
+/* Takes the answers out of bytes read from the terminal and appends the
+ * rest (keys) to keys. An escape sequence cut at the end of the bytes is
+ * held while an answer is awaited (until more comes, or termout_pump
+ * gives it up as keys after a short while). */
+void termout_input(termout *o, const char *b, size_t n, double now, abuf *keys);
+/* Sends what the pacing allows of the picture, checks the time-outs and
+ * gives up held key bytes that waited too long (appended to keys). */
+void termout_pump(termout *o, double now, abuf *keys);
+/* Seconds until termout_pump has something to do without new input; < 0
+ * when nothing. */
+double termout_wait(const termout *o, double now);
+/* True while answers are awaited. */
+bool termout_awaiting(const termout *o);
+
+/* The loop was busy (a command ran) and did not read the answers in time:
+ * those awaited now tell nothing about the link. */
+void termout_stale(termout *o, double now);
+/* Waits up to max_seconds for every awaited answer, reading in_fd (keys
+ * read meanwhile are appended to keys): before a part of rtsh that reads
+ * the terminal on its own (key mode, the pager). */
+void termout_settle(termout *o, int in_fd, double max_seconds, abuf *keys);
+
+termout_state termout_get_state(const termout *o);
+/* After the probe: 1 when the terminal said it has 24-bit colour, 0 when
+ * it did not (or was not asked). */
+int termout_truecolor(const termout *o);
+/* A message to show once (the fall-back to unpaced output), then NULL. */
+const char *termout_notice(termout *o);
+termout_stats termout_get_stats(const termout *o);
+
+#endif

@@ -1,0 +1,114 @@
+#!/bin/sh
+# Signals under tmux: at the prompt, during `render` and in `view` (key
+# mode), every fatal signal (TERM HUP QUIT SEGV) leaves the terminal as it
+# was before rtsh: main screen, cursor shown, keypad and cursor keys in
+# normal mode (#{alternate_on} #{cursor_flag} #{keypad_flag}
+# #{keypad_cursor_flag} = "0 1 0 0"). Ctrl-Z (SIGTSTP) gives the terminal
+# back the same way and SIGCONT takes it again (alternate screen, and the
+# keypad in key mode); SIGINT stops a render or leaves key mode without
+# leaving a mode set.
+set -u
+s=rtsh-signals-$$
+fail() { echo "FAIL: $*"; tmux kill-session -t "$s" 2>/dev/null; tmux kill-session -t "$s-keep" 2>/dev/null; exit 1; }
+flags() { tmux display -p -t "$s" '#{alternate_on} #{cursor_flag} #{keypad_flag} #{keypad_cursor_flag}'; }
+screen() { tmux capture-pane -t "$s" -p; }
+# wait_for TEXT WHAT: up to 10 s for TEXT on the screen.
+wait_for() {
+	for i in $(seq 1 100); do
+		case $(screen) in *"$1"*) return 0 ;; esac
+		sleep 0.1
+	done
+	fail "$2; the screen ends with:
+$(screen | tail -n 4)"
+}
+# wait_flags WANT WHAT: up to 5 s for the flags to read WANT.
+wait_flags() {
+	for i in $(seq 1 50); do
+		[ "$(flags)" = "$1" ] && return 0
+		sleep 0.1
+	done
+	fail "$2: the pane's flags are \"$(flags)\", expected \"$1\" (alternate cursor keypad keypad-cursor)"
+}
+dead() { case $(screen) in *rtsh-ended*) return 0 ;; esac; return 1; }
+
+cat >"$TMP/s.rt" <<'EOF'
+A 0.3 255,255,255
+C 0,0,-10 0,0,1 70
+L -10,10,-10 0.7 255,255,255
+sp 0,0,0 4 230,60,50
+pl 0,-2,0 0,1,0 200,200,200
+EOF
+
+# start CONTEXT: rtsh in a pane under a shell that outlives it (a dead
+# pane's flags are tmux's own), brought to the prompt, into a long
+# `render`, or into `view`.
+start() {
+	tmux new-session -d -s "$s" -x 100 -y 32 \
+		"ulimit -c 0; env TERM=tmux-256color COLORTERM=truecolor HOME='$TMP' '$RTSH' -t 1 -s 64 '$TMP/s.rt'; echo rtsh-ended; exec sleep 60" ||
+		fail "tmux"
+	wait_for "rtsh>" "no prompt"
+	pid=$(ps -o pid= --ppid "$(tmux display -p -t "$s" '#{pane_pid}')" | tr -d ' ')
+	[ -n "$pid" ] || fail "no rtsh process under the pane's shell"
+	case $1 in
+	render)
+		tmux send-keys -t "$s" 'set resolution 3000x2000; render' Enter
+		wait_for "(Ctrl-C stops)" "the render did not start" ;;
+	view)
+		tmux send-keys -t "$s" 'view' Enter
+		wait_for " view │" "key mode did not start"
+		wait_flags "1 0 1 1" "key mode has no keypad mode" ;;
+	esac
+}
+
+# A session that keeps the tmux server up between the test's own ones (a
+# new session races with a server that is shutting down).
+tmux new-session -d -s "$s-keep" "exec sleep 600" || fail "tmux"
+for ctx in prompt render view; do
+	for sig in TERM HUP QUIT SEGV; do
+		start $ctx
+		kill -s $sig "$pid"
+		for i in $(seq 1 50); do dead && break; sleep 0.1; done
+		dead || fail "SIG$sig in $ctx: rtsh is still running"
+		wait_flags "0 1 0 0" "SIG$sig in $ctx"
+		tmux kill-session -t "$s"
+	done
+
+	# Ctrl-Z and fg.
+	start $ctx
+	kill -s TSTP "$pid"
+	for i in $(seq 1 50); do
+		case $(ps -o stat= -p "$pid") in T*) break ;; esac
+		sleep 0.1
+	done
+	case $(ps -o stat= -p "$pid") in T*) ;; *) fail "SIGTSTP in $ctx: rtsh did not stop" ;; esac
+	wait_flags "0 1 0 0" "SIGTSTP in $ctx"
+	kill -s CONT "$pid"
+	if [ $ctx = view ]; then
+		wait_flags "1 0 1 1" "SIGCONT in view"
+		wait_for " view │" "SIGCONT in view: key mode is not drawn again"
+	else
+		for i in $(seq 1 50); do
+			[ "$(tmux display -p -t "$s" '#{alternate_on}')" = 1 ] && break
+			sleep 0.1
+		done
+		[ "$(tmux display -p -t "$s" '#{alternate_on}')" = 1 ] || fail "SIGCONT in $ctx: not on the alternate screen"
+		if [ $ctx = render ]; then
+			wait_for "(Ctrl-C stops)" "SIGCONT in render: no progress in the status line"
+		else
+			wait_for "rtsh>" "SIGCONT at the prompt: no prompt"
+		fi
+	fi
+
+	# Ctrl-C: stops the render or leaves key mode; rtsh goes on.
+	kill -s INT "$pid"
+	sleep 0.5
+	dead && fail "SIGINT in $ctx ended rtsh"
+	wait_flags "1 1 0 0" "SIGINT in $ctx (after a stop and a continue)"
+	tmux send-keys -t "$s" 'quit' Enter
+	for i in $(seq 1 50); do dead && break; sleep 0.1; done
+	dead || fail "quit after $ctx: rtsh is still running"
+	wait_flags "0 1 0 0" "quit after $ctx"
+	tmux kill-session -t "$s"
+done
+tmux kill-session -t "$s-keep"
+echo "ok"

@@ -1,0 +1,48 @@
+#!/bin/sh
+# The link simulator (linksim.c): rtsh on a pty behind a slow wire, with a
+# terminal that answers DSR, DA1, DECRQSS and XTGETTCAP only when the
+# query arrives. Checks, on cornell.rt refining in path mode at 200x60:
+#   - 30 KB/s, 100 ms round trip: every typed key echoes, the 95th
+#     percentile within 2x the 300 ms target (the machine may be loaded);
+#     after the render ends, the wire falls idle within the time of one
+#     full frame (200x60 cells at 40 bytes a cell at most) + 2 s, that is no
+#     backlog of stale frames; Ctrl-C: idle within 1.5 s; the terminal,
+#     with no COLORTERM, said it has truecolor: the picture is 24-bit;
+#   - 1 MB/s, 20 ms: no backlog either (the same bound).
+# Usage: run.sh RTSH LINKSIM. The figures go to $RTSH_TEST_RESULTS/link.txt.
+set -u
+rtsh=$1; sim=$2
+case $rtsh in /*) ;; *) rtsh="$PWD/$rtsh" ;; esac
+results=${RTSH_TEST_RESULTS:-build/test-results}
+mkdir -p "$results"
+passed=0 failed=0
+tmp=$(mktemp -d)
+run() { # rate rtt scenario -> line
+	"$sim" --rate "$1" --rtt "$2" --scenario "$3" --cols 200 --rows 60 --samples 128 --timeout 90 -- \
+		env -i PATH="$PATH" HOME="$tmp" TERM=xterm-256color "$rtsh" -t 2 scenes/cornell.rt
+}
+# check NAME CONDITION (awk expression over the line's fields)
+check() {
+	if echo "$line" | tr ' ' '\n' | awk -F= '{ v[$1] = $2 } END { exit !('"$2"') }'; then
+		passed=$((passed + 1)); echo "[       OK ] link: $1"
+	else
+		failed=$((failed + 1)); echo "[  FAILED  ] link: $1"; echo "    $line"
+	fi
+}
+full_frame_s() { awk -v r="$1" 'BEGIN { print 200 * 60 * 40 / r + 2 }'; }
+
+line=$(run 30000 0.1 refine); echo "$line" >"$results/link.txt"
+b=$(full_frame_s 30000)
+check "30 KB/s: every key echoes" 'v["keys"] >= 4 && v["echoed"] == v["keys"]'
+check "30 KB/s: echo p95 <= 0.6 s" 'v["echo_p95"] >= 0 && v["echo_p95"] <= 0.6'
+check "30 KB/s: idle <= $b s after the render" "v[\"render_end\"] > 0 && v[\"idle_after_end\"] <= $b"
+check "30 KB/s: truecolor from the terminal's answer" 'v["sgr24"] > 0'
+line=$(run 30000 0.1 ctrlc); echo "$line" >>"$results/link.txt"
+check "30 KB/s: idle <= 1.5 s after Ctrl-C" 'v["idle_after_ctrlc"] >= 0 && v["idle_after_ctrlc"] <= 1.5'
+line=$(run 1000000 0.02 refine); echo "$line" >>"$results/link.txt"
+b=$(full_frame_s 1000000)
+check "1 MB/s: idle <= $b s after the render" "v[\"render_end\"] > 0 && v[\"idle_after_end\"] <= $b"
+rm -rf "$tmp"
+echo "[==========] link simulator: $passed passed, $failed failed"
+echo "$passed $failed" >"$results/link.count"
+[ $failed = 0 ]
