@@ -4,7 +4,8 @@
 #   make run        build and open the shell on the built-in showcase scene
 #   make test       build and run every test, then again under ASan+UBSan, and
 #                   the threaded tests under TSan
-#   make bench      build and run the benchmark (writes build/bench.tsv)
+#   make bench      build and run the benchmark (writes build/bench.tsv, and
+#                   build/bench-mpi.tsv when mpirun exists)
 #   make mpi        build ./rtsh-mpi, the Open MPI renderer (`make` builds it
 #                   too when mpicc is installed)
 #   make install    PREFIX=/usr/local DESTDIR=  (binary, man pages, scenes)
@@ -147,12 +148,14 @@ bench: all $(BENCH_BIN)
 		$(MAKE) --no-print-directory $(EMBREE_BIN); \
 	else echo "bench: no embree3/rtcore.h, so no Embree row (apt-get install libembree-dev)"; fi
 	./$(BENCH_BIN) --out $(BUILD)/bench.tsv
+	@sh bench/mpi.sh --out $(BUILD)/bench-mpi.tsv
 
 bench-quick: all $(BENCH_BIN)
 	./$(BENCH_BIN) --quick --out $(BUILD)/bench-quick.tsv
+	@sh bench/mpi.sh --quick --out $(BUILD)/bench-mpi-quick.tsv
 
 check-man:
-	@for m in man/rtsh.1 man/rtsh.5; do \
+	@for m in man/rtsh.1 man/rtsh.5 man/rtsh-mpi.1; do \
 		out=$$(LC_ALL=C.UTF-8 MANWIDTH=80 groff -man -ww -z $$m 2>&1); \
 		if [ -n "$$out" ]; then echo "$$m: $$out"; exit 1; fi; \
 		if command -v mandoc >/dev/null 2>&1; then out=$$(mandoc -Tlint -W style $$m 2>&1); if [ -n "$$out" ]; then echo "$$out"; exit 1; fi; fi; \
@@ -162,12 +165,15 @@ install: all
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/man/man1 \
 		$(DESTDIR)$(PREFIX)/share/man/man5 $(DESTDIR)$(PREFIX)/share/rtsh/scenes
 	install -m 755 $(BIN) $(DESTDIR)$(PREFIX)/bin/rtsh
+	if [ -x $(MPI_BIN) ]; then install -m 755 $(MPI_BIN) $(DESTDIR)$(PREFIX)/bin/rtsh-mpi; \
+		install -m 644 man/rtsh-mpi.1 $(DESTDIR)$(PREFIX)/share/man/man1/rtsh-mpi.1; fi
 	install -m 644 man/rtsh.1 $(DESTDIR)$(PREFIX)/share/man/man1/rtsh.1
 	install -m 644 man/rtsh.5 $(DESTDIR)$(PREFIX)/share/man/man5/rtsh.5
 	install -m 644 scenes/*.rt $(DESTDIR)$(PREFIX)/share/rtsh/scenes/
 
 uninstall:
 	rm -f $(DESTDIR)$(PREFIX)/bin/rtsh $(DESTDIR)$(PREFIX)/share/man/man1/rtsh.1 \
+		$(DESTDIR)$(PREFIX)/bin/rtsh-mpi $(DESTDIR)$(PREFIX)/share/man/man1/rtsh-mpi.1 \
 		$(DESTDIR)$(PREFIX)/share/man/man5/rtsh.5
 	rm -rf $(DESTDIR)$(PREFIX)/share/rtsh
 

@@ -318,7 +318,7 @@ typedef struct crew {
 	/* all below under lock */
 	int64_t *queue;      /* tiles to render (ring) */
 	int qhead, qlen, cap;
-	char **spare;        /* free message buffers */
+	char **spare;        /* free message buffers (2 k: k tiles, and sends in flight) */
 	int nspare;
 	outgoing *out;       /* rendered, to send (ring) */
 	int ohead, olen;
@@ -334,15 +334,14 @@ static void *crew_thread(void *arg)
 	world_rays_reset();
 	pthread_mutex_lock(&c->lock);
 	for (;;) {
-		while (c->qlen == 0 && !c->no_more)
+		/* a tile and a buffer for it (one may still be on its way to rank 0) */
+		while ((c->qlen == 0 || c->nspare == 0) && !(c->qlen == 0 && c->no_more))
 			pthread_cond_wait(&c->work, &c->lock);
 		if (c->qlen == 0)
 			break;
 		int64_t i = c->queue[c->qhead];
 		c->qhead = (c->qhead + 1) % c->cap;
 		c->qlen--;
-		/* There is a spare: the tiles queued, rendering and unsent are
-		 * never more than the buffers (farm.h). */
 		char *msg = c->spare[--c->nspare];
 		pthread_mutex_unlock(&c->lock);
 
@@ -383,16 +382,20 @@ bool farm_work(const world *w, const render_settings *s, const farm_opts *o, far
 	size_t most = (size_t)o->tile * (size_t)o->tile * 3, msgsize = sizeof(int64_t) + most * sizeof(float);
 	crew c = {.w = w, .s = s, .t = tiling_of(s, o->tile), .delay = o->delay_us * 1e-6, .cap = k};
 	c.queue = calloc((size_t)k, sizeof *c.queue);
-	c.spare = calloc((size_t)k, sizeof *c.spare);
+	int nbuf = 2 * k;
+	c.spare = calloc((size_t)nbuf, sizeof *c.spare);
+	MPI_Request *sreq = calloc((size_t)nbuf, sizeof *sreq);
+	char **smsg = calloc((size_t)nbuf, sizeof *smsg);
+	int nsend = 0; /* results on their way (MPI_Isend: no core spins while rank 0 takes them) */
 	c.out = calloc((size_t)k, sizeof *c.out);
 	int64_t *reply = calloc((size_t)k + 1, sizeof *reply);
 	double *sent_at = calloc((size_t)k + 1, sizeof *sent_at);
 	pthread_t *tid = calloc((size_t)n, sizeof *tid);
-	char *slab = malloc((size_t)k * msgsize);
-	bool ok = c.queue && c.spare && c.out && reply && sent_at && tid && slab;
+	char *slab = malloc((size_t)nbuf * msgsize);
+	bool ok = c.queue && c.spare && c.out && reply && sent_at && tid && slab && sreq && smsg;
 	if (!ok)
-		rt_error_set(err, "out of memory for %d tiles of %dx%d", k, o->tile, o->tile);
-	for (int i = 0; ok && i < k; i++)
+		rt_error_set(err, "out of memory for %d tiles of %dx%d", nbuf, o->tile, o->tile);
+	for (int i = 0; ok && i < nbuf; i++)
 		c.spare[c.nspare++] = slab + (size_t)i * msgsize;
 	pthread_mutex_init(&c.lock, NULL);
 	pthread_cond_init(&c.work, NULL);
@@ -467,7 +470,8 @@ bool farm_work(const world *w, const render_settings *s, const farm_opts *o, far
 			if (!g.msg)
 				break;
 			event = true;
-			MPI_Send(g.msg, (int)g.bytes, MPI_BYTE, 0, FARM_RESULT, MPI_COMM_WORLD);
+			smsg[nsend] = g.msg;
+			MPI_Isend(g.msg, (int)g.bytes, MPI_BYTE, 0, FARM_RESULT, MPI_COMM_WORLD, &sreq[nsend++]);
 			bytes += (double)g.bytes;
 			sent++;
 			if (!c.no_more) {
@@ -475,11 +479,24 @@ bool farm_work(const world *w, const render_settings *s, const farm_opts *o, far
 				sent_at[sq] = now();
 				sq = (sq + 1) % (k + 1);
 			}
-			pthread_mutex_lock(&c.lock);
-			c.spare[c.nspare++] = g.msg;
-			pthread_mutex_unlock(&c.lock);
 		}
-		if (c.no_more && sent == assigned)
+		/* sends that are through give their buffers back */
+		for (int i = 0; i < nsend;) {
+			int flag = 0;
+			MPI_Test(&sreq[i], &flag, MPI_STATUS_IGNORE);
+			if (!flag) {
+				i++;
+				continue;
+			}
+			event = true;
+			pthread_mutex_lock(&c.lock);
+			c.spare[c.nspare++] = smsg[i];
+			pthread_cond_signal(&c.work);
+			pthread_mutex_unlock(&c.lock);
+			sreq[i] = sreq[--nsend];
+			smsg[i] = smsg[nsend];
+		}
+		if (c.no_more && sent == assigned && nsend == 0)
 			break;
 		if (event) {
 			nap = 20.0;
@@ -489,7 +506,7 @@ bool farm_work(const world *w, const render_settings *s, const farm_opts *o, far
 		 * a reply is due (MPI cannot wake us), or until the next delayed
 		 * tile may go. */
 		pthread_mutex_lock(&c.lock);
-		double wait = expect > 0 ? nap : 1e6;
+		double wait = expect > 0 || nsend > 0 ? nap : 1e6;
 		if (next_ready >= 0.0 && (next_ready - t) * 1e6 < wait)
 			wait = (next_ready - t) * 1e6 + 1.0;
 		if (c.olen == 0 || next_ready >= 0.0)
@@ -502,6 +519,7 @@ bool farm_work(const world *w, const render_settings *s, const farm_opts *o, far
 		MPI_Cancel(&req);
 		MPI_Wait(&req, MPI_STATUS_IGNORE);
 	}
+	/* Sends still in flight only after an error, which aborts the job. */
 	pthread_mutex_lock(&c.lock);
 	c.no_more = true; /* on an error, the threads stop after their tile */
 	c.qlen = 0;
@@ -528,5 +546,7 @@ bool farm_work(const world *w, const render_settings *s, const farm_opts *o, far
 	free(sent_at);
 	free(tid);
 	free(slab);
+	free(sreq);
+	free(smsg);
 	return ok;
 }

@@ -17,8 +17,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 #include <fcntl.h>
+#include <sys/resource.h>
 
 #include "mpi/farm.h"
 #include "mpi/fileset.h"
@@ -158,7 +160,7 @@ static void setup(int argc, char **argv, job_config *c, fileset *files, world **
 		        "Try 'rtsh-mpi --help' for more information.\n", o.output);
 		goto out;
 	}
-	long tile = env_number("RTSH_MPI_TILE", 32, 4, 1024);
+	long tile = env_number("RTSH_MPI_TILE", 0, 4, 1024); /* 0: auto_tile */
 	long prefetch = env_number("RTSH_MPI_PREFETCH", 2, 0, 1024);
 	long delay = env_number("RTSH_MPI_DELAY_US", 0, 0, 10000000);
 	if (tile < 0 || prefetch < 0 || delay < 0)
@@ -212,13 +214,44 @@ out:
 	free(args);
 }
 
+/* Waits for a request, sleeping between tests: Open MPI's blocking calls
+ * spin, and a rank waiting for rank 0 (while it reads the scene, or renders
+ * its last tiles) must not take a core from it. */
+static void wait_for(MPI_Request *req)
+{
+	long nap = 50;
+	for (;;) {
+		int flag = 0;
+		MPI_Test(req, &flag, MPI_STATUS_IGNORE);
+		if (flag)
+			return;
+		struct timespec t = {0, nap * 1000};
+		nanosleep(&t, NULL);
+		if (nap < 2000)
+			nap *= 2;
+	}
+}
+
+static void bcast(void *buf, int count, MPI_Datatype type)
+{
+	MPI_Request r;
+	MPI_Ibcast(buf, count, type, 0, MPI_COMM_WORLD, &r);
+	wait_for(&r);
+}
+
+static void gather(const void *mine, void *all, int bytes)
+{
+	MPI_Request r;
+	MPI_Igather(mine, bytes, MPI_BYTE, all, bytes, MPI_BYTE, 0, MPI_COMM_WORLD, &r);
+	wait_for(&r);
+}
+
 /* Broadcasts size bytes from rank 0 in pieces an int can count. */
 static void bcast_bytes(char *buf, uint64_t size)
 {
 	for (uint64_t at = 0; at < size; at += BCAST_PIECE) {
 		uint64_t left = size - at;
-		MPI_Bcast(buf + at, (int)(left < BCAST_PIECE ? left : BCAST_PIECE), MPI_BYTE, 0,
-		          MPI_COMM_WORLD);
+		bcast(buf + at, (int)(left < BCAST_PIECE ? left : BCAST_PIECE), MPI_BYTE);
 	}
 }
 
@@ -313,6 +346,18 @@ static void on_stop(int sig)
 	raise(sig);
 }
 
+/* The tile side when RTSH_MPI_TILE does not set one: 32 pixels, halved
+ * (down to 8) until there are at least 8 tiles for every render thread of
+ * the job, so that the last wave of tiles is a small part of the render
+ * (bench/README.md has the model). */
+static int auto_tile(int w, int h, long threads)
+{
+	int s = 32;
+	while (s > 8 && (long)((w + s - 1) / s) * (long)((h + s - 1) / s) < 8 * threads)
+		s /= 2;
+	return s;
+}
+
 /* Ends the whole job from any rank with one message. */
 static void die(int rank, const char *host, const char *what, const rt_error *err)
 {
@@ -326,14 +371,15 @@ static void die(int rank, const char *host, const char *what, const rt_error *er
 static void print_figures(const farm_stats *st, int size, const job_config *c, double total)
 {
 	double tiles = 0, rays = 0, bytes = 0;
-	fprintf(stderr, "%-5s %-16s %7s %7s %8s %8s %9s %11s %9s\n", "rank", "host", "threads",
-	        "tiles", "seconds", "busy", "Mrays/s", "bytes sent", "rtt (us)");
+	fprintf(stderr, "%-5s %-16s %7s %7s %8s %8s %9s %11s %9s %9s\n", "rank", "host", "threads",
+	        "tiles", "seconds", "busy", "Mrays/s", "bytes sent", "rtt (us)", "peak MiB");
 	for (int r = 0; r < size; r++) {
 		const farm_stats *f = &st[r];
 		double cap = f->seconds * f->threads;
-		fprintf(stderr, "%-5d %-16.16s %7d %7.0f %8.2f %7.0f%% %9.2f %11.0f %9.0f\n", r, f->host,
-		        f->threads, f->tiles, f->seconds, cap > 0 ? 100.0 * f->busy / cap : 0.0,
-		        f->seconds > 0 ? f->rays / f->seconds * 1e-6 : 0.0, f->bytes, f->rtt * 1e6);
+		fprintf(stderr, "%-5d %-16.16s %7d %7.0f %8.2f %7.0f%% %9.2f %11.0f %9.0f %9.0f\n", r,
+		        f->host, f->threads, f->tiles, f->seconds, cap > 0 ? 100.0 * f->busy / cap : 0.0,
+		        f->seconds > 0 ? f->rays / f->seconds * 1e-6 : 0.0, f->bytes, f->rtt * 1e6,
+		        f->peak / 1048576.0);
 		tiles += f->tiles;
 		rays += f->rays;
 		bytes += f->bytes;
@@ -382,7 +428,7 @@ int main(int argc, char **argv)
 			c.files = packed_size;
 		}
 	}
-	MPI_Bcast(&c, (int)sizeof c, MPI_BYTE, 0, MPI_COMM_WORLD);
+	bcast(&c, (int)sizeof c, MPI_BYTE);
 	if (c.status >= 0) {
 		/* a usage or scene error: rank 0 said it once; all end alike (and
 		 * the launcher may stop the last ones: quietly) */
@@ -397,7 +443,7 @@ int main(int argc, char **argv)
 	rt_error err;
 	rank_id me = {(int32_t)getpid(), {0}}, *ids = rank == 0 ? calloc((size_t)size, sizeof *ids) : NULL;
 	memcpy(me.host, host, sizeof me.host);
-	MPI_Gather(&me, (int)sizeof me, MPI_BYTE, ids, (int)sizeof me, MPI_BYTE, 0, MPI_COMM_WORLD);
+	gather(&me, ids, (int)sizeof me);
 	if (rank == 0 && ids) {
 		stop_ids = ids;
 		atomic_store(&stop_nids, size);
@@ -428,11 +474,18 @@ int main(int argc, char **argv)
 	free(packed);
 	fileset_free(&files);
 
+	int threads = rank_threads(&c.set);
+	long all_threads = threads, mine = threads;
+	MPI_Request ar;
+	MPI_Iallreduce(&mine, &all_threads, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD, &ar);
+	wait_for(&ar);
+	if (c.tile == 0)
+		c.tile = auto_tile(c.set.width, c.set.height, all_threads);
 	farm_opts fo = {
 		.tile = c.tile,
 		.prefetch = c.prefetch,
 		.delay_us = c.delay_us,
-		.threads = rank_threads(&c.set),
+		.threads = threads,
 		.progress = c.progress != 0,
 	};
 	farm_stats st;
@@ -442,11 +495,14 @@ int main(int argc, char **argv)
 	if (!ok)
 		die(rank, host, "", &err);
 	memcpy(st.host, host, sizeof st.host);
+	struct rusage ru;
+	if (getrusage(RUSAGE_SELF, &ru) == 0)
+		st.peak = (double)ru.ru_maxrss * 1024.0; /* Linux: KiB */
 	if (rank == 0)
 		st.bytes += (double)c.files * (size > 1);
 	world_free(w);
 	farm_stats *all = rank == 0 ? calloc((size_t)size, sizeof *all) : NULL;
-	MPI_Gather(&st, (int)sizeof st, MPI_BYTE, all, (int)sizeof st, MPI_BYTE, 0, MPI_COMM_WORLD);
+	gather(&st, all, (int)sizeof st);
 
 	int status = 0;
 	if (rank == 0) {
@@ -468,7 +524,7 @@ int main(int argc, char **argv)
 	atomic_store(&stop_nids, 0);
 	free(ids);
 	fb_free(fb);
-	MPI_Bcast(&status, 1, MPI_INT, 0, MPI_COMM_WORLD);
+	bcast(&status, 1, MPI_INT);
 	atomic_store(&stop_rank, -1); /* all said: the launcher may stop us quietly */
 	MPI_Finalize();
 	return status;
