@@ -8,6 +8,8 @@
 #                   build/bench-mpi.tsv when mpirun exists)
 #   make mpi        build ./rtsh-mpi, the Open MPI renderer (`make` builds it
 #                   too when mpicc is installed)
+#   make fuzz       build the libFuzzer targets (clang) and run each for
+#                   FUZZ_SECONDS (default 60) on tests/fuzz/corpus
 #   make install    PREFIX=/usr/local DESTDIR=  (binary, man pages, scenes)
 #
 # Variants build in their own folder: `make BUILD=build/asan SAN=address,undefined`.
@@ -66,7 +68,7 @@ MPI_BIN  := $(patsubst %rtsh,%rtsh-mpi,$(BIN))
 HAVE_MPI := $(shell command -v $(MPICC) 2>/dev/null)
 
 .PHONY: all run test test-bins test-unit test-scripts bench bench-quick install uninstall \
-        clean deps check-man mpi
+        clean deps check-man fuzz fuzz-bins fuzz-link mpi
 
 all: deps $(BIN) $(if $(HAVE_MPI),$(MPI_BIN))
 
@@ -153,6 +155,27 @@ bench: all $(BENCH_BIN)
 bench-quick: all $(BENCH_BIN)
 	./$(BENCH_BIN) --quick --out $(BUILD)/bench-quick.tsv
 	@sh bench/mpi.sh --quick --out $(BUILD)/bench-mpi-quick.tsv
+
+# libFuzzer targets (tests/fuzz/fuzz_NAME.c), built with clang under
+# ASan+UBSan in build/fuzz; `make fuzz` runs each for FUZZ_SECONDS.
+FUZZ_SRC     := $(sort $(wildcard tests/fuzz/fuzz_*.c))
+FUZZ_BIN     := $(FUZZ_SRC:tests/fuzz/%.c=$(BUILD)/%)
+FUZZ_SECONDS ?= 60
+
+fuzz-bins:
+	@$(MAKE) --no-print-directory -s BUILD=build/fuzz CC=clang OPT=-O1 \
+		SAN=fuzzer-no-link,address,undefined fuzz-link
+
+fuzz-link: $(FUZZ_BIN)
+
+$(BUILD)/fuzz_%: tests/fuzz/fuzz_%.c $(FRONTLIB) $(LIB)
+	@mkdir -p $(@D)
+	@echo "  FUZZ    $@"
+	@$(CC) $(CPPFLAGS) $(CFLAGS) -fsanitize=fuzzer,address,undefined -o $@ $< $(FRONTLIB) $(LIB) \
+		$(LDLIBS_FRONT)
+
+fuzz: deps fuzz-bins
+	@sh tests/fuzz/run.sh build/fuzz $(FUZZ_SECONDS)
 
 check-man:
 	@for m in man/rtsh.1 man/rtsh.5 man/rtsh-mpi.1; do \
