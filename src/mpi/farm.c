@@ -21,6 +21,14 @@ static double now(void)
 	return (double)t.tv_sec + t.tv_nsec * 1e-9;
 }
 
+/* CPU seconds of the calling thread. */
+static double thread_cpu(void)
+{
+	struct timespec t;
+	clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+	return (double)t.tv_sec + t.tv_nsec * 1e-9;
+}
+
 static void sleep_us(long us)
 {
 	struct timespec t = {us / 1000000, (us % 1000000) * 1000};
@@ -223,7 +231,7 @@ bool farm_serve(const world *w, const render_settings *s, const farm_opts *o, fr
 		free(bufs);
 		return rt_error_set(err, "out of memory for %d tiles of %dx%d", n + 1, o->tile, o->tile);
 	}
-	double t0 = now(), bytes = 0.0, shown = 0.0;
+	double t0 = now(), bytes = 0.0, shown = 0.0, cpu0 = thread_cpu();
 	int started = 0;
 	for (; started < n; started++) {
 		args[started] = (server_arg){&sv, bufs + (size_t)started * most};
@@ -288,6 +296,7 @@ bool farm_serve(const world *w, const render_settings *s, const farm_opts *o, fr
 		.busy = atomic_load(&sv.busy) + own_busy,
 		.rays = (double)atomic_load(&sv.rays),
 		.bytes = bytes,
+		.serve = thread_cpu() - cpu0 - own_busy,
 		.threads = started ? started : 1,
 	};
 	free(bufs);

@@ -36,6 +36,7 @@ typedef struct farm_stats {
 	double rays;      /* rays traced (camera, shadow, secondary) */
 	double bytes;     /* bytes this rank sent */
 	double rtt;       /* worker: mean seconds from sending a result to the next tile arriving */
+	double serve;     /* rank 0: CPU seconds its serving thread spent (not rendering) */
 	double peak;      /* the process's peak resident memory, bytes (filled by the caller) */
 	int threads;
 	char host[64];

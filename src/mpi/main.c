@@ -67,21 +67,23 @@ static void print_warning(void *ctx, const rt_error *w)
 	fprintf(stderr, "%s (warning)\n", buf);
 }
 
-/* A whole number in lo..hi from the environment variable, or def when it is
- * unset; -1 (message printed) when it is not valid. */
-static long env_number(const char *name, long def, long lo, long hi)
+/* A whole number in lo..hi from the environment variable into *out, or def
+ * when it is unset; false (message printed) when it is not valid. */
+static bool env_number(const char *name, long def, long lo, long hi, long *out)
 {
 	const char *v = getenv(name);
+	*out = def;
 	if (!v || !*v)
-		return def;
+		return true;
 	char *end;
 	long n = strtol(v, &end, 10);
 	if (*end || n < lo || n > hi) {
 		fprintf(stderr, "rtsh-mpi: %s=\"%s\" is not valid; expected a whole number in %ld..%ld\n",
 		        name, v, lo, hi);
-		return -1;
+		return false;
 	}
-	return n;
+	*out = n;
+	return true;
 }
 
 /* Under mpirun, standard error is a pipe to mpirun even when the user
@@ -160,10 +162,10 @@ static void setup(int argc, char **argv, job_config *c, fileset *files, world **
 		        "Try 'rtsh-mpi --help' for more information.\n", o.output);
 		goto out;
 	}
-	long tile = env_number("RTSH_MPI_TILE", 0, 4, 1024); /* 0: auto_tile */
-	long prefetch = env_number("RTSH_MPI_PREFETCH", 2, 0, 1024);
-	long delay = env_number("RTSH_MPI_DELAY_US", 0, 0, 10000000);
-	if (tile < 0 || prefetch < 0 || delay < 0)
+	long tile, prefetch, delay; /* tile 0: auto_tile; prefetch -1: half the threads, at least 2 */
+	if (!env_number("RTSH_MPI_TILE", 0, 4, 1024, &tile) ||
+	    !env_number("RTSH_MPI_PREFETCH", -1, 0, 1024, &prefetch) ||
+	    !env_number("RTSH_MPI_DELAY_US", 0, 0, 10000000, &delay))
 		goto out;
 	c->tile = (int32_t)tile;
 	c->prefetch = (int32_t)prefetch;
@@ -386,6 +388,10 @@ static void print_figures(const farm_stats *st, int size, const job_config *c, d
 	}
 	fprintf(stderr, "all   %d ranks, %.0f tiles of %dx%d, %.2f s, %.2f Mrays/s, %.0f bytes sent\n",
 	        size, tiles, c->tile, c->tile, total, total > 0 ? rays / total * 1e-6 : 0.0, bytes);
+	double remote = tiles - st[0].tiles;
+	if (remote > 0)
+		fprintf(stderr, "rank 0 served %.0f tiles to the others with %.1f us of CPU each\n", remote,
+		        st[0].serve / remote * 1e6);
 }
 
 int main(int argc, char **argv)
@@ -483,7 +489,7 @@ int main(int argc, char **argv)
 		c.tile = auto_tile(c.set.width, c.set.height, all_threads);
 	farm_opts fo = {
 		.tile = c.tile,
-		.prefetch = c.prefetch,
+		.prefetch = c.prefetch >= 0 ? c.prefetch : threads / 2 > 2 ? threads / 2 : 2,
 		.delay_us = c.delay_us,
 		.threads = threads,
 		.progress = c.progress != 0,
