@@ -27,7 +27,7 @@ WARN    := -Wall -Wextra -Wpedantic -Werror -Wshadow -Wstrict-prototypes -Wmissi
 CPPFLAGS += -Iinclude -Isrc -I$(BUILD) -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -DRTSH_VERSION=\"$(VERSION)\"
 CFLAGS  ?= $(OPT) -g
 CFLAGS  += $(CSTD) $(WARN) -pthread -MMD -MP
-LDLIBS_CORE := -lpng -lm -pthread
+LDLIBS_CORE := -lpng -lassimp -lXpm -lstb -lm -pthread
 LDLIBS_FRONT := -lreadline -lncursesw $(LDLIBS_CORE)
 
 ifneq ($(SAN),)
@@ -52,6 +52,7 @@ BENCH_BIN := $(BUILD)/bench/bench
 # Optional: Embree 3's single-ray speed on the same rays, built by `make bench`
 # only when embree3/rtcore.h is installed (apt-get install libembree-dev).
 EMBREE_BIN := $(BUILD)/bench/embree_primary
+EMBREE_MESH_BIN := $(BUILD)/bench/embree_mesh
 # Equal-quality rows (rtsh against Blender's Cycles, preview time to an
 # error): bench/quality.c, run by `make bench` after the speed table.
 QUALITY_BIN := $(BUILD)/bench/quality
@@ -148,9 +149,13 @@ $(EMBREE_BIN): bench/embree_primary.c $(LIB)
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -o $@ $< $(LIB) -lembree3 $(LDLIBS_CORE)
 
+$(EMBREE_MESH_BIN): bench/embree_mesh.c bench/mesh_rays.h $(LIB)
+	@mkdir -p $(@D)
+	$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -o $@ $< $(LIB) -lembree3 $(LDLIBS_CORE)
+
 bench: all $(BENCH_BIN)
 	@if printf '#include <embree3/rtcore.h>\n' | $(CC) -E -x c - >/dev/null 2>&1; then \
-		$(MAKE) --no-print-directory $(EMBREE_BIN); \
+		$(MAKE) --no-print-directory $(EMBREE_BIN) $(EMBREE_MESH_BIN); \
 	else echo "bench: no embree3/rtcore.h, so no Embree row (apt-get install libembree-dev)"; fi
 	./$(BENCH_BIN) --out $(BUILD)/bench.tsv
 	@sh bench/mpi.sh --out $(BUILD)/bench-mpi.tsv

@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "integrators.h"
+#include "rtsh/texture.h"
 
 const char *render_mode_name(render_mode m)
 {
@@ -165,6 +166,7 @@ static void render_tile(shared *sh, long t)
 	int x1 = x0 + RENDER_TILE < fb->w ? x0 + RENDER_TILE : fb->w;
 	int y1 = y0 + RENDER_TILE < fb->h ? y0 + RENDER_TILE : fb->h;
 	double inv = 1.0 / job->sample_end;
+	texture_set_pixel_angle(2.0 * job->w->cam.tan_half / fb->w); /* texture footprints */
 	for (int y = y0; y < y1; y++)
 		for (int x = x0; x < x1; x++) {
 			size_t i = ((size_t)y * (size_t)fb->w + (size_t)x) * 3;
