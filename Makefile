@@ -4,8 +4,10 @@
 #   make run        build and open the shell on the built-in showcase scene
 #   make test       build and run every test, then again under ASan+UBSan, and
 #                   the threaded tests under TSan
-#   make bench      build and run the benchmark (writes build/bench.tsv, and
-#                   build/bench-mpi.tsv when mpirun exists)
+#   make bench      build and run the benchmark (writes build/bench.tsv), the
+#                   rtsh-mpi rows (build/bench-mpi.tsv, when mpirun exists), then
+#                   bench-quality: rtsh against Cycles at equal noise (skipped
+#                   without blender) and the preview's time to an error
 #   make mpi        build ./rtsh-mpi, the Open MPI renderer (`make` builds it
 #                   too when mpicc is installed)
 #   make fuzz       build the libFuzzer targets (clang) and run each for
