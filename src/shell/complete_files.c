@@ -11,7 +11,8 @@
 #include "rtsh/image.h"
 
 /* What `load` reads; a model format joins here when load reads it. */
-static const char *const scene_exts[] = {".rt", NULL};
+/* what `load` opens: scenes, and models for the model viewer (rtsh(1)) */
+static const char *const scene_exts[] = {".rt", ".obj", ".ply", ".gltf", ".glb", ".stl", NULL};
 
 /* What `save` writes besides the image formats of image.h. */
 static const char *const text_exts[] = {".ans", ".rt", NULL};
