@@ -17,6 +17,18 @@ have_header zlib.h || missing="$missing zlib1g-dev"
 printf '#include <stdarg.h>\n#include <stddef.h>\n#include <setjmp.h>\n#include <cmocka.h>\n' |
 	${CC:-cc} -E -x c - >/dev/null 2>&1 || missing="$missing libcmocka-dev"
 command -v ${CC:-cc} >/dev/null 2>&1 || missing="$missing build-essential"
+# Optional: Open MPI for rtsh-mpi (`make mpi`); rtsh builds without it.
+optional=""
+command -v mpicc >/dev/null 2>&1 && command -v mpirun >/dev/null 2>&1 ||
+	optional="openmpi-bin libopenmpi-dev"
+if [ -n "$optional" ]; then
+	if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1 &&
+		DEBIAN_FRONTEND=noninteractive apt-get install -y $optional >/dev/null 2>&1; then
+		echo "rtsh: installed $optional (for rtsh-mpi)" >&2
+	else
+		echo "rtsh: no Open MPI, so no rtsh-mpi; to build it: apt-get install $optional" >&2
+	fi
+fi
 [ -z "$missing" ] && exit 0
 cmd="apt-get install -y$missing"
 if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then

@@ -152,6 +152,22 @@ typedef struct shared {
 	pthread_cond_t finished;
 } shared;
 
+/* Adds samples [s0, s1) of pixel (x, y) of an fw x fh image to acc, in
+ * sample order: render_tile and render_rect share it, so a tile rendered
+ * anywhere holds the same bits as the whole image. */
+static void pixel_add(const world *w, const render_settings *s, int x, int y, int fw, int fh,
+                      int s0, int s1, double acc[3], double *sq)
+{
+	for (int k = s0; k < s1; k++) {
+		vec3 c = render_sample(w, s, x, y, fw, fh, k);
+		acc[0] += c.x;
+		acc[1] += c.y;
+		acc[2] += c.z;
+		if (sq) /* the squared brightness of the samples, for the denoiser */
+			*sq += denoise_sq(c);
+	}
+}
+
 static void render_tile(shared *sh, long t)
 {
 	render_job *job = sh->job;
@@ -166,32 +182,40 @@ static void render_tile(shared *sh, long t)
 			size_t i = ((size_t)y * (size_t)fb->w + (size_t)x) * 3;
 			/* A first pass starts from zero whatever the sums hold (a
 			 * cancelled pass leaves them half done). */
-			double r = 0.0, g = 0.0, b = 0.0;
+			double acc[3] = {0.0, 0.0, 0.0};
 			if (job->sample_begin > 0) {
-				r = fb->sum[i];
-				g = fb->sum[i + 1];
-				b = fb->sum[i + 2];
+				acc[0] = fb->sum[i];
+				acc[1] = fb->sum[i + 1];
+				acc[2] = fb->sum[i + 2];
 			}
-			double sq = 0.0; /* the squared brightness of the samples, for the denoiser */
-			for (int s = job->sample_begin; s < job->sample_end; s++) {
-				vec3 c = render_sample(job->w, &job->set, x, y, fb->w, fb->h, s);
-				r += c.x;
-				g += c.y;
-				b += c.z;
-				if (fb->feat)
-					sq += denoise_sq(c);
-			}
+			double sq = 0.0;
+			pixel_add(job->w, &job->set, x, y, fb->w, fb->h, job->sample_begin,
+			          job->sample_end, acc, fb->feat ? &sq : NULL);
 			if (fb->sum) {
-				fb->sum[i] = r;
-				fb->sum[i + 1] = g;
-				fb->sum[i + 2] = b;
+				fb->sum[i] = acc[0];
+				fb->sum[i + 1] = acc[1];
+				fb->sum[i + 2] = acc[2];
 			}
-			fb->rgb[i] = (float)(r * inv);
-			fb->rgb[i + 1] = (float)(g * inv);
-			fb->rgb[i + 2] = (float)(b * inv);
+			fb->rgb[i] = (float)(acc[0] * inv);
+			fb->rgb[i + 1] = (float)(acc[1] * inv);
+			fb->rgb[i + 2] = (float)(acc[2] * inv);
 			if (fb->feat && job->set.mode == MODE_PATH)
 				denoise_features(job->w, x, y, fb->w, fb->h, job->sample_begin,
 				                 job->sample_end, sq, fb->feat + i / 3 * DENOISE_FEATURES);
+		}
+}
+
+void render_rect(const world *w, const render_settings *s, int x0, int y0, int x1, int y1,
+                 float *out)
+{
+	double inv = 1.0 / s->samples;
+	for (int y = y0; y < y1; y++)
+		for (int x = x0; x < x1; x++) {
+			double acc[3] = {0.0, 0.0, 0.0};
+			pixel_add(w, s, x, y, s->width, s->height, 0, s->samples, acc, NULL);
+			*out++ = (float)(acc[0] * inv);
+			*out++ = (float)(acc[1] * inv);
+			*out++ = (float)(acc[2] * inv);
 		}
 }
 
