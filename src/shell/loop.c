@@ -155,6 +155,7 @@ static void draw_picture(shell *sh)
 	fflush(stdout);
 	double t0 = now();
 	screen_picture(scr, sh->srgb, im->w, im->h);
+	termout_picture_final(scr->out, im->done);
 	termout_pump(scr->out, t0, &keys);
 	sh->last_draw = now();
 	sh->frame_cost = sh->last_draw - t0;

@@ -10,7 +10,7 @@
 #include <unistd.h>
 
 /* Aim for passes of about this long, so the picture refreshes steadily. */
-#define PASS_SECONDS 0.2
+#define PASS_SECONDS 0.1
 
 struct preview {
 	int wake_fd;

@@ -48,6 +48,7 @@ struct termout {
 	double hold_since;
 
 	int truecolor;
+	bool final;         /* the picture is not a refinement pass */
 	bool notice_given;
 	const char *notice;
 	termout_stats st;
@@ -60,6 +61,7 @@ termout *termout_new(int fd)
 		return NULL;
 	o->fd = fd;
 	o->state = TERMOUT_IDLE;
+	o->final = true;
 	abuf_init(&o->buf);
 	return o;
 }
@@ -81,6 +83,20 @@ void termout_text(termout *o, const void *b, size_t n)
 void termout_set_picture(termout *o, encoder *e)
 {
 	o->pic = e;
+}
+
+void termout_picture_final(termout *o, bool final)
+{
+	o->final = final;
+}
+
+/* Lossy damage for refinement passes on a slow link. */
+static void set_lossy(termout *o)
+{
+	if (!o->pic || !o->pic->ops->set_lossy)
+		return;
+	bool slow = o->state == TERMOUT_PACED && o->st.bps > 0 && o->st.bps < TERMOUT_SLOW_BPS;
+	o->pic->ops->set_lossy(o->pic, slow && !o->final ? TERMOUT_JND : 0);
 }
 
 void termout_drop_picture(termout *o)
@@ -340,6 +356,7 @@ void termout_pump(termout *o, double now, abuf *keys)
 	if (o->state == TERMOUT_PACED && o->st.in_flight > 0 && o->qlen > 0 &&
 	    now - o->q[o->qhead].sent >= slice_timeout(o))
 		give_up(o, "the terminal stopped answering status queries: the picture is not paced");
+	set_lossy(o);
 	if (!o->pic || o->state == TERMOUT_PROBING || !encoder_dirty(o->pic))
 		return;
 	abuf *a = &o->buf;
