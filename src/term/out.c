@@ -80,14 +80,12 @@ void termout_text(termout *o, const void *b, size_t n)
 		write_all(o->fd, b, n);
 }
 
+static void set_lossy(termout *o);
+
 void termout_set_picture(termout *o, encoder *e)
 {
 	o->pic = e;
-}
-
-void termout_picture_final(termout *o, bool final)
-{
-	o->final = final;
+	set_lossy(o);
 }
 
 /* Lossy damage for refinement passes on a slow link. */
@@ -97,6 +95,12 @@ static void set_lossy(termout *o)
 		return;
 	bool slow = o->state == TERMOUT_PACED && o->st.bps > 0 && o->st.bps < TERMOUT_SLOW_BPS;
 	o->pic->ops->set_lossy(o->pic, slow && !o->final ? TERMOUT_JND : 0);
+}
+
+void termout_picture_final(termout *o, bool final)
+{
+	o->final = final;
+	set_lossy(o);
 }
 
 void termout_drop_picture(termout *o)
