@@ -252,6 +252,12 @@ static void interrupt(shell *sh)
 		draw_status(sh);
 		return;
 	}
+	if (sh->scr && sh->scr->out && termout_picture_pending(sh->scr->out)) {
+		/* The render is done but its picture is still on its way over a
+		 * slow link: Ctrl-C stops that too. */
+		termout_drop_picture(sh->scr->out);
+		shell_notice(sh, "Ctrl-C: the rest of the picture was not sent");
+	}
 	rl_callback_sigcleanup();
 	rl_replace_line("", 0);
 	fputs("^C", rl_outstream);

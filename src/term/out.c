@@ -103,6 +103,11 @@ void termout_picture_final(termout *o, bool final)
 	set_lossy(o);
 }
 
+bool termout_picture_pending(const termout *o)
+{
+	return o->pic && encoder_dirty(o->pic);
+}
+
 void termout_drop_picture(termout *o)
 {
 	if (o->pic)

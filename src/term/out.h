@@ -75,6 +75,8 @@ void termout_set_picture(termout *o, encoder *e);
 /* Drops the picture's changes not yet sent (Ctrl-C): the terminal keeps
  * what it shows. */
 void termout_drop_picture(termout *o);
+/* True while the terminal does not show the newest picture yet. */
+bool termout_picture_pending(const termout *o);
 /* Whether the picture is final (the render is done) or a refinement pass.
  * On a slow link (paced, under TERMOUT_SLOW_BPS) a refinement pass is sent
  * with lossy damage: cells whose colour moved by at most TERMOUT_JND sRGB
