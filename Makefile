@@ -5,6 +5,8 @@
 #   make test       build and run every test, then again under ASan+UBSan, and
 #                   the threaded tests under TSan
 #   make bench      build and run the benchmark (writes build/bench.tsv)
+#   make fuzz       build the libFuzzer targets (clang) and run each for
+#                   FUZZ_SECONDS (default 60) on tests/fuzz/corpus
 #   make install    PREFIX=/usr/local DESTDIR=  (binary, man pages, scenes)
 #
 # Variants build in their own folder: `make BUILD=build/asan SAN=address,undefined`.
@@ -56,7 +58,7 @@ BIN := $(BUILD)/rtsh
 endif
 
 .PHONY: all run test test-bins test-unit test-scripts bench bench-quick install uninstall \
-        clean deps check-man
+        clean deps check-man fuzz fuzz-bins fuzz-link
 
 all: deps $(BIN)
 
@@ -130,6 +132,27 @@ bench: all $(BENCH_BIN)
 
 bench-quick: all $(BENCH_BIN)
 	./$(BENCH_BIN) --quick --out $(BUILD)/bench-quick.tsv
+
+# libFuzzer targets (tests/fuzz/fuzz_NAME.c), built with clang under
+# ASan+UBSan in build/fuzz; `make fuzz` runs each for FUZZ_SECONDS.
+FUZZ_SRC     := $(sort $(wildcard tests/fuzz/fuzz_*.c))
+FUZZ_BIN     := $(FUZZ_SRC:tests/fuzz/%.c=$(BUILD)/%)
+FUZZ_SECONDS ?= 60
+
+fuzz-bins:
+	@$(MAKE) --no-print-directory -s BUILD=build/fuzz CC=clang OPT=-O1 \
+		SAN=fuzzer-no-link,address,undefined fuzz-link
+
+fuzz-link: $(FUZZ_BIN)
+
+$(BUILD)/fuzz_%: tests/fuzz/fuzz_%.c $(FRONTLIB) $(LIB)
+	@mkdir -p $(@D)
+	@echo "  FUZZ    $@"
+	@$(CC) $(CPPFLAGS) $(CFLAGS) -fsanitize=fuzzer,address,undefined -o $@ $< $(FRONTLIB) $(LIB) \
+		$(LDLIBS_FRONT)
+
+fuzz: deps fuzz-bins
+	@sh tests/fuzz/run.sh build/fuzz $(FUZZ_SECONDS)
 
 check-man:
 	@for m in man/rtsh.1 man/rtsh.5; do \

@@ -107,6 +107,8 @@ static int batch_render(const rtsh_options *o)
 		fprintf(stderr, "%s\n", msg);
 		return 1;
 	}
+	if (*file_write_note())
+		fprintf(stderr, "rtsh: %s\n", file_write_note());
 	if (!o->quiet && isatty(STDERR_FILENO))
 		fprintf(stderr, "wrote %s (%dx%d, %d samples, %s) in %.2fs\n", o->output, set.width,
 		        set.height, set.samples, render_mode_name(set.mode), since(&ps.start));

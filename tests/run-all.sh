@@ -28,5 +28,12 @@ ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	step "command-file tests (ASan+UBSan)" sh tests/run-scripts.sh build/asan/rtsh
 step "build (TSan)" $MAKE --no-print-directory -s BUILD=build/tsan SAN=thread OPT=-O1 build/tsan/rtsh build/tsan/tests/test_render build/tsan/tests/test_preview build/tsan/tests/test_keymode
 TSAN_OPTIONS=halt_on_error=1 step "threaded tests (TSan)" sh tests/run-unit.sh build/tsan build/tsan/tests/test_render build/tsan/tests/test_preview build/tsan/tests/test_keymode
+# The libFuzzer targets (tests/fuzz), a few seconds each, when clang has libFuzzer.
+if sh tests/fuzz/have-libfuzzer.sh; then
+	step "build (libFuzzer)" $MAKE --no-print-directory -s fuzz-bins
+	step "fuzz smoke (3 s a target)" sh tests/fuzz/run.sh build/fuzz 3
+else
+	echo "=== fuzz smoke: skipped (no clang with -fsanitize=fuzzer; apt-get install clang)"
+fi
 sh tests/summary.sh "$results" || status=1
 exit $status

@@ -39,9 +39,7 @@ bool image_write(const char *path, const framebuffer *fb, double exposure, rt_er
 framebuffer *image_read_pfm(const char *path, rt_error *err);
 framebuffer *image_read_ppm(const char *path, rt_error *err);
 
-/* Writes a file atomically: `write` fills the temporary file; on success it
- * is flushed, synced and renamed over path; on failure path is untouched. */
-typedef bool (*file_writer_fn)(FILE *f, void *ctx, rt_error *err);
-bool file_write_atomic(const char *path, file_writer_fn write, void *ctx, rt_error *err);
+/* file_write_atomic (atomic.h) writes every image. */
+#include "rtsh/atomic.h"
 
 #endif

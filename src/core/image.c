@@ -1,4 +1,4 @@
-/* rtsh — image files and atomic writes (image.h). */
+/* rtsh — image files (image.h); atomic.c writes them. */
 #include "rtsh/image.h"
 
 #include <errno.h>
@@ -71,56 +71,6 @@ double srgb8_to_linear(double code)
 {
 	double c = code / 255.0;
 	return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4);
-}
-
-bool file_write_atomic(const char *path, file_writer_fn write, void *ctx, rt_error *err)
-{
-	size_t n = strlen(path);
-	char *tmp = malloc(n + 32);
-	if (!tmp)
-		return rt_error_set(err, "%s: out of memory", path);
-	/* The temporary file sits beside the target so rename() stays on one
-	 * file system and is atomic. */
-	const char *slash = strrchr(path, '/');
-	size_t dir = slash ? (size_t)(slash - path) + 1 : 0;
-	snprintf(tmp, n + 32, "%.*s.%s.tmp.XXXXXX", (int)dir, path, path + dir);
-	int fd = mkstemp(tmp);
-	if (fd < 0) {
-		rt_error_at(err, path, 0, 0, "cannot create a file in that folder (%s); expected a writable folder",
-		            strerror(errno));
-		free(tmp);
-		return false;
-	}
-	FILE *f = fdopen(fd, "wb");
-	if (!f) {
-		close(fd);
-		unlink(tmp);
-		free(tmp);
-		return rt_error_at(err, path, 0, 0, "cannot write (%s)", strerror(errno));
-	}
-	bool ok = write(f, ctx, err);
-	if (ok && (fflush(f) != 0 || ferror(f) || fsync(fd) != 0)) {
-		rt_error_at(err, path, 0, 0, "write failed (%s); expected free space", strerror(errno));
-		ok = false;
-	}
-	if (fclose(f) != 0 && ok) {
-		rt_error_at(err, path, 0, 0, "write failed (%s); expected free space", strerror(errno));
-		ok = false;
-	}
-	if (ok) {
-		/* mkstemp makes the file 0600; give it the usual mode. */
-		mode_t mask = umask(0);
-		umask(mask);
-		chmod(tmp, 0666 & ~mask);
-		if (rename(tmp, path) != 0) {
-			rt_error_at(err, path, 0, 0, "cannot replace the file (%s)", strerror(errno));
-			ok = false;
-		}
-	}
-	if (!ok)
-		unlink(tmp);
-	free(tmp);
-	return ok;
 }
 
 typedef struct image_ctx {
@@ -254,6 +204,16 @@ static bool read_header(FILE *f, const char *magic, int *w, int *h, double *max)
 	return true;
 }
 
+/* True when the rest of a regular file holds `need` bytes: a header that
+ * promises a 16384x16384 image in a 20-byte file allocates nothing. */
+static bool data_fits(FILE *f, double need)
+{
+	struct stat st;
+	long at = ftell(f);
+	return fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode) || at < 0 ||
+	       (double)st.st_size - (double)at >= need;
+}
+
 framebuffer *image_read_pfm(const char *path, rt_error *err)
 {
 	FILE *f = fopen(path, "rb");
@@ -264,7 +224,7 @@ framebuffer *image_read_pfm(const char *path, rt_error *err)
 	int w, h;
 	double scale;
 	framebuffer *fb = NULL;
-	if (!read_header(f, "PF", &w, &h, &scale) || !(fb = fb_new(w, h))) {
+	if (!read_header(f, "PF", &w, &h, &scale) || !data_fits(f, 12.0 * w * h) || !(fb = fb_new(w, h))) {
 		fclose(f);
 		rt_error_at(err, path, 0, 0, "not a PFM colour image; expected PF W H SCALE");
 		return NULL;
@@ -300,7 +260,8 @@ framebuffer *image_read_ppm(const char *path, rt_error *err)
 	int w, h;
 	double max;
 	framebuffer *fb = NULL;
-	if (!read_header(f, "P6", &w, &h, &max) || max != 255 || !(fb = fb_new(w, h))) {
+	if (!read_header(f, "P6", &w, &h, &max) || max != 255 || !data_fits(f, 3.0 * w * h) ||
+	    !(fb = fb_new(w, h))) {
 		fclose(f);
 		rt_error_at(err, path, 0, 0, "not an 8-bit PPM image; expected P6 W H 255");
 		return NULL;

@@ -8,6 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rtsh/memory.h"
+
 const setting_def settings_table[] = {
 #define AT(field) offsetof(render_settings, field)
 	{"resolution", SETTING_RESOLUTION, 1, RENDER_MAX_DIM, AT(width), "full-resolution image size, WxH"},
@@ -111,6 +113,10 @@ bool settings_set(render_settings *s, const setting_def *def, const char *value,
 			return rt_error_set(err, "resolution \"%s\" is not valid; expected WxH with each of W "
 			                         "and H in %.0f..%.0f",
 			                    value, def->min, def->max);
+		char what[64];
+		snprintf(what, sizeof what, "a %ldx%ld image", a, b);
+		if (!mem_check((double)a * (double)b * MEM_PER_PIXEL, what, err))
+			return false;
 		s->width = (int)a;
 		s->height = (int)b;
 		return true;

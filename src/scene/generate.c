@@ -18,6 +18,9 @@
  */
 #include "rtsh/generate.h"
 
+#include "rtsh/memory.h"
+
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -257,6 +260,10 @@ scene *scene_generate(size_t n, uint64_t seed, const gen_opts *opts, rt_error *e
 		rt_error_set(err, "cannot generate %zu objects; expected 1..%d", n, GENERATE_MAX);
 		return NULL;
 	}
+	char what[64];
+	snprintf(what, sizeof what, "generating %zu objects", n);
+	if (!mem_check((double)(n + 1) * MEM_PER_OBJECT, what, err))
+		return NULL;
 	bool spheres = opts && opts->spheres_only;
 	scene *s = scene_new();
 	if (!s) {

@@ -779,7 +779,9 @@ static bool add_object(parser *p, const elem_def *e, object *o, const zero_size 
 	rt_error_clear(&verr);
 	if (!object_validate(o, &verr))
 		return fail(p, p->toks[0].col, "%s: %s", e->name, verr.msg);
-	return scene_add_object(p->s, o, p->err);
+	if (!scene_add_object(p->s, o, &verr)) /* too many objects for the memory */
+		return fail(p, p->toks[0].col, "%s", verr.msg);
+	return true;
 }
 
 /* DIFFUSE SPECULAR SHININESS REFLECTIVE from toks[first..first+3]. */

@@ -1,8 +1,11 @@
 /* rtsh — the scene model (scene.h). */
 #include "rtsh/scene.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "rtsh/memory.h"
 
 static const struct {
 	const char *id, *name;
@@ -176,6 +179,12 @@ static bool grow(void **arr, size_t *cap, size_t n, size_t size, rt_error *err)
 
 bool scene_insert_object(scene *s, size_t i, const object *o, rt_error *err)
 {
+	/* Before the array doubles: what a scene of this size will need. */
+	char what[64];
+	if (s->nobjs == s->cap_objs && s->nobjs >= 65536 &&
+	    (snprintf(what, sizeof what, "a scene of more than %zu objects", s->nobjs),
+	     !mem_check((double)s->nobjs * 2 * MEM_PER_OBJECT, what, err)))
+		return false;
 	if (!grow((void **)&s->objs, &s->cap_objs, s->nobjs, sizeof *o, err))
 		return false;
 	if (i > s->nobjs)

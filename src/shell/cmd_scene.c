@@ -115,6 +115,8 @@ bool cmd_save(shell *sh, int argc, char **argv, const char *rest)
 		}
 		ok = shell_fail(sh, "save: \"%s\" has an unknown type; expected %s", path, exts);
 	}
+	if (ok && *file_write_note()) /* written in place: say so */
+		shell_note(sh, "save: %s\n", file_write_note());
 	free(path);
 	return ok;
 }

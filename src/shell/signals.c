@@ -6,6 +6,7 @@
 #include <termios.h>
 #include <unistd.h>
 
+#include "rtsh/atomic.h"
 #include "term/screen.h"
 
 volatile sig_atomic_t shell_sig_int, shell_sig_term, shell_sig_winch, shell_sig_cont;
@@ -81,6 +82,7 @@ static void on_signal(int sig)
 
 static void on_crash(int sig)
 {
+	atomic_cleanup_on_signal(); /* a save in progress leaves no temporary file */
 	screen_restore_async();
 	int fd = modes_fd;
 	if (fd >= 0)

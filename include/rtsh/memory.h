@@ -1,0 +1,37 @@
+/* rtsh — memory estimates: refuse a request before starting it.
+ *
+ * A request that needs more memory than the machine has would either fail
+ * half way (malloc returns NULL after minutes of work) or, worse, push the
+ * machine into swap and the OOM killer. So the big requests (a generated
+ * scene, a loaded scene, a framebuffer) estimate what they need first and
+ * are refused with a message when it is more than the process may use: the
+ * smaller of the physical memory (sysconf _SC_PHYS_PAGES x _SC_PAGE_SIZE),
+ * RLIMIT_AS and RLIMIT_DATA, and a limit set by mem_set_limit (tests and
+ * fuzzers).
+ */
+#ifndef RTSH_MEMORY_H
+#define RTSH_MEMORY_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "rtsh/error.h"
+
+/* Bytes one scene object costs from loading to rendering: the scene model,
+ * the undo copy of the editor, the world's object and the BVH (measured:
+ * bench/README.md, "memory per object"). */
+#define MEM_PER_OBJECT 1024.0
+/* Bytes one pixel of a full-resolution image costs: the framebuffer's linear
+ * RGB floats, its running sums (doubles) and the 8-bit copy written out. */
+#define MEM_PER_PIXEL 40.0
+
+/* The most bytes this process may use, and what sets that figure ("physical
+ * memory", "RLIMIT_AS", "RLIMIT_DATA" or "the set limit"). */
+double mem_limit(const char **why);
+/* Caps the limit at `bytes` (0: no cap beyond the machine's). */
+void mem_set_limit(size_t bytes);
+/* True when `bytes` fits in the limit; else sets err to
+ * "WHAT needs about X of memory; expected at most Y (WHY)" and returns false. */
+bool mem_check(double bytes, const char *what, rt_error *err);
+
+#endif

@@ -1,0 +1,472 @@
+/* rtsh — saving a file so that it keeps what was there (atomic.h).
+ *
+ * The steps of file_write_atomic:
+ *   1. follow symbolic links to the file that is really written;
+ *   2. look at what is there: nothing (create), an ordinary file with one
+ *      link (replace atomically), or something whose identity must stay
+ *      (hard links, another owner, a FIFO, a device: write in place);
+ *   3. replace: remove stale temporary files of our naming, create one with
+ *      mkstemp, register it for the signal handlers, fill it, flush, sync,
+ *      give it the old mode and owner, rename it over the target, sync the
+ *      folder;
+ *   4. in place: make the whole content in memory, then write it over the
+ *      file from its start and cut the file to its new length.
+ */
+#include "rtsh/atomic.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <limits.h>
+#include <pthread.h>
+#include <stdint.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#define MAX_HOPS 40
+/* The temporary file's name keeps at most this much of the target's name,
+ * so that ".NAME.tmp.PID.XXXXXX" stays within NAME_MAX. */
+#define TMP_BASE_MAX 200
+
+static _Thread_local char note[PATH_MAX + 128];
+
+const char *file_write_note(void)
+{
+	return note;
+}
+
+/* --- the temporary file, for the signal handlers --- */
+
+static char sig_tmp[PATH_MAX + 64];
+static volatile sig_atomic_t sig_tmp_set;
+
+void atomic_cleanup_on_signal(void)
+{
+	if (sig_tmp_set) {
+		int saved = errno;
+		unlink(sig_tmp);
+		sig_tmp_set = 0;
+		errno = saved;
+	}
+}
+
+/* Signals whose default action ends the process; while a temporary file
+ * exists, those the program leaves at the default get a handler that
+ * removes it and then dies of the same signal. */
+static const int fatal_signals[] = {SIGTERM, SIGHUP, SIGINT, SIGQUIT};
+#define NFATAL (sizeof fatal_signals / sizeof fatal_signals[0])
+
+static void on_fatal(int sig)
+{
+	atomic_cleanup_on_signal();
+	/* SA_RESETHAND made the action the default again: the signal, raised
+	 * now and delivered when this returns, ends the process as before. */
+	raise(sig);
+}
+
+typedef struct guard {
+	struct sigaction old[NFATAL];
+	bool ours[NFATAL];
+} guard;
+
+/* Installs the handlers; the temporary file is registered later. */
+static void guard_on(guard *g)
+{
+	struct sigaction sa;
+	memset(&sa, 0, sizeof sa);
+	sa.sa_handler = on_fatal;
+	sa.sa_flags = SA_RESETHAND;
+	sigemptyset(&sa.sa_mask);
+	for (size_t i = 0; i < NFATAL; i++) {
+		g->ours[i] = false;
+		if (sigaction(fatal_signals[i], NULL, &g->old[i]) == 0 && !(g->old[i].sa_flags & SA_SIGINFO) &&
+		    g->old[i].sa_handler == SIG_DFL)
+			g->ours[i] = sigaction(fatal_signals[i], &sa, NULL) == 0;
+	}
+}
+
+/* Creates the temporary file from the template and registers it, with the
+ * fatal signals blocked in between, so none can come before it is known. */
+static int create_registered(char *tmp)
+{
+	sigset_t block, old;
+	sigemptyset(&block);
+	for (size_t i = 0; i < NFATAL; i++)
+		sigaddset(&block, fatal_signals[i]);
+	pthread_sigmask(SIG_BLOCK, &block, &old);
+	int fd = mkstemp(tmp);
+	int e = errno;
+	if (fd >= 0) {
+		size_t n = strlen(tmp);
+		if (n >= sizeof sig_tmp)
+			n = sizeof sig_tmp - 1;
+		memcpy(sig_tmp, tmp, n);
+		sig_tmp[n] = '\0';
+		sig_tmp_set = 1;
+	}
+	pthread_sigmask(SIG_SETMASK, &old, NULL);
+	errno = e;
+	return fd;
+}
+
+static void guard_off(guard *g)
+{
+	for (size_t i = 0; i < NFATAL; i++)
+		if (g->ours[i])
+			sigaction(fatal_signals[i], &g->old[i], NULL);
+	sig_tmp_set = 0;
+}
+
+/* --- names --- */
+
+/* The folder part of path ("" for a bare name, "/" kept) and the name. */
+static void split(const char *path, char *dir, size_t dsize, const char **base)
+{
+	const char *slash = strrchr(path, '/');
+	int n = slash ? (int)(slash - path) + 1 : 0;
+	snprintf(dir, dsize, "%.*s", n, path);
+	*base = slash ? slash + 1 : path;
+}
+
+/* The file that writing `path` really writes: symbolic links followed, each
+ * relative target taken from its link's folder. A link to a missing file
+ * gives the missing file's path (it is created). Malloc'ed; NULL with err. */
+static char *resolve(const char *path, rt_error *err)
+{
+	char *cur = strdup(path);
+	if (!cur) {
+		rt_error_at(err, path, 0, 0, "out of memory");
+		return NULL;
+	}
+	for (int hop = 0;; hop++) {
+		struct stat st;
+		if (lstat(cur, &st) != 0 || !S_ISLNK(st.st_mode))
+			return cur;
+		if (hop == MAX_HOPS) {
+			free(cur);
+			rt_error_at(err, path, 0, 0, "too many levels of symbolic links; expected a link to a file");
+			return NULL;
+		}
+		char target[PATH_MAX];
+		ssize_t n = readlink(cur, target, sizeof target - 1);
+		if (n < 0) {
+			int e = errno;
+			free(cur);
+			rt_error_at(err, path, 0, 0, "cannot read the symbolic link (%s)", strerror(e));
+			return NULL;
+		}
+		target[n] = '\0';
+		char dir[PATH_MAX];
+		const char *base;
+		split(cur, dir, sizeof dir, &base);
+		size_t len = (target[0] == '/' ? 0 : strlen(dir)) + (size_t)n + 1;
+		char *next = malloc(len);
+		if (!next) {
+			free(cur);
+			rt_error_at(err, path, 0, 0, "out of memory");
+			return NULL;
+		}
+		snprintf(next, len, "%s%s", target[0] == '/' ? "" : dir, target);
+		free(cur);
+		cur = next;
+	}
+}
+
+/* True when dir is on the file system of the device nodes (/dev), when that
+ * is not the root file system. */
+static bool device_folder(const char *dir)
+{
+	struct stat d, null, root;
+	return stat(*dir ? dir : ".", &d) == 0 && stat("/dev/null", &null) == 0 && S_ISCHR(null.st_mode) &&
+	       stat("/", &root) == 0 && null.st_dev != root.st_dev && d.st_dev == null.st_dev;
+}
+
+/* --- stale temporary files --- */
+
+static struct timespec process_start;
+
+__attribute__((constructor)) static void note_start(void)
+{
+	clock_gettime(CLOCK_REALTIME, &process_start);
+}
+
+static bool older_than_process(const struct stat *st)
+{
+	return st->st_mtim.tv_sec < process_start.tv_sec ||
+	       (st->st_mtim.tv_sec == process_start.tv_sec && st->st_mtim.tv_nsec < process_start.tv_nsec);
+}
+
+/* Removes ".BASE.tmp.PID.XXXXXX" files (and the older ".BASE.tmp.XXXXXX")
+ * in dir that a save of the same file left when its process was killed:
+ * ours (same user), older than this process, and whose process no longer
+ * runs. */
+static void remove_stale(const char *dir, const char *base)
+{
+	char prefix[TMP_BASE_MAX + 8];
+	int plen = snprintf(prefix, sizeof prefix, ".%.*s.tmp.", TMP_BASE_MAX, base);
+	DIR *d = opendir(*dir ? dir : ".");
+	if (!d)
+		return;
+	struct dirent *e;
+	while ((e = readdir(d))) {
+		if (strncmp(e->d_name, prefix, (size_t)plen) != 0)
+			continue;
+		const char *rest = e->d_name + plen;
+		const char *dot = strchr(rest, '.');
+		long pid = 0;
+		if (dot) {
+			char *end;
+			pid = strtol(rest, &end, 10);
+			if (end != dot || pid <= 0 || strlen(dot + 1) != 6)
+				continue;
+		} else if (strlen(rest) != 6) {
+			continue;
+		}
+		if (pid && pid != (long)getpid() && !(kill((pid_t)pid, 0) != 0 && errno == ESRCH))
+			continue; /* its process still runs: a save in progress */
+		char full[PATH_MAX];
+		if (snprintf(full, sizeof full, "%s%s", dir, e->d_name) >= (int)sizeof full)
+			continue;
+		struct stat st;
+		if (lstat(full, &st) == 0 && S_ISREG(st.st_mode) && st.st_uid == geteuid() && older_than_process(&st))
+			unlink(full);
+	}
+	closedir(d);
+}
+
+/* --- writing --- */
+
+static bool write_all(int fd, const char *buf, size_t n)
+{
+	while (n > 0) {
+		ssize_t w = write(fd, buf, n);
+		if (w < 0) {
+			if (errno == EINTR)
+				continue;
+			return false;
+		}
+		buf += w;
+		n -= (size_t)w;
+	}
+	return true;
+}
+
+/* Runs the writer into memory; the text (malloc'ed) and its length. */
+static char *make_content(const char *path, file_writer_fn write, void *ctx, size_t *len, rt_error *err)
+{
+	char *buf = NULL;
+	FILE *f = open_memstream(&buf, len);
+	if (!f) {
+		rt_error_at(err, path, 0, 0, "out of memory");
+		return NULL;
+	}
+	bool ok = write(f, ctx, err);
+	if (fclose(f) != 0 && ok)
+		ok = rt_error_at(err, path, 0, 0, "out of memory");
+	if (!ok) {
+		free(buf);
+		return NULL;
+	}
+	return buf;
+}
+
+/* Writes the content over the existing file target, from its start. */
+static bool write_in_place(const char *path, const char *target, const struct stat *st, file_writer_fn write,
+                           void *ctx, rt_error *err)
+{
+	size_t len;
+	char *buf = make_content(path, write, ctx, &len, err);
+	if (!buf)
+		return false;
+	bool fifo = S_ISFIFO(st->st_mode);
+	/* A FIFO with no reader would block the shell: say so instead. */
+	int fd = open(target, O_WRONLY | O_NOCTTY | O_CLOEXEC | (fifo ? O_NONBLOCK : 0));
+	if (fd < 0) {
+		int e = errno;
+		free(buf);
+		if (fifo && e == ENXIO)
+			return rt_error_at(err, path, 0, 0, "is a FIFO with no reader; expected a program reading it");
+		return rt_error_at(err, path, 0, 0, "cannot open the file to write it in place (%s)", strerror(e));
+	}
+	if (fifo)
+		fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+	bool regular = S_ISREG(st->st_mode);
+	bool ok = write_all(fd, buf, len) && (!regular || ftruncate(fd, (off_t)len) == 0) &&
+	          (!regular || fsync(fd) == 0);
+	int e = errno;
+	if (close(fd) != 0 && ok) {
+		ok = false;
+		e = errno;
+	}
+	free(buf);
+	if (!ok)
+		return rt_error_at(err, path, 0, 0, "write failed (%s)", strerror(e));
+	return true;
+}
+
+/* Syncs the folder, so that the rename itself survives a power cut. */
+static void sync_folder(const char *dir)
+{
+	int fd = open(*dir ? dir : ".", O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+	if (fd >= 0) {
+		fsync(fd);
+		close(fd);
+	}
+}
+
+typedef enum replace_result { REPLACED, FAILED, CANNOT_CREATE, CANNOT_KEEP_OWNER } replace_result;
+
+/* Writes a temporary file beside target and renames it over target. `old`
+ * is the file being replaced (NULL: a new file). */
+static replace_result replace(const char *path, const char *target, const struct stat *old, file_writer_fn write,
+                              void *ctx, rt_error *err)
+{
+	char dir[PATH_MAX];
+	const char *base;
+	split(target, dir, sizeof dir, &base);
+	remove_stale(dir, base);
+	char tmp[PATH_MAX + 64];
+	if (snprintf(tmp, sizeof tmp, "%s.%.*s.tmp.%ld.XXXXXX", dir, TMP_BASE_MAX, base, (long)getpid()) >=
+	    (int)sizeof tmp) {
+		rt_error_at(err, path, 0, 0, "the path is too long");
+		return FAILED;
+	}
+	guard g;
+	guard_on(&g);
+	int fd = create_registered(tmp);
+	if (fd < 0) {
+		int e = errno;
+		guard_off(&g);
+		rt_error_at(err, path, 0, 0, "cannot create a file in that folder (%s); expected a writable folder",
+		            strerror(e));
+		return e == EACCES || e == EPERM || e == EROFS ? CANNOT_CREATE : FAILED;
+	}
+	replace_result res = FAILED;
+	if (old) {
+		/* The old file's owner and group, then its mode (chown may clear
+		 * set-id bits). Another user's file that we cannot give back to
+		 * its owner is written in place instead; a group we may not set
+		 * stays ours. */
+		if (old->st_uid != geteuid() && fchown(fd, old->st_uid, old->st_gid) != 0) {
+			res = CANNOT_KEEP_OWNER;
+			goto fail_fd;
+		}
+		if (old->st_uid == geteuid() && old->st_gid != getegid())
+			(void)!fchown(fd, (uid_t)-1, old->st_gid);
+		fchmod(fd, old->st_mode & 07777);
+	} else {
+		/* mkstemp makes the file 0600; a new file gets the usual mode. */
+		mode_t mask = umask(0);
+		umask(mask);
+		fchmod(fd, 0666 & ~mask);
+	}
+	FILE *f = fdopen(fd, "wb");
+	if (!f) {
+		rt_error_at(err, path, 0, 0, "cannot write (%s)", strerror(errno));
+		goto fail_fd;
+	}
+	errno = 0;
+	bool ok = write(f, ctx, err);
+	int e = errno;
+	if (!ok && ferror(f) && e) /* the writer stopped on a write error: say which */
+		rt_error_at(err, path, 0, 0, "write failed (%s)", strerror(e));
+	if (ok && (fflush(f) != 0 || ferror(f) || fsync(fd) != 0))
+		ok = rt_error_at(err, path, 0, 0, "write failed (%s)", strerror(errno ? errno : EIO));
+	if (fclose(f) != 0 && ok)
+		ok = rt_error_at(err, path, 0, 0, "write failed (%s)", strerror(errno));
+	if (ok && rename(tmp, target) != 0)
+		ok = rt_error_at(err, path, 0, 0, "cannot replace the file (%s)", strerror(errno));
+	if (!ok)
+		unlink(tmp);
+	guard_off(&g);
+	if (ok)
+		sync_folder(dir);
+	return ok ? REPLACED : FAILED;
+fail_fd:
+	close(fd);
+	unlink(tmp);
+	guard_off(&g);
+	return res;
+}
+
+static const char *kind_name(mode_t m)
+{
+	return S_ISFIFO(m) ? "a FIFO" : S_ISCHR(m) ? "a character device" : S_ISBLK(m) ? "a block device" : "";
+}
+
+bool file_write_atomic(const char *path, file_writer_fn write, void *ctx, rt_error *err)
+{
+	note[0] = '\0';
+	char *target = resolve(path, err);
+	if (!target)
+		return false;
+	bool ok = false;
+	struct stat st;
+	if (lstat(target, &st) != 0) {
+		if (errno != ENOENT) {
+			rt_error_at(err, path, 0, 0, "cannot look at the file (%s)", strerror(errno));
+			goto done;
+		}
+		char dir[PATH_MAX];
+		const char *base;
+		split(target, dir, sizeof dir, &base);
+		if (device_folder(dir)) {
+			rt_error_at(err, path, 0, 0,
+			            "that folder holds device nodes; expected a folder for files (no file was created)");
+			goto done;
+		}
+		ok = replace(path, target, NULL, write, ctx, err) == REPLACED;
+		goto done;
+	}
+	if (S_ISDIR(st.st_mode)) {
+		rt_error_at(err, path, 0, 0, "is a folder; expected a file name");
+		goto done;
+	}
+	if (S_ISFIFO(st.st_mode) || S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode)) {
+		ok = write_in_place(path, target, &st, write, ctx, err);
+		if (ok)
+			snprintf(note, sizeof note, "%s is %s: written to it in place", path, kind_name(st.st_mode));
+		goto done;
+	}
+	if (!S_ISREG(st.st_mode)) {
+		rt_error_at(err, path, 0, 0, "is a socket or other special file; expected a regular file");
+		goto done;
+	}
+	if (st.st_nlink > 1) {
+		ok = write_in_place(path, target, &st, write, ctx, err);
+		if (ok)
+			snprintf(note, sizeof note, "%s has %ju hard links: written in place to keep them", path,
+			         (uintmax_t)st.st_nlink);
+		goto done;
+	}
+	switch (replace(path, target, &st, write, ctx, err)) {
+	case REPLACED:
+		ok = true;
+		break;
+	case FAILED:
+		break;
+	case CANNOT_KEEP_OWNER:
+		ok = write_in_place(path, target, &st, write, ctx, err);
+		if (ok)
+			snprintf(note, sizeof note, "%s belongs to another user: written in place to keep its owner",
+			         path);
+		break;
+	case CANNOT_CREATE:
+		/* The folder is read-only; the file may still be writable. */
+		if (access(target, W_OK) == 0) {
+			ok = write_in_place(path, target, &st, write, ctx, err);
+			if (ok)
+				snprintf(note, sizeof note,
+				         "%s: the folder is not writable, so the file was written in place (not atomically)",
+				         path);
+		}
+		break;
+	}
+done:
+	free(target);
+	return ok;
+}

@@ -1,0 +1,69 @@
+/* rtsh — memory estimates (memory.h). */
+#include "rtsh/memory.h"
+
+#include <stdatomic.h>
+#include <stdio.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+static _Atomic size_t set_limit;
+
+void mem_set_limit(size_t bytes)
+{
+	atomic_store(&set_limit, bytes);
+}
+
+double mem_limit(const char **why)
+{
+	double best = 1e300;
+	const char *by = "no limit";
+	long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+	if (pages > 0 && page > 0) {
+		best = (double)pages * (double)page;
+		by = "physical memory";
+	}
+	static const struct {
+		int res;
+		const char *name;
+	} limits[] = {{RLIMIT_AS, "RLIMIT_AS"}, {RLIMIT_DATA, "RLIMIT_DATA"}};
+	for (size_t i = 0; i < sizeof limits / sizeof limits[0]; i++) {
+		struct rlimit rl;
+		if (getrlimit(limits[i].res, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY &&
+		    (double)rl.rlim_cur < best) {
+			best = (double)rl.rlim_cur;
+			by = limits[i].name;
+		}
+	}
+	size_t cap = atomic_load(&set_limit);
+	if (cap && (double)cap < best) {
+		best = (double)cap;
+		by = "the set limit";
+	}
+	if (why)
+		*why = by;
+	return best;
+}
+
+/* "1.5 GiB", "300 MiB", "12 KiB". */
+static void human(double bytes, char *buf, size_t size)
+{
+	static const char *unit[] = {"bytes", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"};
+	int u = 0;
+	while (bytes >= 1024 && u < 6) {
+		bytes /= 1024;
+		u++;
+	}
+	snprintf(buf, size, u && bytes < 10 ? "%.1f %s" : "%.0f %s", bytes, unit[u]);
+}
+
+bool mem_check(double bytes, const char *what, rt_error *err)
+{
+	const char *why;
+	double limit = mem_limit(&why);
+	if (!(bytes > limit))
+		return true;
+	char need[32], have[32];
+	human(bytes, need, sizeof need);
+	human(limit, have, sizeof have);
+	return rt_error_set(err, "%s needs about %s of memory; expected at most %s (%s)", what, need, have, why);
+}
