@@ -16,12 +16,13 @@
 #define TCAP_QUERY "\x1bP+q524742;5463\x1b\\"
 
 #define MAX_QUERIES 64
-#define HOLD_SECONDS 0.15   /* a cut escape sequence waits this long for its end */
+#define HOLD_SECONDS 0.3    /* a cut Esc waits this long for the rest of an answer */
+#define HOLD_ANSWER 2.0     /* a cut answer (CSI digits, DCS) waits this long for its end */
 #define HOLD_MAX 512        /* bytes of a cut sequence held at most */
 #define SLICE_MIN 1024
 #define SLICE_FIRST 4096    /* before the link is measured */
 #define SLICE_MAX (4u << 20)
-#define SLICE_TIMEOUT_MIN 5.0
+#define SLICE_TIMEOUT_MIN 10.0
 
 typedef enum query_kind { Q_DSR, Q_DA1, Q_RQSS, Q_TCAP } query_kind;
 
@@ -45,7 +46,7 @@ struct termout {
 	/* Input held: an escape sequence cut at the end of a read. */
 	char hold[HOLD_MAX];
 	size_t nhold;
-	double hold_since;
+	double hold_since, hold_for;
 
 	int truecolor;
 	bool final;         /* the picture is not a refinement pass */
@@ -325,6 +326,10 @@ void termout_input(termout *o, const char *b, size_t n, double now, abuf *keys)
 		memmove(o->hold, p + used, rest);
 		if (!was_held || o->nhold == 0 || used > 0)
 			o->hold_since = now;
+		/* Keys come whole (a terminal writes a key's sequence at once);
+		 * an answer may come in pieces, the more so on a loaded machine:
+		 * "ESC [ digits", "ESC [ ?" and a DCS wait longer than a lone Esc. */
+		o->hold_for = rest > 1 ? HOLD_ANSWER : HOLD_SECONDS;
 	}
 	o->nhold = rest;
 	free(tmp);
@@ -355,7 +360,7 @@ static void give_up(termout *o, const char *why)
 
 void termout_pump(termout *o, double now, abuf *keys)
 {
-	if (o->nhold && now - o->hold_since >= HOLD_SECONDS) {
+	if (o->nhold && now - o->hold_since >= o->hold_for) {
 		/* Nothing more came: keys after all (Esc, Alt+key). */
 		abuf_add(keys, o->hold, o->nhold);
 		o->nhold = 0;
@@ -399,7 +404,7 @@ double termout_wait(const termout *o, double now)
 			best = d_;                    \
 	} while (0)
 	if (o->nhold)
-		CONSIDER(o->hold_since + HOLD_SECONDS);
+		CONSIDER(o->hold_since + o->hold_for);
 	if (o->state == TERMOUT_PROBING)
 		CONSIDER(o->probe_sent + TERMOUT_PROBE_TIMEOUT);
 	if (o->state == TERMOUT_PACED && o->qlen > 0 && o->st.in_flight > 0)

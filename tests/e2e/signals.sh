@@ -19,7 +19,7 @@ wait_for() {
 		sleep 0.1
 	done
 	fail "$2; the screen ends with:
-$(screen | tail -n 4)"
+$(screen | grep -v '^ *$' | tail -n 6)"
 }
 # wait_flags WANT WHAT: up to 5 s for the flags to read WANT.
 wait_flags() {
