@@ -167,6 +167,11 @@ void answer_loaded(shell *sh, const char *verb, const render_settings *before)
 	const char *where = sh->label ? sh->label : sh->name;
 	shell_info(sh, "%s %s: %zu object%s, %zu light%s, %zu camera%s\n", verb, where, s->nobjs,
 	           plural(s->nobjs), s->nlights, plural(s->nlights), s->ncams, plural(s->ncams));
+	answer_setting_changes(sh, before);
+}
+
+void answer_setting_changes(shell *sh, const render_settings *before)
+{
 	for (size_t i = 0; i < settings_count && i < sizeof sh->hand_set * 8; i++) {
 		if (!(sh->hand_set & 1u << i))
 			continue;

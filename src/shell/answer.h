@@ -24,6 +24,9 @@ void answer_camera_fields(shell *sh, size_t i);
  * then one line for each setting set by hand (`set`) that the new scene
  * changed: "samples 16 -> 1 (from x.rt)". */
 void answer_loaded(shell *sh, const char *verb, const render_settings *before);
+/* Only the lines for the settings set by hand that changed (generate, and
+ * undo or redo of a load). */
+void answer_setting_changes(shell *sh, const render_settings *before);
 
 /* "undone: WHAT" / "redone: WHAT", with the note taken before the step. */
 void answer_undo(shell *sh, const char *verb, const char *note);

@@ -300,12 +300,15 @@ static bool undo_redo(shell *sh, bool redo)
 {
 	const char *note = redo ? editor_redo_note(sh->ed) : editor_undo_note(sh->ed);
 	char *copy = note ? strdup(note) : NULL;
+	render_settings before = sh->set;
 	rt_error err;
 	shell_edit_begin(sh);
 	bool ok = redo ? editor_redo(sh->ed, &err) : editor_undo(sh->ed, &err);
 	shell_edit_end(sh);
-	if (ok)
+	if (ok) {
 		answer_undo(sh, redo ? "redone" : "undone", copy);
+		answer_setting_changes(sh, &before);
+	}
 	free(copy);
 	return ok ? true : shell_fail(sh, "%s: %s", redo ? "redo" : "undo", err.msg);
 }

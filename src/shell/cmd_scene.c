@@ -273,9 +273,11 @@ bool cmd_generate(shell *sh, int argc, char **argv, const char *rest)
 		return shell_fail(sh, "generate: %s", err.msg);
 	char label[96];
 	snprintf(label, sizeof label, "generate:%ld:%" PRIu64, n, seed);
+	render_settings before = sh->set;
 	if (!shell_replace_scene(sh, s, label))
 		return false;
 	shell_info(sh, "generated %ld object%s with seed %" PRIu64 "\n", n, n == 1 ? "" : "s", seed);
+	answer_setting_changes(sh, &before);
 	return true;
 }
 
