@@ -49,6 +49,9 @@ BENCH_BIN := $(BUILD)/bench/bench
 # Optional: Embree 3's single-ray speed on the same rays, built by `make bench`
 # only when embree3/rtcore.h is installed (apt-get install libembree-dev).
 EMBREE_BIN := $(BUILD)/bench/embree_primary
+# Equal-quality rows (rtsh against Blender's Cycles, preview time to an
+# error): bench/quality.c, run by `make bench` after the speed table.
+QUALITY_BIN := $(BUILD)/bench/quality
 
 # The binary: ./rtsh for the default build, $(BUILD)/rtsh for variants.
 ifeq ($(BUILD),build)
@@ -57,7 +60,7 @@ else
 BIN := $(BUILD)/rtsh
 endif
 
-.PHONY: all run test test-bins test-unit test-scripts bench bench-quick install uninstall \
+.PHONY: all run test test-bins test-unit test-scripts bench bench-quick bench-quality install uninstall \
         clean deps check-man fuzz fuzz-bins fuzz-link
 
 all: deps $(BIN)
@@ -129,6 +132,17 @@ bench: all $(BENCH_BIN)
 		$(MAKE) --no-print-directory $(EMBREE_BIN); \
 	else echo "bench: no embree3/rtcore.h, so no Embree row (apt-get install libembree-dev)"; fi
 	./$(BENCH_BIN) --out $(BUILD)/bench.tsv
+	$(MAKE) --no-print-directory bench-quality
+
+# rtsh against Cycles (skipped with a message without `blender`) and the
+# preview's time to an error; references are rendered once into
+# $(BUILD)/quality/ (minutes the first time).
+bench-quality: all $(QUALITY_BIN)
+	./$(QUALITY_BIN) --out $(BUILD)/bench-quality.tsv
+
+$(QUALITY_BIN): bench/quality.c $(LIB)
+	@mkdir -p $(@D)
+	$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -o $@ $< $(LIB) $(LDLIBS_CORE)
 
 bench-quick: all $(BENCH_BIN)
 	./$(BENCH_BIN) --quick --out $(BUILD)/bench-quick.tsv

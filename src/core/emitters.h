@@ -28,6 +28,9 @@ struct emitter {
 	vec3 n;          /* flat shapes: unit normal */
 	double r;        /* sphere radius */
 	double area;     /* flat shapes */
+	double reach2;   /* flat shapes: sampled by solid angle from points closer
+	                  * to c than sqrt(reach2), by area beyond (0: always by
+	                  * area) */
 };
 
 /* Fills w->emitters with the scene's emissive spheres, rectangles, discs
@@ -40,10 +43,11 @@ bool emitters_build(world *w, const scene *s, rt_error *err);
  * (flat shapes); the choice of the emitter is not included. */
 double emitter_pdf(const emitter *e, vec3 p, vec3 d, double t);
 
-/* A direction *wi from p towards e, from the solid angle a sphere subtends
- * (uniform in its cone) or the area of a flat shape, with its density *pdf
- * (per steradian) and the distance *t to the emitter's surface along it.
- * False when p is inside the sphere or the sample is degenerate. */
-bool emitter_sample(const emitter *e, vec3 p, rng *g, vec3 *wi, double *pdf, double *t);
+/* A direction *wi from p towards e made from the uniform numbers (u1, u2),
+ * from the solid angle a sphere subtends (uniform in its cone) or the area
+ * of a flat shape, with its density *pdf (per steradian) and the distance
+ * *t to the emitter's surface along it. False when p is inside the sphere
+ * or the sample is degenerate. */
+bool emitter_sample(const emitter *e, vec3 p, double u1, double u2, vec3 *wi, double *pdf, double *t);
 
 #endif

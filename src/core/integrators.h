@@ -8,9 +8,9 @@
 /* Radiance arriving along r (unit direction) by ambient + Phong + hard
  * shadows + mirror reflection / refraction up to s->depth (whitted.c). */
 vec3 whitted_radiance(const world *w, const render_settings *s, ray r);
-/* A Monte-Carlo estimate of the radiance along r (path.c); g is the sample's
- * own random stream. */
-vec3 path_radiance(const world *w, const render_settings *s, ray r, rng *g);
+/* A Monte-Carlo estimate of the radiance along r (path.c); g gives the
+ * camera sample's numbers, from dimension g->dim on. */
+vec3 path_radiance(const world *w, const render_settings *s, ray r, sampler *g);
 
 /* The scattering at one path vertex (path.c): the material's lobes, each
  * with its share of the energy (shares sum to at most 1; see rtsh(5),
@@ -45,8 +45,11 @@ typedef struct bsdf_sample {
 void bsdf_make(bsdf *b, const mat_lin *m, const hit *h, vec3 wo);
 /* The BSDF value f(wi, wo) of the non-delta lobes (per steradian). */
 vec3 bsdf_eval(const bsdf *b, vec3 wi);
-/* Samples a lobe and a direction with random numbers from g; false when
- * the path is absorbed. */
+/* Samples a lobe and a direction from three uniform numbers: u[0] picks
+ * the lobe (and, rescaled, glass's reflection or refraction), u[1], u[2]
+ * the direction; false when the path is absorbed. */
+bool bsdf_sample_u(const bsdf *b, const double u[3], bsdf_sample *out);
+/* The same with three numbers from g. */
 bool bsdf_sample_dir(const bsdf *b, rng *g, bsdf_sample *out);
 /* The Phong exponent of a mirror lobe of roughness fuzz in (0,1]. */
 double fuzz_exponent(double fuzz);

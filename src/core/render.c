@@ -113,15 +113,16 @@ vec3 render_sample(const world *w, const render_settings *s, int px, int py, int
 {
 	uint64_t pixel = (uint64_t)py * (uint64_t)fw + (uint64_t)px;
 	double u = 0.5, v = 0.5;
-	rng g = {0};
-	/* one Whitted sample at the pixel centre needs no random numbers */
-	if (s->samples > 1 || s->mode == MODE_PATH) {
-		g = rng_for(s->seed, pixel, (uint64_t)sample);
-		if (s->samples > 1)
-			pixel_offset((uint32_t)sample, rng_u64(&g), &u, &v);
-	}
+	/* Dimensions 0 and 1 place the sample in its pixel (one Whitted sample
+	 * sits at the centre and needs no numbers); the path's numbers follow.
+	 * Every pixel has its own scrambles, the same for all its samples, so
+	 * that its first 2^k positions are stratified (sampler.h). */
+	sampler sp = sampler_for(s->seed, pixel, (uint32_t)sample);
+	if (s->samples > 1)
+		samp_2d(&sp, &u, &v);
+	sp.dim = 2;
 	ray r = cam_ray(&w->cam, px + u, py + v, fw, fh);
-	vec3 c = s->mode == MODE_PATH ? path_radiance(w, s, r, &g) : whitted_radiance(w, s, r);
+	vec3 c = s->mode == MODE_PATH ? path_radiance(w, s, r, &sp) : whitted_radiance(w, s, r);
 	/* A NaN or infinity from a degenerate case must not poison the pixel. */
 	if (!v3_finite(c))
 		c = v3(0, 0, 0);

@@ -1,0 +1,443 @@
+/* rtsh — equal-quality benchmarks (`make bench` runs them after the speed
+ * table; bench/README.md explains the rows):
+ *
+ *   quality [--only cycles|preview] [--scene cornell|glass-sky] [--out FILE.tsv]
+ *           [--no-cycles]
+ *
+ * cycles   rtsh's path mode against Blender's Cycles on the same scenes
+ *          (scenes/cornell.rt and bench/glass-sky.rt, rebuilt in Cycles by
+ *          bench/cycles_scene.py): CPU, one thread, 256x256, a 1-pixel box
+ *          filter, no adaptive sampling, no denoising, the scene's bounces.
+ *          Each renderer is judged against its own 4096-sample reference
+ *          (rendered once and kept in build/quality/). At 16, 64 and 256
+ *          samples it prints the CPU seconds per sample and
+ *            eff = (MSE x seconds of rtsh) / (MSE x seconds of Cycles)
+ *          over the whole picture and away from emitter edges: below 1 rtsh
+ *          reaches a given noise in less time. Without `blender` the rtsh
+ *          columns are still measured and the Cycles ones say why not.
+ * preview  the shell's progressive preview of scenes/cornell.rt at 160x96
+ *          (all threads, passes of 1, 1, 2, 4, ... samples): the RMS error
+ *          of the picture after each pass against a 4096-sample reference,
+ *          and the time it takes to reach given errors.
+ *
+ * Times are CPU seconds of the render (the rendering thread for one thread,
+ * the process for the preview), so that the other work on a shared machine
+ * counts less. Nothing here asserts a time.
+ */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "rtsh/image.h"
+#include "rtsh/render.h"
+#include "rtsh/rtfile.h"
+#include "rtsh/world.h"
+
+#ifndef QDIR
+#define QDIR "build/quality"
+#endif
+
+static FILE *tsv;
+
+static void die(const char *what, const rt_error *err)
+{
+	fprintf(stderr, "quality: %s: %s\n", what, err ? err->msg : strerror(errno));
+	exit(1);
+}
+
+static double cpu_now(clockid_t id)
+{
+	struct timespec ts;
+	clock_gettime(id, &ts);
+	return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+static scene *load(const char *path)
+{
+	rt_error err;
+	scene *s = rt_load_file(path, NULL, &err);
+	if (!s)
+		die(path, &err);
+	return s;
+}
+
+static render_settings path_settings(int w, int h, int spp, int depth, int threads, uint64_t seed)
+{
+	render_settings set = render_settings_default();
+	set.width = w;
+	set.height = h;
+	set.samples = spp;
+	set.depth = depth;
+	set.threads = threads;
+	set.mode = MODE_PATH;
+	set.seed = seed;
+	return set;
+}
+
+/* A one-pass render; *cpu = the CPU seconds of this thread (one thread
+ * renders here) or of the process. */
+static framebuffer *render_timed(const world *w, const render_settings *set, double *cpu)
+{
+	clockid_t id = set->threads == 1 ? CLOCK_THREAD_CPUTIME_ID : CLOCK_PROCESS_CPUTIME_ID;
+	rt_error err;
+	double t0 = cpu_now(id);
+	framebuffer *fb = render_image(w, set, NULL, NULL, NULL, &err);
+	*cpu = cpu_now(id) - t0;
+	if (!fb)
+		die("render", &err);
+	return fb;
+}
+
+static bool exists(const char *path)
+{
+	struct stat st;
+	return stat(path, &st) == 0;
+}
+
+/* The cached reference at path, rendered first when missing. */
+static framebuffer *reference(const world *w, render_settings set, const char *path)
+{
+	rt_error err;
+	if (!exists(path)) {
+		fprintf(stderr, "quality: rendering the reference %s (%d samples, once)\n", path, set.samples);
+		set.threads = 0;
+		double cpu;
+		framebuffer *fb = render_timed(w, &set, &cpu);
+		if (!image_write(path, fb, 0.0, &err))
+			die(path, &err);
+		fb_free(fb);
+	}
+	framebuffer *ref = image_read_pfm(path, &err);
+	if (!ref)
+		die(path, &err);
+	return ref;
+}
+
+/* Pixels whose camera ray (through the pixel's centre) meets an emitter or
+ * leaves the scene (the sky or background) are "emitter" pixels; a pixel
+ * within 2 pixels of both kinds is on an emitter's edge. */
+static unsigned char *edge_mask(const world *w, int fw, int fh)
+{
+	unsigned char *em = calloc((size_t)fw * fh, 1), *edge = calloc((size_t)fw * fh, 1);
+	if (!em || !edge)
+		die("memory", NULL);
+	for (int y = 0; y < fh; y++)
+		for (int x = 0; x < fw; x++) {
+			ray r = cam_ray(&w->cam, x + 0.5, y + 0.5, fw, fh);
+			hit h;
+			bool hit_it = world_intersect(w, &r, 0.0, INFINITY, &h);
+			vec3 e = hit_it ? w->mats[h.object].emission : v3(1, 1, 1);
+			em[y * fw + x] = e.x > 0 || e.y > 0 || e.z > 0;
+		}
+	for (int y = 0; y < fh; y++)
+		for (int x = 0; x < fw; x++) {
+			int kinds = 0;
+			for (int dy = -2; dy <= 2; dy++)
+				for (int dx = -2; dx <= 2; dx++) {
+					int X = x + dx, Y = y + dy;
+					if (X >= 0 && Y >= 0 && X < fw && Y < fh)
+						kinds |= em[Y * fw + X] ? 1 : 2;
+				}
+			edge[y * fw + x] = kinds == 3;
+		}
+	free(em);
+	return edge;
+}
+
+/* Mean squared error of the linear radiance over all pixels and over the
+ * pixels off the mask. */
+static void mse(const framebuffer *a, const framebuffer *ref, const unsigned char *edge, double *all,
+                double *off)
+{
+	double s = 0, so = 0;
+	long n = (long)a->w * a->h, no = 0;
+	for (long i = 0; i < n; i++) {
+		double e = 0;
+		for (int c = 0; c < 3; c++) {
+			double d = (double)a->rgb[i * 3 + c] - ref->rgb[i * 3 + c];
+			e += d * d;
+		}
+		s += e;
+		if (!edge[i]) {
+			so += e;
+			no++;
+		}
+	}
+	*all = s / (3.0 * n);
+	*off = so / (3.0 * (no ? no : 1));
+}
+
+static double mean(const framebuffer *fb)
+{
+	double s = 0;
+	long n = (long)fb->w * fb->h * 3;
+	for (long i = 0; i < n; i++)
+		s += fb->rgb[i];
+	return s / n;
+}
+
+/* --- rtsh against Cycles ---------------------------------------------------- */
+
+#define NSPP 3
+static const int spps[NSPP] = {16, 64, 256};
+
+static bool have_blender(void)
+{
+	return system("command -v blender >/dev/null 2>&1") == 0;
+}
+
+/* Runs bench/cycles_scene.py; fills secs[] for spps (< 0 when missing) and
+ * writes QDIR/NAME-cycles-SPP.pfm. */
+static bool run_cycles(const char *path, const char *name, int w, int h, int threads, int seed,
+                       const char *tag, const int *spp, int n, double *secs)
+{
+	char cmd[1024];
+	int len = snprintf(cmd, sizeof cmd,
+	                   "blender -b --factory-startup -P bench/cycles_scene.py -- %s %dx%d %d %d "
+	                   QDIR "/%s-%s",
+	                   path, w, h, threads, seed, name, tag);
+	for (int i = 0; i < n; i++)
+		len += snprintf(cmd + len, sizeof cmd - (size_t)len, " %d", spp[i]);
+	snprintf(cmd + len, sizeof cmd - (size_t)len, " 2>&1");
+	FILE *p = popen(cmd, "r");
+	if (!p)
+		return false;
+	for (int i = 0; i < n; i++)
+		secs[i] = -1;
+	char line[512];
+	while (fgets(line, sizeof line, p)) {
+		int s;
+		double t;
+		if (sscanf(line, "cycles %d %lf", &s, &t) == 2) {
+			for (int i = 0; i < n; i++)
+				if (spp[i] == s)
+					secs[i] = t;
+		} else if (strstr(line, "cycles_scene.py:") || strstr(line, "Error")) {
+			fprintf(stderr, "quality: blender: %s", line);
+		}
+	}
+	int rc = pclose(p);
+	return rc == 0;
+}
+
+static void bench_cycles_scene(const char *path, const char *name, bool cycles)
+{
+	const int W = 256, H = 256, REF = 4096;
+	scene *s = load(path);
+	int depth = s->hints.depth >= 0 ? s->hints.depth : 5;
+	rt_error err;
+	world *w = world_build(s, &err);
+	if (!w)
+		die("world_build", &err);
+	char rpath[256], cpath[256];
+	snprintf(rpath, sizeof rpath, QDIR "/%s-rtsh-ref.pfm", name);
+	framebuffer *ref = reference(w, path_settings(W, H, REF, depth, 0, 4242), rpath);
+	unsigned char *edge = edge_mask(w, W, H);
+	long nedge = 0;
+	for (int i = 0; i < W * H; i++)
+		nedge += edge[i];
+
+	framebuffer *cref = NULL;
+	double csec[NSPP];
+	const char *why = NULL;
+	if (!cycles) {
+		why = "not asked for (--no-cycles)";
+	} else if (!have_blender()) {
+		why = "blender is not installed (apt-get install blender); skipped";
+	} else {
+		snprintf(cpath, sizeof cpath, QDIR "/%s-cycles-ref-%d.pfm", name, REF);
+		if (!exists(cpath)) {
+			fprintf(stderr, "quality: rendering the Cycles reference %s (once; minutes)\n", cpath);
+			double t;
+			const int one = REF;
+			if (!run_cycles(path, name, W, H, 2, 4242, "cycles-ref", &one, 1, &t))
+				why = "blender failed on the reference";
+		}
+		if (!why && !(cref = image_read_pfm(cpath, &err)))
+			why = "no Cycles reference";
+		if (!why && !run_cycles(path, name, W, H, 1, 7, "cycles", spps, NSPP, csec))
+			why = "blender failed";
+	}
+	printf("\n%s, %dx%d, depth %d, one thread, against each renderer's own %d-sample reference\n",
+	       name, W, H, depth, REF);
+	printf("(%ld pixels within 2 of an emitter's edge are left out of the \"away\" columns)\n", nedge);
+	if (cref)
+		printf("references: mean radiance rtsh / Cycles = %.4f\n", mean(ref) / mean(cref));
+	else
+		printf("Cycles: %s\n", why);
+	printf("%5s %9s %9s %11s %11s %11s %11s %7s %7s\n", "spp", "rtsh s/spp", "cyc s/spp", "rtsh MSE",
+	       "cyc MSE", "rtsh away", "cyc away", "eff", "eff away");
+	for (int i = 0; i < NSPP; i++) {
+		double t;
+		render_settings set = path_settings(W, H, spps[i], depth, 1, 1 + (uint64_t)i);
+		framebuffer *fb = render_timed(w, &set, &t);
+		double m, mo, cm = -1, cmo = -1, ct = -1;
+		mse(fb, ref, edge, &m, &mo);
+		fb_free(fb);
+		if (cref && csec[i] > 0) {
+			snprintf(cpath, sizeof cpath, QDIR "/%s-cycles-%d.pfm", name, spps[i]);
+			framebuffer *cfb = image_read_pfm(cpath, &err);
+			if (cfb && cfb->w == W && cfb->h == H) {
+				mse(cfb, cref, edge, &cm, &cmo);
+				ct = csec[i];
+			}
+			fb_free(cfb);
+		}
+		if (ct > 0) {
+			double eff = m * t / (cm * ct), effo = mo * t / (cmo * ct);
+			printf("%5d %9.5f %9.5f %11.4g %11.4g %11.4g %11.4g %7.3f %7.3f\n", spps[i], t / spps[i],
+			       ct / spps[i], m, cm, mo, cmo, eff, effo);
+			if (tsv)
+				fprintf(tsv, "%s\tcycles\t%d\t%.6f\t%.6f\t%.6g\t%.6g\t%.6g\t%.6g\t%.4f\t%.4f\n", name,
+				        spps[i], t, ct, m, cm, mo, cmo, eff, effo);
+		} else {
+			printf("%5d %9.5f %9s %11.4g %11s %11.4g %11s %7s %7s\n", spps[i], t / spps[i], "-", m, "-",
+			       mo, "-", "-", "-");
+			if (tsv)
+				fprintf(tsv, "%s\tcycles\t%d\t%.6f\t-\t%.6g\t-\t%.6g\t-\t-\t-\n", name, spps[i], t, m,
+				        mo);
+		}
+		fflush(stdout);
+	}
+	free(edge);
+	fb_free(cref);
+	fb_free(ref);
+	world_free(w);
+	scene_free(s);
+}
+
+/* --- the progressive preview ------------------------------------------------ */
+
+/* The RMS error of the displayed picture: sRGB codes / 255, as the
+ * terminal shows it (exposure 0, clamped). */
+static double rms_display(const framebuffer *a, const framebuffer *ref)
+{
+	double s = 0;
+	long n = (long)a->w * a->h * 3;
+	for (long i = 0; i < n; i++) {
+		double d = ((double)linear_to_srgb8(a->rgb[i]) - linear_to_srgb8(ref->rgb[i])) / 255.0;
+		s += d * d;
+	}
+	return sqrt(s / n);
+}
+
+/* The RMS error of the linear radiance. */
+static double rms_linear(const framebuffer *a, const framebuffer *ref)
+{
+	double s = 0;
+	long n = (long)a->w * a->h * 3;
+	for (long i = 0; i < n; i++) {
+		double d = (double)a->rgb[i] - ref->rgb[i];
+		s += d * d;
+	}
+	return sqrt(s / n);
+}
+
+/* Updates reach[k], the time target k was first met, from the errors
+ * (prev_t, prev_e) and (t, e) of two passes, interpolated in log-log. */
+static void crossing(const double *targets, int nt, double *reach, double prev_t, double prev_e, double t,
+                     double e)
+{
+	for (int k = 0; k < nt; k++)
+		if (reach[k] < 0 && e <= targets[k]) {
+			if (prev_t > 0 && prev_e > e)
+				reach[k] = exp(log(prev_t) + (log(targets[k]) - log(prev_e)) / (log(e) - log(prev_e)) *
+				                                 (log(t) - log(prev_t)));
+			else
+				reach[k] = t;
+		}
+}
+
+static void bench_preview(void)
+{
+	const int W = 160, H = 96, MAX = 256;
+	scene *s = load("scenes/cornell.rt");
+	int depth = s->hints.depth >= 0 ? s->hints.depth : 5;
+	rt_error err;
+	world *w = world_build(s, &err);
+	if (!w)
+		die("world_build", &err);
+	framebuffer *ref = reference(w, path_settings(W, H, 4096, depth, 0, 4242),
+	                             QDIR "/cornell-preview-ref.pfm");
+	static const double targets[] = {0.05, 0.03, 0.02};
+	const int nt = 3;
+	double reach[2][3] = {{-1, -1, -1}, {-1, -1, -1}}, prev_t = 0, prev_e[2] = {0, 0};
+	printf("\ncornell.rt preview, %dx%d, all threads, passes 1, 1, 2, 4, ... samples; RMS error "
+	       "against a 4096-sample reference, of the displayed sRGB picture (codes / 255) and of the "
+	       "linear radiance\n",
+	       W, H);
+	printf("%6s %10s %10s %10s\n", "spp", "cpu s", "rms sRGB", "rms linear");
+	framebuffer *fb = fb_new(W, H);
+	render_settings set = path_settings(W, H, MAX, depth, 0, 3);
+	double t = 0;
+	for (int done = 0, n = 1; done < MAX; done += n, n = done) {
+		render_job job = {.w = w, .set = set, .fb = fb, .sample_begin = done, .sample_end = done + n};
+		double t0 = cpu_now(CLOCK_PROCESS_CPUTIME_ID);
+		if (render_run(&job, &err) != RENDER_DONE)
+			die("render", &err);
+		t += cpu_now(CLOCK_PROCESS_CPUTIME_ID) - t0;
+		double e[2] = {rms_display(fb, ref), rms_linear(fb, ref)};
+		printf("%6d %10.4f %10.5f %10.5f\n", done + n, t, e[0], e[1]);
+		for (int m = 0; m < 2; m++) {
+			crossing(targets, nt, reach[m], prev_t, prev_e[m], t, e[m]);
+			prev_e[m] = e[m];
+		}
+		prev_t = t;
+	}
+	for (int m = 0; m < 2; m++)
+		for (int k = 0; k < nt; k++) {
+			const char *space = m ? "linear" : "sRGB";
+			if (reach[m][k] > 0)
+				printf("RMS %s %.3f reached after %.3f CPU s\n", space, targets[k], reach[m][k]);
+			else
+				printf("RMS %s %.3f not reached in %d samples\n", space, targets[k], MAX);
+			if (tsv)
+				fprintf(tsv, "cornell.rt\tpreview-rms-%s\t%.3f\t%.4f\n", space, targets[k],
+				        reach[m][k]);
+		}
+	fb_free(fb);
+	fb_free(ref);
+	world_free(w);
+	scene_free(s);
+}
+
+int main(int argc, char **argv)
+{
+	const char *only = NULL, *out = NULL, *one = NULL;
+	bool cycles = true;
+	for (int i = 1; i < argc; i++) {
+		if (strcmp(argv[i], "--only") == 0 && i + 1 < argc)
+			only = argv[++i];
+		else if (strcmp(argv[i], "--out") == 0 && i + 1 < argc)
+			out = argv[++i];
+		else if (strcmp(argv[i], "--no-cycles") == 0)
+			cycles = false;
+		else if (strcmp(argv[i], "--scene") == 0 && i + 1 < argc)
+			one = argv[++i];
+		else {
+			fputs("usage: quality [--only cycles|preview] [--scene cornell|glass-sky] [--out FILE.tsv] "
+			      "[--no-cycles]\n",
+			      stderr);
+			return 2;
+		}
+	}
+	mkdir("build", 0777);
+	mkdir(QDIR, 0777);
+	if (out && !(tsv = fopen(out, "w")))
+		die(out, NULL);
+	if (!only || strcmp(only, "cycles") == 0) {
+		if (!one || strcmp(one, "cornell") == 0)
+			bench_cycles_scene("scenes/cornell.rt", "cornell", cycles);
+		if (!one || strcmp(one, "glass-sky") == 0)
+			bench_cycles_scene("bench/glass-sky.rt", "glass-sky", cycles);
+	}
+	if (!only || strcmp(only, "preview") == 0)
+		bench_preview();
+	if (tsv && fclose(tsv) != 0)
+		die(out, NULL);
+	return 0;
+}
