@@ -1526,7 +1526,7 @@ bool keymode_run(shell *sh)
 	if (scr->out) {
 		abuf junk;
 		abuf_init(&junk);
-		termout_settle(scr->out, in, 1.0, &junk);
+		termout_settle(scr->out, in, 5.0, &junk);
 		abuf_free(&junk);
 	}
 	keys *k = keys_open(in, 25);

@@ -115,7 +115,7 @@ static void settle(shell *sh)
 		return;
 	abuf got;
 	abuf_init(&got);
-	termout_settle(sh->scr->out, STDIN_FILENO, 1.0, &got);
+	termout_settle(sh->scr->out, STDIN_FILENO, 5.0, &got);
 	if (got.len)
 		take_input_raw(&got);
 	abuf_free(&got);
