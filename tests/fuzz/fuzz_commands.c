@@ -7,7 +7,7 @@
  * the machine). The shell starts at 32x18 pixels, 1 sample, 1 thread;
  * a watchdog cancels any render still running after a second (the cancel
  * flag Ctrl-C sets), so `set resolution 16384x16384; render` costs a second,
- * not an hour; and memory requests are held to 1 GiB (mem_set_limit), so a
+ * not an hour; and memory requests are held to 256 MiB (mem_set_limit), so a
  * request beyond it must be refused with a message, as it would be beyond
  * the machine's memory.
  */
@@ -77,7 +77,7 @@ int LLVMFuzzerInitialize(int *argc, char ***argv)
 	add_setting("resolution", "32x18");
 	add_setting("samples", "1");
 	add_setting("threads", "1");
-	mem_set_limit((size_t)1 << 30);
+	mem_set_limit((size_t)256 << 20);
 	pthread_t t;
 	if (pthread_create(&t, NULL, watchdog, NULL) != 0)
 		abort();

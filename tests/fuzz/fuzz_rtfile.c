@@ -2,7 +2,9 @@
  *
  * Any input the reader accepts must save to text that the reader accepts
  * again, and saving that second scene must give the same bytes: whatever
- * loads, saves and reloads, which is what `save x.rt` promises. A reader
+ * loads, saves and reloads, which is what `save x.rt` promises. And the
+ * keeping writer (rtkeep.h) must give back the very bytes it was given when
+ * nothing was edited. A reader
  * crash, a leak, undefined behaviour, or a saved scene that does not reload
  * or reloads to something else stops the fuzzer (abort).
  */
@@ -12,6 +14,7 @@
 #include <string.h>
 
 #include "rtsh/rtfile.h"
+#include "rtsh/rtkeep.h"
 #include "rtsh/scene.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -40,6 +43,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	scene *s = rt_load_string((const char *)data, size, "fuzz.rt", &opts, &err);
 	if (!s)
 		return 0;
+	/* Saving with no edit keeps the file byte for byte (rtkeep.h), unless
+	 * the keeping writer gave up (NULL: it writes from scratch then). */
+	size_t klen;
+	char *kept = rt_keep_text(s, (const char *)data, size, &klen);
+	if (kept && (klen != size || memcmp(kept, data, size) != 0)) {
+		fprintf(stderr, "keeping writer: an unedited scene saves to other bytes\n--- saved:\n%.*s\n", (int)klen,
+		        kept);
+		abort();
+	}
+	free(kept);
 	size_t alen, blen;
 	char *a = save_text(s, &alen);
 	rt_load_opts plain = {0};
