@@ -5,9 +5,10 @@
  *           [--no-cycles]
  *
  * cycles   rtsh's path mode against Blender's Cycles on the same scenes
- *          (scenes/cornell.rt and bench/glass-sky.rt, rebuilt in Cycles by
- *          bench/cycles_scene.py): CPU, one thread, 256x256, a 1-pixel box
- *          filter, no adaptive sampling, no denoising, the scene's bounces.
+ *          (scenes/cornell.rt at 256x256 and bench/glass-sky.rt at 128x128,
+ *          rebuilt in Cycles by bench/cycles_scene.py): CPU, one thread, a
+ *          1-pixel box filter, no adaptive sampling, no denoising, the
+ *          scene's bounces.
  *          Each renderer is judged against its own 4096-sample reference
  *          (rendered once and kept in build/quality/). At 16, 64 and 256
  *          samples it prints the CPU seconds per sample and
@@ -224,9 +225,9 @@ static bool run_cycles(const char *path, const char *name, int w, int h, int thr
 	return rc == 0;
 }
 
-static void bench_cycles_scene(const char *path, const char *name, bool cycles)
+static void bench_cycles_scene(const char *path, const char *name, int W, int H, bool cycles)
 {
-	const int W = 256, H = 256, REF = 4096;
+	const int REF = 4096;
 	scene *s = load(path);
 	int depth = s->hints.depth >= 0 ? s->hints.depth : 5;
 	rt_error err;
@@ -431,9 +432,9 @@ int main(int argc, char **argv)
 		die(out, NULL);
 	if (!only || strcmp(only, "cycles") == 0) {
 		if (!one || strcmp(one, "cornell") == 0)
-			bench_cycles_scene("scenes/cornell.rt", "cornell", cycles);
+			bench_cycles_scene("scenes/cornell.rt", "cornell", 256, 256, cycles);
 		if (!one || strcmp(one, "glass-sky") == 0)
-			bench_cycles_scene("bench/glass-sky.rt", "glass-sky", cycles);
+			bench_cycles_scene("bench/glass-sky.rt", "glass-sky", 128, 128, cycles);
 	}
 	if (!only || strcmp(only, "preview") == 0)
 		bench_preview();
