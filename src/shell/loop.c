@@ -21,7 +21,7 @@
 
 #include "shell/complete.h"
 #include "shell/history.h"
-#include "shell/pager.h"
+#include "term/pager.h"
 #include "shell/signals.h"
 #include "shell/shell.h"
 #include "term/abuf.h"
