@@ -4,7 +4,9 @@
 #   make run        build and open the shell on the built-in showcase scene
 #   make test       build and run every test, then again under ASan+UBSan, and
 #                   the threaded tests under TSan
-#   make bench      build and run the benchmark (writes build/bench.tsv)
+#   make bench      build and run the benchmark (writes build/bench.tsv), then
+#                   bench-quality: rtsh against Cycles at equal noise (skipped
+#                   without blender) and the preview's time to an error
 #   make fuzz       build the libFuzzer targets (clang) and run each for
 #                   FUZZ_SECONDS (default 60) on tests/fuzz/corpus
 #   make install    PREFIX=/usr/local DESTDIR=  (binary, man pages, scenes)
@@ -24,7 +26,7 @@ WARN    := -Wall -Wextra -Wpedantic -Werror -Wshadow -Wstrict-prototypes -Wmissi
 CPPFLAGS += -Iinclude -Isrc -I$(BUILD) -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -DRTSH_VERSION=\"$(VERSION)\"
 CFLAGS  ?= $(OPT) -g
 CFLAGS  += $(CSTD) $(WARN) -pthread -MMD -MP
-LDLIBS_CORE := -lpng -lm -pthread
+LDLIBS_CORE := -lpng -lassimp -lXpm -lstb -lm -pthread
 LDLIBS_FRONT := -lreadline -lncursesw $(LDLIBS_CORE)
 
 ifneq ($(SAN),)
@@ -49,6 +51,7 @@ BENCH_BIN := $(BUILD)/bench/bench
 # Optional: Embree 3's single-ray speed on the same rays, built by `make bench`
 # only when embree3/rtcore.h is installed (apt-get install libembree-dev).
 EMBREE_BIN := $(BUILD)/bench/embree_primary
+EMBREE_MESH_BIN := $(BUILD)/bench/embree_mesh
 # Equal-quality rows (rtsh against Blender's Cycles, preview time to an
 # error): bench/quality.c, run by `make bench` after the speed table.
 QUALITY_BIN := $(BUILD)/bench/quality
@@ -127,9 +130,13 @@ $(EMBREE_BIN): bench/embree_primary.c $(LIB)
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -o $@ $< $(LIB) -lembree3 $(LDLIBS_CORE)
 
+$(EMBREE_MESH_BIN): bench/embree_mesh.c bench/mesh_rays.h $(LIB)
+	@mkdir -p $(@D)
+	$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -o $@ $< $(LIB) -lembree3 $(LDLIBS_CORE)
+
 bench: all $(BENCH_BIN)
 	@if printf '#include <embree3/rtcore.h>\n' | $(CC) -E -x c - >/dev/null 2>&1; then \
-		$(MAKE) --no-print-directory $(EMBREE_BIN); \
+		$(MAKE) --no-print-directory $(EMBREE_BIN) $(EMBREE_MESH_BIN); \
 	else echo "bench: no embree3/rtcore.h, so no Embree row (apt-get install libembree-dev)"; fi
 	./$(BENCH_BIN) --out $(BUILD)/bench.tsv
 	$(MAKE) --no-print-directory bench-quality

@@ -34,6 +34,8 @@
 #include <unistd.h>
 
 #include "core/bvh.h"
+#include "mesh_rays.h"
+#include "rtsh/mesh.h"
 #include "rtsh/generate.h"
 #include "rtsh/render.h"
 #include "rtsh/rtfile.h"
@@ -665,6 +667,185 @@ static void bench_keymode(void)
 	close(p[1]);
 }
 
+/* --- triangle meshes beside Embree 3 (issue 10) --- */
+
+#define BUNNY "../shared/models/stanford-bunny.obj"
+
+/* Runs the Embree mesh harness once: 0 on success. */
+static int run_embree_mesh(const char *model, int w, int h, double *build, double *bytes, double *primary,
+                           double *sec)
+{
+	char exe[512], cmd[1400];
+	snprintf(exe, sizeof exe, "%s/embree_mesh", bench_dir);
+	if (access(exe, X_OK) != 0)
+		return -1;
+	snprintf(cmd, sizeof cmd, "%s %s %d %d 2>&1", exe, model, w, h);
+	FILE *p = popen(cmd, "r");
+	if (!p)
+		return -1;
+	char line[256];
+	int got = 0;
+	while (fgets(line, sizeof line, p)) {
+		long hits;
+		if (sscanf(line, "build %lf bytes %lf primary %lf hits %ld secondary %lf", build, bytes, primary, &hits,
+		           sec) == 5)
+			got = 1;
+	}
+	return pclose(p) == 0 && got ? 0 : -1;
+}
+
+/* A w x h grid of quads on a torus: 2 w h triangles, as an OBJ file. */
+static bool write_torus_obj(const char *path, int w, int h)
+{
+	FILE *f = fopen(path, "w");
+	if (!f)
+		return false;
+	for (int j = 0; j < h; j++)
+		for (int i = 0; i < w; i++) {
+			double a = 2 * RT_PI * i / w, b = 2 * RT_PI * j / h, r = 1 + 0.3 * cos(b);
+			fprintf(f, "v %.6f %.6f %.6f\n", r * cos(a), 0.3 * sin(b), r * sin(a));
+		}
+	for (int j = 0; j < h; j++)
+		for (int i = 0; i < w; i++) {
+			int a = j * w + i + 1, b = j * w + (i + 1) % w + 1, c = (j + 1) % h * w + i + 1,
+			    d = (j + 1) % h * w + (i + 1) % w + 1;
+			fprintf(f, "f %d %d %d\nf %d %d %d\n", a, c, b, b, c, d);
+		}
+	return fclose(f) == 0;
+}
+
+static void bench_mesh_load(void)
+{
+	/* 1M triangles in an OBJ: rtsh's reader and assimp's */
+	char path[64];
+	snprintf(path, sizeof path, "/tmp/rtsh-bench-%ld.obj", (long)getpid());
+	int gw = quick ? 100 : 1000, gh = quick ? 50 : 500;
+	if (!write_torus_obj(path, gw, gh))
+		fail("writing the torus OBJ", NULL);
+	double t[MAX_RUNS], ta[MAX_RUNS];
+	int n = quick ? 1 : 3;
+	for (int i = 0; i < n; i++) {
+		rt_error err = {0};
+		double t0 = now();
+		mesh *m = mesh_read_obj(path, &err);
+		t[i] = now() - t0;
+		if (!m)
+			fail(path, &err);
+		mesh_free(m);
+		t0 = now();
+		m = mesh_read_assimp(path, &err);
+		ta[i] = now() - t0;
+		if (!m)
+			fail(path, &err);
+		mesh_free(m);
+	}
+	double mo = median(t, n), ma = median(ta, n);
+	char name[48];
+	snprintf(name, sizeof name, "torus %dk tris .obj", 2 * gw * gh / 1000);
+	row *r = add_row(name, "load-rtsh", 0, 0, 0, 1, n, mo, -1);
+	snprintf(r->note, sizeof r->note, "our OBJ reader (target < 1.5 s for 1M); %.2fx faster than assimp", ma / mo);
+	r = add_row(name, "load-assimp", 0, 0, 0, 1, n, ma, -1);
+	snprintf(r->note, sizeof r->note, "aiImportFile, triangulate + pretransform");
+	unlink(path);
+}
+
+static void bench_mesh(void)
+{
+	bench_mesh_load();
+	if (access(BUNNY, R_OK) != 0) {
+		row *r = add_row("bunny", "triangles", 0, 0, 0, 1, 0, -1, -1);
+		snprintf(r->note, sizeof r->note, "skipped: %s is absent", BUNNY);
+		return;
+	}
+	int w = quick ? 320 : 1920, h = quick ? 180 : 1080;
+	rt_error err = {0};
+	/* the tree alone, as Embree's build: the mesh read again each time */
+	double tb[MAX_RUNS];
+	mesh *m = NULL;
+	for (int i = 0; i < runs; i++) {
+		mesh_free(m);
+		m = mesh_load(BUNNY, &err);
+		if (!m)
+			fail(BUNNY, &err);
+		double t0 = now();
+		if (!mesh_prepare(m, false, 0, &err))
+			fail(BUNNY, &err);
+		tb[i] = now() - t0;
+	}
+	box bb = m->bounds;
+	uint32_t ntris = m->ntris;
+	mesh_free(m);
+	/* the world: the model where it is (its box centre, its longest side) */
+	camera c = bench_mesh_camera(bb);
+	vec3 ctr = box_center(bb), ext = v3_sub(bb.hi, bb.lo);
+	char text[1024];
+	snprintf(text, sizeof text, "C %.17g,%.17g,%.17g %.17g,%.17g,%.17g %g\nmesh %s %.17g,%.17g,%.17g 0,1,0 %.17g smooth=0\n",
+	         c.pos.x, c.pos.y, c.pos.z, c.dir.x, c.dir.y, c.dir.z, c.fov, "stanford-bunny.obj", ctr.x, ctr.y, ctr.z,
+	         v3_max_comp(ext));
+	scene *s = rt_load_string(text, strlen(text), "../shared/models/bench.rt", NULL, &err);
+	if (!s)
+		fail("bunny scene", &err);
+	world *wd = build(s);
+	double bytes = (double)world_memory(wd) / ntris;
+	double eps = 1e-4 * v3_len(ext);
+	double tp[MAX_RUNS], ts[MAX_RUNS], be[MAX_RUNS], byte_e = -1, pe[MAX_RUNS], se[MAX_RUNS];
+	int ne = 0;
+	ray *sr = malloc((size_t)w * h * sizeof *sr);
+	if (!sr)
+		fail("secondary rays", NULL);
+	long hits = 0, nsec = 0;
+	for (int i = 0; i < runs; i++) {
+		tp[i] = primary_pass(wd, w, h, false, &hits);
+		nsec = 0;
+		for (int y = 0; y < h; y++)
+			for (int x = 0; x < w; x++) {
+				ray r = cam_ray(&wd->cam, x + 0.5, y + 0.5, w, h);
+				hit hh;
+				if (!world_intersect(wd, &r, 0.0, INFINITY, &hh))
+					continue;
+				vec3 n = hh.front ? hh.n : v3_neg(hh.n);
+				sr[nsec++] = (ray){v3_madd(hh.p, n, eps), bench_diffuse_dir(n, (uint64_t)y * (uint64_t)w + (uint64_t)x)};
+			}
+		double t0 = now();
+		for (long k = 0; k < nsec; k++) {
+			hit hh;
+			world_intersect(wd, &sr[k], 0.0, INFINITY, &hh);
+		}
+		ts[i] = now() - t0;
+		double eb, ebytes, ep, es;
+		if (!quick && run_embree_mesh(BUNNY, w, h, &eb, &ebytes, &ep, &es) == 0) {
+			be[ne] = eb;
+			pe[ne] = ep;
+			se[ne++] = es;
+			byte_e = ebytes / ntris;
+		}
+	}
+	free(sr);
+	double mb = median(tb, runs), mp = median(tp, runs), ms = median(ts, runs);
+	double mrp = (double)w * h / mp * 1e-6, mrs = (double)nsec / ms * 1e-6;
+	double eb = ne ? median(be, ne) : -1, ep = ne ? median(pe, ne) : -1, es = ne ? median(se, ne) : -1;
+	row *r = add_row("bunny 69k tris", "tri-build", 0, 0, 0, 1, runs, mb, -1);
+	if (ne)
+		snprintf(r->note, sizeof r->note, "BVH over triangles; Embree high %.3f s: %.2fx its time; %.1f B/tri, Embree %.1f",
+		         eb, mb / eb, bytes, byte_e);
+	else
+		snprintf(r->note, sizeof r->note, "BVH over triangles; %.1f bytes/triangle in the world", bytes);
+	r = add_row("bunny 69k tris", "tri-primary", w, h, 1, 1, runs, mp, mrp);
+	if (ne)
+		snprintf(r->note, sizeof r->note, "%.0f%% hit; Embree rtcIntersect1 %.2f Mrays/s: rtsh %.2fx Embree",
+		         100.0 * hits / ((double)w * h), ep, mrp / ep);
+	r = add_row("bunny 69k tris", "tri-diffuse", w, h, 1, 1, runs, ms, mrs);
+	if (ne)
+		snprintf(r->note, sizeof r->note, "1 cosine ray per primary hit; Embree %.2f Mrays/s: rtsh %.2fx Embree", es,
+		         mrs / es);
+	if (!ne && !quick) {
+		r = add_row("bunny 69k tris", "embree-mesh", 0, 0, 0, 1, 0, -1, -1);
+		snprintf(r->note, sizeof r->note, "no %s/embree_mesh (needs embree3/rtcore.h)", bench_dir);
+	}
+	world_free(wd);
+	scene_free(s);
+}
+
 static void print_table(FILE *f, bool tsv)
 {
 	if (tsv)
@@ -698,7 +879,7 @@ static void print_table(FILE *f, bool tsv)
 
 static void usage(void)
 {
-	fputs("usage: bench [--quick] [--runs N] [--out FILE.tsv] [--only grid|primary|spheres|load|path|preview|keymode]\n",
+	fputs("usage: bench [--quick] [--runs N] [--out FILE.tsv] [--only grid|primary|spheres|load|path|preview|keymode|mesh]\n",
 	      stderr);
 	exit(2);
 }
@@ -759,6 +940,8 @@ int main(int argc, char **argv)
 		bench_preview();
 	if (!only || strcmp(only, "keymode") == 0)
 		bench_keymode();
+	if (!only || strcmp(only, "mesh") == 0)
+		bench_mesh();
 	la = fopen("/proc/loadavg", "r");
 	if (la && fscanf(la, "%lf %lf %lf", &load1, &load5, &load15) == 3)
 		fprintf(stderr, "bench: done in %.0f s; load average %.2f %.2f %.2f\n", now() - t0, load1, load5,

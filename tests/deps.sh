@@ -9,6 +9,9 @@ have_header() {
 have_header png.h || missing="$missing libpng-dev"
 have_header readline/readline.h || missing="$missing libreadline-dev"
 have_header ncurses.h || missing="$missing libncurses-dev"
+have_header assimp/cimport.h || missing="$missing libassimp-dev"
+have_header stb/stb_image.h || missing="$missing libstb-dev"
+have_header X11/xpm.h || missing="$missing libxpm-dev"
 printf '#include <stdarg.h>\n#include <stddef.h>\n#include <setjmp.h>\n#include <cmocka.h>\n' |
 	${CC:-cc} -E -x c - >/dev/null 2>&1 || missing="$missing libcmocka-dev"
 command -v ${CC:-cc} >/dev/null 2>&1 || missing="$missing build-essential"

@@ -31,6 +31,10 @@ typedef struct rt_load_opts {
  * added; with opts->strict that is an error). A loaded scene has at least
  * one camera and cam == 0. */
 scene *rt_load_file(const char *path, const rt_load_opts *opts, rt_error *err);
+/* The model viewer's scene for a model file (.obj .ply .gltf .glb .stl):
+ * the model on a ground plane, framed by the camera, with a light and a
+ * sky (viewer.c). rt_load_file calls it for those extensions. */
+scene *rt_load_model(const char *path, const rt_load_opts *opts, rt_error *err);
 /* Loads a scene from memory (text need not be NUL-terminated); `name` is the
  * file name used in messages. */
 scene *rt_load_string(const char *text, size_t len, const char *name, const rt_load_opts *opts,

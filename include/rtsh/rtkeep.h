@@ -33,6 +33,9 @@
 bool rt_write_keeping(const scene *s, const char *src, size_t len, FILE *f, rt_error *err);
 /* The same to path, atomically. */
 bool rt_save_keeping(const scene *s, const char *src, size_t len, const char *path, rt_error *err);
+/* The file the source text came from, for this thread (NULL: none): model
+ * and texture names in its lines are relative to its folder. */
+extern _Thread_local const char *rt_keep_source;
 /* The text rt_write_keeping writes, in a new buffer (*out_len bytes, NUL
  * after them); NULL when out of memory or when it falls back to rt_write. */
 char *rt_keep_text(const scene *s, const char *src, size_t len, size_t *out_len);

@@ -26,8 +26,16 @@ typedef enum obj_kind {
 	OBJ_DISC,
 	OBJ_RECT,
 	OBJ_TRIANGLE,
-	OBJ_KIND_COUNT
+	OBJ_KIND_COUNT, /* the kinds drawn from the unit shapes (shape.h) */
+	OBJ_MESH = OBJ_KIND_COUNT, /* a model file (mesh.h), placed like a unit shape */
+	OBJ_KIND_ALL
 } obj_kind;
+
+/* One shared copy of the string s[0..n) that lives as long as the process:
+ * equal strings give the same pointer, so objects holding file names stay
+ * plain values (copied, compared and undone like numbers). NULL when out
+ * of memory. */
+const char *rt_intern(const char *s, size_t n);
 
 /* The .rt identifier ("sp", "pl", ...) and the English name of a kind. */
 const char *obj_kind_id(obj_kind k);
@@ -48,6 +56,13 @@ typedef struct material {
 	double ior;      /* ior=    0 opaque, else refractive index >= 1 (0) */
 	double emission; /* emit=   emitted radiance = emit x colour (0) */
 	int checker;     /* checker= 0 none, else squares per unit (0) */
+	/* Textures (rt_intern'ed paths, NULL = none; see rtsh(5), "Textures"). */
+	const char *texture;   /* texture=   colour image, sRGB */
+	const char *normalmap; /* normalmap= tangent-space normal map, linear */
+	const char *bump;      /* bump=      height map */
+	double bumpscale;      /* bumpscale= height of white in scene units (1) */
+	double uvscale[2];     /* uvscale=U,V (1,1) */
+	double uvoffset[2];    /* uvoffset=U,V (0,0) */
 } material;
 
 /* The default material of a 42-format object: diffuse 0.9, specular 0.9,
@@ -66,6 +81,13 @@ typedef struct object {
 	double shear[6];  /* xy xz yx yz zx zy; all zero = none */
 	vec3 tri[3];      /* OBJ_TRIANGLE: the vertices (pos/dir/scale unused) */
 	material mat;
+	/* OBJ_MESH: the model file (rt_intern'ed, as the reader resolved it:
+	 * relative to the .rt file's folder, or absolute), whether the colour
+	 * was left out (the model's own materials are used), and the normals. */
+	const char *file;
+	bool file_colors;
+	int smooth;       /* smooth= 0 flat faces, 1 smooth normals (1) */
+	double crease;    /* crease= degrees beyond which an edge stays sharp (60) */
 } object;
 
 typedef struct light {
@@ -90,6 +112,8 @@ typedef struct sky {
 	vec3 zenith;     /* sRGB 0..255 */
 	vec3 horizon;    /* sRGB 0..255 */
 	double strength; /* radiance scale, >= 0 */
+	const char *file; /* sky FILE [STRENGTH [ROTATION]]: an HDR image (rt_intern'ed), or NULL */
+	double rotation;  /* degrees about +Y */
 } sky;
 
 /* Per-scene render hints from the file (`R`, `set` lines). scene_new sets

@@ -26,7 +26,16 @@ typedef struct mat_lin {
 	vec3 emission;     /* emitted radiance (linear) */
 	double checker;    /* squares per unit; 0 = none */
 	int32_t light;     /* index into world.emitters; -1 when not sampled */
+	const struct mat_tex *tx; /* textures, or NULL (most materials): 8 bytes here */
 } mat_lin;
+
+/* The textures of a material (texture.h; NULL = none), held by the world. */
+typedef struct mat_tex {
+	const struct texture *tex, *nmap, *bump;
+	bool tint;         /* tex x albedo (texture= with a colour); else tex alone */
+	double bumpscale;
+	double uvs[2], uvo[2]; /* uv x uvs + uvo */
+} mat_tex;
 
 typedef struct light_lin {
 	vec3 pos;
@@ -62,6 +71,7 @@ typedef enum prim_tag {
 	PRIM_SPHERE,   /* u.sph */
 	PRIM_TRIANGLE, /* u.index into world.tris */
 	PRIM_SHAPE,    /* u.index into world.shapes: a unit shape and its matrix */
+	PRIM_MESH,     /* u.index into world.insts: a mesh instance */
 } prim_tag;
 
 typedef struct prim {
@@ -95,6 +105,17 @@ typedef struct prim_plane {
 	uint32_t shape; /* its matrix in world.shapes (texture coordinates) */
 } prim_plane;
 
+/* An instance of a shared mesh (mesh.h): O(1) memory however many
+ * triangles it has. `inv` takes world space to the mesh file's own
+ * coordinates (the object's transform after the mesh's bounding box is
+ * centred and its longest side scaled to 2, the unit shapes' size), `fwd`
+ * back. Sub-materials of the file are mats[mat_base + i]. */
+typedef struct prim_inst {
+	double inv[3][4], fwd[3][4];
+	const struct mesh *mesh;
+	uint32_t mat_base;   /* UINT32_MAX: the object's own material */
+} prim_inst;
+
 typedef struct bvh bvh;
 
 typedef struct world {
@@ -102,6 +123,7 @@ typedef struct world {
 	vec3 ambient;   /* linear ambient radiance (ratio x colour) */
 	bool has_sky;
 	vec3 sky_zenith, sky_horizon; /* linear, already x strength */
+	const struct envmap *env; /* an HDR sky (envmap.h), or NULL */
 	light_lin *lights;
 	size_t nlights;
 	prim *prims;     /* bounded primitives, in BVH order */
@@ -112,6 +134,14 @@ typedef struct world {
 	size_t nshapes;
 	prim_tri *tris;  /* of the PRIM_TRIANGLE primitives */
 	size_t ntris;
+	prim_inst *insts; /* of the PRIM_MESH primitives */
+	size_t ninsts;
+	struct mesh **meshes; /* the distinct meshes the instances share (held) */
+	size_t nmeshes;
+	struct texture **texs; /* the textures the materials use (held) */
+	size_t ntexs;
+	mat_tex *mtex;   /* what mat_lin.tx points to */
+	size_t nmtex;
 	mat_lin *mats;   /* indexed by prim.object */
 	size_t nmats;
 	emitter *emitters; /* sampled in path mode; nemitters = 0 turns that off */
@@ -127,8 +157,12 @@ typedef struct hit {
 	vec3 p;        /* the point */
 	vec3 n;        /* unit geometric normal, outward */
 	vec3 local;    /* the point in object space (textures) */
-	bool front;    /* the ray arrived on the outward side */
+	bool front;    /* the ray arrived on the outward side (of the geometric normal) */
 	uint32_t object;
+	uint32_t mat;  /* index into world.mats (the object's, or a model's own) */
+	bool has_uv;   /* u, v, dpdu, dpdv are set */
+	double u, v;   /* texture coordinates, uvscale/uvoffset applied */
+	vec3 dpdu, dpdv; /* world-space change of the point per unit u and v */
 } hit;
 
 /* Builds the world for the scene's active camera; NULL (err set) when out of

@@ -27,6 +27,7 @@
  * radiance ratio L gives a surface the irradiance pi * L * cos(theta), so a
  * white Lambertian surface facing it sends back exactly L. */
 #include "integrators.h"
+#include "envmap.h"
 
 #include "emitters.h"
 #include "warp.h"
@@ -325,14 +326,20 @@ vec3 path_radiance(const world *w, const render_settings *s, ray r, sampler *g)
 	 * when the emitters were also sampled there (0: weigh emission by 1). */
 	vec3 from = r.o;
 	double from_pdf = 0.0;
+	double env_from_pdf = 0.0; /* the same for the HDR sky (envmap.c) */
 	for (int bounce = 0;; bounce++) {
 		g->dim = dim0 + 6u * (uint32_t)bounce;
 		hit h;
 		if (!world_intersect(w, &r, 0.0, INFINITY, &h)) {
-			radiance = v3_add(radiance, v3_mul(thr, world_background(w, r.d, MODE_PATH)));
+			vec3 bg = world_background(w, r.d, MODE_PATH);
+			if (w->env && env_from_pdf > 0.0) {
+				double pe = envmap_pdf(w->env, r.d);
+				bg = v3_scale(bg, env_from_pdf * env_from_pdf / (env_from_pdf * env_from_pdf + pe * pe));
+			}
+			radiance = v3_add(radiance, v3_mul(thr, bg));
 			break;
 		}
-		const mat_lin *m = &w->mats[h.object];
+		const mat_lin *m = &w->mats[h.mat];
 		if (m->light >= 0 && from_pdf > 0.0) {
 			double pdf_l = emitter_pdf(&w->emitters[m->light], from, r.d, h.t) /
 			               (double)w->nemitters;
@@ -351,6 +358,12 @@ vec3 path_radiance(const world *w, const render_settings *s, ray r, sampler *g)
 		bool sample_emitters = b.smooth && w->nemitters;
 		if (sample_emitters)
 			radiance = v3_add(radiance, v3_mul(thr, emitter_light(w, &b, p, h.object, g)));
+		if (b.smooth && w->env) {
+			/* the sky's two numbers: hashed dimensions of their own, far
+			 * from the bounces' (envmap.c) */
+			g->dim = (1u << 20) + 2u * (uint32_t)bounce;
+			radiance = v3_add(radiance, v3_mul(thr, envmap_light(w, &b, p, g)));
+		}
 
 		g->dim = dim0 + 6u * (uint32_t)bounce + 2u;
 		double u[3];
@@ -365,6 +378,7 @@ vec3 path_radiance(const world *w, const render_settings *s, ray r, sampler *g)
 		r = (ray){bs.transmit ? offset_point(w, h.p, v3_neg(b.n)) : p, bs.wi};
 		from = r.o;
 		from_pdf = sample_emitters && !bs.delta ? bsdf_pdf(&b, bs.wi) : 0.0;
+		env_from_pdf = b.smooth && w->env && !bs.delta ? bsdf_pdf(&b, bs.wi) : 0.0;
 
 		/* Russian roulette after the third bounce: survive with q, weigh
 		 * the survivors by 1 / q. q is the square root of the throughput,

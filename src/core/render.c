@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "integrators.h"
+#include "rtsh/texture.h"
 
 const char *render_mode_name(render_mode m)
 {
@@ -117,10 +118,13 @@ vec3 render_sample(const world *w, const render_settings *s, int px, int py, int
 	 * sits at the centre and needs no numbers); the path's numbers follow.
 	 * Every pixel has its own scrambles, the same for all its samples, so
 	 * that its first 2^k positions are stratified (sampler.h). */
-	sampler sp = sampler_for(s->seed, pixel, (uint32_t)sample);
-	if (s->samples > 1)
-		samp_2d(&sp, &u, &v);
-	sp.dim = 2;
+	sampler sp = {0, 0, 0, 0};
+	if (s->samples > 1 || s->mode == MODE_PATH) {
+		sp = sampler_for(s->seed, pixel, (uint32_t)sample);
+		if (s->samples > 1)
+			samp_2d(&sp, &u, &v);
+		sp.dim = 2;
+	}
 	ray r = cam_ray(&w->cam, px + u, py + v, fw, fh);
 	vec3 c = s->mode == MODE_PATH ? path_radiance(w, s, r, &sp) : whitted_radiance(w, s, r);
 	/* A NaN or infinity from a degenerate case must not poison the pixel. */
@@ -151,6 +155,7 @@ static void render_tile(shared *sh, long t)
 	int x1 = x0 + RENDER_TILE < fb->w ? x0 + RENDER_TILE : fb->w;
 	int y1 = y0 + RENDER_TILE < fb->h ? y0 + RENDER_TILE : fb->h;
 	double inv = 1.0 / job->sample_end;
+	texture_set_pixel_angle(2.0 * job->w->cam.tan_half / fb->w); /* texture footprints */
 	for (int y = y0; y < y1; y++)
 		for (int x = x0; x < x1; x++) {
 			size_t i = ((size_t)y * (size_t)fb->w + (size_t)x) * 3;

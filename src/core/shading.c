@@ -1,8 +1,12 @@
 /* rtsh — shading helpers shared by the integrators. */
 #include "integrators.h"
+#include "envmap.h"
+#include "rtsh/texture.h"
 
 vec3 world_background(const world *w, vec3 dir, render_mode mode)
 {
+	if (w->env)
+		return envmap_eval(w->env, dir);
 	if (w->has_sky) {
 		/* The height gradient of the path-tracer seed: horizon at and
 		 * below y = 0, zenith straight up. */
@@ -14,6 +18,13 @@ vec3 world_background(const world *w, vec3 dir, render_mode mode)
 
 vec3 hit_albedo(const mat_lin *m, const hit *h)
 {
+	if (m->tx && m->tx->tex && h->has_uv) {
+		/* the footprint of a pixel at this distance, in u units */
+		double du = v3_len(h->dpdu);
+		double width = du > 0 ? h->t * texture_pixel_angle() / du : 0;
+		vec3 c = texture_lookup(m->tx->tex, h->u, h->v, width);
+		return m->tx->tint ? v3_mul(c, m->albedo) : c;
+	}
 	if (m->checker <= 0.0)
 		return m->albedo;
 	/* Alternate squares of side 1/checker object units are darkened. */

@@ -20,7 +20,7 @@ static vec3 trace(const world *w, ray r, int depth)
 	hit h;
 	if (!world_intersect(w, &r, 0.0, INFINITY, &h))
 		return world_background(w, r.d, MODE_WHITTED);
-	const mat_lin *m = &w->mats[h.object];
+	const mat_lin *m = &w->mats[h.mat];
 	vec3 n = h.front ? h.n : v3_neg(h.n);
 	vec3 albedo = hit_albedo(m, &h);
 	vec3 v = v3_neg(r.d);

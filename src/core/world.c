@@ -12,6 +12,8 @@
 
 #include "bvh.h"
 #include "emitters.h"
+#include "envmap.h"
+#include "surface.h"
 #include "rtsh/shape.h"
 
 /* sRGB code (0..255, not necessarily whole) to linear, IEC 61966-2-1. */
@@ -80,6 +82,7 @@ static mat_lin material_linear(const material *m)
 	l.emission = v3_scale(l.albedo, m->emission);
 	l.checker = m->checker;
 	l.light = -1; /* set by emitters_build */
+	l.tx = NULL;  /* set by surf_material */
 	return l;
 }
 
@@ -92,13 +95,15 @@ static bool is_fast_sphere(const object *o)
 	for (int i = 0; i < 6; i++)
 		if (o->shear[i] != 0.0)
 			return false;
-	return o->mat.checker == 0;
+	return o->mat.checker == 0 && !o->mat.texture && !o->mat.normalmap && !o->mat.bump;
 }
 
 /* Fills p (and the side record it needs) for object o and its world bounds
  * *b (planes: see make_plane). */
 static bool make_prim(world *w, const object *o, uint32_t index, prim *p, box *b, rt_error *err)
 {
+	if (o->kind == OBJ_MESH)
+		return surf_make_inst(w, o, index, p, b, err);
 	memset(p, 0, sizeof *p);
 	p->object = index;
 	if (o->kind == OBJ_TRIANGLE) {
@@ -201,7 +206,14 @@ world *world_build(const scene *s, rt_error *err)
 	if (s->has_ambient)
 		w->ambient = v3_scale(srgb255_to_linear(s->amb.color), s->amb.ratio);
 	w->has_sky = s->has_sky;
-	if (s->has_sky) {
+	if (s->has_sky && s->sky.file) {
+		envmap *env = envmap_new(s->sky.file, s->sky.strength, s->sky.rotation, err);
+		if (!env) {
+			world_free(w);
+			return NULL;
+		}
+		w->env = env;
+	} else if (s->has_sky) {
 		w->sky_zenith = v3_scale(srgb255_to_linear(s->sky.zenith), s->sky.strength);
 		w->sky_horizon = v3_scale(srgb255_to_linear(s->sky.horizon), s->sky.strength);
 	}
@@ -210,7 +222,7 @@ world *world_build(const scene *s, rt_error *err)
 		const object *o = &s->objs[i];
 		nplanes += o->kind == OBJ_PLANE;
 		ntris += o->kind == OBJ_TRIANGLE;
-		nshapes += o->kind != OBJ_TRIANGLE && !is_fast_sphere(o);
+		nshapes += o->kind != OBJ_TRIANGLE && o->kind != OBJ_MESH && !is_fast_sphere(o);
 	}
 	size_t nbounded = s->nobjs - nplanes;
 	w->lights = calloc(s->nlights ? s->nlights : 1, sizeof *w->lights);
@@ -234,14 +246,21 @@ world *world_build(const scene *s, rt_error *err)
 		w->lights[i].radiance = v3_scale(srgb255_to_linear(s->lights[i].color), s->lights[i].ratio);
 	}
 	w->nmats = s->nobjs;
+	if (!surf_begin(w, s, err)) {
+		free(bounds);
+		free(order);
+		world_free(w);
+		return NULL;
+	}
 	w->bounds = box_empty();
 	double extent = v3_max_abs(c.pos);
 	for (size_t i = 0; i < s->nobjs; i++) {
 		const object *o = &s->objs[i];
 		w->mats[i] = material_linear(&o->mat);
 		bool plane = o->kind == OBJ_PLANE;
-		if (plane ? !make_plane(w, o, (uint32_t)i, &w->planes[w->nplanes], err)
-		          : !make_prim(w, o, (uint32_t)i, &w->prims[w->nprims], &bounds[w->nprims], err)) {
+		if (!surf_material(w, o, (uint32_t)i, err) ||
+		    (plane ? !make_plane(w, o, (uint32_t)i, &w->planes[w->nplanes], err)
+		           : !make_prim(w, o, (uint32_t)i, &w->prims[w->nprims], &bounds[w->nprims], err))) {
 			free(bounds);
 			free(order);
 			world_free(w);
@@ -273,7 +292,10 @@ world *world_build(const scene *s, rt_error *err)
 		return NULL;
 	}
 	for (size_t i = 0; i < w->nprims; i++)
-		costs[i] = w->prims[i].tag == PRIM_SPHERE ? 1.0f : w->prims[i].tag == PRIM_TRIANGLE ? 2.0f : 8.0f;
+		costs[i] = w->prims[i].tag == PRIM_SPHERE     ? 1.0f
+		           : w->prims[i].tag == PRIM_TRIANGLE ? 2.0f
+		           : w->prims[i].tag == PRIM_MESH     ? 32.0f
+		                                              : 8.0f;
 	w->tree = bvh_build(bounds, costs, w->nprims, order, err);
 	free(costs);
 	free(bounds);
@@ -299,6 +321,8 @@ void world_free(world *w)
 	free(w->shapes);
 	free(w->tris);
 	free(w->emitters);
+	surf_free(w);
+	envmap_free((envmap *)w->env);
 	bvh_free(w->tree);
 	free(w);
 }
@@ -351,6 +375,8 @@ static bool other_hit(const world *w, const prim *p, const ray *r, double tmin, 
 		const prim_tri *tr = &w->tris[p->u.index];
 		return tri_intersect(tr->v0, tr->e1, tr->e2, r->o, r->d, tmin, tmax, t);
 	}
+	if (p->tag == PRIM_MESH)
+		return surf_inst_hit(w, p, r, tmin, tmax, t, nl);
 	const prim_shape *sh = &w->shapes[p->u.index];
 	vec3 o, d;
 	to_object(sh, r, &o, &d);
@@ -364,6 +390,8 @@ static bool other_occluded(const world *w, const prim *p, const ray *r, double t
 		const prim_tri *tr = &w->tris[p->u.index];
 		return tri_intersect(tr->v0, tr->e1, tr->e2, r->o, r->d, tmin, tmax, &t);
 	}
+	if (p->tag == PRIM_MESH)
+		return surf_inst_occluded(w, p, r, tmin, tmax);
 	const prim_shape *sh = &w->shapes[p->u.index];
 	vec3 o, d;
 	to_object(sh, r, &o, &d);
@@ -417,6 +445,7 @@ static void finish_plane(const world *w, const prim_plane *pl, const ray *r, dou
 	                  m[2][0] * q.x + m[2][1] * q.y + m[2][2] * q.z + m[2][3]};
 	h->front = v3_dot(pl->n, r->d) < 0.0;
 	h->n = pl->n;
+	surf_shape_uv(w, OBJ_PLANE, sh->inv, pl->n, h);
 }
 
 /* Fills the hit record for the primitive found nearest. */
@@ -425,6 +454,8 @@ static void finish_hit(const world *w, const prim *p, const ray *r, double t, ve
 	h->t = t;
 	h->p = ray_at(*r, t);
 	h->object = p->object;
+	h->mat = p->object;
+	h->has_uv = false;
 	vec3 n;
 	if (p->tag == PRIM_SPHERE) {
 		n = v3_norm(v3_sub(h->p, p->u.sph.c));
@@ -433,13 +464,18 @@ static void finish_hit(const world *w, const prim *p, const ray *r, double t, ve
 		h->n = n;
 		return;
 	}
+	if (p->tag == PRIM_MESH) {
+		surf_inst_finish(w, p, r, nl, h);
+		return;
+	}
+	const prim_shape *shp = NULL;
 	if (p->tag == PRIM_TRIANGLE) {
 		const prim_tri *tr = &w->tris[p->u.index];
 		n = v3_cross(tr->e1, tr->e2);
 		h->local = h->p;
 	} else {
-		const prim_shape *sh = &w->shapes[p->u.index];
-		const double(*m)[4] = sh->inv;
+		shp = &w->shapes[p->u.index];
+		const double(*m)[4] = shp->inv;
 		n = (vec3){m[0][0] * nl.x + m[1][0] * nl.y + m[2][0] * nl.z,
 		           m[0][1] * nl.x + m[1][1] * nl.y + m[2][1] * nl.z,
 		           m[0][2] * nl.x + m[1][2] * nl.y + m[2][2] * nl.z};
@@ -451,6 +487,12 @@ static void finish_hit(const world *w, const prim *p, const ray *r, double t, ve
 	n = v3_norm(n);
 	h->front = v3_dot(n, r->d) < 0.0;
 	h->n = n;
+	if (shp) {
+		surf_shape_uv(w, shp->kind, shp->inv, nl, h);
+	} else {
+		const prim_tri *tr = &w->tris[p->u.index];
+		surf_triangle_uv(w, tr->v0, tr->e1, tr->e2, h);
+	}
 }
 
 /* --- the tree walk --- */
@@ -475,7 +517,7 @@ size_t world_memory(const world *w)
 	           w->nemitters * sizeof *w->emitters;
 	if (w->tree)
 		n += sizeof *w->tree + w->tree->nnodes * sizeof *w->tree->nodes;
-	return n;
+	return n + surf_memory(w) + (w->env ? envmap_memory(w->env) : 0);
 }
 
 /* What the slab tests need of a ray, computed once per ray. The tests run in

@@ -29,7 +29,16 @@ typedef struct rt_key {
 	double def;         /* the value that means "absent"; not written */
 	bool (*extra)(double v); /* a further rule within [min,max], or NULL */
 	const char *expect; /* what a valid value is, for messages */
+	int type;           /* RT_KEY_NUM (0), RT_KEY_FILE or RT_KEY_PAIR */
+	bool mesh_only;     /* only on mesh objects */
 } rt_key;
+
+/* RT_KEY_FILE: a file name (const char * field, rt_intern'ed, resolved
+ * against the .rt file's folder); RT_KEY_PAIR: U,V into double[2]. */
+enum { RT_KEY_NUM, RT_KEY_FILE, RT_KEY_PAIR };
+/* The folder model and texture names are written relative to (rt_save sets
+ * it for the duration of a write; "" = as stored). */
+extern _Thread_local const char *rt_write_dir;
 
 extern const rt_key rt_keys[];
 extern const size_t rt_nkeys;

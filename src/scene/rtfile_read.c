@@ -17,7 +17,9 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "rtsh/mesh.h"
 #include "rtsh/render.h"
+#include "rtsh/texture.h"
 #include "rtsh/rtfile.h"
 #include "scene/rtfile_priv.h"
 
@@ -35,15 +37,31 @@ static bool ior_rule(double v) { return v == 0.0 || v >= 1.0; }
 
 const rt_key rt_keys[] = {
 	{"twist", offsetof(object, twist), false, false, -RT_NUM_MAX, RT_NUM_MAX, 0, NULL,
-	 "twist in degrees"},
-	{"fuzz", offsetof(object, mat.fuzz), false, true, 0, 1, 0, NULL, "fuzz in [0,1]"},
-	{"metal", offsetof(object, mat.metal), false, true, 0, 1, 0, NULL, "metal in [0,1]"},
+	 "twist in degrees", RT_KEY_NUM, false},
+	{"fuzz", offsetof(object, mat.fuzz), false, true, 0, 1, 0, NULL, "fuzz in [0,1]", RT_KEY_NUM, false},
+	{"metal", offsetof(object, mat.metal), false, true, 0, 1, 0, NULL, "metal in [0,1]", RT_KEY_NUM, false},
 	{"ior", offsetof(object, mat.ior), false, true, 0, 10, 0, ior_rule,
-	 "ior 0 (opaque) or a refractive index in [1,10]"},
+	 "ior 0 (opaque) or a refractive index in [1,10]", RT_KEY_NUM, false},
 	{"emit", offsetof(object, mat.emission), false, true, 0, 1e6, 0, NULL,
-	 "emit in [0,1e6]"},
+	 "emit in [0,1e6]", RT_KEY_NUM, false},
 	{"checker", offsetof(object, mat.checker), true, true, 0, 1000, 0, NULL,
-	 "checker a whole number in [0,1000]"},
+	 "checker a whole number in [0,1000]", RT_KEY_NUM, false},
+	{"texture", offsetof(object, mat.texture), false, true, 0, 0, 0, NULL,
+	 "texture=FILE, a PNG, JPEG, BMP, TGA, HDR, PPM, PFM or XPM image", RT_KEY_FILE, false},
+	{"normalmap", offsetof(object, mat.normalmap), false, true, 0, 0, 0, NULL,
+	 "normalmap=FILE, a tangent-space normal map image", RT_KEY_FILE, false},
+	{"bump", offsetof(object, mat.bump), false, true, 0, 0, 0, NULL,
+	 "bump=FILE, a height map image", RT_KEY_FILE, false},
+	{"bumpscale", offsetof(object, mat.bumpscale), false, true, -1e6, 1e6, 1, NULL,
+	 "bumpscale in [-1e6,1e6]", RT_KEY_NUM, false},
+	{"uvscale", offsetof(object, mat.uvscale), false, true, -1e6, 1e6, 1, NULL,
+	 "uvscale=U,V, two numbers in [-1e6,1e6], not 0", RT_KEY_PAIR, false},
+	{"uvoffset", offsetof(object, mat.uvoffset), false, true, -1e6, 1e6, 0, NULL,
+	 "uvoffset=U,V, two numbers in [-1e6,1e6]", RT_KEY_PAIR, false},
+	{"smooth", offsetof(object, smooth), true, false, 0, 1, 1, NULL,
+	 "smooth 0 (flat faces) or 1 (smooth normals)", RT_KEY_NUM, true},
+	{"crease", offsetof(object, crease), false, false, 0, 180, 60, NULL,
+	 "crease in degrees, [0,180]", RT_KEY_NUM, true},
 };
 const size_t rt_nkeys = sizeof rt_keys / sizeof rt_keys[0];
 
@@ -85,6 +103,7 @@ typedef struct tok {
 	size_t len;
 	int col;       /* 1-based byte column of the first character */
 	int endcol;    /* the column just after the token */
+	bool quoted;   /* written in double quotes */
 } tok;
 
 typedef struct parser {
@@ -107,6 +126,7 @@ typedef struct parser {
 	char *text;
 	size_t cap_text;
 	char quote[96];   /* a token shortened for a message */
+	char *dir;        /* the .rt file's folder ("" = the current one) */
 } parser;
 
 typedef struct elem_def elem_def;
@@ -210,6 +230,24 @@ static bool lex_line(parser *p, const char *s, size_t len)
 		if (comment_at(s, i, len))
 			break;
 		tok t = {.s = out, .col = (int)i + 1};
+		if (s[i] == '"') {
+			/* a quoted file name: blanks, '#' and ',' are its own */
+			const char *q = memchr(s + i + 1, '"', len - i - 1);
+			if (!q)
+				return fail(p, (int)i + 1, "a quote that is not closed; expected \"NAME\"");
+			size_t n = (size_t)(q - (s + i + 1));
+			memcpy(out, s + i + 1, n);
+			out += n;
+			t.quoted = true;
+			i = (size_t)(q - s) + 1;
+			t.endcol = (int)i + 1;
+			t.len = n;
+			*out++ = '\0';
+			p->endcol = t.endcol;
+			if (!push_tok(p, t))
+				return false;
+			continue;
+		}
 		for (;;) {
 			while (i < len && !is_blank(s[i]) && !comment_at(s, i, len))
 				*out++ = s[i++];
@@ -578,18 +616,30 @@ static bool parse_resolution(parser *p, const elem_def *e)
 	return r >= 0;
 }
 
+static bool get_file(parser *p, const tok *t, const char *name, size_t n, const rt_key *key,
+                     const char **out);
+
 static bool parse_sky(parser *p, const elem_def *e)
 {
 	sky k = {.strength = 1};
-	if (!no_keys(p, e) || !count_ok(p, e, 2, 3, e->usage) ||
+	if (p->np >= 1 && (p->toks[1].quoted || !memchr(p->toks[1].s, ',', p->toks[1].len))) {
+		/* sky FILE [STRENGTH [ROTATION]]: an HDR image */
+		if (!no_keys(p, e) || !count_ok(p, e, 1, 3, e->usage) ||
+		    !get_file(p, &p->toks[1], p->toks[1].s, p->toks[1].len, NULL, &k.file))
+			return false;
+		if (p->np >= 2 && !get_num(p, &p->toks[2], e->name, "strength", &R_NONNEG, &k.strength))
+			return false;
+		if (p->np >= 3 && !get_num(p, &p->toks[3], e->name, "rotation", &R_ANY, &k.rotation))
+			return false;
+	} else if (!no_keys(p, e) || !count_ok(p, e, 2, 3, e->usage) ||
 	    !get_color(p, &p->toks[1], e->name, "zenith colour", &k.zenith) ||
 	    !get_color(p, &p->toks[2], e->name, "horizon colour", &k.horizon))
 		return false;
-	if (p->np == 3 && !get_num(p, &p->toks[3], e->name, "strength", &R_NONNEG, &k.strength))
+	else if (p->np == 3 && !get_num(p, &p->toks[3], e->name, "strength", &R_NONNEG, &k.strength))
 		return false;
 	const sky *o = &p->s->sky;
 	bool same = p->s->has_sky && v3_eq(o->zenith, k.zenith) && v3_eq(o->horizon, k.horizon) &&
-	            o->strength == k.strength;
+	            o->strength == k.strength && o->file == k.file && o->rotation == k.rotation;
 	int r = once(p, e, "sky", &p->line_sky, same);
 	if (r > 0) {
 		p->s->has_sky = true;
@@ -689,6 +739,48 @@ static bool parse_set(parser *p, const elem_def *e)
 	return r >= 0;
 }
 
+/* A file name field: resolved against the .rt file's folder, checked to
+ * load (a model or an image, so that a bad file is reported with this
+ * line), and interned. */
+static bool get_file(parser *p, const tok *t, const char *name, size_t n, const rt_key *key,
+                     const char **out)
+{
+	if (n == 0)
+		return fail(p, t->col, "%s is empty; expected %s", key ? key->name : "mesh file",
+		            key ? key->expect : "a model file");
+	char rel[4096];
+	if (n >= sizeof rel)
+		return fail(p, t->col, "the file name is longer than %zu bytes", sizeof rel - 1);
+	memcpy(rel, name, n);
+	rel[n] = '\0';
+	char full[8192];
+	if (rel[0] == '/' || !p->dir || !p->dir[0])
+		snprintf(full, sizeof full, "%s", rel);
+	else
+		snprintf(full, sizeof full, "%s/%s", p->dir, rel);
+	rt_error ferr;
+	rt_error_clear(&ferr);
+	bool ok = true;
+	bool image = key || strcmp(p->toks[0].s, "sky") == 0;
+	if (image) {
+		texture *tx = texture_cache_get(full, key && strcmp(key->name, "texture") == 0, &ferr);
+		ok = tx != NULL;
+		texture_cache_put(tx);
+	} else if (!mesh_format_known(full)) {
+		ok = mesh_load(full, &ferr) != NULL; /* gives the message */
+	}
+	if (!ok) {
+		char msg[RT_ERROR_MSG_MAX];
+		rt_error_format(&ferr, msg, sizeof msg);
+		return fail(p, t->col, "%s \"%s\": %s", key ? key->name : image ? "sky file" : "mesh file",
+		            quoted(p, t), msg);
+	}
+	*out = rt_intern(full, strlen(full));
+	if (!*out)
+		return rt_error_set(p->err, "out of memory");
+	return true;
+}
+
 /* The trailing key=value fields of an object, from rt_keys. */
 static bool parse_keys(parser *p, const elem_def *e, object *o)
 {
@@ -722,11 +814,32 @@ static bool parse_keys(parser *p, const elem_def *e, object *o)
 			                list);
 		}
 		const rt_key *key = &rt_keys[k];
+		if (key->mesh_only && o->kind != OBJ_MESH)
+			return fail_tok(p, t, e->name, "key", "applies to meshes only",
+			                "smooth= and crease= on mesh lines");
 		if (seen & (1u << k))
 			return fail_tok(p, t, e->name, "key", "repeats a key", "each key at most once");
 		seen |= 1u << k;
 		double v = 0;
 		const char *val = eq + 1;
+		if (key->type == RT_KEY_FILE) {
+			if (!get_file(p, t, val, t->len - nlen - 1, key, (const char **)(void *)((char *)o + key->offset)))
+				return false;
+			continue;
+		}
+		if (key->type == RT_KEY_PAIR) {
+			tok pt = *t;
+			pt.s = val;
+			pt.len = t->len - nlen - 1;
+			double uv[2];
+			range r = {key->min, key->max, false, false, key->expect};
+			if (!get_tuple(p, &pt, e->name, key->name, 2, "U,V", &r, uv))
+				return false;
+			if (strcmp(key->name, "uvscale") == 0 && (uv[0] == 0 || uv[1] == 0))
+				return fail_tok(p, t, e->name, "key", "has a zero component", key->expect);
+			memcpy((char *)o + key->offset, uv, sizeof uv);
+			continue;
+		}
 		num_status st = num_parse(val, t->len - nlen - 1, &v);
 		if (st == NUM_BIG)
 			return fail_tok(p, t, e->name, "key", "is out of range", key->expect);
@@ -937,6 +1050,49 @@ static bool parse_triangle(parser *p, const elem_def *e)
 
 #define EXT_TAIL " POS ROT SCALE R,G,B [DIFFUSE SPECULAR SHININESS REFLECTIVE [SHEAR]]"
 
+/* mesh FILE POS DIR SIZE [R,G,B [DIFFUSE SPECULAR SHININESS REFLECTIVE]] */
+static bool parse_mesh(parser *p, const elem_def *e)
+{
+	if (p->strict)
+		return fail(p, p->toks[0].col, "%s: not allowed in strict mode; expected the 42 elements",
+		            e->name);
+	if (!count_ok(p, e, 4, 9, e->usage) || !group_ok(p, e, 5))
+		return false;
+	const tok *t = p->toks;
+	object o = object_make(OBJ_MESH, v3(255, 255, 255));
+	if (!get_file(p, &t[1], t[1].s, t[1].len, NULL, &o.file) ||
+	    !get_vec(p, &t[2], e->name, "position", &R_ANY, &o.pos) ||
+	    !get_dir(p, &t[3], e->name, "direction", &o.dir))
+		return false;
+	if (plain_number(&t[4])) {
+		double sz;
+		if (!get_num(p, &t[4], e->name, "size", &R_POS, &sz))
+			return false;
+		o.scale = v3_splat(sz);
+	} else if (!get_vec(p, &t[4], e->name, "size", &R_SCALE, &o.scale)) {
+		return false;
+	}
+	o.file_colors = p->np < 5;
+	if (p->np >= 5 && !get_color(p, &t[5], e->name, "colour", &o.mat.color))
+		return false;
+	if (p->np >= 9 && !get_material(p, e, 6, &o.mat))
+		return false;
+	if (!parse_keys(p, e, &o))
+		return false;
+	/* load it now (it stays cached for the render), so that a bad model
+	 * is reported with this line */
+	rt_error merr;
+	rt_error_clear(&merr);
+	mesh *m = mesh_cache_get(o.file, o.smooth != 0, o.crease, &merr);
+	if (!m) {
+		char msg[RT_ERROR_MSG_MAX];
+		rt_error_format(&merr, msg, sizeof msg);
+		return fail(p, t[1].col, "mesh file \"%s\": %s", quoted(p, &t[1]), msg);
+	}
+	mesh_cache_put(m);
+	return add_object(p, e, &o, NULL);
+}
+
 static const elem_def elements[] = {
 	{"A", "ambient", -1, true, parse_ambient, "A RATIO R,G,B", NULL},
 	{"C", "camera", -1, true, parse_camera, "C POSITION DIRECTION FOV", NULL},
@@ -959,7 +1115,9 @@ static const elem_def elements[] = {
 	{"sq", "square", OBJ_RECT, false, parse_square, "sq CENTER NORMAL SIDE R,G,B", NULL},
 	{"tr", "triangle", OBJ_TRIANGLE, false, parse_triangle,
 	 "tr P1 P2 P3 R,G,B [DIFFUSE SPECULAR SHININESS REFLECTIVE]", NULL},
-	{"sky", "sky", -1, false, parse_sky, "sky ZENITH_R,G,B HORIZON_R,G,B [STRENGTH]", NULL},
+	{"mesh", "mesh", OBJ_MESH, false, parse_mesh,
+	 "mesh FILE POSITION DIRECTION SIZE [R,G,B [DIFFUSE SPECULAR SHININESS REFLECTIVE]]", NULL},
+	{"sky", "sky", -1, false, parse_sky, "sky ZENITH_R,G,B HORIZON_R,G,B [STRENGTH] or sky FILE.hdr [STRENGTH [ROTATION]]", NULL},
 	{"set", "set", -1, false, parse_set, "set samples|depth|mode|resolution VALUE", NULL},
 };
 #define NELEMENTS (sizeof elements / sizeof elements[0])
@@ -1055,10 +1213,21 @@ static void parser_init(parser *p, scene *s, const char *name, const rt_load_opt
 	p->strict = opts && opts->strict;
 	p->warn = opts ? opts->warn : NULL;
 	p->err = err;
+	/* model and texture names are relative to the .rt file's folder */
+	const char *slash = strrchr(p->name, '/');
+	if (slash) {
+		size_t n = slash == p->name ? 1 : (size_t)(slash - p->name);
+		p->dir = malloc(n + 1);
+		if (p->dir) {
+			memcpy(p->dir, p->name, n);
+			p->dir[n] = '\0';
+		}
+	}
 }
 
 static void parser_done(parser *p)
 {
+	free(p->dir);
 	free(p->toks);
 	free(p->text);
 }
@@ -1164,6 +1333,8 @@ fail:
 
 scene *rt_load_file(const char *path, const rt_load_opts *opts, rt_error *err)
 {
+	if (mesh_format_known(path) && !(opts && opts->strict))
+		return rt_load_model(path, opts, err);
 	if (opts && opts->strict && !has_rt_extension(path)) {
 		rt_error_at(err, path, 0, 0,
 		            "the file name does not end in .rt; expected a .rt file (strict mode)");

@@ -121,10 +121,57 @@ static void fmt_material(sbuf *b, const material *m)
 	sb_field(b, m->reflective);
 }
 
+_Thread_local const char *rt_write_dir = "";
+
+/* A model or texture name as the file being written should say it:
+ * relative to its folder when it lies below it, else as stored (and made
+ * absolute when a relative name would not be found from the new folder). */
+static void sb_file(sbuf *b, const char *file)
+{
+	char abs[4096];
+	const char *dir = rt_write_dir ? rt_write_dir : "";
+	size_t n = strlen(dir);
+	const char *name = file;
+	if (n && strncmp(file, dir, n) == 0 && file[n] == '/')
+		name = file + n + 1;
+	else if (n && file[0] != '/' && realpath(file, abs))
+		name = abs;
+	bool quote = strpbrk(name, " \t,#\"") != NULL || strstr(name, "//") != NULL || !name[0];
+	if (quote)
+		sb_put(b, "\"");
+	sb_put(b, name);
+	if (quote)
+		sb_put(b, "\"");
+}
+
 static void fmt_keys(sbuf *b, const object *o)
 {
 	for (size_t i = 0; i < rt_nkeys; i++) {
 		const rt_key *k = &rt_keys[i];
+		if (k->mesh_only && o->kind != OBJ_MESH)
+			continue;
+		if (k->type == RT_KEY_FILE) {
+			const char *f = *(const char *const *)(const void *)((const char *)o + k->offset);
+			if (!f)
+				continue;
+			sb_put(b, " ");
+			sb_put(b, k->name);
+			sb_put(b, "=");
+			sb_file(b, f);
+			continue;
+		}
+		if (k->type == RT_KEY_PAIR) {
+			const double *uv = (const double *)(const void *)((const char *)o + k->offset);
+			if (uv[0] == k->def && uv[1] == k->def)
+				continue;
+			sb_put(b, " ");
+			sb_put(b, k->name);
+			sb_put(b, "=");
+			sb_num(b, uv[0]);
+			sb_put(b, ",");
+			sb_num(b, uv[1]);
+			continue;
+		}
 		double v = rt_key_get(k, o);
 		if (v == k->def || (o->kind == OBJ_TRIANGLE && !k->triangles))
 			continue;
@@ -138,7 +185,21 @@ static void fmt_keys(sbuf *b, const object *o)
 static void fmt_object(sbuf *b, const object *o)
 {
 	const material *m = &o->mat;
-	if (o->kind == OBJ_TRIANGLE) {
+	if (o->kind == OBJ_MESH) {
+		sb_put(b, "mesh ");
+		sb_file(b, o->file ? o->file : "");
+		sb_vec(b, o->pos);
+		sb_vec(b, o->dir);
+		if (o->scale.x == o->scale.y && o->scale.y == o->scale.z)
+			sb_field(b, o->scale.x);
+		else
+			sb_vec(b, o->scale);
+		if (!o->file_colors) {
+			sb_vec(b, m->color);
+			if (!base_material_default(m))
+				fmt_material(b, m);
+		}
+	} else if (o->kind == OBJ_TRIANGLE) {
 		sb_put(b, "tr");
 		for (int i = 0; i < 3; i++)
 			sb_vec(b, o->tri[i]);
@@ -267,7 +328,15 @@ static void write_scene(const scene *s, FILE *f)
 		fmt_light(&b, &s->lights[i]);
 		put_line(f, &b);
 	}
-	if (s->has_sky) {
+	if (s->has_sky && s->sky.file) {
+		sb_put(&b, "sky ");
+		sb_file(&b, s->sky.file);
+		if (s->sky.strength != 1 || s->sky.rotation != 0)
+			sb_field(&b, s->sky.strength);
+		if (s->sky.rotation != 0)
+			sb_field(&b, s->sky.rotation);
+		put_line(f, &b);
+	} else if (s->has_sky) {
 		sb_put(&b, "sky");
 		sb_vec(&b, s->sky.zenith);
 		sb_vec(&b, s->sky.horizon);
@@ -307,5 +376,21 @@ static bool save_writer(FILE *f, void *ctx, rt_error *err)
 bool rt_save(const scene *s, const char *path, rt_error *err)
 {
 	save_ctx c = {s};
-	return file_write_atomic(path, save_writer, &c, err);
+	/* file names below the new file's folder are written relative to it */
+	char dir[4096] = "";
+	const char *slash = strrchr(path, '/');
+	if (slash) {
+		size_t n = slash == path ? 1 : (size_t)(slash - path);
+		if (n < sizeof dir) {
+			memcpy(dir, path, n);
+			dir[n] = '\0';
+		}
+	} else {
+		snprintf(dir, sizeof dir, ".");
+	}
+	const char *old = rt_write_dir;
+	rt_write_dir = strcmp(dir, ".") == 0 ? "" : dir;
+	bool ok = file_write_atomic(path, save_writer, &c, err);
+	rt_write_dir = old;
+	return ok;
 }

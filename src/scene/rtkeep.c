@@ -13,13 +13,17 @@
 #include "rtsh/rtkeep.h"
 
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "rtsh/image.h"
 #include "rtsh/rtfile.h"
+#include "scene/rtfile_priv.h"
 
 #define NONE SIZE_MAX
+
+_Thread_local const char *rt_keep_source;
 /* The largest middle part matched by dynamic programming (cells of 4 bytes);
  * beyond it a walk with a bounded look-ahead matches them (exact for edits
  * in place and for runs of up to LOOKAHEAD deletions or insertions). */
@@ -253,7 +257,8 @@ static bool base_read(base *b, const char *src, size_t len)
 			t->cam = 0;
 			t->has_ambient = t->has_sky = false;
 			t->hints = unset;
-			if (!rt_parse_line(t, buf, "source", (int)b->nlines + 1, NULL, &err)) {
+			if (!rt_parse_line(t, buf, rt_keep_source ? rt_keep_source : "source", (int)b->nlines + 1, NULL,
+			                   &err)) {
 				ok = false;
 				break;
 			}
@@ -907,7 +912,11 @@ static char *keep_text(const scene *s, const char *src, size_t len, size_t *out_
 static bool loads_to(const char *text, size_t len, const scene *s)
 {
 	rt_error err;
-	scene *t = rt_load_string(text, len, "saved.rt", NULL, &err);
+	/* model and texture names resolve against the folder written to */
+	char name[4200];
+	snprintf(name, sizeof name, "%s%ssaved.rt", rt_write_dir ? rt_write_dir : "",
+	         rt_write_dir && rt_write_dir[0] ? "/" : "");
+	scene *t = rt_load_string(text, len, name, NULL, &err);
 	if (!t)
 		return false;
 	scene c = *s;
@@ -958,5 +967,19 @@ static bool keep_writer(FILE *f, void *ctx, rt_error *err)
 bool rt_save_keeping(const scene *s, const char *src, size_t len, const char *path, rt_error *err)
 {
 	keep_ctx c = {s, src, len};
-	return file_write_atomic(path, keep_writer, &c, err);
+	/* file names are written (and checked) relative to the new file's folder */
+	char dir[4096] = "";
+	const char *slash = strrchr(path, '/');
+	if (slash) {
+		size_t n = slash == path ? 1 : (size_t)(slash - path);
+		if (n < sizeof dir) {
+			memcpy(dir, path, n);
+			dir[n] = '\0';
+		}
+	}
+	const char *old = rt_write_dir;
+	rt_write_dir = dir;
+	bool ok = file_write_atomic(path, keep_writer, &c, err);
+	rt_write_dir = old;
+	return ok;
 }

@@ -9,7 +9,7 @@
 
 static const struct {
 	const char *id, *name;
-} kind_names[OBJ_KIND_COUNT] = {
+} kind_names[OBJ_KIND_ALL] = {
 	[OBJ_SPHERE] = {"sp", "sphere"},
 	[OBJ_PLANE] = {"pl", "plane"},
 	[OBJ_CYLINDER] = {"cy", "cylinder"},
@@ -18,21 +18,22 @@ static const struct {
 	[OBJ_DISC] = {"di", "disc"},
 	[OBJ_RECT] = {"rc", "rectangle"},
 	[OBJ_TRIANGLE] = {"tr", "triangle"},
+	[OBJ_MESH] = {"mesh", "mesh"},
 };
 
 const char *obj_kind_id(obj_kind k)
 {
-	return (unsigned)k < OBJ_KIND_COUNT ? kind_names[k].id : "?";
+	return (unsigned)k < OBJ_KIND_ALL ? kind_names[k].id : "?";
 }
 
 const char *obj_kind_name(obj_kind k)
 {
-	return (unsigned)k < OBJ_KIND_COUNT ? kind_names[k].name : "object";
+	return (unsigned)k < OBJ_KIND_ALL ? kind_names[k].name : "object";
 }
 
 int obj_kind_from_id(const char *id)
 {
-	for (int k = 0; k < OBJ_KIND_COUNT; k++)
+	for (int k = 0; k < OBJ_KIND_ALL; k++)
 		if (strcmp(id, kind_names[k].id) == 0)
 			return k;
 	if (strcmp(id, "sq") == 0)
@@ -48,6 +49,8 @@ material material_default(vec3 color)
 		.specular = 0.9,
 		.shininess = 200.0,
 		.reflective = 0.0,
+		.bumpscale = 1.0,
+		.uvscale = {1.0, 1.0},
 	};
 }
 
@@ -109,7 +112,10 @@ static bool material_equal(const material *a, const material *b)
 	return v3_eq(a->color, b->color) && a->diffuse == b->diffuse && a->specular == b->specular &&
 	       a->shininess == b->shininess && a->reflective == b->reflective && a->fuzz == b->fuzz &&
 	       a->metal == b->metal && a->ior == b->ior && a->emission == b->emission &&
-	       a->checker == b->checker;
+	       a->checker == b->checker && a->texture == b->texture && a->normalmap == b->normalmap &&
+	       a->bump == b->bump && a->bumpscale == b->bumpscale && a->uvscale[0] == b->uvscale[0] &&
+	       a->uvscale[1] == b->uvscale[1] && a->uvoffset[0] == b->uvoffset[0] &&
+	       a->uvoffset[1] == b->uvoffset[1];
 }
 
 bool object_equal(const object *a, const object *b)
@@ -122,6 +128,9 @@ bool object_equal(const object *a, const object *b)
 	for (int i = 0; i < 6; i++)
 		if (a->shear[i] != b->shear[i])
 			return false;
+	if (a->file != b->file || a->file_colors != b->file_colors || a->smooth != b->smooth ||
+	    a->crease != b->crease)
+		return false;
 	return v3_eq(a->pos, b->pos) && v3_eq(a->dir, b->dir) && a->twist == b->twist &&
 	       v3_eq(a->scale, b->scale);
 }
@@ -145,7 +154,8 @@ bool scene_equal(const scene *a, const scene *b)
 		return false;
 	if (a->has_sky && (!v3_eq(a->sky.zenith, b->sky.zenith) ||
 	                   !v3_eq(a->sky.horizon, b->sky.horizon) ||
-	                   a->sky.strength != b->sky.strength))
+	                   a->sky.strength != b->sky.strength || a->sky.file != b->sky.file ||
+	                   a->sky.rotation != b->sky.rotation))
 		return false;
 	if (memcmp(&a->hints, &b->hints, sizeof a->hints) != 0)
 		return false;
@@ -256,6 +266,8 @@ object object_make(obj_kind k, vec3 color)
 	o.dir = v3(0, 1, 0);
 	o.scale = v3(1, 1, 1);
 	o.mat = material_default(color);
+	o.smooth = 1;
+	o.crease = 60;
 	if (k == OBJ_TRIANGLE) {
 		o.tri[0] = v3(-0.5, -0.5, 0);
 		o.tri[1] = v3(0.5, -0.5, 0);

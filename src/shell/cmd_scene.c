@@ -12,6 +12,7 @@
 
 #include "rtsh/generate.h"
 #include "rtsh/image.h"
+#include "rtsh/mesh.h"
 #include "rtsh/rtfile.h"
 #include "rtsh/settings.h"
 #include "shell/answer.h"
@@ -209,8 +210,15 @@ static void list_objects(shell *sh, const scene *s)
 	if (s->nobjs == 0)
 		shell_out(sh, "no objects\n");
 	for (size_t i = 0; i < s->nobjs; i++) {
-		rt_format_object(&s->objs[i], line, sizeof line);
-		shell_out(sh, "object %zu: %s\n", i + 1, line);
+		const object *o = &s->objs[i];
+		rt_format_object(o, line, sizeof line);
+		/* a mesh: its triangle count (the model is cached, so this is cheap) */
+		mesh *m = o->kind == OBJ_MESH && o->file ? mesh_cache_get(o->file, o->smooth != 0, o->crease, NULL) : NULL;
+		if (m)
+			shell_out(sh, "object %zu: %s  # %u triangles\n", i + 1, line, m->ntris);
+		else
+			shell_out(sh, "object %zu: %s\n", i + 1, line);
+		mesh_cache_put(m);
 	}
 }
 

@@ -18,7 +18,9 @@
 
 const command command_table[] = {
 	{"load", NULL, "load FILE", 1, 1, {"@scene"},
-	 "replace the scene by a .rt file; on any error the current scene stays", cmd_load},
+	 "replace the scene by a .rt file, or by a model (.obj .ply .gltf .glb .stl) on a framed stage; on any "
+	 "error the current scene stays",
+	 cmd_load},
 	{"save", NULL, "save FILE.ppm|FILE.pfm|FILE.png|FILE.ans|FILE.rt", 1, 1, {"@output"},
 	 "write the image (full resolution, rendered first if needed), the picture as ANSI text, or the scene",
 	 cmd_save},
@@ -77,6 +79,11 @@ static const struct {
 	const char *name, *text;
 } details[] = {
 	{"view", keymode_help},
+	{"add", "examples: add sp 0,1,0 1 255,0,0 texture=earth.png\n"
+	        "          add mesh bunny.obj 0,0.5,0 0,1,0 1 200,200,200 smooth=1 crease=60\n"
+	        "          add sky sky.hdr 1 90   (an HDR sky, turned 90 degrees)\n"
+	        "keys: texture= normalmap= bump= bumpscale= uvscale=U,V uvoffset=U,V, and for a mesh smooth= "
+	        "crease= (see rtsh(5))\n"},
 };
 
 /* True when `word` is one of the space-separated names in list. */

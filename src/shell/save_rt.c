@@ -66,7 +66,9 @@ bool save_rt(shell *sh, const char *path, rt_error *err)
 		return rt_save(&s, path, err);
 	size_t len = 0;
 	char *src = read_source(label, &len);
+	rt_keep_source = label; /* its folder resolves model and texture names */
 	bool ok = rt_save_keeping(&s, src, len, path, err);
+	rt_keep_source = NULL;
 	free(src);
 	return ok;
 }

@@ -321,7 +321,7 @@ static void test_mirror_shows_sky(void **state)
 		set_ambient(s, 0.7, v3(200, 220, 255));
 		if (gradient) {
 			s->has_sky = true;
-			s->sky = (sky){v3(40, 90, 250), v3(250, 240, 200), 1.5};
+			s->sky = (sky){.zenith = v3(40, 90, 250), .horizon = v3(250, 240, 200), .strength = 1.5};
 		}
 		object m = obj(OBJ_SPHERE, v3(0, 0, 0), v3_splat(2), v3(255, 255, 255), 0);
 		m.mat.reflective = 1;
@@ -566,7 +566,7 @@ static scene *convergence_scene(void)
 {
 	scene *s = cam_scene(v3(0, 1.2, -4), v3(0, -0.25, 1), 60);
 	s->has_sky = true;
-	s->sky = (sky){v3(120, 170, 255), v3(255, 255, 255), 1};
+	s->sky = (sky){.zenith = v3(120, 170, 255), .horizon = v3(255, 255, 255), .strength = 1};
 	light l = {v3(2, 4, -2), 0.7, v3(255, 255, 255)};
 	assert_true(scene_add_light(s, &l, NULL));
 	object p = obj(OBJ_PLANE, v3(0, 0, 0), v3(1, 1, 1), v3(200, 200, 200), 0.9);
@@ -636,7 +636,7 @@ static scene *material_scene(void)
 {
 	scene *s = cam_scene(v3(0, 1.5, -6), v3(0, -0.2, 1), 70);
 	s->has_sky = true;
-	s->sky = (sky){v3(100, 150, 255), v3(255, 250, 240), 1};
+	s->sky = (sky){.zenith = v3(100, 150, 255), .horizon = v3(255, 250, 240), .strength = 1};
 	light l = {v3(-3, 5, -3), 0.8, v3(255, 240, 220)};
 	assert_true(scene_add_light(s, &l, NULL));
 	object p = obj(OBJ_PLANE, v3(0, 0, 0), v3(2, 2, 2), v3(230, 230, 230), 0.9);

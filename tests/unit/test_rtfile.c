@@ -557,7 +557,7 @@ typedef struct err_case {
 static const err_case field_errors[] = {
 	/* unknown elements, case-sensitive */
 	{CAM "xx 1 2\n", 2, 1,
-	 "unknown element \"xx\"; expected one of A C c L l R sp pl cy co cu di rc sq tr sky set"},
+	 "unknown element \"xx\"; expected one of A C c L l R sp pl cy co cu di rc sq tr mesh sky set"},
 	{CAM "SP 0,0,0 1 255,0,0\n", 2, 1, "unknown element \"SP\""},
 	{CAM "  fuzz=1\n", 2, 3, "unknown element \"fuzz=1\""},
 	/* A */
@@ -1141,7 +1141,7 @@ static scene *rand_scene(test_rng *r)
 	}
 	if (trand(r) < 0.3) {
 		s->has_sky = true;
-		s->sky = (sky){rand_color(r), rand_color(r), trand(r) < 0.5 ? 1 : trange(r, 0, 5)};
+		s->sky = (sky){.zenith = rand_color(r), .horizon = rand_color(r), .strength = trand(r) < 0.5 ? 1 : trange(r, 0, 5)};
 	}
 	if (trand(r) < 0.3) {
 		s->hints.width = 1 + (int)trange(r, 0, 4000);

@@ -8,6 +8,7 @@
 
 #include "rtsh/rtfile.h"
 #include "rtsh/rtkeep.h"
+#include "scene/rtfile_priv.h"
 
 static scene *load(const char *text)
 {
@@ -77,8 +78,16 @@ static void test_every_example_scene(void **state)
 		size_t got = fread(src, 1, (1 << 20) - 1, f);
 		fclose(f);
 		src[got] = '\0';
-		scene *s = load(src);
+		/* model and texture names are relative to the scene's folder */
+		rt_error err;
+		scene *s = rt_load_string(src, strlen(src), path, NULL, &err);
+		if (!s)
+			fail_msg("load: %s", err.msg);
+		rt_keep_source = path;
+		rt_write_dir = "scenes";
 		char *t = keep(s, src);
+		rt_keep_source = NULL;
+		rt_write_dir = "";
 		if (strcmp(t, src) != 0)
 			fail_msg("%s does not save to the same bytes", path);
 		free(t);

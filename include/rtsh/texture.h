@@ -1,0 +1,70 @@
+/* rtsh — image textures: reading images, mip-maps and filtered lookups.
+ *
+ * Any image rtsh reads (PNG, JPEG, BMP, TGA and Radiance HDR through
+ * stb_image; PPM/PGM and PFM by our own code; XPM through libXpm) becomes a
+ * texture: linear RGB floats in a chain of mip levels, each half the size
+ * of the one above (box-filtered). A lookup takes texture coordinates
+ * (u right, v up: (0,0) is the image's bottom-left corner, as in OBJ and
+ * glTF after its flip) and the footprint of the pixel in u units; it picks
+ * the two levels around the footprint and filters each bilinearly
+ * (trilinear filtering, Williams, "Pyramidal parametrics", 1983), which
+ * keeps a distant checkerboard from shimmering in the low-resolution
+ * terminal preview. Coordinates wrap (repeat).
+ */
+#ifndef RTSH_TEXTURE_H
+#define RTSH_TEXTURE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "rtsh/error.h"
+#include "rtsh/math.h"
+
+#define TEX_MAX_LEVELS 24
+
+typedef struct tex_level {
+	int w, h;
+	float *rgb; /* w * h * 3, top row first */
+} tex_level;
+
+typedef struct texture {
+	char *path;
+	bool srgb;
+	int nlevels;
+	tex_level level[TEX_MAX_LEVELS];
+	size_t refs;
+} texture;
+
+/* An image as read: w x h linear RGB floats, top row first. srgb: 8-bit
+ * codes are sRGB-decoded (colour textures); otherwise divided by 255 (normal
+ * and bump maps). HDR and PFM are linear whatever srgb says. NULL (err set,
+ * "PATH: what is wrong") on failure: a missing file, an unknown extension,
+ * a corrupt or zero-sized image, an XPM with a bad colour table. */
+float *image_load_rgb(const char *path, bool srgb, int *w, int *h, rt_error *err);
+/* The same from memory; the format from `path`'s extension (fuzzing). */
+float *image_decode_rgb(const char *path, const unsigned char *buf, size_t len, bool srgb, int *w, int *h,
+                        rt_error *err);
+/* True when the extension is one image_load_rgb reads. */
+bool image_format_known(const char *path);
+
+/* A texture with its mip chain; takes the pixels. */
+texture *texture_make(float *rgb, int w, int h, rt_error *err);
+texture *texture_load(const char *path, bool srgb, rt_error *err);
+void texture_free(texture *t);
+
+/* Loaded once per (path, srgb, file version); thread-safe. */
+texture *texture_cache_get(const char *path, bool srgb, rt_error *err);
+void texture_cache_put(texture *t);
+
+/* The filtered colour at (u, v); `width` is the footprint in u units (0:
+ * the finest level, bilinear). */
+vec3 texture_lookup(const texture *t, double u, double v, double width);
+/* One texel of level 0 (x right, y down from the top row), clamped. */
+vec3 texture_texel(const texture *t, int x, int y);
+
+/* The angle one pixel of the image being rendered spans, for footprints:
+ * render.c sets it for its thread (0: no footprint, finest level). */
+void texture_set_pixel_angle(double a);
+double texture_pixel_angle(void);
+
+#endif

@@ -1,0 +1,628 @@
+/* rtsh — meshes: the builder the readers share, welding, normals, the tree
+ * and the cache (mesh.h). */
+#include "rtsh/mesh.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <float.h>
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+
+#include "core/bvh.h"
+
+/* --- the builder --- */
+
+static bool grow(void **a, size_t *cap, size_t need, size_t size)
+{
+	if (need <= *cap)
+		return true;
+	size_t c = *cap ? *cap : 64;
+	while (c < need) {
+		if (c > SIZE_MAX / 2 / size)
+			return false;
+		c *= 2;
+	}
+	void *p = realloc(*a, c * size);
+	if (!p)
+		return false;
+	*a = p;
+	*cap = c;
+	return true;
+}
+
+bool mb_vertex(mesh_builder *b, const float p[3])
+{
+	if (!grow((void **)&b->v, &b->cv, b->nv + 1, sizeof *b->v))
+		return false;
+	memcpy(b->v[b->nv++], p, sizeof *b->v);
+	return true;
+}
+
+bool mb_uv(mesh_builder *b, const float t[2])
+{
+	if (!grow((void **)&b->vt, &b->cvt, b->nvt + 1, sizeof *b->vt))
+		return false;
+	memcpy(b->vt[b->nvt++], t, sizeof *b->vt);
+	return true;
+}
+
+bool mb_normal(mesh_builder *b, const float n[3])
+{
+	if (!grow((void **)&b->vn, &b->cvn, b->nvn + 1, sizeof *b->vn))
+		return false;
+	memcpy(b->vn[b->nvn++], n, sizeof *b->vn);
+	return true;
+}
+
+bool mb_triangle(mesh_builder *b, int32_t c[3][3])
+{
+	if (!grow((void **)&b->c, &b->cc, b->nc + 3, sizeof *b->c) ||
+	    !grow((void **)&b->fm, &b->cf, b->nf + 1, sizeof *b->fm))
+		return false;
+	memcpy(b->c[b->nc], c, 3 * sizeof *b->c);
+	b->nc += 3;
+	b->fm[b->nf++] = b->cur_mat;
+	return true;
+}
+
+static void mat_free(mesh_mat *m)
+{
+	free(m->name);
+	free(m->map_kd);
+	free(m->map_bump);
+	free(m->map_norm);
+}
+
+void mb_free(mesh_builder *b)
+{
+	free(b->v);
+	free(b->vt);
+	free(b->vn);
+	free(b->c);
+	free(b->fm);
+	for (size_t i = 0; i < b->nmats; i++)
+		mat_free(&b->mats[i]);
+	free(b->mats);
+	memset(b, 0, sizeof *b);
+}
+
+static uint64_t hash3(const int32_t k[3])
+{
+	uint64_t h = (uint32_t)k[0] * 0x9E3779B97F4A7C15ull;
+	h ^= ((uint64_t)(uint32_t)k[1] + 0x632BE59BD9B4E019ull) * 0xC2B2AE3D27D4EB4Full;
+	h ^= ((uint64_t)(uint32_t)k[2] + 0x85EBCA77C2B2AE63ull) * 0x165667B19E3779F9ull;
+	return h ^ (h >> 29);
+}
+
+/* Is the triangle of positions a, b, c of non-zero area? */
+static bool tri_ok(const float *a, const float *b, const float *c)
+{
+	double e1[3], e2[3];
+	for (int i = 0; i < 3; i++) {
+		e1[i] = (double)b[i] - a[i];
+		e2[i] = (double)c[i] - a[i];
+	}
+	double x = e1[1] * e2[2] - e1[2] * e2[1], y = e1[2] * e2[0] - e1[0] * e2[2],
+	       z = e1[0] * e2[1] - e1[1] * e2[0];
+	return x * x + y * y + z * z > 0.0;
+}
+
+mesh *mb_finish(mesh_builder *b, rt_error *err)
+{
+	mesh *m = calloc(1, sizeof *m);
+	size_t ntri = b->nc / 3;
+	uint32_t *slot = NULL;
+	if (!m)
+		goto oom;
+	if (ntri > UINT32_MAX / 4 || b->nv > UINT32_MAX / 4) {
+		rt_error_set(err, "%s: %zu triangles, %zu vertices: too many (at most %u)", b->name, ntri,
+		             b->nv, UINT32_MAX / 4);
+		goto fail;
+	}
+	/* keep the triangles of non-zero area */
+	size_t kept = 0;
+	for (size_t t = 0; t < ntri; t++) {
+		int32_t(*c)[3] = &b->c[3 * t];
+		if (!tri_ok(b->v[c[0][0]], b->v[c[1][0]], b->v[c[2][0]]))
+			continue;
+		memmove(&b->c[3 * kept], c, 3 * sizeof *c);
+		b->fm[kept++] = b->fm[t];
+	}
+	ntri = kept;
+	if (ntri == 0) {
+		rt_error_set(err, "%s: the model has no triangle of non-zero area; expected at least one face",
+		             b->name);
+		goto fail;
+	}
+	bool plain = true, has_uv = b->nvt > 0, has_n = b->nvn > 0;
+	for (size_t i = 0; i < 3 * ntri; i++) {
+		if (b->c[i][1] < 0)
+			has_uv = false;
+		if (b->c[i][2] < 0)
+			has_n = false;
+	}
+	plain = !has_uv && !has_n;
+	m->ntris = (uint32_t)ntri;
+	m->tri = malloc(ntri * sizeof *m->tri);
+	if (!m->tri)
+		goto oom;
+	if (plain) {
+		/* the positions are the vertices */
+		m->nverts = (uint32_t)b->nv;
+		m->p = b->v;
+		b->v = NULL;
+		for (size_t t = 0; t < ntri; t++)
+			for (int k = 0; k < 3; k++)
+				m->tri[t][k] = (uint32_t)b->c[3 * t + k][0];
+	} else {
+		/* weld equal (position, uv, normal) triples into one vertex */
+		size_t cap = 16;
+		while (cap < 6 * ntri)
+			cap *= 2;
+		slot = malloc(cap * sizeof *slot);
+		m->p = malloc(3 * ntri * sizeof *m->p);
+		if (has_uv)
+			m->uv = malloc(3 * ntri * sizeof *m->uv);
+		if (has_n)
+			m->n = malloc(3 * ntri * sizeof *m->n);
+		if (!slot || !m->p || (has_uv && !m->uv) || (has_n && !m->n))
+			goto oom;
+		memset(slot, 0xff, cap * sizeof *slot);
+		uint32_t nv = 0;
+		for (size_t i = 0; i < 3 * ntri; i++) {
+			int32_t key[3] = {b->c[i][0], has_uv ? b->c[i][1] : -1, has_n ? b->c[i][2] : -1};
+			size_t h = (size_t)hash3(key) & (cap - 1);
+			uint32_t found = UINT32_MAX;
+			while (slot[h] != UINT32_MAX) {
+				uint32_t s = slot[h];
+				const int32_t *o = b->c[s];
+				if (o[0] == key[0] && (!has_uv || o[1] == key[1]) && (!has_n || o[2] == key[2])) {
+					found = m->tri[s / 3][s % 3];
+					break;
+				}
+				h = (h + 1) & (cap - 1);
+			}
+			if (found == UINT32_MAX) {
+				slot[h] = (uint32_t)i;
+				found = nv++;
+				memcpy(m->p[found], b->v[key[0]], sizeof *m->p);
+				if (has_uv)
+					memcpy(m->uv[found], b->vt[key[1]], sizeof *m->uv);
+				if (has_n) {
+					const float *n = b->vn[key[2]];
+					double l = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+					for (int k = 0; k < 3; k++)
+						m->n[found][k] = l > 0 ? (float)(n[k] / l) : 0.0f;
+				}
+			}
+			m->tri[i / 3][i % 3] = found;
+		}
+		m->nverts = nv;
+		free(slot);
+		slot = NULL;
+	}
+	m->nmats = (uint32_t)b->nmats;
+	m->mats = b->mats;
+	b->mats = NULL;
+	b->nmats = 0;
+	if (m->nmats > 1) {
+		m->tmat = b->fm;
+		b->fm = NULL;
+	}
+	m->bounds = box_empty();
+	for (uint32_t i = 0; i < m->nverts; i++)
+		m->bounds = box_add(m->bounds, v3(m->p[i][0], m->p[i][1], m->p[i][2]));
+	mb_free(b);
+	return m;
+oom:
+	rt_error_set(err, "%s: out of memory reading the model", b->name);
+fail:
+	free(slot);
+	mb_free(b);
+	mesh_free(m);
+	return NULL;
+}
+
+void mesh_free(mesh *m)
+{
+	if (!m)
+		return;
+	free(m->path);
+	free(m->p);
+	free(m->n);
+	free(m->uv);
+	free(m->tri);
+	free(m->tmat);
+	for (uint32_t i = 0; i < m->nmats; i++)
+		mat_free(&m->mats[i]);
+	free(m->mats);
+	bvh_free(m->tree);
+	free(m);
+}
+
+size_t mesh_memory(const mesh *m)
+{
+	size_t n = sizeof *m + (size_t)m->nverts * sizeof *m->p + (size_t)m->ntris * sizeof *m->tri;
+	if (m->n)
+		n += (size_t)m->nverts * sizeof *m->n;
+	if (m->uv)
+		n += (size_t)m->nverts * sizeof *m->uv;
+	if (m->tmat)
+		n += (size_t)m->ntris * sizeof *m->tmat;
+	if (m->tree)
+		n += sizeof *m->tree + m->tree->nnodes * sizeof *m->tree->nodes;
+	return n;
+}
+
+/* --- normals --- */
+
+static vec3 vtx(const mesh *m, uint32_t i)
+{
+	return v3(m->p[i][0], m->p[i][1], m->p[i][2]);
+}
+
+/* Smooth normals weighted by corner angle (Thürmer & Wüthrich, "Computing
+ * vertex normals from polygonal facets", 1998), a face contributing to a
+ * corner only when it meets the corner's face at no more than the crease
+ * angle; corners of one position with different normals become different
+ * vertices. */
+static bool smooth_normals(mesh *m, double crease_deg, rt_error *err)
+{
+	uint32_t nv = m->nverts, nt = m->ntris;
+	vec3 *fn = malloc((size_t)nt * sizeof *fn);
+	uint32_t *start = calloc((size_t)nv + 1, sizeof *start);
+	uint32_t *list = malloc((size_t)nt * 3 * sizeof *list);
+	uint32_t *newid = malloc((size_t)nt * 3 * sizeof *newid);
+	float(*nn)[3] = malloc((size_t)nt * 3 * sizeof *nn);
+	if (!fn || !start || !list || !newid || !nn)
+		goto oom;
+	for (uint32_t t = 0; t < nt; t++) {
+		vec3 a = vtx(m, m->tri[t][0]), b = vtx(m, m->tri[t][1]), c = vtx(m, m->tri[t][2]);
+		vec3 n = v3_cross(v3_sub(b, a), v3_sub(c, a));
+		double l = v3_len(n);
+		fn[t] = l > 0 ? v3_scale(n, 1.0 / l) : v3(0, 0, 0);
+		for (int k = 0; k < 3; k++)
+			start[m->tri[t][k] + 1]++;
+	}
+	for (uint32_t v = 0; v < nv; v++)
+		start[v + 1] += start[v];
+	{
+		uint32_t *fill = malloc((size_t)nv * sizeof *fill);
+		if (!fill)
+			goto oom;
+		memcpy(fill, start, (size_t)nv * sizeof *fill);
+		for (uint32_t t = 0; t < nt; t++)
+			for (uint32_t k = 0; k < 3; k++)
+				list[fill[m->tri[t][k]]++] = 3 * t + k;
+		free(fill);
+	}
+	double cosc = cos(crease_deg * M_PI / 180.0) - 1e-9;
+	uint32_t next = nv;
+	for (uint32_t v = 0; v < nv; v++) {
+		uint32_t s = start[v], e = start[v + 1], deg = e - s;
+		for (uint32_t i = s; i < e; i++) {
+			uint32_t ci = list[i], ti = ci / 3;
+			vec3 sum = v3(0, 0, 0);
+			for (uint32_t j = s; j < e; j++) {
+				uint32_t cj = list[j], tj = cj / 3, kj = cj % 3;
+				if (deg <= 256 && v3_dot(fn[ti], fn[tj]) < cosc)
+					continue;
+				vec3 p = vtx(m, m->tri[tj][kj]);
+				vec3 a = v3_sub(vtx(m, m->tri[tj][(kj + 1) % 3]), p);
+				vec3 b = v3_sub(vtx(m, m->tri[tj][(kj + 2) % 3]), p);
+				double la = v3_len(a), lb = v3_len(b);
+				double ang = la > 0 && lb > 0 ? acos(clampd(v3_dot(a, b) / (la * lb), -1, 1)) : 0;
+				sum = v3_madd(sum, fn[tj], ang);
+			}
+			double l = v3_len(sum);
+			vec3 n = l > 0 ? v3_scale(sum, 1.0 / l) : fn[ti];
+			nn[ci][0] = (float)n.x;
+			nn[ci][1] = (float)n.y;
+			nn[ci][2] = (float)n.z;
+			/* the same vertex as an earlier corner with this normal */
+			uint32_t id = UINT32_MAX;
+			for (uint32_t j = s; j < i && id == UINT32_MAX; j++)
+				if (memcmp(nn[list[j]], nn[ci], sizeof *nn) == 0)
+					id = newid[list[j]];
+			if (id == UINT32_MAX)
+				id = i == s ? v : next++;
+			newid[ci] = id;
+		}
+	}
+	float(*p)[3] = malloc((size_t)next * sizeof *p);
+	float(*n)[3] = malloc((size_t)next * sizeof *n);
+	float(*uv)[2] = m->uv ? malloc((size_t)next * sizeof *uv) : NULL;
+	if (!p || !n || (m->uv && !uv)) {
+		free(p);
+		free(n);
+		free(uv);
+		goto oom;
+	}
+	for (uint32_t v = 0; v < nv; v++) {
+		memcpy(p[v], m->p[v], sizeof *p);
+		memset(n[v], 0, sizeof *n);
+		if (uv)
+			memcpy(uv[v], m->uv[v], sizeof *uv);
+	}
+	for (uint32_t c = 0; c < 3 * nt; c++) {
+		uint32_t old = m->tri[c / 3][c % 3], id = newid[c];
+		memcpy(p[id], m->p[old], sizeof *p);
+		memcpy(n[id], nn[c], sizeof *n);
+		if (uv)
+			memcpy(uv[id], m->uv[old], sizeof *uv);
+		m->tri[c / 3][c % 3] = id;
+	}
+	free(m->p);
+	free(m->uv);
+	m->p = p;
+	m->n = n;
+	m->uv = uv;
+	m->nverts = next;
+	free(fn);
+	free(start);
+	free(list);
+	free(newid);
+	free(nn);
+	return true;
+oom:
+	free(fn);
+	free(start);
+	free(list);
+	free(newid);
+	free(nn);
+	return rt_error_set(err, "%s: out of memory computing normals", m->path ? m->path : "mesh");
+}
+
+bool mesh_prepare(mesh *m, bool smooth, double crease_deg, rt_error *err)
+{
+	if (!smooth) {
+		free(m->n);
+		m->n = NULL;
+	} else if (!m->n && !smooth_normals(m, crease_deg, err)) {
+		return false;
+	}
+	box *bounds = malloc((size_t)m->ntris * sizeof *bounds);
+	uint32_t *order = malloc((size_t)m->ntris * sizeof *order);
+	uint32_t(*tri)[3] = malloc((size_t)m->ntris * sizeof *tri);
+	uint16_t *tmat = m->tmat ? malloc((size_t)m->ntris * sizeof *tmat) : NULL;
+	if (!bounds || !order || !tri || (m->tmat && !tmat)) {
+		free(bounds);
+		free(order);
+		free(tri);
+		free(tmat);
+		return rt_error_set(err, "%s: out of memory building the triangle tree", m->path);
+	}
+	for (uint32_t t = 0; t < m->ntris; t++) {
+		box b = box_point(vtx(m, m->tri[t][0]));
+		b = box_add(b, vtx(m, m->tri[t][1]));
+		bounds[t] = box_add(b, vtx(m, m->tri[t][2]));
+	}
+	m->tree = bvh_build(bounds, NULL, m->ntris, order, err);
+	free(bounds);
+	if (!m->tree) {
+		free(order);
+		free(tri);
+		free(tmat);
+		return false;
+	}
+	for (uint32_t i = 0; i < m->ntris; i++) {
+		memcpy(tri[i], m->tri[order[i]], sizeof *tri);
+		if (tmat)
+			tmat[i] = m->tmat[order[i]];
+	}
+	free(order);
+	free(m->tri);
+	free(m->tmat);
+	m->tri = tri;
+	m->tmat = tmat;
+	/* vertices in the order the tree's leaves first use them, so that a
+	 * leaf's triangles find theirs close together in memory */
+	uint32_t *newid = malloc((size_t)m->nverts * sizeof *newid);
+	float(*p)[3] = malloc((size_t)m->nverts * sizeof *p);
+	float(*n)[3] = m->n ? malloc((size_t)m->nverts * sizeof *n) : NULL;
+	float(*uv)[2] = m->uv ? malloc((size_t)m->nverts * sizeof *uv) : NULL;
+	if (newid && p && (!m->n || n) && (!m->uv || uv)) {
+		memset(newid, 0xff, (size_t)m->nverts * sizeof *newid);
+		uint32_t next = 0;
+		for (uint32_t t = 0; t < m->ntris; t++)
+			for (int k = 0; k < 3; k++) {
+				uint32_t v = m->tri[t][k];
+				if (newid[v] == UINT32_MAX)
+					newid[v] = next++;
+				m->tri[t][k] = newid[v];
+			}
+		for (uint32_t v = 0; v < m->nverts; v++) {
+			if (newid[v] == UINT32_MAX)
+				newid[v] = next++; /* unused by any triangle */
+			memcpy(p[newid[v]], m->p[v], sizeof *p);
+			if (n)
+				memcpy(n[newid[v]], m->n[v], sizeof *n);
+			if (uv)
+				memcpy(uv[newid[v]], m->uv[v], sizeof *uv);
+		}
+		free(m->p);
+		free(m->n);
+		free(m->uv);
+		m->p = p;
+		m->n = n;
+		m->uv = uv;
+	} else {
+		free(p);
+		free(n);
+		free(uv);
+	}
+	free(newid);
+	double ext = fmax(v3_max_abs(m->bounds.lo), v3_max_abs(m->bounds.hi));
+	m->eps = (float)(ext * 0x1p-19);
+	return true;
+}
+
+/* --- surface --- */
+
+void mesh_surface(const mesh *m, uint32_t t, const float b[3], mesh_surf *s)
+{
+	const uint32_t *i = m->tri[t];
+	vec3 p0 = vtx(m, i[0]), p1 = vtx(m, i[1]), p2 = vtx(m, i[2]);
+	vec3 e1 = v3_sub(p1, p0), e2 = v3_sub(p2, p0);
+	s->ng = v3_norm(v3_cross(e1, e2));
+	s->ns = s->ng;
+	if (m->n) {
+		vec3 n = v3(0, 0, 0);
+		for (int k = 0; k < 3; k++)
+			n = v3_madd(n, v3(m->n[i[k]][0], m->n[i[k]][1], m->n[i[k]][2]), b[k]);
+		double l = v3_len(n);
+		if (l > 0) {
+			n = v3_scale(n, 1.0 / l);
+			/* a normal on the far side of the face would shade it black */
+			s->ns = v3_dot(n, s->ng) >= 0 ? n : v3_neg(n);
+		}
+	}
+	s->u = s->v = 0;
+	s->dpdu = s->dpdv = v3(0, 0, 0);
+	if (m->uv) {
+		const float *a = m->uv[i[0]], *bb = m->uv[i[1]], *c = m->uv[i[2]];
+		s->u = b[0] * a[0] + b[1] * bb[0] + b[2] * c[0];
+		s->v = b[0] * a[1] + b[1] * bb[1] + b[2] * c[1];
+		double du1 = bb[0] - a[0], dv1 = bb[1] - a[1], du2 = c[0] - a[0], dv2 = c[1] - a[1];
+		double det = du1 * dv2 - dv1 * du2;
+		if (det != 0.0) {
+			s->dpdu = v3_scale(v3_sub(v3_scale(e1, dv2), v3_scale(e2, dv1)), 1.0 / det);
+			s->dpdv = v3_scale(v3_sub(v3_scale(e2, du1), v3_scale(e1, du2)), 1.0 / det);
+		}
+	}
+	s->mat = m->nmats == 0 ? -1 : m->tmat ? m->tmat[t] : 0;
+}
+
+/* --- loading by extension, and the cache --- */
+
+static const char *ext_of(const char *path)
+{
+	const char *slash = strrchr(path, '/');
+	const char *dot = strrchr(slash ? slash : path, '.');
+	return dot ? dot + 1 : "";
+}
+
+bool mesh_format_known(const char *path)
+{
+	static const char *const known[] = {"obj", "ply", "gltf", "glb", "stl"};
+	const char *e = ext_of(path);
+	for (size_t i = 0; i < sizeof known / sizeof known[0]; i++)
+		if (strcasecmp(e, known[i]) == 0)
+			return true;
+	return false;
+}
+
+mesh *mesh_load(const char *path, rt_error *err)
+{
+	const char *e = ext_of(path);
+	mesh *m;
+	if (strcasecmp(e, "obj") == 0)
+		m = mesh_read_obj(path, err);
+	else if (strcasecmp(e, "ply") == 0)
+		m = mesh_read_ply(path, err);
+	else if (strcasecmp(e, "gltf") == 0 || strcasecmp(e, "glb") == 0 || strcasecmp(e, "stl") == 0)
+		m = mesh_read_assimp(path, err);
+	else {
+		rt_error_set(err, "%s: unknown model format \".%s\"; expected .obj, .ply, .gltf, .glb or .stl",
+		             path, e);
+		return NULL;
+	}
+	if (m && !m->path) {
+		m->path = strdup(path);
+		if (!m->path) {
+			mesh_free(m);
+			rt_error_set(err, "%s: out of memory", path);
+			return NULL;
+		}
+	}
+	return m;
+}
+
+typedef struct cache_entry {
+	mesh *m;
+	char *path;
+	bool smooth;
+	double crease;
+	off_t size;
+	struct timespec mtime;
+} cache_entry;
+
+static pthread_mutex_t cache_lock = PTHREAD_MUTEX_INITIALIZER;
+static cache_entry *cache;
+static size_t ncache, ccache;
+
+mesh *mesh_cache_get(const char *path, bool smooth, double crease_deg, rt_error *err)
+{
+	struct stat st;
+	if (stat(path, &st) != 0) {
+		rt_error_set(err, "%s: cannot read the model: %s", path, strerror(errno));
+		return NULL;
+	}
+	if (!smooth)
+		crease_deg = 0;
+	pthread_mutex_lock(&cache_lock);
+	for (size_t i = 0; i < ncache; i++) {
+		cache_entry *c = &cache[i];
+		if (strcmp(c->path, path) == 0 && c->smooth == smooth && c->crease == crease_deg &&
+		    c->size == st.st_size && c->mtime.tv_sec == st.st_mtim.tv_sec &&
+		    c->mtime.tv_nsec == st.st_mtim.tv_nsec) {
+			c->m->refs++;
+			pthread_mutex_unlock(&cache_lock);
+			return c->m;
+		}
+	}
+	pthread_mutex_unlock(&cache_lock);
+	mesh *m = mesh_load(path, err);
+	if (!m)
+		return NULL;
+	if (!mesh_prepare(m, smooth, crease_deg, err)) {
+		mesh_free(m);
+		return NULL;
+	}
+	pthread_mutex_lock(&cache_lock);
+	char *p = strdup(path);
+	if (!p || !grow((void **)&cache, &ccache, ncache + 1, sizeof *cache)) {
+		pthread_mutex_unlock(&cache_lock);
+		free(p);
+		mesh_free(m);
+		rt_error_set(err, "%s: out of memory", path);
+		return NULL;
+	}
+	m->refs = 1;
+	cache[ncache++] = (cache_entry){m, p, smooth, crease_deg, st.st_size, st.st_mtim};
+	pthread_mutex_unlock(&cache_lock);
+	return m;
+}
+
+/* Meshes nobody uses stay cached (a world is rebuilt on every edit, and the
+ * next one usually wants the same models) unless the cache holds more than
+ * this many unused ones, when the unused are dropped. */
+#define CACHE_KEEP 8
+
+void mesh_cache_put(mesh *m)
+{
+	if (!m)
+		return;
+	pthread_mutex_lock(&cache_lock);
+	if (m->refs > 0)
+		m->refs--;
+	size_t unused = 0;
+	for (size_t i = 0; i < ncache; i++)
+		unused += cache[i].m->refs == 0;
+	if (unused > CACHE_KEEP) {
+		size_t j = 0;
+		for (size_t i = 0; i < ncache; i++) {
+			if (cache[i].m->refs == 0) {
+				mesh_free(cache[i].m);
+				free(cache[i].path);
+			} else {
+				cache[j++] = cache[i];
+			}
+		}
+		ncache = j;
+	}
+	pthread_mutex_unlock(&cache_lock);
+}

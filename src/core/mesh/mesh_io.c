@@ -1,0 +1,193 @@
+/* rtsh — file and number helpers of the model and image readers. */
+#include "core/mesh/mesh_io.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+/* Files larger than this are refused rather than read. */
+#define SLURP_MAX ((size_t)4 << 30)
+
+char *file_slurp(const char *path, const char *what, size_t *len, rt_error *err)
+{
+	FILE *f = fopen(path, "rb");
+	if (!f) {
+		rt_error_set(err, "%s: cannot read the %s: %s", path, what, strerror(errno));
+		return NULL;
+	}
+	struct stat st;
+	if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
+		fclose(f);
+		rt_error_set(err, "%s: cannot read the %s: not a regular file", path, what);
+		return NULL;
+	}
+	if ((unsigned long long)st.st_size > SLURP_MAX) {
+		fclose(f);
+		rt_error_set(err, "%s: the %s is %lld bytes; expected at most %zu", path, what,
+		             (long long)st.st_size, SLURP_MAX);
+		return NULL;
+	}
+	size_t n = (size_t)st.st_size;
+	char *buf = malloc(n + 1);
+	if (!buf) {
+		fclose(f);
+		rt_error_set(err, "%s: out of memory reading the %s (%zu bytes)", path, what, n);
+		return NULL;
+	}
+	size_t got = fread(buf, 1, n, f);
+	bool bad = ferror(f);
+	fclose(f);
+	if (bad || got != n) {
+		free(buf);
+		rt_error_set(err, "%s: cannot read the %s: %s", path, what, bad ? strerror(errno) : "short read");
+		return NULL;
+	}
+	buf[n] = '\0';
+	*len = n;
+	return buf;
+}
+
+char *path_join(const char *dir, const char *rel)
+{
+	if (rel[0] == '/' || !dir[0] || strcmp(dir, ".") == 0)
+		return strdup(rel);
+	size_t a = strlen(dir), b = strlen(rel);
+	char *p = malloc(a + b + 2);
+	if (!p)
+		return NULL;
+	memcpy(p, dir, a);
+	size_t k = a;
+	if (dir[a - 1] != '/')
+		p[k++] = '/';
+	memcpy(p + k, rel, b + 1);
+	return p;
+}
+
+char *path_dir(const char *path)
+{
+	const char *slash = strrchr(path, '/');
+	if (!slash)
+		return strdup("");
+	size_t n = slash == path ? 1 : (size_t)(slash - path);
+	char *d = malloc(n + 1);
+	if (!d)
+		return NULL;
+	memcpy(d, path, n);
+	d[n] = '\0';
+	return d;
+}
+
+static const double pow10_pos[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9, 1e10,
+                                   1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+
+static bool word_at(const char *s, const char *end, const char *w)
+{
+	size_t n = strlen(w);
+	if ((size_t)(end - s) < n)
+		return false;
+	for (size_t i = 0; i < n; i++)
+		if ((s[i] | 0x20) != w[i])
+			return false;
+	return true;
+}
+
+bool scan_double(const char **sp, const char *end, double *out)
+{
+	const char *s = *sp;
+	bool neg = false;
+	if (s < end && (*s == '-' || *s == '+'))
+		neg = *s++ == '-';
+	if (word_at(s, end, "nan")) {
+		*out = NAN;
+		*sp = s + 3;
+		return true;
+	}
+	if (word_at(s, end, "inf")) {
+		*out = neg ? -INFINITY : INFINITY;
+		s += 3;
+		if (word_at(s, end, "inity"))
+			s += 5;
+		*sp = s;
+		return true;
+	}
+	uint64_t mant = 0;
+	int digits = 0, scale = 0;
+	bool any = false;
+	while (s < end && *s >= '0' && *s <= '9') {
+		any = true;
+		if (digits < 19) {
+			mant = mant * 10 + (uint64_t)(*s - '0');
+			if (mant)
+				digits++;
+		} else {
+			scale++;
+		}
+		s++;
+	}
+	if (s < end && *s == '.') {
+		s++;
+		while (s < end && *s >= '0' && *s <= '9') {
+			any = true;
+			if (digits < 19) {
+				mant = mant * 10 + (uint64_t)(*s - '0');
+				if (mant)
+					digits++;
+				scale--;
+			}
+			s++;
+		}
+	}
+	if (!any)
+		return false;
+	if (s < end && (*s == 'e' || *s == 'E')) {
+		const char *e = s + 1;
+		bool eneg = false;
+		if (e < end && (*e == '-' || *e == '+'))
+			eneg = *e++ == '-';
+		if (e < end && *e >= '0' && *e <= '9') {
+			int x = 0;
+			while (e < end && *e >= '0' && *e <= '9') {
+				if (x < 100000)
+					x = x * 10 + (*e - '0');
+				e++;
+			}
+			scale += eneg ? -x : x;
+			s = e;
+		}
+	}
+	double v = (double)mant;
+	if (mant == 0)
+		v = 0.0;
+	else if (scale >= 0 && scale <= 22)
+		v *= pow10_pos[scale];
+	else if (scale < 0 && scale >= -22)
+		v /= pow10_pos[-scale];
+	else
+		v *= pow(10.0, scale);
+	*out = neg ? -v : v;
+	*sp = s;
+	return true;
+}
+
+bool scan_long(const char **sp, const char *end, long *out)
+{
+	const char *s = *sp;
+	bool neg = false;
+	if (s < end && (*s == '-' || *s == '+'))
+		neg = *s++ == '-';
+	if (!(s < end && *s >= '0' && *s <= '9'))
+		return false;
+	long v = 0;
+	while (s < end && *s >= '0' && *s <= '9') {
+		if (v < 100000000000L)
+			v = v * 10 + (*s - '0');
+		s++;
+	}
+	*out = neg ? -v : v;
+	*sp = s;
+	return true;
+}

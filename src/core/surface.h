@@ -1,0 +1,29 @@
+/* rtsh — what world.c asks of meshes and textures (surface.c): mesh
+ * instances in the world, texture coordinates per shape, textures in
+ * materials, and normal / bump mapping. Private to the core. */
+#ifndef RTSH_SURFACE_H
+#define RTSH_SURFACE_H
+
+#include "rtsh/world.h"
+
+/* Before the objects are placed: loads the scene's meshes (shared, once per
+ * file) and makes room for their instances and sub-materials. */
+bool surf_begin(world *w, const scene *s, rt_error *err);
+/* After w->mats[i] is set from object i: its textures, and a mesh's own
+ * materials (appended to w->mats). */
+bool surf_material(world *w, const object *o, uint32_t i, rt_error *err);
+/* A mesh object's primitive and world bounds. */
+bool surf_make_inst(world *w, const object *o, uint32_t i, prim *p, box *b, rt_error *err);
+/* Instance tests: the nearest hit stores (triangle, b1, b2) in *nl. */
+bool surf_inst_hit(const world *w, const prim *p, const ray *r, double tmin, double tmax, double *t, vec3 *nl);
+bool surf_inst_occluded(const world *w, const prim *p, const ray *r, double tmin, double tmax);
+void surf_inst_finish(const world *w, const prim *p, const ray *r, vec3 nl, hit *h);
+/* Texture coordinates of a unit shape of kind `kind` (or a world-space
+ * triangle: its vertex, edges) at h, when its material has a texture;
+ * inv is the world-to-object matrix (NULL for triangles). */
+void surf_shape_uv(const world *w, uint32_t kind, const double (*inv)[4], vec3 nl, hit *h);
+void surf_triangle_uv(const world *w, vec3 v0, vec3 e1, vec3 e2, hit *h);
+void surf_free(world *w);
+size_t surf_memory(const world *w);
+
+#endif

@@ -1,0 +1,452 @@
+/* rtsh — reading images into linear RGB floats (texture.h).
+ *
+ * PNG, JPEG, BMP, TGA and Radiance HDR: stb_image (libstb). PPM/PGM (P2, P3,
+ * P5, P6, 8 or 16 bits) and PFM (PF colour, Pf grey; the sign of the scale
+ * gives the byte order, rows bottom first): our own readers, after the
+ * netpbm and PFM format descriptions. XPM: libXpm reads the file; we turn
+ * its colour table (#RGB, #RRGGBB, #RRRRGGGGBBBB, None and the common names)
+ * into colours and fail on anything else.
+ */
+#include <errno.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include <X11/xpm.h>
+#include <stb/stb_image.h>
+
+#include "core/mesh/mesh_io.h"
+#include "rtsh/texture.h"
+
+/* Images larger than this (in pixels) are refused. */
+#define IMAGE_MAX_PIXELS ((size_t)1 << 28)
+
+static const char *ext_of(const char *path)
+{
+	const char *slash = strrchr(path, '/');
+	const char *dot = strrchr(slash ? slash : path, '.');
+	return dot ? dot + 1 : "";
+}
+
+enum { F_NONE, F_STB, F_PPM, F_PFM, F_XPM };
+
+static int format_of(const char *path)
+{
+	static const struct {
+		const char *ext;
+		int f;
+	} t[] = {{"png", F_STB}, {"jpg", F_STB}, {"jpeg", F_STB}, {"bmp", F_STB}, {"tga", F_STB},
+	         {"hdr", F_STB}, {"ppm", F_PPM}, {"pgm", F_PPM}, {"pnm", F_PPM}, {"pfm", F_PFM},
+	         {"xpm", F_XPM}};
+	const char *e = ext_of(path);
+	for (size_t i = 0; i < sizeof t / sizeof t[0]; i++)
+		if (strcasecmp(e, t[i].ext) == 0)
+			return t[i].f;
+	return F_NONE;
+}
+
+bool image_format_known(const char *path)
+{
+	return format_of(path) != F_NONE;
+}
+
+static float srgb_decode(double v)
+{
+	return (float)(v <= 0.04045 ? v / 12.92 : pow((v + 0.055) / 1.055, 2.4));
+}
+
+/* 8-bit codes to floats, through a table */
+static void codes_to_float(const unsigned char *in, size_t n, int comp, bool srgb, float *out)
+{
+	float lut[256];
+	for (int i = 0; i < 256; i++)
+		lut[i] = srgb ? srgb_decode(i / 255.0) : (float)(i / 255.0);
+	for (size_t i = 0; i < n; i++)
+		for (int c = 0; c < 3; c++)
+			out[3 * i + c] = lut[in[i * (size_t)comp + (comp >= 3 ? c : 0)]];
+}
+
+static bool size_ok(const char *path, long w, long h, rt_error *err)
+{
+	if (w <= 0 || h <= 0)
+		return rt_error_set(err, "%s: the image is %ldx%ld pixels; expected a size of at least 1x1", path, w, h);
+	if ((size_t)w * (size_t)h > IMAGE_MAX_PIXELS || w > 1 << 20 || h > 1 << 20)
+		return rt_error_set(err, "%s: the image is %ldx%ld pixels; expected at most 2^28 pixels", path, w, h);
+	return true;
+}
+
+static float *read_stb(const char *path, const unsigned char *buf, size_t len, bool srgb, int *w, int *h,
+                       rt_error *err)
+{
+	if (len > INT32_MAX) {
+		rt_error_set(err, "%s: the image file is too large", path);
+		return NULL;
+	}
+	int x = 0, y = 0, comp = 0;
+	if (!stbi_info_from_memory(buf, (int)len, &x, &y, &comp)) {
+		rt_error_set(err, "%s: cannot decode the image: %s", path, stbi_failure_reason());
+		return NULL;
+	}
+	if (!size_ok(path, x, y, err))
+		return NULL;
+	float *out = malloc((size_t)x * (size_t)y * 3 * sizeof *out);
+	if (!out) {
+		rt_error_set(err, "%s: out of memory (%dx%d image)", path, x, y);
+		return NULL;
+	}
+	if (stbi_is_hdr_from_memory(buf, (int)len)) {
+		float *f = stbi_loadf_from_memory(buf, (int)len, &x, &y, &comp, 3);
+		if (!f) {
+			free(out);
+			rt_error_set(err, "%s: cannot decode the image: %s", path, stbi_failure_reason());
+			return NULL;
+		}
+		memcpy(out, f, (size_t)x * (size_t)y * 3 * sizeof *out);
+		stbi_image_free(f);
+	} else {
+		unsigned char *c = stbi_load_from_memory(buf, (int)len, &x, &y, &comp, 3);
+		if (!c) {
+			free(out);
+			rt_error_set(err, "%s: cannot decode the image: %s", path, stbi_failure_reason());
+			return NULL;
+		}
+		codes_to_float(c, (size_t)x * (size_t)y, 3, srgb, out);
+		stbi_image_free(c);
+	}
+	*w = x;
+	*h = y;
+	return out;
+}
+
+/* --- netpbm --- */
+
+typedef struct pnm {
+	const unsigned char *s, *end, *start;
+	const char *path;
+} pnm;
+
+static bool pnm_int(pnm *p, long *v)
+{
+	for (;;) {
+		while (p->s < p->end && (*p->s == ' ' || *p->s == '\t' || *p->s == '\r' || *p->s == '\n'))
+			p->s++;
+		if (p->s < p->end && *p->s == '#') {
+			while (p->s < p->end && *p->s != '\n')
+				p->s++;
+			continue;
+		}
+		break;
+	}
+	const char *c = (const char *)p->s;
+	if (!scan_long(&c, (const char *)p->end, v))
+		return false;
+	p->s = (const unsigned char *)c;
+	return true;
+}
+
+static float *read_ppm(const char *path, const unsigned char *buf, size_t len, bool srgb, int *w, int *h,
+                       rt_error *err)
+{
+	pnm p = {buf, buf + len, buf, path};
+	if (len < 2 || buf[0] != 'P' || !strchr("2356", buf[1])) {
+		rt_error_set(err, "%s: not a PPM/PGM image; expected P2, P3, P5 or P6 first", path);
+		return NULL;
+	}
+	char kind = (char)buf[1];
+	p.s += 2;
+	long x, y, maxv;
+	if (!pnm_int(&p, &x) || !pnm_int(&p, &y) || !pnm_int(&p, &maxv)) {
+		rt_error_set(err, "%s: byte %zu: a bad header; expected WIDTH HEIGHT MAXVAL", path,
+		             (size_t)(p.s - buf));
+		return NULL;
+	}
+	if (!size_ok(path, x, y, err))
+		return NULL;
+	if (maxv < 1 || maxv > 65535) {
+		rt_error_set(err, "%s: maxval %ld; expected 1..65535", path, maxv);
+		return NULL;
+	}
+	bool color = kind == '3' || kind == '6', binary = kind == '5' || kind == '6';
+	int comp = color ? 3 : 1, bps = maxv > 255 ? 2 : 1;
+	size_t n = (size_t)x * (size_t)y;
+	if (binary) {
+		if (p.s >= p.end) {
+			rt_error_set(err, "%s: byte %zu: the file ends after the header (truncated?); expected pixel data",
+			             path, len);
+			return NULL;
+		}
+		p.s++; /* the one blank after maxval */
+		if ((size_t)(p.end - p.s) / ((size_t)comp * (size_t)bps) < n) {
+			rt_error_set(err, "%s: byte %zu: the pixel data ends early (truncated?); expected %zu bytes",
+			             path, (size_t)(p.end - buf), n * (size_t)comp * (size_t)bps);
+			return NULL;
+		}
+	} else if ((size_t)(p.end - p.s) / 2 < n * (size_t)comp / 2) {
+		rt_error_set(err, "%s: the file is too short for a %ldx%ld image (truncated?)", path, x, y);
+		return NULL;
+	}
+	float *out = malloc(n * 3 * sizeof *out);
+	if (!out) {
+		rt_error_set(err, "%s: out of memory (%ldx%ld image)", path, x, y);
+		return NULL;
+	}
+	for (size_t i = 0; i < n; i++)
+		for (int c = 0; c < comp; c++) {
+			long v;
+			if (binary) {
+				v = bps == 2 ? (long)p.s[0] << 8 | p.s[1] : p.s[0];
+				p.s += bps;
+			} else if (!pnm_int(&p, &v)) {
+				free(out);
+				rt_error_set(err, "%s: byte %zu: expected pixel value %zu of %zu", path, (size_t)(p.s - buf),
+				             i * (size_t)comp + (size_t)c + 1, n * (size_t)comp);
+				return NULL;
+			}
+			double f = (double)(v < 0 ? 0 : v > maxv ? maxv : v) / (double)maxv;
+			float lf = srgb ? srgb_decode(f) : (float)f;
+			if (comp == 1)
+				out[3 * i] = out[3 * i + 1] = out[3 * i + 2] = lf;
+			else
+				out[3 * i + (size_t)c] = lf;
+		}
+	*w = (int)x;
+	*h = (int)y;
+	return out;
+}
+
+static float *read_pfm(const char *path, const unsigned char *buf, size_t len, int *w, int *h, rt_error *err)
+{
+	pnm p = {buf, buf + len, buf, path};
+	if (len < 2 || buf[0] != 'P' || (buf[1] != 'F' && buf[1] != 'f')) {
+		rt_error_set(err, "%s: not a PFM image; expected PF or Pf first", path);
+		return NULL;
+	}
+	int comp = buf[1] == 'F' ? 3 : 1;
+	p.s += 2;
+	long x, y;
+	double scale;
+	if (!pnm_int(&p, &x) || !pnm_int(&p, &y)) {
+		rt_error_set(err, "%s: a bad header; expected WIDTH HEIGHT SCALE", path);
+		return NULL;
+	}
+	while (p.s < p.end && (*p.s == ' ' || *p.s == '\n' || *p.s == '\r' || *p.s == '\t'))
+		p.s++;
+	const char *c = (const char *)p.s;
+	if (!scan_double(&c, (const char *)p.end, &scale) || scale == 0 || !isfinite(scale)) {
+		rt_error_set(err, "%s: a bad scale; expected a non-zero number (negative: little-endian)", path);
+		return NULL;
+	}
+	p.s = (const unsigned char *)c + 1;
+	if (!size_ok(path, x, y, err))
+		return NULL;
+	size_t n = (size_t)x * (size_t)y;
+	if (p.s > p.end || (size_t)(p.end - p.s) / (4 * (size_t)comp) < n) {
+		rt_error_set(err, "%s: byte %zu: the pixel data ends early (truncated?); expected %zu bytes", path, len,
+		             n * 4 * (size_t)comp);
+		return NULL;
+	}
+	float *out = malloc(n * 3 * sizeof *out);
+	if (!out) {
+		rt_error_set(err, "%s: out of memory (%ldx%ld image)", path, x, y);
+		return NULL;
+	}
+	bool little = scale < 0;
+	for (long row = 0; row < y; row++) {
+		long dst = y - 1 - row; /* the file's rows run bottom to top */
+		for (long col = 0; col < x; col++)
+			for (int k = 0; k < comp; k++) {
+				unsigned char b[4];
+				memcpy(b, p.s, 4);
+				p.s += 4;
+				uint32_t u = little ? (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24
+				                    : (uint32_t)b[3] | (uint32_t)b[2] << 8 | (uint32_t)b[1] << 16 | (uint32_t)b[0] << 24;
+				float f;
+				memcpy(&f, &u, 4);
+				if (!isfinite(f))
+					f = 0;
+				size_t o = 3 * ((size_t)dst * (size_t)x + (size_t)col);
+				if (comp == 1)
+					out[o] = out[o + 1] = out[o + 2] = f;
+				else
+					out[o + (size_t)k] = f;
+			}
+	}
+	*w = (int)x;
+	*h = (int)y;
+	return out;
+}
+
+/* --- XPM --- */
+
+static int hexval(char c)
+{
+	if (c >= '0' && c <= '9')
+		return c - '0';
+	c = (char)(c | 0x20);
+	return c >= 'a' && c <= 'f' ? c - 'a' + 10 : -1;
+}
+
+static bool xpm_color(const char *s, float rgb[3], bool srgb)
+{
+	static const struct {
+		const char *name;
+		unsigned char c[3];
+	} names[] = {{"black", {0, 0, 0}},       {"white", {255, 255, 255}}, {"red", {255, 0, 0}},
+	             {"green", {0, 255, 0}},     {"blue", {0, 0, 255}},      {"yellow", {255, 255, 0}},
+	             {"cyan", {0, 255, 255}},    {"magenta", {255, 0, 255}}, {"gray", {190, 190, 190}},
+	             {"grey", {190, 190, 190}},  {"orange", {255, 165, 0}},  {"brown", {165, 42, 42}}};
+	if (!s)
+		return false;
+	double c[3];
+	if (strcasecmp(s, "none") == 0) {
+		c[0] = c[1] = c[2] = 0;
+	} else if (s[0] == '#') {
+		size_t n = strlen(s + 1);
+		if (n != 3 && n != 6 && n != 12)
+			return false;
+		size_t d = n / 3;
+		for (int k = 0; k < 3; k++) {
+			double v = 0;
+			for (size_t i = 0; i < d; i++) {
+				int h = hexval(s[1 + k * d + i]);
+				if (h < 0)
+					return false;
+				v = v * 16 + h;
+			}
+			c[k] = v / (pow(16.0, (double)d) - 1) * 255.0;
+		}
+	} else {
+		size_t i = 0;
+		while (i < sizeof names / sizeof names[0] && strcasecmp(names[i].name, s) != 0)
+			i++;
+		if (i == sizeof names / sizeof names[0])
+			return false;
+		for (int k = 0; k < 3; k++)
+			c[k] = names[i].c[k];
+	}
+	for (int k = 0; k < 3; k++)
+		rgb[k] = srgb ? srgb_decode(c[k] / 255.0) : (float)(c[k] / 255.0);
+	return true;
+}
+
+static float *read_xpm(const char *path, const unsigned char *buf, size_t len, bool srgb, int *w, int *h,
+                       rt_error *err)
+{
+	/* the values line ("W H NCOLORS CPP"), checked against the file's size
+	 * before libXpm allocates what it promises */
+	const unsigned char *q = memchr(buf, '"', len);
+	long v[4] = {0, 0, 0, 0};
+	const char *vc = q ? (const char *)q + 1 : NULL, *end = (const char *)buf + len;
+	for (int k = 0; vc && k < 4; k++) {
+		while (vc < end && (*vc == ' ' || *vc == '\t'))
+			vc++;
+		if (!scan_long(&vc, end, &v[k]))
+			vc = NULL;
+	}
+	if (!vc) {
+		rt_error_set(err, "%s: no XPM values line; expected \"WIDTH HEIGHT NCOLORS CHARS_PER_PIXEL\"", path);
+		return NULL;
+	}
+	if (!size_ok(path, v[0], v[1], err))
+		return NULL;
+	if (v[3] < 1 || v[3] > 8 || v[2] < 1 || (size_t)v[2] > len / ((size_t)v[3] + 4) ||
+	    (size_t)v[0] * (size_t)v[1] > len / (size_t)v[3]) {
+		rt_error_set(err, "%s: the XPM values line promises %ldx%ld pixels, %ld colours, %ld characters "
+		             "per pixel: more than the file holds", path, v[0], v[1], v[2], v[3]);
+		return NULL;
+	}
+	char *text = malloc(len + 1);
+	if (!text) {
+		rt_error_set(err, "%s: out of memory", path);
+		return NULL;
+	}
+	memcpy(text, buf, len);
+	text[len] = '\0';
+	XpmImage img;
+	memset(&img, 0, sizeof img);
+	int rc = XpmCreateXpmImageFromBuffer(text, &img, NULL);
+	free(text);
+	if (rc != XpmSuccess) {
+		XpmFreeXpmImage(&img); /* what libXpm left allocated (it may leave some) */
+		rt_error_set(err, "%s: cannot read the XPM image: %s", path, XpmGetErrorString(rc));
+		return NULL;
+	}
+	float *out = NULL;
+	float(*table)[3] = NULL;
+	if (!size_ok(path, (long)img.width, (long)img.height, err))
+		goto done;
+	if (img.ncolors == 0) {
+		rt_error_set(err, "%s: the XPM colour table is empty; expected at least one colour", path);
+		goto done;
+	}
+	table = malloc(img.ncolors * sizeof *table);
+	out = malloc((size_t)img.width * img.height * 3 * sizeof *out);
+	if (!table || !out) {
+		free(out);
+		out = NULL;
+		rt_error_set(err, "%s: out of memory", path);
+		goto done;
+	}
+	for (unsigned i = 0; i < img.ncolors; i++) {
+		const XpmColor *c = &img.colorTable[i];
+		const char *spec = c->c_color ? c->c_color : c->g_color ? c->g_color : c->g4_color ? c->g4_color : c->m_color;
+		if (!xpm_color(spec, table[i], srgb)) {
+			free(out);
+			out = NULL;
+			rt_error_set(err, "%s: XPM colour %u (\"%s\") is \"%s\"; expected #RGB, #RRGGBB, "
+			             "None or a basic colour name", path, i + 1, c->string ? c->string : "",
+			             spec ? spec : "(none)");
+			goto done;
+		}
+	}
+	for (size_t i = 0; i < (size_t)img.width * img.height; i++) {
+		unsigned k = img.data[i];
+		if (k >= img.ncolors) {
+			free(out);
+			out = NULL;
+			rt_error_set(err, "%s: XPM pixel %zu uses colour %u of %u", path, i, k + 1, img.ncolors);
+			goto done;
+		}
+		memcpy(&out[3 * i], table[k], sizeof *table);
+	}
+	*w = (int)img.width;
+	*h = (int)img.height;
+done:
+	free(table);
+	XpmFreeXpmImage(&img);
+	return out;
+}
+
+float *image_decode_rgb(const char *path, const unsigned char *buf, size_t len, bool srgb, int *w, int *h,
+                        rt_error *err)
+{
+	switch (format_of(path)) {
+	case F_STB:
+		return read_stb(path, buf, len, srgb, w, h, err);
+	case F_PPM:
+		return read_ppm(path, buf, len, srgb, w, h, err);
+	case F_PFM:
+		return read_pfm(path, buf, len, w, h, err);
+	case F_XPM:
+		return read_xpm(path, buf, len, srgb, w, h, err);
+	default:
+		rt_error_set(err, "%s: unknown image format \".%s\"; expected .png .jpg .jpeg .bmp .tga .hdr .ppm "
+		             ".pgm .pfm or .xpm", path, ext_of(path));
+		return NULL;
+	}
+}
+
+float *image_load_rgb(const char *path, bool srgb, int *w, int *h, rt_error *err)
+{
+	if (format_of(path) == F_NONE)
+		return image_decode_rgb(path, NULL, 0, srgb, w, h, err);
+	size_t len;
+	char *buf = file_slurp(path, "image", &len, err);
+	if (!buf)
+		return NULL;
+	float *out = image_decode_rgb(path, (const unsigned char *)buf, len, srgb, w, h, err);
+	free(buf);
+	return out;
+}

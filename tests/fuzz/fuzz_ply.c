@@ -1,0 +1,18 @@
+/* rtsh — fuzz target: the PLY reader (ASCII and binary, faces and strips).
+ * Build as fuzz_obj.c. */
+#include <stddef.h>
+#include <stdint.h>
+
+#include "rtsh/mesh.h"
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+	rt_error err;
+	mesh *m = mesh_parse_ply("fuzz.ply", (const char *)data, size, &err);
+	if (m && m->ntris < 100000)
+		mesh_prepare(m, true, 60, &err);
+	mesh_free(m);
+	return 0;
+}

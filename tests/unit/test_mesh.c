@@ -1,0 +1,578 @@
+/* rtsh — meshes: readers, bad input, the triangle tree, instances and the
+ * mesh element (mesh.h, surface.c, rtfile). Expected values come from the
+ * files' own descriptions, from formulas or from an independent count. */
+#include "testutil.h"
+
+#include <unistd.h>
+
+#include "core/bvh.h"
+#include "rtsh/mesh.h"
+#include "rtsh/render.h"
+#include "rtsh/rtfile.h"
+#include "rtsh/world.h"
+
+#define MODELS "../shared/models"
+
+static char tmpdir[64];
+
+static int setup(void **state)
+{
+	(void)state;
+	snprintf(tmpdir, sizeof tmpdir, "/tmp/rtsh-mesh-XXXXXX");
+	return mkdtemp(tmpdir) ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+	(void)state;
+	char cmd[128];
+	snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
+	return system(cmd) == 0 ? 0 : -1;
+}
+
+static const char *tmp_write(const char *name, const void *data, size_t len)
+{
+	static char path[8][256];
+	static int k;
+	char *p = path[k++ % 8];
+	snprintf(p, 256, "%s/%s", tmpdir, name);
+	FILE *f = fopen(p, "wb");
+	assert_non_null(f);
+	assert_int_equal(fwrite(data, 1, len, f), len);
+	fclose(f);
+	return p;
+}
+
+static const char *tmp_text(const char *name, const char *text)
+{
+	return tmp_write(name, text, strlen(text));
+}
+
+static bool have_models(void)
+{
+	if (access(MODELS "/stanford-bunny.obj", R_OK) == 0)
+		return true;
+	print_message("skipped: " MODELS " is absent\n");
+	return false;
+}
+
+/* --- readers --- */
+
+static void test_obj_polygons_and_indices(void **state)
+{
+	(void)state;
+	/* a unit cube: six quads, the second half of the file with negative
+	 * indices, v/vt/vn and v//vn corners, a group and a usemtl */
+	const char *obj = "# cube\n"
+	                  "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+	                  "vt 0 0\nvt 1 0\nvt 1 1\nvn 0 0 -1\n"
+	                  "g sides\nusemtl red\n"
+	                  "f 1/1/1 4/3/1 3/2/1 2/1/1\n"
+	                  "f 5 6 7 8\n"
+	                  "f 1//1 2//1 6//1 5//1\n"
+	                  "f -5 -1 -2 -6\n" /* 4 8 7 3 */
+	                  "f 1 5 8 4\n"
+	                  "f 2 3 7 6\n";
+	rt_error err = {0};
+	mesh *m = mesh_parse_obj("cube.obj", "", obj, strlen(obj), &err);
+	assert_non_null(m);
+	/* 6 quads = 12 triangles; the box is the unit cube */
+	assert_int_equal(m->ntris, 12);
+	assert_vec_near(m->bounds.lo, v3(0, 0, 0), 0);
+	assert_vec_near(m->bounds.hi, v3(1, 1, 1), 0);
+	/* faces mix corners with and without uv/normals: positions only */
+	assert_null(m->uv);
+	assert_int_equal(m->nmats, 1);
+	/* the area of the cube's surface: 6 */
+	double area = 0;
+	for (uint32_t t = 0; t < m->ntris; t++) {
+		vec3 p[3];
+		for (int k = 0; k < 3; k++)
+			p[k] = v3(m->p[m->tri[t][k]][0], m->p[m->tri[t][k]][1], m->p[m->tri[t][k]][2]);
+		area += 0.5 * v3_len(v3_cross(v3_sub(p[1], p[0]), v3_sub(p[2], p[0])));
+	}
+	assert_near(area, 6, 1e-12);
+	mesh_free(m);
+}
+
+static void test_obj_welds_uv_corners(void **state)
+{
+	(void)state;
+	/* two triangles sharing an edge, with different uvs on one shared
+	 * position: 4 positions, 5 distinct (v, vt) pairs */
+	const char *obj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+	                  "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvt 0.5 0.5\n"
+	                  "f 1/1 2/2 3/3\nf 1/5 3/3 4/4\n";
+	rt_error err = {0};
+	mesh *m = mesh_parse_obj("q.obj", "", obj, strlen(obj), &err);
+	assert_non_null(m);
+	assert_int_equal(m->ntris, 2);
+	assert_int_equal(m->nverts, 5);
+	assert_non_null(m->uv);
+	mesh_free(m);
+}
+
+/* A message must name the file and the place. */
+static void expect_error(mesh *m, const rt_error *err, const char *want1, const char *want2)
+{
+	assert_null(m);
+	char buf[1024];
+	rt_error_format(err, buf, sizeof buf);
+	if (!strstr(buf, want1) || (want2 && !strstr(buf, want2)))
+		fail_msg("message \"%s\" lacks \"%s\" / \"%s\"", buf, want1, want2 ? want2 : "");
+}
+
+static void test_obj_bad_input(void **state)
+{
+	(void)state;
+	static const struct {
+		const char *text, *want1, *want2;
+	} cases[] = {
+		{"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 0\n", "bad.obj:4", "out of range"},
+		{"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", "bad.obj:4", "expected 1..3"},
+		{"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n", "bad.obj:4", "out of range"},
+		{"v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n", "bad.obj:2", "not a finite number"},
+		{"v 0 0 0\nv 1e300 0 0\nv 0 1 0\nf 1 2 3\n", "bad.obj:2", "not a finite number"},
+		{"v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n", "bad.obj", "no triangle of non-zero area"},
+		{"v 0 0 0\nv 1 0 0\nv 0 1 0\n", "bad.obj", "no faces"},
+		{"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n", "bad.obj:4", "fewer than 3"},
+		{"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 x 3\n", "bad.obj:4", "expected a vertex index"},
+		{"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/2 2/2 3/2\n", "bad.obj:4", "texture index 2 refers to no"},
+	};
+	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+		rt_error err = {0};
+		mesh *m = mesh_parse_obj("bad.obj", "", cases[i].text, strlen(cases[i].text), &err);
+		expect_error(m, &err, cases[i].want1, cases[i].want2);
+	}
+	rt_error err = {0};
+	expect_error(mesh_load("/nonexistent/x.obj", &err), &err, "/nonexistent/x.obj", "cannot read");
+	expect_error(mesh_load(tmp_text("m.xyz", "hello"), &err), &err, "m.xyz", "unknown model format");
+}
+
+/* PLY: ascii faces, and a binary strip with a -1 restart. */
+static void test_ply_faces_and_strips(void **state)
+{
+	(void)state;
+	const char *ply = "ply\nformat ascii 1.0\ncomment a square and a triangle\n"
+	                  "element vertex 5\nproperty float x\nproperty float y\nproperty float z\n"
+	                  "element face 2\nproperty list uchar int vertex_indices\nend_header\n"
+	                  "0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n"
+	                  "4 0 1 2 3\n3 0 1 4\n";
+	rt_error err = {0};
+	mesh *m = mesh_parse_ply("a.ply", ply, strlen(ply), &err);
+	assert_non_null(m);
+	assert_int_equal(m->ntris, 3); /* a quad is two triangles */
+	mesh_free(m);
+
+	/* a strip of 5 vertices (3 triangles), -1, a strip of 4 (2 triangles):
+	 * a strip of n vertices has n - 2 triangles */
+	unsigned char buf[1024];
+	const char *hdr = "ply\nformat binary_little_endian 1.0\nelement vertex 7\n"
+	                  "property float x\nproperty float y\nproperty float z\n"
+	                  "element tristrips 1\nproperty list int int vertex_indices\nend_header\n";
+	size_t n = strlen(hdr);
+	memcpy(buf, hdr, n);
+	float v[7][3] = {{0, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0}, {2, 0, 0}, {0, 0, 1}, {0, 1, 1}};
+	memcpy(buf + n, v, sizeof v);
+	n += sizeof v;
+	int32_t strip[] = {10, 0, 1, 2, 3, 4, -1, 5, 6, 2, 3};
+	memcpy(buf + n, strip, sizeof strip);
+	n += sizeof strip;
+	m = mesh_parse_ply("s.ply", (const char *)buf, n, &err);
+	assert_non_null(m);
+	assert_int_equal(m->ntris, 3 + 2);
+	/* every triangle of a strip keeps its winding: all normals of the
+	 * first strip (in the z = 0 plane) point the same way */
+	int up = 0, down = 0;
+	for (uint32_t t = 0; t < m->ntris; t++) {
+		const float *a = m->p[m->tri[t][0]], *b = m->p[m->tri[t][1]], *c = m->p[m->tri[t][2]];
+		if (a[2] != 0 || b[2] != 0 || c[2] != 0)
+			continue;
+		double nz = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+		up += nz > 0;
+		down += nz < 0;
+	}
+	assert_int_equal(up + down, 3);
+	assert_true(up == 0 || down == 0);
+	mesh_free(m);
+
+	/* truncated: cut inside the strip */
+	expect_error(mesh_parse_ply("t.ply", (const char *)buf, n - 6, &err), &err, "t.ply: byte", "truncated");
+	/* counts larger than the file */
+	const char *big = "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\n"
+	                  "property float x\nproperty float y\nproperty float z\nend_header\n";
+	expect_error(mesh_parse_ply("big.ply", big, strlen(big), &err), &err, "big.ply: byte", "claims 4000000000");
+	/* an index out of range */
+	const char *oob = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+	                  "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+	                  "0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n";
+	expect_error(mesh_parse_ply("oob.ply", oob, strlen(oob), &err), &err, "oob.ply:13", "index 7 is out of range");
+	expect_error(mesh_parse_ply("x.ply", "plx\n", 4, &err), &err, "x.ply:1", "not a PLY file");
+}
+
+/* glTF 2.0 and STL through assimp: a square of two triangles under a node
+ * that moves it by 5 along X and doubles it; one STL facet. */
+static void test_gltf_and_stl(void **state)
+{
+	(void)state;
+	const char *gltf =
+	    "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
+	    "\"nodes\":[{\"mesh\":0,\"translation\":[5,0,0],\"scale\":[2,2,2]}],"
+	    "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":0}]}],"
+	    "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.25,0.5,0.75,1]}}],"
+	    "\"buffers\":[{\"byteLength\":60,\"uri\":\"data:application/octet-stream;base64,"
+	    "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAACAPwAAgD8AAAAAAAAAAAAAgD8AAAAAAAABAAIAAAACAAMA\"}],"
+	    "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},"
+	    "{\"buffer\":0,\"byteOffset\":48,\"byteLength\":12}],"
+	    "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+	    "\"min\":[0,0,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5123,\"count\":6,"
+	    "\"type\":\"SCALAR\"}]}";
+	rt_error err = {0};
+	mesh *m = mesh_load(tmp_text("sq.gltf", gltf), &err);
+	if (!m)
+		fail_msg("%s", err.msg);
+	assert_int_equal(m->ntris, 2);
+	assert_vec_near(m->bounds.lo, v3(5, 0, 0), 1e-6);
+	assert_vec_near(m->bounds.hi, v3(7, 2, 0), 1e-6);
+	mesh_surf sf;
+	float b[3] = {1.0f / 3, 1.0f / 3, 1.0f / 3};
+	mesh_surface(m, 0, b, &sf);
+	assert_true(sf.mat >= 0);
+	assert_near(m->mats[sf.mat].kd[0], 0.25, 1e-6);
+	assert_near(m->mats[sf.mat].kd[2], 0.75, 1e-6);
+	mesh_free(m);
+	m = mesh_load(tmp_text("t.stl", "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 2 0 0\n"
+	                                "vertex 0 3 0\nendloop\nendfacet\nendsolid t\n"), &err);
+	assert_non_null(m);
+	assert_int_equal(m->ntris, 1);
+	assert_vec_near(m->bounds.hi, v3(2, 3, 0), 0);
+	mesh_free(m);
+	expect_error(mesh_load(tmp_text("bad.gltf", "garbage"), &err), &err, "bad.gltf", "cannot read the model");
+}
+
+/* --- the tree and the watertight test --- */
+
+static mesh *sphere_mesh(int nu, int nv)
+{
+	mesh_builder b = {.name = "sphere"};
+	for (int j = 0; j <= nv; j++)
+		for (int i = 0; i < nu; i++) {
+			double th = RT_PI * j / nv, ph = 2 * RT_PI * i / nu;
+			float p[3] = {(float)(sin(th) * cos(ph)), (float)cos(th), (float)(sin(th) * sin(ph))};
+			mb_vertex(&b, p);
+		}
+	for (int j = 0; j < nv; j++)
+		for (int i = 0; i < nu; i++) {
+			int a = j * nu + i, c = j * nu + (i + 1) % nu, d = (j + 1) * nu + i, e = (j + 1) * nu + (i + 1) % nu;
+			int32_t t1[3][3] = {{a, -1, -1}, {d, -1, -1}, {c, -1, -1}}, t2[3][3] = {{c, -1, -1}, {d, -1, -1}, {e, -1, -1}};
+			mb_triangle(&b, t1);
+			mb_triangle(&b, t2);
+		}
+	rt_error err = {0};
+	mesh *m = mb_finish(&b, &err);
+	assert_non_null(m);
+	assert_true(mesh_prepare(m, true, 60, &err));
+	return m;
+}
+
+static void test_tree_matches_brute_force(void **state)
+{
+	(void)state;
+	mesh *m = sphere_mesh(40, 20);
+	test_rng r = {7};
+	for (int i = 0; i < 4000; i++) {
+		vec3 o = v3_scale(tdir(&r), 3), d = tdir(&r);
+		if (i % 2)
+			d = v3_norm(v3_sub(v3_scale(tdir(&r), 0.5), o)); /* toward the sphere */
+		mesh_ray mr;
+		mesh_ray_make(&mr, o, d);
+		float t1 = INFINITY, t2 = INFINITY, b1[3], b2[3];
+		uint32_t k1 = 0, k2 = 0;
+		bool h1 = mesh_intersect(m, &mr, 0, &t1, &k1, b1);
+		bool h2 = mesh_intersect_brute(m, &mr, 0, &t2, &k2, b2);
+		assert_int_equal(h1, h2);
+		assert_int_equal(mesh_occluded(m, &mr, 0, INFINITY), h2);
+		if (h1) {
+			assert_true(t1 == t2);
+			assert_near(b1[0] + b1[1] + b1[2], 1, 1e-5);
+		}
+	}
+	mesh_free(m);
+}
+
+/* Rays aimed exactly at shared vertices and edges of a closed mesh from
+ * inside it must hit: no cracks (Woop et al.). */
+static void test_watertight(void **state)
+{
+	(void)state;
+	mesh *m = sphere_mesh(17, 9);
+	int miss = 0;
+	for (uint32_t t = 0; t < m->ntris; t++)
+		for (int k = 0; k < 3; k++) {
+			const float *a = m->p[m->tri[t][k]], *b = m->p[m->tri[t][(k + 1) % 3]];
+			vec3 targets[2] = {v3(a[0], a[1], a[2]), v3((a[0] + (double)b[0]) / 2, (a[1] + (double)b[1]) / 2,
+			                                           (a[2] + (double)b[2]) / 2)};
+			for (int q = 0; q < 2; q++) {
+				mesh_ray mr;
+				vec3 o = v3(0.01, -0.02, 0.015);
+				mesh_ray_make(&mr, o, v3_sub(targets[q], o));
+				float tt = INFINITY, bb[3];
+				uint32_t kk;
+				miss += !mesh_intersect(m, &mr, 0, &tt, &kk, bb);
+			}
+		}
+	assert_int_equal(miss, 0);
+	mesh_free(m);
+}
+
+/* --- the mesh element --- */
+
+static const char *cube_obj(void)
+{
+	return tmp_text("cube.obj", "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\n"
+	                            "v -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n"
+	                            "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n");
+}
+
+static scene *load_text(const char *text)
+{
+	char name[128];
+	snprintf(name, sizeof name, "%s/t.rt", tmpdir);
+	rt_error err = {0};
+	scene *s = rt_load_string(text, strlen(text), name, NULL, &err);
+	if (!s) {
+		char buf[1024];
+		rt_error_format(&err, buf, sizeof buf);
+		fail_msg("%s", buf);
+	}
+	return s;
+}
+
+/* Which object each pixel's primary ray hits (-1: none). */
+static int *hit_mask(const scene *s, int w, int h)
+{
+	rt_error err = {0};
+	world *wd = world_build(s, &err);
+	assert_non_null(wd);
+	int *mask = malloc((size_t)w * h * sizeof *mask);
+	for (int y = 0; y < h; y++)
+		for (int x = 0; x < w; x++) {
+			ray r = cam_ray(&wd->cam, x + 0.5, y + 0.5, w, h);
+			hit hh;
+			mask[y * w + x] = world_intersect(wd, &r, 0, INFINITY, &hh) ? (int)hh.object : -1;
+		}
+	world_free(wd);
+	return mask;
+}
+
+static void test_cube_obj_silhouette_is_cu(void **state)
+{
+	(void)state;
+	cube_obj();
+	const char *cam = "C 1.3,2.1,-4.7 -0.31,-0.43,1 50\n";
+	char a[512], b[512];
+	snprintf(a, sizeof a, "%scu 0.2,0.1,0.3 0.3,1,0.1 2,2,2 255,0,0\n", cam);
+	snprintf(b, sizeof b, "%smesh cube.obj 0.2,0.1,0.3 0.3,1,0.1 2 255,0,0\n", cam);
+	scene *sa = load_text(a), *sb = load_text(b);
+	int w = 160, h = 120;
+	int *ma = hit_mask(sa, w, h), *mb = hit_mask(sb, w, h);
+	int inside = 0;
+	for (int i = 0; i < w * h; i++) {
+		inside += ma[i] >= 0;
+		if (ma[i] != mb[i])
+			fail_msg("pixel %d,%d: cu %d, mesh %d", i % w, i / w, ma[i], mb[i]);
+	}
+	assert_true(inside > 1000);
+	free(ma);
+	free(mb);
+	scene_free(sa);
+	scene_free(sb);
+}
+
+/* A convex body seen along d covers half the sum over faces of
+ * area x |n . d|: count parallel rays on a fine grid. */
+static void test_tetrahedron_projected_area(void **state)
+{
+	(void)state;
+	tmp_text("tet.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+	/* longest side of the box 1 -> SIZE 1 keeps the size; centre at 0 */
+	scene *s = load_text("C 0,0,-5 0,0,1 60\nmesh tet.obj 0,0,0 0,1,0 1 255,255,255\n");
+	rt_error err = {0};
+	world *wd = world_build(s, &err);
+	assert_non_null(wd);
+	vec3 d = v3_norm(v3(0.3, -0.5, 1));
+	vec3 vtx[4] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+	int faces[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+	double want = 0;
+	for (int f = 0; f < 4; f++) {
+		vec3 n = v3_cross(v3_sub(vtx[faces[f][1]], vtx[faces[f][0]]), v3_sub(vtx[faces[f][2]], vtx[faces[f][0]]));
+		want += 0.25 * fabs(v3_dot(n, d)); /* |n| = 2 x area */
+	}
+	vec3 tu = v3_norm(v3_cross(d, v3(0, 1, 0))), tv = v3_cross(tu, d);
+	int n = 800, hits = 0;
+	double span = 2.0, step = span / n;
+	for (int i = 0; i < n; i++)
+		for (int j = 0; j < n; j++) {
+			vec3 o = v3_add(v3_scale(d, -5), v3_add(v3_scale(tu, -1 + (i + 0.5) * step), v3_scale(tv, -1 + (j + 0.5) * step)));
+			hits += world_occluded(wd, &(ray){o, d}, 0, INFINITY);
+		}
+	double got = hits * step * step;
+	assert_near(got / want, 1, 0.005);
+	world_free(wd);
+	scene_free(s);
+}
+
+static void test_mesh_line_round_trip(void **state)
+{
+	(void)state;
+	cube_obj();
+	scene *s = load_text("mesh cube.obj 1,2,3 0,1,0 2,3,4 10,20,30 0.5 0.5 50 0.1 smooth=0 crease=30 twist=15\n"
+	                     "mesh \"cube.obj\" 0,0,0 0,0,1 1.5\n");
+	assert_int_equal(s->nobjs, 2);
+	assert_int_equal(s->objs[0].kind, OBJ_MESH);
+	assert_false(s->objs[0].file_colors);
+	assert_true(s->objs[1].file_colors);
+	assert_int_equal(s->objs[0].smooth, 0);
+	assert_near(s->objs[0].crease, 30, 0);
+	assert_ptr_equal(s->objs[0].file, s->objs[1].file); /* interned */
+	char path[256];
+	snprintf(path, sizeof path, "%s/out.rt", tmpdir);
+	rt_error err = {0};
+	assert_true(rt_save(s, path, &err));
+	scene *t = rt_load_file(path, NULL, &err);
+	assert_non_null(t);
+	assert_true(scene_equal(s, t));
+	/* written relative to the file's folder */
+	char line[256];
+	rt_format_object(&t->objs[1], line, sizeof line);
+	assert_non_null(strstr(line, "cube.obj"));
+	scene_free(s);
+	scene_free(t);
+}
+
+static void test_mesh_line_errors(void **state)
+{
+	(void)state;
+	static const struct {
+		const char *line, *want;
+	} cases[] = {
+		{"mesh nothere.obj 0,0,0 0,1,0 1\n", "t.rt:1:6: mesh file \"nothere.obj\""},
+		{"mesh cube.xyz 0,0,0 0,1,0 1\n", "unknown model format"},
+		{"mesh bad.obj 0,0,0 0,1,0 1\n", "bad.obj:2: face vertex index 2 is out of range; expected 1..1"},
+		{"mesh cube.obj 0,0,0 0,1,0 0\n", "mesh size \"0\" is not positive"},
+		{"sp 0,0,0 1 255,0,0 smooth=0\n", "applies to meshes only"},
+		{"sp 0,0,0 1 255,0,0 texture=none.png\n", "texture \"texture=none.png\""},
+		{"sp 0,0,0 1 255,0,0 texture=corrupt.png\n", "corrupt.png: cannot decode"},
+		{"sp 0,0,0 1 255,0,0 texture=zero.ppm\n", "zero.ppm: the image is 0x4 pixels"},
+		{"sp 0,0,0 1 255,0,0 normalmap=bad.xpm\n", "bad.xpm: XPM colour 1"},
+		{"sp 0,0,0 1 255,0,0 uvscale=0,1\n", "has a zero component"},
+	};
+	cube_obj();
+	tmp_text("cube.xyz", "x");
+	tmp_text("bad.obj", "v 0 0 0\nf 1 2 9\n");
+	tmp_text("corrupt.png", "\x89PNG\r\n\x1a\nnot really a png at all");
+	tmp_text("zero.ppm", "P6 0 4 255\n");
+	tmp_text("bad.xpm", "/* XPM */\nstatic char *x[] = {\n\"2 1 1 1\",\n\"a c #12345\",\n\"aa\"};\n");
+	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+		char name[128];
+		snprintf(name, sizeof name, "%s/t.rt", tmpdir);
+		rt_error err = {0};
+		scene *s = rt_load_string(cases[i].line, strlen(cases[i].line), name, NULL, &err);
+		assert_null(s);
+		char buf[1024];
+		rt_error_format(&err, buf, sizeof buf);
+		if (!strstr(buf, cases[i].want))
+			fail_msg("%s -> \"%s\", expected \"%s\"", cases[i].line, buf, cases[i].want);
+	}
+}
+
+/* Instancing: one mesh shared by every instance; memory per instance O(1). */
+static void test_instances_share_one_mesh(void **state)
+{
+	(void)state;
+	cube_obj();
+	char *text = malloc(200 * 80);
+	size_t n = 0;
+	n += (size_t)sprintf(text + n, "C 0,0,-60 0,0,1 60\n");
+	for (int i = 0; i < 100; i++)
+		n += (size_t)sprintf(text + n, "mesh cube.obj %d,%d,0 0,1,0 1 255,255,255\n", i % 10 * 3 - 15, i / 10 * 3 - 15);
+	scene *s = load_text(text);
+	rt_error err = {0};
+	world *w = world_build(s, &err);
+	assert_non_null(w);
+	assert_int_equal(w->ninsts, 100);
+	assert_int_equal(w->nmeshes, 1);
+	size_t m100 = world_memory(w);
+	world_free(w);
+	s->nobjs = 50;
+	w = world_build(s, &err);
+	size_t m50 = world_memory(w);
+	world_free(w);
+	/* 50 more instances: a prim, an instance record and a material each */
+	assert_true(m100 - m50 <= 50 * (sizeof(prim) + sizeof(prim_inst) + sizeof(mat_lin) + 64));
+	free(text);
+	scene_free(s);
+}
+
+/* --- the shared models (skipped without ../shared) --- */
+
+/* The README's counts, and the box from a scan of the file's v lines. */
+static void test_bunny_counts(void **state)
+{
+	(void)state;
+	if (!have_models())
+		return;
+	rt_error err = {0};
+	mesh *m = mesh_load(MODELS "/stanford-bunny.obj", &err);
+	assert_non_null(m);
+	assert_int_equal(m->nverts, 35947);
+	assert_int_equal(m->ntris, 69451);
+	FILE *f = fopen(MODELS "/stanford-bunny.obj", "r");
+	char line[256];
+	box b = box_empty();
+	while (fgets(line, sizeof line, f)) {
+		double x, y, z;
+		if (sscanf(line, "v %lf %lf %lf", &x, &y, &z) == 3)
+			b = box_add(b, v3((float)x, (float)y, (float)z));
+	}
+	fclose(f);
+	assert_vec_near(m->bounds.lo, b.lo, 0);
+	assert_vec_near(m->bounds.hi, b.hi, 0);
+	mesh_free(m);
+}
+
+/* igea.ply is one closed genus-0 surface of 134,345 vertices (README):
+ * by Euler's formula V - E + F = 2 with 3F = 2E, F = 2V - 4. */
+static void test_igea_strips(void **state)
+{
+	(void)state;
+	if (!have_models())
+		return;
+	rt_error err = {0};
+	mesh *m = mesh_load(MODELS "/igea.ply", &err);
+	assert_non_null(m);
+	assert_int_equal(m->nverts, 134345);
+	assert_int_equal(m->ntris, 2 * 134345 - 4);
+	mesh_free(m);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_obj_polygons_and_indices),
+		cmocka_unit_test(test_obj_welds_uv_corners),
+		cmocka_unit_test(test_obj_bad_input),
+		cmocka_unit_test(test_ply_faces_and_strips),
+		cmocka_unit_test(test_gltf_and_stl),
+		cmocka_unit_test(test_tree_matches_brute_force),
+		cmocka_unit_test(test_watertight),
+		cmocka_unit_test(test_cube_obj_silhouette_is_cu),
+		cmocka_unit_test(test_tetrahedron_projected_area),
+		cmocka_unit_test(test_mesh_line_round_trip),
+		cmocka_unit_test(test_mesh_line_errors),
+		cmocka_unit_test(test_instances_share_one_mesh),
+		cmocka_unit_test(test_bunny_counts),
+		cmocka_unit_test(test_igea_strips),
+	};
+	return cmocka_run_group_tests(tests, setup, teardown);
+}
