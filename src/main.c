@@ -64,8 +64,12 @@ static int batch_render(const rtsh_options *o)
 {
 	rt_error err;
 	char msg[RT_ERROR_MSG_MAX + RT_ERROR_FILE_MAX + 32];
-	if (image_format_of(o->output) == IMAGE_UNKNOWN)
-		return usage_error("output \"%s\" has an unknown type; expected .ppm, .pfm or .png", o->output);
+	if (image_format_of(o->output) == IMAGE_UNKNOWN) {
+		char exts[128], fmt[512]; /* the extensions from image.c's table of formats */
+		image_extensions(exts, sizeof exts, false);
+		snprintf(fmt, sizeof fmt, "output \"%%s\" has an unknown type; expected %s", exts);
+		return usage_error(fmt, o->output);
+	}
 	if (!o->scene)
 		return usage_error("-o needs a scene file%s", "");
 	rt_warnings warn = {print_warning, NULL};

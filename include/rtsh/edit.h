@@ -26,6 +26,7 @@
 
 #include "rtsh/error.h"
 #include "rtsh/rtfile.h"
+#include "rtsh/rules.h"
 #include "rtsh/scene.h"
 
 /* How many undo steps are kept (older ones are forgotten). */
@@ -89,6 +90,9 @@ bool editor_object_move(editor *ed, size_t i, vec3 d, rt_error *err);
 bool editor_object_rotate(editor *ed, size_t i, vec3 deg, rt_error *err);
 bool editor_object_scale(editor *ed, size_t i, vec3 factor, rt_error *err);
 bool editor_object_color(editor *ed, size_t i, vec3 rgb, rt_error *err);
+/* One key=value field ("ior=1.5"), read and checked as the reader does
+ * (the same table, scanner and rules). */
+bool editor_object_set_key(editor *ed, size_t i, const char *assignment, rt_error *err);
 /* Light i. */
 bool editor_light_pos(editor *ed, size_t i, vec3 p, rt_error *err);
 bool editor_light_move(editor *ed, size_t i, vec3 d, rt_error *err);
@@ -128,11 +132,6 @@ const char *editor_redo_note(const editor *ed);
 void editor_group_begin(editor *ed);
 void editor_group_end(editor *ed);
 
-/* --- validation, shared with the front ends --- */
-bool light_validate(const light *l, rt_error *err);
-bool camera_validate(const camera *c, rt_error *err);
-bool ambient_validate(const ambient *a, rt_error *err);
-/* A colour with each channel in 0..255. */
-bool color_validate(vec3 rgb, const char *what, rt_error *err);
+/* Validation, shared with the reader and the front ends: rules.h. */
 
 #endif

@@ -25,6 +25,25 @@ typedef enum image_format {
 /* By the path's extension (case-insensitive). */
 image_format image_format_of(const char *path);
 
+/* One image file format: the table in image.c, by extension. */
+typedef struct image_type {
+	const char *ext;    /* ".ppm" */
+	const char *name;   /* "PPM" */
+	image_format format;
+	bool (*write)(FILE *f, void *ctx, rt_error *err); /* image.c's encoder */
+	framebuffer *(*read)(const char *path, rt_error *err); /* NULL: not read */
+	const char *help;   /* one line */
+} image_type;
+
+/* The i-th format, NULL past the last; the format of path, or NULL. */
+const image_type *image_type_at(size_t i);
+const image_type *image_type_of(const char *path);
+/* The extensions as a message lists them (".ppm, .pfm or .png"); only
+ * those read back when `readable`. */
+void image_extensions(char *buf, size_t size, bool readable);
+/* Reads any readable format, by extension. */
+framebuffer *image_read(const char *path, rt_error *err);
+
 /* Linear [0,1] to 8-bit sRGB, rounded, clamped; exact inverse of srgb8_to_linear
  * on the 256 codes. */
 uint8_t linear_to_srgb8(double v);

@@ -46,12 +46,27 @@ scene *rt_load_string(const char *text, size_t len, const char *name, const rt_l
 bool rt_parse_line(scene *s, const char *line, const char *name, int lineno,
                    const rt_load_opts *opts, rt_error *err);
 
+/* The i-th element the reader knows, in the order of its messages (A C c L
+ * l R, then the shape kinds' identifiers from shape.h, then sky set): its
+ * identifier, and in *usage every form it is read in. NULL past the last.
+ * `help add` and completion list them from here. */
+const char *rt_element(size_t i, const char **usage);
+
+/* The i-th key=value field objects take (the reader's one table of keys):
+ * its name, and in *help one line saying what it does and its range. NULL
+ * past the last. A new material key is one line of that table
+ * (src/scene/rtfile_read.c, rt_keys). */
+const char *rt_key_info(size_t i, const char **help);
+
 /* Writes the scene as .rt text; load(write(s)) is equal to s (scene_equal). */
 bool rt_write(const scene *s, FILE *f, rt_error *err);
 /* Writes the scene to path atomically. */
 bool rt_save(const scene *s, const char *path, rt_error *err);
 /* The one .rt line for an element (no newline), as `list` shows it. */
 void rt_format_object(const object *o, char *buf, size_t size);
+/* The same in the extended form whatever the short form could say
+ * (triangles: their only form). */
+void rt_format_object_extended(const object *o, char *buf, size_t size);
 void rt_format_light(const light *l, char *buf, size_t size);
 void rt_format_camera(const camera *c, char *buf, size_t size);
 

@@ -17,19 +17,24 @@
 #include "rtsh/error.h"
 #include "rtsh/math.h"
 
+/* What the model needs to know about a kind (kinds.def). */
+enum {
+	KIND_UNBOUNDED = 1, /* no size: scale is unused (the plane) */
+	KIND_VERTICES = 2,  /* three world-space vertices in tri[], no transform (the triangle) */
+	KIND_TUBE = 4,      /* uses object.tube (the torus) */
+};
+
 typedef enum obj_kind {
-	OBJ_SPHERE,
-	OBJ_PLANE,
-	OBJ_CYLINDER,
-	OBJ_CONE,
-	OBJ_CUBE,
-	OBJ_DISC,
-	OBJ_RECT,
-	OBJ_TRIANGLE,
-	OBJ_KIND_COUNT, /* the kinds drawn from the unit shapes (shape.h) */
+#define RT_KIND(e, id, name, desc, flags) OBJ_##e,
+#include "rtsh/kinds.def"
+#undef RT_KIND
+	OBJ_KIND_COUNT, /* the kinds drawn from the unit shapes (shape.h, kinds.def) */
 	OBJ_MESH = OBJ_KIND_COUNT, /* a model file (mesh.h), placed like a unit shape */
 	OBJ_KIND_ALL
 } obj_kind;
+
+/* The KIND_* flags of a kind (0 for OBJ_MESH). */
+unsigned obj_kind_flags(obj_kind k);
 
 /* One shared copy of the string s[0..n) that lives as long as the process:
  * equal strings give the same pointer, so objects holding file names stay
@@ -40,7 +45,8 @@ const char *rt_intern(const char *s, size_t n);
 /* The .rt identifier ("sp", "pl", ...) and the English name of a kind. */
 const char *obj_kind_id(obj_kind k);
 const char *obj_kind_name(obj_kind k);
-/* Kind from an identifier ("sp", "sq" -> OBJ_RECT, "tr", ...); -1 if none. */
+/* Kind from its identifier ("sp", "tr", ...); -1 if none. (The short-form
+ * aliases such as "sq" are the reader's: shape.h.) */
 int obj_kind_from_id(const char *id);
 
 typedef struct material {
@@ -79,7 +85,8 @@ typedef struct object {
 	double twist;     /* degrees about dir (twist=) */
 	vec3 scale;       /* extents on the local axes, all > 0 (see rtsh(5)) */
 	double shear[6];  /* xy xz yx yz zx zy; all zero = none */
-	vec3 tri[3];      /* OBJ_TRIANGLE: the vertices (pos/dir/scale unused) */
+	vec3 tri[3];      /* KIND_VERTICES: the vertices (pos/dir/scale unused) */
+	double tube;      /* the torus: tube-to-ring diameter ratio (tube=), > 0; 0.5 by default */
 	material mat;
 	/* OBJ_MESH: the model file (rt_intern'ed, as the reader resolved it:
 	 * relative to the .rt file's folder, or absolute), whether the colour

@@ -14,6 +14,7 @@
  *   cube      [-1,1]^3
  *   disc      y = 0, x^2 + z^2 <= 1
  *   rect      y = 0, |x| <= 1, |z| <= 1
+ *   torus     see torus.c
  *   triangle  in world space (its own vertices), Moller-Trumbore
  */
 #ifndef RTSH_SHAPE_H
@@ -24,20 +25,77 @@
 #include "rtsh/math.h"
 #include "rtsh/scene.h"
 
-typedef struct shape_ops {
-	/* Nearest hit with tmin < t < tmax: sets *t and the outward object-space
-	 * normal *n (not normalised). */
-	bool (*intersect)(vec3 o, vec3 d, double tmin, double tmax, double *t, vec3 *n);
-	/* Any hit with tmin < t < tmax (shadow rays). */
-	bool (*occluded)(vec3 o, vec3 d, double tmin, double tmax);
-	bool bounded; /* false for the plane */
-} shape_ops;
+/* A form of a kind's .rt line: the identifier, the fields of its short
+ * (42) form between the identifier and R,G,B, and whether the extended form
+ * `ID POS ROT SCALE R,G,B ...` is read under the same identifier. */
+typedef struct shape_form {
+	const char *id;        /* "sp"; NULL: no such form */
+	const char *name;      /* in messages: "sphere" */
+	bool strict;           /* allowed by --strict (the 42 subject's elements) */
+	bool extended;         /* ID POS ROT SCALE ... is read under this id too */
+	bool material;         /* [DIFFUSE SPECULAR SHININESS REFLECTIVE] may follow R,G,B */
+	int nfields;           /* fields of the short form; 0: none */
+	const char *usage;     /* those fields for usage lines: "CENTER DIAMETER" */
+	const char *fields[4]; /* their names in messages: "center", "diameter" */
+	const char *types;     /* one letter a field: p point, d direction (-> dir),
+	                        * s size > 0 (a 0 leaves the object out, with a warning) */
+	/* The object's scale (and tube) from the sizes, in order. */
+	void (*read)(object *o, const double *sizes);
+	/* The sizes that read back to exactly o's; false when the short form
+	 * cannot say o (the writer then uses the extended form). */
+	bool (*write)(const object *o, double *sizes);
+} shape_form;
 
-/* Indexed by obj_kind; the triangle's entry is unused (see tri_*). */
-extern const shape_ops shape_table[OBJ_KIND_COUNT];
+/* How the random generator (generate.c) sizes a kind: per axis x, y, z, a
+ * share of the typical size in percent, uniform in [lo, hi]; lo = 0 copies
+ * axis `hi` (0 x, 1 y) instead, lo = -1 fixes the axis at 1. Axes are drawn
+ * in order x, y, z. tube_lo..tube_hi (percent, 0: none) draws object.tube. */
+typedef struct shape_recipe {
+	bool use;              /* generated at all */
+	short lo[3], hi[3];
+	short tube_lo, tube_hi;
+} shape_recipe;
+
+/* One kind of shape (kinds.def names it, its geometry file defines it). */
+typedef struct shape_kind {
+	shape_form form;   /* the kind's own identifier */
+	shape_form alias;  /* another identifier with its own short form ("sq"), or id NULL */
+	/* Nearest hit with tmin < t < tmax in object space: sets *t and the
+	 * outward object-space normal *n (not normalised). `tube` is the
+	 * object's tube ratio (kinds with KIND_TUBE; others ignore it). NULL for
+	 * KIND_VERTICES (tri_intersect). */
+	bool (*intersect)(vec3 o, vec3 d, double tube, double tmin, double tmax, double *t, vec3 *n);
+	/* Any hit with tmin < t < tmax (shadow rays). */
+	bool (*occluded)(vec3 o, vec3 d, double tube, double tmin, double tmax);
+	/* The object-space bounds (within [-1,1]^3; infinite when unbounded). */
+	box (*bounds)(double tube);
+	/* The surface parameterisation textures use, at an object-space point
+	 * p of the surface: u, v in [0,1] and the unit tangent along u. */
+	void (*uv)(vec3 p, double tube, double *u, double *v, vec3 *tangent);
+	/* Traced in world space from its centre and radius when its scale is
+	 * uniform with no shear or texture (the sphere). */
+	bool world_sphere;
+	/* What its test costs, relative to a world-space sphere, for the
+	 * BVH's surface area heuristic (a matrix, a call and the test: 8 for
+	 * the quadrics and slabs, measured for issue 5). */
+	float cost;
+	shape_recipe recipe;
+} shape_kind;
+
+#define RT_KIND(e, id, name, desc, flags) extern const shape_kind desc;
+#include "rtsh/kinds.def"
+#undef RT_KIND
+
+/* The descriptors, indexed by obj_kind (from kinds.def). */
+extern const shape_kind *const shape_kinds[OBJ_KIND_COUNT];
+/* The descriptor of kind k; NULL when k is not a kind. */
+const shape_kind *shape_kind_of(obj_kind k);
+/* The kind whose form (or alias) has the identifier id, and that form;
+ * NULL if none. */
+const shape_kind *shape_kind_find(const char *id, obj_kind *k, const shape_form **form);
 
 /* The unit shape's object-space bounds (all of them fit [-1,1]^3). */
-box shape_local_bounds(obj_kind k);
+box shape_local_bounds(obj_kind k, double tube);
 
 /* Triangle v0 v1 v2 (world space): nearest hit; *n = (v1-v0) x (v2-v0). */
 bool tri_intersect(vec3 v0, vec3 e1, vec3 e2, vec3 o, vec3 d, double tmin, double tmax, double *t);

@@ -89,6 +89,7 @@ typedef struct prim {
 typedef struct prim_shape {
 	double inv[3][4]; /* world -> object (the last row is 0 0 0 1) */
 	uint32_t kind;    /* obj_kind */
+	double tube;      /* object.tube (the torus) */
 } prim_shape;
 
 typedef struct prim_tri {

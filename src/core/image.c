@@ -12,19 +12,18 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-image_format image_format_of(const char *path)
+/* The extension of path ("" when none). */
+static const char *extension(const char *path)
 {
 	const char *dot = strrchr(path, '.');
 	const char *slash = strrchr(path, '/');
-	if (!dot || (slash && dot < slash))
-		return IMAGE_UNKNOWN;
-	if (strcasecmp(dot, ".ppm") == 0)
-		return IMAGE_PPM;
-	if (strcasecmp(dot, ".pfm") == 0)
-		return IMAGE_PFM;
-	if (strcasecmp(dot, ".png") == 0)
-		return IMAGE_PNG;
-	return IMAGE_UNKNOWN;
+	return !dot || (slash && dot < slash) ? "" : dot;
+}
+
+image_format image_format_of(const char *path)
+{
+	const image_type *t = image_type_of(path);
+	return t ? t->format : IMAGE_UNKNOWN;
 }
 
 /* The 8-bit code of a linear value is the sRGB encoding (IEC 61966-2-1)
@@ -161,19 +160,66 @@ static bool write_png(FILE *f, void *vctx, rt_error *err)
 	return ok || rt_error_at(err, c->path, 0, 0, "PNG encoding failed");
 }
 
+/* The formats, by extension: a new one is a line here (and its encoder
+ * above, its decoder below). */
+static const image_type types[] = {
+	{".ppm", "PPM", IMAGE_PPM, write_ppm, image_read_ppm, "8-bit sRGB, binary netpbm (P6)"},
+	{".pfm", "PFM", IMAGE_PFM, write_pfm, image_read_pfm, "linear 32-bit float, as rendered"},
+	{".png", "PNG", IMAGE_PNG, write_png, NULL, "8-bit sRGB, libpng"},
+};
+#define NTYPES (sizeof types / sizeof types[0])
+
+const image_type *image_type_at(size_t i)
+{
+	return i < NTYPES ? &types[i] : NULL;
+}
+
+const image_type *image_type_of(const char *path)
+{
+	const char *ext = extension(path);
+	for (size_t i = 0; i < NTYPES; i++)
+		if (strcasecmp(ext, types[i].ext) == 0)
+			return &types[i];
+	return NULL;
+}
+
+void image_extensions(char *buf, size_t size, bool readable)
+{
+	size_t n = 0, k = 0;
+	for (size_t i = 0; i < NTYPES; i++)
+		n += !readable || types[i].read;
+	buf[0] = '\0';
+	for (size_t i = 0, used = 0; i < NTYPES; i++) {
+		if (readable && !types[i].read)
+			continue;
+		k++;
+		used += (size_t)snprintf(buf + used, used < size ? size - used : 0, "%s%s",
+		                         k == 1 ? "" : k == n ? " or " : ", ", types[i].ext);
+	}
+}
+
 bool image_write(const char *path, const framebuffer *fb, double exposure, rt_error *err)
 {
 	image_ctx c = {fb, exp2(exposure), path};
-	switch (image_format_of(path)) {
-	case IMAGE_PPM:
-		return file_write_atomic(path, write_ppm, &c, err);
-	case IMAGE_PFM:
-		return file_write_atomic(path, write_pfm, &c, err);
-	case IMAGE_PNG:
-		return file_write_atomic(path, write_png, &c, err);
-	default:
-		return rt_error_at(err, path, 0, 0, "unknown image type; expected .ppm, .pfm or .png");
+	const image_type *t = image_type_of(path);
+	if (!t) {
+		char exts[128];
+		image_extensions(exts, sizeof exts, false);
+		return rt_error_at(err, path, 0, 0, "unknown image type; expected %s", exts);
 	}
+	return file_write_atomic(path, t->write, &c, err);
+}
+
+framebuffer *image_read(const char *path, rt_error *err)
+{
+	const image_type *t = image_type_of(path);
+	if (!t || !t->read) {
+		char exts[128];
+		image_extensions(exts, sizeof exts, true);
+		rt_error_at(err, path, 0, 0, "cannot read this image type; expected %s", exts);
+		return NULL;
+	}
+	return t->read(path, err);
 }
 
 /* Reads the netpbm header "MAGIC W H MAX" (whitespace and # comments). */

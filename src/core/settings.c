@@ -1,6 +1,8 @@
 /* rtsh — the settings table (settings.h). */
 #include "rtsh/settings.h"
 
+#include "rtsh/num.h"
+
 #include <errno.h>
 #include <stddef.h>
 #include <inttypes.h>
@@ -61,15 +63,7 @@ static const void *cfield(const render_settings *s, const setting_def *def)
 /* A whole number in [min, max] filling all of s. */
 static bool parse_long(const char *s, double min, double max, long *out)
 {
-	if (!*s)
-		return false;
-	char *end;
-	errno = 0;
-	long v = strtol(s, &end, 10);
-	if (errno || *end || v < min || v > max)
-		return false;
-	*out = v;
-	return true;
+	return num_scan_long(s, (long)min, (long)max, out) == NUM_OK;
 }
 
 bool settings_set(render_settings *s, const setting_def *def, const char *value, rt_error *err)
@@ -83,19 +77,16 @@ bool settings_set(render_settings *s, const setting_def *def, const char *value,
 		*(int *)field(s, def) = (int)a;
 		return true;
 	case SETTING_U64: {
-		char *end;
-		errno = 0;
-		unsigned long long v = strtoull(value, &end, 10);
-		if (!*value || *value == '-' || errno || *end)
+		unsigned long long v;
+		if (num_scan_u64(value, &v) != NUM_OK)
 			return rt_error_set(err, "%s \"%s\" is not valid; expected a whole number >= 0",
 			                    def->name, value);
 		*(uint64_t *)field(s, def) = v;
 		return true;
 	}
 	case SETTING_DOUBLE: {
-		char *end;
-		double v = strtod(value, &end);
-		if (!*value || *end || !(v >= def->min && v <= def->max))
+		double v = 0;
+		if (num_scan_str(value, HUGE_VAL, &v) != NUM_OK || !(v >= def->min && v <= def->max))
 			return rt_error_set(err, "%s \"%s\" is not valid; expected a number in %g..%g",
 			                    def->name, value, def->min, def->max);
 		*(double *)field(s, def) = v;

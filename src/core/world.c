@@ -90,7 +90,7 @@ static mat_lin material_linear(const material *m)
  * could turn is traced directly in world space. */
 static bool is_fast_sphere(const object *o)
 {
-	if (o->kind != OBJ_SPHERE || o->scale.x != o->scale.y || o->scale.y != o->scale.z)
+	if (o->kind >= OBJ_KIND_COUNT || !shape_kinds[o->kind]->world_sphere || o->scale.x != o->scale.y || o->scale.y != o->scale.z)
 		return false;
 	for (int i = 0; i < 6; i++)
 		if (o->shear[i] != 0.0)
@@ -106,7 +106,7 @@ static bool make_prim(world *w, const object *o, uint32_t index, prim *p, box *b
 		return surf_make_inst(w, o, index, p, b, err);
 	memset(p, 0, sizeof *p);
 	p->object = index;
-	if (o->kind == OBJ_TRIANGLE) {
+	if (obj_kind_flags(o->kind) & KIND_VERTICES) {
 		p->tag = PRIM_TRIANGLE;
 		p->u.index = (uint32_t)w->ntris;
 		prim_tri *t = &w->tris[w->ntris++];
@@ -135,7 +135,8 @@ static bool make_prim(world *w, const object *o, uint32_t index, prim *p, box *b
 		for (int j = 0; j < 4; j++)
 			sh->inv[i][j] = x.inv.m[i][j];
 	sh->kind = o->kind;
-	*b = xf_box(&x, shape_local_bounds(o->kind));
+	sh->tube = o->tube;
+	*b = xf_box(&x, shape_local_bounds(o->kind, o->tube));
 	return true;
 }
 
@@ -220,9 +221,10 @@ world *world_build(const scene *s, rt_error *err)
 	size_t nplanes = 0, ntris = 0, nshapes = 0;
 	for (size_t i = 0; i < s->nobjs; i++) {
 		const object *o = &s->objs[i];
-		nplanes += o->kind == OBJ_PLANE;
-		ntris += o->kind == OBJ_TRIANGLE;
-		nshapes += o->kind != OBJ_TRIANGLE && o->kind != OBJ_MESH && !is_fast_sphere(o);
+		unsigned f = obj_kind_flags(o->kind);
+		nplanes += (f & KIND_UNBOUNDED) != 0;
+		ntris += (f & KIND_VERTICES) != 0;
+		nshapes += !(f & KIND_VERTICES) && o->kind != OBJ_MESH && !is_fast_sphere(o);
 	}
 	size_t nbounded = s->nobjs - nplanes;
 	w->lights = calloc(s->nlights ? s->nlights : 1, sizeof *w->lights);
@@ -257,7 +259,7 @@ world *world_build(const scene *s, rt_error *err)
 	for (size_t i = 0; i < s->nobjs; i++) {
 		const object *o = &s->objs[i];
 		w->mats[i] = material_linear(&o->mat);
-		bool plane = o->kind == OBJ_PLANE;
+		bool plane = (obj_kind_flags(o->kind) & KIND_UNBOUNDED) != 0;
 		if (!surf_material(w, o, (uint32_t)i, err) ||
 		    (plane ? !make_plane(w, o, (uint32_t)i, &w->planes[w->nplanes], err)
 		           : !make_prim(w, o, (uint32_t)i, &w->prims[w->nprims], &bounds[w->nprims], err))) {
@@ -295,7 +297,7 @@ world *world_build(const scene *s, rt_error *err)
 		costs[i] = w->prims[i].tag == PRIM_SPHERE     ? 1.0f
 		           : w->prims[i].tag == PRIM_TRIANGLE ? 2.0f
 		           : w->prims[i].tag == PRIM_MESH     ? 32.0f
-		                                              : 8.0f;
+		                                              : shape_kinds[w->shapes[w->prims[i].u.index].kind]->cost;
 	w->tree = bvh_build(bounds, costs, w->nprims, order, err);
 	free(costs);
 	free(bounds);
@@ -380,7 +382,7 @@ static bool other_hit(const world *w, const prim *p, const ray *r, double tmin, 
 	const prim_shape *sh = &w->shapes[p->u.index];
 	vec3 o, d;
 	to_object(sh, r, &o, &d);
-	return shape_table[sh->kind].intersect(o, d, tmin, tmax, t, nl);
+	return shape_kinds[sh->kind]->intersect(o, d, sh->tube, tmin, tmax, t, nl);
 }
 
 static bool other_occluded(const world *w, const prim *p, const ray *r, double tmin, double tmax)
@@ -395,7 +397,7 @@ static bool other_occluded(const world *w, const prim *p, const ray *r, double t
 	const prim_shape *sh = &w->shapes[p->u.index];
 	vec3 o, d;
 	to_object(sh, r, &o, &d);
-	return shape_table[sh->kind].occluded(o, d, tmin, tmax);
+	return shape_kinds[sh->kind]->occluded(o, d, sh->tube, tmin, tmax);
 }
 
 /* The nearest hit of one primitive in (tmin, tmax). */

@@ -10,7 +10,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rtsh/num.h"
 #include "rtsh/world.h"
+#include "scene/rtfile_priv.h"
 
 typedef enum rec_kind {
 	REC_OBJECT,        /* replace object idx by u.obj */
@@ -164,50 +166,9 @@ void editor_group_end(editor *ed)
 		ed->depth--;
 }
 
-/* --- validation --- */
-
-bool color_validate(vec3 c, const char *what, rt_error *err)
-{
-	if (!(c.x >= 0 && c.x <= 255 && c.y >= 0 && c.y <= 255 && c.z >= 0 && c.z <= 255))
-		return rt_error_set(err, "%s %g,%g,%g is out of range; expected R,G,B with each in 0..255",
-		                    what, c.x, c.y, c.z);
-	return true;
-}
-
-bool light_validate(const light *l, rt_error *err)
-{
-	if (!v3_finite(l->pos))
-		return rt_error_set(err, "light position is not finite; expected numbers");
-	if (!(l->ratio >= 0 && l->ratio <= 1))
-		return rt_error_set(err, "light brightness %g is out of range; expected 0..1", l->ratio);
-	return color_validate(l->color, "light colour", err);
-}
-
-bool camera_validate(const camera *c, rt_error *err)
-{
-	if (!v3_finite(c->pos))
-		return rt_error_set(err, "camera position is not finite; expected numbers");
-	if (!v3_finite(c->dir) || !(v3_len(c->dir) > 0))
-		return rt_error_set(err, "camera direction is the zero vector; expected a non-zero direction");
-	if (!(c->fov > 0 && c->fov < 180))
-		return rt_error_set(err, "camera field of view %g is out of range; expected degrees "
-		                         "between 0 and 180 (both excluded)",
-		                    c->fov);
-	return true;
-}
-
-bool ambient_validate(const ambient *a, rt_error *err)
-{
-	if (!(a->ratio >= 0 && a->ratio <= 1))
-		return rt_error_set(err, "ambient brightness %g is out of range; expected 0..1", a->ratio);
-	return color_validate(a->color, "ambient colour", err);
-}
-
 static bool object_check(const object *o, rt_error *err)
 {
-	if (!object_validate(o, err))
-		return false;
-	return color_validate(o->mat.color, "object colour", err);
+	return object_rules(o, err);
 }
 
 /* --- applying records --- */
@@ -497,12 +458,8 @@ bool editor_set_sky(editor *ed, bool has, const sky *sk, rt_error *err)
 {
 	record r = {.kind = REC_SKY, .has = has};
 	if (has) {
-		if (!color_validate(sk->zenith, "sky zenith colour", err) ||
-		    !color_validate(sk->horizon, "sky horizon colour", err))
+		if (!sky_validate(sk, err))
 			return false;
-		if (!(sk->strength >= 0 && isfinite(sk->strength)))
-			return rt_error_set(err, "sky strength %g is out of range; expected a number >= 0",
-			                    sk->strength);
 		r.u.sk = *sk;
 	} else {
 		r.u.sk = ed->s->sky;
@@ -704,6 +661,40 @@ bool editor_object_color(editor *ed, size_t i, vec3 rgb, rt_error *err)
 	return editor_set_object(ed, i, &o, err);
 }
 
+bool editor_object_set_key(editor *ed, size_t i, const char *assignment, rt_error *err)
+{
+	object o;
+	if (!get_object(ed, i, &o, err))
+		return false;
+	const char *eq = strchr(assignment, '=');
+	size_t nlen = eq ? (size_t)(eq - assignment) : strlen(assignment);
+	const rt_key *k = NULL;
+	for (size_t j = 0; j < rt_nkeys && !k; j++)
+		if (strlen(rt_keys[j].name) == nlen && strncmp(rt_keys[j].name, assignment, nlen) == 0)
+			k = &rt_keys[j];
+	if (!k || !eq || !rt_key_applies(k, o.kind)) {
+		char list[256] = "";
+		size_t used = 0;
+		for (size_t j = 0; j < rt_nkeys; j++)
+			if (rt_key_applies(&rt_keys[j], o.kind))
+				used += (size_t)snprintf(list + used, sizeof list - used, "%s%s=",
+				                         used ? " " : "", rt_keys[j].name);
+		return rt_error_set(err, "\"%s\" is %s; expected KEY=VALUE with one of %s", assignment,
+		                    !eq ? "not KEY=VALUE" : !k ? "an unknown key" : "a key this object does not take",
+		                    list);
+	}
+	if (k->type != RT_KEY_NUM)
+		return rt_error_set(err, "\"%s\": %s= takes a file or U,V; expected it on the object's line "
+		                         "(add, or edit the .rt file)",
+		                    assignment, k->name);
+	double v;
+	if (num_scan_str(eq + 1, RT_NUM_MAX, &v) != NUM_OK || v < k->min || v > k->max ||
+	    (k->is_int && v != floor(v)) || (k->extra && !k->extra(v)))
+		return rt_error_set(err, "\"%s\" is out of range; expected %s", assignment, k->expect);
+	rt_key_set(k, &o, v);
+	return editor_set_object(ed, i, &o, err);
+}
+
 static bool get_light(editor *ed, size_t i, light *l, rt_error *err)
 {
 	if (!index_ok(i, ed->s->nlights, "light", err))
@@ -787,6 +778,9 @@ bool editor_camera_fov(editor *ed, double deg, rt_error *err)
 {
 	camera c;
 	size_t i = active_camera(ed, &c);
+	bool clamped; /* 0 and 180 as in files: clamped to the renderable ends */
+	if (!fov_rule(&deg, &clamped, err))
+		return false;
 	c.fov = deg;
 	return editor_set_camera(ed, i, &c, err);
 }

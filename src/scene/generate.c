@@ -17,6 +17,7 @@
  * The lights and the camera depend on the seed only, not on n.
  */
 #include "rtsh/generate.h"
+#include "rtsh/shape.h"
 
 #include "rtsh/memory.h"
 
@@ -172,16 +173,21 @@ static object gen_sphere(gen_rng *r, int64_t d, bool plain)
 
 static object gen_shape(gen_rng *r, int64_t d)
 {
-	static const obj_kind kinds[] = {OBJ_SPHERE, OBJ_CYLINDER, OBJ_CONE, OBJ_CUBE,
-	                                 OBJ_DISC,   OBJ_RECT,     OBJ_TRIANGLE};
-	obj_kind k = kinds[gen_int(r, 0, (int64_t)(sizeof kinds / sizeof kinds[0]) - 1)];
-	if (k == OBJ_SPHERE)
+	/* the kinds with a recipe (shape.h), in the order of the kinds */
+	obj_kind kinds[OBJ_KIND_COUNT];
+	int64_t nk = 0;
+	for (int k = 0; k < OBJ_KIND_COUNT; k++)
+		if (shape_kinds[k]->recipe.use)
+			kinds[nk++] = (obj_kind)k;
+	obj_kind k = kinds[gen_int(r, 0, nk - 1)];
+	const shape_kind *desc = shape_kinds[k];
+	if (desc->world_sphere)
 		return gen_sphere(r, d, false);
 	object o = object_make(k, v3(0, 0, 0));
 	int64_t c[3];
 	gen_center(r, d / 20 + 1, c);
 	o.mat = gen_material(r);
-	if (k == OBJ_TRIANGLE) {
+	if (obj_kind_flags(k) & KIND_VERTICES) {
 		/* vertices within d/2 of the centre, in ten-thousandths */
 		for (;;) {
 			for (int i = 0; i < 3; i++) {
@@ -198,25 +204,13 @@ static object gen_shape(gen_rng *r, int64_t d)
 	o.dir = gen_chance(r, 30) ? v3(0, 1, 0) : gen_dir(r);
 	if (gen_chance(r, 25))
 		o.twist = (double)gen_int(r, 1, 359);
-	switch (k) {
-	case OBJ_CYLINDER:
-	case OBJ_CONE: {
-		double w = part(d, gen_int(r, 40, 100));
-		o.scale = v3(w, part(d, gen_int(r, 60, 140)), w);
-		break;
-	}
-	case OBJ_CUBE:
-		o.scale = v3(part(d, gen_int(r, 50, 100)), part(d, gen_int(r, 50, 100)), part(d, gen_int(r, 50, 100)));
-		break;
-	case OBJ_DISC: {
-		double w = part(d, gen_int(r, 50, 100));
-		o.scale = v3(w, 1, w);
-		break;
-	}
-	default: /* OBJ_RECT */
-		o.scale = v3(part(d, gen_int(r, 50, 120)), 1, part(d, gen_int(r, 50, 120)));
-		break;
-	}
+	const shape_recipe *rc = &desc->recipe;
+	double s[3];
+	for (int a = 0; a < 3; a++)
+		s[a] = rc->lo[a] > 0 ? part(d, gen_int(r, rc->lo[a], rc->hi[a])) : rc->lo[a] < 0 ? 1.0 : s[rc->hi[a]];
+	o.scale = v3(s[0], s[1], s[2]);
+	if (rc->tube_hi > 0)
+		o.tube = (double)gen_int(r, rc->tube_lo, rc->tube_hi) / 100.0;
 	if (gen_chance(r, 10)) {
 		/* |entries| <= 0.3 keeps every row diagonally dominant: invertible */
 		for (int i = 0; i < 6; i++)

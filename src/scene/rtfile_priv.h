@@ -12,23 +12,22 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "rtsh/rules.h"
 #include "rtsh/scene.h"
 
-/* Numbers in .rt files never exceed this magnitude. Scenes in the wild use
- * coordinates up to 1.5e18 (and -2^31 is common); 1e20 keeps every product
- * the renderer forms far from overflow. */
-#define RT_NUM_MAX 1e20
-#define RT_NUM_MAX_TEXT "1e20"
 
 typedef struct rt_key {
 	const char *name;   /* as written before '=' */
 	size_t offset;      /* of the field in struct object */
 	bool is_int;        /* an int field (else double) */
 	bool triangles;     /* allowed on triangles */
+	unsigned needs;     /* a KIND_* flag the kind must have (0: any kind) */
+	bool in_short;      /* the short form says it already: written in the extended form only */
 	double min, max;    /* inclusive range */
 	double def;         /* the value that means "absent"; not written */
 	bool (*extra)(double v); /* a further rule within [min,max], or NULL */
 	const char *expect; /* what a valid value is, for messages */
+	const char *help;   /* one line for `help` */
 	int type;           /* RT_KEY_NUM (0), RT_KEY_FILE or RT_KEY_PAIR */
 	bool mesh_only;     /* only on mesh objects */
 } rt_key;
@@ -42,6 +41,9 @@ extern _Thread_local const char *rt_write_dir;
 
 extern const rt_key rt_keys[];
 extern const size_t rt_nkeys;
+
+/* Whether key k may be given on an object of kind kind. */
+bool rt_key_applies(const rt_key *k, obj_kind kind);
 
 /* The key's value in o, as a double. */
 double rt_key_get(const rt_key *k, const object *o);

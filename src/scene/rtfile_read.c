@@ -18,70 +18,17 @@
 #include <sys/stat.h>
 
 #include "rtsh/mesh.h"
+#include "rtsh/num.h"
 #include "rtsh/render.h"
 #include "rtsh/texture.h"
 #include "rtsh/rtfile.h"
+#include "rtsh/shape.h"
 #include "scene/rtfile_priv.h"
 
 /* Files larger than this are refused rather than read. */
 #define RT_FILE_MAX ((size_t)1 << 30)
 /* --strict: a direction is unit length when |length - 1| <= this. */
 #define STRICT_UNIT_TOL 1e-2
-/* The renderable ends of the field of view, for fov 0 and 180. */
-#define FOV_MIN 0.01
-#define FOV_MAX 179.99
-
-/* --- the key=value table (shared with the writer) --- */
-
-static bool ior_rule(double v) { return v == 0.0 || v >= 1.0; }
-
-const rt_key rt_keys[] = {
-	{"twist", offsetof(object, twist), false, false, -RT_NUM_MAX, RT_NUM_MAX, 0, NULL,
-	 "twist in degrees", RT_KEY_NUM, false},
-	{"fuzz", offsetof(object, mat.fuzz), false, true, 0, 1, 0, NULL, "fuzz in [0,1]", RT_KEY_NUM, false},
-	{"metal", offsetof(object, mat.metal), false, true, 0, 1, 0, NULL, "metal in [0,1]", RT_KEY_NUM, false},
-	{"ior", offsetof(object, mat.ior), false, true, 0, 10, 0, ior_rule,
-	 "ior 0 (opaque) or a refractive index in [1,10]", RT_KEY_NUM, false},
-	{"emit", offsetof(object, mat.emission), false, true, 0, 1e6, 0, NULL,
-	 "emit in [0,1e6]", RT_KEY_NUM, false},
-	{"checker", offsetof(object, mat.checker), true, true, 0, 1000, 0, NULL,
-	 "checker a whole number in [0,1000]", RT_KEY_NUM, false},
-	{"texture", offsetof(object, mat.texture), false, true, 0, 0, 0, NULL,
-	 "texture=FILE, a PNG, JPEG, BMP, TGA, HDR, PPM, PFM or XPM image", RT_KEY_FILE, false},
-	{"normalmap", offsetof(object, mat.normalmap), false, true, 0, 0, 0, NULL,
-	 "normalmap=FILE, a tangent-space normal map image", RT_KEY_FILE, false},
-	{"bump", offsetof(object, mat.bump), false, true, 0, 0, 0, NULL,
-	 "bump=FILE, a height map image", RT_KEY_FILE, false},
-	{"bumpscale", offsetof(object, mat.bumpscale), false, true, -1e6, 1e6, 1, NULL,
-	 "bumpscale in [-1e6,1e6]", RT_KEY_NUM, false},
-	{"uvscale", offsetof(object, mat.uvscale), false, true, -1e6, 1e6, 1, NULL,
-	 "uvscale=U,V, two numbers in [-1e6,1e6], not 0", RT_KEY_PAIR, false},
-	{"uvoffset", offsetof(object, mat.uvoffset), false, true, -1e6, 1e6, 0, NULL,
-	 "uvoffset=U,V, two numbers in [-1e6,1e6]", RT_KEY_PAIR, false},
-	{"smooth", offsetof(object, smooth), true, false, 0, 1, 1, NULL,
-	 "smooth 0 (flat faces) or 1 (smooth normals)", RT_KEY_NUM, true},
-	{"crease", offsetof(object, crease), false, false, 0, 180, 60, NULL,
-	 "crease in degrees, [0,180]", RT_KEY_NUM, true},
-};
-const size_t rt_nkeys = sizeof rt_keys / sizeof rt_keys[0];
-
-double rt_key_get(const rt_key *k, const object *o)
-{
-	const char *base = (const char *)o + k->offset;
-	if (k->is_int)
-		return *(const int *)(const void *)base;
-	return *(const double *)(const void *)base;
-}
-
-void rt_key_set(const rt_key *k, object *o, double v)
-{
-	char *base = (char *)o + k->offset;
-	if (k->is_int)
-		*(int *)(void *)base = (int)v;
-	else
-		*(double *)(void *)base = v;
-}
-
 void rt_numloc_enter(rt_numloc *l)
 {
 	l->c = newlocale(LC_NUMERIC_MASK, "C", (locale_t)0);
@@ -126,6 +73,7 @@ typedef struct parser {
 	char *text;
 	size_t cap_text;
 	char quote[96];   /* a token shortened for a message */
+	char usage[256], usage42[128]; /* an object element's usage lines */
 	char *dir;        /* the .rt file's folder ("" = the current one) */
 } parser;
 
@@ -138,6 +86,7 @@ struct elem_def {
 	bool (*parse)(parser *p, const elem_def *e);
 	const char *usage;  /* every accepted form */
 	const char *usage42; /* the 42 subject's form, or NULL */
+	const shape_form *form; /* objects: the form of the kind it reads */
 };
 
 static bool fail(parser *p, int col, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
@@ -273,66 +222,11 @@ static bool lex_line(parser *p, const char *s, size_t len)
 
 /* --- numbers --- */
 
-static bool is_digit(char c) { return c >= '0' && c <= '9'; }
-
-/* The end of the decimal number that starts at s, or NULL if none does:
- * [+-] (digits [. digits] | . digits) [(e|E) [+-] digits]. */
-static const char *scan_decimal(const char *s, const char *end)
-{
-	const char *q = s;
-	if (q < end && (*q == '+' || *q == '-'))
-		q++;
-	size_t ndig = 0;
-	while (q < end && is_digit(*q)) {
-		q++;
-		ndig++;
-	}
-	if (q < end && *q == '.') {
-		q++;
-		while (q < end && is_digit(*q)) {
-			q++;
-			ndig++;
-		}
-	}
-	if (ndig == 0)
-		return NULL;
-	if (q < end && (*q == 'e' || *q == 'E')) {
-		q++;
-		if (q < end && (*q == '+' || *q == '-'))
-			q++;
-		const char *e0 = q;
-		while (q < end && is_digit(*q))
-			q++;
-		if (q == e0)
-			return NULL;
-	}
-	return q;
-}
-
-typedef enum num_status { NUM_OK, NUM_EMPTY, NUM_BAD, NUM_BIG } num_status;
-
-/* Reads s[0..len), which must be followed by ',', 'x' or NUL. */
+/* Reads s[0..len), which must be followed by ',', 'x' or NUL: the one
+ * scanner of num.h, within RT_NUM_MAX. */
 static num_status num_parse(const char *s, size_t len, double *out)
 {
-	if (len == 0)
-		return NUM_EMPTY;
-	if (scan_decimal(s, s + len) != s + len)
-		return NUM_BAD;
-	/* The syntax is checked: strtod reads exactly these bytes, except that
-	 * "0x" would start a hexadecimal number, so copy the short ones. */
-	char buf[64];
-	double v;
-	if (len < sizeof buf) {
-		memcpy(buf, s, len);
-		buf[len] = '\0';
-		v = strtod(buf, NULL);
-	} else {
-		v = strtod(s, NULL);
-	}
-	if (!(fabs(v) <= RT_NUM_MAX))
-		return NUM_BIG;
-	*out = v;
-	return NUM_OK;
+	return num_scan(s, len, RT_NUM_MAX, out);
 }
 
 /* A field's range: lo..hi (lo excluded when lo_open), whole numbers only
@@ -551,14 +445,14 @@ static bool parse_camera(parser *p, const elem_def *e)
 	    !get_dir(p, &p->toks[2], e->name, "direction", &c.dir) ||
 	    !get_num(p, &p->toks[3], e->name, "fov", &R_FOV, &c.fov))
 		return false;
-	if (c.fov < FOV_MIN || c.fov > FOV_MAX) {
-		double to = c.fov < FOV_MIN ? FOV_MIN : FOV_MAX;
+	bool clamped;
+	if (!fov_rule(&c.fov, &clamped, p->err)) /* R_FOV has checked [0,180] */
+		return false;
+	if (clamped)
 		rt_warn(p->warn, p->name, p->line, p->toks[3].col,
 		        "camera fov \"%s\" is clamped to %g degrees; expected an angle strictly "
 		        "between 0 and 180",
-		        quoted(p, &p->toks[3]), to);
-		c.fov = to;
-	}
+		        quoted(p, &p->toks[3]), c.fov);
 	scene *s = p->s;
 	if (strcmp(e->id, "C") != 0)
 		return scene_add_camera(s, &c, p->err);
@@ -801,17 +695,16 @@ static bool parse_keys(parser *p, const elem_def *e, object *o)
 		while (k < rt_nkeys &&
 		       !(strlen(rt_keys[k].name) == nlen && memcmp(rt_keys[k].name, t->s, nlen) == 0))
 			k++;
-		bool tri = o->kind == OBJ_TRIANGLE;
-		if (k == rt_nkeys || (tri && !rt_keys[k].triangles)) {
+		if (k == rt_nkeys || (!rt_keys[k].mesh_only && !rt_key_applies(&rt_keys[k], o->kind))) {
 			char list[256] = "";
 			size_t used = 0;
 			for (size_t j = 0; j < rt_nkeys; j++)
-				if (!tri || rt_keys[j].triangles)
+				if (rt_key_applies(&rt_keys[j], o->kind))
 					used += (size_t)snprintf(list + used, sizeof list - used, "%s%s=",
 					                         used ? " " : "", rt_keys[j].name);
-			return fail_tok(p, t, e->name, "key",
-			                k == rt_nkeys ? "is unknown" : "does not apply to triangles",
-			                list);
+			char what[64];
+			snprintf(what, sizeof what, "does not apply to %ss", e->name);
+			return fail_tok(p, t, e->name, "key", k == rt_nkeys ? "is unknown" : what, list);
 		}
 		const rt_key *key = &rt_keys[k];
 		if (key->mesh_only && o->kind != OBJ_MESH)
@@ -890,7 +783,7 @@ static bool add_object(parser *p, const elem_def *e, object *o, const zero_size 
 	}
 	rt_error verr;
 	rt_error_clear(&verr);
-	if (!object_validate(o, &verr))
+	if (!object_rules(o, &verr)) /* the editor's rules too */
 		return fail(p, p->toks[0].col, "%s: %s", e->name, verr.msg);
 	if (!scene_add_object(p->s, o, &verr)) /* too many objects for the memory */
 		return fail(p, p->toks[0].col, "%s", verr.msg);
@@ -961,73 +854,48 @@ static object short_object(const elem_def *e, vec3 pos, vec3 dir, vec3 scale, ve
 
 static bool plain_number(const tok *t) { return !memchr(t->s, ',', t->len); }
 
-static bool parse_sphere(parser *p, const elem_def *e)
+/* The short form of e->form: its fields (shape.h), then R,G,B; the
+ * extended form instead when the form has one and the line is not short:
+ * when the first size field is missing or not a plain number, or (no size
+ * field) when there are more fields than the short form's. */
+static bool parse_form(parser *p, const elem_def *e)
 {
-	if (p->np < 2 || !plain_number(&p->toks[2]))
-		return parse_extended(p, e);
-	vec3 c, color;
-	double d;
+	const shape_form *f = e->form;
+	size_t nf = (size_t)f->nfields;
+	if (f->extended) {
+		const char *sz = strchr(f->types, 's');
+		size_t k = sz ? (size_t)(sz - f->types) + 1 : 0;
+		if (k ? p->np < k || !plain_number(&p->toks[k]) : p->np > nf + 1)
+			return parse_extended(p, e);
+	}
+	if (!count_ok(p, e, nf + 1, nf + 1 + (f->material ? 4 : 0), usage_of(p, e)) ||
+	    !group_ok(p, e, nf + 1))
+		return false;
+	vec3 pos = v3(0, 0, 0), dir = v3(0, 1, 0), color;
+	double sizes[4] = {0, 0, 0, 0};
+	size_t ns = 0;
 	zero_size zero = {0};
-	if (!count_ok(p, e, 3, 3, usage_of(p, e)) ||
-	    !get_vec(p, &p->toks[1], e->name, "center", &R_ANY, &c) ||
-	    !get_size(p, &p->toks[2], e->name, "diameter", &d, &zero) ||
-	    !get_color(p, &p->toks[3], e->name, "colour", &color))
+	for (size_t i = 0; i < nf; i++) {
+		const tok *t = &p->toks[1 + i];
+		bool ok = f->types[i] == 'p'   ? get_vec(p, t, e->name, f->fields[i], &R_ANY, &pos)
+		          : f->types[i] == 'd' ? get_dir(p, t, e->name, f->fields[i], &dir)
+		                               : get_size(p, t, e->name, f->fields[i], &sizes[ns++], &zero);
+		if (!ok)
+			return false;
+	}
+	if (!get_color(p, &p->toks[nf + 1], e->name, "colour", &color))
 		return false;
-	object o = short_object(e, c, v3(0, 1, 0), v3_splat(d), color);
-	return add_object(p, e, &o, &zero);
-}
-
-static bool parse_plane(parser *p, const elem_def *e)
-{
-	if (p->np > 3)
-		return parse_extended(p, e);
-	vec3 pt, n, color;
-	if (!count_ok(p, e, 3, 3, usage_of(p, e)) ||
-	    !get_vec(p, &p->toks[1], e->name, "point", &R_ANY, &pt) ||
-	    !get_dir(p, &p->toks[2], e->name, "normal", &n) ||
-	    !get_color(p, &p->toks[3], e->name, "colour", &color))
+	object o = short_object(e, pos, dir, v3_splat(1), color);
+	if (p->np == nf + 5 && !get_material(p, e, nf + 2, &o.mat))
 		return false;
-	object o = short_object(e, pt, n, v3_splat(1), color);
-	return add_object(p, e, &o, NULL);
-}
-
-/* cy and co */
-static bool parse_tube(parser *p, const elem_def *e)
-{
-	if (p->np < 3 || !plain_number(&p->toks[3]))
-		return parse_extended(p, e);
-	vec3 c, axis, color;
-	double d, h;
-	zero_size zero = {0};
-	if (!count_ok(p, e, 5, 5, usage_of(p, e)) ||
-	    !get_vec(p, &p->toks[1], e->name, "center", &R_ANY, &c) ||
-	    !get_dir(p, &p->toks[2], e->name, "axis", &axis) ||
-	    !get_size(p, &p->toks[3], e->name, "diameter", &d, &zero) ||
-	    !get_size(p, &p->toks[4], e->name, "height", &h, &zero) ||
-	    !get_color(p, &p->toks[5], e->name, "colour", &color))
-		return false;
-	object o = short_object(e, c, axis, v3(d, h, d), color);
-	return add_object(p, e, &o, &zero);
-}
-
-static bool parse_square(parser *p, const elem_def *e)
-{
-	vec3 c, n, color;
-	double side;
-	zero_size zero = {0};
-	if (!count_ok(p, e, 4, 4, e->usage) ||
-	    !get_vec(p, &p->toks[1], e->name, "center", &R_ANY, &c) ||
-	    !get_dir(p, &p->toks[2], e->name, "normal", &n) ||
-	    !get_size(p, &p->toks[3], e->name, "side", &side, &zero) ||
-	    !get_color(p, &p->toks[4], e->name, "colour", &color))
-		return false;
-	object o = short_object(e, c, n, v3(side, 1, side), color);
+	if (!zero.t)
+		f->read(&o, sizes);
 	return add_object(p, e, &o, &zero);
 }
 
 static bool parse_triangle(parser *p, const elem_def *e)
 {
-	static const char *const names[3] = {"first point", "second point", "third point"};
+	const char *const *names = e->form->fields;
 	vec3 v[3], color;
 	if (!count_ok(p, e, 4, 8, e->usage) || !group_ok(p, e, 4))
 		return false;
@@ -1036,7 +904,7 @@ static bool parse_triangle(parser *p, const elem_def *e)
 			return false;
 	if (!get_color(p, &p->toks[4], e->name, "colour", &color))
 		return false;
-	object o = object_make(OBJ_TRIANGLE, color);
+	object o = object_make((obj_kind)e->kind, color);
 	if (p->np == 8 && !get_material(p, e, 5, &o.mat))
 		return false;
 	vec3 n = v3_cross(v3_sub(v[1], v[0]), v3_sub(v[2], v[0]));
@@ -1093,50 +961,118 @@ static bool parse_mesh(parser *p, const elem_def *e)
 	return add_object(p, e, &o, NULL);
 }
 
-static const elem_def elements[] = {
-	{"A", "ambient", -1, true, parse_ambient, "A RATIO R,G,B", NULL},
-	{"C", "camera", -1, true, parse_camera, "C POSITION DIRECTION FOV", NULL},
-	{"c", "camera", -1, false, parse_camera, "c POSITION DIRECTION FOV", NULL},
-	{"L", "light", -1, true, parse_light, "L POSITION RATIO [R,G,B]", "L POSITION RATIO R,G,B"},
-	{"l", "light", -1, false, parse_light, "l POSITION RATIO [R,G,B]", NULL},
-	{"R", "resolution", -1, false, parse_resolution, "R WIDTH HEIGHT", NULL},
-	{"sp", "sphere", OBJ_SPHERE, true, parse_sphere,
-	 "sp CENTER DIAMETER R,G,B" " or sp" EXT_TAIL, "sp CENTER DIAMETER R,G,B"},
-	{"pl", "plane", OBJ_PLANE, true, parse_plane,
-	 "pl POINT NORMAL R,G,B" " or pl" EXT_TAIL, "pl POINT NORMAL R,G,B"},
-	{"cy", "cylinder", OBJ_CYLINDER, true, parse_tube,
-	 "cy CENTER AXIS DIAMETER HEIGHT R,G,B" " or cy" EXT_TAIL,
-	 "cy CENTER AXIS DIAMETER HEIGHT R,G,B"},
-	{"co", "cone", OBJ_CONE, false, parse_tube,
-	 "co CENTER AXIS DIAMETER HEIGHT R,G,B" " or co" EXT_TAIL, NULL},
-	{"cu", "cube", OBJ_CUBE, false, parse_extended, "cu" EXT_TAIL, NULL},
-	{"di", "disc", OBJ_DISC, false, parse_extended, "di" EXT_TAIL, NULL},
-	{"rc", "rectangle", OBJ_RECT, false, parse_extended, "rc" EXT_TAIL, NULL},
-	{"sq", "square", OBJ_RECT, false, parse_square, "sq CENTER NORMAL SIDE R,G,B", NULL},
-	{"tr", "triangle", OBJ_TRIANGLE, false, parse_triangle,
-	 "tr P1 P2 P3 R,G,B [DIFFUSE SPECULAR SHININESS REFLECTIVE]", NULL},
-	{"mesh", "mesh", OBJ_MESH, false, parse_mesh,
-	 "mesh FILE POSITION DIRECTION SIZE [R,G,B [DIFFUSE SPECULAR SHININESS REFLECTIVE]]", NULL},
-	{"sky", "sky", -1, false, parse_sky, "sky ZENITH_R,G,B HORIZON_R,G,B [STRENGTH] or sky FILE.hdr [STRENGTH [ROTATION]]", NULL},
-	{"set", "set", -1, false, parse_set, "set samples|depth|mode|resolution VALUE", NULL},
+/* The elements before the objects and after them; the objects' come from
+ * the shape kinds (shape.h, kinds.def), in the order of the kinds, each
+ * kind's own identifier and then its alias. */
+static const elem_def elements_head[] = {
+	{"A", "ambient", -1, true, parse_ambient, "A RATIO R,G,B", NULL, NULL},
+	{"C", "camera", -1, true, parse_camera, "C POSITION DIRECTION FOV", NULL, NULL},
+	{"c", "camera", -1, false, parse_camera, "c POSITION DIRECTION FOV", NULL, NULL},
+	{"L", "light", -1, true, parse_light, "L POSITION RATIO [R,G,B]", "L POSITION RATIO R,G,B", NULL},
+	{"l", "light", -1, false, parse_light, "l POSITION RATIO [R,G,B]", NULL, NULL},
+	{"R", "resolution", -1, false, parse_resolution, "R WIDTH HEIGHT", NULL, NULL},
 };
-#define NELEMENTS (sizeof elements / sizeof elements[0])
+static const elem_def elements_tail[] = {
+	{"mesh", "mesh", OBJ_MESH, false, parse_mesh,
+	 "mesh FILE POSITION DIRECTION SIZE [R,G,B [DIFFUSE SPECULAR SHININESS REFLECTIVE]]", NULL, NULL},
+	{"sky", "sky", -1, false, parse_sky,
+	 "sky ZENITH_R,G,B HORIZON_R,G,B [STRENGTH] or sky FILE.hdr [STRENGTH [ROTATION]]", NULL, NULL},
+	{"set", "set", -1, false, parse_set, "set samples|depth|mode|resolution VALUE", NULL, NULL},
+};
+#define NHEAD (sizeof elements_head / sizeof elements_head[0])
+#define NTAIL (sizeof elements_tail / sizeof elements_tail[0])
+
+/* The element of an object's form, its usage lines written into p. */
+static elem_def object_element(parser *p, obj_kind k, const shape_form *f)
+{
+	char *u = p->usage, *u42 = p->usage42;
+	size_t n = sizeof p->usage;
+	int used = 0;
+	if (f->nfields)
+		used = snprintf(u, n, "%s %s R,G,B%s", f->id, f->usage,
+		                f->material ? " [DIFFUSE SPECULAR SHININESS REFLECTIVE]" : "");
+	if (f->extended)
+		snprintf(u + used, n - (size_t)used, "%s%s" EXT_TAIL, used ? " or " : "", f->id);
+	if (f->strict && f->nfields)
+		snprintf(u42, sizeof p->usage42, "%s %s R,G,B", f->id, f->usage);
+	bool (*parse)(parser *, const elem_def *) =
+	    obj_kind_flags(k) & KIND_VERTICES ? parse_triangle : f->nfields ? parse_form : parse_extended;
+	return (elem_def){f->id, f->name, (int)k, f->strict, parse, u, f->strict && f->nfields ? u42 : NULL,
+	                  f};
+}
+
+const char *rt_element(size_t i, const char **usage)
+{
+	if (i < NHEAD) {
+		*usage = elements_head[i].usage;
+		return elements_head[i].id;
+	}
+	i -= NHEAD;
+	/* one parser's usage buffers per call: static, so one caller at a time */
+	static parser p;
+	for (int k = 0; k < OBJ_KIND_COUNT; k++) {
+		const shape_kind *d = shape_kinds[k];
+		for (int a = 0; a < 2; a++) {
+			const shape_form *f = a ? &d->alias : &d->form;
+			if (!f->id)
+				continue;
+			if (i-- == 0) {
+				elem_def e = object_element(&p, (obj_kind)k, f);
+				*usage = e.usage;
+				return e.id;
+			}
+		}
+	}
+	if (i < NTAIL) {
+		*usage = elements_tail[i].usage;
+		return elements_tail[i].id;
+	}
+	return NULL;
+}
+
+/* Every element identifier, in order, for messages (strict: only those
+ * strict mode allows). */
+static void element_list(const parser *p, char *list, size_t size)
+{
+	size_t used = 0;
+	list[0] = '\0';
+#define ADD(id, ok) \
+	if (!p->strict || (ok)) \
+		used += (size_t)snprintf(list + used, used < size ? size - used : 0, " %s", id)
+	for (size_t i = 0; i < NHEAD; i++)
+		ADD(elements_head[i].id, elements_head[i].strict);
+	for (int k = 0; k < OBJ_KIND_COUNT; k++) {
+		const shape_kind *d = shape_kinds[k];
+		ADD(d->form.id, d->form.strict);
+		if (d->alias.id)
+			ADD(d->alias.id, d->alias.strict);
+	}
+	for (size_t i = 0; i < NTAIL; i++)
+		ADD(elements_tail[i].id, elements_tail[i].strict);
+#undef ADD
+}
 
 /* Parses the tokens of one line (at least one). */
 static bool parse_tokens(parser *p)
 {
 	const tok *id = &p->toks[0];
 	const elem_def *e = NULL;
-	for (size_t i = 0; i < NELEMENTS && !e; i++)
-		if (strcmp(elements[i].id, id->s) == 0)
-			e = &elements[i];
+	elem_def obj;
+	for (size_t i = 0; i < NHEAD && !e; i++)
+		if (strcmp(elements_head[i].id, id->s) == 0)
+			e = &elements_head[i];
+	for (size_t i = 0; i < NTAIL && !e; i++)
+		if (strcmp(elements_tail[i].id, id->s) == 0)
+			e = &elements_tail[i];
+	obj_kind k;
+	const shape_form *f;
+	if (!e && shape_kind_find(id->s, &k, &f)) {
+		obj = object_element(p, k, f);
+		e = &obj;
+	}
 	if (!e || (p->strict && !e->strict)) {
-		char list[128] = "";
-		size_t used = 0;
-		for (size_t i = 0; i < NELEMENTS; i++)
-			if (!p->strict || elements[i].strict)
-				used += (size_t)snprintf(list + used, sizeof list - used, " %s",
-				                         elements[i].id);
+		char list[256];
+		element_list(p, list, sizeof list);
 		return fail(p, id->col, "%s element \"%s\"; expected one of%s%s",
 		            e ? "strict mode does not allow the" : "unknown", quoted(p, id), list,
 		            p->strict ? " (strict mode)" : "");

@@ -16,6 +16,7 @@
 #include "rtsh/image.h"
 #include "rtsh/render.h"
 #include "rtsh/rtfile.h"
+#include "rtsh/shape.h"
 #include "scene/rtfile_priv.h"
 
 /* A bounded string builder: output is cut at size - 1 bytes, always
@@ -92,25 +93,17 @@ static bool has_shear(const object *o)
 	return false;
 }
 
-/* True when the object is exactly what its 42 (or 2019) short form reads to. */
-static bool short_form_ok(const object *o)
+/* The sizes of o's short form f, when f reads back to exactly o: no twist,
+ * shear or material beyond the default, a direction only if f has one,
+ * and sizes the form can say (shape.h). */
+static bool short_form_ok(const object *o, const shape_form *f, double *sizes)
 {
-	if (o->twist != 0 || has_shear(o) || !base_material_default(&o->mat))
+	if (!f->id || !f->nfields || o->twist != 0 || has_shear(o) ||
+	    (!f->material && !base_material_default(&o->mat)))
 		return false;
-	vec3 s = o->scale;
-	switch (o->kind) {
-	case OBJ_SPHERE:
-		return v3_eq(o->dir, v3(0, 1, 0)) && s.x == s.y && s.y == s.z;
-	case OBJ_PLANE:
-		return v3_eq(s, v3_splat(1));
-	case OBJ_CYLINDER:
-	case OBJ_CONE:
-		return s.x == s.z;
-	case OBJ_RECT:
-		return s.x == s.z && s.y == 1;
-	default:
+	if (!strchr(f->types, 'd') && !v3_eq(o->dir, v3(0, 1, 0)))
 		return false;
-	}
+	return f->write(o, sizes);
 }
 
 static void fmt_material(sbuf *b, const material *m)
@@ -144,11 +137,11 @@ static void sb_file(sbuf *b, const char *file)
 		sb_put(b, "\"");
 }
 
-static void fmt_keys(sbuf *b, const object *o)
+static void fmt_keys(sbuf *b, const object *o, bool short_form)
 {
 	for (size_t i = 0; i < rt_nkeys; i++) {
 		const rt_key *k = &rt_keys[i];
-		if (k->mesh_only && o->kind != OBJ_MESH)
+		if (!rt_key_applies(k, o->kind))
 			continue;
 		if (k->type == RT_KEY_FILE) {
 			const char *f = *(const char *const *)(const void *)((const char *)o + k->offset);
@@ -173,7 +166,7 @@ static void fmt_keys(sbuf *b, const object *o)
 			continue;
 		}
 		double v = rt_key_get(k, o);
-		if (v == k->def || (o->kind == OBJ_TRIANGLE && !k->triangles))
+		if (v == k->def || !rt_key_applies(k, o->kind) || (short_form && k->in_short))
 			continue;
 		sb_put(b, " ");
 		sb_put(b, k->name);
@@ -182,9 +175,12 @@ static void fmt_keys(sbuf *b, const object *o)
 	}
 }
 
-static void fmt_object(sbuf *b, const object *o)
+static void fmt_object(sbuf *b, const object *o, bool extended)
 {
 	const material *m = &o->mat;
+	const shape_kind *d = o->kind < OBJ_KIND_COUNT ? shape_kinds[o->kind] : NULL;
+	double sizes[4];
+	const shape_form *f = NULL;
 	if (o->kind == OBJ_MESH) {
 		sb_put(b, "mesh ");
 		sb_file(b, o->file ? o->file : "");
@@ -199,37 +195,31 @@ static void fmt_object(sbuf *b, const object *o)
 			if (!base_material_default(m))
 				fmt_material(b, m);
 		}
-	} else if (o->kind == OBJ_TRIANGLE) {
-		sb_put(b, "tr");
+	} else if (obj_kind_flags(o->kind) & KIND_VERTICES) {
+		sb_put(b, d->form.id);
 		for (int i = 0; i < 3; i++)
 			sb_vec(b, o->tri[i]);
 		sb_vec(b, m->color);
 		if (!base_material_default(m))
 			fmt_material(b, m);
-	} else if (short_form_ok(o)) {
-		vec3 s = o->scale;
-		sb_put(b, o->kind == OBJ_RECT ? "sq" : obj_kind_id(o->kind));
-		sb_vec(b, o->pos);
-		switch (o->kind) {
-		case OBJ_SPHERE:
-			sb_field(b, s.x);
-			break;
-		case OBJ_PLANE:
-			sb_vec(b, o->dir);
-			break;
-		case OBJ_RECT:
-			sb_vec(b, o->dir);
-			sb_field(b, s.x);
-			break;
-		default: /* cylinder, cone */
-			sb_vec(b, o->dir);
-			sb_field(b, s.x);
-			sb_field(b, s.y);
-			break;
+	} else if (!extended &&
+	           (short_form_ok(o, f = &d->form, sizes) || short_form_ok(o, f = &d->alias, sizes))) {
+		sb_put(b, f->id);
+		size_t ns = 0;
+		for (int i = 0; i < f->nfields; i++) {
+			if (f->types[i] == 'p')
+				sb_vec(b, o->pos);
+			else if (f->types[i] == 'd')
+				sb_vec(b, o->dir);
+			else
+				sb_field(b, sizes[ns++]);
 		}
 		sb_vec(b, m->color);
+		if (f->material && !base_material_default(m))
+			fmt_material(b, m);
 	} else {
-		sb_put(b, o->kind == OBJ_RECT ? "rc" : obj_kind_id(o->kind));
+		f = NULL;
+		sb_put(b, d->form.extended ? d->form.id : d->alias.id);
 		sb_vec(b, o->pos);
 		sb_vec(b, o->dir);
 		sb_vec(b, o->scale);
@@ -244,7 +234,7 @@ static void fmt_object(sbuf *b, const object *o)
 			}
 		}
 	}
-	fmt_keys(b, o);
+	fmt_keys(b, o, f != NULL);
 }
 
 static void fmt_light(sbuf *b, const light *l)
@@ -268,7 +258,16 @@ void rt_format_object(const object *o, char *buf, size_t size)
 	rt_numloc loc;
 	rt_numloc_enter(&loc);
 	sbuf b = sb_make(buf, size);
-	fmt_object(&b, o);
+	fmt_object(&b, o, false);
+	rt_numloc_leave(&loc);
+}
+
+void rt_format_object_extended(const object *o, char *buf, size_t size)
+{
+	rt_numloc loc;
+	rt_numloc_enter(&loc);
+	sbuf b = sb_make(buf, size);
+	fmt_object(&b, o, true);
 	rt_numloc_leave(&loc);
 }
 
@@ -345,7 +344,7 @@ static void write_scene(const scene *s, FILE *f)
 		put_line(f, &b);
 	}
 	for (size_t i = 0; i < s->nobjs; i++) {
-		fmt_object(&b, &s->objs[i]);
+		fmt_object(&b, &s->objs[i], false);
 		put_line(f, &b);
 	}
 }

@@ -520,40 +520,11 @@ static void put_int(obuf *o, long v)
 }
 
 /* An object in the extended form, whatever the short form could say. */
-static void put_extended(obuf *o, const object *ob, const char *formatted)
+static void put_extended(obuf *o, const object *ob)
 {
-	ob_str(o, ob->kind == OBJ_RECT ? "rc" : obj_kind_id(ob->kind));
-	ob_str(o, " ");
-	put_vec(o, ob->pos);
-	ob_str(o, " ");
-	put_vec(o, ob->dir);
-	ob_str(o, " ");
-	put_vec(o, ob->scale);
-	ob_str(o, " ");
-	put_vec(o, ob->mat.color);
-	const double m[4] = {ob->mat.diffuse, ob->mat.specular, ob->mat.shininess, ob->mat.reflective};
-	for (int k = 0; k < 4; k++) {
-		ob_str(o, " ");
-		put_num(o, m[k]);
-	}
-	bool sheared = false;
-	for (int k = 0; k < 6; k++)
-		sheared |= ob->shear[k] != 0;
-	for (int k = 0; sheared && k < 6; k++) {
-		ob_str(o, k ? "," : " ");
-		put_num(o, ob->shear[k]);
-	}
-	/* The key=value fields, as the writer gives them. */
-	for (const char *p = formatted; *p;) {
-		size_t k = strcspn(p, " ");
-		if (memchr(p, '=', k)) {
-			ob_str(o, " ");
-			ob_add(o, p, k);
-		}
-		p += k;
-		while (*p == ' ')
-			p++;
-	}
+	char f[BODY_MAX];
+	rt_format_object_extended(ob, f, sizeof f);
+	ob_str(o, f);
 }
 
 static void put_object(obuf *o, const object *ob, bool want_short)
@@ -562,10 +533,10 @@ static void put_object(obuf *o, const object *ob, bool want_short)
 	rt_format_object(ob, f, sizeof f);
 	lline l;
 	lex(f, strlen(f), &l);
-	if (ob->kind == OBJ_TRIANGLE || want_short || !short_form(f, &l))
+	if (want_short || !short_form(f, &l))
 		ob_str(o, f);
 	else
-		put_extended(o, ob, f);
+		put_extended(o, ob);
 }
 
 /* id: the identifier to keep ("L" or "l", "C" or "c"). */

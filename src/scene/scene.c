@@ -9,16 +9,12 @@
 
 static const struct {
 	const char *id, *name;
+	unsigned flags;
 } kind_names[OBJ_KIND_ALL] = {
-	[OBJ_SPHERE] = {"sp", "sphere"},
-	[OBJ_PLANE] = {"pl", "plane"},
-	[OBJ_CYLINDER] = {"cy", "cylinder"},
-	[OBJ_CONE] = {"co", "cone"},
-	[OBJ_CUBE] = {"cu", "cube"},
-	[OBJ_DISC] = {"di", "disc"},
-	[OBJ_RECT] = {"rc", "rectangle"},
-	[OBJ_TRIANGLE] = {"tr", "triangle"},
-	[OBJ_MESH] = {"mesh", "mesh"},
+#define RT_KIND(e, i, n, desc, f) [OBJ_##e] = {i, n, f},
+#include "rtsh/kinds.def"
+#undef RT_KIND
+	[OBJ_MESH] = {"mesh", "mesh", 0},
 };
 
 const char *obj_kind_id(obj_kind k)
@@ -31,13 +27,16 @@ const char *obj_kind_name(obj_kind k)
 	return (unsigned)k < OBJ_KIND_ALL ? kind_names[k].name : "object";
 }
 
+unsigned obj_kind_flags(obj_kind k)
+{
+	return (unsigned)k < OBJ_KIND_ALL ? kind_names[k].flags : 0;
+}
+
 int obj_kind_from_id(const char *id)
 {
 	for (int k = 0; k < OBJ_KIND_ALL; k++)
 		if (strcmp(id, kind_names[k].id) == 0)
 			return k;
-	if (strcmp(id, "sq") == 0)
-		return OBJ_RECT;
 	return -1;
 }
 
@@ -122,7 +121,7 @@ bool object_equal(const object *a, const object *b)
 {
 	if (a->kind != b->kind || !material_equal(&a->mat, &b->mat))
 		return false;
-	if (a->kind == OBJ_TRIANGLE)
+	if ((obj_kind_flags(a->kind) & KIND_VERTICES))
 		return v3_eq(a->tri[0], b->tri[0]) && v3_eq(a->tri[1], b->tri[1]) &&
 		       v3_eq(a->tri[2], b->tri[2]);
 	for (int i = 0; i < 6; i++)
@@ -132,6 +131,7 @@ bool object_equal(const object *a, const object *b)
 	    a->crease != b->crease)
 		return false;
 	return v3_eq(a->pos, b->pos) && v3_eq(a->dir, b->dir) && a->twist == b->twist &&
+	       (!(obj_kind_flags(a->kind) & KIND_TUBE) || a->tube == b->tube) &&
 	       v3_eq(a->scale, b->scale);
 }
 
@@ -265,10 +265,11 @@ object object_make(obj_kind k, vec3 color)
 	o.kind = k;
 	o.dir = v3(0, 1, 0);
 	o.scale = v3(1, 1, 1);
+	o.tube = 0.5;
 	o.mat = material_default(color);
 	o.smooth = 1;
 	o.crease = 60;
-	if (k == OBJ_TRIANGLE) {
+	if ((obj_kind_flags(k) & KIND_VERTICES)) {
 		o.tri[0] = v3(-0.5, -0.5, 0);
 		o.tri[1] = v3(0.5, -0.5, 0);
 		o.tri[2] = v3(0, 0.5, 0);
@@ -286,7 +287,7 @@ static bool has_shear(const object *o)
 
 bool object_xform(const object *o, xform *out)
 {
-	if (o->kind == OBJ_TRIANGLE) {
+	if ((obj_kind_flags(o->kind) & KIND_VERTICES)) {
 		*out = xf_identity();
 		return true;
 	}
@@ -294,7 +295,7 @@ bool object_xform(const object *o, xform *out)
 	if (!(len > 0.0) || !isfinite(len))
 		return false;
 	vec3 s = o->scale;
-	if (o->kind == OBJ_PLANE)
+	if ((obj_kind_flags(o->kind) & KIND_UNBOUNDED))
 		s = v3(2, 2, 2); /* a plane has no size: object units are world units */
 	mat4 m = m4_mul(m4_translate(o->pos), m4_orient(v3_scale(o->dir, 1.0 / len), deg_to_rad(o->twist)));
 	if (has_shear(o))
@@ -305,7 +306,7 @@ bool object_xform(const object *o, xform *out)
 
 vec3 object_center(const object *o)
 {
-	if (o->kind == OBJ_TRIANGLE)
+	if ((obj_kind_flags(o->kind) & KIND_VERTICES))
 		return v3_scale(v3_add(v3_add(o->tri[0], o->tri[1]), o->tri[2]), 1.0 / 3.0);
 	return o->pos;
 }
@@ -313,7 +314,7 @@ vec3 object_center(const object *o)
 bool object_validate(const object *o, rt_error *err)
 {
 	const char *name = obj_kind_name(o->kind);
-	if (o->kind == OBJ_TRIANGLE) {
+	if ((obj_kind_flags(o->kind) & KIND_VERTICES)) {
 		for (int i = 0; i < 3; i++)
 			if (!v3_finite(o->tri[i]))
 				return rt_error_set(err, "triangle vertex %d is not finite; expected numbers", i + 1);
@@ -326,20 +327,27 @@ bool object_validate(const object *o, rt_error *err)
 	}
 	if (!v3_finite(o->pos) || !v3_finite(o->dir) || !v3_finite(o->scale) || !isfinite(o->twist))
 		return rt_error_set(err, "%s has a number that is not finite; expected finite numbers", name);
+	if ((obj_kind_flags(o->kind) & KIND_TUBE) && !(o->tube > 0.0 && o->tube <= 100.0))
+		return rt_error_set(err, "%s tube ratio is out of range; expected tube= in (0,100]", name);
 	if (!(v3_len(o->dir) > 0.0))
 		return rt_error_set(err, "%s direction is the zero vector; expected a non-zero direction", name);
-	if (o->kind != OBJ_PLANE && !(o->scale.x > 0 && o->scale.y > 0 && o->scale.z > 0))
+	if (!(obj_kind_flags(o->kind) & KIND_UNBOUNDED) && !(o->scale.x > 0 && o->scale.y > 0 && o->scale.z > 0))
 		return rt_error_set(err, "%s scaling has a component <= 0; expected sizes > 0", name);
 	xform x;
-	if (!object_xform(o, &x))
-		return rt_error_set(err, "%s transform is not invertible (check the shear); "
-		                         "expected a shear that keeps the shape solid", name);
+	if (!object_xform(o, &x)) {
+		if (has_shear(o))
+			return rt_error_set(err, "%s transform is not invertible (check the shear); "
+			                         "expected a shear that keeps the shape solid", name);
+		return rt_error_set(err, "%s scaling %g,%g,%g is too small or too uneven to place; "
+		                         "expected sizes whose product is far from 0",
+		                    name, o->scale.x, o->scale.y, o->scale.z);
+	}
 	return true;
 }
 
 void object_move(object *o, vec3 d)
 {
-	if (o->kind == OBJ_TRIANGLE) {
+	if ((obj_kind_flags(o->kind) & KIND_VERTICES)) {
 		for (int i = 0; i < 3; i++)
 			o->tri[i] = v3_add(o->tri[i], d);
 		return;
@@ -368,7 +376,7 @@ bool object_rotate(object *o, vec3 deg, rt_error *err)
 	                m4_mul(m4_rotate_y(deg_to_rad(deg.y)), m4_rotate_x(deg_to_rad(deg.x))));
 	if (!v3_finite(deg))
 		return rt_error_set(err, "rotation angles are not finite; expected degrees");
-	if (o->kind == OBJ_TRIANGLE) {
+	if ((obj_kind_flags(o->kind) & KIND_VERTICES)) {
 		vec3 c = object_center(o);
 		for (int i = 0; i < 3; i++)
 			o->tri[i] = v3_add(c, m4_vector(&q, v3_sub(o->tri[i], c)));
@@ -384,7 +392,7 @@ bool object_scale(object *o, vec3 f, rt_error *err)
 {
 	if (!(f.x > 0 && f.y > 0 && f.z > 0) || !v3_finite(f))
 		return rt_error_set(err, "scale factors must be > 0; expected SX,SY,SZ like 2,2,2");
-	if (o->kind == OBJ_TRIANGLE) {
+	if ((obj_kind_flags(o->kind) & KIND_VERTICES)) {
 		vec3 c = object_center(o);
 		for (int i = 0; i < 3; i++)
 			o->tri[i] = v3_add(c, v3_mul(v3_sub(o->tri[i], c), f));

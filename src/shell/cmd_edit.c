@@ -13,7 +13,7 @@
 
 #define SUBS_CAMERA "pos|dir|lookat|fov|move|turn"
 #define SUBS_LIGHT "pos|move|brightness|color"
-#define SUBS_OBJECT "move|rotate|scale|color"
+#define SUBS_OBJECT "move|rotate|scale|color|set"
 
 /* The subcommand `word` among choices, or a message naming them. */
 static int pick_sub(shell *sh, const char *cmd, const char *kind, const char *choices, const char *word)
@@ -93,8 +93,8 @@ bool cmd_camera(shell *sh, int argc, char **argv, const char *rest)
 			return false;
 		EDIT(sh, what, editor_camera_lookat(sh->ed, p, &err_));
 	case 3:
-		if (!parse_number(v, &d) || !(d > 0 && d < 180))
-			return shell_fail(sh, "%s: \"%s\" is not a field of view; expected degrees between 0 and 180",
+		if (!parse_number(v, &d)) /* the range is the editor's, as in files (rules.h) */
+			return shell_fail(sh, "%s: \"%s\" is not a field of view; expected degrees in [0,180]",
 			                  what, v);
 		EDIT(sh, what, editor_camera_fov(sh->ed, d, &err_));
 	case 4:
@@ -182,9 +182,11 @@ bool cmd_object(shell *sh, int argc, char **argv, const char *rest)
 	int sub = pick_sub(sh, "object", "an object command", SUBS_OBJECT, argv[1]);
 	if (sub < 0)
 		return false;
-	static const char *const names[] = {"move", "rotate", "scale", "color"};
+	static const char *const names[] = {"move", "rotate", "scale", "color", "set"};
 	char what[32];
 	snprintf(what, sizeof what, "object %s", names[sub]);
+	if (sub == 4) /* KEY=VALUE, from the reader's table of keys (rtfile.h) */
+		EDIT(sh, what, editor_object_set_key(sh->ed, i, argv[2], &err_));
 	const char *v = argv[2];
 	vec3 p;
 	switch (sub) {

@@ -10,6 +10,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "rtsh/num.h"
 #include "rtsh/generate.h"
 #include "rtsh/image.h"
 #include "rtsh/mesh.h"
@@ -264,10 +265,8 @@ bool cmd_generate(shell *sh, int argc, char **argv, const char *rest)
 		return false;
 	uint64_t seed;
 	if (argc == 2) {
-		char *end;
-		errno = 0;
-		unsigned long long v = strtoull(argv[1], &end, 10);
-		if (!*argv[1] || *argv[1] == '-' || *end || errno)
+		unsigned long long v;
+		if (num_scan_u64(argv[1], &v) != NUM_OK) /* num.h */
 			return shell_fail(sh, "generate: \"%s\" is not a seed; expected a whole number >= 0", argv[1]);
 		seed = v;
 	} else {

@@ -3,18 +3,21 @@
 
 #include <ctype.h>
 #include <errno.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "rtsh/num.h"
+#include "rtsh/rtfile.h"
 #include "shell/answer.h"
 #include "shell/keymode.h"
 #include "shell/suggest.h"
 
 #define SUBS_CAMERA "pos|dir|lookat|fov|move|turn"
 #define SUBS_LIGHT "pos|move|brightness|color"
-#define SUBS_OBJECT "move|rotate|scale|color"
+#define SUBS_OBJECT "move|rotate|scale|color|set"
 
 const command command_table[] = {
 	{"load", NULL, "load FILE", 1, 1, {"@scene"},
@@ -42,13 +45,13 @@ const command command_table[] = {
 	 0, 3, {"@light", SUBS_LIGHT}, "list the lights, show light N, or edit it", cmd_light},
 	{"object", "obj",
 	 "object\nobject N\nobject N move DX,DY,DZ\nobject N rotate RX,RY,RZ\nobject N scale SX,SY,SZ\n"
-	 "object N color R,G,B",
-	 0, 3, {"@object", SUBS_OBJECT},
+	 "object N color R,G,B\nobject N set KEY=VALUE",
+	 0, 3, {"@object", SUBS_OBJECT, "@key"},
 	 "list the objects, show object N, or edit it (move in world axes, rotate in degrees about X, Y, Z)",
 	 cmd_object},
 	{"ambient", NULL, "ambient\nambient brightness B\nambient color R,G,B", 0, 2, {"brightness|color"},
 	 "show or edit the ambient light", cmd_ambient},
-	{"add", NULL, "add LINE", 1, CMD_ANY, {NULL},
+	{"add", NULL, "add LINE", 1, CMD_ANY, {"@element"},
 	 "add an element written as a .rt line (A and C replace theirs, c adds a camera)", cmd_add},
 	{"delete", "del rm", "delete object N\ndelete light N\ndelete camera N", 1, 2,
 	 {"object|light|camera", "@ref"}, "remove an object, a light or a camera", cmd_delete},
@@ -227,36 +230,7 @@ int split_words(const char *s, char **argv, int max, char *buf, size_t *rest_at,
 
 bool parse_number(const char *s, double *out)
 {
-	const char *p = s;
-	if (*p == '+' || *p == '-')
-		p++;
-	int digits = 0;
-	while (isdigit((unsigned char)*p))
-		p++, digits++;
-	if (*p == '.') {
-		p++;
-		while (isdigit((unsigned char)*p))
-			p++, digits++;
-	}
-	if (!digits)
-		return false;
-	if (*p == 'e' || *p == 'E') {
-		p++;
-		if (*p == '+' || *p == '-')
-			p++;
-		if (!isdigit((unsigned char)*p))
-			return false;
-		while (isdigit((unsigned char)*p))
-			p++;
-	}
-	if (*p)
-		return false;
-	errno = 0;
-	double v = strtod(s, NULL);
-	if (!isfinite(v) || fabs(v) > 1e20)
-		return false;
-	*out = v;
-	return true;
+	return num_scan_str(s, 1e20, out) == NUM_OK; /* the .rt reader's numbers (num.h) */
 }
 
 bool arg_number(shell *sh, const char *what, const char *word, double lo, double hi, double *out)
@@ -272,12 +246,11 @@ bool arg_number(shell *sh, const char *what, const char *word, double lo, double
 
 bool arg_int(shell *sh, const char *what, const char *word, long lo, long hi, long *out)
 {
-	char *end;
-	errno = 0;
-	long v = strtol(word, &end, 10);
-	if (!*word || *end || errno || isspace((unsigned char)*word))
+	long v = 0;
+	num_status st = num_scan_long(word, LONG_MIN, LONG_MAX, &v);
+	if (st == NUM_EMPTY || st == NUM_BAD)
 		return shell_fail(sh, "%s: \"%s\" is not a whole number; expected %ld..%ld", what, word, lo, hi);
-	if (v < lo || v > hi)
+	if (st != NUM_OK || v < lo || v > hi)
 		return shell_fail(sh, "%s: %s is out of range; expected %ld..%ld", what, word, lo, hi);
 	*out = v;
 	return true;
@@ -328,10 +301,8 @@ bool arg_color(shell *sh, const char *what, const char *word, vec3 *out)
 
 bool arg_index(shell *sh, const char *what, const char *word, const char *kind, size_t n, size_t *out)
 {
-	char *end;
-	errno = 0;
-	unsigned long long v = strtoull(word, &end, 10);
-	bool ok = *word && isdigit((unsigned char)*word) && !*end && !errno && v >= 1 && v <= n;
+	unsigned long long v = 0;
+	bool ok = num_scan_u64(word, &v) == NUM_OK && v >= 1 && v <= n; /* num.h */
 	if (!ok) {
 		if (n == 0)
 			return shell_fail(sh, "%s: \"%s\" is not %s %s number; the scene has no %ss", what, word,
@@ -423,6 +394,18 @@ bool cmd_help(shell *sh, int argc, char **argv, const char *rest)
 		for (size_t i = 0; i < sizeof details / sizeof details[0]; i++)
 			if (strcmp(details[i].name, c->name) == 0)
 				shell_out(sh, "%s", details[i].text);
+		if (c->run == cmd_add) { /* the elements, from the reader's table */
+			const char *usage;
+			shell_out(sh, "elements (rtsh(5)):\n");
+			for (size_t i = 0; rt_element(i, &usage); i++)
+				shell_out(sh, "  %s\n", usage);
+		}
+		if (c->run == cmd_add || c->run == cmd_object) { /* the keys, from the reader's table */
+			const char *name, *kh;
+			shell_out(sh, "object keys (KEY=VALUE after the fields, or object N set KEY=VALUE):\n");
+			for (size_t i = 0; (name = rt_key_info(i, &kh)); i++)
+				shell_out(sh, "  %-8s %s\n", name, kh);
+		}
 		if (c->aliases)
 			shell_out(sh, "also: %s\n", c->aliases);
 		return true;

@@ -31,8 +31,10 @@ typedef struct command {
 	/* What to complete for the first words after the name: alternatives
 	 * separated by '|'; "@file" (any), "@scene" (what load reads),
 	 * "@output" (what save writes), "@command", "@setting", "@value" (of the
-	 * setting before), "@object", "@light", "@camera" (their numbers) and
-	 * "@ref" (numbers of the kind named by the word before). */
+	 * setting before), "@object", "@light", "@camera" (their numbers),
+	 * "@element" (the .rt elements, rtfile.h), "@key" (after "set": the
+	 * object keys, rtfile.h) and "@ref" (numbers of the
+	 * kind named by the word before). */
 	const char *complete[3];
 	const char *help;      /* one line */
 	cmd_fn run;

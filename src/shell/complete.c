@@ -8,6 +8,7 @@
 
 #include <readline/readline.h>
 
+#include "rtsh/rtfile.h"
 #include "rtsh/settings.h"
 #include "shell/commands.h"
 #include "shell/complete_files.h"
@@ -93,6 +94,18 @@ static void add_alternative(list *l, const shell *sh, const char *alt, size_t le
 			add(l, "whitted", text);
 			add(l, "path", text);
 		}
+	} else if (strcmp(a, "@key") == 0) {
+		const char *name, *kh;
+		char buf[64];
+		if (nwords >= 1 && strcmp(words[nwords - 1], "set") == 0)
+			for (size_t i = 0; (name = rt_key_info(i, &kh)); i++) {
+				snprintf(buf, sizeof buf, "%s=", name);
+				add(l, buf, text);
+			}
+	} else if (strcmp(a, "@element") == 0) {
+		const char *usage;
+		for (size_t i = 0; rt_element(i, &usage); i++)
+			add(l, rt_element(i, &usage), text);
 	} else if (strcmp(a, "@object") == 0) {
 		add_numbers(l, s->nobjs, text);
 	} else if (strcmp(a, "@light") == 0) {

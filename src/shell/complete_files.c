@@ -11,14 +11,11 @@
 #include "rtsh/image.h"
 
 /* What `load` reads; a model format joins here when load reads it. */
-static const char *const scene_exts[] = {".rt", NULL};
+/* what `load` opens: scenes, and models for the model viewer (rtsh(1)) */
+static const char *const scene_exts[] = {".rt", ".obj", ".ply", ".gltf", ".glb", ".stl", NULL};
 
 /* What `save` writes besides the image formats of image.h. */
 static const char *const text_exts[] = {".ans", ".rt", NULL};
-/* Image extensions to ask image_format_of about. */
-static const char *const image_probe[] = {".ppm", ".pfm", ".png", ".jpg", ".jpeg", ".hdr", ".exr",
-                                          ".bmp", ".tga", ".tif", ".webp", NULL};
-
 static bool ends_with(const char *name, const char *ext)
 {
 	size_t n = strlen(name), e = strlen(ext);
@@ -35,15 +32,12 @@ static bool in(const char *const *exts, const char *name)
 
 const char *const *output_extensions(void)
 {
-	static const char *list[sizeof image_probe / sizeof image_probe[0] + 2];
+	/* image.c's table of formats, then the text outputs */
+	static const char *list[32];
 	if (!list[0]) {
 		size_t n = 0;
-		for (size_t i = 0; image_probe[i]; i++) {
-			char probe[16];
-			snprintf(probe, sizeof probe, "x%s", image_probe[i]);
-			if (image_format_of(probe) != IMAGE_UNKNOWN)
-				list[n++] = image_probe[i];
-		}
+		for (size_t i = 0; image_type_at(i) && n < 24; i++)
+			list[n++] = image_type_at(i)->ext;
 		for (size_t i = 0; text_exts[i]; i++)
 			list[n++] = text_exts[i];
 		list[n] = NULL;

@@ -1,4 +1,5 @@
 /* rtsh — the full-screen layout (screen.h). */
+#define _XOPEN_SOURCE 700 /* wcwidth */
 #include "term/screen.h"
 
 #include <errno.h>
@@ -6,6 +7,7 @@
 #include <signal.h>
 #include <stdio.h>
 #include <string.h>
+#include <wchar.h>
 #include <sys/ioctl.h>
 #include <unistd.h>
 
@@ -154,20 +156,41 @@ static void draw_status(screen *s, abuf *a)
 	if (s->status_row < 0)
 		return;
 	abuf_printf(a, "\x1b" "7\x1b[%dH\x1b[7m", s->status_row + 1);
-	/* Count columns as code points (the text is ASCII plus a few symbols). */
-	int width = 0;
-	const char *p = s->status;
-	for (; *p && width < s->cols; p++) {
-		abuf_char(a, *p);
-		if (((unsigned char)*p & 0xc0) != 0x80)
-			width++;
-	}
-	/* Finish a code point cut at the edge. */
-	while (((unsigned char)*p & 0xc0) == 0x80)
-		abuf_char(a, *p++);
-	for (; width < s->cols; width++)
-		abuf_char(a, ' ');
+	screen_fit_text(a, s->status, s->cols);
 	abuf_str(a, "\x1b[m\x1b" "8");
+}
+
+void screen_fit_text(abuf *a, const char *text, int cols)
+{
+	/* Columns by wcwidth (a CJK character or an emoji takes two, a
+	 * combining mark none), in the locale's encoding; a byte that is not a
+	 * character there counts one column. */
+	int width = 0;
+	const char *p = text;
+	size_t left = strlen(text);
+	mbstate_t st;
+	memset(&st, 0, sizeof st);
+	while (left > 0) {
+		wchar_t wc;
+		size_t n = mbrtowc(&wc, p, left, &st);
+		int w = 1;
+		if (n == (size_t)-1 || n == (size_t)-2 || n == 0) {
+			n = 1;
+			memset(&st, 0, sizeof st);
+		} else {
+			w = wcwidth(wc);
+			if (w < 0)
+				w = 1;
+		}
+		if (width + w > cols)
+			break;
+		abuf_add(a, p, n);
+		p += n;
+		left -= n;
+		width += w;
+	}
+	for (; width < cols; width++)
+		abuf_char(a, ' ');
 }
 
 /* Clears the screen, sets the scroll region, draws the status line and puts

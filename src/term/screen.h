@@ -64,6 +64,9 @@ void screen_clear_all(screen *s);
 /* Another palette (the terminal said it has truecolor): lays out and
  * clears the screen again. */
 void screen_set_palette(screen *s, frame_palette pal);
+/* text fitted to exactly cols terminal columns (cut on a character, padded
+ * with spaces), counted by wcwidth in the current locale: the status line. */
+void screen_fit_text(abuf *a, const char *text, int cols);
 /* Sets and draws the status line. */
 void screen_status(screen *s, const char *text);
 /* Puts an sRGB image of img_w x img_h pixels in the picture area

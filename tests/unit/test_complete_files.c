@@ -54,15 +54,15 @@ static void test_by_type(void **state)
 	(void)state;
 	char dir[] = "/tmp/rtsh-complete-XXXXXX";
 	assert_non_null(mkdtemp(dir));
-	const char *names[] = {"a.rt", "b.png", "c.txt", "d.PPM", ".e.rt", "f.ans"};
-	for (size_t i = 0; i < 6; i++)
+	const char *names[] = {"a.rt", "b.png", "c.txt", "d.PPM", ".e.rt", "f.ans", "g.obj"};
+	for (size_t i = 0; i < 7; i++)
 		touch(dir, names[i]);
 	char sub[600], text[600], want[2048];
 	snprintf(sub, sizeof sub, "%s/sub", dir);
 	assert_int_equal(mkdir(sub, 0700), 0);
-	/* load: the folder and the scene file; not the image, text or hidden. */
+	/* load: the folder, the scene and the model; not the image, text or hidden. */
 	snprintf(text, sizeof text, "%s/", dir);
-	snprintf(want, sizeof want, "%s/a.rt %s/sub/", dir, dir);
+	snprintf(want, sizeof want, "%s/a.rt %s/g.obj %s/sub/", dir, dir, dir);
 	check(text, FILES_SCENE, want);
 	/* Hidden files when asked for. */
 	snprintf(text, sizeof text, "%s/.", dir);

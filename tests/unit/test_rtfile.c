@@ -557,7 +557,7 @@ typedef struct err_case {
 static const err_case field_errors[] = {
 	/* unknown elements, case-sensitive */
 	{CAM "xx 1 2\n", 2, 1,
-	 "unknown element \"xx\"; expected one of A C c L l R sp pl cy co cu di rc sq tr mesh sky set"},
+	 "unknown element \"xx\"; expected one of A C c L l R sp pl cy co cu di rc sq tr to mesh sky set"},
 	{CAM "SP 0,0,0 1 255,0,0\n", 2, 1, "unknown element \"SP\""},
 	{CAM "  fuzz=1\n", 2, 3, "unknown element \"fuzz=1\""},
 	/* A */

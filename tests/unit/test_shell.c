@@ -117,7 +117,7 @@ static void test_arguments_and_messages(void **state)
 	assert_string_equal(sh->err, "light color: 300,0,0 is out of range; expected R,G,B with each in 0..255");
 	assert_false(command_run(sh, "object 1 spin 1,2,3"));
 	assert_string_equal(sh->err,
-	                    "object: \"spin\" is not an object command; expected move, rotate, scale or color");
+	                    "object: \"spin\" is not an object command; expected move, rotate, scale, color or set");
 	assert_false(command_run(sh, "delete"));
 	assert_string_equal(sh->err, "delete: too few arguments; usage: delete object N | delete light N | "
 	                             "delete camera N");
@@ -126,8 +126,10 @@ static void test_arguments_and_messages(void **state)
 	assert_false(command_run(sh, "undo"));
 	assert_string_equal(sh->err, "undo: nothing to undo");
 	assert_false(command_run(sh, "set samples lots"));
-	assert_false(command_run(sh, "camera fov 180"));
-	assert_string_equal(sh->err, "camera fov: \"180\" is not a field of view; expected degrees between 0 and 180");
+	/* fov 180 is clamped as in files (issue 14: one rule); 181 is refused */
+	assert_false(command_run(sh, "camera fov 181"));
+	assert_string_equal(sh->err, "camera fov: camera field of view 181 is out of range; expected degrees "
+	                             "in [0,180] (the ends are clamped to 0.01 and 179.99)");
 	/* Good commands change the scene and undo brings it back. */
 	scene *before = scene_clone(editor_scene(sh->ed));
 	assert_true(command_run(sh, "obj 1 mo 1,0,0"));
@@ -171,7 +173,12 @@ static void test_completion(void **state)
 	assert_candidates(complete_at_end(sh, "set sa", &files), "samples");
 	assert_candidates(complete_at_end(sh, "set mode ", &files), "whitted path");
 	assert_candidates(complete_at_end(sh, "set m", &files), "mode");
-	assert_candidates(complete_at_end(sh, "object 1 ", &files), "move rotate scale color");
+	assert_candidates(complete_at_end(sh, "object 1 ", &files), "move rotate scale color set");
+	/* the keys after set come from the reader's table (rtfile.h) */
+	assert_candidates(complete_at_end(sh, "object 1 set ", &files),
+	                  "twist= fuzz= metal= ior= emit= checker= tube= texture= normalmap= bump= bumpscale= "
+	                  "uvscale= uvoffset= smooth= crease=");
+	assert_candidates(complete_at_end(sh, "object 1 move ", &files), "");
 	assert_candidates(complete_at_end(sh, "obj 2 r", &files), "rotate");
 	assert_candidates(complete_at_end(sh, "light ", &files), "1 2 3");
 	assert_candidates(complete_at_end(sh, "delete li", &files), "light");

@@ -24,8 +24,9 @@ static void side(vec3 o, vec3 d, double tt, double tmin, double *best, vec3 *n)
 	keep(tt, g, tmin, best, n);
 }
 
-bool cone_intersect(vec3 o, vec3 d, double tmin, double tmax, double *t, vec3 *n)
+static bool cone_intersect(vec3 o, vec3 d, double tube, double tmin, double tmax, double *t, vec3 *n)
 {
+	(void)tube;
 	const double k2 = 0.25;
 	double best = tmax;
 	double oy = o.y - 1.0;
@@ -54,9 +55,32 @@ bool cone_intersect(vec3 o, vec3 d, double tmin, double tmax, double *t, vec3 *n
 	return true;
 }
 
-bool cone_occluded(vec3 o, vec3 d, double tmin, double tmax)
+static bool cone_occluded(vec3 o, vec3 d, double tube, double tmin, double tmax)
 {
+	(void)tube;
 	double t;
 	vec3 n;
-	return cone_intersect(o, d, tmin, tmax, &t, &n);
+	return cone_intersect(o, d, tube, tmin, tmax, &t, &n);
 }
+
+/* Around the side, v up the axis; the base as a flat shape. */
+static void cone_uv(vec3 p, double tube, double *u, double *v, vec3 *tangent)
+{
+	if (p.y <= -1.0 + 1e-9) {
+		uv_flat(p, tube, u, v, tangent);
+		return;
+	}
+	*u = around_y(p, tangent);
+	*v = clampd(0.5 * (p.y + 1.0), 0.0, 1.0);
+}
+
+const shape_kind cone_kind = {
+	.form = {"co", "cone", false, true, false, 4, "CENTER AXIS DIAMETER HEIGHT",
+	         {"center", "axis", "diameter", "height"}, "pdss", read_tube, write_tube},
+	.intersect = cone_intersect,
+	.occluded = cone_occluded,
+	.bounds = unit_cube_bounds,
+	.uv = cone_uv,
+	.cost = 8,
+	.recipe = {true, {40, 60, 0}, {100, 140, 0}, 0, 0},
+};

@@ -41,8 +41,9 @@ static vec3 face_normal(int axis, double coord)
 	return axis == 0 ? v3(s, 0, 0) : axis == 1 ? v3(0, s, 0) : v3(0, 0, s);
 }
 
-bool cube_intersect(vec3 o, vec3 d, double tmin, double tmax, double *t, vec3 *n)
+static bool cube_intersect(vec3 o, vec3 d, double tube, double tmin, double tmax, double *t, vec3 *n)
 {
+	(void)tube;
 	double t0, t1;
 	int a0 = 0, a1 = 0;
 	if (!slabs(o, d, &t0, &t1, &a0, &a1))
@@ -63,11 +64,43 @@ bool cube_intersect(vec3 o, vec3 d, double tmin, double tmax, double *t, vec3 *n
 	return true;
 }
 
-bool cube_occluded(vec3 o, vec3 d, double tmin, double tmax)
+static bool cube_occluded(vec3 o, vec3 d, double tube, double tmin, double tmax)
 {
+	(void)tube;
 	double t0, t1;
 	int a0 = 0, a1 = 0;
 	if (!slabs(o, d, &t0, &t1, &a0, &a1))
 		return false;
 	return (t0 > tmin && t0 < tmax) || (t1 > tmin && t1 < tmax);
 }
+
+/* Each face [0,1]^2 in its two other coordinates, the tangent along the
+ * first of them. */
+static void cube_uv(vec3 p, double tube, double *u, double *v, vec3 *tangent)
+{
+	(void)tube;
+	double ax = fabs(p.x), ay = fabs(p.y), az = fabs(p.z);
+	if (ax >= ay && ax >= az) {
+		*u = 0.5 * (p.z + 1.0);
+		*v = 0.5 * (p.y + 1.0);
+		*tangent = v3(0, 0, 1);
+	} else if (ay >= az) {
+		*u = 0.5 * (p.x + 1.0);
+		*v = 0.5 * (p.z + 1.0);
+		*tangent = v3(1, 0, 0);
+	} else {
+		*u = 0.5 * (p.x + 1.0);
+		*v = 0.5 * (p.y + 1.0);
+		*tangent = v3(1, 0, 0);
+	}
+}
+
+const shape_kind cube_kind = {
+	.form = {"cu", "cube", false, true, false, 0, NULL, {NULL}, "", NULL, NULL},
+	.intersect = cube_intersect,
+	.occluded = cube_occluded,
+	.bounds = unit_cube_bounds,
+	.uv = cube_uv,
+	.cost = 8,
+	.recipe = {true, {50, 50, 50}, {100, 100, 100}, 0, 0},
+};

@@ -16,30 +16,68 @@ static bool flat_hit(vec3 o, vec3 d, double tmin, double tmax, bool round, doubl
 	return true;
 }
 
-bool disc_intersect(vec3 o, vec3 d, double tmin, double tmax, double *t, vec3 *n)
+static bool disc_intersect(vec3 o, vec3 d, double tube, double tmin, double tmax, double *t, vec3 *n)
 {
+	(void)tube;
 	if (!flat_hit(o, d, tmin, tmax, true, t))
 		return false;
 	*n = v3(0, 1, 0);
 	return true;
 }
 
-bool disc_occluded(vec3 o, vec3 d, double tmin, double tmax)
+static bool disc_occluded(vec3 o, vec3 d, double tube, double tmin, double tmax)
 {
+	(void)tube;
 	double t;
 	return flat_hit(o, d, tmin, tmax, true, &t);
 }
 
-bool rect_intersect(vec3 o, vec3 d, double tmin, double tmax, double *t, vec3 *n)
+static bool rect_intersect(vec3 o, vec3 d, double tube, double tmin, double tmax, double *t, vec3 *n)
 {
+	(void)tube;
 	if (!flat_hit(o, d, tmin, tmax, false, t))
 		return false;
 	*n = v3(0, 1, 0);
 	return true;
 }
 
-bool rect_occluded(vec3 o, vec3 d, double tmin, double tmax)
+static bool rect_occluded(vec3 o, vec3 d, double tube, double tmin, double tmax)
 {
+	(void)tube;
 	double t;
 	return flat_hit(o, d, tmin, tmax, false, &t);
 }
+
+/* sq CENTER NORMAL SIDE: scale (side, 1, side). */
+static void square_read(object *o, const double *sizes)
+{
+	o->scale = v3(sizes[0], 1, sizes[0]);
+}
+
+static bool square_write(const object *o, double *sizes)
+{
+	sizes[0] = o->scale.x;
+	return o->scale.x == o->scale.z && o->scale.y == 1;
+}
+
+const shape_kind disc_kind = {
+	.form = {"di", "disc", false, true, false, 0, NULL, {NULL}, "", NULL, NULL},
+	.intersect = disc_intersect,
+	.occluded = disc_occluded,
+	.bounds = unit_flat_bounds,
+	.uv = uv_flat,
+	.cost = 8,
+	.recipe = {true, {50, -1, 0}, {100, 0, 0}, 0, 0},
+};
+
+const shape_kind rect_kind = {
+	.form = {"rc", "rectangle", false, true, false, 0, NULL, {NULL}, "", NULL, NULL},
+	.alias = {"sq", "square", false, false, false, 3, "CENTER NORMAL SIDE", {"center", "normal", "side"},
+	          "pds", square_read, square_write},
+	.intersect = rect_intersect,
+	.occluded = rect_occluded,
+	.bounds = unit_flat_bounds,
+	.uv = uv_flat,
+	.cost = 8,
+	.recipe = {true, {50, -1, 50}, {120, 0, 120}, 0, 0},
+};

@@ -1,8 +1,9 @@
 /* rtsh — the plane y = 0 with normal +Y, unbounded. */
 #include "shapes.h"
 
-bool plane_intersect(vec3 o, vec3 d, double tmin, double tmax, double *t, vec3 *n)
+static bool plane_intersect(vec3 o, vec3 d, double tube, double tmin, double tmax, double *t, vec3 *n)
 {
+	(void)tube;
 	if (d.y == 0.0)
 		return false;
 	double tt = -o.y / d.y;
@@ -13,10 +14,48 @@ bool plane_intersect(vec3 o, vec3 d, double tmin, double tmax, double *t, vec3 *
 	return true;
 }
 
-bool plane_occluded(vec3 o, vec3 d, double tmin, double tmax)
+static bool plane_occluded(vec3 o, vec3 d, double tube, double tmin, double tmax)
 {
+	(void)tube;
 	if (d.y == 0.0)
 		return false;
 	double tt = -o.y / d.y;
 	return tt > tmin && tt < tmax;
 }
+
+static box plane_bounds(double tube)
+{
+	(void)tube;
+	return (box){v3_splat(-INFINITY), v3_splat(INFINITY)};
+}
+
+/* Unit squares of the plane's own (world-size) units. */
+static void plane_uv(vec3 p, double tube, double *u, double *v, vec3 *tangent)
+{
+	(void)tube;
+	*u = p.x - floor(p.x);
+	*v = p.z - floor(p.z);
+	*tangent = v3(1, 0, 0);
+}
+
+static void plane_read(object *o, const double *sizes)
+{
+	(void)sizes;
+	o->scale = v3_splat(1);
+}
+
+static bool plane_write(const object *o, double *sizes)
+{
+	(void)sizes;
+	return v3_eq(o->scale, v3_splat(1));
+}
+
+const shape_kind plane_kind = {
+	.form = {"pl", "plane", true, true, false, 2, "POINT NORMAL", {"point", "normal"}, "pd", plane_read,
+	         plane_write},
+	.intersect = plane_intersect,
+	.occluded = plane_occluded,
+	.bounds = plane_bounds,
+	.uv = plane_uv,
+	.cost = 8,
+};

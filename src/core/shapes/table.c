@@ -1,56 +1,59 @@
 /* rtsh — the shape table, solver and bounds (shape.h). */
 #include "shapes.h"
 
-#include "rtsh/world.h"
+#include <string.h>
 
-const shape_ops shape_table[OBJ_KIND_COUNT] = {
-	[OBJ_SPHERE] = {sphere_intersect, sphere_occluded, true},
-	[OBJ_PLANE] = {plane_intersect, plane_occluded, false},
-	[OBJ_CYLINDER] = {cylinder_intersect, cylinder_occluded, true},
-	[OBJ_CONE] = {cone_intersect, cone_occluded, true},
-	[OBJ_CUBE] = {cube_intersect, cube_occluded, true},
-	[OBJ_DISC] = {disc_intersect, disc_occluded, true},
-	[OBJ_RECT] = {rect_intersect, rect_occluded, true},
-	[OBJ_TRIANGLE] = {NULL, NULL, true},
+const shape_kind *const shape_kinds[OBJ_KIND_COUNT] = {
+#define RT_KIND(e, id, name, desc, flags) [OBJ_##e] = &desc,
+#include "rtsh/kinds.def"
+#undef RT_KIND
 };
 
-bool solve_quadratic_half(double a, double b, double c, double *t0, double *t1)
+const shape_kind *shape_kind_of(obj_kind k)
 {
-	double disc = b * b - a * c;
-	if (disc < 0.0 || a == 0.0)
-		return false;
-	/* q = -(b + sign(b) sqrt(disc)) avoids cancellation (Numerical Recipes 5.6). */
-	double q = -(b + copysign(sqrt(disc), b));
-	double r0 = q / a;
-	double r1 = q != 0.0 ? c / q : r0;
-	*t0 = fmin(r0, r1);
-	*t1 = fmax(r0, r1);
-	return true;
+	return (unsigned)k < OBJ_KIND_COUNT ? shape_kinds[k] : NULL;
 }
 
-box shape_local_bounds(obj_kind k)
+const shape_kind *shape_kind_find(const char *id, obj_kind *k, const shape_form **form)
 {
-	switch (k) {
-	case OBJ_PLANE:
-		return (box){v3_splat(-INFINITY), v3_splat(INFINITY)};
-	case OBJ_DISC:
-	case OBJ_RECT:
-		return (box){v3(-1, 0, -1), v3(1, 0, 1)};
-	default:
-		return (box){v3(-1, -1, -1), v3(1, 1, 1)};
+	for (int i = 0; i < OBJ_KIND_COUNT; i++) {
+		const shape_kind *d = shape_kinds[i];
+		const shape_form *f = strcmp(d->form.id, id) == 0                    ? &d->form
+		                      : d->alias.id && strcmp(d->alias.id, id) == 0 ? &d->alias
+		                                                                    : NULL;
+		if (f) {
+			*k = (obj_kind)i;
+			*form = f;
+			return d;
+		}
 	}
+	return NULL;
+}
+
+/* The triangle is defined by its world-space vertices (tri_intersect). */
+const shape_kind triangle_kind = {
+	.form = {"tr", "triangle", false, false, true, 3, "P1 P2 P3",
+	         {"first point", "second point", "third point"}, "ppp", NULL, NULL},
+	.bounds = unit_cube_bounds,
+	.recipe = {.use = true}, /* generate.c places the vertices */
+};
+
+box shape_local_bounds(obj_kind k, double tube)
+{
+	return shape_kinds[k]->bounds(tube);
 }
 
 box object_bounds(const object *o)
 {
-	if (o->kind == OBJ_TRIANGLE)
+	unsigned f = obj_kind_flags(o->kind);
+	if (f & KIND_VERTICES)
 		return box_add(box_add(box_point(o->tri[0]), o->tri[1]), o->tri[2]);
-	if (o->kind == OBJ_PLANE)
-		return shape_local_bounds(OBJ_PLANE);
+	if (f & KIND_UNBOUNDED)
+		return shape_local_bounds(o->kind, o->tube);
 	xform x;
 	if (!object_xform(o, &x))
 		return box_empty();
-	return xf_box(&x, shape_local_bounds(o->kind));
+	return xf_box(&x, shape_local_bounds(o->kind, o->tube));
 }
 
 bool tri_intersect(vec3 v0, vec3 e1, vec3 e2, vec3 o, vec3 d, double tmin, double tmax, double *t)

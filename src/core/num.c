@@ -1,0 +1,125 @@
+/* rtsh — the one strict number scanner (num.h). */
+#include "rtsh/num.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <locale.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+
+static bool is_digit(char c) { return c >= '0' && c <= '9'; }
+
+/* The end of the decimal number that starts at s, or NULL if none does. */
+static const char *scan_decimal(const char *s, const char *end)
+{
+	const char *q = s;
+	if (q < end && (*q == '+' || *q == '-'))
+		q++;
+	size_t ndig = 0;
+	while (q < end && is_digit(*q)) {
+		q++;
+		ndig++;
+	}
+	if (q < end && *q == '.') {
+		q++;
+		while (q < end && is_digit(*q)) {
+			q++;
+			ndig++;
+		}
+	}
+	if (ndig == 0)
+		return NULL;
+	if (q < end && (*q == 'e' || *q == 'E')) {
+		q++;
+		if (q < end && (*q == '+' || *q == '-'))
+			q++;
+		const char *e0 = q;
+		while (q < end && is_digit(*q))
+			q++;
+		if (q == e0)
+			return NULL;
+	}
+	return q;
+}
+
+static locale_t c_locale;
+static pthread_once_t c_once = PTHREAD_ONCE_INIT;
+
+static void c_locale_init(void)
+{
+	c_locale = newlocale(LC_NUMERIC_MASK, "C", (locale_t)0);
+}
+
+num_status num_scan(const char *s, size_t len, double max, double *out)
+{
+	if (len == 0)
+		return NUM_EMPTY;
+	if (scan_decimal(s, s + len) != s + len)
+		return NUM_BAD;
+	/* The syntax is checked: strtod reads exactly these bytes (in the "C"
+	 * locale). Short ones from a copy ("0" before an 'x' would start a hex
+	 * number); long ones in place, where the text after them (',', 'x',
+	 * NUL: see num.h) ends the number, which the end pointer confirms. */
+	char small[64];
+	const char *from = s;
+	if (len < sizeof small) {
+		memcpy(small, s, len);
+		small[len] = '\0';
+		from = small;
+	}
+	pthread_once(&c_once, c_locale_init);
+	locale_t old = c_locale ? uselocale(c_locale) : (locale_t)0;
+	char *end;
+	double v = strtod(from, &end);
+	if (c_locale)
+		uselocale(old);
+	if (end != from + len)
+		return NUM_BAD;
+	if (!(fabs(v) <= max))
+		return NUM_BIG;
+	*out = v;
+	return NUM_OK;
+}
+
+num_status num_scan_str(const char *s, double max, double *out)
+{
+	return num_scan(s, strlen(s), max, out);
+}
+
+num_status num_scan_long(const char *s, long min, long max, long *out)
+{
+	const char *q = s;
+	if (!*q)
+		return NUM_EMPTY;
+	if (*q == '+' || *q == '-')
+		q++;
+	if (!is_digit(*q))
+		return NUM_BAD;
+	while (is_digit(*q))
+		q++;
+	if (*q)
+		return NUM_BAD;
+	errno = 0;
+	long v = strtol(s, NULL, 10);
+	if (errno == ERANGE || v < min || v > max)
+		return NUM_BIG;
+	*out = v;
+	return NUM_OK;
+}
+
+num_status num_scan_u64(const char *s, unsigned long long *out)
+{
+	if (!*s)
+		return NUM_EMPTY;
+	for (const char *q = s; *q; q++)
+		if (!is_digit(*q))
+			return NUM_BAD;
+	errno = 0;
+	unsigned long long v = strtoull(s, NULL, 10);
+	if (errno == ERANGE)
+		return NUM_BIG;
+	*out = v;
+	return NUM_OK;
+}

@@ -1,0 +1,88 @@
+/* rtsh — the one table of the objects' key=value fields (rtfile_priv.h),
+ * which the reader, the writer, the editor's rules, `help` and completion
+ * read. A new material key is a line of rt_keys (and its field in
+ * scene.h's material, and a paragraph in rtsh(5)). */
+#include <math.h>
+#include <stddef.h>
+
+#include "rtsh/rtfile.h"
+#include "scene/rtfile_priv.h"
+
+static bool ior_rule(double v) { return v == 0.0 || v >= 1.0; }
+static bool positive(double v) { return v > 0.0; }
+
+/* name, field, int, on triangles, kinds, in the short form, min, max, default, rule,
+ * expected, help */
+const rt_key rt_keys[] = {
+	{"twist", offsetof(object, twist), false, false, 0, false, -RT_NUM_MAX, RT_NUM_MAX, 0, NULL,
+	 "twist in degrees", "turn about the object's own axis, degrees", RT_KEY_NUM, false},
+	{"fuzz", offsetof(object, mat.fuzz), false, true, 0, false, 0, 1, 0, NULL, "fuzz in [0,1]",
+	 "roughness of the mirror lobe (0 sharp, 1 broad)", RT_KEY_NUM, false},
+	{"metal", offsetof(object, mat.metal), false, true, 0, false, 0, 1, 0, NULL, "metal in [0,1]",
+	 "how much reflections take the object's colour", RT_KEY_NUM, false},
+	{"ior", offsetof(object, mat.ior), false, true, 0, false, 0, 10, 0, ior_rule,
+	 "ior 0 (opaque) or a refractive index in [1,10]", "glass: refractive index (0 opaque)", RT_KEY_NUM,
+	 false},
+	{"emit", offsetof(object, mat.emission), false, true, 0, false, 0, 1e6, 0, NULL,
+	 "emit in [0,1e6]", "emitted radiance, times the colour (path mode)", RT_KEY_NUM, false},
+	{"checker", offsetof(object, mat.checker), true, true, 0, false, 0, 1000, 0, NULL,
+	 "checker a whole number in [0,1000]", "checker texture: squares per unit (0 none)", RT_KEY_NUM,
+	 false},
+	{"tube", offsetof(object, tube), false, false, KIND_TUBE, true, 0, 100, 0.5, positive,
+	 "tube a ratio in (0,100]", "torus: tube diameter / ring diameter", RT_KEY_NUM, false},
+	{"texture", offsetof(object, mat.texture), false, true, 0, false, 0, 0, 0, NULL,
+	 "texture=FILE, a PNG, JPEG, BMP, TGA, HDR, PPM, PFM or XPM image", "colour texture image file",
+	 RT_KEY_FILE, false},
+	{"normalmap", offsetof(object, mat.normalmap), false, true, 0, false, 0, 0, 0, NULL,
+	 "normalmap=FILE, a tangent-space normal map image", "tangent-space normal map image file",
+	 RT_KEY_FILE, false},
+	{"bump", offsetof(object, mat.bump), false, true, 0, false, 0, 0, 0, NULL,
+	 "bump=FILE, a height map image", "height map image file", RT_KEY_FILE, false},
+	{"bumpscale", offsetof(object, mat.bumpscale), false, true, 0, false, -1e6, 1e6, 1, NULL,
+	 "bumpscale in [-1e6,1e6]", "height of the bump map", RT_KEY_NUM, false},
+	{"uvscale", offsetof(object, mat.uvscale), false, true, 0, false, -1e6, 1e6, 1, NULL,
+	 "uvscale=U,V, two numbers in [-1e6,1e6], not 0", "texture repeats along U,V", RT_KEY_PAIR, false},
+	{"uvoffset", offsetof(object, mat.uvoffset), false, true, 0, false, -1e6, 1e6, 0, NULL,
+	 "uvoffset=U,V, two numbers in [-1e6,1e6]", "texture shift along U,V", RT_KEY_PAIR, false},
+	{"smooth", offsetof(object, smooth), true, false, 0, false, 0, 1, 1, NULL,
+	 "smooth 0 (flat faces) or 1 (smooth normals)", "mesh: smooth normals (1) or flat faces (0)",
+	 RT_KEY_NUM, true},
+	{"crease", offsetof(object, crease), false, false, 0, false, 0, 180, 60, NULL,
+	 "crease in degrees, [0,180]", "mesh: edges sharper than this stay sharp, degrees", RT_KEY_NUM, true},
+};
+const size_t rt_nkeys = sizeof rt_keys / sizeof rt_keys[0];
+
+const char *rt_key_info(size_t i, const char **help)
+{
+	if (i >= rt_nkeys)
+		return NULL;
+	*help = rt_keys[i].help;
+	return rt_keys[i].name;
+}
+
+bool rt_key_applies(const rt_key *k, obj_kind kind)
+{
+	unsigned f = obj_kind_flags(kind);
+	if (k->mesh_only && kind != OBJ_MESH)
+		return false;
+	if ((f & KIND_VERTICES) && !k->triangles)
+		return false;
+	return !k->needs || (f & k->needs);
+}
+
+double rt_key_get(const rt_key *k, const object *o)
+{
+	const char *base = (const char *)o + k->offset;
+	if (k->is_int)
+		return *(const int *)(const void *)base;
+	return *(const double *)(const void *)base;
+}
+
+void rt_key_set(const rt_key *k, object *o, double v)
+{
+	char *base = (char *)o + k->offset;
+	if (k->is_int)
+		*(int *)(void *)base = (int)v;
+	else
+		*(double *)(void *)base = v;
+}
