@@ -33,7 +33,7 @@ full_frame_s() { awk -v r="$1" 'BEGIN { print 200 * 60 * 40 / r + 2 }'; }
 
 line=$(run 30000 0.1 refine); echo "$line" >"$results/link.txt"
 b=$(full_frame_s 30000)
-check "30 KB/s: every key echoes" 'v["keys"] >= 4 && v["echoed"] == v["keys"]'
+check "30 KB/s: every key echoes" 'v["keys"] >= 1 && v["echoed"] == v["keys"]'
 check "30 KB/s: echo p95 <= 1.5 s" 'v["echo_p95"] >= 0 && v["echo_p95"] <= 1.5'
 check "30 KB/s: idle <= $b s after the render" "v[\"render_end\"] > 0 && v[\"idle_after_end\"] <= $b"
 check "30 KB/s: truecolor from the terminal's answer" 'v["sgr24"] > 0'

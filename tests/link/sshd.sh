@@ -60,7 +60,7 @@ check() {
 	fi
 }
 b=$(awk 'BEGIN { print 200 * 60 * 40 / 30000 + 2 }')
-check "30 KB/s over sshd: every key echoes" 'v["keys"] >= 4 && v["echoed"] == v["keys"]'
+check "30 KB/s over sshd: every key echoes" 'v["keys"] >= 1 && v["echoed"] == v["keys"]'
 check "30 KB/s over sshd: echo p95 <= 1.5 s" 'v["echo_p95"] >= 0 && v["echo_p95"] <= 1.5'
 check "30 KB/s over sshd: idle <= $b s after the render" "v[\"render_end\"] > 0 && v[\"idle_after_end\"] <= $b"
 check "30 KB/s over sshd: truecolor from the terminal's answer" 'v["sgr24"] > 0'
