@@ -4,9 +4,12 @@
 #   make run        build and open the shell on the built-in showcase scene
 #   make test       build and run every test, then again under ASan+UBSan, and
 #                   the threaded tests under TSan
-#   make bench      build and run the benchmark (writes build/bench.tsv), then
+#   make bench      build and run the benchmark (writes build/bench.tsv), the
+#                   rtsh-mpi rows (build/bench-mpi.tsv, when mpirun exists), then
 #                   bench-quality: rtsh against Cycles at equal noise (skipped
 #                   without blender) and the preview's time to an error
+#   make mpi        build ./rtsh-mpi, the Open MPI renderer (`make` builds it
+#                   too when mpicc is installed)
 #   make fuzz       build the libFuzzer targets (clang) and run each for
 #                   FUZZ_SECONDS (default 60) on tests/fuzz/corpus
 #   make install    PREFIX=/usr/local DESTDIR=  (binary, man pages, scenes)
@@ -63,10 +66,28 @@ else
 BIN := $(BUILD)/rtsh
 endif
 
-.PHONY: all run test test-bins test-unit test-scripts bench bench-quick bench-quality install uninstall \
-        clean deps check-man fuzz fuzz-bins fuzz-link
+# rtsh-mpi: only its own objects are compiled with mpicc; rtsh never links MPI.
+MPICC    ?= mpicc
+MPI_SRC  := $(sort $(wildcard src/mpi/*.c))
+MPI_OBJ  := $(MPI_SRC:%.c=$(BUILD)/%.o)
+MPI_BIN  := $(patsubst %rtsh,%rtsh-mpi,$(BIN))
+HAVE_MPI := $(shell command -v $(MPICC) 2>/dev/null)
 
-all: deps $(BIN)
+.PHONY: all run test test-bins test-unit test-scripts bench bench-quick bench-quality install uninstall \
+        clean deps check-man fuzz fuzz-bins fuzz-link mpi
+
+all: deps $(BIN) $(if $(HAVE_MPI),$(MPI_BIN))
+
+mpi: deps $(MPI_BIN)
+
+$(MPI_BIN): $(MPI_OBJ) $(FRONTLIB) $(LIB)
+	@echo "  LD      $@"
+	@$(MPICC) $(LDFLAGS) -o $@ $^ $(LDLIBS_CORE)
+
+$(BUILD)/src/mpi/%.o: src/mpi/%.c
+	@mkdir -p $(@D)
+	@echo "  MPICC   $<"
+	@$(MPICC) $(CPPFLAGS) $(CFLAGS) -c -o $@ $<
 
 deps:
 	@sh tests/deps.sh
@@ -139,6 +160,7 @@ bench: all $(BENCH_BIN)
 		$(MAKE) --no-print-directory $(EMBREE_BIN) $(EMBREE_MESH_BIN); \
 	else echo "bench: no embree3/rtcore.h, so no Embree row (apt-get install libembree-dev)"; fi
 	./$(BENCH_BIN) --out $(BUILD)/bench.tsv
+	@sh bench/mpi.sh --out $(BUILD)/bench-mpi.tsv
 	$(MAKE) --no-print-directory bench-quality
 
 # rtsh against Cycles (skipped with a message without `blender`) and the
@@ -153,6 +175,7 @@ $(QUALITY_BIN): bench/quality.c $(LIB)
 
 bench-quick: all $(BENCH_BIN)
 	./$(BENCH_BIN) --quick --out $(BUILD)/bench-quick.tsv
+	@sh bench/mpi.sh --quick --out $(BUILD)/bench-mpi-quick.tsv
 
 # libFuzzer targets (tests/fuzz/fuzz_NAME.c), built with clang under
 # ASan+UBSan in build/fuzz; `make fuzz` runs each for FUZZ_SECONDS.
@@ -176,7 +199,7 @@ fuzz: deps fuzz-bins
 	@sh tests/fuzz/run.sh build/fuzz $(FUZZ_SECONDS)
 
 check-man:
-	@for m in man/rtsh.1 man/rtsh.5; do \
+	@for m in man/rtsh.1 man/rtsh.5 man/rtsh-mpi.1; do \
 		out=$$(LC_ALL=C.UTF-8 MANWIDTH=80 groff -man -ww -z $$m 2>&1); \
 		if [ -n "$$out" ]; then echo "$$m: $$out"; exit 1; fi; \
 		if command -v mandoc >/dev/null 2>&1; then out=$$(mandoc -Tlint -W style $$m 2>&1); if [ -n "$$out" ]; then echo "$$out"; exit 1; fi; fi; \
@@ -186,16 +209,19 @@ install: all
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/man/man1 \
 		$(DESTDIR)$(PREFIX)/share/man/man5 $(DESTDIR)$(PREFIX)/share/rtsh/scenes
 	install -m 755 $(BIN) $(DESTDIR)$(PREFIX)/bin/rtsh
+	if [ -x $(MPI_BIN) ]; then install -m 755 $(MPI_BIN) $(DESTDIR)$(PREFIX)/bin/rtsh-mpi; \
+		install -m 644 man/rtsh-mpi.1 $(DESTDIR)$(PREFIX)/share/man/man1/rtsh-mpi.1; fi
 	install -m 644 man/rtsh.1 $(DESTDIR)$(PREFIX)/share/man/man1/rtsh.1
 	install -m 644 man/rtsh.5 $(DESTDIR)$(PREFIX)/share/man/man5/rtsh.5
 	install -m 644 scenes/*.rt $(DESTDIR)$(PREFIX)/share/rtsh/scenes/
 
 uninstall:
 	rm -f $(DESTDIR)$(PREFIX)/bin/rtsh $(DESTDIR)$(PREFIX)/share/man/man1/rtsh.1 \
+		$(DESTDIR)$(PREFIX)/bin/rtsh-mpi $(DESTDIR)$(PREFIX)/share/man/man1/rtsh-mpi.1 \
 		$(DESTDIR)$(PREFIX)/share/man/man5/rtsh.5
 	rm -rf $(DESTDIR)$(PREFIX)/share/rtsh
 
 clean:
-	rm -rf build rtsh
+	rm -rf build rtsh rtsh-mpi
 
--include $(CORE_OBJ:.o=.d) $(FRONT_OBJ:.o=.d) $(MAIN_OBJ:.o=.d)
+-include $(CORE_OBJ:.o=.d) $(FRONT_OBJ:.o=.d) $(MAIN_OBJ:.o=.d) $(MPI_OBJ:.o=.d)

@@ -73,7 +73,7 @@ static int batch_render(const rtsh_options *o)
 	if (!o->scene)
 		return usage_error("-o needs a scene file%s", "");
 	rt_warnings warn = {print_warning, NULL};
-	rt_load_opts lo = {o->strict, o->quiet ? NULL : &warn};
+	rt_load_opts lo = {.strict = o->strict, .warn = o->quiet ? NULL : &warn};
 	scene *s = rt_load_file(o->scene, &lo, &err);
 	if (!s) {
 		rt_error_format(&err, msg, sizeof msg);

@@ -20,6 +20,18 @@ command -v ${CC:-cc} >/dev/null 2>&1 || missing="$missing build-essential"
 if [ -z "$missing" ] && [ ! -x /usr/sbin/sshd ] && [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
 	DEBIAN_FRONTEND=noninteractive apt-get install -y openssh-server >/dev/null 2>&1 || true
 fi
+# Optional: Open MPI for rtsh-mpi (`make mpi`); rtsh builds without it.
+optional=""
+command -v mpicc >/dev/null 2>&1 && command -v mpirun >/dev/null 2>&1 ||
+	optional="openmpi-bin libopenmpi-dev"
+if [ -n "$optional" ]; then
+	if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1 &&
+		DEBIAN_FRONTEND=noninteractive apt-get install -y $optional >/dev/null 2>&1; then
+		echo "rtsh: installed $optional (for rtsh-mpi)" >&2
+	else
+		echo "rtsh: no Open MPI, so no rtsh-mpi; to build it: apt-get install $optional" >&2
+	fi
+fi
 [ -z "$missing" ] && exit 0
 cmd="apt-get install -y$missing"
 if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then

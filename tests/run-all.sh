@@ -1,6 +1,7 @@
 #!/bin/sh
 # The whole test suite, as `make test` runs it: the unit tests and the
-# command-file tests on the plain build, the end-to-end tmux test, then the
+# command-file tests on the plain build, the end-to-end tmux test, the
+# rtsh-mpi tests (skipped without mpirun), then the
 # unit and command-file tests again under AddressSanitizer +
 # UndefinedBehaviorSanitizer, and the threaded tests under ThreadSanitizer.
 # Goes on after a failure; the last line is "N passed, N failed".
@@ -21,6 +22,7 @@ step "command-file tests" sh tests/run-scripts.sh ./rtsh
 step "end-to-end (tmux)" sh tests/e2e/run.sh ./rtsh
 step "link simulator" sh tests/link/run.sh ./rtsh build/tests/linksim
 step "over sshd" sh tests/link/sshd.sh ./rtsh build/tests/linksim
+step "rtsh-mpi (Open MPI)" sh tests/mpi/run.sh ./rtsh ./rtsh-mpi
 step "build (ASan+UBSan)" $MAKE --no-print-directory -s BUILD=build/asan SAN=address,undefined OPT=-O1 build/asan/rtsh test-bins
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	step "unit tests (ASan+UBSan)" sh tests/run-unit.sh build/asan build/asan/tests/test_*

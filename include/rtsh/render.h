@@ -101,6 +101,13 @@ render_status render_run(render_job *job, rt_error *err);
 framebuffer *render_image(const world *w, const render_settings *s, atomic_bool *cancel,
                           render_progress_fn progress, void *ctx, rt_error *err);
 
+/* Renders the pixels x0 <= x < x1, y0 <= y < y1 of the s->width x s->height
+ * image, all s->samples samples, on the calling thread, into out: (x1-x0) x
+ * (y1-y0) pixels, rows top to bottom, 3 floats each, bit for bit the values
+ * render_image gives those pixels (rtsh-mpi renders its tiles with it). */
+void render_rect(const world *w, const render_settings *s, int x0, int y0, int x1, int y1,
+                 float *out);
+
 /* The radiance along one camera sample: the integrators (whitted.c, path.c).
  * px, py: pixel; sample: index; the random stream depends only on these and
  * the seed. */

@@ -19,10 +19,23 @@
 #include "rtsh/error.h"
 #include "rtsh/scene.h"
 
+/* Reads a whole file into a new NUL-terminated buffer of *len bytes (plus
+ * the NUL); NULL with err set ("PATH: cannot open: ..."). */
+typedef char *(*rt_read_fn)(void *ctx, const char *path, size_t *len, rt_error *err);
+
 typedef struct rt_load_opts {
 	bool strict;               /* the 42 subject's rules (rtsh --strict) */
 	const rt_warnings *warn;   /* optional sink for warnings */
+	/* Optional: how the scene file and every file it references are read;
+	 * NULL reads them from disk. rtsh-mpi records them on rank 0 and serves
+	 * them from memory on the other ranks. */
+	rt_read_fn read;
+	void *read_ctx;
 } rt_load_opts;
+
+/* Reads a file the way the loader does: through opts->read when set, else
+ * from disk (at most 1 GiB). opts may be NULL. */
+char *rt_read_file(const char *path, const rt_load_opts *opts, size_t *len, rt_error *err);
 
 /* Loads a scene file (at most 1 GiB); NULL with err set on the first
  * problem. opts may be NULL. Non-fatal notes go to opts->warn: a clamped

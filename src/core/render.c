@@ -147,6 +147,20 @@ typedef struct shared {
 	pthread_cond_t finished;
 } shared;
 
+/* Adds samples [s0, s1) of pixel (x, y) of an fw x fh image to acc, in
+ * sample order: render_tile and render_rect share it, so a tile rendered
+ * anywhere holds the same bits as the whole image. */
+static void pixel_add(const world *w, const render_settings *s, int x, int y, int fw, int fh,
+                      int s0, int s1, double acc[3])
+{
+	for (int k = s0; k < s1; k++) {
+		vec3 c = render_sample(w, s, x, y, fw, fh, k);
+		acc[0] += c.x;
+		acc[1] += c.y;
+		acc[2] += c.z;
+	}
+}
+
 static void render_tile(shared *sh, long t)
 {
 	render_job *job = sh->job;
@@ -161,26 +175,36 @@ static void render_tile(shared *sh, long t)
 			size_t i = ((size_t)y * (size_t)fb->w + (size_t)x) * 3;
 			/* A first pass starts from zero whatever the sums hold (a
 			 * cancelled pass leaves them half done). */
-			double r = 0.0, g = 0.0, b = 0.0;
+			double acc[3] = {0.0, 0.0, 0.0};
 			if (job->sample_begin > 0) {
-				r = fb->sum[i];
-				g = fb->sum[i + 1];
-				b = fb->sum[i + 2];
+				acc[0] = fb->sum[i];
+				acc[1] = fb->sum[i + 1];
+				acc[2] = fb->sum[i + 2];
 			}
-			for (int s = job->sample_begin; s < job->sample_end; s++) {
-				vec3 c = render_sample(job->w, &job->set, x, y, fb->w, fb->h, s);
-				r += c.x;
-				g += c.y;
-				b += c.z;
-			}
+			pixel_add(job->w, &job->set, x, y, fb->w, fb->h, job->sample_begin,
+			          job->sample_end, acc);
 			if (fb->sum) {
-				fb->sum[i] = r;
-				fb->sum[i + 1] = g;
-				fb->sum[i + 2] = b;
+				fb->sum[i] = acc[0];
+				fb->sum[i + 1] = acc[1];
+				fb->sum[i + 2] = acc[2];
 			}
-			fb->rgb[i] = (float)(r * inv);
-			fb->rgb[i + 1] = (float)(g * inv);
-			fb->rgb[i + 2] = (float)(b * inv);
+			fb->rgb[i] = (float)(acc[0] * inv);
+			fb->rgb[i + 1] = (float)(acc[1] * inv);
+			fb->rgb[i + 2] = (float)(acc[2] * inv);
+		}
+}
+
+void render_rect(const world *w, const render_settings *s, int x0, int y0, int x1, int y1,
+                 float *out)
+{
+	double inv = 1.0 / s->samples;
+	for (int y = y0; y < y1; y++)
+		for (int x = x0; x < x1; x++) {
+			double acc[3] = {0.0, 0.0, 0.0};
+			pixel_add(w, s, x, y, s->width, s->height, 0, s->samples, acc);
+			*out++ = (float)(acc[0] * inv);
+			*out++ = (float)(acc[1] * inv);
+			*out++ = (float)(acc[2] * inv);
 		}
 }
 

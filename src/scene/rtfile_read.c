@@ -1202,8 +1202,9 @@ scene *rt_load_string(const char *text, size_t len, const char *name, const rt_l
 }
 
 /* The whole file in a new buffer; NULL with err set on failure. */
-static char *read_file(const char *path, size_t *len, rt_error *err)
+static char *read_file(void *ctx, const char *path, size_t *len, rt_error *err)
 {
+	(void)ctx;
 	FILE *f = fopen(path, "rb");
 	if (!f) {
 		rt_error_at(err, path, 0, 0, "cannot open: %s; expected a readable .rt file",
@@ -1259,12 +1260,20 @@ static char *read_file(const char *path, size_t *len, rt_error *err)
 		}
 	}
 	fclose(f);
+	buf[n] = '\0';
 	*len = n;
 	return buf;
 fail:
 	free(buf);
 	fclose(f);
 	return NULL;
+}
+
+char *rt_read_file(const char *path, const rt_load_opts *opts, size_t *len, rt_error *err)
+{
+	if (opts && opts->read)
+		return opts->read(opts->read_ctx, path, len, err);
+	return read_file(NULL, path, len, err);
 }
 
 scene *rt_load_file(const char *path, const rt_load_opts *opts, rt_error *err)
@@ -1277,7 +1286,7 @@ scene *rt_load_file(const char *path, const rt_load_opts *opts, rt_error *err)
 		return NULL;
 	}
 	size_t len = 0;
-	char *text = read_file(path, &len, err);
+	char *text = rt_read_file(path, opts, &len, err);
 	if (!text)
 		return NULL;
 	scene *s = rt_load_string(text, len, path, opts, err);

@@ -468,7 +468,7 @@ bool shell_init(shell *sh, const rtsh_options *o, int wake_fd)
 	sh->opt = o;
 	sh->wake[0] = sh->wake[1] = -1;
 	sh->warn = (rt_warnings){print_warning, sh};
-	sh->load_opts = (rt_load_opts){o->strict, o->quiet ? NULL : &sh->warn};
+	sh->load_opts = (rt_load_opts){.strict = o->strict, .warn = o->quiet ? NULL : &sh->warn};
 	atomic_init(&sh->cancel, false);
 	rt_error err;
 	scene *s;

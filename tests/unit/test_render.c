@@ -1,6 +1,6 @@
 /* rtsh — tests of the renderer: a Phong value computed by hand, shadows,
  * reflections, the sRGB transfer, thread-count invariance, progressive
- * passes, cancelling, image files, and an end-to-end render through the rtsh
+ * passes, rectangles (rtsh-mpi's tiles), cancelling, image files, and an end-to-end render through the rtsh
  * binary checked against the projection formula. */
 #include "testutil.h"
 
@@ -241,6 +241,39 @@ static void test_progressive_equals_batch(void **state)
 	scene_free(s);
 }
 
+/* render_rect gives any rectangle of the image (rtsh-mpi's tiles) bit for
+ * bit as the whole image holds it, in both modes, edges included. */
+static void test_rect_equals_image(void **state)
+{
+	(void)state;
+	scene *s = busy_scene();
+	world *w = world_build(s, NULL);
+	for (int mode = MODE_WHITTED; mode <= MODE_PATH; mode++) {
+		render_settings set = render_settings_default();
+		set.width = 53;
+		set.height = 37;
+		set.samples = 3;
+		set.threads = 2;
+		set.mode = (render_mode)mode;
+		framebuffer *fb = render_image(w, &set, NULL, NULL, NULL, NULL);
+		const int rects[][4] = {{0, 0, 53, 37}, {0, 0, 1, 1}, {17, 5, 40, 22}, {48, 30, 53, 37}};
+		for (size_t r = 0; r < sizeof rects / sizeof rects[0]; r++) {
+			const int *q = rects[r];
+			int rw = q[2] - q[0], rh = q[3] - q[1];
+			float *out = malloc(sizeof(float) * 3 * (size_t)(rw * rh));
+			render_rect(w, &set, q[0], q[1], q[2], q[3], out);
+			for (int y = 0; y < rh; y++)
+				assert_memory_equal(out + (size_t)y * rw * 3,
+				                    fb->rgb + ((size_t)(q[1] + y) * 53 + q[0]) * 3,
+				                    sizeof(float) * 3 * (size_t)rw);
+			free(out);
+		}
+		fb_free(fb);
+	}
+	world_free(w);
+	scene_free(s);
+}
+
 static void test_cancel(void **state)
 {
 	(void)state;
@@ -410,6 +443,7 @@ int main(void)
 		cmocka_unit_test(test_reflection),
 		cmocka_unit_test(test_threads_identical),
 		cmocka_unit_test(test_progressive_equals_batch),
+		cmocka_unit_test(test_rect_equals_image),
 		cmocka_unit_test(test_cancel),
 		cmocka_unit_test(test_srgb),
 		cmocka_unit_test(test_image_files),

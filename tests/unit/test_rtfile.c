@@ -33,7 +33,7 @@ static scene *load_with(const char *text, size_t len, const char *name, bool str
                         rt_error *err)
 {
 	rt_warnings w = {warn_collect, log};
-	rt_load_opts o = {strict, log ? &w : NULL};
+	rt_load_opts o = {.strict = strict, .warn = log ? &w : NULL};
 	rt_error_clear(err);
 	return rt_load_string(text, len, name, &o, err);
 }
@@ -969,7 +969,7 @@ static void test_save_and_load_file(void **state)
 	scene *s = load_ok(SUBJECT);
 	rt_error err;
 	assert_true(rt_save(s, path, &err));
-	rt_load_opts strict = {true, NULL};
+	rt_load_opts strict = {.strict = true};
 	scene *t = rt_load_file(path, &strict, &err);
 	assert_non_null(t);
 	assert_true(scene_equal(s, t));
@@ -1044,7 +1044,7 @@ static void test_parse_line(void **state)
 	assert_false(rt_parse_line(s, "   # just a comment", "add", 1, NULL, &err));
 	assert_false(rt_parse_line(s, "sp 0,0,0 1 255,0,0\nsp 0,0,0 1 255,0,0", "add", 1, NULL, &err));
 	assert_non_null(strstr(err.msg, "control character 0x0A"));
-	rt_load_opts strict = {true, NULL};
+	rt_load_opts strict = {.strict = true};
 	assert_false(rt_parse_line(s, "co 0,0,0 0,1,0 1 1 1,1,1", "add", 1, &strict, &err));
 	assert_true(scene_equal(before, s));
 	scene_free(before);
@@ -1246,7 +1246,7 @@ static void test_wild_corpus(void **state)
 			print_message("must load: %s\n", buf);
 			problems++;
 		}
-		rt_load_opts strict = {true, NULL};
+		rt_load_opts strict = {.strict = true};
 		scene *t = rt_load_file(full, &strict, &err);
 		if (!t)
 			v->strict_failed++;

@@ -1,0 +1,56 @@
+/* rtsh-mpi — the tile farm: rank 0 hands out tiles from one counter, its
+ * own threads take theirs from the same counter, and every other rank
+ * renders the tiles it is given with all of its threads and sends each one
+ * back as linear radiance (floats) for rank 0 to place in the image.
+ *
+ * Messages (all between rank 0 and one worker, in order):
+ *   worker -> 0   FARM_ASK      int64 k: send me k tiles (once, at the start)
+ *   0 -> worker   FARM_TILES    int64[] tile numbers, -1 last when none are left
+ *   worker -> 0   FARM_RESULT   int64 tile number, then the tile's floats;
+ *                               answered by FARM_TILES with one more tile
+ * A worker holds at most threads + prefetch tiles (rendering, queued or
+ * waiting to be sent) and never the image. After rank 0 has sent a worker
+ * its -1 it sends it nothing more.
+ */
+#ifndef RTSH_MPI_FARM_H
+#define RTSH_MPI_FARM_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "rtsh/render.h"
+
+typedef struct farm_opts {
+	int tile;       /* tile side in pixels */
+	int prefetch;   /* tiles a worker asks for beyond its threads */
+	int delay_us;   /* test mode: each result waits this long before it is sent */
+	int threads;    /* render threads on this rank */
+	bool progress;  /* rank 0: a progress line on standard error */
+} farm_opts;
+
+/* One rank's figures (gathered on rank 0 for -v). */
+typedef struct farm_stats {
+	double tiles;     /* tiles rendered */
+	double seconds;   /* wall time of the render phase */
+	double busy;      /* thread-seconds spent rendering */
+	double rays;      /* rays traced (camera, shadow, secondary) */
+	double bytes;     /* bytes this rank sent */
+	double rtt;       /* worker: mean seconds from sending a result to the next tile arriving */
+	double serve;     /* rank 0: CPU seconds its serving thread spent (not rendering) */
+	double peak;      /* the process's peak resident memory, bytes (filled by the caller) */
+	int threads;
+	char host[64];
+} farm_stats;
+
+/* Both return false (err set) when a message breaks the protocol or memory
+ * runs out; the caller then ends the job. */
+/* Rank 0: renders the image into fb (s->width x s->height, rgb only) with
+ * the workers of MPI_COMM_WORLD. */
+bool farm_serve(const world *w, const render_settings *s, const farm_opts *o, framebuffer *fb,
+                farm_stats *st, rt_error *err);
+/* Every other rank: renders the tiles rank 0 hands out until it says none
+ * are left. */
+bool farm_work(const world *w, const render_settings *s, const farm_opts *o, farm_stats *st,
+               rt_error *err);
+
+#endif

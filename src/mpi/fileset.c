@@ -1,0 +1,152 @@
+/* rtsh-mpi — the files a scene needs, in memory (fileset.h). */
+#include "mpi/fileset.h"
+
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rtsh/rtfile.h"
+
+void fileset_free(fileset *fs)
+{
+	for (size_t i = 0; i < fs->n; i++) {
+		free(fs->files[i].path);
+		free(fs->files[i].data);
+	}
+	free(fs->files);
+	*fs = (fileset){0};
+}
+
+static char *dup_bytes(const char *p, size_t len)
+{
+	char *c = malloc(len + 1);
+	if (c) {
+		memcpy(c, p, len);
+		c[len] = '\0';
+	}
+	return c;
+}
+
+/* Takes ownership of path and data (freed on failure). */
+static bool add(fileset *fs, char *path, char *data, size_t len)
+{
+	if (path && data && fs->n == fs->cap) {
+		size_t cap = fs->cap ? fs->cap * 2 : 8;
+		file_entry *f = realloc(fs->files, cap * sizeof *f);
+		if (f) {
+			fs->files = f;
+			fs->cap = cap;
+		}
+	}
+	if (!path || !data || fs->n == fs->cap) {
+		free(path);
+		free(data);
+		return false;
+	}
+	fs->files[fs->n++] = (file_entry){path, data, len};
+	return true;
+}
+
+static const file_entry *find(const fileset *fs, const char *path)
+{
+	for (size_t i = 0; i < fs->n; i++)
+		if (strcmp(fs->files[i].path, path) == 0)
+			return &fs->files[i];
+	return NULL;
+}
+
+char *fileset_record(void *ctx, const char *path, size_t *len, rt_error *err)
+{
+	fileset *fs = ctx;
+	const file_entry *e = find(fs, path);
+	if (e) {
+		*len = e->len;
+		return dup_bytes(e->data, e->len);
+	}
+	char *data = rt_read_file(path, NULL, len, err);
+	if (!data)
+		return NULL;
+	char *copy = dup_bytes(data, *len), *name = dup_bytes(path, strlen(path));
+	if (!copy || !name || !add(fs, name, copy, *len)) {
+		if (!copy || !name) {
+			free(copy);
+			free(name);
+		}
+		free(data);
+		rt_error_at(err, path, 0, 0, "out of memory keeping the file for the other ranks");
+		return NULL;
+	}
+	return data;
+}
+
+char *fileset_serve(void *ctx, const char *path, size_t *len, rt_error *err)
+{
+	const file_entry *e = find(ctx, path);
+	if (!e) {
+		rt_error_at(err, path, 0, 0, "not among the files rank 0 sent; expected a file rank 0 read");
+		return NULL;
+	}
+	char *c = dup_bytes(e->data, e->len);
+	if (!c) {
+		rt_error_at(err, path, 0, 0, "out of memory");
+		return NULL;
+	}
+	*len = e->len;
+	return c;
+}
+
+static char *put_u64(char *p, uint64_t v)
+{
+	for (int i = 0; i < 8; i++)
+		*p++ = (char)(v >> (8 * i) & 0xff);
+	return p;
+}
+
+static bool get_u64(const char **p, const char *end, uint64_t *v)
+{
+	if (end - *p < 8)
+		return false;
+	*v = 0;
+	for (int i = 0; i < 8; i++)
+		*v |= (uint64_t)(unsigned char)(*p)[i] << (8 * i);
+	*p += 8;
+	return true;
+}
+
+char *fileset_pack(const fileset *fs, size_t *size)
+{
+	size_t n = 0;
+	for (size_t i = 0; i < fs->n; i++)
+		n += 16 + strlen(fs->files[i].path) + fs->files[i].len;
+	char *buf = malloc(n ? n : 1), *p = buf;
+	if (!buf)
+		return NULL;
+	for (size_t i = 0; i < fs->n; i++) {
+		size_t pl = strlen(fs->files[i].path);
+		p = put_u64(p, pl);
+		memcpy(p, fs->files[i].path, pl);
+		p = put_u64(p + pl, fs->files[i].len);
+		memcpy(p, fs->files[i].data, fs->files[i].len);
+		p += fs->files[i].len;
+	}
+	*size = n;
+	return buf;
+}
+
+bool fileset_unpack(fileset *fs, const char *buf, size_t size)
+{
+	const char *p = buf, *end = buf + size;
+	while (p < end) {
+		uint64_t pl, dl;
+		if (!get_u64(&p, end, &pl) || pl > (uint64_t)(end - p))
+			return false;
+		const char *path = p;
+		p += pl;
+		if (!get_u64(&p, end, &dl) || dl > (uint64_t)(end - p) || memchr(path, '\0', pl))
+			return false;
+		if (!add(fs, dup_bytes(path, pl), dup_bytes(p, dl), dl))
+			return false;
+		p += dl;
+	}
+	return true;
+}

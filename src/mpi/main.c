@@ -1,0 +1,537 @@
+/* rtsh-mpi — one image rendered by many processes: `mpirun -n N rtsh-mpi
+ * SCENE -o OUT [options]` writes the same bytes as `rtsh SCENE -o OUT
+ * [options]`.
+ *
+ * Rank 0 reads the command line, the scene and every file it references,
+ * and broadcasts the settings and the files' bytes (fileset.h); every rank
+ * builds the same world from them. Rank 0 then serves tiles from one queue
+ * while rendering too, the others render the tiles they are given with all
+ * their threads (farm.h), and rank 0 assembles the image and writes it
+ * atomically. Every rank ends with the same exit status.
+ */
+#include <errno.h>
+#include <mpi.h>
+#include <signal.h>
+#include <stdatomic.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+#include <fcntl.h>
+#include <sys/resource.h>
+
+#include "mpi/farm.h"
+#include "mpi/fileset.h"
+#include "rtsh/image.h"
+#include "rtsh/render.h"
+#include "rtsh/rtfile.h"
+#include "rtsh/settings.h"
+#include "rtsh/world.h"
+#include "shell/args.h"
+
+#define MSG_MAX (RT_ERROR_MSG_MAX + RT_ERROR_FILE_MAX + 32)
+/* MPI counts are ints: large buffers go in pieces of 1 GiB. */
+#define BCAST_PIECE (1 << 30)
+
+/* What rank 0 tells every rank before the render. */
+typedef struct job_config {
+	int32_t status;   /* -1: render; else every rank exits with it */
+	int32_t verbose, progress, strict;
+	int32_t tile, prefetch, delay_us;
+	render_settings set;
+	uint64_t files;   /* bytes of the packed file set */
+} job_config;
+
+static void usage(FILE *f)
+{
+	fputs("usage: mpirun -n N [--hostfile HOSTS] rtsh-mpi SCENE.rt -o OUT [OPTIONS]\n"
+	      "Renders SCENE.rt to OUT (.ppm .pfm .png) across the ranks of an MPI job; the\n"
+	      "output is the same, byte for byte, as `rtsh SCENE.rt -o OUT [OPTIONS]`.\n"
+	      "  -v, --verbose                per-rank figures at the end: tiles, seconds,\n"
+	      "                               Mrays/s, bytes sent\n"
+	      "  -t N                         render threads per rank (0: the node's CPUs\n"
+	      "                               shared among its ranks)\n"
+	      "and rtsh's batch options:\n",
+	      f);
+	args_usage(f, ARGS_BATCH, "rtsh-mpi");
+	fputs("See rtsh-mpi(1).\n", f);
+}
+
+static void print_warning(void *ctx, const rt_error *w)
+{
+	(void)ctx;
+	char buf[MSG_MAX];
+	rt_error_format(w, buf, sizeof buf);
+	fprintf(stderr, "%s (warning)\n", buf);
+}
+
+/* A whole number in lo..hi from the environment variable into *out, or def
+ * when it is unset; false (message printed) when it is not valid. */
+static bool env_number(const char *name, long def, long lo, long hi, long *out)
+{
+	const char *v = getenv(name);
+	*out = def;
+	if (!v || !*v)
+		return true;
+	char *end;
+	long n = strtol(v, &end, 10);
+	if (*end || n < lo || n > hi) {
+		fprintf(stderr, "rtsh-mpi: %s=\"%s\" is not valid; expected a whole number in %ld..%ld\n",
+		        name, v, lo, hi);
+		return false;
+	}
+	*out = n;
+	return true;
+}
+
+/* Under mpirun, standard error is a pipe to mpirun even when the user
+ * watches a terminal: then the job's controlling terminal says so. */
+static bool watched(void)
+{
+	if (isatty(STDERR_FILENO))
+		return true;
+	if (!getenv("OMPI_COMM_WORLD_SIZE"))
+		return false;
+	int fd = open("/dev/tty", O_WRONLY | O_NOCTTY);
+	if (fd < 0)
+		return false;
+	close(fd);
+	return true;
+}
+
+/* Whether a file can be created in path's folder (as image_write will). */
+static bool folder_writable(const char *path, rt_error *err)
+{
+	const char *slash = strrchr(path, '/');
+	char dir[4096];
+	if (!slash)
+		snprintf(dir, sizeof dir, ".");
+	else if (slash == path)
+		snprintf(dir, sizeof dir, "/");
+	else
+		snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+	if (access(dir, W_OK | X_OK) == 0)
+		return true;
+	return rt_error_at(err, path, 0, 0,
+	                   "cannot create a file in that folder (%s); expected a writable folder",
+	                   strerror(errno));
+}
+
+/* Rank 0: the command line, the scene and its files, the world, the image.
+ * Sets c->status to an exit status when the job must not render. */
+static void setup(int argc, char **argv, job_config *c, fileset *files, world **w,
+                  framebuffer **fb, const char **output)
+{
+	char msg[MSG_MAX];
+	rt_error err;
+	c->status = 2;
+	/* rtsh-mpi's own option -v, and its own help; the rest are rtsh's */
+	char **args = calloc((size_t)argc + 1, sizeof *args);
+	if (!args) {
+		fputs("rtsh-mpi: out of memory\n", stderr);
+		c->status = 1;
+		return;
+	}
+	int n = 0;
+	bool dashdash = false;
+	for (int i = 0; i < argc; i++) {
+		const char *a = argv[i];
+		if (i > 0 && !dashdash && (strcmp(a, "-v") == 0 || strcmp(a, "--verbose") == 0)) {
+			c->verbose = 1;
+			continue;
+		}
+		if (i > 0 && !dashdash && (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0)) {
+			usage(stdout);
+			c->status = 0;
+			goto out;
+		}
+		if (strcmp(a, "--") == 0)
+			dashdash = true;
+		args[n++] = argv[i];
+	}
+	rtsh_options o;
+	int rc = args_parse(n, args, ARGS_BATCH, "rtsh-mpi", &o);
+	if (rc >= 0) {
+		c->status = rc;
+		goto out;
+	}
+	if (image_format_of(o.output) == IMAGE_UNKNOWN) {
+		fprintf(stderr, "rtsh-mpi: output \"%s\" has an unknown type; expected .ppm, .pfm or .png\n"
+		        "Try 'rtsh-mpi --help' for more information.\n", o.output);
+		goto out;
+	}
+	long tile, prefetch, delay; /* tile 0: auto_tile; prefetch -1: half the threads, at least 2 */
+	if (!env_number("RTSH_MPI_TILE", 0, 4, 1024, &tile) ||
+	    !env_number("RTSH_MPI_PREFETCH", -1, 0, 1024, &prefetch) ||
+	    !env_number("RTSH_MPI_DELAY_US", 0, 0, 10000000, &delay))
+		goto out;
+	c->tile = (int32_t)tile;
+	c->prefetch = (int32_t)prefetch;
+	c->delay_us = (int32_t)delay;
+	c->strict = o.strict;
+
+	c->status = 1;
+	rt_warnings warn = {print_warning, NULL};
+	rt_load_opts lo = {.strict = o.strict, .warn = o.quiet ? NULL : &warn,
+	                   .read = fileset_record, .read_ctx = files};
+	scene *s = rt_load_file(o.scene, &lo, &err);
+	if (!s) {
+		rt_error_format(&err, msg, sizeof msg);
+		fprintf(stderr, "%s\n", msg);
+		goto out;
+	}
+	c->set = render_settings_default();
+	if (render_settings_apply_hints(&c->set, &s->hints) && !o.quiet)
+		fprintf(stderr, "%s: resolution %dx%d is too large; rendering %dx%d (use -r to choose)\n",
+		        o.scene, s->hints.width, s->hints.height, c->set.width, c->set.height);
+	options_apply_settings(&o, &c->set);
+	*w = world_build(s, &err);
+	scene_free(s);
+	if (!*w) {
+		rt_error_format(&err, msg, sizeof msg);
+		fprintf(stderr, "%s: %s\n", o.scene, msg);
+		goto out;
+	}
+	/* An hour's render must not end in a folder that cannot take the file:
+	 * check it now, in the words the final write would use. */
+	if (!folder_writable(o.output, &err)) {
+		rt_error_format(&err, msg, sizeof msg);
+		fprintf(stderr, "%s\n", msg);
+		goto out;
+	}
+	*fb = fb_new(c->set.width, c->set.height);
+	if (!*fb) {
+		fprintf(stderr, "%s: cannot make a %dx%d image; expected 1..%d pixels a side, and memory\n",
+		        o.scene, c->set.width, c->set.height, RENDER_MAX_DIM);
+		goto out;
+	}
+	free((*fb)->sum); /* one pass: no running sums, as render_image */
+	(*fb)->sum = NULL;
+	c->progress = !o.quiet && watched();
+	*output = o.output;
+	c->status = -1;
+out:
+	free(args);
+}
+
+/* Waits for a request, sleeping between tests: Open MPI's blocking calls
+ * spin, and a rank waiting for rank 0 (while it reads the scene, or renders
+ * its last tiles) must not take a core from it. */
+static void wait_for(MPI_Request *req)
+{
+	long nap = 50;
+	for (;;) {
+		int flag = 0;
+		MPI_Test(req, &flag, MPI_STATUS_IGNORE);
+		if (flag)
+			return;
+		struct timespec t = {0, nap * 1000};
+		nanosleep(&t, NULL);
+		if (nap < 2000)
+			nap *= 2;
+	}
+}
+
+static void bcast(void *buf, int count, MPI_Datatype type)
+{
+	MPI_Request r;
+	MPI_Ibcast(buf, count, type, 0, MPI_COMM_WORLD, &r);
+	wait_for(&r);
+}
+
+static void gather(const void *mine, void *all, int bytes)
+{
+	MPI_Request r;
+	MPI_Igather(mine, bytes, MPI_BYTE, all, bytes, MPI_BYTE, 0, MPI_COMM_WORLD, &r);
+	wait_for(&r);
+}
+
+/* Broadcasts size bytes from rank 0 in pieces an int can count. */
+static void bcast_bytes(char *buf, uint64_t size)
+{
+	for (uint64_t at = 0; at < size; at += BCAST_PIECE) {
+		uint64_t left = size - at;
+		bcast(buf + at, (int)(left < BCAST_PIECE ? left : BCAST_PIECE), MPI_BYTE);
+	}
+}
+
+/* The render threads of this rank: -t, or the node's CPUs shared among the
+ * ranks on the node. */
+static int rank_threads(const render_settings *s)
+{
+	if (s->threads > 0)
+		return s->threads;
+	MPI_Comm node;
+	int here = 1;
+	if (MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node) ==
+	    MPI_SUCCESS) {
+		MPI_Comm_size(node, &here);
+		MPI_Comm_free(&node);
+	}
+	int cpus = render_threads(s);
+	return cpus / here > 1 ? cpus / here : 1;
+}
+
+/* Who each rank is, for the message about a rank that ended. */
+typedef struct rank_id {
+	int32_t pid;
+	char host[64];
+} rank_id;
+
+/* What rank 0's SIGTERM/SIGINT handler reads: set before it is installed
+ * (output) or published once complete (ids, by the atomic store). */
+static const char *stop_output;
+static rank_id *stop_ids;
+static _Atomic int stop_nids;
+static _Atomic int stop_progress; /* a progress line is open: end it first */
+
+static void put(char *buf, size_t *n, size_t cap, const char *s)
+{
+	while (*s && *n < cap)
+		buf[(*n)++] = *s++;
+}
+
+static void put_int(char *buf, size_t *n, size_t cap, int v)
+{
+	char d[16];
+	int k = 0;
+	do
+		d[k++] = (char)('0' + v % 10);
+	while ((v /= 10) > 0 && k < 15);
+	while (k > 0 && *n < cap)
+		buf[(*n)++] = d[--k];
+}
+
+/* Rank 0, on the launcher's SIGTERM (sent to every rank when one dies, and
+ * on Ctrl-C at mpirun) or SIGINT: says which ranks on its host are gone
+ * (those on other hosts it cannot see) and that no image was written, then
+ * ends by the signal. The launcher follows with SIGKILL within about a
+ * second and rank 0 may be inside a blocking MPI call, so this is done here,
+ * with async-signal-safe calls only (kill, write, strcmp, raise). */
+static _Atomic int stop_rank = -1; /* this process's rank once known */
+
+static void on_stop(int sig)
+{
+	if (atomic_load(&stop_rank) != 0) {
+		/* another rank, or MPI not started yet: end quietly */
+		signal(sig, SIG_DFL);
+		raise(sig);
+		return;
+	}
+	char buf[4096];
+	size_t n = 0, cap = sizeof buf;
+	if (atomic_load(&stop_progress))
+		put(buf, &n, cap, "\n");
+	int named = 0, nids = atomic_load(&stop_nids);
+	for (int r = 1; r < nids; r++)
+		if (strcmp(stop_ids[r].host, stop_ids[0].host) == 0 && kill(stop_ids[r].pid, 0) != 0 &&
+		    errno == ESRCH) {
+			put(buf, &n, cap, "rtsh-mpi: rank ");
+			put_int(buf, &n, cap, r);
+			put(buf, &n, cap, " on ");
+			put(buf, &n, cap, stop_ids[r].host);
+			put(buf, &n, cap, " ended before the image was complete\n");
+			named++;
+		}
+	if (!named)
+		put(buf, &n, cap, sig == SIGINT ? "rtsh-mpi: interrupted before the image was complete\n"
+		                                : "rtsh-mpi: stopped before the image was complete "
+		                                  "(interrupted, or a rank on another host ended)\n");
+	put(buf, &n, cap, "rtsh-mpi: ");
+	put(buf, &n, cap, stop_output ? stop_output : "the image");
+	put(buf, &n, cap, " not written\n");
+	ssize_t wr = write(STDERR_FILENO, buf, n);
+	(void)wr;
+	signal(sig, SIG_DFL);
+	raise(sig);
+}
+
+/* The tile side when RTSH_MPI_TILE does not set one: 32 pixels, halved
+ * (down to 8) until there are at least 8 tiles for every render thread of
+ * the job, so that the last wave of tiles is a small part of the render
+ * (bench/README.md has the model). */
+static int auto_tile(int w, int h, long threads)
+{
+	int s = 32;
+	while (s > 8 && (long)((w + s - 1) / s) * (long)((h + s - 1) / s) < 8 * threads)
+		s /= 2;
+	return s;
+}
+
+/* Ends the whole job from any rank with one message. */
+static void die(int rank, const char *host, const char *what, const rt_error *err)
+{
+	char msg[MSG_MAX];
+	rt_error_format(err, msg, sizeof msg);
+	fprintf(stderr, "rtsh-mpi: rank %d on %s: %s%s%s\n", rank, host, what, *what ? ": " : "", msg);
+	fflush(stderr);
+	MPI_Abort(MPI_COMM_WORLD, 1);
+}
+
+static void print_figures(const farm_stats *st, int size, const job_config *c, double total)
+{
+	double tiles = 0, rays = 0, bytes = 0;
+	fprintf(stderr, "%-5s %-16s %7s %7s %8s %8s %9s %11s %9s %9s\n", "rank", "host", "threads",
+	        "tiles", "seconds", "busy", "Mrays/s", "bytes sent", "rtt (us)", "peak MiB");
+	for (int r = 0; r < size; r++) {
+		const farm_stats *f = &st[r];
+		double cap = f->seconds * f->threads;
+		fprintf(stderr, "%-5d %-16.16s %7d %7.0f %8.2f %7.0f%% %9.2f %11.0f %9.0f %9.0f\n", r,
+		        f->host, f->threads, f->tiles, f->seconds, cap > 0 ? 100.0 * f->busy / cap : 0.0,
+		        f->seconds > 0 ? f->rays / f->seconds * 1e-6 : 0.0, f->bytes, f->rtt * 1e6,
+		        f->peak / 1048576.0);
+		tiles += f->tiles;
+		rays += f->rays;
+		bytes += f->bytes;
+	}
+	fprintf(stderr, "all   %d ranks, %.0f tiles of %dx%d, %.2f s, %.2f Mrays/s, %.0f bytes sent\n",
+	        size, tiles, c->tile, c->tile, total, total > 0 ? rays / total * 1e-6 : 0.0, bytes);
+	double remote = tiles - st[0].tiles;
+	if (remote > 0)
+		fprintf(stderr, "rank 0 served %.0f tiles to the others with %.1f us of CPU each\n", remote,
+		        st[0].serve / remote * 1e6);
+}
+
+int main(int argc, char **argv)
+{
+	int provided, rank, size;
+	struct sigaction sa;
+	memset(&sa, 0, sizeof sa);
+	sa.sa_handler = on_stop;
+	sigemptyset(&sa.sa_mask);
+	sigaction(SIGTERM, &sa, NULL);
+	sigaction(SIGINT, &sa, NULL);
+	MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+	MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+	atomic_store(&stop_rank, rank);
+	MPI_Comm_size(MPI_COMM_WORLD, &size);
+	char host[64] = "?";
+	int hl;
+	char name[MPI_MAX_PROCESSOR_NAME];
+	if (MPI_Get_processor_name(name, &hl) == MPI_SUCCESS)
+		snprintf(host, sizeof host, "%.63s", name);
+
+	job_config c;
+	memset(&c, 0, sizeof c);
+	fileset files = {0};
+	world *w = NULL;
+	framebuffer *fb = NULL;
+	const char *output = NULL;
+	char *packed = NULL;
+	size_t packed_size = 0;
+	if (rank == 0) {
+		setup(argc, argv, &c, &files, &w, &fb, &output);
+		stop_output = output;
+		atomic_store(&stop_progress, c.progress);
+		if (c.status < 0) {
+			packed = fileset_pack(&files, &packed_size);
+			if (!packed) {
+				fputs("rtsh-mpi: out of memory packing the scene's files\n", stderr);
+				c.status = 1;
+			}
+			c.files = packed_size;
+		}
+	}
+	bcast(&c, (int)sizeof c, MPI_BYTE);
+	if (c.status >= 0) {
+		/* a usage or scene error: rank 0 said it once; all end alike (and
+		 * the launcher may stop the last ones: quietly) */
+		atomic_store(&stop_rank, -1);
+		world_free(w);
+		fb_free(fb);
+		fileset_free(&files);
+		MPI_Finalize();
+		return c.status;
+	}
+	double t0 = MPI_Wtime();
+	rt_error err;
+	rank_id me = {(int32_t)getpid(), {0}}, *ids = rank == 0 ? calloc((size_t)size, sizeof *ids) : NULL;
+	memcpy(me.host, host, sizeof me.host);
+	gather(&me, ids, (int)sizeof me);
+	if (rank == 0 && ids) {
+		stop_ids = ids;
+		atomic_store(&stop_nids, size);
+	}
+	if (rank != 0) {
+		packed = malloc(c.files ? c.files : 1);
+		if (!packed) {
+			rt_error_set(&err, "out of memory for the scene's %llu bytes",
+			             (unsigned long long)c.files);
+			die(rank, host, "", &err);
+		}
+	}
+	bcast_bytes(packed, c.files);
+	if (rank != 0) {
+		rt_load_opts lo = {.strict = c.strict, .read = fileset_serve, .read_ctx = &files};
+		if (!fileset_unpack(&files, packed, c.files) || files.n == 0) {
+			rt_error_set(&err, "the scene's files arrived damaged or memory ran out");
+			die(rank, host, "", &err);
+		}
+		scene *s = rt_load_file(files.files[0].path, &lo, &err);
+		if (!s)
+			die(rank, host, "loading the scene rank 0 sent", &err);
+		w = world_build(s, &err);
+		scene_free(s);
+		if (!w)
+			die(rank, host, "building the world", &err);
+	}
+	free(packed);
+	fileset_free(&files);
+
+	int threads = rank_threads(&c.set);
+	long all_threads = threads, mine = threads;
+	MPI_Request ar;
+	MPI_Iallreduce(&mine, &all_threads, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD, &ar);
+	wait_for(&ar);
+	if (c.tile == 0)
+		c.tile = auto_tile(c.set.width, c.set.height, all_threads);
+	farm_opts fo = {
+		.tile = c.tile,
+		.prefetch = c.prefetch >= 0 ? c.prefetch : threads / 2 > 2 ? threads / 2 : 2,
+		.delay_us = c.delay_us,
+		.threads = threads,
+		.progress = c.progress != 0,
+	};
+	farm_stats st;
+	bool ok = rank == 0 ? farm_serve(w, &c.set, &fo, fb, &st, &err)
+	                    : farm_work(w, &c.set, &fo, &st, &err);
+	atomic_store(&stop_progress, 0);
+	if (!ok)
+		die(rank, host, "", &err);
+	memcpy(st.host, host, sizeof st.host);
+	struct rusage ru;
+	if (getrusage(RUSAGE_SELF, &ru) == 0)
+		st.peak = (double)ru.ru_maxrss * 1024.0; /* Linux: KiB */
+	if (rank == 0)
+		st.bytes += (double)c.files * (size > 1);
+	world_free(w);
+	farm_stats *all = rank == 0 ? calloc((size_t)size, sizeof *all) : NULL;
+	gather(&st, all, (int)sizeof st);
+
+	int status = 0;
+	if (rank == 0) {
+		double rendered = MPI_Wtime() - t0;
+		if (!image_write(output, fb, c.set.exposure, &err)) {
+			char msg[MSG_MAX];
+			rt_error_format(&err, msg, sizeof msg);
+			fprintf(stderr, "%s\n", msg);
+			status = 1;
+		}
+		if (c.verbose && all)
+			print_figures(all, size, &c, rendered);
+		if (status == 0 && c.progress)
+			fprintf(stderr, "wrote %s (%dx%d, %d samples, %s) on %d ranks in %.2fs\n", output,
+			        c.set.width, c.set.height, c.set.samples, render_mode_name(c.set.mode), size,
+			        MPI_Wtime() - t0);
+	}
+	free(all);
+	atomic_store(&stop_nids, 0);
+	free(ids);
+	fb_free(fb);
+	bcast(&status, 1, MPI_INT);
+	atomic_store(&stop_rank, -1); /* all said: the launcher may stop us quietly */
+	MPI_Finalize();
+	return status;
+}
