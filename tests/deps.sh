@@ -17,6 +17,11 @@ have_header zlib.h || missing="$missing zlib1g-dev"
 printf '#include <stdarg.h>\n#include <stddef.h>\n#include <setjmp.h>\n#include <cmocka.h>\n' |
 	${CC:-cc} -E -x c - >/dev/null 2>&1 || missing="$missing libcmocka-dev"
 command -v ${CC:-cc} >/dev/null 2>&1 || missing="$missing build-essential"
+# Test-only packages: installed as root when missing, never required (the
+# tests that need them say they were skipped).
+if [ -z "$missing" ] && [ ! -x /usr/sbin/sshd ] && [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+	DEBIAN_FRONTEND=noninteractive apt-get install -y openssh-server >/dev/null 2>&1 || true
+fi
 # Optional: Open MPI for rtsh-mpi (`make mpi`); rtsh builds without it.
 optional=""
 command -v mpicc >/dev/null 2>&1 && command -v mpirun >/dev/null 2>&1 ||

@@ -21,6 +21,7 @@ step "unit tests" sh tests/run-unit.sh build build/tests/test_*
 step "command-file tests" sh tests/run-scripts.sh ./rtsh
 step "end-to-end (tmux)" sh tests/e2e/run.sh ./rtsh
 step "link simulator" sh tests/link/run.sh ./rtsh build/tests/linksim
+step "over sshd" sh tests/link/sshd.sh ./rtsh build/tests/linksim
 step "rtsh-mpi (Open MPI)" sh tests/mpi/run.sh ./rtsh ./rtsh-mpi
 step "build (ASan+UBSan)" $MAKE --no-print-directory -s BUILD=build/asan SAN=address,undefined OPT=-O1 build/asan/rtsh test-bins
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \

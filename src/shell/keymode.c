@@ -1127,39 +1127,31 @@ static void km_after_replace(keymode *km, const char *label_before)
 		km_layout(km);
 }
 
-/* Runs a shell command (next, prev) with its notes on standard error
- * caught and shown in the status line instead. */
+/* Runs a shell command (next, prev) with its output and notes caught
+ * (the shell's sinks, not the terminal) and the last line shown in the
+ * status line instead. */
 static bool km_shell_command(keymode *km, cmd_fn fn)
 {
 	shell *sh = km->sh;
-	fflush(stdout);
-	fflush(stderr);
-	FILE *tmp = tmpfile();
-	int saved_err = -1, saved_out = -1;
-	if (tmp) {
-		saved_err = dup(STDERR_FILENO);
-		saved_out = dup(STDOUT_FILENO);
-		dup2(fileno(tmp), STDERR_FILENO);
-		dup2(fileno(tmp), STDOUT_FILENO);
-	}
+	abuf out;
+	abuf_init(&out);
+	abuf *capture = sh->capture, *notes = sh->notes;
+	sh->capture = sh->notes = &out;
 	sh->err[0] = '\0';
 	bool ok = fn(sh, 0, NULL, "");
-	fflush(stdout);
-	fflush(stderr);
+	sh->capture = capture;
+	sh->notes = notes;
+	/* The last line that says something. */
 	char last[256] = "";
-	if (tmp) {
-		dup2(saved_err, STDERR_FILENO);
-		dup2(saved_out, STDOUT_FILENO);
-		close(saved_err);
-		close(saved_out);
-		rewind(tmp);
-		char line[256];
-		while (fgets(line, sizeof line, tmp))
-			if (line[0] != '\n')
-				snprintf(last, sizeof last, "%s", line);
-		fclose(tmp);
-		last[strcspn(last, "\r\n")] = '\0';
+	for (size_t i = 0; i < out.len && !out.failed;) {
+		size_t j = i;
+		while (j < out.len && out.b[j] != '\n')
+			j++;
+		if (j > i)
+			snprintf(last, sizeof last, "%.*s", (int)(j - i), out.b + i);
+		i = j + 1;
 	}
+	abuf_free(&out);
 	if (!ok)
 		km_message(km, "%s", sh->err);
 	else if (last[0])
@@ -1526,7 +1518,7 @@ bool keymode_run(shell *sh)
 	if (scr->out) {
 		abuf junk;
 		abuf_init(&junk);
-		termout_settle(scr->out, in, 1.0, &junk);
+		termout_settle(scr->out, in, 5.0, &junk);
 		abuf_free(&junk);
 	}
 	keys *k = keys_open(in, 25);

@@ -21,7 +21,7 @@
 
 #include "shell/complete.h"
 #include "shell/history.h"
-#include "shell/pager.h"
+#include "term/pager.h"
 #include "shell/signals.h"
 #include "shell/shell.h"
 #include "term/abuf.h"
@@ -115,7 +115,7 @@ static void settle(shell *sh)
 		return;
 	abuf got;
 	abuf_init(&got);
-	termout_settle(sh->scr->out, STDIN_FILENO, 1.0, &got);
+	termout_settle(sh->scr->out, STDIN_FILENO, 5.0, &got);
 	if (got.len)
 		take_input_raw(&got);
 	abuf_free(&got);
@@ -155,6 +155,7 @@ static void draw_picture(shell *sh)
 	fflush(stdout);
 	double t0 = now();
 	screen_picture(scr, sh->srgb, im->w, im->h);
+	termout_picture_final(scr->out, im->done);
 	termout_pump(scr->out, t0, &keys);
 	sh->last_draw = now();
 	sh->frame_cost = sh->last_draw - t0;
@@ -250,6 +251,12 @@ static void interrupt(shell *sh)
 			termout_drop_picture(sh->scr->out);
 		draw_status(sh);
 		return;
+	}
+	if (sh->scr && sh->scr->out && termout_picture_pending(sh->scr->out)) {
+		/* The render is done but its picture is still on its way over a
+		 * slow link: Ctrl-C stops that too. */
+		termout_drop_picture(sh->scr->out);
+		shell_notice(sh, "Ctrl-C: the rest of the picture was not sent");
 	}
 	rl_callback_sigcleanup();
 	rl_replace_line("", 0);

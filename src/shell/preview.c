@@ -12,7 +12,7 @@
 #include "rtsh/denoise.h"
 
 /* Aim for passes of about this long, so the picture refreshes steadily. */
-#define PASS_SECONDS 0.2
+#define PASS_SECONDS 0.1
 
 struct preview {
 	int wake_fd;

@@ -78,11 +78,17 @@ void shell_info(shell *sh, const char *fmt, ...)
 
 void shell_note(shell *sh, const char *fmt, ...)
 {
-	(void)sh;
-	fflush(stdout);
 	va_list ap;
 	va_start(ap, fmt);
-	vfprintf(stderr, fmt, ap);
+	if (sh && sh->notes) {
+		char buf[1024];
+		int n = vsnprintf(buf, sizeof buf, fmt, ap);
+		if (n > 0)
+			abuf_add(sh->notes, buf, (size_t)n < sizeof buf ? (size_t)n : sizeof buf - 1);
+	} else {
+		fflush(stdout);
+		vfprintf(stderr, fmt, ap);
+	}
 	va_end(ap);
 }
 
@@ -119,11 +125,9 @@ char *shell_expand_path(const char *path)
 
 static void print_warning(void *ctx, const rt_error *w)
 {
-	(void)ctx;
 	char buf[RT_ERROR_MSG_MAX + RT_ERROR_FILE_MAX + 32];
 	rt_error_format(w, buf, sizeof buf);
-	fflush(stdout);
-	fprintf(stderr, "%s (warning)\n", buf);
+	shell_note(ctx, "%s (warning)\n", buf);
 }
 
 /* --- settings per scene --- */

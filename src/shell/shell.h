@@ -57,6 +57,7 @@ typedef struct shell {
 	frame_palette pal;     /* for `show` on standard output */
 	screen *scr;           /* NULL: no picture */
 	abuf *capture;         /* when set, shell_out/shell_info append here (the pager) */
+	abuf *notes;           /* when set, shell_note and load warnings append here (key mode) */
 	preview *pv;           /* the world cache, and the background preview */
 	preview_image img;     /* the newest preview image shown */
 	uint8_t *srgb;         /* img as sRGB bytes */

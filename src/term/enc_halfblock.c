@@ -70,6 +70,11 @@ static void hb_keep_shown(encoder *e)
 	frame_keep_shown(((halfblock *)e)->fr);
 }
 
+static void hb_set_lossy(encoder *e, int tol)
+{
+	((halfblock *)e)->fr->tol = tol;
+}
+
 const encoder_ops encoder_halfblock = {
 	.name = "halfblock",
 	.canvas = hb_canvas,
@@ -81,4 +86,5 @@ const encoder_ops encoder_halfblock = {
 	.update = hb_update,
 	.dirty = hb_dirty,
 	.keep_shown = hb_keep_shown,
+	.set_lossy = hb_set_lossy,
 };

@@ -53,6 +53,9 @@ typedef struct encoder_ops {
 	bool (*dirty)(const encoder *e);
 	/* Drops the part not yet sent: what the terminal shows stays. */
 	void (*keep_shown)(encoder *e);
+	/* Lossy damage: parts that moved by at most tol (sRGB levels) need
+	 * not be sent; 0: exact. NULL when the encoder is always exact. */
+	void (*set_lossy)(encoder *e, int tol);
 } encoder_ops;
 
 /* Every encoder starts with this. */

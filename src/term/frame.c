@@ -434,6 +434,24 @@ static void update_begin(const frame *f, update_state *u, abuf *out)
 
 /* Appends the changed runs of row y; true when it sent anything. The row
  * then counts as shown. */
+/* True when the terminal's cell b may stay for a: equal, or in truecolor
+ * within f->tol in every channel of both pixels. */
+static bool cell_close(const frame *f, frame_cell a, frame_cell b)
+{
+	if (cell_eq(a, b))
+		return true;
+	if (f->tol <= 0 || f->pal != PALETTE_TRUECOLOR || a.top == FRAME_DEFAULT || a.bot == FRAME_DEFAULT ||
+	    b.top == FRAME_DEFAULT || b.bot == FRAME_DEFAULT || b.top == unknown_cell.top)
+		return false;
+	for (int sh = 0; sh < 24; sh += 8) {
+		int d1 = (int)((a.top >> sh) & 0xff) - (int)((b.top >> sh) & 0xff);
+		int d2 = (int)((a.bot >> sh) & 0xff) - (int)((b.bot >> sh) & 0xff);
+		if (d1 > f->tol || d1 < -f->tol || d2 > f->tol || d2 < -f->tol)
+			return false;
+	}
+	return true;
+}
+
 static bool update_row(frame *f, update_state *u, int y)
 {
 	abuf *out = u->out;
@@ -442,14 +460,14 @@ static bool update_row(frame *f, update_state *u, int y)
 	bool sent = false;
 	int x = 0;
 	for (;;) {
-		while (x < f->cols && cell_eq(row[x], old[x]))
+		while (x < f->cols && cell_close(f, row[x], old[x]))
 			x++;
 		if (x >= f->cols)
 			break;
 		/* A run from x: extend over changed cells and short gaps. */
 		int end = x + 1;
 		for (int k = end; k < f->cols; k++) {
-			if (!cell_eq(row[k], old[k]))
+			if (!cell_close(f, row[k], old[k]))
 				end = k + 1;
 			else if (k - end >= GAP_FILL)
 				break;
@@ -468,12 +486,12 @@ static bool update_row(frame *f, update_state *u, int y)
 			cursor_to(out, f->y0 + y, f->x0 + x);
 		}
 		emit_run(f->pal, out, row, x, end, &u->s);
+		memcpy(old + x, row + x, sizeof *row * (size_t)(end - x));
 		u->row = y;
 		u->col = end;
 		x = end;
 		sent = true;
 	}
-	memcpy(old, row, sizeof *row * (size_t)f->cols);
 	return sent;
 }
 
@@ -511,7 +529,7 @@ bool frame_dirty(const frame *f)
 		return true;
 	size_t n = (size_t)f->cols * (size_t)f->rows;
 	for (size_t i = 0; i < n; i++)
-		if (!cell_eq(f->cur[i], f->shown[i]))
+		if (!cell_close(f, f->cur[i], f->shown[i]))
 			return true;
 	return false;
 }

@@ -52,6 +52,8 @@ typedef struct frame {
 	frame_cell *shown; /* what the terminal shows */
 	bool have_shown;   /* false: the next update sends every cell */
 	int next_row;      /* where the next frame_update_part starts */
+	int tol;           /* truecolor: a shown cell within tol (sRGB levels, each
+	                      channel) of the current one is left as it is; 0: exact */
 	abuf out;
 } frame;
 

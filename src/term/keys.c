@@ -82,11 +82,34 @@ keys *keys_open(int in_fd, int esc_ms)
 	return k;
 }
 
+/* After an Esc that ncurses could not make a key of: true (and the bytes
+ * gone) when it starts a terminal's answer to a status query that came
+ * late (CSI digits n, CSI ? digits c: no key looks like that); else the
+ * bytes read are put back. */
+static bool late_answer(keys *k)
+{
+	int seq[24], n = 0, d;
+	while (n < 24 && (d = wgetch(k->pad)) != ERR) {
+		seq[n++] = d;
+		if (d >= KEY_MIN || (n == 1 && d != '[') || (n > 1 && d >= 0x40 && d <= 0x7e))
+			break;
+	}
+	bool answer = n >= 3 && seq[0] == '[' && (seq[n - 1] == 'n' || (seq[n - 1] == 'c' && seq[1] == '?'));
+	for (int i = 1; answer && i < n - 1; i++)
+		answer = (seq[i] >= '0' && seq[i] <= '9') || seq[i] == ';' || (i == 1 && seq[i] == '?');
+	if (!answer)
+		while (n > 0)
+			ungetch(seq[--n]);
+	return answer;
+}
+
 int keys_next(keys *k)
 {
 	int c = wgetch(k->pad);
 	if (c == ERR)
 		return KEYS_NONE;
+	if (c == 27 && late_answer(k))
+		return KEYS_OTHER;
 	if (c < KEY_MIN)
 		return c;
 	if (c >= KEY_F(1) && c <= KEY_F(63))

@@ -16,12 +16,13 @@
 #define TCAP_QUERY "\x1bP+q524742;5463\x1b\\"
 
 #define MAX_QUERIES 64
-#define HOLD_SECONDS 0.15   /* a cut escape sequence waits this long for its end */
+#define HOLD_SECONDS 0.3    /* a cut Esc waits this long for the rest of an answer */
+#define HOLD_ANSWER 2.0     /* a cut answer (CSI digits, DCS) waits this long for its end */
 #define HOLD_MAX 512        /* bytes of a cut sequence held at most */
 #define SLICE_MIN 1024
 #define SLICE_FIRST 4096    /* before the link is measured */
 #define SLICE_MAX (4u << 20)
-#define SLICE_TIMEOUT_MIN 5.0
+#define SLICE_TIMEOUT_MIN 10.0
 
 typedef enum query_kind { Q_DSR, Q_DA1, Q_RQSS, Q_TCAP } query_kind;
 
@@ -45,11 +46,12 @@ struct termout {
 	/* Input held: an escape sequence cut at the end of a read. */
 	char hold[HOLD_MAX];
 	size_t nhold;
-	double hold_since;
+	double hold_since, hold_for;
 
 	int truecolor;
 	bool ask_pixels;   /* the pixel questions go with the probe */
 	pixels_caps pix;   /* their answers */
+	bool final;         /* the picture is not a refinement pass */
 	bool notice_given;
 	const char *notice;
 	termout_stats st;
@@ -62,6 +64,7 @@ termout *termout_new(int fd)
 		return NULL;
 	o->fd = fd;
 	o->state = TERMOUT_IDLE;
+	o->final = true;
 	abuf_init(&o->buf);
 	return o;
 }
@@ -80,9 +83,32 @@ void termout_text(termout *o, const void *b, size_t n)
 		write_all(o->fd, b, n);
 }
 
+static void set_lossy(termout *o);
+
 void termout_set_picture(termout *o, encoder *e)
 {
 	o->pic = e;
+	set_lossy(o);
+}
+
+/* Lossy damage for refinement passes on a slow link. */
+static void set_lossy(termout *o)
+{
+	if (!o->pic || !o->pic->ops->set_lossy)
+		return;
+	bool slow = o->state == TERMOUT_PACED && o->st.bps > 0 && o->st.bps < TERMOUT_SLOW_BPS;
+	o->pic->ops->set_lossy(o->pic, slow && !o->final ? TERMOUT_JND : 0);
+}
+
+void termout_picture_final(termout *o, bool final)
+{
+	o->final = final;
+	set_lossy(o);
+}
+
+bool termout_picture_pending(const termout *o)
+{
+	return o->pic && encoder_dirty(o->pic);
 }
 
 void termout_drop_picture(termout *o)
@@ -329,6 +355,10 @@ void termout_input(termout *o, const char *b, size_t n, double now, abuf *keys)
 		memmove(o->hold, p + used, rest);
 		if (!was_held || o->nhold == 0 || used > 0)
 			o->hold_since = now;
+		/* Keys come whole (a terminal writes a key's sequence at once);
+		 * an answer may come in pieces, the more so on a loaded machine:
+		 * "ESC [ digits", "ESC [ ?" and a DCS wait longer than a lone Esc. */
+		o->hold_for = rest > 1 ? HOLD_ANSWER : HOLD_SECONDS;
 	}
 	o->nhold = rest;
 	free(tmp);
@@ -359,7 +389,7 @@ static void give_up(termout *o, const char *why)
 
 void termout_pump(termout *o, double now, abuf *keys)
 {
-	if (o->nhold && now - o->hold_since >= HOLD_SECONDS) {
+	if (o->nhold && now - o->hold_since >= o->hold_for) {
 		/* Nothing more came: keys after all (Esc, Alt+key). */
 		abuf_add(keys, o->hold, o->nhold);
 		o->nhold = 0;
@@ -369,6 +399,7 @@ void termout_pump(termout *o, double now, abuf *keys)
 	if (o->state == TERMOUT_PACED && o->st.in_flight > 0 && o->qlen > 0 &&
 	    now - o->q[o->qhead].sent >= slice_timeout(o))
 		give_up(o, "the terminal stopped answering status queries: the picture is not paced");
+	set_lossy(o);
 	if (!o->pic || o->state == TERMOUT_PROBING || !encoder_dirty(o->pic))
 		return;
 	abuf *a = &o->buf;
@@ -402,7 +433,7 @@ double termout_wait(const termout *o, double now)
 			best = d_;                    \
 	} while (0)
 	if (o->nhold)
-		CONSIDER(o->hold_since + HOLD_SECONDS);
+		CONSIDER(o->hold_since + o->hold_for);
 	if (o->state == TERMOUT_PROBING)
 		CONSIDER(o->probe_sent + TERMOUT_PROBE_TIMEOUT);
 	if (o->state == TERMOUT_PACED && o->qlen > 0 && o->st.in_flight > 0)

@@ -44,6 +44,8 @@
 
 #define TERMOUT_SLICE_SECONDS 0.08
 #define TERMOUT_PROBE_TIMEOUT 2.0
+#define TERMOUT_SLOW_BPS 2e6
+#define TERMOUT_JND 4
 
 typedef struct termout termout;
 
@@ -74,6 +76,13 @@ void termout_set_picture(termout *o, encoder *e);
 /* Drops the picture's changes not yet sent (Ctrl-C): the terminal keeps
  * what it shows. */
 void termout_drop_picture(termout *o);
+/* True while the terminal does not show the newest picture yet. */
+bool termout_picture_pending(const termout *o);
+/* Whether the picture is final (the render is done) or a refinement pass.
+ * On a slow link (paced, under TERMOUT_SLOW_BPS) a refinement pass is sent
+ * with lossy damage: cells whose colour moved by at most TERMOUT_JND sRGB
+ * levels in every channel stay as they are; a final picture is exact. */
+void termout_picture_final(termout *o, bool final);
 
 /* Also asks, in the next termout_probe, what pixels the terminal shows
  * (term/pixels.h: the kitty graphics query, XTSMGRAPHICS, the cell size);

@@ -12,14 +12,14 @@ s=rtsh-signals-$$
 fail() { echo "FAIL: $*"; tmux kill-session -t "$s" 2>/dev/null; tmux kill-session -t "$s-keep" 2>/dev/null; exit 1; }
 flags() { tmux display -p -t "$s" '#{alternate_on} #{cursor_flag} #{keypad_flag} #{keypad_cursor_flag}'; }
 screen() { tmux capture-pane -t "$s" -p; }
-# wait_for TEXT WHAT: up to 10 s for TEXT on the screen.
+# wait_for TEXT WHAT: up to 30 s for TEXT on the screen (a loaded machine).
 wait_for() {
-	for i in $(seq 1 100); do
+	for i in $(seq 1 300); do
 		case $(screen) in *"$1"*) return 0 ;; esac
 		sleep 0.1
 	done
 	fail "$2; the screen ends with:
-$(screen | tail -n 4)"
+$(screen | grep -v '^ *$' | tail -n 6)"
 }
 # wait_flags WANT WHAT: up to 5 s for the flags to read WANT.
 wait_flags() {

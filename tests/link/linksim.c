@@ -296,7 +296,7 @@ int main(int argc, char **argv)
 	snprintf(done_pat, sizeof done_pat, "%d/%d spp \xe2\x94\x82", samples, samples);
 	bytes prog = {0}; /* everything the program wrote, for the pattern */
 	size_t end_off = 0;
-	const char *dump = getenv("LINKSIM_DUMP"); /* what the program wrote after the render's end */
+	const char *dump = getenv("LINKSIM_DUMP"); /* what the program wrote after the event */
 	double t0 = now(), render_end = -1, key_at = -1, next_key = -1, first_pic_written = -1;
 	down.last = up.last = t0;
 	bool child_done = false;
@@ -359,6 +359,7 @@ int main(int argc, char **argv)
 		}
 		if (ctrlc && tm.picture && key_at < 0 && t - tm.first_picture >= 2.0) {
 			key_at = t;
+			end_off = prog.len;
 			answer(&up, "\x03");
 		}
 		/* Done when the wire has been idle for 3 s after the event. */

@@ -4,7 +4,7 @@
 
 #include <string.h>
 
-#include "shell/pager.h"
+#include "term/pager.h"
 
 static int rows(const char *s, int cols)
 {

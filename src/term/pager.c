@@ -1,5 +1,5 @@
 /* rtsh — the pager (pager.h). */
-#include "shell/pager.h"
+#include "term/pager.h"
 
 #include <errno.h>
 #include <poll.h>

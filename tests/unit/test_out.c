@@ -1,0 +1,278 @@
+/* rtsh — tests of the output scheduler (term/out.h): answers taken out of
+ * the keys, the start-up probe, slices paced by DSR answers, a newer
+ * picture overtaking one half sent (the terminal ends up showing exactly
+ * the newest), the fall-back when nothing answers, and lossy damage for
+ * refinement passes on a slow link with an exact final picture. The time
+ * is passed in, so the tests need no waiting. */
+#include "termemu.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include "term/encoder.h"
+#include "term/frame.h"
+#include "term/out.h"
+
+static int write_end = -1;
+
+/* A scheduler writing into a pipe, the pipe's read end in *rd. */
+static termout *open_out(int *rd)
+{
+	int p[2];
+	assert_int_equal(pipe(p), 0);
+	fcntl(p[0], F_SETFL, fcntl(p[0], F_GETFL) | O_NONBLOCK);
+	*rd = p[0];
+	write_end = p[1];
+	termout *o = termout_new(p[1]);
+	assert_non_null(o);
+	return o;
+}
+
+/* Frees o and closes both ends of its pipe (termout does not own its fd). */
+static void close_out(termout *o, int rd)
+{
+	termout_free(o);
+	close(rd);
+	close(write_end);
+}
+
+/* Everything written so far. */
+static size_t drain(int rd, char *buf, size_t size)
+{
+	size_t n = 0;
+	ssize_t r;
+	while (n < size - 1 && (r = read(rd, buf + n, size - 1 - n)) > 0)
+		n += (size_t)r;
+	buf[n] = '\0';
+	return n;
+}
+
+static void feed(termout *o, const char *s, double t, abuf *keys)
+{
+	termout_input(o, s, strlen(s), t, keys);
+}
+
+static void test_answers_out_of_keys(void **state)
+{
+	(void)state;
+	int rd;
+	termout *o = open_out(&rd);
+	char buf[4096];
+	abuf keys;
+	abuf_init(&keys);
+	termout_probe(o, true, 0.0);
+	drain(rd, buf, sizeof buf);
+	/* The questions, in order, the DA1 fence last. */
+	const char *rqss = strstr(buf, "\x1bP$qm\x1b\\"), *tcap = strstr(buf, "\x1bP+q524742;5463\x1b\\"),
+	           *da1 = strstr(buf, "\x1b[c");
+	assert_non_null(rqss);
+	assert_non_null(tcap);
+	assert_non_null(da1);
+	assert_true(rqss < tcap && tcap < da1);
+	assert_int_equal(termout_get_state(o), TERMOUT_PROBING);
+
+	/* Keys around an answer cut in three reads; an arrow key stays a key. */
+	feed(o, "ab\x1bP1$r0;48:2::1", 0.05, &keys);
+	feed(o, ":2:3m\x1b", 0.06, &keys);
+	feed(o, "\\c\x1b[A", 0.07, &keys);
+	assert_int_equal(keys.len, 6);
+	assert_memory_equal(keys.b, "abc\x1b[A", 6);
+	assert_int_equal(termout_truecolor(o), 1);
+	/* XTGETTCAP not answered (the terminal ignores it): DA1 ends the probe. */
+	feed(o, "\x1b[?62;22c", 0.1, &keys);
+	assert_int_equal(keys.len, 6);
+	assert_int_equal(termout_get_state(o), TERMOUT_PACED);
+	assert_false(termout_awaiting(o));
+	termout_stats st = termout_get_stats(o);
+	assert_near(st.rtt, 0.07, 1e-9); /* the quickest answer: DECRQSS, complete at 0.07 */
+	/* With nothing awaited, a lone Esc is a key at once. */
+	feed(o, "\x1b", 0.2, &keys);
+	assert_int_equal(keys.len, 7);
+	abuf_free(&keys);
+	close_out(o, rd);
+}
+
+static void test_probe_without_color_and_timeout(void **state)
+{
+	(void)state;
+	int rd;
+	termout *o = open_out(&rd);
+	char buf[4096];
+	abuf keys;
+	abuf_init(&keys);
+	/* A terminal that says no to 24-bit colour (DECRQSS gives the SGR
+	 * without it) and answers the rest. */
+	termout_probe(o, true, 0.0);
+	feed(o, "\x1bP1$r0;48;5;16m\x1b\\\x1bP0+r\x1b\\\x1b[?1;2c", 0.05, &keys);
+	assert_int_equal(keys.len, 0);
+	assert_int_equal(termout_truecolor(o), 0);
+	assert_int_equal(termout_get_state(o), TERMOUT_PACED);
+	assert_null(termout_notice(o));
+	drain(rd, buf, sizeof buf);
+	close_out(o, rd);
+
+	/* A terminal that answers nothing: unpaced after the time-out, said once. */
+	o = open_out(&rd);
+	termout_probe(o, false, 10.0);
+	termout_pump(o, 10.0 + TERMOUT_PROBE_TIMEOUT / 2, &keys);
+	assert_int_equal(termout_get_state(o), TERMOUT_PROBING);
+	assert_near(termout_wait(o, 10.0 + TERMOUT_PROBE_TIMEOUT / 2), TERMOUT_PROBE_TIMEOUT / 2, 1e-9);
+	termout_pump(o, 10.0 + TERMOUT_PROBE_TIMEOUT, &keys);
+	assert_int_equal(termout_get_state(o), TERMOUT_UNPACED);
+	assert_non_null(termout_notice(o));
+	assert_null(termout_notice(o));
+	/* A cut sequence held while an answer is awaited is keys after a while. */
+	drain(rd, buf, sizeof buf);
+	close_out(o, rd);
+	o = open_out(&rd);
+	termout_probe(o, false, 0.0);
+	feed(o, "\x1b[1", 0.0, &keys);
+	assert_int_equal(keys.len, 0);
+	termout_pump(o, 1.0, &keys); /* an answer cut on a loaded machine: it waits */
+	assert_int_equal(keys.len, 0);
+	termout_pump(o, 2.0, &keys);
+	assert_int_equal(keys.len, 3);
+	assert_memory_equal(keys.b, "\x1b[1", 3);
+	abuf_free(&keys);
+	drain(rd, buf, sizeof buf);
+	close_out(o, rd);
+}
+
+static void fill(uint8_t *img, int w, int h, unsigned seed)
+{
+	test_rng r = {seed};
+	for (int i = 0; i < w * h * 3; i++)
+		img[i] = (uint8_t)(trand(&r) * 256);
+}
+
+/* Feeds a slice to the emulator, checking it ends with the DSR query. */
+static void apply_slice(emu *e, const char *b, size_t n)
+{
+	assert_true(n >= 4);
+	assert_memory_equal(b + n - 4, "\x1b[5n", 4);
+	emu_feed(e, b, n - 4);
+}
+
+/* The screen shows exactly the encoder's picture of img (truecolor). */
+static void assert_screen_shows(const emu *e, const uint8_t *img, int w, int h, int tol)
+{
+	for (int y = 0; y < h; y += 2)
+		for (int x = 0; x < w; x++) {
+			const emu_cell *c = &e->cell[(y / 2) * e->cols + x];
+			uint32_t top = 0, bot = 0;
+			emu_pixels(c, &top, &bot, false);
+			const uint8_t *t = img + ((size_t)y * w + x) * 3, *b = t + (size_t)w * 3;
+			uint32_t wt = (uint32_t)t[0] << 16 | (uint32_t)t[1] << 8 | t[2];
+			uint32_t wb = (uint32_t)b[0] << 16 | (uint32_t)b[1] << 8 | b[2];
+			for (int sh = 0; sh < 24; sh += 8) {
+				int d1 = (int)((top >> sh) & 0xff) - (int)((wt >> sh) & 0xff);
+				int d2 = (int)((bot >> sh) & 0xff) - (int)((wb >> sh) & 0xff);
+				if (abs(d1) > tol || abs(d2) > tol)
+					fail_msg("cell %d,%d shows %06x/%06x, expected %06x/%06x (tolerance %d)", y / 2, x, top,
+					         bot, wt, wb, tol);
+			}
+		}
+}
+
+static void test_paced_slices_and_overtaking(void **state)
+{
+	(void)state;
+	enum { COLS = 40, ROWS = 12, W = COLS, H = 2 * ROWS };
+	int rd;
+	termout *o = open_out(&rd);
+	static char buf[1 << 20];
+	abuf keys;
+	abuf_init(&keys);
+	encoder_geom g = {.cols = COLS, .rows = ROWS, .pal = PALETTE_TRUECOLOR};
+	encoder *enc = encoder_halfblock.open(&g);
+	assert_non_null(enc);
+	termout_set_picture(o, enc);
+	termout_probe(o, false, 0.0);
+	drain(rd, buf, sizeof buf);
+	feed(o, "\x1b[?62c", 0.01, &keys);
+	assert_int_equal(termout_get_state(o), TERMOUT_PACED);
+
+	uint8_t a[W * H * 3], b[W * H * 3];
+	fill(a, W, H, 1);
+	fill(b, W, H, 2);
+	emu e;
+	emu_init(&e, COLS, ROWS);
+	encoder_put(enc, a, W, H, 0, 0);
+	/* Random colours cost about 40 bytes a cell: the first slice (4 KB
+	 * before the link is measured) holds only some of the 12 rows. */
+	termout_pump(o, 1.0, &keys);
+	size_t n = drain(rd, buf, sizeof buf);
+	assert_true(n > 0 && n < 4096 + 40 * COLS + 64);
+	apply_slice(&e, buf, n);
+	/* Nothing more until the answer. */
+	termout_pump(o, 1.01, &keys);
+	assert_int_equal(drain(rd, buf, sizeof buf), 0);
+	assert_true(termout_get_stats(o).in_flight > 0);
+	/* A newer picture overtakes the half-sent one. */
+	encoder_put(enc, b, W, H, 0, 0);
+	double t = 1.1;
+	for (int i = 0; i < 100 && encoder_dirty(enc); i++) {
+		feed(o, "\x1b[0n", t, &keys);
+		termout_pump(o, t, &keys);
+		n = drain(rd, buf, sizeof buf);
+		if (n)
+			apply_slice(&e, buf, n);
+		t += 0.1;
+	}
+	assert_false(encoder_dirty(enc));
+	assert_screen_shows(&e, b, W, H, 0);
+	assert_int_equal(keys.len, 0);
+	/* The link was measured from the answers. */
+	assert_true(termout_get_stats(o).bps > 0);
+
+	/* A refinement pass on this slow link: cells within the JND stay, the
+	 * others go; the final picture is exact. */
+	feed(o, "\x1b[0n", t, &keys);
+	uint8_t c[W * H * 3];
+	memcpy(c, b, sizeof c);
+	for (int i = 0; i < W * H * 3; i++)
+		c[i] = (uint8_t)(c[i] > 128 ? c[i] - 3 : c[i] + 3); /* within the JND */
+	for (int x = 0; x < 5; x++)
+		c[x * 3] = (uint8_t)(c[x * 3] ^ 0x80); /* five pixels of row 0 move far */
+	termout_picture_final(o, false);
+	encoder_put(enc, c, W, H, 0, 0);
+	t += 0.1;
+	termout_pump(o, t, &keys);
+	n = drain(rd, buf, sizeof buf);
+	assert_true(n > 0);
+	apply_slice(&e, buf, n);
+	assert_false(encoder_dirty(enc));
+	assert_true(n < 40 * 10); /* a run of five cells, not the picture */
+	assert_screen_shows(&e, c, W, H, TERMOUT_JND);
+	termout_picture_final(o, true);
+	for (int i = 0; i < 100 && encoder_dirty(enc); i++) {
+		feed(o, "\x1b[0n", t, &keys);
+		termout_pump(o, t, &keys);
+		n = drain(rd, buf, sizeof buf);
+		if (n)
+			apply_slice(&e, buf, n);
+		t += 0.1;
+	}
+	assert_screen_shows(&e, c, W, H, 0);
+
+	/* Ctrl-C: what is not sent is dropped. */
+	feed(o, "\x1b[0n", t, &keys);
+	encoder_put(enc, a, W, H, 0, 0);
+	termout_drop_picture(o);
+	assert_false(encoder_dirty(enc));
+	emu_free(&e);
+	abuf_free(&keys);
+	encoder_close(enc);
+	drain(rd, buf, sizeof buf);
+	close_out(o, rd);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_answers_out_of_keys),
+		cmocka_unit_test(test_probe_without_color_and_timeout),
+		cmocka_unit_test(test_paced_slices_and_overtaking),
+	};
+	return cmocka_run_group_tests_name("out", tests, NULL, NULL);
+}
