@@ -20,6 +20,10 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "rtsh/error.h"
 #include "rtsh/world.h"
 
@@ -41,6 +45,55 @@ typedef struct bvh_node {
 	uint32_t child[BVH_WIDTH];          /* inner: node index; leaf: first primitive */
 	uint32_t meta[BVH_WIDTH];           /* inner: 0; leaf: BVH_LEAF | primitive count */
 } bvh_node;
+
+/* The slab test's state for one ray: the origin rounded for the near and
+ * far planes and the inverse direction, per axis, and the rows of
+ * bvh_node.b that hold each axis's near and far planes. Each walker fills
+ * it its own way; bvh_slab4 reads it. */
+typedef struct bvh_ray {
+#if defined(__SSE2__)
+	__m128 on[3], of[3], inv[3];
+#else
+	float on[3], of[3], inv[3];
+#endif
+	int near[3], far[3];
+} bvh_ray;
+
+/* Widens tmax by the rounding of three float operations, so a box the ray
+ * grazes is never missed. */
+#define BVH_SLAB_SLACK (1.0f + 2.0f * (3.0f * 0x1p-24f) / (1.0f - 3.0f * 0x1p-24f))
+
+/* Slab tests of the four children of n against [tmin, tmax]: bit k of the
+ * result is set when child k may be hit, and tn[k] is (about) where the ray
+ * enters it. */
+static inline unsigned bvh_slab4(const bvh_node *n, const bvh_ray *q, float tmin, float tmax, float tn[4])
+{
+#if defined(__SSE2__)
+	__m128 t0 = _mm_set1_ps(tmin), t1 = _mm_set1_ps(tmax);
+	for (int a = 0; a < 3; a++) {
+		__m128 nb = _mm_load_ps(n->b[q->near[a]]), fb = _mm_load_ps(n->b[q->far[a]]);
+		/* max(x, acc) and min(x, acc) return acc when x is NaN */
+		t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(nb, q->on[a]), q->inv[a]), t0);
+		t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(fb, q->of[a]), q->inv[a]), t1);
+	}
+	_mm_storeu_ps(tn, t0);
+	return (unsigned)_mm_movemask_ps(_mm_cmple_ps(t0, _mm_mul_ps(t1, _mm_set1_ps(BVH_SLAB_SLACK))));
+#else
+	unsigned m = 0;
+	for (int k = 0; k < BVH_WIDTH; k++) {
+		float t0 = tmin, t1 = tmax;
+		for (int a = 0; a < 3; a++) {
+			float tnear = (n->b[q->near[a]][k] - q->on[a]) * q->inv[a];
+			float tfar = (n->b[q->far[a]][k] - q->of[a]) * q->inv[a];
+			t0 = tnear > t0 ? tnear : t0;
+			t1 = tfar < t1 ? tfar : t1;
+		}
+		tn[k] = t0;
+		m |= (unsigned)(t0 <= t1 * BVH_SLAB_SLACK) << k;
+	}
+	return m;
+#endif
+}
 
 struct bvh {
 	bvh_node *nodes;    /* 64-byte aligned; none when the root is a leaf */

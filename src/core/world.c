@@ -539,16 +539,6 @@ size_t world_memory(const world *w)
  * On x86-64 the four children are tested at once in SSE registers; the
  * scalar loop is the same test for other machines (GCC 12 vectorises it,
  * but the explicit version measured faster). */
-#define SLAB_SLACK (1.0f + 2.0f * (3.0f * 0x1p-24f) / (1.0f - 3.0f * 0x1p-24f))
-
-typedef struct ray_pre {
-#if defined(__SSE2__)
-	__m128 on[3], of[3], inv[3];
-#else
-	float on[3], of[3], inv[3]; /* origin, rounded for the near / far planes */
-#endif
-	int near[3], far[3]; /* rows of bvh_node.b */
-} ray_pre;
 
 /* A float <= v and a float >= v (a step of |f| 2^-23 covers the rounding;
  * cheaper than nextafterf, which is a library call). */
@@ -568,7 +558,7 @@ static inline float to_float_up(double v)
 	return f == -INFINITY ? -FLT_MAX : f + (fabsf(f) * 0x1p-23f + 0x1p-149f);
 }
 
-static inline void ray_prepare(const ray *r, ray_pre *q)
+static inline void ray_prepare(const ray *r, bvh_ray *q)
 {
 	double o[3] = {r->o.x, r->o.y, r->o.z}, d[3] = {r->d.x, r->d.y, r->d.z};
 	for (int a = 0; a < 3; a++) {
@@ -591,38 +581,6 @@ static inline void ray_prepare(const ray *r, ray_pre *q)
 		q->inv[a] = inv;
 #endif
 	}
-}
-
-/* Slab tests of the four children of n against [tmin, tmax]: bit k of the
- * result is set when child k may be hit, and tn[k] is (about) where the ray
- * enters it. */
-static inline unsigned slab4(const bvh_node *n, const ray_pre *q, float tmin, float tmax, float tn[4])
-{
-#if defined(__SSE2__)
-	__m128 t0 = _mm_set1_ps(tmin), t1 = _mm_set1_ps(tmax);
-	for (int a = 0; a < 3; a++) {
-		__m128 nb = _mm_load_ps(n->b[q->near[a]]), fb = _mm_load_ps(n->b[q->far[a]]);
-		/* max(x, acc) and min(x, acc) return acc when x is NaN */
-		t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(nb, q->on[a]), q->inv[a]), t0);
-		t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(fb, q->of[a]), q->inv[a]), t1);
-	}
-	_mm_storeu_ps(tn, t0);
-	return (unsigned)_mm_movemask_ps(_mm_cmple_ps(t0, _mm_mul_ps(t1, _mm_set1_ps(SLAB_SLACK))));
-#else
-	unsigned m = 0;
-	for (int k = 0; k < BVH_WIDTH; k++) {
-		float t0 = tmin, t1 = tmax;
-		for (int a = 0; a < 3; a++) {
-			float tnear = (n->b[q->near[a]][k] - q->on[a]) * q->inv[a];
-			float tfar = (n->b[q->far[a]][k] - q->of[a]) * q->inv[a];
-			t0 = tnear > t0 ? tnear : t0;
-			t1 = tfar < t1 ? tfar : t1;
-		}
-		tn[k] = t0;
-		m |= (unsigned)(t0 <= t1 * SLAB_SLACK) << k;
-	}
-	return m;
-#endif
 }
 
 typedef struct walk_entry {
@@ -668,7 +626,7 @@ bool world_intersect(const world *w, const ray *r, double tmin, double tmax, hit
 	if (w->nprims) {
 		const bvh *tree = w->tree;
 		const bvh_node *nodes = tree->nodes;
-		ray_pre q;
+		bvh_ray q;
 		ray_prepare(r, &q);
 		float ftmin = to_float_down(tmin), ftmax = to_float_up(tmax);
 		walk_entry stack[BVH_STACK];
@@ -688,7 +646,7 @@ bool world_intersect(const world *w, const ray *r, double tmin, double tmax, hit
 			} else {
 				const bvh_node *n = &nodes[child];
 				float tn[BVH_WIDTH];
-				unsigned m = slab4(n, &q, ftmin, ftmax, tn);
+				unsigned m = bvh_slab4(n, &q, ftmin, ftmax, tn);
 				if (m) {
 					if (m & (m - 1)) {
 						/* several: the nearest now, the others later */
@@ -703,7 +661,7 @@ bool world_intersect(const world *w, const ray *r, double tmin, double tmax, hit
 				}
 			}
 			/* the next entry that a nearer hit has not ruled out */
-			while (sp > 0 && stack[sp - 1].t > (double)SLAB_SLACK * tmax)
+			while (sp > 0 && stack[sp - 1].t > (double)BVH_SLAB_SLACK * tmax)
 				sp--;
 			if (sp == 0)
 				break;
@@ -731,7 +689,7 @@ bool world_occluded(const world *w, const ray *r, double tmin, double tmax)
 		return false;
 	const bvh *tree = w->tree;
 	const bvh_node *nodes = tree->nodes;
-	ray_pre q;
+	bvh_ray q;
 	ray_prepare(r, &q);
 	float ftmin = to_float_down(tmin), ftmax = to_float_up(tmax);
 	walk_entry stack[BVH_STACK];
@@ -747,7 +705,7 @@ bool world_occluded(const world *w, const ray *r, double tmin, double tmax)
 		} else {
 			const bvh_node *n = &nodes[child];
 			float tn[BVH_WIDTH];
-			unsigned m = slab4(n, &q, ftmin, ftmax, tn);
+			unsigned m = bvh_slab4(n, &q, ftmin, ftmax, tn);
 			if (m) {
 				/* any hit will do: no sorting, the first child now */
 				int k = __builtin_ctz(m);

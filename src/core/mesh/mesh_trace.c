@@ -20,7 +20,6 @@
 #include "core/bvh.h"
 #include "rtsh/mesh.h"
 
-#define SLACK (1.0f + 2.0f * (3.0f * 0x1p-24f) / (1.0f - 3.0f * 0x1p-24f))
 
 void mesh_ray_make(mesh_ray *r, vec3 o, vec3 d)
 {
@@ -86,16 +85,7 @@ typedef struct entry {
 	uint32_t pad;
 } entry;
 
-typedef struct pre {
-#if defined(__SSE2__)
-	__m128 on[3], of[3], inv[3];
-#else
-	float on[3], of[3], inv[3];
-#endif
-	int near[3], far[3];
-} pre;
-
-static inline void prepare(const mesh_ray *r, pre *q)
+static inline void prepare(const mesh_ray *r, bvh_ray *q)
 {
 	for (int a = 0; a < 3; a++) {
 		float inv = 1.0f / r->d[a];
@@ -115,38 +105,10 @@ static inline void prepare(const mesh_ray *r, pre *q)
 	}
 }
 
-static inline unsigned slab4(const bvh_node *n, const pre *q, float tmin, float tmax, float tn[4])
-{
-#if defined(__SSE2__)
-	__m128 t0 = _mm_set1_ps(tmin), t1 = _mm_set1_ps(tmax);
-	for (int a = 0; a < 3; a++) {
-		__m128 nb = _mm_load_ps(n->b[q->near[a]]), fb = _mm_load_ps(n->b[q->far[a]]);
-		t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(nb, q->on[a]), q->inv[a]), t0);
-		t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(fb, q->of[a]), q->inv[a]), t1);
-	}
-	_mm_storeu_ps(tn, t0);
-	return (unsigned)_mm_movemask_ps(_mm_cmple_ps(t0, _mm_mul_ps(t1, _mm_set1_ps(SLACK))));
-#else
-	unsigned m = 0;
-	for (int k = 0; k < BVH_WIDTH; k++) {
-		float t0 = tmin, t1 = tmax;
-		for (int a = 0; a < 3; a++) {
-			float tnear = (n->b[q->near[a]][k] - q->on[a]) * q->inv[a];
-			float tfar = (n->b[q->far[a]][k] - q->of[a]) * q->inv[a];
-			t0 = tnear > t0 ? tnear : t0;
-			t1 = tfar < t1 ? tfar : t1;
-		}
-		tn[k] = t0;
-		m |= (unsigned)(t0 <= t1 * SLACK) << k;
-	}
-	return m;
-#endif
-}
-
 bool mesh_intersect(const mesh *m, const mesh_ray *r, float tmin, float *tmax, uint32_t *tri, float b[3])
 {
 	const bvh *tree = m->tree;
-	pre q;
+	bvh_ray q;
 	prepare(r, &q);
 	entry stack[BVH_STACK];
 	int sp = 0;
@@ -164,7 +126,7 @@ bool mesh_intersect(const mesh *m, const mesh_ray *r, float tmin, float *tmax, u
 		} else {
 			const bvh_node *n = &tree->nodes[child];
 			float tn[BVH_WIDTH];
-			unsigned hm = slab4(n, &q, tmin, best, tn);
+			unsigned hm = bvh_slab4(n, &q, tmin, best, tn);
 			if (hm) {
 				if (hm & (hm - 1)) {
 					int idx[BVH_WIDTH], c = 0;
@@ -190,7 +152,7 @@ bool mesh_intersect(const mesh *m, const mesh_ray *r, float tmin, float *tmax, u
 				continue;
 			}
 		}
-		while (sp > 0 && stack[sp - 1].t > SLACK * best)
+		while (sp > 0 && stack[sp - 1].t > BVH_SLAB_SLACK * best)
 			sp--;
 		if (sp == 0)
 			break;
@@ -207,7 +169,7 @@ bool mesh_intersect(const mesh *m, const mesh_ray *r, float tmin, float *tmax, u
 bool mesh_occluded(const mesh *m, const mesh_ray *r, float tmin, float tmax)
 {
 	const bvh *tree = m->tree;
-	pre q;
+	bvh_ray q;
 	prepare(r, &q);
 	entry stack[BVH_STACK];
 	int sp = 0;
@@ -224,7 +186,7 @@ bool mesh_occluded(const mesh *m, const mesh_ray *r, float tmin, float tmax)
 		} else {
 			const bvh_node *n = &tree->nodes[child];
 			float tn[BVH_WIDTH];
-			unsigned hm = slab4(n, &q, tmin, tmax, tn);
+			unsigned hm = bvh_slab4(n, &q, tmin, tmax, tn);
 			if (hm) {
 				int k = __builtin_ctz(hm);
 				for (unsigned rest = hm & (hm - 1); rest; rest &= rest - 1) {
