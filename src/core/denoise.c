@@ -209,6 +209,40 @@ static void setup_rows(job *j, int y0, int y1)
 		}
 }
 
+/* The brightness of the 3x3 neighbours of (x, y) in src that lie on the
+ * same surface: those whose features k0..5 are within a squared distance
+ * of 4 of the pixel's own (k0 = 3: the normals alone; 0: all of them).
+ * Sums the brightness and its square into s1 and s2 and counts them in n;
+ * the pixel itself counts when with_self. */
+static void neighbours(const job *j, const texel *src, int x, int y, int k0, bool with_self,
+                       float *s1, float *s2, float *n)
+{
+	int w = j->fb->w, h = j->fb->h;
+	const guide *gp = &j->g[(size_t)y * w + x];
+	*s1 = *s2 = *n = 0;
+	for (int dy = -1; dy <= 1; dy++) {
+		int qy = y + dy;
+		if (qy < 0 || qy >= h)
+			continue;
+		for (int dx = -1; dx <= 1; dx++) {
+			int qx = x + dx;
+			if (qx < 0 || qx >= w || (!with_self && dx == 0 && dy == 0))
+				continue;
+			size_t q = (size_t)qy * w + qx;
+			const guide *gq = &j->g[q];
+			float d = 0; /* the features' squared distance, scaled */
+			for (int k = k0; k < 6; k++)
+				d += (gp->f[k] - gq->f[k]) * (gp->f[k] - gq->f[k]);
+			if (d > 4.0f)
+				continue;
+			float l = lum(src[q].c);
+			*s1 += l;
+			*s2 += l * l;
+			*n += 1;
+		}
+	}
+}
+
 /* The noise variance of each pixel's brightness: from its own samples
  * (the mean of their squares), or with a single sample the variance over
  * its 3x3 neighbours on the same surface (a spatial estimate, as SVGF's
@@ -216,79 +250,37 @@ static void setup_rows(job *j, int y0, int y1)
 static void variance_rows(job *j, int y0, int y1)
 {
 	const framebuffer *fb = j->fb;
-	int w = fb->w, h = fb->h;
+	int w = fb->w;
 	texel *t = j->buf[1];
 	for (int y = y0; y < y1; y++)
 		for (int x = 0; x < w; x++) {
 			size_t i = (size_t)y * w + x;
-			const guide *gp = &j->g[i];
-			float s1 = 0, s2 = 0, n = 0;
-			for (int dy = -1; dy <= 1; dy++) {
-				int qy = y + dy;
-				if (qy < 0 || qy >= h)
-					continue;
-				for (int dx = -1; dx <= 1; dx++) {
-					int qx = x + dx;
-					if (qx < 0 || qx >= w)
-						continue;
-					size_t q = (size_t)qy * w + qx;
-					const guide *gq = &j->g[q];
-					float dn = 0; /* the normals' squared distance / SIGMA_N2 */
-					for (int k = 3; k < 6; k++)
-						dn += (gp->f[k] - gq->f[k]) * (gp->f[k] - gq->f[k]);
-					if (dn > 4.0f)
-						continue;
-					float l = lum(t[q].c);
-					s1 += l;
-					s2 += l * l;
-					n += 1;
-				}
-			}
-			float mean = s1 / n, var = s2 / n - mean * mean;
-			/* n samples estimate it with n - 1 degrees of freedom */
-			t[i].var = n > 1 ? (var > 0 ? var : 0) * n / (n - 1) : 0.0f;
 			if (fb->spp >= 2) {
 				/* The variance of the pixel's mean, from its own samples,
 				 * over the albedo squared like its radiance. */
 				float m1 = lum(fb->rgb + i * 3), m2 = fb->feat[i * DENOISE_FEATURES + 7];
-				float am = lum(gp->am);
+				float am = lum(j->g[i].am);
 				float v = (m2 - m1 * m1) / (float)(fb->spp - 1) / (am * am);
 				t[i].var = v > 0 ? v : 0;
+				continue;
 			}
+			float s1, s2, n;
+			neighbours(j, t, x, y, 3, true, &s1, &s2, &n);
+			float mean = s1 / n, var = s2 / n - mean * mean;
+			/* n samples estimate it with n - 1 degrees of freedom */
+			t[i].var = n > 1 ? (var > 0 ? var : 0) * n / (n - 1) : 0.0f;
 		}
 }
 
 /* Fireflies brought down (FIREFLY_K), src to dst. */
 static void clamp_rows(job *j, const texel *src, texel *dst, int y0, int y1)
 {
-	const framebuffer *fb = j->fb;
-	int w = fb->w, h = fb->h;
+	int w = j->fb->w;
 	for (int y = y0; y < y1; y++)
 		for (int x = 0; x < w; x++) {
 			size_t i = (size_t)y * w + x;
-			const guide *gp = &j->g[i];
-			float s1 = 0, s2 = 0, n = 0;
-			for (int dy = -1; dy <= 1; dy++) {
-				int qy = y + dy;
-				if (qy < 0 || qy >= h)
-					continue;
-				for (int dx = -1; dx <= 1; dx++) {
-					int qx = x + dx;
-					if (qx < 0 || qx >= w || (dx == 0 && dy == 0))
-						continue;
-					size_t q = (size_t)qy * w + qx;
-					const guide *gq = &j->g[q];
-					float d = 0; /* the features' squared distance, scaled */
-					for (int k = 0; k < 6; k++)
-						d += (gp->f[k] - gq->f[k]) * (gp->f[k] - gq->f[k]);
-					if (d > 4.0f)
-						continue;
-					float l = lum(src[q].c);
-					s1 += l;
-					s2 += l * l;
-					n += 1;
-				}
-			}
+			float s1, s2, n;
+			neighbours(j, src, x, y, 0, false, &s1, &s2, &n);
 			dst[i] = src[i];
 			if (n < 3)
 				continue;
