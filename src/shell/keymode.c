@@ -3,7 +3,7 @@
  * Three parts:
  *   1. keys to edits: pure functions of the key, the scene and the
  *      selection (unit-tested without a terminal);
- *   2. the session: a render thread of its own, the adaptive pixel ratio,
+ *   2. the session: requests to the render service, the adaptive pixel ratio,
  *      the picture with the selection marked, the status line and the help
  *      bar;
  *   3. the terminal: ncurses for the keys, termios, signals, and giving the
@@ -26,7 +26,6 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
-#include <pthread.h>
 #include <signal.h>
 #include <stdarg.h>
 #include <stdatomic.h>
@@ -346,264 +345,14 @@ bool keymode_apply(editor *ed, const km_action *a, rt_error *err)
 /* 2. The session                                                      */
 /* ------------------------------------------------------------------ */
 
-/* A render request to the session's thread. */
-typedef struct km_req {
-	uint64_t seq;         /* newer requests have larger numbers */
+/* The request the newest images must answer. */
+typedef struct km_cur {
+	uint64_t seq;         /* rsvc_start's number (0: none yet) */
 	uint64_t gen;         /* the scene generation the world shows */
-	const world *w;
-	render_settings set;  /* samples = the target of a refine */
+	render_settings set;
 	int w_px, h_px;       /* the render size */
 	bool refine;          /* all the samples, in passes that accumulate */
-} km_req;
-
-/* An image the thread published. */
-typedef struct km_img {
-	uint64_t seq;
-	int w, h;
-	float *rgb;
-	size_t cap;
-	int spp, target;
-	bool done, refine;
-	double seconds;       /* the render time of this frame / pass */
-	double px_cost;       /* seconds per pixel and sample it measured */
-} km_img;
-
-typedef struct km_worker {
-	pthread_t thread;
-	bool started;
-	int wake_fd;
-	pthread_mutex_t m; /* guards quit, pending, busy, req */
-	pthread_cond_t work, idle;
-	bool quit, pending, busy;
-	km_req req;
-	atomic_bool cancel;
-
-	pthread_mutex_t im; /* guards img, serial, the cancel report */
-	km_img img;
-	uint64_t serial;
-	/* The last fast frame that was cancelled: how far it got. */
-	uint64_t cut_seq;
-	double cut_seconds, cut_frac;
-
-	/* The thread's own. */
-	framebuffer *fast, *fb;
-	km_req fb_req;     /* what fb holds */
-	long tiles_done, tiles_total;
-} km_worker;
-
-static void wk_wake(km_worker *wk)
-{
-	if (wk->wake_fd >= 0) {
-		ssize_t r = write(wk->wake_fd, "k", 1);
-		(void)r; /* a full pipe already holds a wake-up */
-	}
-}
-
-static void wk_publish(km_worker *wk, const km_req *req, const framebuffer *fb, int target, double seconds,
-                       double px_cost)
-{
-	size_t n = (size_t)fb->w * (size_t)fb->h * 3;
-	pthread_mutex_lock(&wk->im);
-	km_img *img = &wk->img;
-	bool ok = true;
-	if (n > img->cap) {
-		float *p = realloc(img->rgb, n * sizeof *p);
-		if (p) {
-			img->rgb = p;
-			img->cap = n;
-		} else {
-			ok = false;
-		}
-	}
-	if (ok) {
-		memcpy(img->rgb, fb->rgb, n * sizeof *img->rgb);
-		img->seq = req->seq;
-		img->w = fb->w;
-		img->h = fb->h;
-		img->spp = fb->spp;
-		img->target = target;
-		img->done = fb->spp >= target;
-		img->refine = req->refine;
-		img->seconds = seconds;
-		img->px_cost = px_cost;
-		wk->serial++;
-	}
-	pthread_mutex_unlock(&wk->im);
-	if (ok)
-		wk_wake(wk);
-}
-
-static void wk_progress(void *ctx, long done, long total)
-{
-	km_worker *wk = ctx;
-	wk->tiles_done = done;
-	wk->tiles_total = total;
-}
-
-/* True when fb (rendered for a) can take more samples for b. */
-static bool wk_continues(const km_req *a, const km_req *b)
-{
-	return a->refine && b->refine && a->gen == b->gen && a->w == b->w && a->w_px == b->w_px &&
-	       a->h_px == b->h_px && a->set.mode == b->set.mode && a->set.depth == b->set.depth &&
-	       a->set.seed == b->set.seed && (a->set.samples > 1) == (b->set.samples > 1);
-}
-
-static void wk_run(km_worker *wk, const km_req *req)
-{
-	rt_error err;
-	double t0 = now();
-	render_job job = {
-		.w = req->w,
-		.set = req->set,
-		.cancel = &wk->cancel,
-		.progress = wk_progress,
-		.progress_ctx = wk,
-	};
-	wk->tiles_done = 0;
-	wk->tiles_total = 1;
-	if (!req->refine) {
-		/* A fast frame: one centred sample per pixel. */
-		framebuffer *fb = fb_reuse(&wk->fast, req->w_px, req->h_px);
-		if (!fb)
-			return;
-		job.set.samples = 1;
-		job.fb = fb;
-		job.sample_begin = 0;
-		job.sample_end = 1;
-		render_status st = render_run(&job, &err);
-		double dt = now() - t0;
-		if (st == RENDER_DONE) {
-			wk_publish(wk, req, fb, 1, dt, dt / ((double)fb->w * fb->h));
-		} else if (st == RENDER_CANCELLED) {
-			pthread_mutex_lock(&wk->im);
-			wk->cut_seq = req->seq;
-			wk->cut_seconds = dt;
-			wk->cut_frac = wk->tiles_total > 0 ? (double)wk->tiles_done / (double)wk->tiles_total : 0.0;
-			pthread_mutex_unlock(&wk->im);
-		}
-		return;
-	}
-	/* A refine: go on from the samples fb holds when it shows the same. */
-	framebuffer *fb = wk->fb;
-	bool cont = fb && fb->spp > 0 && fb->spp <= req->set.samples && wk_continues(&wk->fb_req, req);
-	if (!cont)
-		fb = fb_reuse(&wk->fb, req->w_px, req->h_px);
-	if (!fb)
-		return;
-	wk->fb_req = *req;
-	int target = req->set.samples, done = fb->spp, n = 1;
-	if (done >= target) {
-		wk_publish(wk, req, fb, target, 0.0, 0.0);
-		return;
-	}
-	while (done < target) {
-		if (n > target - done)
-			n = target - done;
-		job.fb = fb;
-		job.sample_begin = done;
-		job.sample_end = done + n;
-		double t1 = now();
-		if (render_run(&job, &err) != RENDER_DONE)
-			return;
-		double dt = now() - t1, per = dt / n;
-		done += n;
-		wk_publish(wk, req, fb, target, dt, per / ((double)fb->w * fb->h));
-		/* Passes of about 0.2 s after the first. */
-		n = per > 0 ? (int)(0.2 / per) : 64;
-		if (n < 1)
-			n = 1;
-	}
-}
-
-static void *wk_main(void *arg)
-{
-	km_worker *wk = arg;
-	pthread_mutex_lock(&wk->m);
-	for (;;) {
-		while (!wk->quit && !wk->pending)
-			pthread_cond_wait(&wk->work, &wk->m);
-		if (wk->quit)
-			break;
-		km_req req = wk->req;
-		wk->pending = false;
-		wk->busy = true;
-		pthread_mutex_unlock(&wk->m);
-		wk_run(wk, &req);
-		pthread_mutex_lock(&wk->m);
-		wk->busy = false;
-		pthread_cond_broadcast(&wk->idle);
-	}
-	pthread_mutex_unlock(&wk->m);
-	return NULL;
-}
-
-static void wk_init(km_worker *wk, int wake_fd)
-{
-	memset(wk, 0, sizeof *wk);
-	wk->wake_fd = wake_fd;
-	pthread_mutex_init(&wk->m, NULL);
-	pthread_mutex_init(&wk->im, NULL);
-	pthread_cond_init(&wk->work, NULL);
-	pthread_cond_init(&wk->idle, NULL);
-	atomic_init(&wk->cancel, false);
-}
-
-/* Cancels the render in flight and any request waiting; returns once the
- * thread no longer uses the world. */
-static void wk_hold(km_worker *wk)
-{
-	pthread_mutex_lock(&wk->m);
-	wk->pending = false;
-	atomic_store(&wk->cancel, true);
-	while (wk->busy)
-		pthread_cond_wait(&wk->idle, &wk->m);
-	atomic_store(&wk->cancel, false);
-	pthread_mutex_unlock(&wk->m);
-}
-
-static bool wk_busy(km_worker *wk)
-{
-	pthread_mutex_lock(&wk->m);
-	bool b = wk->busy || wk->pending;
-	pthread_mutex_unlock(&wk->m);
-	return b;
-}
-
-static bool wk_start(km_worker *wk, const km_req *req)
-{
-	pthread_mutex_lock(&wk->m);
-	wk->req = *req;
-	wk->pending = true;
-	if (!wk->started) {
-		if (pthread_create(&wk->thread, NULL, wk_main, wk) == 0)
-			wk->started = true;
-		else
-			wk->pending = false;
-	}
-	bool ok = wk->pending;
-	pthread_cond_signal(&wk->work);
-	pthread_mutex_unlock(&wk->m);
-	return ok;
-}
-
-static void wk_free(km_worker *wk)
-{
-	if (wk->started) {
-		pthread_mutex_lock(&wk->m);
-		wk->quit = true;
-		atomic_store(&wk->cancel, true);
-		pthread_cond_signal(&wk->work);
-		pthread_mutex_unlock(&wk->m);
-		pthread_join(wk->thread, NULL);
-	}
-	fb_free(wk->fast);
-	fb_free(wk->fb);
-	free(wk->img.rgb);
-	pthread_mutex_destroy(&wk->m);
-	pthread_mutex_destroy(&wk->im);
-	pthread_cond_destroy(&wk->work);
-	pthread_cond_destroy(&wk->idle);
-}
+} km_cur;
 
 /* The pixel ratios a fast frame may use. */
 static const double ratios[] = {1, 1.5, 2, 3, 4, 6, 8, 12, 16};
@@ -626,8 +375,8 @@ struct keymode {
 	double layout_aspect;  /* the image aspect the layout is for */
 	bool repaint;          /* clear the screen before the next frame */
 
-	km_worker wk;
-	const world *w;        /* the preview's world for wgen (NULL: none yet) */
+	rsvc *rs;              /* the shell's render service */
+	const world *w;        /* a reference to the world for wgen (NULL: none yet) */
 	uint64_t wgen;
 	double step;
 
@@ -636,18 +385,15 @@ struct keymode {
 	int run_key;
 	km_sel run_sel;
 
-	uint64_t seq;          /* the newest request */
-	km_req cur;
+	km_cur cur;
 	bool want_fast, want_refine; /* a render to start */
 	bool refined;          /* the newest request is a refine (or needs none) */
 	bool stopped;
 	double last_key;
 	int ratio_i;
 	double cost;           /* seconds per pixel and sample; 0 = not known */
-	uint64_t cut_seen;
-	uint64_t taken;        /* the thread's image serial last looked at */
-
-	km_img img;            /* the newest image taken */
+	rsvc_image img;        /* the newest image taken (of the request cur) */
+	rsvc_image spare;      /* what rsvc_take copies out, swapped in when it answers cur */
 	bool have_img, dirty;
 	bool held;             /* a new image waits to be drawn */
 	double last_draw;
@@ -717,17 +463,19 @@ static void km_message(keymode *km, const char *fmt, ...)
 
 /* --- the world and the requests --- */
 
-/* The world for the editor's scene, built when the scene changed (the
- * thread must not be rendering). */
+/* The world for the editor's scene, from the render service (built when
+ * the scene changed); key mode holds a reference until the scene changes
+ * again, so neither the selection marks nor a render ever use a world the
+ * service (or the shell's preview) let go of. */
 static const world *km_world(keymode *km)
 {
 	uint64_t gen = editor_generation(km->sh->ed);
 	if (km->w && km->wgen == gen)
 		return km->w;
-	preview_hold(km->sh->pv); /* cheap when held: the shell may have released it */
+	world_release(km->w);
 	rt_error err;
 	rt_error_clear(&err);
-	km->w = preview_world(km->sh->pv, editor_scene(km->sh->ed), gen, &err);
+	km->w = rsvc_world(km->rs, editor_scene(km->sh->ed), gen, &err);
 	km->wgen = gen;
 	if (!km->w)
 		km_message(km, "the scene cannot be shown: %s", err.msg);
@@ -759,14 +507,10 @@ static int km_pick_ratio(keymode *km)
 /* What the last cancelled fast frame says about the cost of a pixel. */
 static void km_learn_from_cut(keymode *km)
 {
-	km_worker *wk = &km->wk;
-	pthread_mutex_lock(&wk->im);
-	uint64_t seq = wk->cut_seq;
-	double sec = wk->cut_seconds, frac = wk->cut_frac;
-	pthread_mutex_unlock(&wk->im);
-	if (seq == km->cut_seen || seq != km->cur.seq || km->cur.refine)
+	uint64_t seq;
+	double sec, frac;
+	if (!rsvc_cut(km->rs, &seq, &sec, &frac) || seq != km->cur.seq || km->cur.refine)
 		return;
-	km->cut_seen = seq;
 	double px = (double)km->cur.w_px * km->cur.h_px;
 	if (px <= 0 || sec < 0.002)
 		return; /* cut at once: says nothing */
@@ -780,36 +524,36 @@ static void km_start(keymode *km, bool refine)
 	shell *sh = km->sh;
 	if (km->img_w <= 0 || km->img_h <= 0)
 		return;
-	wk_hold(&km->wk);
+	rsvc_hold(km->rs);
 	km_learn_from_cut(km);
 	const world *w = km_world(km);
 	if (!w)
 		return;
-	km_req r;
-	memset(&r, 0, sizeof r);
-	r.seq = ++km->seq;
-	r.gen = km->wgen;
-	r.w = w;
-	r.set = sh->set;
-	r.refine = refine;
+	rsvc_request r = {
+		.world = w,
+		.gen = km->wgen,
+		.set = sh->set,
+		.w = km->img_w,
+		.h = km->img_h,
+	};
+	km_cur c = {.gen = km->wgen, .set = sh->set, .refine = refine, .w_px = km->img_w, .h_px = km->img_h};
 	if (refine) {
-		r.w_px = km->img_w;
-		r.h_px = km->img_h;
+		/* Goes on from the samples already in when only their number
+		 * changed. */
+		r.kind = RSVC_REFINE;
+		r.accumulate = true;
+		r.pass_seconds = KEYMODE_PASS_SECONDS;
 	} else {
 		km->ratio_i = km_pick_ratio(km);
-		double q = ratios[km->ratio_i];
-		/* The picture's aspect kept, so the pixels stay square. */
-		r.w_px = (int)ceil(km->img_w / q);
-		r.h_px = (int)lround((double)r.w_px * km->img_h / km->img_w);
-		if (r.w_px < 1)
-			r.w_px = 1;
-		if (r.h_px < 1)
-			r.h_px = 1;
+		r.kind = RSVC_FRAME;
+		r.ratio = ratios[km->ratio_i];
+		rsvc_frame_size(km->img_w, km->img_h, r.ratio, &c.w_px, &c.h_px);
 	}
-	km->cur = r;
+	c.seq = rsvc_start(km->rs, &r);
+	km->cur = c;
 	km->refined = refine;
 	km->stopped = false;
-	if (!wk_start(&km->wk, &r))
+	if (!c.seq)
 		km_message(km, "cannot start the render thread");
 }
 
@@ -981,23 +725,24 @@ static void km_status_text(keymode *km, char *buf, size_t size)
 	shell *sh = km->sh;
 	char sel[128], spp[64], res[48] = "", fps[32] = "", t[32] = "";
 	km_sel_name(km, sel, sizeof sel);
-	const km_img *im = &km->img;
+	const rsvc_image *im = &km->img;
+	bool refine = im->kind == RSVC_REFINE;
 	if (!km->have_img)
 		snprintf(spp, sizeof spp, "rendering");
-	else if (!im->refine && !km->refined)
+	else if (!refine && !km->refined)
 		snprintf(spp, sizeof spp, "moving");
-	else if (!im->refine)
+	else if (!refine)
 		snprintf(spp, sizeof spp, "1/1 spp");
 	else
 		snprintf(spp, sizeof spp, "%d/%d spp%s", im->spp, im->target,
 		         km->stopped ? " stopped" : im->done ? "" : "…");
-	if (km->have_img && !im->refine && ratios[km->ratio_i] > 1)
+	if (km->have_img && !refine && ratios[km->ratio_i] > 1)
 		snprintf(res, sizeof res, " (1/%g res)", ratios[km->ratio_i]);
 	double f = km_fps(km);
 	if (f > 0)
 		snprintf(fps, sizeof fps, " │ %.0f fps", f);
 	if (km->have_img)
-		snprintf(t, sizeof t, " │ %.0f ms", im->seconds * 1000);
+		snprintf(t, sizeof t, " │ %.0f ms", im->pass_seconds * 1000);
 	/* A message goes right after the selection, where it is not cut off. */
 	bool msg = km->msg[0] && now() < km->msg_until;
 	snprintf(buf, size, " view │ %s │ %s%s%s │ %s │ %s │ depth %d │ %dx%d%s%s%s │ step %.3g", sh->name, sel,
@@ -1065,7 +810,7 @@ static void km_draw(keymode *km)
 			put_help(a, km->rows - 1, km->cols);
 		km->repaint = false;
 	}
-	const km_img *im = &km->img;
+	const rsvc_image *im = &km->img;
 	if (km->fr && km->have_img && im->w > 0 && im->h > 0) {
 		int W = km->img_w, H = km->img_h;
 		size_t n = (size_t)W * H * 3, sn = (size_t)im->w * im->h * 3;
@@ -1237,9 +982,9 @@ void keymode_key(keymode *km, int key)
 		break;
 	case KM_UNDO:
 	case KM_REDO:
-		/* The shell's calls below hold and release its preview: nothing
+		/* The shell's calls below hold and release the render service: nothing
 		 * of ours may be rendering then. */
-		wk_hold(&km->wk);
+		rsvc_hold(km->rs);
 		shell_edit_begin(sh);
 		if (!(a.op == KM_UNDO ? editor_undo(sh->ed, &err) : editor_redo(sh->ed, &err)))
 			km_message(km, "%s", err.msg);
@@ -1251,7 +996,7 @@ void keymode_key(keymode *km, int key)
 			km->want_refine = true; /* the render held above goes on */
 		break;
 	case KM_SCENE:
-		wk_hold(&km->wk);
+		rsvc_hold(km->rs);
 		km_shell_command(km, a.n > 0 ? cmd_next : cmd_prev);
 		km_after_replace(km, label_copy);
 		km->want_refine = true;
@@ -1263,8 +1008,8 @@ void keymode_key(keymode *km, int key)
 		km_settings(km, &a);
 		break;
 	case KM_STOP:
-		if (wk_busy(&km->wk) || km->want_fast || km->want_refine || !km->refined) {
-			wk_hold(&km->wk);
+		if (rsvc_busy(km->rs) || km->want_fast || km->want_refine || !km->refined) {
+			rsvc_hold(km->rs);
 			km->want_fast = km->want_refine = false;
 			km->refined = true;
 			km->stopped = true;
@@ -1291,35 +1036,15 @@ void keymode_key(keymode *km, int key)
 	free(label_copy);
 }
 
-/* Takes the newest image from the thread; true when there is one to show. */
+/* Takes the newest image from the service; true when there is one to show
+ * (images of an older request are dropped). */
 static bool km_take(keymode *km)
 {
-	km_worker *wk = &km->wk;
-	pthread_mutex_lock(&wk->im);
-	/* Images of an older request are dropped. */
-	bool fresh = wk->serial != km->taken && wk->img.seq == km->cur.seq;
-	km->taken = wk->serial;
-	if (fresh) {
-		size_t n = (size_t)wk->img.w * wk->img.h * 3;
-		if (n > km->img.cap) {
-			float *p = realloc(km->img.rgb, n * sizeof *p);
-			if (!p) {
-				pthread_mutex_unlock(&wk->im);
-				return false;
-			}
-			km->img.rgb = p;
-			km->img.cap = n;
-		}
-		float *keep = km->img.rgb;
-		size_t cap = km->img.cap;
-		km->img = wk->img;
-		km->img.rgb = keep;
-		km->img.cap = cap;
-		memcpy(km->img.rgb, wk->img.rgb, n * sizeof *keep);
-	}
-	pthread_mutex_unlock(&wk->im);
-	if (!fresh)
+	if (!rsvc_take(km->rs, &km->spare) || km->spare.seq != km->cur.seq)
 		return false;
+	rsvc_image t = km->img;
+	km->img = km->spare;
+	km->spare = t;
 	km->have_img = true;
 	/* What a pixel costs, for the next fast frame's ratio. */
 	if (km->img.px_cost > 0)
@@ -1337,7 +1062,7 @@ int keymode_tick(keymode *km)
 	} else if (km->want_refine || (!km->refined && t - km->last_key >= KEYMODE_IDLE)) {
 		km->want_refine = false;
 		/* A fast frame at full resolution with one sample is final. */
-		const km_req *c = &km->cur;
+		const km_cur *c = &km->cur;
 		bool final = c->seq != 0 && !c->refine && km->ratio_i == 0 && km->sh->set.samples == 1 &&
 		             c->gen == editor_generation(km->sh->ed) && c->set.mode == km->sh->set.mode &&
 		             c->set.depth == km->sh->set.depth && c->w_px == km->img_w && c->h_px == km->img_h;
@@ -1350,7 +1075,7 @@ int keymode_tick(keymode *km)
 		km->held = true;
 	/* Fast frames are drawn at once; passes of a refine at most 10 times a
 	 * second (its first and last pass at once). */
-	bool picture = km->held && (!km->img.refine || km->img.done || km->img.spp <= 1 ||
+	bool picture = km->held && (km->img.kind != RSVC_REFINE || km->img.done || km->img.spp <= 1 ||
 	                            t - km->last_draw >= 0.1);
 	if (km->msg[0] && t >= km->msg_until) {
 		km->msg[0] = '\0';
@@ -1367,7 +1092,7 @@ int keymode_tick(keymode *km)
 		if (picture) {
 			km->held = false;
 			km->frames++;
-			if (!km->img.refine)
+			if (km->img.kind != RSVC_REFINE)
 				km->fast_times[km->fast_frames++ % 16] = km->last_draw;
 			return 1;
 		}
@@ -1447,8 +1172,8 @@ keymode *keymode_new(shell *sh, int fd, frame_palette pal, int cols, int rows)
 	km->rows = rows;
 	km->help = true;
 	abuf_init(&km->out);
-	wk_init(&km->wk, sh->wake[1]);
-	preview_hold(sh->pv);
+	km->rs = sh->rs;
+	rsvc_hold(km->rs);
 	km->step = keymode_step(editor_scene(sh->ed));
 	km->sel = (km_sel){KM_SEL_CAMERA, 0};
 	km_layout(km);
@@ -1462,12 +1187,13 @@ void keymode_free(keymode *km)
 {
 	if (!km)
 		return;
-	wk_hold(&km->wk);
-	wk_free(&km->wk);
+	rsvc_hold(km->rs);
+	world_release(km->w);
 	km_close_run(km);
 	frame_free(km->fr);
 	abuf_free(&km->out);
-	free(km->img.rgb);
+	rsvc_image_free(&km->img);
+	rsvc_image_free(&km->spare);
 	free(km->small);
 	free(km->big);
 	free(km->mask);

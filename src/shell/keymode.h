@@ -46,6 +46,9 @@
  * after the last key before the picture is refined. */
 #define KEYMODE_FRAME_BUDGET 0.025
 #define KEYMODE_IDLE 0.15
+/* Seconds: the length the refine's passes aim at (after a first of one
+ * sample). */
+#define KEYMODE_PASS_SECONDS 0.2
 
 /* What the keys act on: the camera, or an object or a light (0-based). */
 typedef enum km_sel_kind {
@@ -115,12 +118,13 @@ vec3 keymode_axis_euler(vec3 axis, double deg);
 typedef struct keymode keymode;
 
 /* A key-mode session on sh's scene drawing frames of cols x rows cells to
- * fd in palette pal; the render thread writes a byte to sh->wake[1] when a
- * frame is ready. The shell's preview is held until keymode_free. NULL (the
- * shell's error set) on failure. */
+ * fd in palette pal. Its frames and refines are requests to the shell's
+ * render service (sh->rs), which wakes the wake-up pipe the shell gave it
+ * when a frame is ready; the shell's preview does not run until
+ * keymode_free. NULL (the shell's error set) on failure. */
 keymode *keymode_new(shell *sh, int fd, frame_palette pal, int cols, int rows);
-/* Ends the session: stops its thread, closes an open undo group, frees it.
- * The preview stays held (the caller restarts it). */
+/* Ends the session: cancels its render, closes an open undo group, frees
+ * it. The render service stays held (the caller restarts the preview). */
 void keymode_free(keymode *km);
 /* Handles one key (edits go to the editor at once; renders start in
  * keymode_tick). */

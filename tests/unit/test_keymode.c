@@ -457,6 +457,50 @@ static void test_session(void **state)
 	session_close(&ss);
 }
 
+/* Issue 9: after an undo the shell releases the render service, and
+ * something else may queue a request then (here, one for another scene):
+ * the service's kept world is replaced. Key mode holds its own reference,
+ * so its selection marks and its renders never use a freed world (ASan
+ * would report a use after free), and the picture goes on. */
+static void test_undo_then_another_request(void **state)
+{
+	(void)state;
+	session ss;
+	session_open(&ss);
+	assert_true(run_for(&ss, 0.3) >= 1);
+	keymode_key(ss.km, KEYS_UP);
+	run_for(&ss, 0.2);
+	keymode_key(ss.km, 'u');
+	run_for(&ss, 0.3); /* key mode takes the world of the undone scene */
+	scene *other = load("C 0,0,-5 0,0,1 70\nL 0,5,-5 0.7\nsp 0,0,0 2 255,255,0\n");
+	rsvc_request rq = {
+		.s = other,
+		.gen = (uint64_t)1 << 40,
+		.set = ss.sh.set,
+		.w = 32,
+		.h = 18,
+		.kind = RSVC_REFINE,
+	};
+	rq.set.samples = 1;
+	rsvc_start(ss.sh.rs, &rq);
+	for (int i = 0; i < 500 && rsvc_busy(ss.sh.rs); i++)
+		usleep(10000);
+	assert_false(rsvc_busy(ss.sh.rs));
+	rsvc_hold(ss.sh.rs);
+	scene_free(other);
+	/* The marks of a selected object trace key mode's world; Right moves
+	 * it and renders from that world too. */
+	size_t before = ss.len;
+	keymode_key(ss.km, '\t');
+	run_for(&ss, 0.3);
+	assert_true(strstr(ss.text + before, "8;2;255;205;0m") != NULL); /* the gold outline */
+	keymode_key(ss.km, KEYS_RIGHT);
+	assert_true(run_for(&ss, 0.3) >= 1);
+	assert_non_null(strstr(ss.text + before, "object 1 sphere"));
+	assert_vec_near(editor_scene(ss.sh.ed)->objs[0].pos, v3(0.5, 0, 0), 1e-12);
+	session_close(&ss);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -464,6 +508,7 @@ int main(void)
 		cmocka_unit_test(test_movement_keys), cmocka_unit_test(test_other_keys),
 		cmocka_unit_test(test_axis_euler),    cmocka_unit_test(test_apply),
 		cmocka_unit_test(test_turns),         cmocka_unit_test(test_session),
+		cmocka_unit_test(test_undo_then_another_request),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
