@@ -1,25 +1,16 @@
-/* rtsh — key mode (keymode.h).
+/* rtsh — key mode (keymode.h): the session and its loop.
  *
- * Three parts:
- *   1. keys to edits: pure functions of the key, the scene and the
- *      selection (unit-tested without a terminal);
- *   2. the session: requests to the render service, the adaptive pixel ratio,
- *      the picture with the selection marked, the status line and the help
- *      bar;
- *   3. the terminal: ncurses for the keys, termios, signals, and giving the
- *      shell's screen back.
- *
- * Escape sequences sent here, besides the frame encoder's (term/frame.h):
- *   \e[?2026h \e[?2026l   begin / end synchronized update, around each frame
- *   \e[r                  reset the scroll region (the shell's is restored
- *                         by screen_layout on the way out)
- *   \e[2J                 clear the screen
- *   \e[R;CH               move the cursor
- *   \e[7m  \e[m           reverse video (the status line) / reset
- *   \e[K                  clear to the end of the line
- *   \e[?25l \e[?25h       hide / show the cursor
- *   smkx / rmkx           terminfo's keypad transmit on / off, so that the
- *                         arrow keys send what terminfo (and ncurses) expect
+ * Key mode is three files: the key table and the edits keys make
+ * (keymode_keys.c), the key view's drawing (term/keyview.c: every escape
+ * sequence of key mode, sent through the output scheduler), and this one:
+ *   1. the session: requests to the render service (shell/render_service.h),
+ *      the adaptive pixel ratio, the picture with the selection marked and
+ *      the status line's text;
+ *   2. the loop: the terminal's input through the output scheduler (its
+ *      answers pace the picture) and on to ncurses for the keys, termios,
+ *      signals, and giving the shell's screen back.
+ * The keypad transmit mode (terminfo's smkx / rmkx, so that the arrow keys
+ * send what ncurses expects) is sent by screen_keypad (term/screen.h).
  */
 #include "shell/keymode.h"
 
@@ -47,38 +38,7 @@
 #include "term/abuf.h"
 #include "term/frame.h"
 #include "term/keys.h"
-
-/* The help bar and `help view`. */
-const char keymode_help[] =
-	"keys in view (key mode; letters in either case but u and U):\n"
-	"  Up Down Left Right, w s a d  move forward, back, left, right (the camera flies where it\n"
-	"                               looks; a selected object or light moves level with the floor)\n"
-	"  r f                          move up, down\n"
-	"  i k j l, Shift+arrows        turn the camera (pitch, yaw) by 3 degrees\n"
-	"  Tab, Shift+Tab               select the next / previous object or light, then the camera\n"
-	"  [ ]                          turn the selected object about the vertical by 15 degrees\n"
-	"  { }                          roll it about the line of sight by 15 degrees\n"
-	"  - +                          shrink / grow it (x1.1); a light: dimmer / brighter;\n"
-	"                               the camera: zoom out / in (field of view)\n"
-	"  , .                          halve / double the samples per pixel\n"
-	"  < >                          depth one less / one more\n"
-	"  PgUp PgDn                    the previous / next .rt file of the scene's folder\n"
-	"  m                            switch between whitted and path mode\n"
-	"  Space                        stop the render in progress\n"
-	"  u U                          undo / redo (a run of the same key is one step)\n"
-	"  ? F1                         hide / show the help bar;  Ctrl-L F5  repaint\n"
-	"  Esc q                        back to the shell; every change stays (undo, save x.rt)\n"
-	"a movement key moves by 1/40 of the size of the scene (the box around the objects\n"
-	"but planes, the lights and the camera); see KEY MODE in rtsh(1)\n";
-
-/* The help bar: keys (in bold) and what they do, as many as fit. */
-static const struct {
-	const char *keys, *what;
-} help_bar[] = {
-	{"Esc", "back"}, {"←↑↓→ wasd", "move"}, {"r f", "up/down"}, {"ijkl ⇧←↑↓→", "turn"}, {"Tab", "select"},
-	{"[ ] { }", "rotate"}, {"- +", "size"}, {"u", "undo"}, {"m", "mode"}, {", .", "spp"}, {"< >", "depth"},
-	{"PgUp PgDn", "scene"}, {"Space", "stop"}, {"?", "hide this"},
-};
+#include "term/keyview.h"
 
 static double now(void)
 {
@@ -88,261 +48,7 @@ static double now(void)
 }
 
 /* ------------------------------------------------------------------ */
-/* 1. Keys to edits                                                    */
-/* ------------------------------------------------------------------ */
-
-double keymode_step(const scene *s)
-{
-	camera c = scene_camera(s);
-	box b = box_point(c.pos);
-	for (size_t i = 0; i < s->nobjs; i++) {
-		if (s->objs[i].kind == OBJ_PLANE)
-			continue;
-		box o = object_bounds(&s->objs[i]);
-		if (!box_is_empty(o) && v3_finite(o.lo) && v3_finite(o.hi))
-			b = box_union(b, o);
-	}
-	for (size_t i = 0; i < s->nlights; i++)
-		b = box_add(b, s->lights[i].pos);
-	double side = v3_max_comp(v3_sub(b.hi, b.lo));
-	if (!(side > 0) || !isfinite(side))
-		side = 1.0;
-	return side * KEYMODE_STEP_FRACTION;
-}
-
-bool keymode_sel_valid(const scene *s, km_sel sel)
-{
-	switch (sel.kind) {
-	case KM_SEL_OBJECT:
-		return sel.index < s->nobjs;
-	case KM_SEL_LIGHT:
-		return sel.index < s->nlights;
-	case KM_SEL_CAMERA:
-		break;
-	}
-	return true;
-}
-
-km_sel keymode_select(const scene *s, km_sel sel, int dir)
-{
-	size_t total = 1 + s->nobjs + s->nlights, at = 0;
-	if (sel.kind == KM_SEL_OBJECT && sel.index < s->nobjs)
-		at = 1 + sel.index;
-	else if (sel.kind == KM_SEL_LIGHT && sel.index < s->nlights)
-		at = 1 + s->nobjs + sel.index;
-	at = dir >= 0 ? (at + 1) % total : (at + total - 1) % total;
-	if (at == 0)
-		return (km_sel){KM_SEL_CAMERA, 0};
-	if (at <= s->nobjs)
-		return (km_sel){KM_SEL_OBJECT, at - 1};
-	return (km_sel){KM_SEL_LIGHT, at - 1 - s->nobjs};
-}
-
-vec3 keymode_axis_euler(vec3 axis, double deg)
-{
-	mat4 r = m4_rotate_axis(v3_norm(axis), deg_to_rad(deg));
-	/* r = Rz(c) Ry(b) Rx(a): r[2][0] = -sin b, r[2][1] = cos b sin a,
-	 * r[2][2] = cos b cos a, r[1][0] = sin c cos b, r[0][0] = cos c cos b. */
-	double sb = clampd(-r.m[2][0], -1.0, 1.0);
-	double a, b = asin(sb), c;
-	if (fabs(sb) < 0.9999999) {
-		a = atan2(r.m[2][1], r.m[2][2]);
-		c = atan2(r.m[1][0], r.m[0][0]);
-	} else {
-		/* Gimbal lock: only a - c (or a + c) is defined; put it all in a. */
-		c = 0.0;
-		a = atan2(-r.m[1][2], r.m[1][1]);
-	}
-	return v3(rad_to_deg(a), rad_to_deg(b), rad_to_deg(c));
-}
-
-static km_action act(km_op op, km_sel sel)
-{
-	km_action a;
-	memset(&a, 0, sizeof a);
-	a.op = op;
-	a.sel = sel;
-	return a;
-}
-
-static km_action move_by(km_sel sel, vec3 dir, double amount)
-{
-	km_action a = act(KM_MOVE, sel);
-	a.d = v3_scale(dir, amount);
-	return a;
-}
-
-km_action keymode_map(int key, const scene *s, km_sel sel, double step)
-{
-	camera c = scene_camera(s);
-	cam_view v = cam_view_make(&c);
-	vec3 fwd = v.fwd, right = v.right, up = v3(0, 1, 0);
-	if (sel.kind != KM_SEL_CAMERA) {
-		/* Objects and lights slide level with the floor. */
-		vec3 flat = v3(v.fwd.x, 0, v.fwd.z);
-		fwd = v3_len(flat) > 1e-6 ? v3_norm(flat) : v3_norm(v3(v.up.x, 0, v.up.z));
-	}
-	km_action a = act(KM_NONE, sel);
-	switch (key) {
-	case KEYS_UP:
-	case 'w':
-	case 'W':
-		return move_by(sel, fwd, step);
-	case KEYS_DOWN:
-	case 's':
-	case 'S':
-		return move_by(sel, fwd, -step);
-	case KEYS_LEFT:
-	case 'a':
-	case 'A':
-		return move_by(sel, right, -step);
-	case KEYS_RIGHT:
-	case 'd':
-	case 'D':
-		return move_by(sel, right, step);
-	case 'r':
-	case 'R':
-		return move_by(sel, up, step);
-	case 'f':
-	case 'F':
-		return move_by(sel, up, -step);
-	case 'j':
-	case 'J':
-	case KEYS_SHIFT_LEFT:
-		a = act(KM_TURN, sel);
-		a.a = -KEYMODE_TURN_DEG;
-		return a;
-	case 'l':
-	case 'L':
-	case KEYS_SHIFT_RIGHT:
-		a = act(KM_TURN, sel);
-		a.a = KEYMODE_TURN_DEG;
-		return a;
-	case 'i':
-	case 'I':
-	case KEYS_SHIFT_UP:
-		a = act(KM_TURN, sel);
-		a.b = KEYMODE_TURN_DEG;
-		return a;
-	case 'k':
-	case 'K':
-	case KEYS_SHIFT_DOWN:
-		a = act(KM_TURN, sel);
-		a.b = -KEYMODE_TURN_DEG;
-		return a;
-	case '[': /* the front turns to the left, as the camera sees it */
-		a = act(KM_ROTATE, sel);
-		a.d = v3(0, KEYMODE_ROTATE_DEG, 0);
-		return a;
-	case ']':
-		a = act(KM_ROTATE, sel);
-		a.d = v3(0, -KEYMODE_ROTATE_DEG, 0);
-		return a;
-	case '{': /* counterclockwise on the screen */
-		a = act(KM_ROTATE, sel);
-		a.d = keymode_axis_euler(v.fwd, KEYMODE_ROTATE_DEG);
-		return a;
-	case '}':
-		a = act(KM_ROTATE, sel);
-		a.d = keymode_axis_euler(v.fwd, -KEYMODE_ROTATE_DEG);
-		return a;
-	case '-':
-	case '_':
-		a = act(KM_SCALE, sel);
-		a.a = 1.0 / KEYMODE_SCALE;
-		return a;
-	case '+':
-	case '=':
-		a = act(KM_SCALE, sel);
-		a.a = KEYMODE_SCALE;
-		return a;
-	case '\t':
-	case KEYS_BACKTAB:
-		a = act(KM_SELECT, keymode_select(s, sel, key == '\t' ? 1 : -1));
-		a.n = key == '\t' ? 1 : -1;
-		return a;
-	case ',':
-	case '.':
-		a = act(KM_SAMPLES, sel);
-		a.n = key == '.' ? 1 : -1;
-		return a;
-	case '<':
-	case '>':
-		a = act(KM_DEPTH, sel);
-		a.n = key == '>' ? 1 : -1;
-		return a;
-	case KEYS_PAGE_UP:
-	case KEYS_PAGE_DOWN:
-		a = act(KM_SCENE, sel);
-		a.n = key == KEYS_PAGE_DOWN ? 1 : -1;
-		return a;
-	case 'm':
-	case 'M':
-		return act(KM_MODE, sel);
-	case ' ':
-		return act(KM_STOP, sel);
-	case 'u':
-		return act(KM_UNDO, sel);
-	case 'U':
-		return act(KM_REDO, sel);
-	case 12: /* Ctrl-L */
-	case KEYS_F(5):
-		return act(KM_REDRAW, sel);
-	case '?':
-	case KEYS_F(1):
-		return act(KM_HELP, sel);
-	case KEYS_ESC:
-	case 'q':
-	case 'Q':
-		return act(KM_QUIT, sel);
-	default:
-		return a;
-	}
-}
-
-bool keymode_is_edit(km_op op)
-{
-	return op == KM_MOVE || op == KM_TURN || op == KM_ROTATE || op == KM_SCALE;
-}
-
-bool keymode_apply(editor *ed, const km_action *a, rt_error *err)
-{
-	const scene *s = editor_scene(ed);
-	if (!keymode_sel_valid(s, a->sel))
-		return rt_error_set(err, "the selection is gone; press Tab to select again");
-	size_t i = a->sel.index;
-	switch (a->op) {
-	case KM_MOVE:
-		if (a->sel.kind == KM_SEL_OBJECT)
-			return editor_object_move(ed, i, a->d, err);
-		if (a->sel.kind == KM_SEL_LIGHT)
-			return editor_light_move(ed, i, a->d, err);
-		return editor_camera_pos(ed, v3_add(scene_camera(s).pos, a->d), err);
-	case KM_TURN:
-		return editor_camera_turn(ed, a->a, a->b, err);
-	case KM_ROTATE:
-		if (a->sel.kind != KM_SEL_OBJECT)
-			return rt_error_set(err, "only objects rotate; press Tab to select one");
-		return editor_object_rotate(ed, i, a->d, err);
-	case KM_SCALE:
-		if (a->sel.kind == KM_SEL_OBJECT)
-			return editor_object_scale(ed, i, v3_splat(a->a), err);
-		if (a->sel.kind == KM_SEL_LIGHT) {
-			double r = s->lights[i].ratio + (a->a > 1 ? KEYMODE_BRIGHTNESS : -KEYMODE_BRIGHTNESS);
-			r = clampd(round(r * 1000.0) / 1000.0, 0.0, 1.0);
-			return r == s->lights[i].ratio ? true : editor_light_brightness(ed, i, r, err);
-		} else {
-			double fov = scene_camera(s).fov + (a->a > 1 ? -KEYMODE_FOV_DEG : KEYMODE_FOV_DEG);
-			fov = clampd(fov, 5.0, 170.0);
-			return fov == scene_camera(s).fov ? true : editor_camera_fov(ed, fov, err);
-		}
-	default:
-		return rt_error_set(err, "not a scene edit");
-	}
-}
-
-/* ------------------------------------------------------------------ */
-/* 2. The session                                                      */
+/* 1. The session                                                      */
 /* ------------------------------------------------------------------ */
 
 /* The request the newest images must answer. */
@@ -363,17 +69,12 @@ static const uint8_t mark_rgb[3] = {255, 205, 0};
 
 struct keymode {
 	shell *sh;
-	int fd;
-	frame_palette pal;
-	int cols, rows;
-	int pic_rows;          /* the picture's rows; the status line and help bar follow */
-	int img_w, img_h;      /* the picture in pixels ... */
-	int img_x, img_y;      /* ... and its place on the cols x 2*pic_rows canvas */
-	frame *fr;
-	abuf out;
+	keyview kv;            /* the screen (term/keyview.h) */
+	keyview_item bar[32];  /* the help bar, from the key table */
+	termout *out;          /* borrowed: the output scheduler */
+	abuf late;             /* key bytes the scheduler gave up holding (keymode_late_keys) */
 	bool help;             /* the help bar is shown */
 	double layout_aspect;  /* the image aspect the layout is for */
-	bool repaint;          /* clear the screen before the next frame */
 
 	rsvc *rs;              /* the shell's render service */
 	const world *w;        /* a reference to the world for wgen (NULL: none yet) */
@@ -408,7 +109,6 @@ struct keymode {
 
 	char msg[256];
 	double msg_until;
-	char status_shown[1024];
 	double fast_times[16]; /* when the last fast frames were drawn */
 	long fast_frames, frames;
 	int edits;
@@ -424,29 +124,8 @@ static double km_aspect(const keymode *km)
 
 static void km_layout(keymode *km)
 {
-	int bars = km->help ? 2 : 1;
 	km->layout_aspect = km_aspect(km);
-	km->pic_rows = km->rows - bars;
-	frame_free(km->fr);
-	km->fr = NULL;
-	km->img_w = km->img_h = 0;
-	if (km->pic_rows < 2 || km->cols < 8) {
-		km->pic_rows = 0;
-	} else {
-		bool whole = km->pal == PALETTE_NONE;
-		screen_fit(km->cols, km->pic_rows, km_aspect(km), whole, &km->img_w, &km->img_h);
-		km->img_x = (km->cols - km->img_w) / 2;
-		km->img_y = (2 * km->pic_rows - km->img_h) / 2;
-		if (whole)
-			km->img_y &= ~1;
-		km->fr = frame_new(km->cols, km->pic_rows, km->pal);
-		if (km->fr)
-			km->fr->sync = false; /* each whole update is bracketed here */
-		else
-			km->img_w = km->img_h = 0;
-	}
-	km->repaint = true;
-	km->status_shown[0] = '\0';
+	keyview_layout(&km->kv, km->kv.cols, km->kv.rows, km->help, km->layout_aspect);
 	km->mask_ok = false;
 }
 
@@ -489,7 +168,7 @@ static int km_pick_ratio(keymode *km)
 	int loose = NRATIOS - 1, strict = NRATIOS - 1;
 	for (int i = NRATIOS - 1; i >= 0; i--) {
 		double r = ratios[i];
-		double px = ceil(km->img_w / r) * ceil(km->img_h / r);
+		double px = ceil(km->kv.img_w / r) * ceil(km->kv.img_h / r);
 		double t = px * km->cost;
 		if (t <= KEYMODE_FRAME_BUDGET)
 			loose = i;
@@ -522,7 +201,7 @@ static void km_learn_from_cut(keymode *km)
 static void km_start(keymode *km, bool refine)
 {
 	shell *sh = km->sh;
-	if (km->img_w <= 0 || km->img_h <= 0)
+	if (km->kv.img_w <= 0 || km->kv.img_h <= 0)
 		return;
 	rsvc_hold(km->rs);
 	km_learn_from_cut(km);
@@ -533,10 +212,10 @@ static void km_start(keymode *km, bool refine)
 		.world = w,
 		.gen = km->wgen,
 		.set = sh->set,
-		.w = km->img_w,
-		.h = km->img_h,
+		.w = km->kv.img_w,
+		.h = km->kv.img_h,
 	};
-	km_cur c = {.gen = km->wgen, .set = sh->set, .refine = refine, .w_px = km->img_w, .h_px = km->img_h};
+	km_cur c = {.gen = km->wgen, .set = sh->set, .refine = refine, .w_px = km->kv.img_w, .h_px = km->kv.img_h};
 	if (refine) {
 		/* Goes on from the samples already in when only their number
 		 * changed. */
@@ -547,7 +226,7 @@ static void km_start(keymode *km, bool refine)
 		km->ratio_i = km_pick_ratio(km);
 		r.kind = RSVC_FRAME;
 		r.ratio = ratios[km->ratio_i];
-		rsvc_frame_size(km->img_w, km->img_h, r.ratio, &c.w_px, &c.h_px);
+		rsvc_frame_size(km->kv.img_w, km->kv.img_h, r.ratio, &c.w_px, &c.h_px);
 	}
 	c.seq = rsvc_start(km->rs, &r);
 	km->cur = c;
@@ -577,30 +256,30 @@ static void km_mask(keymode *km)
 {
 	uint64_t gen = km->wgen;
 	if (km->mask_ok && km->mask_gen == gen && km->mask_sel.kind == km->sel.kind &&
-	    km->mask_sel.index == km->sel.index && km->mask_w == km->img_w && km->mask_h == km->img_h)
+	    km->mask_sel.index == km->sel.index && km->mask_w == km->kv.img_w && km->mask_h == km->kv.img_h)
 		return;
 	km->mask_ok = false;
 	km->sel_visible = false;
 	if (km->sel.kind != KM_SEL_OBJECT || !km->w)
 		return;
-	size_t n = (size_t)km->img_w * (size_t)km->img_h;
+	size_t n = (size_t)km->kv.img_w * (size_t)km->kv.img_h;
 	if (!grow(&km->mask, &km->mask_cap, n))
 		return;
 	const world *w = km->w;
 	uint32_t want = (uint32_t)km->sel.index;
-	for (int y = 0; y < km->img_h; y++)
-		for (int x = 0; x < km->img_w; x++) {
-			ray r = cam_ray(&w->cam, x + 0.5, y + 0.5, km->img_w, km->img_h);
+	for (int y = 0; y < km->kv.img_h; y++)
+		for (int x = 0; x < km->kv.img_w; x++) {
+			ray r = cam_ray(&w->cam, x + 0.5, y + 0.5, km->kv.img_w, km->kv.img_h);
 			hit h;
 			bool on = world_intersect(w, &r, 0.0, INFINITY, &h) && h.object == want;
-			km->mask[(size_t)y * km->img_w + x] = on;
+			km->mask[(size_t)y * km->kv.img_w + x] = on;
 			km->sel_visible |= on;
 		}
 	km->mask_ok = true;
 	km->mask_gen = gen;
 	km->mask_sel = km->sel;
-	km->mask_w = km->img_w;
-	km->mask_h = km->img_h;
+	km->mask_w = km->kv.img_w;
+	km->mask_h = km->kv.img_h;
 }
 
 static void put_px(uint8_t *img, int w, int h, int x, int y, const uint8_t c[3])
@@ -613,7 +292,7 @@ static void put_px(uint8_t *img, int w, int h, int x, int y, const uint8_t c[3])
 /* Marks the selection on the picture (img_w x img_h sRGB). */
 static void km_mark(keymode *km, uint8_t *img)
 {
-	int w = km->img_w, h = km->img_h;
+	int w = km->kv.img_w, h = km->kv.img_h;
 	if (km->sel.kind == KM_SEL_OBJECT) {
 		km_mask(km);
 		if (!km->mask_ok)
@@ -747,72 +426,17 @@ static void km_status_text(keymode *km, char *buf, size_t size)
 	bool msg = km->msg[0] && now() < km->msg_until;
 	snprintf(buf, size, " view │ %s │ %s%s%s │ %s │ %s │ depth %d │ %dx%d%s%s%s │ step %.3g", sh->name, sel,
 	         msg ? " │ " : "", msg ? km->msg : "", render_mode_name(sh->set.mode), spp, sh->set.depth,
-	         km->img_w, km->img_h, res, fps, t, km->step);
+	         km->kv.img_w, km->kv.img_h, res, fps, t, km->step);
 }
 
-/* Appends a line of text at row (0-based), cut to the width. */
-static void put_line(abuf *a, int row, int cols, const char *text, bool reverse)
-{
-	abuf_printf(a, "\x1b[%dH%s", row + 1, reverse ? "\x1b[7m" : "");
-	int width = 0, max = reverse ? cols : cols - 1; /* never the last cell of the last row */
-	const char *p = text;
-	for (; *p && width < max; p++) {
-		abuf_char(a, *p);
-		if (((unsigned char)p[1] & 0xc0) != 0x80)
-			width++;
-	}
-	while (((unsigned char)*p & 0xc0) == 0x80)
-		abuf_char(a, *p++);
-	if (reverse)
-		for (; width < cols; width++)
-			abuf_char(a, ' ');
-	abuf_str(a, "\x1b[m");
-	if (!reverse)
-		abuf_str(a, "\x1b[K");
-}
-
-/* Code points in s (the bars hold single-width characters only). */
-static int text_width(const char *s)
-{
-	int n = 0;
-	for (; *s; s++)
-		n += ((unsigned char)*s & 0xc0) != 0x80;
-	return n;
-}
-
-static void put_help(abuf *a, int row, int cols)
-{
-	abuf_printf(a, "\x1b[%dH", row + 1);
-	int used = 0;
-	for (size_t i = 0; i < sizeof help_bar / sizeof help_bar[0]; i++) {
-		int w = 2 + text_width(help_bar[i].keys) + 1 + text_width(help_bar[i].what);
-		if (used + w > cols - 1) /* never the last cell of the last row */
-			break;
-		abuf_printf(a, "  \x1b[1m%s\x1b[22m %s", help_bar[i].keys, help_bar[i].what);
-		used += w;
-	}
-	abuf_str(a, "\x1b[K");
-}
-
-/* Draws the newest image (scaled up to the picture size), the marker and
- * the bars, as one write(). */
+/* Puts the newest image (scaled up to the picture size) with the marks
+ * for the output scheduler, and draws the status line (and all of the
+ * screen after a repaint). */
 static void km_draw(keymode *km)
 {
-	abuf *a = &km->out;
-	abuf_reset(a);
-	abuf_str(a, "\x1b[?2026h");
-	if (km->repaint) {
-		abuf_str(a, "\x1b[r\x1b[m\x1b[2J\x1b[?25l");
-		if (km->fr)
-			frame_invalidate(km->fr);
-		km->status_shown[0] = '\0';
-		if (km->help)
-			put_help(a, km->rows - 1, km->cols);
-		km->repaint = false;
-	}
 	const rsvc_image *im = &km->img;
-	if (km->fr && km->have_img && im->w > 0 && im->h > 0) {
-		int W = km->img_w, H = km->img_h;
+	if (km->kv.enc && km->have_img && im->w > 0 && im->h > 0) {
+		int W = km->kv.img_w, H = km->kv.img_h;
 		size_t n = (size_t)W * H * 3, sn = (size_t)im->w * im->h * 3;
 		if (grow(&km->small, &km->small_cap, sn) && grow(&km->big, &km->big_cap, n)) {
 			frame_srgb_from_linear(im->rgb, (size_t)im->w * im->h, km->sh->set.exposure, km->small);
@@ -825,20 +449,13 @@ static void km_draw(keymode *km)
 					memcpy(dst + (size_t)x * 3, src + (size_t)((long)x * im->w / W) * 3, 3);
 			}
 			km_mark(km, km->big);
-			frame_put_image(km->fr, km->big, W, H, km->img_x, km->img_y);
-			const abuf *f = frame_update(km->fr);
-			abuf_add(a, f->b, f->len);
+			keyview_picture(&km->kv, km->big, im->kind != RSVC_REFINE || im->done);
 		}
 	}
 	char status[1024];
 	km_status_text(km, status, sizeof status);
-	if (strcmp(status, km->status_shown) != 0 && km->rows >= 1) {
-		put_line(a, km->pic_rows, km->cols, status, true);
-		snprintf(km->status_shown, sizeof km->status_shown, "%s", status);
-	}
-	abuf_str(a, "\x1b[?25l\x1b[?2026l");
-	if (!a->failed)
-		write_all(km->fd, a->b, a->len);
+	keyview_draw(&km->kv, status);
+	termout_pump(km->out, now(), &km->late);
 	km->dirty = false;
 	km->last_draw = now();
 }
@@ -1019,7 +636,7 @@ void keymode_key(keymode *km, int key)
 		}
 		break;
 	case KM_REDRAW:
-		km->repaint = true;
+		keyview_repaint(&km->kv);
 		km->dirty = true;
 		break;
 	case KM_HELP:
@@ -1065,7 +682,7 @@ int keymode_tick(keymode *km)
 		const km_cur *c = &km->cur;
 		bool final = c->seq != 0 && !c->refine && km->ratio_i == 0 && km->sh->set.samples == 1 &&
 		             c->gen == editor_generation(km->sh->ed) && c->set.mode == km->sh->set.mode &&
-		             c->set.depth == km->sh->set.depth && c->w_px == km->img_w && c->h_px == km->img_h;
+		             c->set.depth == km->sh->set.depth && c->w_px == km->kv.img_w && c->h_px == km->kv.img_h;
 		if (final)
 			km->refined = true;
 		else
@@ -1085,9 +702,9 @@ int keymode_tick(keymode *km)
 		/* The status line alone may have changed (the fps figure). */
 		char status[1024];
 		km_status_text(km, status, sizeof status);
-		km->dirty = strcmp(status, km->status_shown) != 0;
+		km->dirty = keyview_status_differs(&km->kv, status);
 	}
-	if (picture || km->dirty || km->repaint) {
+	if (picture || km->dirty || km->kv.repaint) {
 		km_draw(km);
 		if (picture) {
 			km->held = false;
@@ -1151,14 +768,14 @@ long keymode_frames(const keymode *km)
 
 void keymode_resize(keymode *km, int cols, int rows)
 {
-	km->cols = cols;
-	km->rows = rows;
+	km->kv.cols = cols;
+	km->kv.rows = rows;
 	km_layout(km);
 	km->want_refine = true;
 	km->dirty = true;
 }
 
-keymode *keymode_new(shell *sh, int fd, frame_palette pal, int cols, int rows)
+keymode *keymode_new(shell *sh, termout *out, frame_palette pal, int cols, int rows)
 {
 	keymode *km = calloc(1, sizeof *km);
 	if (!km) {
@@ -1166,12 +783,13 @@ keymode *keymode_new(shell *sh, int fd, frame_palette pal, int cols, int rows)
 		return NULL;
 	}
 	km->sh = sh;
-	km->fd = fd;
-	km->pal = pal;
-	km->cols = cols;
-	km->rows = rows;
+	km->out = out;
+	size_t nbar = keymode_help_bar(km->bar, sizeof km->bar / sizeof km->bar[0]);
+	keyview_init(&km->kv, out, pal, km->bar, nbar);
+	km->kv.cols = cols;
+	km->kv.rows = rows;
 	km->help = true;
-	abuf_init(&km->out);
+	abuf_init(&km->late);
 	km->rs = sh->rs;
 	rsvc_hold(km->rs);
 	km->step = keymode_step(editor_scene(sh->ed));
@@ -1190,8 +808,9 @@ void keymode_free(keymode *km)
 	rsvc_hold(km->rs);
 	world_release(km->w);
 	km_close_run(km);
-	frame_free(km->fr);
-	abuf_free(&km->out);
+	keyview_end(&km->kv);
+	keyview_free(&km->kv);
+	abuf_free(&km->late);
 	rsvc_image_free(&km->img);
 	rsvc_image_free(&km->spare);
 	free(km->small);
@@ -1201,7 +820,7 @@ void keymode_free(keymode *km)
 }
 
 /* ------------------------------------------------------------------ */
-/* 3. The terminal                                                     */
+/* 2. The loop                                                         */
 /* ------------------------------------------------------------------ */
 
 static void term_size(int fd, int *cols, int *rows)
@@ -1228,27 +847,50 @@ static void raw_modes(int fd, const struct termios *saved)
 	tcsetattr(fd, TCSANOW, &t);
 }
 
+/* Moves the key bytes in *b to ncurses' pipe (the terminal's input minus
+ * the scheduler's answers). */
+static void feed_keys(int fd, abuf *b)
+{
+	if (b->len && !b->failed) {
+		ssize_t r = write(fd, b->b, b->len);
+		(void)r; /* a full pipe: keys typed faster than 64 KiB ahead are dropped */
+	}
+	abuf_reset(b);
+}
+
 bool keymode_run(shell *sh)
 {
 	screen *scr = sh->scr;
-	if (!sh->interactive || !scr || !scr->active || sh->wake[0] < 0 || sh->wake[1] < 0 ||
+	if (!sh->interactive || !scr || !scr->active || !scr->out || sh->wake[0] < 0 || sh->wake[1] < 0 ||
 	    !isatty(STDIN_FILENO))
 		return shell_fail(sh, "view: key mode needs the full-screen shell on a terminal");
 	int in = STDIN_FILENO, fd = scr->fd;
+	termout *out = scr->out;
 	fflush(stdout);
 	struct termios saved;
 	if (tcgetattr(in, &saved) != 0)
 		return shell_fail(sh, "view: cannot read the terminal's modes: %s", strerror(errno));
-	/* The answers the terminal owes the shell's output scheduler come in
-	 * before ncurses reads the keys (keys typed meanwhile are dropped). */
-	if (scr->out) {
-		abuf junk;
-		abuf_init(&junk);
-		termout_settle(scr->out, in, 5.0, &junk);
-		abuf_free(&junk);
+	/* The answers the terminal owes the output scheduler come in before
+	 * ncurses reads the keys (keys typed meanwhile are dropped). */
+	abuf pend;
+	abuf_init(&pend);
+	termout_settle(out, in, 5.0, &pend);
+	abuf_reset(&pend);
+	/* The terminal's input goes through the scheduler, which takes its
+	 * answers out (they pace the picture), and the keys on to ncurses
+	 * through a pipe. */
+	int kp[2];
+	if (pipe(kp) != 0) {
+		abuf_free(&pend);
+		return shell_fail(sh, "view: %s", strerror(errno));
 	}
-	keys *k = keys_open(in, 25);
+	for (int i = 0; i < 2; i++)
+		fcntl(kp[i], F_SETFL, fcntl(kp[i], F_GETFL) | O_NONBLOCK);
+	keys *k = keys_open(kp[0], 25);
 	if (!k) {
+		close(kp[0]);
+		close(kp[1]);
+		abuf_free(&pend);
 		return shell_fail(sh, "view: ncurses cannot read the keys of this terminal (TERM=%s)",
 		                  getenv("TERM") ? getenv("TERM") : "");
 	}
@@ -1264,12 +906,14 @@ bool keymode_run(shell *sh)
 	int cols, rows;
 	term_size(fd, &cols, &rows);
 	size_t undo0 = editor_undo_count(sh->ed);
-	keymode *km = keymode_new(sh, fd, scr->pal, cols, rows);
+	keymode *km = keymode_new(sh, out, scr->pal, cols, rows);
 	bool ok = km != NULL;
 	int wake = sh->wake[0];
 	while (km && !keymode_done(km)) {
 		keymode_tick(km);
-		double to = keymode_timeout(km);
+		double to = keymode_timeout(km), tw = termout_wait(out, now());
+		if (tw >= 0 && (to < 0 || tw < to))
+			to = tw;
 		fd_set rd;
 		FD_ZERO(&rd);
 		FD_SET(in, &rd);
@@ -1308,13 +952,24 @@ bool keymode_run(shell *sh)
 			term_size(fd, &cols, &rows);
 			keymode_resize(km, cols, rows);
 		}
-		/* Every key waiting, before the next frame starts. */
+		/* The terminal's answers first (they let the next slice go),
+		 * then every key waiting, before the next frame starts. */
 		if (n > 0 && FD_ISSET(in, &rd)) {
-			int c;
-			while (!keymode_done(km) && (c = keys_next(k)) != KEYS_NONE)
-				if (c != KEYS_RESIZE)
-					keymode_key(km, c);
+			char buf[4096];
+			ssize_t r = read(in, buf, sizeof buf);
+			if (r == 0)
+				break; /* the terminal is gone */
+			if (r > 0)
+				termout_input(out, buf, (size_t)r, now(), &pend);
 		}
+		termout_pump(out, now(), &pend);
+		abuf_add(&pend, km->late.b, km->late.len);
+		abuf_reset(&km->late);
+		feed_keys(kp[1], &pend);
+		int c;
+		while (!keymode_done(km) && (c = keys_next(k)) != KEYS_NONE)
+			if (c != KEYS_RESIZE)
+				keymode_key(km, c);
 	}
 	keymode_free(km);
 	size_t steps = editor_undo_count(sh->ed);
@@ -1322,10 +977,13 @@ bool keymode_run(shell *sh)
 	/* Give the terminal and the screen back to the shell. */
 	screen_keypad(fd, NULL, NULL, false);
 	keys_close(k);
+	close(kp[0]);
+	close(kp[1]);
+	abuf_free(&pend);
 	tcsetattr(in, TCSANOW, &saved);
-	write_all(fd, "\x1b[m\x1b[?25h", 9);
 	sh->scr = scr;
 	sh->status_hook = hook;
+	termout_set_picture(out, scr->enc);
 	screen_layout(scr, (double)sh->set.width / sh->set.height, true);
 	rl_set_screen_size(scr->rows - scr->region_top, scr->cols);
 	shell_refresh(sh);
