@@ -43,7 +43,7 @@ void keyview_layout(keyview *v, int cols, int rows, bool help, double aspect)
 		v->img_y = (2 * v->pic_rows - v->img_h) / 2;
 		if (whole)
 			v->img_y &= ~1;
-		encoder_geom g = {.cols = cols, .rows = v->pic_rows, .pal = v->pal};
+		encoder_geom g = {.cols = cols, .rows = v->pic_rows, .pal = v->pal, .cursor_off = true};
 		v->enc = encoder_halfblock.open(&g);
 		if (!v->enc)
 			v->img_w = v->img_h = 0;
