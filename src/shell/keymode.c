@@ -24,7 +24,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/ioctl.h>
-#include <sys/select.h>
 #include <termios.h>
 #include <time.h>
 #include <unistd.h>
@@ -861,23 +860,25 @@ static void feed_keys(int fd, abuf *b)
 bool keymode_run(shell *sh)
 {
 	screen *scr = sh->scr;
-	if (!sh->interactive || !scr || !scr->active || !scr->out || sh->wake[0] < 0 || sh->wake[1] < 0 ||
-	    !isatty(STDIN_FILENO))
+	evloop *ev = sh->ev;
+	if (!sh->interactive || !scr || !scr->active || !scr->out || !ev || evloop_out(ev) != scr->out ||
+	    !isatty(evloop_in_fd(ev)))
 		return shell_fail(sh, "view: key mode needs the full-screen shell on a terminal");
-	int in = STDIN_FILENO, fd = scr->fd;
+	int in = evloop_in_fd(ev), fd = scr->fd;
 	termout *out = scr->out;
 	fflush(stdout);
 	struct termios saved;
 	if (tcgetattr(in, &saved) != 0)
 		return shell_fail(sh, "view: cannot read the terminal's modes: %s", strerror(errno));
 	/* The answers the terminal owes the output scheduler come in before
-	 * ncurses reads the keys (keys typed meanwhile are dropped). */
+	 * key mode starts (keys typed meanwhile are dropped). */
+	evloop_settle(ev, 5.0);
+	while (evloop_getc(ev) >= 0)
+		;
 	abuf pend;
 	abuf_init(&pend);
-	termout_settle(out, in, 5.0, &pend);
-	abuf_reset(&pend);
-	/* The terminal's input goes through the scheduler, which takes its
-	 * answers out (they pace the picture), and the keys on to ncurses
+	/* The shell's event loop reads the terminal: the scheduler takes its
+	 * answers out (they pace the picture), and the keys go on to ncurses
 	 * through a pipe. */
 	int kp[2];
 	if (pipe(kp) != 0) {
@@ -908,30 +909,11 @@ bool keymode_run(shell *sh)
 	size_t undo0 = editor_undo_count(sh->ed);
 	keymode *km = keymode_new(sh, out, scr->pal, cols, rows);
 	bool ok = km != NULL;
-	int wake = sh->wake[0];
 	while (km && !keymode_done(km)) {
 		keymode_tick(km);
-		double to = keymode_timeout(km), tw = termout_wait(out, now());
-		if (tw >= 0 && (to < 0 || tw < to))
-			to = tw;
-		fd_set rd;
-		FD_ZERO(&rd);
-		FD_SET(in, &rd);
-		FD_SET(wake, &rd);
-		struct timeval tv, *tvp = NULL;
-		if (to >= 0) {
-			tv.tv_sec = (time_t)to;
-			tv.tv_usec = (suseconds_t)((to - (double)tv.tv_sec) * 1e6);
-			tvp = &tv;
-		}
-		int n = select((in > wake ? in : wake) + 1, &rd, NULL, NULL, tvp);
-		if (n < 0 && errno != EINTR)
-			break;
-		if (n > 0 && FD_ISSET(wake, &rd)) {
-			char buf[256];
-			while (read(wake, buf, sizeof buf) > 0)
-				;
-		}
+		/* Keys, wake-ups (a frame, a signal), the scheduler's slices and
+		 * time-outs, or key mode's own timer. */
+		evloop_wait(ev, keymode_timeout(km));
 		if (shell_sig_term)
 			break;
 		if (shell_sig_int) {
@@ -952,17 +934,10 @@ bool keymode_run(shell *sh)
 			term_size(fd, &cols, &rows);
 			keymode_resize(km, cols, rows);
 		}
-		/* The terminal's answers first (they let the next slice go),
-		 * then every key waiting, before the next frame starts. */
-		if (n > 0 && FD_ISSET(in, &rd)) {
-			char buf[4096];
-			ssize_t r = read(in, buf, sizeof buf);
-			if (r == 0)
-				break; /* the terminal is gone */
-			if (r > 0)
-				termout_input(out, buf, (size_t)r, now(), &pend);
-		}
-		termout_pump(out, now(), &pend);
+		/* Every key waiting, before the next frame starts. */
+		int b;
+		while ((b = evloop_getc(ev)) >= 0)
+			abuf_char(&pend, (char)b);
 		abuf_add(&pend, km->late.b, km->late.len);
 		abuf_reset(&km->late);
 		feed_keys(kp[1], &pend);
@@ -970,6 +945,8 @@ bool keymode_run(shell *sh)
 		while (!keymode_done(km) && (c = keys_next(k)) != KEYS_NONE)
 			if (c != KEYS_RESIZE)
 				keymode_key(km, c);
+		if (evloop_eof(ev))
+			break; /* the terminal is gone */
 	}
 	keymode_free(km);
 	size_t steps = editor_undo_count(sh->ed);
