@@ -6,6 +6,8 @@
 #include <unistd.h>
 
 #include "core/bvh.h"
+#include "core/integrators.h"
+#include "rtsh/image.h"
 #include "rtsh/mesh.h"
 #include "rtsh/render.h"
 #include "rtsh/rtfile.h"
@@ -236,6 +238,7 @@ static void test_gltf_and_stl(void **state)
 	assert_vec_near(m->bounds.hi, v3(7, 2, 0), 1e-6);
 	mesh_surf sf;
 	float b[3] = {1.0f / 3, 1.0f / 3, 1.0f / 3};
+	assert_true(mesh_prepare(m, false, 0, &err));
 	mesh_surface(m, 0, b, &sf);
 	assert_true(sf.mat >= 0);
 	assert_near(m->mats[sf.mat].kd[0], 0.25, 1e-6);
@@ -250,9 +253,130 @@ static void test_gltf_and_stl(void **state)
 	expect_error(mesh_load(tmp_text("bad.gltf", "garbage"), &err), &err, "bad.gltf", "cannot read the model");
 }
 
+/* --- a .glb with its texture inside --- */
+
+static scene *load_text(const char *text);
+
+static void put_u32(unsigned char *p, uint32_t v)
+{
+	for (int i = 0; i < 4; i++)
+		p[i] = (unsigned char)(v >> (8 * i));
+}
+
+/* A binary glTF (glTF 2.0 spec, "GLB file format"): a 12-byte header,
+ * then a JSON chunk padded with blanks and a BIN chunk padded with zeros
+ * to 4 bytes. Returns the length written to out. */
+static size_t make_glb(unsigned char *out, const char *json, const unsigned char *bin, size_t nbin)
+{
+	size_t nj = strlen(json), pj = (nj + 3) / 4 * 4, pb = (nbin + 3) / 4 * 4;
+	size_t total = 12 + 8 + pj + 8 + pb;
+	memcpy(out, "glTF", 4);
+	put_u32(out + 4, 2);
+	put_u32(out + 8, (uint32_t)total);
+	put_u32(out + 12, (uint32_t)pj);
+	memcpy(out + 16, "JSON", 4);
+	memcpy(out + 20, json, nj);
+	memset(out + 20 + nj, ' ', pj - nj);
+	unsigned char *b = out + 20 + pj;
+	put_u32(b, (uint32_t)pb);
+	memcpy(b + 4, "BIN", 4); /* "BIN\0" */
+	memcpy(b + 8, bin, nbin);
+	memset(b + 8 + nbin, 0, pb - nbin);
+	return total;
+}
+
+/* A unit quad in the XY plane (z = 0, facing +Z) whose base colour texture
+ * is a 2x2 PNG inside the .glb: red, green on the top row, blue, white
+ * below. glTF puts uv (0,0) at the image's top-left, so the quad's corner
+ * (0,1) gets uv (0,0): each quarter of the quad shows the texel of the
+ * same quarter of the image. */
+static const char *textured_glb(const char *name, bool corrupt)
+{
+	/* the image, written by rtsh's PNG writer (sRGB 8-bit: 0 and 255
+	 * stay 0 and 255) */
+	framebuffer *fb = fb_new(2, 2);
+	assert_non_null(fb);
+	const float px[4][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 1}};
+	memcpy(fb->rgb, px, sizeof px);
+	char png[256];
+	snprintf(png, sizeof png, "%s/quad-texture.png", tmpdir);
+	rt_error err = {0};
+	assert_true(image_write(png, fb, 0, &err));
+	fb_free(fb);
+	FILE *f = fopen(png, "rb");
+	assert_non_null(f);
+	unsigned char img[4096];
+	size_t nimg = fread(img, 1, sizeof img, f);
+	fclose(f);
+	assert_true(nimg > 8 && nimg < sizeof img);
+	if (corrupt)
+		memset(img + 8, 0x55, nimg - 8); /* the signature kept, the chunks garbage */
+	/* BIN: positions (48 bytes), uvs (32), indices (12), the image */
+	unsigned char bin[4096 + 92];
+	const float pos[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+	const float uv[4][2] = {{0, 1}, {1, 1}, {1, 0}, {0, 0}};
+	const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+	memcpy(bin, pos, 48);
+	memcpy(bin + 48, uv, 32);
+	memcpy(bin + 80, idx, 12);
+	memcpy(bin + 92, img, nimg);
+	char json[2048];
+	snprintf(json, sizeof json,
+	         "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+	         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"indices\":2,"
+	         "\"material\":0}]}],"
+	         "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}}}],"
+	         "\"textures\":[{\"source\":0}],\"images\":[{\"bufferView\":3,\"mimeType\":\"image/png\"}],"
+	         "\"buffers\":[{\"byteLength\":%zu}],"
+	         "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},"
+	         "{\"buffer\":0,\"byteOffset\":48,\"byteLength\":32},{\"buffer\":0,\"byteOffset\":80,\"byteLength\":12},"
+	         "{\"buffer\":0,\"byteOffset\":92,\"byteLength\":%zu}],"
+	         "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+	         "\"min\":[0,0,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":4,"
+	         "\"type\":\"VEC2\"},{\"bufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}]}",
+	         92 + nimg, nimg);
+	static unsigned char glb[8192];
+	size_t n = make_glb(glb, json, bin, 92 + nimg);
+	return tmp_write(name, glb, n);
+}
+
+static void test_glb_embedded_texture(void **state)
+{
+	(void)state;
+	textured_glb("quad.glb", false);
+	/* size 2 about the origin: the quad spans x, y in [-1, 1] at z = 0 */
+	scene *s = load_text("C 0,0,5 0,0,-1 60\nmesh quad.glb 0,0,0 0,1,0 2\n");
+	rt_error err = {0};
+	world *w = world_build(s, &err);
+	assert_non_null(w);
+	struct {
+		double x, y;
+		vec3 c;
+	} probes[] = {{-0.5, 0.5, {1, 0, 0}}, {0.5, 0.5, {0, 1, 0}}, {-0.5, -0.5, {0, 0, 1}}, {0.5, -0.5, {1, 1, 1}}};
+	for (size_t i = 0; i < 4; i++) {
+		hit h;
+		assert_true(world_intersect(w, &(ray){v3(probes[i].x, probes[i].y, 5), v3(0, 0, -1)}, 0, INFINITY, &h));
+		assert_near(h.t, 5, 1e-6);
+		/* a texel's centre: bilinear filtering gives the texel itself */
+		vec3 c = hit_albedo(&w->mats[h.mat], &h);
+		assert_vec_near(c, probes[i].c, 1e-6);
+	}
+	world_free(w);
+	scene_free(s);
+	/* a corrupt embedded image: the model and the image are named */
+	textured_glb("bad.glb", true);
+	char bad[256];
+	snprintf(bad, sizeof bad, "%s/bad.glb", tmpdir);
+	mesh *m = mesh_load(bad, &err);
+	assert_null(m);
+	assert_non_null(strstr(err.msg, "bad.glb: embedded image 0.png"));
+}
+
 /* --- the tree and the watertight test --- */
 
-static mesh *sphere_mesh(int nu, int nv)
+/* A UV sphere of unit radius, prepared or as built (positions and
+ * triangles as given). */
+static mesh *sphere_mesh_as(int nu, int nv, bool prepare)
 {
 	mesh_builder b = {.name = "sphere"};
 	for (int j = 0; j <= nv; j++)
@@ -271,14 +395,20 @@ static mesh *sphere_mesh(int nu, int nv)
 	rt_error err = {0};
 	mesh *m = mb_finish(&b, &err);
 	assert_non_null(m);
-	assert_true(mesh_prepare(m, true, 60, &err));
+	if (prepare)
+		assert_true(mesh_prepare(m, true, 60, &err));
 	return m;
+}
+
+static mesh *sphere_mesh(int nu, int nv)
+{
+	return sphere_mesh_as(nu, nv, true);
 }
 
 static void test_tree_matches_brute_force(void **state)
 {
 	(void)state;
-	mesh *m = sphere_mesh(40, 20);
+	mesh *m = sphere_mesh(40, 20), *raw = sphere_mesh_as(40, 20, false);
 	test_rng r = {7};
 	for (int i = 0; i < 4000; i++) {
 		vec3 o = v3_scale(tdir(&r), 3), d = tdir(&r);
@@ -289,15 +419,21 @@ static void test_tree_matches_brute_force(void **state)
 		float t1 = INFINITY, t2 = INFINITY, b1[3], b2[3];
 		uint32_t k1 = 0, k2 = 0;
 		bool h1 = mesh_intersect(m, &mr, 0, &t1, &k1, b1);
-		bool h2 = mesh_intersect_brute(m, &mr, 0, &t2, &k2, b2);
+		bool h2 = mesh_intersect_brute(raw, &mr, 0, &t2, &k2, b2);
 		assert_int_equal(h1, h2);
 		assert_int_equal(mesh_occluded(m, &mr, 0, INFINITY), h2);
 		if (h1) {
 			assert_true(t1 == t2);
 			assert_near(b1[0] + b1[1] + b1[2], 1, 1e-5);
+			/* the same triangle: the slot's corners are the raw ones */
+			vec3 c[3];
+			mesh_corners(m, k1, c);
+			for (int k = 0; k < 3; k++)
+				assert_vec_near(c[k], v3(raw->p[raw->tri[k2][k]][0], raw->p[raw->tri[k2][k]][1], raw->p[raw->tri[k2][k]][2]), 0);
 		}
 	}
 	mesh_free(m);
+	mesh_free(raw);
 }
 
 /* Rays aimed exactly at shared vertices and edges of a closed mesh from
@@ -305,11 +441,11 @@ static void test_tree_matches_brute_force(void **state)
 static void test_watertight(void **state)
 {
 	(void)state;
-	mesh *m = sphere_mesh(17, 9);
+	mesh *m = sphere_mesh(17, 9), *raw = sphere_mesh_as(17, 9, false);
 	int miss = 0;
-	for (uint32_t t = 0; t < m->ntris; t++)
+	for (uint32_t t = 0; t < raw->ntris; t++)
 		for (int k = 0; k < 3; k++) {
-			const float *a = m->p[m->tri[t][k]], *b = m->p[m->tri[t][(k + 1) % 3]];
+			const float *a = raw->p[raw->tri[t][k]], *b = raw->p[raw->tri[t][(k + 1) % 3]];
 			vec3 targets[2] = {v3(a[0], a[1], a[2]), v3((a[0] + (double)b[0]) / 2, (a[1] + (double)b[1]) / 2,
 			                                           (a[2] + (double)b[2]) / 2)};
 			for (int q = 0; q < 2; q++) {
@@ -322,6 +458,127 @@ static void test_watertight(void **state)
 			}
 		}
 	assert_int_equal(miss, 0);
+	mesh_free(m);
+	mesh_free(raw);
+}
+
+/* The SSE leaf test and the scalar one find the same hit: the same
+ * triangle, distance and weights to the bit, and the same occlusion. */
+static void same_hits(const mesh *m, vec3 o, vec3 d, float tmin, float tmax)
+{
+	mesh_ray mr;
+	mesh_ray_make(&mr, o, d);
+	float t1 = tmax, t2 = tmax, b1[3] = {0}, b2[3] = {0};
+	uint32_t k1 = UINT32_MAX, k2 = UINT32_MAX;
+	bool h1 = mesh_intersect(m, &mr, tmin, &t1, &k1, b1);
+	bool h2 = mesh_intersect_scalar(m, &mr, tmin, &t2, &k2, b2);
+	assert_int_equal(h1, h2);
+	assert_int_equal(mesh_occluded(m, &mr, tmin, tmax), h2);
+	assert_int_equal(mesh_occluded_scalar(m, &mr, tmin, tmax), h2);
+	if (h1) {
+		assert_int_equal(k1, k2);
+		assert_memory_equal(&t1, &t2, sizeof t1);
+		assert_memory_equal(b1, b2, sizeof b1);
+	}
+}
+
+static void test_sse_leaves_match_scalar(void **state)
+{
+	(void)state;
+	mesh *m = sphere_mesh(40, 20), *raw = sphere_mesh_as(40, 20, false);
+	test_rng r = {11};
+	for (int i = 0; i < 4000; i++) {
+		vec3 o = v3_scale(tdir(&r), 3), d = tdir(&r);
+		if (i % 2)
+			d = v3_norm(v3_sub(v3_scale(tdir(&r), 0.5), o));
+		same_hits(m, o, d, 0, INFINITY);
+		same_hits(m, o, d, 2.5f, 3.5f); /* a window: the far side or nothing */
+	}
+	/* through the vertices and edge midpoints, where edge functions are 0
+	 * and the double fallback runs in some lanes */
+	for (uint32_t t = 0; t < raw->ntris; t++)
+		for (int k = 0; k < 3; k++) {
+			const float *a = raw->p[raw->tri[t][k]], *b = raw->p[raw->tri[t][(k + 1) % 3]];
+			vec3 o = v3(0.01, -0.02, 0.015);
+			same_hits(m, o, v3_sub(v3(a[0], a[1], a[2]), o), 0, INFINITY);
+			same_hits(m, o, v3_sub(v3((a[0] + (double)b[0]) / 2, (a[1] + (double)b[1]) / 2, (a[2] + (double)b[2]) / 2), o), 0,
+			          INFINITY);
+			/* and along the axes, where the shear is zero */
+			same_hits(m, v3(a[0], a[1], 3), v3(0, 0, -1), 0, INFINITY);
+		}
+	mesh_free(m);
+	mesh_free(raw);
+	if (have_models()) {
+		rt_error err = {0};
+		m = mesh_load(MODELS "/stanford-bunny.obj", &err);
+		assert_non_null(m);
+		assert_true(mesh_prepare(m, false, 0, &err));
+		vec3 c = box_center(m->bounds);
+		double rad = v3_len(v3_sub(m->bounds.hi, m->bounds.lo));
+		for (int i = 0; i < 20000; i++) {
+			vec3 o = v3_add(c, v3_scale(tdir(&r), rad)), d = v3_norm(v3_sub(v3_add(c, v3_scale(tdir(&r), 0.3 * rad)), o));
+			same_hits(m, o, d, 0, INFINITY);
+		}
+		mesh_free(m);
+	}
+}
+
+/* Parallel squares at z = 1..6 (two triangles each, 12 in all: whole blocks
+ * and a partial one, whatever the tree makes of them): a ray along z meets
+ * them at distances known by hand. */
+static void test_hit_distances_by_hand(void **state)
+{
+	(void)state;
+	mesh_builder b = {.name = "squares"};
+	for (int z = 1; z <= 6; z++) {
+		float q[4][3] = {{-1, -1, (float)z}, {1, -1, (float)z}, {1, 1, (float)z}, {-1, 1, (float)z}};
+		for (int k = 0; k < 4; k++)
+			assert_true(mb_vertex(&b, q[k]));
+		int v = 4 * (z - 1);
+		int32_t t1[3][3] = {{v, -1, -1}, {v + 1, -1, -1}, {v + 2, -1, -1}};
+		int32_t t2[3][3] = {{v, -1, -1}, {v + 2, -1, -1}, {v + 3, -1, -1}};
+		assert_true(mb_triangle(&b, t1));
+		assert_true(mb_triangle(&b, t2));
+	}
+	rt_error err = {0};
+	mesh *m = mb_finish(&b, &err);
+	assert_non_null(m);
+	assert_true(mesh_prepare(m, false, 0, &err));
+	for (int sse = 0; sse < 2; sse++) {
+		bool (*isect)(const mesh *, const mesh_ray *, float, float *, uint32_t *, float *) =
+		    sse ? mesh_intersect : mesh_intersect_scalar;
+		bool (*occl)(const mesh *, const mesh_ray *, float, float) = sse ? mesh_occluded : mesh_occluded_scalar;
+		mesh_ray mr;
+		float t, bb[3];
+		uint32_t k;
+		/* from z = -1 up: the square at z = 1, 2 away */
+		mesh_ray_make(&mr, v3(0.25, -0.5, -1), v3(0, 0, 1));
+		t = INFINITY;
+		assert_true(isect(m, &mr, 0, &t, &k, bb));
+		assert_true(t == 2.0f);
+		/* past t = 3.5 (z = 2.5): the square at z = 3 */
+		t = INFINITY;
+		assert_true(isect(m, &mr, 3.5f, &t, &k, bb));
+		assert_true(t == 4.0f);
+		/* from z = 3.5 down, a direction of length 2: z = 3 at t = 1/4 */
+		mesh_ray_make(&mr, v3(0.5, 0.5, 3.5), v3(0, 0, -2));
+		t = INFINITY;
+		assert_true(isect(m, &mr, 0, &t, &k, bb));
+		assert_true(t == 0.25f);
+		/* the hit point (0.5, 0.5, 3) from the weights */
+		vec3 c[3];
+		mesh_corners(m, k, c);
+		vec3 hp = v3_add(v3_add(v3_scale(c[0], bb[0]), v3_scale(c[1], bb[1])), v3_scale(c[2], bb[2]));
+		assert_vec_near(hp, v3(0.5, 0.5, 3), 1e-6);
+		/* occlusion: the square at z = 3 is 0.25 away */
+		assert_true(occl(m, &mr, 0, 0.3f));
+		assert_false(occl(m, &mr, 0, 0.2f));
+		/* outside the squares (x = 1.5): nothing */
+		mesh_ray_make(&mr, v3(1.5, 0, -1), v3(0, 0, 1));
+		t = INFINITY;
+		assert_false(isect(m, &mr, 0, &t, &k, bb));
+		assert_false(occl(m, &mr, 0, INFINITY));
+	}
 	mesh_free(m);
 }
 
@@ -564,8 +821,11 @@ int main(void)
 		cmocka_unit_test(test_obj_bad_input),
 		cmocka_unit_test(test_ply_faces_and_strips),
 		cmocka_unit_test(test_gltf_and_stl),
+		cmocka_unit_test(test_glb_embedded_texture),
 		cmocka_unit_test(test_tree_matches_brute_force),
 		cmocka_unit_test(test_watertight),
+		cmocka_unit_test(test_sse_leaves_match_scalar),
+		cmocka_unit_test(test_hit_distances_by_hand),
 		cmocka_unit_test(test_cube_obj_silhouette_is_cu),
 		cmocka_unit_test(test_tetrahedron_projected_area),
 		cmocka_unit_test(test_mesh_line_round_trip),
