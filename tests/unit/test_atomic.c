@@ -12,6 +12,8 @@
 #include <unistd.h>
 
 #include "rtsh/atomic.h"
+#include "rtsh/edit.h"
+#include "rtsh/generate.h"
 #include "rtsh/memory.h"
 
 static char dir[] = "/tmp/rtsh-test-atomic-XXXXXX";
@@ -344,6 +346,110 @@ static void test_memory_check(void **state)
 	assert_false(mem_check(phys * 2, "twice the machine", &err));
 }
 
+/* Bytes as the messages give them (memory.h): in the largest unit of 1024
+ * that leaves at least 1, one decimal below 10. */
+static void human_test(double b, char *buf, size_t size)
+{
+	const char *units[] = {"bytes", "KiB", "MiB", "GiB"};
+	int u = 0;
+	for (; b >= 1024 && u < 3; u++)
+		b /= 1024;
+	snprintf(buf, size, u && b < 10 ? "%.1f %s" : "%.0f %s", b, units[u]);
+}
+
+/* The bytes a scene's model takes, from its arrays' capacities and the
+ * element sizes. */
+static double model_bytes(const scene *s)
+{
+	return (double)(sizeof(scene) + s->cap_cams * sizeof(camera) + s->cap_lights * sizeof(light) +
+	                s->cap_objs * sizeof(object));
+}
+
+/* The scenes an editor holds (its current one and those its undo and redo
+ * history keep after load/generate) are counted by the memory estimates: a
+ * request that fits alone is refused when it does not fit with them. */
+static void test_memory_counts_the_undo_scenes(void **state)
+{
+	(void)state;
+	rt_error err;
+	long n;
+	assert_true(mem_held(&n) == 0.0);
+	assert_int_equal(n, 0);
+	scene *a = scene_generate(1000, 1, NULL, &err);
+	assert_non_null(a);
+	assert_int_equal(a->cap_objs, 1001); /* 1000 and the ground plane, allocated at once */
+	double wa = model_bytes(a);
+	editor *ed = editor_new(a, "a");
+	assert_non_null(ed);
+	assert_true(mem_held(&n) == wa);
+	assert_int_equal(n, 1);
+	/* Three more scenes replace it in turn; each old one is kept for undo. */
+	double want = wa;
+	const size_t sizes[] = {2000, 3000, 4000};
+	for (int i = 0; i < 3; i++) {
+		scene *s = scene_generate(sizes[i], 2, NULL, &err);
+		assert_non_null(s);
+		want += model_bytes(s);
+		assert_true(editor_replace(ed, s, NULL, &err));
+		assert_true(mem_held(&n) == want);
+		assert_int_equal(n, i + 2);
+	}
+	/* Undo and redo move scenes between the stacks: the same are held. */
+	assert_true(editor_undo(ed, &err));
+	assert_true(editor_undo(ed, &err));
+	assert_true(mem_held(&n) == want);
+	assert_int_equal(n, 4);
+	/* A new edit drops the redo history (2 scenes of 3000 and 4000). */
+	double w3 = 0, w4 = 0;
+	{
+		scene *s3 = scene_generate(3000, 2, NULL, &err), *s4 = scene_generate(4000, 2, NULL, &err);
+		w3 = model_bytes(s3);
+		w4 = model_bytes(s4);
+		scene_free(s3);
+		scene_free(s4);
+	}
+	assert_true(editor_object_move(ed, 0, v3(1, 0, 0), &err));
+	want -= w3 + w4;
+	assert_true(mem_held(&n) == want);
+	assert_int_equal(n, 2);
+
+	/* A request of 100 objects: about 101 x MEM_PER_OBJECT alone. With a
+	 * limit between that alone and that on top of what is held, it is
+	 * refused, saying what is held; alone (no editor) it fits. */
+	double alone = 101 * MEM_PER_OBJECT;
+	assert_true(want > 1000); /* a clear gap */
+	mem_set_limit((size_t)(alone + want / 2));
+	assert_null(scene_generate(100, 3, NULL, &err));
+	char expect[512], need[32], held[32], limit[32];
+	human_test(alone, need, sizeof need);
+	human_test(want, held, sizeof held);
+	human_test((double)(size_t)(alone + want / 2), limit, sizeof limit);
+	snprintf(expect, sizeof expect,
+	         "generating 100 objects needs about %s of memory on top of the %s held by 2 scenes (the current "
+	         "one and those kept for undo); expected at most %s in all (the set limit)",
+	         need, held, limit);
+	assert_string_equal(err.msg, expect);
+	/* A request too big on its own is refused as such. */
+	double lim2 = (double)(size_t)(alone + want / 2);
+	assert_false(mem_check(lim2 + 1, "this", &err));
+	human_test(lim2 + 1, need, sizeof need);
+	snprintf(expect, sizeof expect, "this needs about %s of memory; expected at most %s (the set limit)", need,
+	         limit);
+	assert_string_equal(err.msg, expect);
+	mem_set_limit((size_t)(alone + want)); /* exactly fits */
+	scene *fits = scene_generate(100, 3, NULL, &err);
+	assert_non_null(fits);
+	scene_free(fits);
+	mem_set_limit((size_t)(alone + want / 2));
+	editor_free(ed);
+	assert_true(mem_held(&n) == 0.0);
+	assert_int_equal(n, 0);
+	fits = scene_generate(100, 3, NULL, &err);
+	assert_non_null(fits);
+	scene_free(fits);
+	mem_set_limit(0);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -352,6 +458,7 @@ int main(void)
 		cmocka_unit_test(test_stale_temporary_files),
 		cmocka_unit_test(test_xattrs_and_acls_are_kept),
 		cmocka_unit_test(test_memory_check),
+		cmocka_unit_test(test_memory_counts_the_undo_scenes),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
 }
