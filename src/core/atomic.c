@@ -12,6 +12,7 @@
  *   4. in place: make the whole content in memory, then write it over the
  *      file from its start and cut the file to its new length.
  */
+#define _GNU_SOURCE /* fallocate */
 #include "rtsh/atomic.h"
 
 #include <dirent.h>
@@ -324,15 +325,42 @@ static bool write_in_place(const char *path, const char *target, const struct st
 	}
 	if (fifo)
 		fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+	/* A reader that leaves the FIFO before the end: the write fails with
+	 * EPIPE instead of a SIGPIPE ending rtsh (the shell with it). */
+	sigset_t pipe_set, old_mask, pending;
+	sigemptyset(&pipe_set);
+	sigaddset(&pipe_set, SIGPIPE);
+	bool was_pending = sigpending(&pending) == 0 && sigismember(&pending, SIGPIPE);
+	pthread_sigmask(SIG_BLOCK, &pipe_set, &old_mask);
 	bool regular = S_ISREG(st->st_mode);
+	/* The blocks first (beyond the end, the size unchanged): a full disk is
+	 * found before the file's first byte is overwritten. File systems
+	 * without fallocate are written as they are. */
+	if (regular && len > (size_t)st->st_size && fallocate(fd, FALLOC_FL_KEEP_SIZE, 0, (off_t)len) != 0 &&
+	    (errno == ENOSPC || errno == EDQUOT || errno == EFBIG)) {
+		int e = errno;
+		pthread_sigmask(SIG_SETMASK, &old_mask, NULL);
+		close(fd);
+		free(buf);
+		return rt_error_at(err, path, 0, 0, "write failed (%s); the file was left as it was", strerror(e));
+	}
 	bool ok = write_all(fd, buf, len) && (!regular || ftruncate(fd, (off_t)len) == 0) &&
 	          (!regular || fsync(fd) == 0);
 	int e = errno;
+	if (!ok && e == EPIPE && !was_pending) {
+		struct timespec zero = {0, 0};
+		while (sigtimedwait(&pipe_set, NULL, &zero) < 0 && errno == EINTR) {
+		}
+	}
+	pthread_sigmask(SIG_SETMASK, &old_mask, NULL);
 	if (close(fd) != 0 && ok) {
 		ok = false;
 		e = errno;
 	}
 	free(buf);
+	if (!ok && e == EPIPE)
+		return rt_error_at(err, path, 0, 0, "write failed (%s): the program reading it stopped before the end",
+		                   strerror(e));
 	if (!ok)
 		return rt_error_at(err, path, 0, 0, "write failed (%s)", strerror(e));
 	return true;
@@ -456,6 +484,7 @@ typedef enum replace_result {
 
 static _Thread_local char xattr_failed[256];
 static _Thread_local int xattr_errno;
+static _Thread_local int create_errno; /* why the temporary file could not be made */
 
 /* Writes a temporary file beside target and renames it over target. `old`
  * is the file being replaced (NULL: a new file). */
@@ -483,6 +512,7 @@ static replace_result replace(const char *path, const char *target, const struct
 		guard_off(&g);
 		rt_error_at(err, path, 0, 0, "cannot create a file in that folder (%s); expected a writable folder",
 		            strerror(e));
+		create_errno = e;
 		return e == EACCES || e == EPERM || e == EROFS ? CANNOT_CREATE : FAILED;
 	}
 	replace_result res = FAILED;
@@ -607,7 +637,13 @@ bool file_write_atomic(const char *path, file_writer_fn write, void *ctx, rt_err
 		break;
 	case CANNOT_CREATE:
 		/* The folder is read-only; the file may still be writable. */
-		if (access(target, W_OK) == 0) {
+		if (access(target, W_OK) != 0) {
+			int e = errno;
+			rt_error_at(err, path, 0, 0,
+			            "cannot create a file in that folder (%s) nor write the file in place (%s); expected a "
+			            "writable folder or file",
+			            strerror(create_errno), strerror(e));
+		} else {
 			ok = write_in_place(path, target, &st, write, ctx, err);
 			if (ok)
 				snprintf(note, sizeof note,
