@@ -8,8 +8,13 @@
 # for) ends rtsh with status 128 + the signal, and leaves the terminal's
 # modes (stty -g) and the pane's flags (main screen, cursor shown, keypad and
 # cursor keys normal, no mouse reporting, insert/origin/wrap as before) as
-# they were. SIGINT leaves the pager or key mode (rtsh goes on); after it,
-# `quit` leaves them as they were too.
+# they were. The bytes rtsh wrote (tmux pipe-pane) end every private mode
+# it set (alternate screen, bracketed paste, synchronized output, cursor
+# keys, mouse...; tmux has no flag for some of them): the last of each
+# \e[?N h / l is l, but for the cursor (25) and autowrap (7), on by default,
+# whose last is h; the keypad's last is \e> when \e= came. SIGINT leaves
+# the pager or key mode (rtsh goes on); after it, `quit` leaves them as they
+# were too.
 set -u
 s=rtsh-fatal-$$
 fail() { echo "FAIL: $*"; tmux kill-session -t "$s" 2>/dev/null; tmux kill-session -t "$s-keep" 2>/dev/null; exit 1; }
@@ -47,9 +52,10 @@ exec sleep 60
 E
 
 start() {
-	rm -f "$TMP/before" "$TMP/after" "$TMP/status"
+	rm -f "$TMP/before" "$TMP/after" "$TMP/status" "$TMP/out.bytes"
 	tmux new-session -d -s "$s" -x 100 -y 32 "sh '$TMP/pane.sh'" || fail "tmux"
 	wait_for ready "the pane's shell did not start"
+	tmux pipe-pane -t "$s" -o "cat >>'$TMP/out.bytes'" || fail "tmux pipe-pane"
 	before_flags=$(flags)
 	tmux send-keys -t "$s" Enter
 	wait_for "rtsh>" "no prompt"
@@ -80,7 +86,23 @@ before $(cat "$TMP/before")
 after  $(cat "$TMP/after")"
 	after_flags=$(flags)
 	[ "$after_flags" = "$before_flags" ] || fail "$1: the pane's flags are \"$after_flags\", expected \"$before_flags\" ($F)"
+	sleep 0.2
+	left=$(modes_left "$TMP/out.bytes")
+	[ -z "$left" ] || fail "$1: rtsh's output leaves these modes set: $left"
 	tmux kill-session -t "$s"
+}
+
+# modes_left FILE: the private modes whose last setting in FILE is not the
+# default (see above), and "keypad" when the keypad was left in
+# application mode.
+esc=$(printf '\033')
+modes_left() {
+	grep -ao "$esc\[?[0-9;]*[hl]\|$esc[=>]" "$1" | tr -d "$esc" | awk '
+		/^[=>]$/ { keypad = $0; next }
+		{ c = substr($0, length($0)); n = split(substr($0, 3, length($0) - 3), m, ";")
+		  for (i = 1; i <= n; i++) last[m[i]] = c }
+		END { for (k in last) if ((k == 25 || k == 7) ? last[k] != "h" : last[k] != "l") printf "?%s%s ", k, last[k]
+		      if (keypad == "=") printf "keypad" }'
 }
 
 # signum NAME: the signal's number (dash's kill -l gives names from numbers).
