@@ -18,6 +18,7 @@
 #include <assimp/scene.h>
 
 #include "core/mesh/mesh_io.h"
+#include "rtsh/filesrc.h"
 #include "rtsh/mesh.h"
 
 static double lin(double v)
@@ -37,18 +38,11 @@ static char *texture_path(const struct aiMaterial *m, enum aiTextureType type, c
 
 mesh *mesh_read_assimp(const char *path, rt_error *err)
 {
-	FILE *f = fopen(path, "rb");
-	if (!f) {
-		rt_error_set(err, "%s: cannot read the model: %s", path, strerror(errno));
+	/* every file assimp opens is read through the file source */
+	const struct aiScene *sc = rt_file_ai_import(
+	    path, aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType, err);
+	if (!sc)
 		return NULL;
-	}
-	fclose(f);
-	const struct aiScene *sc =
-	    aiImportFile(path, aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType);
-	if (!sc) {
-		rt_error_set(err, "%s: cannot read the model: %s", path, aiGetErrorString());
-		return NULL;
-	}
 	mesh_builder b = {.name = path};
 	char *dir = path_dir(path);
 	bool ok = dir != NULL;
