@@ -436,13 +436,7 @@ bool cmd_clear(shell *sh, int argc, char **argv, const char *rest)
 	if (sh->scr && sh->scr->active) {
 		/* Clear the scroll region only, and start again at its bottom. */
 		fflush(stdout);
-		abuf a;
-		abuf_init(&a);
-		for (int r = sh->scr->region_top; r < sh->scr->rows; r++)
-			abuf_printf(&a, "\x1b[%dH\x1b[K", r + 1);
-		if (!a.failed)
-			write_all(sh->scr->fd, a.b, a.len);
-		abuf_free(&a);
+		screen_clear_commands(sh->scr);
 	}
 	return true;
 }

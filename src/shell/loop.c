@@ -1,9 +1,9 @@
-/* rtsh — the interactive loop: readline's callback interface and select()
- * on standard input and the wake-up pipe, so typing never waits for a
- * render. The render thread (preview.c) writes a byte to the pipe when an
- * image is ready; the signal handlers (signals.c) set a flag and write a
- * byte too; everything else happens here, in the main thread, which alone talks
- * to the terminal.
+/* rtsh — the interactive loop: readline's callback interface on the event
+ * loop (term/evloop.h: standard input, the wake-up pipe, the output
+ * scheduler), so typing never waits for a render. The render thread
+ * (preview.c) writes a byte to the pipe when an image is ready; the signal
+ * handlers (signals.c) set a flag and write a byte too; everything else
+ * happens here, in the main thread, which alone talks to the terminal.
  */
 #include <errno.h>
 #include <locale.h>
@@ -11,7 +11,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/select.h>
 #include <termios.h>
 #include <time.h>
 #include <unistd.h>
@@ -26,6 +25,7 @@
 #include "shell/shell.h"
 #include "term/abuf.h"
 #include "term/caps.h"
+#include "term/evloop.h"
 
 /* At most ten frames a second; and on a slow link (an SSH session whose
  * writes block while the bytes drain), a frame at most every third of the
@@ -40,87 +40,40 @@ static shell_history hist;
 
 static double now(void)
 {
-	struct timespec t;
-	clock_gettime(CLOCK_MONOTONIC, &t);
-	return (double)t.tv_sec + t.tv_nsec * 1e-9;
+	return evloop_now();
 }
 
-/* The keys read from the terminal, the answers to rtsh's queries taken
- * out (term/out.h); readline reads them through loop_getc. */
-static abuf keys;
-static size_t keys_pos;
-static bool keys_eof;
-
-/* Takes bytes read from the terminal: answers out, keys in. */
-static void take_input(shell *sh, const char *b, size_t n)
-{
-	if (keys_pos == keys.len) {
-		abuf_reset(&keys);
-		keys_pos = 0;
-	}
-	if (sh->scr && sh->scr->out)
-		termout_input(sh->scr->out, b, n, now(), &keys);
-	else
-		abuf_add(&keys, b, n);
-}
-
-/* Keys already free of answers, after the ones waiting. */
-static void take_input_raw(const abuf *k)
-{
-	if (keys_pos == keys.len) {
-		abuf_reset(&keys);
-		keys_pos = 0;
-	}
-	abuf_add(&keys, k->b, k->len);
-}
-
-/* Reads what the terminal sent (end of input: keys_eof). */
-static void read_input(shell *sh)
-{
-	char b[4096];
-	ssize_t n = read(STDIN_FILENO, b, sizeof b);
-	if (n > 0)
-		take_input(sh, b, (size_t)n);
-	else if (n == 0 || (errno != EINTR && errno != EAGAIN))
-		keys_eof = true;
-}
-
-static bool keys_waiting(void)
-{
-	return keys_pos < keys.len || keys_eof;
-}
+/* The event loop: keys (answers taken out) for readline through
+ * loop_getc, wake-ups, the output scheduler. */
+static evloop *ev;
 
 /* readline's input: the next key byte, waiting for one if need be. */
 static int loop_getc(FILE *f)
 {
 	(void)f;
-	while (keys_pos >= keys.len) {
-		if (keys_eof || shell_sig_term)
-			return EOF;
-		read_input(active);
-	}
-	return (unsigned char)keys.b[keys_pos++];
+	int c = evloop_getc_wait(ev);
+	return c < 0 ? EOF : c;
 }
 
 static int loop_input_available(void)
 {
-	return keys_pos < keys.len;
+	return evloop_has_keys(ev);
 }
 
-/* Waits for the answers the terminal owes before a part of rtsh reads
- * the terminal on its own (the pager; key mode calls shell_settle). */
-static void settle(shell *sh)
+/* Readers waiting inside the loop give up on SIGTERM (readline: as at the
+ * end of the input). */
+static bool stop_reading(void *ctx)
 {
-	if (!sh->scr || !sh->scr->out)
-		return;
-	abuf got;
-	abuf_init(&got);
-	termout_settle(sh->scr->out, STDIN_FILENO, 5.0, &got);
-	if (got.len)
-		take_input_raw(&got);
-	abuf_free(&got);
+	(void)ctx;
+	return shell_sig_term != 0;
 }
 
+/* The pager gives up on every signal the shell serves. */
+static bool stop_paging(void *ctx)
+{
+	(void)ctx;
+	return shell_sig_term || shell_sig_int || shell_sig_winch || shell_sig_cont;
+}
 
 static void draw_status(shell *sh)
 {
@@ -156,7 +109,7 @@ static void draw_picture(shell *sh)
 	double t0 = now();
 	screen_picture(scr, sh->srgb, im->w, im->h);
 	termout_picture_final(scr->out, im->done);
-	termout_pump(scr->out, t0, &keys);
+	evloop_pump(ev);
 	sh->last_draw = now();
 	sh->frame_cost = sh->last_draw - t0;
 	draw_status(sh); /* the status line tells about the picture shown */
@@ -175,9 +128,12 @@ static void show_output(shell *sh, const abuf *out)
 		return;
 	}
 	fflush(stdout);
-	settle(sh);
+	/* The loop takes the terminal's answers out of the pager's keys; the
+	 * picture waits (screen_clear_all) until the layout comes back. */
 	screen_clear_all(scr);
-	pager_show(STDIN_FILENO, scr->fd, out->b, out->len, scr->cols, scr->rows);
+	evloop_set_interrupt(ev, stop_paging, NULL);
+	pager_show(ev, scr->fd, out->b, out->len, scr->cols, scr->rows);
+	evloop_set_interrupt(ev, stop_reading, NULL);
 	/* Readline draws the prompt again when the command returns. */
 	relayout_screen(sh);
 }
@@ -333,9 +289,17 @@ int shell_interactive(shell *sh, bool use_screen, const int wake[2])
 	frame_palette pal = caps_palette(sh->opt->color, STDOUT_FILENO);
 	if (use_screen && screen_enter(&scr, STDOUT_FILENO, pal, (double)sh->set.width / sh->set.height))
 		sh->scr = &scr;
-	abuf_init(&keys);
-	keys_pos = 0;
-	keys_eof = false;
+	ev = evloop_new(STDIN_FILENO, wake_fd);
+	if (!ev) {
+		if (sh->scr)
+			screen_leave(sh->scr);
+		sh->scr = NULL;
+		fputs("rtsh: out of memory\n", stderr);
+		return 1;
+	}
+	evloop_set_out(ev, sh->scr ? sh->scr->out : NULL);
+	evloop_set_interrupt(ev, stop_reading, NULL);
+	sh->ev = ev;
 	/* Ask the terminal (over SSH, COLORTERM is not there to tell): the
 	 * answers set the pacing and, maybe, truecolor. */
 	asked_color = sh->scr && sh->opt->color == COLOR_AUTO && pal != PALETTE_TRUECOLOR && pal != PALETTE_NONE;
@@ -372,38 +336,14 @@ int shell_interactive(shell *sh, bool use_screen, const int wake[2])
 			status = 128 + shell_sig_term;
 			break;
 		}
-		fd_set rd;
-		FD_ZERO(&rd);
-		FD_SET(STDIN_FILENO, &rd);
-		if (wake_fd >= 0)
-			FD_SET(wake_fd, &rd);
 		double wait = -1;
 		if (sh->redraw) {
 			wait = sh->last_draw + frame_gap(sh) - now();
 			if (wait < 0)
 				wait = 0;
 		}
-		if (sh->scr && sh->scr->out) {
-			double w = termout_wait(sh->scr->out, now());
-			if (w >= 0 && (wait < 0 || w < wait))
-				wait = w;
-		}
-		if (keys_waiting())
-			wait = 0;
-		struct timeval tv, *tvp = NULL;
-		if (wait >= 0) {
-			tv.tv_sec = (time_t)wait;
-			tv.tv_usec = (suseconds_t)((wait - (double)tv.tv_sec) * 1e6);
-			tvp = &tv;
-		}
-		int n = select((wake_fd > STDIN_FILENO ? wake_fd : STDIN_FILENO) + 1, &rd, NULL, NULL, tvp);
-		if (n < 0 && errno != EINTR)
-			break;
-		if (n > 0 && wake_fd >= 0 && FD_ISSET(wake_fd, &rd)) {
-			char buf[256];
-			while (read(wake_fd, buf, sizeof buf) > 0)
-				;
-		}
+		/* Input, wake-ups, the scheduler's slices and time-outs. */
+		evloop_wait(ev, wait);
 		if (shell_sig_term) {
 			status = 128 + shell_sig_term;
 			break;
@@ -424,25 +364,17 @@ int shell_interactive(shell *sh, bool use_screen, const int wake[2])
 			shell_sig_int = 0;
 			interrupt(sh);
 		}
-		/* The terminal's answers first: they let the next slice go. */
-		if (n > 0 && FD_ISSET(STDIN_FILENO, &rd))
-			read_input(sh);
-		if (sh->scr && sh->scr->out) {
-			termout_pump(sh->scr->out, now(), &keys);
+		if (sh->scr && sh->scr->out)
 			after_probe(sh);
-		}
 		if (preview_take(sh->pv, &sh->img))
 			sh->redraw = true;
 		if (sh->redraw && now() - sh->last_draw >= frame_gap(sh))
 			draw_picture(sh);
 		/* Then the keys, to readline (a command may run for a while:
-		 * the answers awaited meanwhile say nothing of the link). */
-		while (keys_waiting() && !sh->quit && !shell_sig_term) {
-			double t0 = now();
+		 * the loop counts the answers awaited meanwhile as stale). */
+		while ((evloop_has_keys(ev) || evloop_eof(ev)) && !sh->quit && !shell_sig_term) {
 			rl_callback_read_char();
-			if (sh->scr && sh->scr->out && now() - t0 > 0.05)
-				termout_stale(sh->scr->out, now());
-			if (keys_eof && keys_pos >= keys.len)
+			if (evloop_eof(ev))
 				break;
 		}
 	}
@@ -455,7 +387,9 @@ int shell_interactive(shell *sh, bool use_screen, const int wake[2])
 		sh->scr = NULL;
 	}
 	signals_interactive_end();
-	abuf_free(&keys);
+	sh->ev = NULL;
+	evloop_free(ev);
+	ev = NULL;
 	sh->wake[0] = sh->wake[1] = -1;
 	active = NULL;
 	return status;

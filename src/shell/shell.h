@@ -26,6 +26,7 @@
 #include "shell/signals.h"
 #include "term/frame.h"
 #include "term/abuf.h"
+#include "term/evloop.h"
 #include "term/screen.h"
 
 #define SHELL_MSG_MAX 1024
@@ -83,6 +84,7 @@ typedef struct shell {
 	unsigned hand_set;     /* bit i: settings_table[i] was changed by `set` (answer.c) */
 	void (*status_hook)(struct shell *sh); /* redraws the status line (interactive) */
 	int wake[2];           /* the interactive loop's wake-up pipe (read, write); -1: none */
+	evloop *ev;            /* the interactive loop's event loop (term/evloop.h); NULL: none */
 } shell;
 
 /* The shell of shell_main (the signal flags are in signals.h). */

@@ -405,7 +405,9 @@ void termout_pump(termout *o, double now, abuf *keys)
 	abuf *a = &o->buf;
 	abuf_reset(a);
 	if (o->state != TERMOUT_PACED) {
-		encoder_update(o->pic, a, SIZE_MAX);
+		/* A part at a time: the loop reads keys between parts, and
+		 * sends the next when the terminal can take it. */
+		encoder_update(o->pic, a, TERMOUT_UNPACED_PART);
 	} else {
 		if (o->st.in_flight > 0 || awaiting(o, Q_DSR))
 			return; /* one slice in flight at most */
@@ -438,11 +440,26 @@ double termout_wait(const termout *o, double now)
 		CONSIDER(o->probe_sent + TERMOUT_PROBE_TIMEOUT);
 	if (o->state == TERMOUT_PACED && o->qlen > 0 && o->st.in_flight > 0)
 		CONSIDER(o->q[o->qhead].sent + slice_timeout(o));
-	if (o->pic && o->state != TERMOUT_PROBING && encoder_dirty(o->pic) &&
-	    !(o->state == TERMOUT_PACED && o->st.in_flight > 0))
+	if (o->pic && o->state == TERMOUT_PACED && encoder_dirty(o->pic) && o->st.in_flight == 0)
 		CONSIDER(now);
 #undef CONSIDER
 	return best;
+}
+
+bool termout_want_write(const termout *o)
+{
+	return o->pic && (o->state == TERMOUT_IDLE || o->state == TERMOUT_UNPACED) && encoder_dirty(o->pic);
+}
+
+int termout_fd(const termout *o)
+{
+	return o->fd;
+}
+
+void termout_release_held(termout *o, abuf *keys)
+{
+	abuf_add(keys, o->hold, o->nhold);
+	o->nhold = 0;
 }
 
 termout_state termout_get_state(const termout *o)

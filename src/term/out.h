@@ -46,6 +46,7 @@
 #define TERMOUT_PROBE_TIMEOUT 2.0
 #define TERMOUT_SLOW_BPS 2e6
 #define TERMOUT_JND 4
+#define TERMOUT_UNPACED_PART (32u << 10)
 
 typedef struct termout termout;
 
@@ -106,6 +107,14 @@ void termout_pump(termout *o, double now, abuf *keys);
 double termout_wait(const termout *o, double now);
 /* True while answers are awaited. */
 bool termout_awaiting(const termout *o);
+/* True when, not paced, a picture part waits for the terminal to take it:
+ * the event loop calls termout_pump when the fd is writable (each part is
+ * at most TERMOUT_UNPACED_PART bytes, so keys are read between parts). */
+bool termout_want_write(const termout *o);
+/* The terminal's fd the scheduler writes to. */
+int termout_fd(const termout *o);
+/* Gives up a cut escape sequence held (appended to keys). */
+void termout_release_held(termout *o, abuf *keys);
 
 /* The loop was busy (a command ran) and did not read the answers in time:
  * those awaited now tell nothing about the link. */

@@ -1,8 +1,6 @@
 /* rtsh — the pager (pager.h). */
 #include "term/pager.h"
 
-#include <errno.h>
-#include <poll.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -12,6 +10,10 @@
 #include <unistd.h>
 
 #include "term/abuf.h"
+#include "term/out.h"
+
+/* Seconds the rest of an escape sequence may take over a slow link. */
+#define PAGER_ESC_WAIT 0.3
 
 /* One display row: a slice of the text. */
 typedef struct slice {
@@ -67,7 +69,7 @@ int pager_rows(const char *text, size_t len, int cols)
 	return split(text, len, cols, NULL);
 }
 
-static void draw(int fd, const slice *rows, int nrows, int top, int page, int cols)
+static void draw(evloop *l, int fd, const slice *rows, int nrows, int top, int page, int cols)
 {
 	abuf a;
 	abuf_init(&a);
@@ -88,36 +90,18 @@ static void draw(int fd, const slice *rows, int nrows, int top, int page, int co
 	for (; w < cols; w++)
 		abuf_char(&a, ' ');
 	abuf_str(&a, "\x1b[m");
-	if (!a.failed)
-		write_all(fd, a.b, a.len);
+	if (!a.failed) {
+		if (evloop_out(l))
+			termout_text(evloop_out(l), a.b, a.len);
+		else
+			write_all(fd, a.b, a.len);
+	}
 	abuf_free(&a);
 }
 
-/* Reads one key: a byte, or an escape sequence read as a whole (waiting
- * briefly for the rest of it on a slow link). 0 on end of input or error. */
-static int read_key(int fd, char *seq, size_t size)
+void pager_show(evloop *l, int fd_out, const char *text, size_t len, int cols, int rows)
 {
-	ssize_t n = read(fd, seq, 1);
-	if (n <= 0)
-		return 0;
-	size_t len = 1;
-	if (seq[0] == '\x1b') {
-		struct pollfd pf = {fd, POLLIN, 0};
-		while (len < size - 1 && poll(&pf, 1, 40) > 0) {
-			if (read(fd, seq + len, 1) != 1)
-				break;
-			len++;
-			char c = seq[len - 1];
-			if (len > 2 && ((c >= 'A' && c <= 'Z') || c == '~'))
-				break;
-		}
-	}
-	seq[len] = '\0';
-	return (int)len;
-}
-
-void pager_show(int fd_in, int fd_out, const char *text, size_t len, int cols, int rows)
-{
+	int fd_in = evloop_in_fd(l);
 	struct termios saved, raw;
 	bool have_tty = tcgetattr(fd_in, &saved) == 0;
 	if (have_tty) {
@@ -136,9 +120,9 @@ void pager_show(int fd_in, int fd_out, const char *text, size_t len, int cols, i
 		for (;;) {
 			int max_top = nrows > page ? nrows - page : 0;
 			top = top < 0 ? 0 : top > max_top ? max_top : top;
-			draw(fd_out, sl, nrows, top, page, cols);
+			draw(l, fd_out, sl, nrows, top, page, cols);
 			char k[16];
-			if (!read_key(fd_in, k, sizeof k))
+			if (!evloop_key(l, k, sizeof k, PAGER_ESC_WAIT))
 				break;
 			if (strcmp(k, " ") == 0 || strcmp(k, "f") == 0 || strcmp(k, "\x1b[6~") == 0) {
 				if (top >= max_top && k[0] == ' ')
@@ -164,5 +148,8 @@ void pager_show(int fd_in, int fd_out, const char *text, size_t len, int cols, i
 	}
 	if (have_tty)
 		tcsetattr(fd_in, TCSADRAIN, &saved);
-	write_all(fd_out, "\x1b[?25h", 6);
+	if (evloop_out(l))
+		termout_text(evloop_out(l), "\x1b[?25h", 6);
+	else
+		write_all(fd_out, "\x1b[?25h", 6);
 }

@@ -10,15 +10,20 @@
 
 #include <stddef.h>
 
+#include "term/evloop.h"
+
 /* The rows text takes on a terminal `cols` wide, long lines wrapped (escape
  * sequences take no room; a code point takes one column). */
 int pager_rows(const char *text, size_t len, int cols);
 
-/* Shows text on the terminal fd_out, reading keys from fd_in (a terminal,
- * put in non-canonical mode for the while): Space / PgDn / f a page on,
+/* Shows text on the terminal fd_out (through the loop's output scheduler
+ * when it has one), reading keys from the event loop l (its input, a
+ * terminal, is put in non-canonical mode for the while): Space / PgDn / f a page on,
  * b / PgUp a page back, Enter / Down / j a line on, Up / k a line back,
  * g / Home the top, G / End the end, q / Esc leave; Space on the last page
- * leaves too. Returns when the user leaves; the caller redraws its screen. */
-void pager_show(int fd_in, int fd_out, const char *text, size_t len, int cols, int rows);
+ * leaves too. Returns when the user leaves, at the end of the input, or when
+ * the loop's interrupt hook says so (a signal); the caller redraws its
+ * screen. */
+void pager_show(evloop *l, int fd_out, const char *text, size_t len, int cols, int rows);
 
 #endif

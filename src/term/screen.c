@@ -248,6 +248,8 @@ static void redraw_chrome(screen *s)
 	abuf_free(&a);
 	if (s->enc)
 		s->enc->ops->invalidate(s->enc);
+	if (s->out)
+		termout_set_picture(s->out, s->enc); /* back after screen_clear_all */
 }
 
 bool screen_layout(screen *s, double aspect, bool force)
@@ -327,10 +329,25 @@ void screen_clear_all(screen *s)
 {
 	static const char seq[] = "\x1b[r\x1b[2J";
 	screen_drop_images(s);
-	if (s->out)
+	if (s->out) {
+		/* No picture goes out until screen_layout gives the screen back. */
+		termout_set_picture(s->out, NULL);
 		termout_text(s->out, seq, sizeof seq - 1);
-	else
+	} else {
 		write_all(s->fd, seq, sizeof seq - 1);
+	}
+}
+
+void screen_clear_commands(screen *s)
+{
+	if (!s->active)
+		return;
+	abuf a;
+	abuf_init(&a);
+	for (int r = s->region_top; r < s->rows; r++)
+		abuf_printf(&a, "\x1b[%dH\x1b[K", r + 1);
+	put(s, &a);
+	abuf_free(&a);
 }
 
 void screen_set_palette(screen *s, frame_palette pal)

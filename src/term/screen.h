@@ -64,8 +64,12 @@ void screen_leave(screen *s);
  * puts the cursor on the last row. True when the image size changed. */
 bool screen_layout(screen *s, double aspect, bool force);
 /* Clears the whole screen and resets the scroll region (before the pager
- * takes the screen; screen_layout gives it back). */
+ * or key mode takes the screen); no picture goes out until screen_layout
+ * gives the screen back. */
 void screen_clear_all(screen *s);
+/* Clears the command area (the scroll region) and leaves the cursor on
+ * its last row. */
+void screen_clear_commands(screen *s);
 /* Another palette (the terminal said it has truecolor): lays out and
  * clears the screen again. */
 void screen_set_palette(screen *s, frame_palette pal);
