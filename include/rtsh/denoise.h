@@ -32,13 +32,26 @@
 #include "rtsh/render.h"
 #include "rtsh/world.h"
 
-/* Floats per pixel in framebuffer.feat: albedo r g b, normal x y z (the
- * side facing the camera), depth (distance along the camera ray; 0 for the
- * sky), and the mean over all the samples of their squared brightness
- * (denoise_sq), from which the noise of the pixel is estimated. */
-#define DENOISE_FEATURES 8
-/* The features are the mean of at most this many samples per pixel. */
+/* Floats per pixel in framebuffer.feat:
+ *   0-2  albedo r g b,
+ *   3-5  normal x y z (the side facing the camera),
+ *   6    depth (distance along the camera ray; 0 for the sky),
+ *   7    the mean over all the samples of their squared brightness
+ *        (denoise_sq), from which the noise of the pixel is estimated,
+ *   8    the mean squared length of the albedo, 9 of the depth (how much
+ *        the features vary inside the pixel).
+ * All but 7 are means over the first DENOISE_FEATURE_SAMPLES samples' camera
+ * rays, or over DENOISE_EDGE_SAMPLES positions where those disagree. */
+#define DENOISE_FEATURES 10
+/* The features are the mean of at most this many samples per pixel... */
 #define DENOISE_FEATURE_SAMPLES 8
+/* ...or of this many camera positions (first hits only, no paths) at a
+ * pixel whose first ones see different surfaces: the albedo the lighting
+ * is multiplied by again after filtering is then as well antialiased as
+ * that many samples would make it. */
+#define DENOISE_EDGE_SAMPLES 64
+/* Doubles of a pixel's feature sums over a run of its samples (denoise_sample). */
+#define DENOISE_ACC 10
 
 /* Gives fb its feature buffer (cleared) if it has none, so that path-mode
  * render jobs into it record features; false when out of memory. */
@@ -51,12 +64,18 @@ static inline double denoise_sq(vec3 c)
 	return l * l;
 }
 
-/* Adds the features of samples [begin, end) of pixel (px, py) of an fw x fh
- * image to f (DENOISE_FEATURES floats holding those of samples [0, begin));
- * sq is the sum of denoise_sq over the new samples. Render jobs call it per
- * pixel. */
-void denoise_features(const world *w, int px, int py, int fw, int fh, int begin, int end, double sq,
-                      float *f);
+/* Adds to acc (DENOISE_ACC doubles, laid out like the features) what the
+ * camera ray r of one sample first sees. */
+void denoise_sample(const world *w, ray r, double *acc);
+
+/* Updates the features f of pixel (px, py) of an fw x fh image (those of
+ * samples [0, begin)) with samples [begin, end): acc holds denoise_sample's
+ * sums over those of them below DENOISE_FEATURE_SAMPLES, sq the sum of
+ * denoise_sq over all of them. Render jobs call it per pixel; when the
+ * pixel reaches DENOISE_FEATURE_SAMPLES and its features vary, the edge
+ * positions are added (render_sample_ray with s). */
+void denoise_features(const world *w, const render_settings *s, int px, int py, int fw, int fh,
+                      int begin, int end, double sq, const double *acc, float *f);
 
 /* Writes the denoised radiance of fb (which has features and samples) to
  * out, w*h*3 linear floats; out may be fb->rgb. threads: the workers to use

@@ -36,10 +36,18 @@ typedef struct mesh_mat {
 	float bump_scale; /* -bm, 1 by default */
 } mesh_mat;
 
+/* Four triangles of a leaf laid out for the leaf test (mesh_trace.c):
+ * v[3 * corner + axis][lane] is a vertex coordinate, the same float as in
+ * mesh.p, so both tests see the same triangle. Lanes past a leaf's count
+ * repeat its last triangle and are masked off. */
+typedef struct mesh_tri4 {
+	_Alignas(16) float v[9][4];
+} mesh_tri4;
+
 typedef struct mesh {
 	char *path;
 	uint32_t nverts, ntris;
-	float (*p)[3];     /* positions */
+	float (*p)[3];     /* positions; NULL once prepared (blk holds them) */
 	float (*n)[3];     /* unit normals, NULL: flat shading */
 	float (*uv)[2];    /* texture coordinates, NULL: none */
 	uint32_t (*tri)[3];
@@ -47,7 +55,11 @@ typedef struct mesh {
 	mesh_mat *mats;
 	uint32_t nmats;
 	box bounds;        /* of the positions */
-	struct bvh *tree;  /* over tri, in tree order (mesh_prepare) */
+	struct bvh *tree;  /* over tri, in tree order (mesh_prepare); a leaf's
+	                      child is its first block in blk */
+	mesh_tri4 *blk;    /* the leaves' triangles, 4 to a block */
+	uint32_t *bfirst;  /* the triangle in lane 0 of each block */
+	uint32_t nblk;
 	float eps;         /* self-hit guard in object units */
 	size_t refs;       /* users in the cache (mesh_cache_get) */
 } mesh;
@@ -108,6 +120,15 @@ void mb_free(mesh_builder *b);
 
 /* --- ray queries (object space, single precision) --- */
 
+/* A prepared mesh names a triangle by its slot in the blocks, 4 * block +
+ * lane: what mesh_intersect returns and mesh_surface takes. */
+static inline uint32_t mesh_slot_tri(const mesh *m, uint32_t slot)
+{
+	return m->bfirst[slot >> 2] + (slot & 3); /* its index in tri and tmat */
+}
+/* The corners of the triangle in a slot. */
+void mesh_corners(const mesh *m, uint32_t slot, vec3 c[3]);
+
 typedef struct mesh_ray {
 	float o[3], d[3];
 	int kx, ky, kz;      /* watertight test: axes, kz the largest |d| */
@@ -115,14 +136,25 @@ typedef struct mesh_ray {
 } mesh_ray;
 
 void mesh_ray_make(mesh_ray *r, vec3 o, vec3 d);
-/* The nearest triangle with tmin < t < *tmax: sets *tmax, *tri and the
- * barycentric weights b[3] of its corners. */
+/* The nearest triangle with tmin < t < *tmax: sets *tmax, *tri (its slot)
+ * and the barycentric weights b[3] of its corners. */
 bool mesh_intersect(const mesh *m, const mesh_ray *r, float tmin, float *tmax, uint32_t *tri, float b[3]);
 bool mesh_occluded(const mesh *m, const mesh_ray *r, float tmin, float tmax);
-/* The same without the tree (tests). */
+/* The same walk with each leaf block tested one lane at a time in scalar
+ * code (on machines without SSE2 it is the only path); tests check that it
+ * finds the very same hits as the SSE path. */
+bool mesh_intersect_scalar(const mesh *m, const mesh_ray *r, float tmin, float *tmax, uint32_t *tri, float b[3]);
+bool mesh_occluded_scalar(const mesh *m, const mesh_ray *r, float tmin, float tmax);
+/* Lays the leaves' triangles out in blocks of four (mesh_prepare calls it
+ * once the tree and the triangle order are final). False when out of
+ * memory. */
+bool mesh_make_blocks(mesh *m);
+/* The same without the tree, on a mesh not prepared (positions and
+ * triangles as read; *tri an index in tri): the tests' reference. */
 bool mesh_intersect_brute(const mesh *m, const mesh_ray *r, float tmin, float *tmax, uint32_t *tri, float b[3]);
 
-/* What shading needs at a hit (object space): geometric normal (unit),
+/* What shading needs at a hit on a prepared mesh (object space, the
+ * triangle by its slot): geometric normal (unit),
  * shading normal (unit, the same side as ng), texture coordinates and the
  * tangents along u and v (zero when there are none). */
 typedef struct mesh_surf {
@@ -130,6 +162,6 @@ typedef struct mesh_surf {
 	double u, v;
 	int mat; /* material of the file, -1 none */
 } mesh_surf;
-void mesh_surface(const mesh *m, uint32_t tri, const float b[3], mesh_surf *s);
+void mesh_surface(const mesh *m, uint32_t slot, const float b[3], mesh_surf *s);
 
 #endif

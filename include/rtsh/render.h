@@ -125,5 +125,8 @@ void render_rect(const world *w, const render_settings *s, int x0, int y0, int x
  * the seed. */
 vec3 render_sample(const world *w, const render_settings *s, int px, int py, int fw, int fh,
                    int sample);
+/* The camera ray of that sample (the denoiser's features follow it). */
+ray render_sample_ray(const world *w, const render_settings *s, int px, int py, int fw, int fh,
+                      int sample);
 
 #endif

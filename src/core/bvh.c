@@ -53,7 +53,16 @@ typedef struct builder {
 	size_t used, cap;
 	int depth;
 	size_t leaves;
+	double trav;    /* SAH cost of a node visit */
+	unsigned block; /* primitives tested together (bvh_build_blocks), 1 */
 } builder;
+
+/* The SAH cost of testing primitives of summed cost `sum` in a leaf: the
+ * sum, or in blocks of b->block (unit costs) the number of blocks. */
+static inline double leaf_cost(const builder *b, double sum)
+{
+	return b->block > 1 ? ceil(sum / b->block) : sum;
+}
 
 static fbox fbox_empty(void)
 {
@@ -220,6 +229,7 @@ static split find_split(const builder *b, size_t begin, size_t end, const fbox *
 	best.total = 0.0;
 	for (int k = 0; k < nbins; k++)
 		best.total += bcost[0][k];
+	best.total = leaf_cost(b, best.total);
 	for (int a = 0; a < 3; a++) {
 		if (!bn.usable[a])
 			continue;
@@ -240,7 +250,8 @@ static split find_split(const builder *b, size_t begin, size_t end, const fbox *
 			sum += bcost[a][k];
 			if (sum == 0.0 || right_cost[k + 1] == 0.0)
 				continue;
-			double cost = fbox_half_area(&acc) * sum + right_area[k + 1] * right_cost[k + 1];
+			double cost = fbox_half_area(&acc) * leaf_cost(b, sum) +
+			              right_area[k + 1] * leaf_cost(b, right_cost[k + 1]);
 			if (cost < best.cost) {
 				best.cost = cost;
 				best.axis = a;
@@ -314,19 +325,19 @@ static void build(builder *b, size_t begin, size_t end, const fbox *bb, const fb
 		b->depth = depth;
 	bool leaf = n <= 1 || (depth >= BALANCED_DEPTH && n <= LEAF_MAX);
 	if (!leaf && n <= LEAF_MAX) {
-		/* A split costs at least COST_TRAVERSE: a node that costs no more
+		/* A split costs at least a node visit: a node that costs no more
 		 * to test whole is a leaf without binning (most small nodes). */
 		double total = 0.0;
 		for (size_t i = begin; i < end; i++)
 			total += b->refs[i].lo[3];
-		leaf = total <= COST_TRAVERSE;
+		leaf = leaf_cost(b, total) <= b->trav;
 	}
 	split s = {.axis = -1};
 	if (!leaf && depth < BALANCED_DEPTH)
 		s = find_split(b, begin, end, cb);
 	if (!leaf && n <= LEAF_MAX && depth < BALANCED_DEPTH) {
 		double area = fbox_half_area(bb);
-		double split_cost = area > 0.0 && s.axis >= 0 ? COST_TRAVERSE + s.cost / area : INFINITY;
+		double split_cost = area > 0.0 && s.axis >= 0 ? b->trav + s.cost / area : INFINITY;
 		leaf = s.total <= split_cost;
 	}
 	if (leaf) {
@@ -411,7 +422,8 @@ static uint32_t collapse(const builder *b, uint32_t n2, bvh_node *out, size_t *u
 	return ni;
 }
 
-bvh *bvh_build(const box *bounds, const float *costs, size_t n, uint32_t *order, rt_error *err)
+static bvh *build_tree(const box *bounds, const float *costs, size_t n, unsigned block, double trav,
+                       uint32_t *order, rt_error *err)
 {
 	bvh *t = calloc(1, sizeof *t);
 	if (!t) {
@@ -426,7 +438,7 @@ bvh *bvh_build(const box *bounds, const float *costs, size_t n, uint32_t *order,
 		rt_error_set(err, "too many objects (%zu); expected at most %u", n, BVH_MAX_PRIMS);
 		return NULL;
 	}
-	builder b = {0};
+	builder b = {.trav = trav, .block = block};
 	b.refs = malloc(n * sizeof *b.refs);
 	b.ids = order; /* partitioned along with the references */
 	b.cap = n > 1 ? n - 1 : 1; /* a binary tree with leaves folded in: < n inner nodes */
@@ -456,10 +468,28 @@ bvh *bvh_build(const box *bounds, const float *costs, size_t n, uint32_t *order,
 	t->depth = b.depth;
 	t->leaves = b.leaves;
 	if (meta2) {
-		/* one leaf: no node at all */
-		t->root = root2;
-		t->root_meta = meta2;
+		/* one leaf: a root node holding it alone, so that a ray that
+		 * misses the box of everything stops at one slab test */
 		free(b.nodes);
+		bvh_node *one = aligned_alloc(64, (sizeof *one + 63) / 64 * 64);
+		if (!one) {
+			free(t);
+			rt_error_set(err, "out of memory building the BVH (%zu objects)", n);
+			return NULL;
+		}
+		for (int k = 0; k < BVH_WIDTH; k++) {
+			fbox fb = k == 0 ? bb : fbox_empty();
+			for (int a = 0; a < 3; a++) {
+				one->b[BVH_LO_X + a][k] = fb.lo[a];
+				one->b[BVH_HI_X + a][k] = fb.hi[a];
+			}
+			one->child[k] = k == 0 ? root2 : 0;
+			one->meta[k] = k == 0 ? meta2 : BVH_LEAF;
+		}
+		t->nodes = one;
+		t->nnodes = 1;
+		t->root = 0;
+		t->root_meta = 0;
 		return t;
 	}
 	/* each 4-wide node takes at least one binary node */
@@ -485,6 +515,16 @@ bvh *bvh_build(const box *bounds, const float *costs, size_t n, uint32_t *order,
 	t->nodes = wide;
 	t->nnodes = used;
 	return t;
+}
+
+bvh *bvh_build(const box *bounds, const float *costs, size_t n, uint32_t *order, rt_error *err)
+{
+	return build_tree(bounds, costs, n, 1, COST_TRAVERSE, order, err);
+}
+
+bvh *bvh_build_blocks(const box *bounds, size_t n, unsigned block, double trav, uint32_t *order, rt_error *err)
+{
+	return build_tree(bounds, NULL, n, block, trav, order, err);
 }
 
 void bvh_free(bvh *t)

@@ -96,10 +96,10 @@ static inline unsigned bvh_slab4(const bvh_node *n, const bvh_ray *q, float tmin
 }
 
 struct bvh {
-	bvh_node *nodes;    /* 64-byte aligned; none when the root is a leaf */
+	bvh_node *nodes;    /* 64-byte aligned; none when there are no primitives */
 	size_t nnodes;
-	uint32_t root;      /* the root as a child reference: node 0, or the */
-	uint32_t root_meta; /* one leaf of all primitives (BVH_LEAF | n) */
+	uint32_t root;      /* the root as a child reference: node 0 (a lone */
+	uint32_t root_meta; /* leaf gets a node too), or an empty leaf */
 	int depth;          /* of the binary tree */
 	size_t leaves;
 };
@@ -111,6 +111,10 @@ struct bvh {
  * place i of tree order (leaves index primitives in that order). NULL (err
  * set) when out of memory or n is too large. */
 bvh *bvh_build(const box *bounds, const float *costs, size_t n, uint32_t *order, rt_error *err);
+/* The same for primitives of equal cost tested `block` at a time (a mesh's
+ * triangles, 4 per SSE test): a leaf costs one unit per started block, a
+ * node visit `trav` units. */
+bvh *bvh_build_blocks(const box *bounds, size_t n, unsigned block, double trav, uint32_t *order, rt_error *err);
 void bvh_free(bvh *t);
 
 /* For the benchmark (bench/bench.c): the rays world_intersect and

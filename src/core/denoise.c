@@ -80,28 +80,65 @@ static void first_surface(const world *w, ray r, double f[7])
 	}
 }
 
-void denoise_features(const world *w, int px, int py, int fw, int fh, int begin, int end, double sq,
-                      float *f)
+/* Albedo below this is not divided out (a black surface has no lighting to
+ * recover). */
+#define ALBEDO_MIN 0.02
+
+static inline double albedo_divisor(double a)
+{
+	return a > ALBEDO_MIN ? a : 1.0;
+}
+
+void denoise_sample(const world *w, ray r, double *acc)
+{
+	double f[7] = {0};
+	first_surface(w, r, f);
+	for (int k = 0; k < 7; k++)
+		acc[k] += f[k];
+	acc[8] += f[0] * f[0] + f[1] * f[1] + f[2] * f[2];
+	acc[9] += f[6] * f[6];
+}
+
+/* Whether the first hits of a pixel's samples differ: albedo or depth
+ * spread, or normals that do not agree (their mean is shorter than one). */
+static bool features_vary(const float *f)
+{
+	if (f[6] <= 0.0f)
+		return false; /* all sky */
+	double a2 = (double)f[0] * f[0] + (double)f[1] * f[1] + (double)f[2] * f[2];
+	double n2 = (double)f[3] * f[3] + (double)f[4] * f[4] + (double)f[5] * f[5];
+	double va = f[8] - a2, vz = f[9] - (double)f[6] * f[6];
+	return va > 1e-4 || vz > 1e-4 * (double)f[6] * f[6] || n2 < 0.998;
+}
+
+void denoise_features(const world *w, const render_settings *s, int px, int py, int fw, int fh,
+                      int begin, int end, double sq, const double *acc, float *f)
 {
 	f[7] = (float)(((double)f[7] * begin + sq) / end);
 	int n0 = begin < DENOISE_FEATURE_SAMPLES ? begin : DENOISE_FEATURE_SAMPLES;
 	int n1 = end < DENOISE_FEATURE_SAMPLES ? end : DENOISE_FEATURE_SAMPLES;
 	if (n1 <= n0)
 		return;
-	double acc[7];
-	for (int k = 0; k < 7; k++)
-		acc[k] = n0 > 0 ? (double)f[k] * n0 : 0.0;
-	for (int s = n0; s < n1; s++) {
-		/* Positions of the R2 sequence (Roberts 2018), a low-discrepancy
-		 * set of its own: the features need the pixel's area, not the
-		 * radiance samples' exact rays. */
-		double u = 0.5 + 0.7548776662466927 * s, v = 0.5 + 0.5698402909980532 * s;
-		u -= floor(u);
-		v -= floor(v);
-		first_surface(w, cam_ray(&w->cam, px + u, py + v, fw, fh), acc);
+	for (int k = 0; k < DENOISE_FEATURES; k++)
+		if (k != 7)
+			f[k] = (float)(((double)f[k] * n0 + acc[k]) / n1);
+	if (n1 < DENOISE_FEATURE_SAMPLES || !features_vary(f))
+		return;
+	/* An edge: more camera positions, the radiance samples' own. */
+	double sum[DENOISE_ACC];
+	for (int k = 0; k < DENOISE_ACC; k++)
+		sum[k] = (double)f[k] * n1;
+	for (int k = n1; k < DENOISE_EDGE_SAMPLES; k++) {
+		double one[7] = {0};
+		first_surface(w, render_sample_ray(w, s, px, py, fw, fh, k), one);
+		for (int q = 0; q < 7; q++)
+			sum[q] += one[q];
+		sum[8] += one[0] * one[0] + one[1] * one[1] + one[2] * one[2];
+		sum[9] += one[6] * one[6];
 	}
-	for (int k = 0; k < 7; k++)
-		f[k] = (float)(acc[k] / n1);
+	for (int k = 0; k < DENOISE_FEATURES; k++)
+		if (k != 7)
+			f[k] = (float)(sum[k] / DENOISE_EDGE_SAMPLES);
 }
 
 /* --- the filter ------------------------------------------------------------ */
@@ -116,15 +153,12 @@ void denoise_features(const world *w, int px, int py, int fw, int fh, int begin,
  * shares of its depth. */
 #define SIGMA_L 8.0f
 #define SIGMA_L_DECAY 0.6f
-#define SIGMA_N2 0.02f
+#define SIGMA_N2 0.08f
 #define SIGMA_A2 0.01f
 #define SIGMA_Z 0.02f
-/* Albedo below this is not divided out (a black surface has no lighting to
- * recover). */
-#define ALBEDO_MIN 0.02f
 /* Fireflies: a pixel brighter than its same-surface 3x3 neighbours' mean by
  * more than this many of their standard deviations is brought down to it. */
-#define FIREFLY_K 2.0f
+#define FIREFLY_K 4.0f
 
 typedef struct guide {
 	float f[6];   /* albedo / sqrt(SIGMA_A2), normal / sqrt(SIGMA_N2) */
@@ -196,7 +230,7 @@ static void setup_rows(job *j, int y0, int y1)
 			for (int k = 0; k < 3; k++) {
 				g->f[k] = f[k] * (1.0f / sqrtf(SIGMA_A2));
 				g->f[3 + k] = f[3 + k] * (1.0f / sqrtf(SIGMA_N2));
-				g->am[k] = f[k] > ALBEDO_MIN ? f[k] : 1.0f;
+				g->am[k] = (float)albedo_divisor(f[k]);
 			}
 			g->z = f[6];
 			g->gx = depth_slope(f + 6, x, w, DENOISE_FEATURES);
@@ -301,6 +335,9 @@ static void clamp_rows(job *j, const texel *src, texel *dst, int y0, int y1)
  * with 5 passes (taps up to 31 pixels away) gave the same error within 1%
  * in 40% of the time. */
 #define KR 1
+/* The first-order fit's slopes are held back by a ridge of this share of
+ * the weights (a plane through few taps would otherwise swing widely). */
+#define LWR_RIDGE 0.15f
 static const float kernel[2 * KR + 1] = {1.0f / 4, 1.0f / 2, 1.0f / 4};
 
 /* One a-trous pass with taps `step` pixels apart, rows [y0, y1) from src to
@@ -340,8 +377,14 @@ static void atrous_rows(job *j, const texel *src, texel *dst, int step, int y0, 
 			while (x + hi * step >= w)
 				hi--;
 			float k0 = kernel[KR] * kernel[KR];
-			float sum[3] = {k0 * tp->c[0], k0 * tp->c[1], k0 * tp->c[2]};
-			float wsum = k0, vsum = k0 * k0 * tp->var;
+			/* the taps: weight, offset (in steps) and texel */
+			float tw[9], tx[9], ty[9];
+			const texel *tt[9];
+			int nt = 0;
+			tw[0] = k0;
+			tx[0] = ty[0] = 0;
+			tt[0] = tp;
+			nt = 1;
 			for (int dy = -KR; dy <= KR; dy++) {
 				int qy = y + dy * step;
 				if (qy < 0 || qy >= h)
@@ -359,31 +402,191 @@ static void atrous_rows(job *j, const texel *src, texel *dst, int step, int y0, 
 						e += (gp->f[k] - gq->f[k]) * (gp->f[k] - gq->f[k]);
 					e += fabsf(gq->z - (zrow + gxs * (float)dx)) * inv_z;
 					e += fabsf(lp - lum(tq->c)) * inv_l;
-					float wt = kernel[dx + KR] * kernel[dy + KR] * exp_neg(e);
-					sum[0] += wt * tq->c[0];
-					sum[1] += wt * tq->c[1];
-					sum[2] += wt * tq->c[2];
-					wsum += wt;
-					vsum += wt * wt * tq->var;
+					tw[nt] = kernel[dx + KR] * kernel[dy + KR] * exp_neg(e);
+					tx[nt] = (float)dx;
+					ty[nt] = (float)dy;
+					tt[nt] = tq;
+					nt++;
 				}
 			}
+			/* Zero order: the weighted mean. First order (a plane through
+			 * the taps, least squares, its value at the centre): the same
+			 * where the weights are symmetric, unbiased on a slope where an
+			 * edge cuts them off on one side. */
+			float s0 = 0, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
+			for (int t = 0; t < nt; t++) {
+				s0 += tw[t];
+				sx += tw[t] * tx[t];
+				sy += tw[t] * ty[t];
+				sxx += tw[t] * tx[t] * tx[t];
+				syy += tw[t] * ty[t] * ty[t];
+				sxy += tw[t] * tx[t] * ty[t];
+			}
+			float ca = 1.0f / s0, cb = 0, cc = 0;
+			{
+				float ridge = LWR_RIDGE * s0;
+				sxx += ridge;
+				syy += ridge;
+				float c00 = sxx * syy - sxy * sxy, c01 = sxy * sy - sx * syy, c02 = sx * sxy - sxx * sy;
+				float det = s0 * c00 + sx * c01 + sy * c02;
+				if (det > 1e-6f * s0 * s0 * s0) {
+					ca = c00 / det;
+					cb = c01 / det;
+					cc = c02 / det;
+				}
+			}
+			float sum[3] = {0, 0, 0}, vsum = 0;
+			for (int t = 0; t < nt; t++) {
+				float l = tw[t] * (ca + cb * tx[t] + cc * ty[t]);
+				sum[0] += l * tt[t]->c[0];
+				sum[1] += l * tt[t]->c[1];
+				sum[2] += l * tt[t]->c[2];
+				vsum += l * l * tt[t]->var;
+			}
 			texel *o = &dst[i];
-			float inv = 1.0f / wsum; /* wsum >= the centre's own weight */
-			o->c[0] = sum[0] * inv;
-			o->c[1] = sum[1] * inv;
-			o->c[2] = sum[2] * inv;
-			o->var = vsum * inv * inv;
+			o->c[0] = sum[0] > 0 ? sum[0] : 0;
+			o->c[1] = sum[1] > 0 ? sum[1] : 0;
+			o->c[2] = sum[2] > 0 ? sum[2] : 0;
+			o->var = vsum;
 		}
 }
 
-static void finish_rows(job *j, const texel *src, int y0, int y1)
+/* The filtered lighting times the albedo again, into dst (radiance and
+ * the variance of its brightness). */
+static void finish_rows(job *j, const texel *src, texel *dst, int y0, int y1)
 {
 	int w = j->fb->w;
 	for (int y = y0; y < y1; y++)
 		for (int x = 0; x < w; x++) {
 			size_t i = (size_t)y * w + x;
 			for (int k = 0; k < 3; k++)
-				j->out[i * 3 + k] = src[i].c[k] * j->g[i].am[k];
+				dst[i].c[k] = src[i].c[k] * j->g[i].am[k];
+			float am = lum(j->g[i].am);
+			dst[i].var = src[i].var * am * am;
+		}
+}
+
+/* The regression may move a pixel by at most this many standard
+ * deviations of its remaining noise. */
+#define REG_K 1.0f
+#define RR 2        /* the regression's window: (2 RR + 1)^2 pixels */
+#define NR 8        /* its unknowns: a constant and 7 feature slopes */
+#define EDGE_D 0.5f /* a neighbour this far in scaled features: an edge */
+
+/* Cholesky solve of the NR x NR system a x = b (a positive definite; a is
+ * overwritten). False when it is not. */
+static bool solve(float a[NR][NR], float b[NR][3], float x[NR][3])
+{
+	for (int c = 0; c < NR; c++) {
+		float d = a[c][c];
+		for (int k = 0; k < c; k++)
+			d -= a[c][k] * a[c][k];
+		if (!(d > 1e-12f))
+			return false;
+		d = sqrtf(d);
+		a[c][c] = d;
+		for (int r = c + 1; r < NR; r++) {
+			float v = a[r][c];
+			for (int k = 0; k < c; k++)
+				v -= a[r][k] * a[c][k];
+			a[r][c] = v / d;
+		}
+	}
+	for (int ch = 0; ch < 3; ch++) {
+		float z[NR];
+		for (int r = 0; r < NR; r++) {
+			float v = b[r][ch];
+			for (int k = 0; k < r; k++)
+				v -= a[r][k] * z[k];
+			z[r] = v / a[r][r];
+		}
+		for (int r = NR - 1; r >= 0; r--) {
+			float v = z[r];
+			for (int k = r + 1; k < NR; k++)
+				v -= a[k][r] * x[k][ch];
+			x[r][ch] = v / a[r][r];
+		}
+	}
+	return true;
+}
+
+/* Pixels on an edge (their own features or a neighbour's differ): a
+ * first-order regression of the filtered radiance on the features over the
+ * window around them, each pixel weighted by the inverse of its remaining
+ * noise, evaluated at the pixel's own features (a pixel that is part one
+ * surface, part another gets the mix its features say). Else copied. */
+static void regress_rows(job *j, const texel *src, int y0, int y1)
+{
+	int w = j->fb->w, h = j->fb->h;
+	for (int y = y0; y < y1; y++)
+		for (int x = 0; x < w; x++) {
+			size_t i = (size_t)y * w + x;
+			const guide *gp = &j->g[i];
+			float *o = j->out + i * 3;
+			bool edge = false;
+			for (int dy = -1; dy <= 1 && !edge; dy++)
+				for (int dx = -1; dx <= 1; dx++) {
+					int qx = x + dx, qy = y + dy;
+					if (qx < 0 || qx >= w || qy < 0 || qy >= h)
+						continue;
+					const guide *gq = &j->g[(size_t)qy * w + qx];
+					float d = 0;
+					for (int k = 0; k < 6; k++)
+						d += (gp->f[k] - gq->f[k]) * (gp->f[k] - gq->f[k]);
+					d += fabsf(gq->z - (gp->z + gp->gx * (float)dx + gp->gy * (float)dy)) /
+					     (SIGMA_Z * gp->z + 1e-6f);
+					if (d > EDGE_D) {
+						edge = true;
+						break;
+					}
+				}
+			float a[NR][NR] = {{0}}, b[NR][3] = {{0}}, beta[NR][3];
+			float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {0, 0, 0};
+			if (edge) {
+				float inv_z = 1.0f / (gp->z + 1e-6f);
+				for (int dy = -RR; dy <= RR; dy++)
+					for (int dx = -RR; dx <= RR; dx++) {
+						int qx = x + dx, qy = y + dy;
+						if (qx < 0 || qx >= w || qy < 0 || qy >= h)
+							continue;
+						size_t q = (size_t)qy * w + qx;
+						const guide *gq = &j->g[q];
+						float v[NR];
+						v[0] = 1;
+						for (int k = 0; k < 6; k++)
+							v[1 + k] = gq->f[k] - gp->f[k];
+						v[7] = (gq->z - gp->z) * inv_z * 10.0f;
+						float wt = 1.0f / (src[q].var + 1e-6f);
+						for (int ch = 0; ch < 3; ch++) {
+							lo[ch] = fminf(lo[ch], src[q].c[ch]);
+							hi[ch] = fmaxf(hi[ch], src[q].c[ch]);
+						}
+						for (int r = 0; r < NR; r++) {
+							for (int c = 0; c <= r; c++)
+								a[r][c] += wt * v[r] * v[c];
+							for (int ch = 0; ch < 3; ch++)
+								b[r][ch] += wt * v[r] * src[q].c[ch];
+						}
+					}
+				float ridge = a[0][0] * 1e-3f;
+				for (int r = 1; r < NR; r++)
+					a[r][r] += ridge;
+			}
+			if (edge && solve(a, b, beta)) {
+				/* A move the pixel's remaining noise cannot explain (more
+				 * than REG_K standard deviations of its brightness) is cut
+				 * down to that. */
+				float r[3], d = 0;
+				for (int k = 0; k < 3; k++)
+					r[k] = fminf(fmaxf(beta[0][k], lo[k]), hi[k]);
+				d = fabsf(lum(r) - lum(src[i].c));
+				float lim = REG_K * sqrtf(src[i].var), t = d > lim ? lim / d : 1.0f;
+				for (int k = 0; k < 3; k++)
+					o[k] = src[i].c[k] + t * (r[k] - src[i].c[k]);
+			} else {
+				for (int k = 0; k < 3; k++)
+					o[k] = src[i].c[k];
+			}
 		}
 }
 
@@ -401,9 +604,14 @@ static void run_rows(job *j, int y0, int y1)
 			pthread_barrier_wait(&j->bar);
 		atrous_rows(j, j->buf[(l + 1) & 1], j->buf[l & 1], 1 << l, y0, y1);
 	}
+	const texel *last = j->buf[(LEVELS + 1) & 1];
+	texel *spare = j->buf[LEVELS & 1];
+	if (j->threads > 1)
+		pthread_barrier_wait(&j->bar); /* spare was the last pass's source */
+	finish_rows(j, last, spare, y0, y1);
 	if (j->threads > 1)
 		pthread_barrier_wait(&j->bar); /* out may be fb->rgb, read by setup */
-	finish_rows(j, j->buf[(LEVELS + 1) & 1], y0, y1);
+	regress_rows(j, spare, y0, y1);
 }
 
 typedef struct worker_arg {

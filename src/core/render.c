@@ -115,7 +115,10 @@ framebuffer *fb_reuse(framebuffer **fb, int w, int h)
 	return *fb;
 }
 
-vec3 render_sample(const world *w, const render_settings *s, int px, int py, int fw, int fh, int sample)
+/* The camera ray of one sample, and the sampler positioned after the two
+ * dimensions that place it in its pixel. */
+static ray sample_ray(const world *w, const render_settings *s, int px, int py, int fw, int fh,
+                      int sample, sampler *sp)
 {
 	uint64_t pixel = (uint64_t)py * (uint64_t)fw + (uint64_t)px;
 	double u = 0.5, v = 0.5;
@@ -123,14 +126,27 @@ vec3 render_sample(const world *w, const render_settings *s, int px, int py, int
 	 * sits at the centre and needs no numbers); the path's numbers follow.
 	 * Every pixel has its own scrambles, the same for all its samples, so
 	 * that its first 2^k positions are stratified (sampler.h). */
-	sampler sp = {0, 0, 0, 0};
+	*sp = (sampler){0, 0, 0, 0};
 	if (s->samples > 1 || s->mode == MODE_PATH) {
-		sp = sampler_for(s->seed, pixel, (uint32_t)sample);
+		*sp = sampler_for(s->seed, pixel, (uint32_t)sample);
 		if (s->samples > 1)
-			samp_2d(&sp, &u, &v);
-		sp.dim = 2;
+			samp_2d(sp, &u, &v);
+		sp->dim = 2;
 	}
-	ray r = cam_ray(&w->cam, px + u, py + v, fw, fh);
+	return cam_ray(&w->cam, px + u, py + v, fw, fh);
+}
+
+ray render_sample_ray(const world *w, const render_settings *s, int px, int py, int fw, int fh,
+                      int sample)
+{
+	sampler sp;
+	return sample_ray(w, s, px, py, fw, fh, sample, &sp);
+}
+
+vec3 render_sample(const world *w, const render_settings *s, int px, int py, int fw, int fh, int sample)
+{
+	sampler sp;
+	ray r = sample_ray(w, s, px, py, fw, fh, sample, &sp);
 	vec3 c = s->mode == MODE_PATH ? path_radiance(w, s, r, &sp) : whitted_radiance(w, s, r);
 	/* A NaN or infinity from a degenerate case must not poison the pixel. */
 	if (!v3_finite(c))
@@ -154,18 +170,26 @@ typedef struct shared {
 
 /* Adds samples [s0, s1) of pixel (x, y) of an fw x fh image to acc, in
  * sample order: render_tile and render_rect share it, so a tile rendered
- * anywhere holds the same bits as the whole image. */
+ * anywhere holds the same bits as the whole image. feat: the pixel's
+ * features for the denoiser (denoise.h), updated with these samples; NULL:
+ * none. */
 static void pixel_add(const world *w, const render_settings *s, int x, int y, int fw, int fh,
-                      int s0, int s1, double acc[3], double *sq)
+                      int s0, int s1, double acc[3], float *feat)
 {
+	double fa[DENOISE_ACC] = {0}, sq = 0.0;
 	for (int k = s0; k < s1; k++) {
 		vec3 c = render_sample(w, s, x, y, fw, fh, k);
 		acc[0] += c.x;
 		acc[1] += c.y;
 		acc[2] += c.z;
-		if (sq) /* the squared brightness of the samples, for the denoiser */
-			*sq += denoise_sq(c);
+		if (feat) {
+			sq += denoise_sq(c);
+			if (k < DENOISE_FEATURE_SAMPLES) /* what this sample's ray first sees */
+				denoise_sample(w, render_sample_ray(w, s, x, y, fw, fh, k), fa);
+		}
 	}
+	if (feat)
+		denoise_features(w, s, x, y, fw, fh, s0, s1, sq, fa, feat);
 }
 
 static void render_tile(shared *sh, long t)
@@ -188,9 +212,9 @@ static void render_tile(shared *sh, long t)
 				acc[1] = fb->sum[i + 1];
 				acc[2] = fb->sum[i + 2];
 			}
-			double sq = 0.0;
-			pixel_add(job->w, &job->set, x, y, fb->w, fb->h, job->sample_begin,
-			          job->sample_end, acc, fb->feat ? &sq : NULL);
+			bool feat = fb->feat && job->set.mode == MODE_PATH;
+			pixel_add(job->w, &job->set, x, y, fb->w, fb->h, job->sample_begin, job->sample_end,
+			          acc, feat ? fb->feat + i / 3 * DENOISE_FEATURES : NULL);
 			if (fb->sum) {
 				fb->sum[i] = acc[0];
 				fb->sum[i + 1] = acc[1];
@@ -199,9 +223,6 @@ static void render_tile(shared *sh, long t)
 			fb->rgb[i] = (float)(acc[0] * inv);
 			fb->rgb[i + 1] = (float)(acc[1] * inv);
 			fb->rgb[i + 2] = (float)(acc[2] * inv);
-			if (fb->feat && job->set.mode == MODE_PATH)
-				denoise_features(job->w, x, y, fb->w, fb->h, job->sample_begin,
-				                 job->sample_end, sq, fb->feat + i / 3 * DENOISE_FEATURES);
 		}
 }
 

@@ -236,6 +236,7 @@ static void test_gltf_and_stl(void **state)
 	assert_vec_near(m->bounds.hi, v3(7, 2, 0), 1e-6);
 	mesh_surf sf;
 	float b[3] = {1.0f / 3, 1.0f / 3, 1.0f / 3};
+	assert_true(mesh_prepare(m, false, 0, &err));
 	mesh_surface(m, 0, b, &sf);
 	assert_true(sf.mat >= 0);
 	assert_near(m->mats[sf.mat].kd[0], 0.25, 1e-6);
@@ -252,7 +253,9 @@ static void test_gltf_and_stl(void **state)
 
 /* --- the tree and the watertight test --- */
 
-static mesh *sphere_mesh(int nu, int nv)
+/* A UV sphere of unit radius, prepared or as built (positions and
+ * triangles as given). */
+static mesh *sphere_mesh_as(int nu, int nv, bool prepare)
 {
 	mesh_builder b = {.name = "sphere"};
 	for (int j = 0; j <= nv; j++)
@@ -271,14 +274,20 @@ static mesh *sphere_mesh(int nu, int nv)
 	rt_error err = {0};
 	mesh *m = mb_finish(&b, &err);
 	assert_non_null(m);
-	assert_true(mesh_prepare(m, true, 60, &err));
+	if (prepare)
+		assert_true(mesh_prepare(m, true, 60, &err));
 	return m;
+}
+
+static mesh *sphere_mesh(int nu, int nv)
+{
+	return sphere_mesh_as(nu, nv, true);
 }
 
 static void test_tree_matches_brute_force(void **state)
 {
 	(void)state;
-	mesh *m = sphere_mesh(40, 20);
+	mesh *m = sphere_mesh(40, 20), *raw = sphere_mesh_as(40, 20, false);
 	test_rng r = {7};
 	for (int i = 0; i < 4000; i++) {
 		vec3 o = v3_scale(tdir(&r), 3), d = tdir(&r);
@@ -289,15 +298,21 @@ static void test_tree_matches_brute_force(void **state)
 		float t1 = INFINITY, t2 = INFINITY, b1[3], b2[3];
 		uint32_t k1 = 0, k2 = 0;
 		bool h1 = mesh_intersect(m, &mr, 0, &t1, &k1, b1);
-		bool h2 = mesh_intersect_brute(m, &mr, 0, &t2, &k2, b2);
+		bool h2 = mesh_intersect_brute(raw, &mr, 0, &t2, &k2, b2);
 		assert_int_equal(h1, h2);
 		assert_int_equal(mesh_occluded(m, &mr, 0, INFINITY), h2);
 		if (h1) {
 			assert_true(t1 == t2);
 			assert_near(b1[0] + b1[1] + b1[2], 1, 1e-5);
+			/* the same triangle: the slot's corners are the raw ones */
+			vec3 c[3];
+			mesh_corners(m, k1, c);
+			for (int k = 0; k < 3; k++)
+				assert_vec_near(c[k], v3(raw->p[raw->tri[k2][k]][0], raw->p[raw->tri[k2][k]][1], raw->p[raw->tri[k2][k]][2]), 0);
 		}
 	}
 	mesh_free(m);
+	mesh_free(raw);
 }
 
 /* Rays aimed exactly at shared vertices and edges of a closed mesh from
@@ -305,11 +320,11 @@ static void test_tree_matches_brute_force(void **state)
 static void test_watertight(void **state)
 {
 	(void)state;
-	mesh *m = sphere_mesh(17, 9);
+	mesh *m = sphere_mesh(17, 9), *raw = sphere_mesh_as(17, 9, false);
 	int miss = 0;
-	for (uint32_t t = 0; t < m->ntris; t++)
+	for (uint32_t t = 0; t < raw->ntris; t++)
 		for (int k = 0; k < 3; k++) {
-			const float *a = m->p[m->tri[t][k]], *b = m->p[m->tri[t][(k + 1) % 3]];
+			const float *a = raw->p[raw->tri[t][k]], *b = raw->p[raw->tri[t][(k + 1) % 3]];
 			vec3 targets[2] = {v3(a[0], a[1], a[2]), v3((a[0] + (double)b[0]) / 2, (a[1] + (double)b[1]) / 2,
 			                                           (a[2] + (double)b[2]) / 2)};
 			for (int q = 0; q < 2; q++) {
@@ -322,6 +337,127 @@ static void test_watertight(void **state)
 			}
 		}
 	assert_int_equal(miss, 0);
+	mesh_free(m);
+	mesh_free(raw);
+}
+
+/* The SSE leaf test and the scalar one find the same hit: the same
+ * triangle, distance and weights to the bit, and the same occlusion. */
+static void same_hits(const mesh *m, vec3 o, vec3 d, float tmin, float tmax)
+{
+	mesh_ray mr;
+	mesh_ray_make(&mr, o, d);
+	float t1 = tmax, t2 = tmax, b1[3] = {0}, b2[3] = {0};
+	uint32_t k1 = UINT32_MAX, k2 = UINT32_MAX;
+	bool h1 = mesh_intersect(m, &mr, tmin, &t1, &k1, b1);
+	bool h2 = mesh_intersect_scalar(m, &mr, tmin, &t2, &k2, b2);
+	assert_int_equal(h1, h2);
+	assert_int_equal(mesh_occluded(m, &mr, tmin, tmax), h2);
+	assert_int_equal(mesh_occluded_scalar(m, &mr, tmin, tmax), h2);
+	if (h1) {
+		assert_int_equal(k1, k2);
+		assert_memory_equal(&t1, &t2, sizeof t1);
+		assert_memory_equal(b1, b2, sizeof b1);
+	}
+}
+
+static void test_sse_leaves_match_scalar(void **state)
+{
+	(void)state;
+	mesh *m = sphere_mesh(40, 20), *raw = sphere_mesh_as(40, 20, false);
+	test_rng r = {11};
+	for (int i = 0; i < 4000; i++) {
+		vec3 o = v3_scale(tdir(&r), 3), d = tdir(&r);
+		if (i % 2)
+			d = v3_norm(v3_sub(v3_scale(tdir(&r), 0.5), o));
+		same_hits(m, o, d, 0, INFINITY);
+		same_hits(m, o, d, 2.5f, 3.5f); /* a window: the far side or nothing */
+	}
+	/* through the vertices and edge midpoints, where edge functions are 0
+	 * and the double fallback runs in some lanes */
+	for (uint32_t t = 0; t < raw->ntris; t++)
+		for (int k = 0; k < 3; k++) {
+			const float *a = raw->p[raw->tri[t][k]], *b = raw->p[raw->tri[t][(k + 1) % 3]];
+			vec3 o = v3(0.01, -0.02, 0.015);
+			same_hits(m, o, v3_sub(v3(a[0], a[1], a[2]), o), 0, INFINITY);
+			same_hits(m, o, v3_sub(v3((a[0] + (double)b[0]) / 2, (a[1] + (double)b[1]) / 2, (a[2] + (double)b[2]) / 2), o), 0,
+			          INFINITY);
+			/* and along the axes, where the shear is zero */
+			same_hits(m, v3(a[0], a[1], 3), v3(0, 0, -1), 0, INFINITY);
+		}
+	mesh_free(m);
+	mesh_free(raw);
+	if (have_models()) {
+		rt_error err = {0};
+		m = mesh_load(MODELS "/stanford-bunny.obj", &err);
+		assert_non_null(m);
+		assert_true(mesh_prepare(m, false, 0, &err));
+		vec3 c = box_center(m->bounds);
+		double rad = v3_len(v3_sub(m->bounds.hi, m->bounds.lo));
+		for (int i = 0; i < 20000; i++) {
+			vec3 o = v3_add(c, v3_scale(tdir(&r), rad)), d = v3_norm(v3_sub(v3_add(c, v3_scale(tdir(&r), 0.3 * rad)), o));
+			same_hits(m, o, d, 0, INFINITY);
+		}
+		mesh_free(m);
+	}
+}
+
+/* Parallel squares at z = 1..6 (two triangles each, 12 in all: whole blocks
+ * and a partial one, whatever the tree makes of them): a ray along z meets
+ * them at distances known by hand. */
+static void test_hit_distances_by_hand(void **state)
+{
+	(void)state;
+	mesh_builder b = {.name = "squares"};
+	for (int z = 1; z <= 6; z++) {
+		float q[4][3] = {{-1, -1, (float)z}, {1, -1, (float)z}, {1, 1, (float)z}, {-1, 1, (float)z}};
+		for (int k = 0; k < 4; k++)
+			assert_true(mb_vertex(&b, q[k]));
+		int v = 4 * (z - 1);
+		int32_t t1[3][3] = {{v, -1, -1}, {v + 1, -1, -1}, {v + 2, -1, -1}};
+		int32_t t2[3][3] = {{v, -1, -1}, {v + 2, -1, -1}, {v + 3, -1, -1}};
+		assert_true(mb_triangle(&b, t1));
+		assert_true(mb_triangle(&b, t2));
+	}
+	rt_error err = {0};
+	mesh *m = mb_finish(&b, &err);
+	assert_non_null(m);
+	assert_true(mesh_prepare(m, false, 0, &err));
+	for (int sse = 0; sse < 2; sse++) {
+		bool (*isect)(const mesh *, const mesh_ray *, float, float *, uint32_t *, float *) =
+		    sse ? mesh_intersect : mesh_intersect_scalar;
+		bool (*occl)(const mesh *, const mesh_ray *, float, float) = sse ? mesh_occluded : mesh_occluded_scalar;
+		mesh_ray mr;
+		float t, bb[3];
+		uint32_t k;
+		/* from z = -1 up: the square at z = 1, 2 away */
+		mesh_ray_make(&mr, v3(0.25, -0.5, -1), v3(0, 0, 1));
+		t = INFINITY;
+		assert_true(isect(m, &mr, 0, &t, &k, bb));
+		assert_true(t == 2.0f);
+		/* past t = 3.5 (z = 2.5): the square at z = 3 */
+		t = INFINITY;
+		assert_true(isect(m, &mr, 3.5f, &t, &k, bb));
+		assert_true(t == 4.0f);
+		/* from z = 3.5 down, a direction of length 2: z = 3 at t = 1/4 */
+		mesh_ray_make(&mr, v3(0.5, 0.5, 3.5), v3(0, 0, -2));
+		t = INFINITY;
+		assert_true(isect(m, &mr, 0, &t, &k, bb));
+		assert_true(t == 0.25f);
+		/* the hit point (0.5, 0.5, 3) from the weights */
+		vec3 c[3];
+		mesh_corners(m, k, c);
+		vec3 hp = v3_add(v3_add(v3_scale(c[0], bb[0]), v3_scale(c[1], bb[1])), v3_scale(c[2], bb[2]));
+		assert_vec_near(hp, v3(0.5, 0.5, 3), 1e-6);
+		/* occlusion: the square at z = 3 is 0.25 away */
+		assert_true(occl(m, &mr, 0, 0.3f));
+		assert_false(occl(m, &mr, 0, 0.2f));
+		/* outside the squares (x = 1.5): nothing */
+		mesh_ray_make(&mr, v3(1.5, 0, -1), v3(0, 0, 1));
+		t = INFINITY;
+		assert_false(isect(m, &mr, 0, &t, &k, bb));
+		assert_false(occl(m, &mr, 0, INFINITY));
+	}
 	mesh_free(m);
 }
 
@@ -566,6 +702,8 @@ int main(void)
 		cmocka_unit_test(test_gltf_and_stl),
 		cmocka_unit_test(test_tree_matches_brute_force),
 		cmocka_unit_test(test_watertight),
+		cmocka_unit_test(test_sse_leaves_match_scalar),
+		cmocka_unit_test(test_hit_distances_by_hand),
 		cmocka_unit_test(test_cube_obj_silhouette_is_cu),
 		cmocka_unit_test(test_tetrahedron_projected_area),
 		cmocka_unit_test(test_mesh_line_round_trip),

@@ -241,12 +241,16 @@ void mesh_free(mesh *m)
 		mat_free(&m->mats[i]);
 	free(m->mats);
 	bvh_free(m->tree);
+	free(m->blk);
+	free(m->bfirst);
 	free(m);
 }
 
 size_t mesh_memory(const mesh *m)
 {
-	size_t n = sizeof *m + (size_t)m->nverts * sizeof *m->p + (size_t)m->ntris * sizeof *m->tri;
+	size_t n = sizeof *m + (size_t)m->ntris * sizeof *m->tri;
+	if (m->p)
+		n += (size_t)m->nverts * sizeof *m->p;
 	if (m->n)
 		n += (size_t)m->nverts * sizeof *m->n;
 	if (m->uv)
@@ -255,6 +259,7 @@ size_t mesh_memory(const mesh *m)
 		n += (size_t)m->ntris * sizeof *m->tmat;
 	if (m->tree)
 		n += sizeof *m->tree + m->tree->nnodes * sizeof *m->tree->nodes;
+	n += (size_t)m->nblk * (sizeof *m->blk + sizeof *m->bfirst);
 	return n;
 }
 
@@ -401,7 +406,10 @@ bool mesh_prepare(mesh *m, bool smooth, double crease_deg, rt_error *err)
 		b = box_add(b, vtx(m, m->tri[t][1]));
 		bounds[t] = box_add(b, vtx(m, m->tri[t][2]));
 	}
-	m->tree = bvh_build(bounds, NULL, m->ntris, order, err);
+	/* leaves in blocks of 4 (mesh_trace.c); a node visit costs about one
+	 * and a half block tests (1, 1.5 and 2 traced the bunny alike; 1.5
+	 * makes 18% fewer nodes than 1) */
+	m->tree = bvh_build_blocks(bounds, m->ntris, 4, 1.5, order, err);
 	free(bounds);
 	if (!m->tree) {
 		free(order);
@@ -456,6 +464,11 @@ bool mesh_prepare(mesh *m, bool smooth, double crease_deg, rt_error *err)
 		free(uv);
 	}
 	free(newid);
+	if (!mesh_make_blocks(m))
+		return rt_error_set(err, "%s: out of memory building the triangle tree", m->path);
+	/* the blocks hold the positions from now on */
+	free(m->p);
+	m->p = NULL;
 	double ext = fmax(v3_max_abs(m->bounds.lo), v3_max_abs(m->bounds.hi));
 	m->eps = (float)(ext * 0x1p-19);
 	return true;
@@ -463,11 +476,13 @@ bool mesh_prepare(mesh *m, bool smooth, double crease_deg, rt_error *err)
 
 /* --- surface --- */
 
-void mesh_surface(const mesh *m, uint32_t t, const float b[3], mesh_surf *s)
+void mesh_surface(const mesh *m, uint32_t slot, const float b[3], mesh_surf *s)
 {
+	uint32_t t = mesh_slot_tri(m, slot);
 	const uint32_t *i = m->tri[t];
-	vec3 p0 = vtx(m, i[0]), p1 = vtx(m, i[1]), p2 = vtx(m, i[2]);
-	vec3 e1 = v3_sub(p1, p0), e2 = v3_sub(p2, p0);
+	vec3 pc[3];
+	mesh_corners(m, slot, pc);
+	vec3 e1 = v3_sub(pc[1], pc[0]), e2 = v3_sub(pc[2], pc[0]);
 	s->ng = v3_norm(v3_cross(e1, e2));
 	s->ns = s->ng;
 	if (m->n) {
