@@ -34,6 +34,9 @@ typedef struct mesh_mat {
 	char *map_bump;   /* height map */
 	char *map_norm;   /* tangent-space normal map */
 	float bump_scale; /* -bm, 1 by default */
+	/* images embedded in the model file (a .glb's), decoded when it is
+	 * read and owned by the mesh; the map_ path is NULL then */
+	struct texture *tex_kd, *tex_norm;
 } mesh_mat;
 
 /* Four triangles of a leaf laid out for the leaf test (mesh_trace.c):

@@ -142,9 +142,14 @@ bool surf_material(world *w, const object *o, uint32_t i, rt_error *err)
 			if (!hold_texture(w, mm->map_kd, true, &t.tex, err))
 				return false;
 			t.tint = false;
+		} else if (mm->tex_kd) { /* embedded in the model: the mesh holds it */
+			t.tex = mm->tex_kd;
+			t.tint = false;
 		}
 		if (mm->map_norm && !hold_texture(w, mm->map_norm, false, &t.nmap, err))
 			return false;
+		if (!mm->map_norm && mm->tex_norm)
+			t.nmap = mm->tex_norm;
 		if (mm->map_bump) {
 			if (!hold_texture(w, mm->map_bump, false, &t.bump, err))
 				return false;

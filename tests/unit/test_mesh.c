@@ -6,6 +6,8 @@
 #include <unistd.h>
 
 #include "core/bvh.h"
+#include "core/integrators.h"
+#include "rtsh/image.h"
 #include "rtsh/mesh.h"
 #include "rtsh/render.h"
 #include "rtsh/rtfile.h"
@@ -249,6 +251,125 @@ static void test_gltf_and_stl(void **state)
 	assert_vec_near(m->bounds.hi, v3(2, 3, 0), 0);
 	mesh_free(m);
 	expect_error(mesh_load(tmp_text("bad.gltf", "garbage"), &err), &err, "bad.gltf", "cannot read the model");
+}
+
+/* --- a .glb with its texture inside --- */
+
+static scene *load_text(const char *text);
+
+static void put_u32(unsigned char *p, uint32_t v)
+{
+	for (int i = 0; i < 4; i++)
+		p[i] = (unsigned char)(v >> (8 * i));
+}
+
+/* A binary glTF (glTF 2.0 spec, "GLB file format"): a 12-byte header,
+ * then a JSON chunk padded with blanks and a BIN chunk padded with zeros
+ * to 4 bytes. Returns the length written to out. */
+static size_t make_glb(unsigned char *out, const char *json, const unsigned char *bin, size_t nbin)
+{
+	size_t nj = strlen(json), pj = (nj + 3) / 4 * 4, pb = (nbin + 3) / 4 * 4;
+	size_t total = 12 + 8 + pj + 8 + pb;
+	memcpy(out, "glTF", 4);
+	put_u32(out + 4, 2);
+	put_u32(out + 8, (uint32_t)total);
+	put_u32(out + 12, (uint32_t)pj);
+	memcpy(out + 16, "JSON", 4);
+	memcpy(out + 20, json, nj);
+	memset(out + 20 + nj, ' ', pj - nj);
+	unsigned char *b = out + 20 + pj;
+	put_u32(b, (uint32_t)pb);
+	memcpy(b + 4, "BIN", 4); /* "BIN\0" */
+	memcpy(b + 8, bin, nbin);
+	memset(b + 8 + nbin, 0, pb - nbin);
+	return total;
+}
+
+/* A unit quad in the XY plane (z = 0, facing +Z) whose base colour texture
+ * is a 2x2 PNG inside the .glb: red, green on the top row, blue, white
+ * below. glTF puts uv (0,0) at the image's top-left, so the quad's corner
+ * (0,1) gets uv (0,0): each quarter of the quad shows the texel of the
+ * same quarter of the image. */
+static const char *textured_glb(const char *name, bool corrupt)
+{
+	/* the image, written by rtsh's PNG writer (sRGB 8-bit: 0 and 255
+	 * stay 0 and 255) */
+	framebuffer *fb = fb_new(2, 2);
+	assert_non_null(fb);
+	const float px[4][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 1}};
+	memcpy(fb->rgb, px, sizeof px);
+	char png[256];
+	snprintf(png, sizeof png, "%s/quad-texture.png", tmpdir);
+	rt_error err = {0};
+	assert_true(image_write(png, fb, 0, &err));
+	fb_free(fb);
+	FILE *f = fopen(png, "rb");
+	assert_non_null(f);
+	unsigned char img[4096];
+	size_t nimg = fread(img, 1, sizeof img, f);
+	fclose(f);
+	assert_true(nimg > 8 && nimg < sizeof img);
+	if (corrupt)
+		memset(img + 8, 0x55, nimg - 8); /* the signature kept, the chunks garbage */
+	/* BIN: positions (48 bytes), uvs (32), indices (12), the image */
+	unsigned char bin[4096 + 92];
+	const float pos[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+	const float uv[4][2] = {{0, 1}, {1, 1}, {1, 0}, {0, 0}};
+	const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+	memcpy(bin, pos, 48);
+	memcpy(bin + 48, uv, 32);
+	memcpy(bin + 80, idx, 12);
+	memcpy(bin + 92, img, nimg);
+	char json[2048];
+	snprintf(json, sizeof json,
+	         "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+	         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"indices\":2,"
+	         "\"material\":0}]}],"
+	         "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}}}],"
+	         "\"textures\":[{\"source\":0}],\"images\":[{\"bufferView\":3,\"mimeType\":\"image/png\"}],"
+	         "\"buffers\":[{\"byteLength\":%zu}],"
+	         "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},"
+	         "{\"buffer\":0,\"byteOffset\":48,\"byteLength\":32},{\"buffer\":0,\"byteOffset\":80,\"byteLength\":12},"
+	         "{\"buffer\":0,\"byteOffset\":92,\"byteLength\":%zu}],"
+	         "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+	         "\"min\":[0,0,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":4,"
+	         "\"type\":\"VEC2\"},{\"bufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}]}",
+	         92 + nimg, nimg);
+	static unsigned char glb[8192];
+	size_t n = make_glb(glb, json, bin, 92 + nimg);
+	return tmp_write(name, glb, n);
+}
+
+static void test_glb_embedded_texture(void **state)
+{
+	(void)state;
+	textured_glb("quad.glb", false);
+	/* size 2 about the origin: the quad spans x, y in [-1, 1] at z = 0 */
+	scene *s = load_text("C 0,0,5 0,0,-1 60\nmesh quad.glb 0,0,0 0,1,0 2\n");
+	rt_error err = {0};
+	world *w = world_build(s, &err);
+	assert_non_null(w);
+	struct {
+		double x, y;
+		vec3 c;
+	} probes[] = {{-0.5, 0.5, {1, 0, 0}}, {0.5, 0.5, {0, 1, 0}}, {-0.5, -0.5, {0, 0, 1}}, {0.5, -0.5, {1, 1, 1}}};
+	for (size_t i = 0; i < 4; i++) {
+		hit h;
+		assert_true(world_intersect(w, &(ray){v3(probes[i].x, probes[i].y, 5), v3(0, 0, -1)}, 0, INFINITY, &h));
+		assert_near(h.t, 5, 1e-6);
+		/* a texel's centre: bilinear filtering gives the texel itself */
+		vec3 c = hit_albedo(&w->mats[h.mat], &h);
+		assert_vec_near(c, probes[i].c, 1e-6);
+	}
+	world_free(w);
+	scene_free(s);
+	/* a corrupt embedded image: the model and the image are named */
+	textured_glb("bad.glb", true);
+	char bad[256];
+	snprintf(bad, sizeof bad, "%s/bad.glb", tmpdir);
+	mesh *m = mesh_load(bad, &err);
+	assert_null(m);
+	assert_non_null(strstr(err.msg, "bad.glb: embedded image 0.png"));
 }
 
 /* --- the tree and the watertight test --- */
@@ -700,6 +821,7 @@ int main(void)
 		cmocka_unit_test(test_obj_bad_input),
 		cmocka_unit_test(test_ply_faces_and_strips),
 		cmocka_unit_test(test_gltf_and_stl),
+		cmocka_unit_test(test_glb_embedded_texture),
 		cmocka_unit_test(test_tree_matches_brute_force),
 		cmocka_unit_test(test_watertight),
 		cmocka_unit_test(test_sse_leaves_match_scalar),

@@ -13,6 +13,7 @@
 
 #include "core/bvh.h"
 #include "rtsh/filesrc.h"
+#include "rtsh/texture.h"
 
 /* --- the builder --- */
 
@@ -75,6 +76,8 @@ static void mat_free(mesh_mat *m)
 	free(m->map_kd);
 	free(m->map_bump);
 	free(m->map_norm);
+	texture_free(m->tex_kd);
+	texture_free(m->tex_norm);
 }
 
 void mb_free(mesh_builder *b)
@@ -246,6 +249,14 @@ void mesh_free(mesh *m)
 	free(m);
 }
 
+static size_t tex_bytes(const texture *t)
+{
+	size_t n = 0;
+	for (int l = 0; t && l < t->nlevels; l++)
+		n += (size_t)t->level[l].w * (size_t)t->level[l].h * 3 * sizeof(float);
+	return n;
+}
+
 size_t mesh_memory(const mesh *m)
 {
 	size_t n = sizeof *m + (size_t)m->ntris * sizeof *m->tri;
@@ -260,6 +271,8 @@ size_t mesh_memory(const mesh *m)
 	if (m->tree)
 		n += sizeof *m->tree + m->tree->nnodes * sizeof *m->tree->nodes;
 	n += (size_t)m->nblk * (sizeof *m->blk + sizeof *m->bfirst);
+	for (uint32_t i = 0; i < m->nmats; i++)
+		n += tex_bytes(m->mats[i].tex_kd) + tex_bytes(m->mats[i].tex_norm);
 	return n;
 }
 

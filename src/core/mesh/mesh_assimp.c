@@ -4,9 +4,14 @@
  * (aiProcess_PreTransformVertices), so each of its meshes arrives in model
  * space; we copy positions, normals, the first UV set and the material
  * index into our builder, and the materials' base colour, emission,
- * metallic-roughness factors and colour / normal textures. Textures
- * embedded in a .glb ("*0") are not read: the base colour stands in.
+ * metallic-roughness factors and colour / normal textures. A texture
+ * embedded in the file (a .glb's images: assimp names them "*N", or by the
+ * name of an image it holds) arrives as an aiTexture: compressed bytes
+ * (PNG, JPEG, ..., mHeight 0, the format in achFormatHint) that
+ * image_decode_rgb reads from memory, or mWidth x mHeight BGRA texels; it
+ * becomes a texture the mesh owns (mesh_mat.tex_kd, tex_norm).
  */
+#include <ctype.h>
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -19,21 +24,120 @@
 
 #include "core/mesh/mesh_io.h"
 #include "rtsh/filesrc.h"
+#include "rtsh/image.h"
 #include "rtsh/mesh.h"
+#include "rtsh/texture.h"
 
 static double lin(double v)
 {
 	return v;
 }
 
-static char *texture_path(const struct aiMaterial *m, enum aiTextureType type, const char *dir)
+static const char *short_name(const char *name)
+{
+	const char *s = strrchr(name, '/'), *b = strrchr(name, '\\');
+	if (b && (!s || b > s))
+		s = b;
+	return s ? s + 1 : name;
+}
+
+/* The embedded image a material names: "*N" (N an index in mTextures), or
+ * an embedded image whose file name has the same last component. NULL when
+ * the name is a file outside the model; *index its place in mTextures. */
+static const struct aiTexture *embedded_image(const struct aiScene *sc, const char *name, unsigned *index)
+{
+	if (name[0] == '*') {
+		char *end;
+		unsigned long i = strtoul(name + 1, &end, 10);
+		*index = (unsigned)i;
+		return end != name + 1 && *end == '\0' && i < sc->mNumTextures ? sc->mTextures[i] : NULL;
+	}
+	for (unsigned i = 0; i < sc->mNumTextures; i++)
+		if (sc->mTextures[i]->mFilename.length > 0 &&
+		    strcmp(short_name(sc->mTextures[i]->mFilename.data), short_name(name)) == 0) {
+			*index = i;
+			return sc->mTextures[i];
+		}
+	return NULL;
+}
+
+/* An embedded image decoded into a texture; NULL (err set, naming the model
+ * and the image) when it cannot be read. */
+static texture *embedded_texture(const struct aiTexture *tx, unsigned index, const char *path, bool srgb,
+                                 rt_error *err)
+{
+	char name[RT_ERROR_FILE_MAX + 64];
+	int w = 0, h = 0;
+	float *rgb = NULL;
+	if (tx->mHeight == 0) {
+		/* compressed: mWidth bytes; the hint is the format's extension */
+		char hint[sizeof tx->achFormatHint + 1] = {0};
+		for (size_t i = 0; i < sizeof tx->achFormatHint && isalnum((unsigned char)tx->achFormatHint[i]); i++)
+			hint[i] = (char)tolower((unsigned char)tx->achFormatHint[i]);
+		snprintf(name, sizeof name, "%s: embedded image %u.%s", path, index, hint[0] ? hint : "png");
+		if (!tx->pcData || tx->mWidth == 0) {
+			rt_error_set(err, "%s: no bytes; expected an image", name);
+			return NULL;
+		}
+		rgb = image_decode_rgb(name, (const unsigned char *)tx->pcData, tx->mWidth, srgb, &w, &h, err);
+		if (!rgb)
+			return NULL;
+	} else {
+		snprintf(name, sizeof name, "%s: embedded image %u", path, index);
+		if (!tx->pcData || tx->mWidth > 65536 || tx->mHeight > 65536) {
+			rt_error_set(err, "%s: %u x %u texels; expected at most 65536 x 65536", name, tx->mWidth,
+			             tx->mHeight);
+			return NULL;
+		}
+		w = (int)tx->mWidth;
+		h = (int)tx->mHeight;
+		rgb = malloc((size_t)w * (size_t)h * 3 * sizeof *rgb);
+		if (!rgb) {
+			rt_error_set(err, "%s: out of memory", name);
+			return NULL;
+		}
+		for (size_t i = 0; i < (size_t)w * (size_t)h; i++) {
+			const struct aiTexel *t = &tx->pcData[i];
+			unsigned char c[3] = {t->r, t->g, t->b};
+			for (int k = 0; k < 3; k++)
+				rgb[3 * i + (size_t)k] = srgb ? (float)srgb8_to_linear(c[k]) : c[k] / 255.0f;
+		}
+	}
+	texture *t = texture_make(rgb, w, h, err);
+	if (!t)
+		return NULL;
+	t->srgb = srgb;
+	t->path = strdup(name);
+	if (!t->path) {
+		texture_free(t);
+		rt_error_set(err, "%s: out of memory", name);
+		return NULL;
+	}
+	return t;
+}
+
+/* A material's texture of `type`: a file beside the model (*file) or an
+ * image embedded in it (*tex). False (err set) when an embedded image
+ * cannot be read. */
+static bool material_texture(const struct aiScene *sc, const struct aiMaterial *m, enum aiTextureType type,
+                             const char *path, const char *dir, bool srgb, char **file, texture **tex,
+                             rt_error *err)
 {
 	struct aiString s;
-	if (aiGetMaterialTexture(m, type, 0, &s, NULL, NULL, NULL, NULL, NULL, NULL) != AI_SUCCESS)
-		return NULL;
-	if (s.length == 0 || s.data[0] == '*')
-		return NULL;
-	return path_join(dir, s.data);
+	*file = NULL;
+	*tex = NULL;
+	if (aiGetMaterialTexture(m, type, 0, &s, NULL, NULL, NULL, NULL, NULL, NULL) != AI_SUCCESS || s.length == 0)
+		return true;
+	unsigned index = 0;
+	const struct aiTexture *tx = embedded_image(sc, s.data, &index);
+	if (tx) {
+		*tex = embedded_texture(tx, index, path, srgb, err);
+		return *tex != NULL;
+	}
+	if (s.data[0] == '*') /* names an image the file does not hold */
+		return true;
+	*file = path_join(dir, s.data);
+	return true;
 }
 
 mesh *mesh_read_assimp(const char *path, rt_error *err)
@@ -74,10 +178,12 @@ mesh *mesh_read_assimp(const char *path, rt_error *err)
 				m->metallic = (float)v;
 			if (aiGetMaterialFloatArray(am, AI_MATKEY_ROUGHNESS_FACTOR, &v, NULL) == AI_SUCCESS)
 				m->roughness = (float)v;
-			m->map_kd = texture_path(am, aiTextureType_BASE_COLOR, dir);
-			if (!m->map_kd)
-				m->map_kd = texture_path(am, aiTextureType_DIFFUSE, dir);
-			m->map_norm = texture_path(am, aiTextureType_NORMALS, dir);
+			ok = material_texture(sc, am, aiTextureType_BASE_COLOR, path, dir, true, &m->map_kd, &m->tex_kd, err);
+			if (ok && !m->map_kd && !m->tex_kd)
+				ok = material_texture(sc, am, aiTextureType_DIFFUSE, path, dir, true, &m->map_kd, &m->tex_kd,
+				                      err);
+			ok = ok &&
+			     material_texture(sc, am, aiTextureType_NORMALS, path, dir, false, &m->map_norm, &m->tex_norm, err);
 		}
 	}
 	bool has_uv = true, has_n = true;
