@@ -4,7 +4,8 @@
  * what to complete for each argument, one line of help and the handler.
  * Lookup (exact names, aliases and unique prefixes), usage errors, `help`,
  * readline completion and the man page's list all come from this table, so
- * a new command is one entry and one function.
+ * a new command is one entry and one function. The table is alone in
+ * command_table.c; lookup and the argument helpers are in commands.c.
  */
 #ifndef RTSH_COMMANDS_H
 #define RTSH_COMMANDS_H
