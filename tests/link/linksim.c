@@ -23,6 +23,14 @@
  *           the others with DSR) while it refined.
  *   ctrlc   presses Ctrl-C 2 s after the first picture; prints the seconds
  *           from the key press to the last byte at the terminal.
+ *   user    what a person does, from the first picture on (the picture
+ *           still refining at first): types "help" Enter at +1 s, q at +4 s
+ *           (the pager), "view" Enter at +6 s, w at +8.5 s and Esc at +10 s
+ *           (key mode: one step forward, then back to the shell), then 'Z'
+ *           every 250 ms from +12 s, four times. Prints the seconds from
+ *           the Enter to the pager's key line at the terminal (pager_s),
+ *           from the Esc to the shell's "change kept" message (view_s), and
+ *           the echo of the Zs.
  * The result is one line of key=value pairs on standard output.
  */
 #define _GNU_SOURCE
@@ -236,7 +244,7 @@ static int cmp_double(const void *a, const void *b)
 
 static void usage(void)
 {
-	fputs("usage: linksim [--rate B/s] [--rtt S] [--cols N] [--rows N] [--samples N] [--scenario refine|ctrlc]\n"
+	fputs("usage: linksim [--rate B/s] [--rtt S] [--cols N] [--rows N] [--samples N] [--scenario refine|ctrlc|user]\n"
 	      "               [--timeout S] -- COMMAND ARGS...\n",
 	      stderr);
 	exit(2);
@@ -274,7 +282,23 @@ int main(int argc, char **argv)
 	}
 	if (i >= argc || rate <= 0)
 		usage();
-	bool ctrlc = strcmp(scenario, "ctrlc") == 0;
+	bool ctrlc = strcmp(scenario, "ctrlc") == 0, user = strcmp(scenario, "user") == 0;
+	/* The person of the user scenario: what to type when, and what the
+	 * terminal should then show. */
+	struct step {
+		double at;
+		const char *keys, *expect;
+		double sent, seen;
+		size_t from;
+	} steps[] = {
+		{1.0, "help\r", "Space next page", -1, -1, 0},
+		{4.0, "q", NULL, -1, -1, 0},
+		{6.0, "view\r", NULL, -1, -1, 0},
+		{8.5, "w", NULL, -1, -1, 0},
+		{10.0, "\x1b", "change kept", -1, -1, 0},
+	};
+	const int nsteps = (int)(sizeof steps / sizeof steps[0]);
+	size_t delivered = 0; /* bytes of down.store at the terminal */
 
 	struct winsize ws = {.ws_row = (unsigned short)rows, .ws_col = (unsigned short)cols};
 	int master;
@@ -330,8 +354,21 @@ int main(int argc, char **argv)
 		wire_tick(&down, t);
 		wire_tick(&up, t);
 		packet *p;
-		while ((p = wire_arrived(&down, t)))
+		while ((p = wire_arrived(&down, t))) {
 			term_feed(&tm, &up, down.store.b + p->off, p->n, t, max_z);
+			delivered = p->off + p->n;
+		}
+		for (int k = 0; user && k < nsteps; k++) {
+			struct step *st = &steps[k];
+			if (st->sent < 0 && tm.picture && t - tm.first_picture >= st->at) {
+				st->sent = t;
+				st->from = delivered;
+				answer(&up, st->keys);
+			}
+			if (st->expect && st->sent >= 0 && st->seen < 0 && delivered > st->from &&
+			    memmem(down.store.b + st->from, delivered - st->from, st->expect, strlen(st->expect)))
+				st->seen = t;
+		}
 		while ((p = wire_arrived(&up, t))) {
 			const char *b = up.store.b + p->off;
 			size_t left = p->n;
@@ -349,7 +386,14 @@ int main(int argc, char **argv)
 			}
 		}
 		/* The person at the terminal. */
-		if (tm.picture && !ctrlc && render_end < 0) {
+		if (user && tm.picture && t - tm.first_picture >= 12.0 && z_typed < 4 && t >= next_key) {
+			if (z_typed == 0)
+				tm.zs = 0; /* Zs in the help text before do not count */
+			z_sent[z_typed++] = t;
+			answer(&up, "Z");
+			next_key = t + 0.25;
+		}
+		if (tm.picture && !ctrlc && !user && render_end < 0) {
 			if (next_key < 0)
 				next_key = t + 0.5;
 			if (t >= next_key && z_typed < max_z) {
@@ -358,7 +402,7 @@ int main(int argc, char **argv)
 				next_key = t + 0.25;
 			}
 		}
-		if (render_end >= 0 && pic_updates_at_end < 0) {
+		if (!user && render_end >= 0 && pic_updates_at_end < 0) {
 			pic_updates_at_end = tm.updates;
 			pictures_at_end = tm.pictures;
 			if (!ctrlc && z_typed)
@@ -370,7 +414,7 @@ int main(int argc, char **argv)
 			answer(&up, "\x03");
 		}
 		/* Done when the wire has been idle for 3 s after the event. */
-		double event = ctrlc ? key_at : render_end;
+		double event = ctrlc ? key_at : user ? (z_typed == 4 ? z_sent[3] : -1) : render_end;
 		if (event >= 0 && !wire_busy(&down) && t - tm.last_byte >= 3.0 && t - event >= 3.0)
 			break;
 		if (child_done && !wire_busy(&down))
@@ -404,7 +448,11 @@ int main(int argc, char **argv)
 	double refine_s = render_end > 0 && tm.first_picture > 0 ? render_end - tm.first_picture : -1;
 	printf("scenario=%s rate=%.0f rtt=%.3f cols=%d rows=%d", scenario, rate, rtt, cols, rows);
 	printf(" first_picture=%.2f", tm.picture ? tm.first_picture - t0 : -1.0);
-	if (!ctrlc) {
+	if (user) {
+		printf(" keys=%ld echoed=%ld echo_p50=%.3f echo_p95=%.3f echo_max=%.3f", z_typed, got, p50, p95, mx);
+		printf(" pager_s=%.2f view_s=%.2f", steps[0].seen > 0 ? steps[0].seen - steps[0].sent : -1.0,
+		       steps[4].seen > 0 ? steps[4].seen - steps[4].sent : -1.0);
+	} else if (!ctrlc) {
 		printf(" keys=%ld echoed=%ld echo_p50=%.3f echo_p95=%.3f echo_max=%.3f", z_typed, got, p50, p95, mx);
 		printf(" render_end=%.2f idle_after_end=%.2f", render_end > 0 ? render_end - t0 : -1.0,
 		       render_end > 0 ? tm.last_byte - render_end : -1.0);

@@ -11,6 +11,11 @@
 #     busy (measured 3.3-3.7 s; the final pass alone changes about 70 KB of
 #     cells, so 1 s cannot be reached at 30 KB/s); Ctrl-C: idle within 1 s;
 #     the terminal, with no COLORTERM, said it has truecolor: 24-bit SGR;
+#   - 30 KB/s, a person's session (linksim --scenario user): "help" while
+#     the picture refines shows the pager within 1 s (before the one event
+#     loop: 5.2 s, the answers owed were awaited first), q, "view", a step,
+#     Esc: the shell's "change kept" message within 3 s; keys typed after
+#     all that echo (p95 within 0.5 s);
 #   - 1 MB/s, 20 ms: idle within 1 s after the render; whole pictures
 #     reach the terminal while it refines (at least 2 a second; measured
 #     7.2, the preview itself made 7.8 on the loaded machine).
@@ -44,6 +49,10 @@ check "30 KB/s: idle <= $b s after the render" "v[\"render_end\"] > 0 && v[\"idl
 check "30 KB/s: truecolor from the terminal's answer" 'v["sgr24"] > 0'
 line=$(run 30000 0.1 ctrlc); echo "$line" >>"$results/link.txt"
 check "30 KB/s: idle <= 1 s after Ctrl-C" 'v["idle_after_ctrlc"] >= 0 && v["idle_after_ctrlc"] <= 1'
+line=$(run 30000 0.1 user); echo "$line" >>"$results/link.txt"
+check "30 KB/s: the pager within 1 s of Enter" 'v["pager_s"] >= 0 && v["pager_s"] <= 1'
+check "30 KB/s: key mode and back within 3 s" 'v["view_s"] >= 0 && v["view_s"] <= 3'
+check "30 KB/s: keys echo after the pager and key mode" 'v["keys"] == 4 && v["echoed"] == 4 && v["echo_p95"] <= 0.5'
 line=$(run 1000000 0.02 refine); echo "$line" >>"$results/link.txt"
 check "1 MB/s: idle <= 1 s after the render" 'v["render_end"] > 0 && v["idle_after_end"] <= 1'
 check "1 MB/s: whole pictures while refining" 'v["pictures_per_s"] >= 2'
