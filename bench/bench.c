@@ -759,7 +759,8 @@ static void bench_keymode(void)
 		fail("shell_init", NULL);
 	sh.wake[0] = p[0];
 	sh.wake[1] = p[1];
-	keymode *km = keymode_new(&sh, out, PALETTE_TRUECOLOR, 160, 48);
+	termout *to = termout_new(out);
+	keymode *km = to ? keymode_new(&sh, to, PALETTE_TRUECOLOR, 160, 48) : NULL;
 	if (!km)
 		fail("keymode_new", NULL);
 	int kruns = quick ? 5 : 41;
@@ -785,6 +786,7 @@ static void bench_keymode(void)
 	         "view at 160x48 cells: key to first frame; %.0f frames/s at 30 Hz repeat; target < 50 ms",
 	         frames / 2.0);
 	keymode_free(km);
+	termout_free(to);
 	shell_free(&sh);
 	close(out);
 	close(p[0]);

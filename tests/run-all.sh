@@ -28,8 +28,8 @@ ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:ha
 	step "unit tests (ASan+UBSan)" sh tests/run-unit.sh build/asan build/asan/tests/test_*
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	step "command-file tests (ASan+UBSan)" sh tests/run-scripts.sh build/asan/rtsh
-step "build (TSan)" $MAKE --no-print-directory -s BUILD=build/tsan SAN=thread OPT=-O1 build/tsan/rtsh build/tsan/tests/test_render build/tsan/tests/test_preview build/tsan/tests/test_keymode build/tsan/tests/test_denoise build/tsan/tests/test_evloop
-TSAN_OPTIONS=halt_on_error=1 step "threaded tests (TSan)" sh tests/run-unit.sh build/tsan build/tsan/tests/test_render build/tsan/tests/test_preview build/tsan/tests/test_keymode build/tsan/tests/test_denoise build/tsan/tests/test_evloop
+step "build (TSan)" $MAKE --no-print-directory -s BUILD=build/tsan SAN=thread OPT=-O1 build/tsan/rtsh build/tsan/tests/test_render build/tsan/tests/test_render_service build/tsan/tests/test_keymode build/tsan/tests/test_denoise build/tsan/tests/test_evloop
+TSAN_OPTIONS=halt_on_error=1 step "threaded tests (TSan)" sh tests/run-unit.sh build/tsan build/tsan/tests/test_render build/tsan/tests/test_render_service build/tsan/tests/test_keymode build/tsan/tests/test_denoise build/tsan/tests/test_evloop
 # The libFuzzer targets (tests/fuzz), a few seconds each, when clang has libFuzzer.
 if sh tests/fuzz/have-libfuzzer.sh; then
 	step "build (libFuzzer)" $MAKE --no-print-directory -s fuzz-bins

@@ -10,6 +10,7 @@
 #ifndef RTSH_WORLD_H
 #define RTSH_WORLD_H
 
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -150,6 +151,7 @@ typedef struct world {
 	bvh *tree;       /* over prims */
 	box bounds;      /* of the bounded primitives */
 	double eps;      /* self-intersection offset scale for this scene */
+	atomic_long refs; /* references (world_retain / world_release) */
 } world;
 
 /* A ray-surface hit in world space. */
@@ -167,8 +169,17 @@ typedef struct hit {
 } hit;
 
 /* Builds the world for the scene's active camera; NULL (err set) when out of
- * memory or an object cannot be placed. The scene is not referenced after. */
+ * memory or an object cannot be placed. The scene is not referenced after.
+ * The caller holds the one reference. */
 world *world_build(const scene *s, rt_error *err);
+/* Worlds are reference-counted, so that no thread renders from a world
+ * another may free: whoever keeps a world beyond a call (a render thread, a
+ * cache, key mode) holds a reference. world_retain takes one more and
+ * returns w; world_release drops one and frees the world with the last.
+ * Both are thread-safe and take NULL. */
+const world *world_retain(const world *w);
+void world_release(const world *w);
+/* world_release: for the one owner that built the world. */
 void world_free(world *w);
 
 /* Nearest hit with tmin < t < tmax. */

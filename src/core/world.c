@@ -202,6 +202,7 @@ world *world_build(const scene *s, rt_error *err)
 		rt_error_set(err, "out of memory preparing the scene");
 		return NULL;
 	}
+	atomic_init(&w->refs, 1);
 	camera c = scene_camera(s);
 	w->cam = cam_view_make(&c);
 	if (s->has_ambient)
@@ -311,9 +312,19 @@ world *world_build(const scene *s, rt_error *err)
 	return w;
 }
 
-void world_free(world *w)
+const world *world_retain(const world *w)
 {
-	if (!w)
+	if (w)
+		atomic_fetch_add_explicit(&((world *)w)->refs, 1, memory_order_relaxed);
+	return w;
+}
+
+/* The last reference frees: the release orders every use of the world by
+ * any thread before the free (acquire on the last). */
+void world_release(const world *cw)
+{
+	world *w = (world *)cw;
+	if (!w || atomic_fetch_sub_explicit(&w->refs, 1, memory_order_acq_rel) != 1)
 		return;
 	free(w->lights);
 	free(w->mats);
@@ -326,6 +337,11 @@ void world_free(world *w)
 	envmap_free((envmap *)w->env);
 	bvh_free(w->tree);
 	free(w);
+}
+
+void world_free(world *w)
+{
+	world_release(w);
 }
 
 /* --- primitive tests --- */

@@ -79,16 +79,19 @@ const command command_table[] = {
 };
 const size_t command_count = sizeof command_table / sizeof command_table[0];
 
-/* More for `help COMMAND` than its usage and one line. */
+/* More for `help COMMAND` than its usage and one line (text, or made by
+ * gen from a table). */
 static const struct {
 	const char *name, *text;
+	const char *(*gen)(void);
 } details[] = {
-	{"view", keymode_help},
+	{"view", NULL, keymode_help_text},
 	{"add", "examples: add sp 0,1,0 1 255,0,0 texture=earth.png\n"
 	        "          add mesh bunny.obj 0,0.5,0 0,1,0 1 200,200,200 smooth=1 crease=60\n"
 	        "          add sky sky.hdr 1 90   (an HDR sky, turned 90 degrees)\n"
 	        "keys: texture= normalmap= bump= bumpscale= uvscale=U,V uvoffset=U,V, and for a mesh smooth= "
-	        "crease= (see rtsh(5))\n"},
+	        "crease= (see rtsh(5))\n",
+	 NULL},
 };
 
 /* True when `word` is one of the space-separated names in list. */
@@ -395,7 +398,7 @@ bool cmd_help(shell *sh, int argc, char **argv, const char *rest)
 		shell_out(sh, "%s\n", c->help);
 		for (size_t i = 0; i < sizeof details / sizeof details[0]; i++)
 			if (strcmp(details[i].name, c->name) == 0)
-				shell_out(sh, "%s", details[i].text);
+				shell_out(sh, "%s", details[i].text ? details[i].text : details[i].gen());
 		if (c->run == cmd_add) { /* the elements, from the reader's table */
 			const char *usage;
 			shell_out(sh, "elements (rtsh(5)):\n");

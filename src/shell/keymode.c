@@ -1,32 +1,22 @@
-/* rtsh — key mode (keymode.h).
+/* rtsh — key mode (keymode.h): the session and its loop.
  *
- * Three parts:
- *   1. keys to edits: pure functions of the key, the scene and the
- *      selection (unit-tested without a terminal);
- *   2. the session: a render thread of its own, the adaptive pixel ratio,
- *      the picture with the selection marked, the status line and the help
- *      bar;
- *   3. the terminal: ncurses for the keys, termios, signals, and giving the
- *      shell's screen back.
- *
- * Escape sequences sent here, besides the frame encoder's (term/frame.h):
- *   \e[?2026h \e[?2026l   begin / end synchronized update, around each frame
- *   \e[r                  reset the scroll region (the shell's is restored
- *                         by screen_layout on the way out)
- *   \e[2J                 clear the screen
- *   \e[R;CH               move the cursor
- *   \e[7m  \e[m           reverse video (the status line) / reset
- *   \e[K                  clear to the end of the line
- *   \e[?25l \e[?25h       hide / show the cursor
- *   smkx / rmkx           terminfo's keypad transmit on / off, so that the
- *                         arrow keys send what terminfo (and ncurses) expect
+ * Key mode is three files: the key table and the edits keys make
+ * (keymode_keys.c), the key view's drawing (term/keyview.c: every escape
+ * sequence of key mode, sent through the output scheduler), and this one:
+ *   1. the session: requests to the render service (shell/render_service.h),
+ *      the adaptive pixel ratio, the picture with the selection marked and
+ *      the status line's text;
+ *   2. the loop: the terminal's input through the output scheduler (its
+ *      answers pace the picture) and on to ncurses for the keys, termios,
+ *      signals, and giving the shell's screen back.
+ * The keypad transmit mode (terminfo's smkx / rmkx, so that the arrow keys
+ * send what ncurses expects) is sent by screen_keypad (term/screen.h).
  */
 #include "shell/keymode.h"
 
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
-#include <pthread.h>
 #include <signal.h>
 #include <stdarg.h>
 #include <stdatomic.h>
@@ -34,7 +24,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/ioctl.h>
-#include <sys/select.h>
 #include <termios.h>
 #include <time.h>
 #include <unistd.h>
@@ -48,38 +37,7 @@
 #include "term/abuf.h"
 #include "term/frame.h"
 #include "term/keys.h"
-
-/* The help bar and `help view`. */
-const char keymode_help[] =
-	"keys in view (key mode; letters in either case but u and U):\n"
-	"  Up Down Left Right, w s a d  move forward, back, left, right (the camera flies where it\n"
-	"                               looks; a selected object or light moves level with the floor)\n"
-	"  r f                          move up, down\n"
-	"  i k j l, Shift+arrows        turn the camera (pitch, yaw) by 3 degrees\n"
-	"  Tab, Shift+Tab               select the next / previous object or light, then the camera\n"
-	"  [ ]                          turn the selected object about the vertical by 15 degrees\n"
-	"  { }                          roll it about the line of sight by 15 degrees\n"
-	"  - +                          shrink / grow it (x1.1); a light: dimmer / brighter;\n"
-	"                               the camera: zoom out / in (field of view)\n"
-	"  , .                          halve / double the samples per pixel\n"
-	"  < >                          depth one less / one more\n"
-	"  PgUp PgDn                    the previous / next .rt file of the scene's folder\n"
-	"  m                            switch between whitted and path mode\n"
-	"  Space                        stop the render in progress\n"
-	"  u U                          undo / redo (a run of the same key is one step)\n"
-	"  ? F1                         hide / show the help bar;  Ctrl-L F5  repaint\n"
-	"  Esc q                        back to the shell; every change stays (undo, save x.rt)\n"
-	"a movement key moves by 1/40 of the size of the scene (the box around the objects\n"
-	"but planes, the lights and the camera); see KEY MODE in rtsh(1)\n";
-
-/* The help bar: keys (in bold) and what they do, as many as fit. */
-static const struct {
-	const char *keys, *what;
-} help_bar[] = {
-	{"Esc", "back"}, {"←↑↓→ wasd", "move"}, {"r f", "up/down"}, {"ijkl ⇧←↑↓→", "turn"}, {"Tab", "select"},
-	{"[ ] { }", "rotate"}, {"- +", "size"}, {"u", "undo"}, {"m", "mode"}, {", .", "spp"}, {"< >", "depth"},
-	{"PgUp PgDn", "scene"}, {"Space", "stop"}, {"?", "hide this"},
-};
+#include "term/keyview.h"
 
 static double now(void)
 {
@@ -89,521 +47,17 @@ static double now(void)
 }
 
 /* ------------------------------------------------------------------ */
-/* 1. Keys to edits                                                    */
+/* 1. The session                                                      */
 /* ------------------------------------------------------------------ */
 
-double keymode_step(const scene *s)
-{
-	camera c = scene_camera(s);
-	box b = box_point(c.pos);
-	for (size_t i = 0; i < s->nobjs; i++) {
-		if (s->objs[i].kind == OBJ_PLANE)
-			continue;
-		box o = object_bounds(&s->objs[i]);
-		if (!box_is_empty(o) && v3_finite(o.lo) && v3_finite(o.hi))
-			b = box_union(b, o);
-	}
-	for (size_t i = 0; i < s->nlights; i++)
-		b = box_add(b, s->lights[i].pos);
-	double side = v3_max_comp(v3_sub(b.hi, b.lo));
-	if (!(side > 0) || !isfinite(side))
-		side = 1.0;
-	return side * KEYMODE_STEP_FRACTION;
-}
-
-bool keymode_sel_valid(const scene *s, km_sel sel)
-{
-	switch (sel.kind) {
-	case KM_SEL_OBJECT:
-		return sel.index < s->nobjs;
-	case KM_SEL_LIGHT:
-		return sel.index < s->nlights;
-	case KM_SEL_CAMERA:
-		break;
-	}
-	return true;
-}
-
-km_sel keymode_select(const scene *s, km_sel sel, int dir)
-{
-	size_t total = 1 + s->nobjs + s->nlights, at = 0;
-	if (sel.kind == KM_SEL_OBJECT && sel.index < s->nobjs)
-		at = 1 + sel.index;
-	else if (sel.kind == KM_SEL_LIGHT && sel.index < s->nlights)
-		at = 1 + s->nobjs + sel.index;
-	at = dir >= 0 ? (at + 1) % total : (at + total - 1) % total;
-	if (at == 0)
-		return (km_sel){KM_SEL_CAMERA, 0};
-	if (at <= s->nobjs)
-		return (km_sel){KM_SEL_OBJECT, at - 1};
-	return (km_sel){KM_SEL_LIGHT, at - 1 - s->nobjs};
-}
-
-vec3 keymode_axis_euler(vec3 axis, double deg)
-{
-	mat4 r = m4_rotate_axis(v3_norm(axis), deg_to_rad(deg));
-	/* r = Rz(c) Ry(b) Rx(a): r[2][0] = -sin b, r[2][1] = cos b sin a,
-	 * r[2][2] = cos b cos a, r[1][0] = sin c cos b, r[0][0] = cos c cos b. */
-	double sb = clampd(-r.m[2][0], -1.0, 1.0);
-	double a, b = asin(sb), c;
-	if (fabs(sb) < 0.9999999) {
-		a = atan2(r.m[2][1], r.m[2][2]);
-		c = atan2(r.m[1][0], r.m[0][0]);
-	} else {
-		/* Gimbal lock: only a - c (or a + c) is defined; put it all in a. */
-		c = 0.0;
-		a = atan2(-r.m[1][2], r.m[1][1]);
-	}
-	return v3(rad_to_deg(a), rad_to_deg(b), rad_to_deg(c));
-}
-
-static km_action act(km_op op, km_sel sel)
-{
-	km_action a;
-	memset(&a, 0, sizeof a);
-	a.op = op;
-	a.sel = sel;
-	return a;
-}
-
-static km_action move_by(km_sel sel, vec3 dir, double amount)
-{
-	km_action a = act(KM_MOVE, sel);
-	a.d = v3_scale(dir, amount);
-	return a;
-}
-
-km_action keymode_map(int key, const scene *s, km_sel sel, double step)
-{
-	camera c = scene_camera(s);
-	cam_view v = cam_view_make(&c);
-	vec3 fwd = v.fwd, right = v.right, up = v3(0, 1, 0);
-	if (sel.kind != KM_SEL_CAMERA) {
-		/* Objects and lights slide level with the floor. */
-		vec3 flat = v3(v.fwd.x, 0, v.fwd.z);
-		fwd = v3_len(flat) > 1e-6 ? v3_norm(flat) : v3_norm(v3(v.up.x, 0, v.up.z));
-	}
-	km_action a = act(KM_NONE, sel);
-	switch (key) {
-	case KEYS_UP:
-	case 'w':
-	case 'W':
-		return move_by(sel, fwd, step);
-	case KEYS_DOWN:
-	case 's':
-	case 'S':
-		return move_by(sel, fwd, -step);
-	case KEYS_LEFT:
-	case 'a':
-	case 'A':
-		return move_by(sel, right, -step);
-	case KEYS_RIGHT:
-	case 'd':
-	case 'D':
-		return move_by(sel, right, step);
-	case 'r':
-	case 'R':
-		return move_by(sel, up, step);
-	case 'f':
-	case 'F':
-		return move_by(sel, up, -step);
-	case 'j':
-	case 'J':
-	case KEYS_SHIFT_LEFT:
-		a = act(KM_TURN, sel);
-		a.a = -KEYMODE_TURN_DEG;
-		return a;
-	case 'l':
-	case 'L':
-	case KEYS_SHIFT_RIGHT:
-		a = act(KM_TURN, sel);
-		a.a = KEYMODE_TURN_DEG;
-		return a;
-	case 'i':
-	case 'I':
-	case KEYS_SHIFT_UP:
-		a = act(KM_TURN, sel);
-		a.b = KEYMODE_TURN_DEG;
-		return a;
-	case 'k':
-	case 'K':
-	case KEYS_SHIFT_DOWN:
-		a = act(KM_TURN, sel);
-		a.b = -KEYMODE_TURN_DEG;
-		return a;
-	case '[': /* the front turns to the left, as the camera sees it */
-		a = act(KM_ROTATE, sel);
-		a.d = v3(0, KEYMODE_ROTATE_DEG, 0);
-		return a;
-	case ']':
-		a = act(KM_ROTATE, sel);
-		a.d = v3(0, -KEYMODE_ROTATE_DEG, 0);
-		return a;
-	case '{': /* counterclockwise on the screen */
-		a = act(KM_ROTATE, sel);
-		a.d = keymode_axis_euler(v.fwd, KEYMODE_ROTATE_DEG);
-		return a;
-	case '}':
-		a = act(KM_ROTATE, sel);
-		a.d = keymode_axis_euler(v.fwd, -KEYMODE_ROTATE_DEG);
-		return a;
-	case '-':
-	case '_':
-		a = act(KM_SCALE, sel);
-		a.a = 1.0 / KEYMODE_SCALE;
-		return a;
-	case '+':
-	case '=':
-		a = act(KM_SCALE, sel);
-		a.a = KEYMODE_SCALE;
-		return a;
-	case '\t':
-	case KEYS_BACKTAB:
-		a = act(KM_SELECT, keymode_select(s, sel, key == '\t' ? 1 : -1));
-		a.n = key == '\t' ? 1 : -1;
-		return a;
-	case ',':
-	case '.':
-		a = act(KM_SAMPLES, sel);
-		a.n = key == '.' ? 1 : -1;
-		return a;
-	case '<':
-	case '>':
-		a = act(KM_DEPTH, sel);
-		a.n = key == '>' ? 1 : -1;
-		return a;
-	case KEYS_PAGE_UP:
-	case KEYS_PAGE_DOWN:
-		a = act(KM_SCENE, sel);
-		a.n = key == KEYS_PAGE_DOWN ? 1 : -1;
-		return a;
-	case 'm':
-	case 'M':
-		return act(KM_MODE, sel);
-	case ' ':
-		return act(KM_STOP, sel);
-	case 'u':
-		return act(KM_UNDO, sel);
-	case 'U':
-		return act(KM_REDO, sel);
-	case 12: /* Ctrl-L */
-	case KEYS_F(5):
-		return act(KM_REDRAW, sel);
-	case '?':
-	case KEYS_F(1):
-		return act(KM_HELP, sel);
-	case KEYS_ESC:
-	case 'q':
-	case 'Q':
-		return act(KM_QUIT, sel);
-	default:
-		return a;
-	}
-}
-
-bool keymode_is_edit(km_op op)
-{
-	return op == KM_MOVE || op == KM_TURN || op == KM_ROTATE || op == KM_SCALE;
-}
-
-bool keymode_apply(editor *ed, const km_action *a, rt_error *err)
-{
-	const scene *s = editor_scene(ed);
-	if (!keymode_sel_valid(s, a->sel))
-		return rt_error_set(err, "the selection is gone; press Tab to select again");
-	size_t i = a->sel.index;
-	switch (a->op) {
-	case KM_MOVE:
-		if (a->sel.kind == KM_SEL_OBJECT)
-			return editor_object_move(ed, i, a->d, err);
-		if (a->sel.kind == KM_SEL_LIGHT)
-			return editor_light_move(ed, i, a->d, err);
-		return editor_camera_pos(ed, v3_add(scene_camera(s).pos, a->d), err);
-	case KM_TURN:
-		return editor_camera_turn(ed, a->a, a->b, err);
-	case KM_ROTATE:
-		if (a->sel.kind != KM_SEL_OBJECT)
-			return rt_error_set(err, "only objects rotate; press Tab to select one");
-		return editor_object_rotate(ed, i, a->d, err);
-	case KM_SCALE:
-		if (a->sel.kind == KM_SEL_OBJECT)
-			return editor_object_scale(ed, i, v3_splat(a->a), err);
-		if (a->sel.kind == KM_SEL_LIGHT) {
-			double r = s->lights[i].ratio + (a->a > 1 ? KEYMODE_BRIGHTNESS : -KEYMODE_BRIGHTNESS);
-			r = clampd(round(r * 1000.0) / 1000.0, 0.0, 1.0);
-			return r == s->lights[i].ratio ? true : editor_light_brightness(ed, i, r, err);
-		} else {
-			double fov = scene_camera(s).fov + (a->a > 1 ? -KEYMODE_FOV_DEG : KEYMODE_FOV_DEG);
-			fov = clampd(fov, 5.0, 170.0);
-			return fov == scene_camera(s).fov ? true : editor_camera_fov(ed, fov, err);
-		}
-	default:
-		return rt_error_set(err, "not a scene edit");
-	}
-}
-
-/* ------------------------------------------------------------------ */
-/* 2. The session                                                      */
-/* ------------------------------------------------------------------ */
-
-/* A render request to the session's thread. */
-typedef struct km_req {
-	uint64_t seq;         /* newer requests have larger numbers */
+/* The request the newest images must answer. */
+typedef struct km_cur {
+	uint64_t seq;         /* rsvc_start's number (0: none yet) */
 	uint64_t gen;         /* the scene generation the world shows */
-	const world *w;
-	render_settings set;  /* samples = the target of a refine */
+	render_settings set;
 	int w_px, h_px;       /* the render size */
 	bool refine;          /* all the samples, in passes that accumulate */
-} km_req;
-
-/* An image the thread published. */
-typedef struct km_img {
-	uint64_t seq;
-	int w, h;
-	float *rgb;
-	size_t cap;
-	int spp, target;
-	bool done, refine;
-	double seconds;       /* the render time of this frame / pass */
-	double px_cost;       /* seconds per pixel and sample it measured */
-} km_img;
-
-typedef struct km_worker {
-	pthread_t thread;
-	bool started;
-	int wake_fd;
-	pthread_mutex_t m; /* guards quit, pending, busy, req */
-	pthread_cond_t work, idle;
-	bool quit, pending, busy;
-	km_req req;
-	atomic_bool cancel;
-
-	pthread_mutex_t im; /* guards img, serial, the cancel report */
-	km_img img;
-	uint64_t serial;
-	/* The last fast frame that was cancelled: how far it got. */
-	uint64_t cut_seq;
-	double cut_seconds, cut_frac;
-
-	/* The thread's own. */
-	framebuffer *fast, *fb;
-	km_req fb_req;     /* what fb holds */
-	long tiles_done, tiles_total;
-} km_worker;
-
-static void wk_wake(km_worker *wk)
-{
-	if (wk->wake_fd >= 0) {
-		ssize_t r = write(wk->wake_fd, "k", 1);
-		(void)r; /* a full pipe already holds a wake-up */
-	}
-}
-
-static void wk_publish(km_worker *wk, const km_req *req, const framebuffer *fb, int target, double seconds,
-                       double px_cost)
-{
-	size_t n = (size_t)fb->w * (size_t)fb->h * 3;
-	pthread_mutex_lock(&wk->im);
-	km_img *img = &wk->img;
-	bool ok = true;
-	if (n > img->cap) {
-		float *p = realloc(img->rgb, n * sizeof *p);
-		if (p) {
-			img->rgb = p;
-			img->cap = n;
-		} else {
-			ok = false;
-		}
-	}
-	if (ok) {
-		memcpy(img->rgb, fb->rgb, n * sizeof *img->rgb);
-		img->seq = req->seq;
-		img->w = fb->w;
-		img->h = fb->h;
-		img->spp = fb->spp;
-		img->target = target;
-		img->done = fb->spp >= target;
-		img->refine = req->refine;
-		img->seconds = seconds;
-		img->px_cost = px_cost;
-		wk->serial++;
-	}
-	pthread_mutex_unlock(&wk->im);
-	if (ok)
-		wk_wake(wk);
-}
-
-static void wk_progress(void *ctx, long done, long total)
-{
-	km_worker *wk = ctx;
-	wk->tiles_done = done;
-	wk->tiles_total = total;
-}
-
-/* True when fb (rendered for a) can take more samples for b. */
-static bool wk_continues(const km_req *a, const km_req *b)
-{
-	return a->refine && b->refine && a->gen == b->gen && a->w == b->w && a->w_px == b->w_px &&
-	       a->h_px == b->h_px && a->set.mode == b->set.mode && a->set.depth == b->set.depth &&
-	       a->set.seed == b->set.seed && (a->set.samples > 1) == (b->set.samples > 1);
-}
-
-static void wk_run(km_worker *wk, const km_req *req)
-{
-	rt_error err;
-	double t0 = now();
-	render_job job = {
-		.w = req->w,
-		.set = req->set,
-		.cancel = &wk->cancel,
-		.progress = wk_progress,
-		.progress_ctx = wk,
-	};
-	wk->tiles_done = 0;
-	wk->tiles_total = 1;
-	if (!req->refine) {
-		/* A fast frame: one centred sample per pixel. */
-		framebuffer *fb = fb_reuse(&wk->fast, req->w_px, req->h_px);
-		if (!fb)
-			return;
-		job.set.samples = 1;
-		job.fb = fb;
-		job.sample_begin = 0;
-		job.sample_end = 1;
-		render_status st = render_run(&job, &err);
-		double dt = now() - t0;
-		if (st == RENDER_DONE) {
-			wk_publish(wk, req, fb, 1, dt, dt / ((double)fb->w * fb->h));
-		} else if (st == RENDER_CANCELLED) {
-			pthread_mutex_lock(&wk->im);
-			wk->cut_seq = req->seq;
-			wk->cut_seconds = dt;
-			wk->cut_frac = wk->tiles_total > 0 ? (double)wk->tiles_done / (double)wk->tiles_total : 0.0;
-			pthread_mutex_unlock(&wk->im);
-		}
-		return;
-	}
-	/* A refine: go on from the samples fb holds when it shows the same. */
-	framebuffer *fb = wk->fb;
-	bool cont = fb && fb->spp > 0 && fb->spp <= req->set.samples && wk_continues(&wk->fb_req, req);
-	if (!cont)
-		fb = fb_reuse(&wk->fb, req->w_px, req->h_px);
-	if (!fb)
-		return;
-	wk->fb_req = *req;
-	int target = req->set.samples, done = fb->spp, n = 1;
-	if (done >= target) {
-		wk_publish(wk, req, fb, target, 0.0, 0.0);
-		return;
-	}
-	while (done < target) {
-		if (n > target - done)
-			n = target - done;
-		job.fb = fb;
-		job.sample_begin = done;
-		job.sample_end = done + n;
-		double t1 = now();
-		if (render_run(&job, &err) != RENDER_DONE)
-			return;
-		double dt = now() - t1, per = dt / n;
-		done += n;
-		wk_publish(wk, req, fb, target, dt, per / ((double)fb->w * fb->h));
-		/* Passes of about 0.2 s after the first. */
-		n = per > 0 ? (int)(0.2 / per) : 64;
-		if (n < 1)
-			n = 1;
-	}
-}
-
-static void *wk_main(void *arg)
-{
-	km_worker *wk = arg;
-	pthread_mutex_lock(&wk->m);
-	for (;;) {
-		while (!wk->quit && !wk->pending)
-			pthread_cond_wait(&wk->work, &wk->m);
-		if (wk->quit)
-			break;
-		km_req req = wk->req;
-		wk->pending = false;
-		wk->busy = true;
-		pthread_mutex_unlock(&wk->m);
-		wk_run(wk, &req);
-		pthread_mutex_lock(&wk->m);
-		wk->busy = false;
-		pthread_cond_broadcast(&wk->idle);
-	}
-	pthread_mutex_unlock(&wk->m);
-	return NULL;
-}
-
-static void wk_init(km_worker *wk, int wake_fd)
-{
-	memset(wk, 0, sizeof *wk);
-	wk->wake_fd = wake_fd;
-	pthread_mutex_init(&wk->m, NULL);
-	pthread_mutex_init(&wk->im, NULL);
-	pthread_cond_init(&wk->work, NULL);
-	pthread_cond_init(&wk->idle, NULL);
-	atomic_init(&wk->cancel, false);
-}
-
-/* Cancels the render in flight and any request waiting; returns once the
- * thread no longer uses the world. */
-static void wk_hold(km_worker *wk)
-{
-	pthread_mutex_lock(&wk->m);
-	wk->pending = false;
-	atomic_store(&wk->cancel, true);
-	while (wk->busy)
-		pthread_cond_wait(&wk->idle, &wk->m);
-	atomic_store(&wk->cancel, false);
-	pthread_mutex_unlock(&wk->m);
-}
-
-static bool wk_busy(km_worker *wk)
-{
-	pthread_mutex_lock(&wk->m);
-	bool b = wk->busy || wk->pending;
-	pthread_mutex_unlock(&wk->m);
-	return b;
-}
-
-static bool wk_start(km_worker *wk, const km_req *req)
-{
-	pthread_mutex_lock(&wk->m);
-	wk->req = *req;
-	wk->pending = true;
-	if (!wk->started) {
-		if (pthread_create(&wk->thread, NULL, wk_main, wk) == 0)
-			wk->started = true;
-		else
-			wk->pending = false;
-	}
-	bool ok = wk->pending;
-	pthread_cond_signal(&wk->work);
-	pthread_mutex_unlock(&wk->m);
-	return ok;
-}
-
-static void wk_free(km_worker *wk)
-{
-	if (wk->started) {
-		pthread_mutex_lock(&wk->m);
-		wk->quit = true;
-		atomic_store(&wk->cancel, true);
-		pthread_cond_signal(&wk->work);
-		pthread_mutex_unlock(&wk->m);
-		pthread_join(wk->thread, NULL);
-	}
-	fb_free(wk->fast);
-	fb_free(wk->fb);
-	free(wk->img.rgb);
-	pthread_mutex_destroy(&wk->m);
-	pthread_mutex_destroy(&wk->im);
-	pthread_cond_destroy(&wk->work);
-	pthread_cond_destroy(&wk->idle);
-}
+} km_cur;
 
 /* The pixel ratios a fast frame may use. */
 static const double ratios[] = {1, 1.5, 2, 3, 4, 6, 8, 12, 16};
@@ -614,20 +68,15 @@ static const uint8_t mark_rgb[3] = {255, 205, 0};
 
 struct keymode {
 	shell *sh;
-	int fd;
-	frame_palette pal;
-	int cols, rows;
-	int pic_rows;          /* the picture's rows; the status line and help bar follow */
-	int img_w, img_h;      /* the picture in pixels ... */
-	int img_x, img_y;      /* ... and its place on the cols x 2*pic_rows canvas */
-	frame *fr;
-	abuf out;
+	keyview kv;            /* the screen (term/keyview.h) */
+	keyview_item bar[32];  /* the help bar, from the key table */
+	termout *out;          /* borrowed: the output scheduler */
+	abuf late;             /* key bytes the scheduler gave up holding (keymode_late_keys) */
 	bool help;             /* the help bar is shown */
 	double layout_aspect;  /* the image aspect the layout is for */
-	bool repaint;          /* clear the screen before the next frame */
 
-	km_worker wk;
-	const world *w;        /* the preview's world for wgen (NULL: none yet) */
+	rsvc *rs;              /* the shell's render service */
+	const world *w;        /* a reference to the world for wgen (NULL: none yet) */
 	uint64_t wgen;
 	double step;
 
@@ -636,18 +85,15 @@ struct keymode {
 	int run_key;
 	km_sel run_sel;
 
-	uint64_t seq;          /* the newest request */
-	km_req cur;
+	km_cur cur;
 	bool want_fast, want_refine; /* a render to start */
 	bool refined;          /* the newest request is a refine (or needs none) */
 	bool stopped;
 	double last_key;
 	int ratio_i;
 	double cost;           /* seconds per pixel and sample; 0 = not known */
-	uint64_t cut_seen;
-	uint64_t taken;        /* the thread's image serial last looked at */
-
-	km_img img;            /* the newest image taken */
+	rsvc_image img;        /* the newest image taken (of the request cur) */
+	rsvc_image spare;      /* what rsvc_take copies out, swapped in when it answers cur */
 	bool have_img, dirty;
 	bool held;             /* a new image waits to be drawn */
 	double last_draw;
@@ -662,7 +108,6 @@ struct keymode {
 
 	char msg[256];
 	double msg_until;
-	char status_shown[1024];
 	double fast_times[16]; /* when the last fast frames were drawn */
 	long fast_frames, frames;
 	int edits;
@@ -678,29 +123,8 @@ static double km_aspect(const keymode *km)
 
 static void km_layout(keymode *km)
 {
-	int bars = km->help ? 2 : 1;
 	km->layout_aspect = km_aspect(km);
-	km->pic_rows = km->rows - bars;
-	frame_free(km->fr);
-	km->fr = NULL;
-	km->img_w = km->img_h = 0;
-	if (km->pic_rows < 2 || km->cols < 8) {
-		km->pic_rows = 0;
-	} else {
-		bool whole = km->pal == PALETTE_NONE;
-		screen_fit(km->cols, km->pic_rows, km_aspect(km), whole, &km->img_w, &km->img_h);
-		km->img_x = (km->cols - km->img_w) / 2;
-		km->img_y = (2 * km->pic_rows - km->img_h) / 2;
-		if (whole)
-			km->img_y &= ~1;
-		km->fr = frame_new(km->cols, km->pic_rows, km->pal);
-		if (km->fr)
-			km->fr->sync = false; /* each whole update is bracketed here */
-		else
-			km->img_w = km->img_h = 0;
-	}
-	km->repaint = true;
-	km->status_shown[0] = '\0';
+	keyview_layout(&km->kv, km->kv.cols, km->kv.rows, km->help, km->layout_aspect);
 	km->mask_ok = false;
 }
 
@@ -717,17 +141,19 @@ static void km_message(keymode *km, const char *fmt, ...)
 
 /* --- the world and the requests --- */
 
-/* The world for the editor's scene, built when the scene changed (the
- * thread must not be rendering). */
+/* The world for the editor's scene, from the render service (built when
+ * the scene changed); key mode holds a reference until the scene changes
+ * again, so neither the selection marks nor a render ever use a world the
+ * service (or the shell's preview) let go of. */
 static const world *km_world(keymode *km)
 {
 	uint64_t gen = editor_generation(km->sh->ed);
 	if (km->w && km->wgen == gen)
 		return km->w;
-	preview_hold(km->sh->pv); /* cheap when held: the shell may have released it */
+	world_release(km->w);
 	rt_error err;
 	rt_error_clear(&err);
-	km->w = preview_world(km->sh->pv, editor_scene(km->sh->ed), gen, &err);
+	km->w = rsvc_world(km->rs, editor_scene(km->sh->ed), gen, &err);
 	km->wgen = gen;
 	if (!km->w)
 		km_message(km, "the scene cannot be shown: %s", err.msg);
@@ -741,7 +167,7 @@ static int km_pick_ratio(keymode *km)
 	int loose = NRATIOS - 1, strict = NRATIOS - 1;
 	for (int i = NRATIOS - 1; i >= 0; i--) {
 		double r = ratios[i];
-		double px = ceil(km->img_w / r) * ceil(km->img_h / r);
+		double px = ceil(km->kv.img_w / r) * ceil(km->kv.img_h / r);
 		double t = px * km->cost;
 		if (t <= KEYMODE_FRAME_BUDGET)
 			loose = i;
@@ -759,14 +185,10 @@ static int km_pick_ratio(keymode *km)
 /* What the last cancelled fast frame says about the cost of a pixel. */
 static void km_learn_from_cut(keymode *km)
 {
-	km_worker *wk = &km->wk;
-	pthread_mutex_lock(&wk->im);
-	uint64_t seq = wk->cut_seq;
-	double sec = wk->cut_seconds, frac = wk->cut_frac;
-	pthread_mutex_unlock(&wk->im);
-	if (seq == km->cut_seen || seq != km->cur.seq || km->cur.refine)
+	uint64_t seq;
+	double sec, frac;
+	if (!rsvc_cut(km->rs, &seq, &sec, &frac) || seq != km->cur.seq || km->cur.refine)
 		return;
-	km->cut_seen = seq;
 	double px = (double)km->cur.w_px * km->cur.h_px;
 	if (px <= 0 || sec < 0.002)
 		return; /* cut at once: says nothing */
@@ -778,38 +200,38 @@ static void km_learn_from_cut(keymode *km)
 static void km_start(keymode *km, bool refine)
 {
 	shell *sh = km->sh;
-	if (km->img_w <= 0 || km->img_h <= 0)
+	if (km->kv.img_w <= 0 || km->kv.img_h <= 0)
 		return;
-	wk_hold(&km->wk);
+	rsvc_hold(km->rs);
 	km_learn_from_cut(km);
 	const world *w = km_world(km);
 	if (!w)
 		return;
-	km_req r;
-	memset(&r, 0, sizeof r);
-	r.seq = ++km->seq;
-	r.gen = km->wgen;
-	r.w = w;
-	r.set = sh->set;
-	r.refine = refine;
+	rsvc_request r = {
+		.world = w,
+		.gen = km->wgen,
+		.set = sh->set,
+		.w = km->kv.img_w,
+		.h = km->kv.img_h,
+	};
+	km_cur c = {.gen = km->wgen, .set = sh->set, .refine = refine, .w_px = km->kv.img_w, .h_px = km->kv.img_h};
 	if (refine) {
-		r.w_px = km->img_w;
-		r.h_px = km->img_h;
+		/* Goes on from the samples already in when only their number
+		 * changed. */
+		r.kind = RSVC_REFINE;
+		r.accumulate = true;
+		r.pass_seconds = KEYMODE_PASS_SECONDS;
 	} else {
 		km->ratio_i = km_pick_ratio(km);
-		double q = ratios[km->ratio_i];
-		/* The picture's aspect kept, so the pixels stay square. */
-		r.w_px = (int)ceil(km->img_w / q);
-		r.h_px = (int)lround((double)r.w_px * km->img_h / km->img_w);
-		if (r.w_px < 1)
-			r.w_px = 1;
-		if (r.h_px < 1)
-			r.h_px = 1;
+		r.kind = RSVC_FRAME;
+		r.ratio = ratios[km->ratio_i];
+		rsvc_frame_size(km->kv.img_w, km->kv.img_h, r.ratio, &c.w_px, &c.h_px);
 	}
-	km->cur = r;
+	c.seq = rsvc_start(km->rs, &r);
+	km->cur = c;
 	km->refined = refine;
 	km->stopped = false;
-	if (!wk_start(&km->wk, &r))
+	if (!c.seq)
 		km_message(km, "cannot start the render thread");
 }
 
@@ -833,30 +255,30 @@ static void km_mask(keymode *km)
 {
 	uint64_t gen = km->wgen;
 	if (km->mask_ok && km->mask_gen == gen && km->mask_sel.kind == km->sel.kind &&
-	    km->mask_sel.index == km->sel.index && km->mask_w == km->img_w && km->mask_h == km->img_h)
+	    km->mask_sel.index == km->sel.index && km->mask_w == km->kv.img_w && km->mask_h == km->kv.img_h)
 		return;
 	km->mask_ok = false;
 	km->sel_visible = false;
 	if (km->sel.kind != KM_SEL_OBJECT || !km->w)
 		return;
-	size_t n = (size_t)km->img_w * (size_t)km->img_h;
+	size_t n = (size_t)km->kv.img_w * (size_t)km->kv.img_h;
 	if (!grow(&km->mask, &km->mask_cap, n))
 		return;
 	const world *w = km->w;
 	uint32_t want = (uint32_t)km->sel.index;
-	for (int y = 0; y < km->img_h; y++)
-		for (int x = 0; x < km->img_w; x++) {
-			ray r = cam_ray(&w->cam, x + 0.5, y + 0.5, km->img_w, km->img_h);
+	for (int y = 0; y < km->kv.img_h; y++)
+		for (int x = 0; x < km->kv.img_w; x++) {
+			ray r = cam_ray(&w->cam, x + 0.5, y + 0.5, km->kv.img_w, km->kv.img_h);
 			hit h;
 			bool on = world_intersect(w, &r, 0.0, INFINITY, &h) && h.object == want;
-			km->mask[(size_t)y * km->img_w + x] = on;
+			km->mask[(size_t)y * km->kv.img_w + x] = on;
 			km->sel_visible |= on;
 		}
 	km->mask_ok = true;
 	km->mask_gen = gen;
 	km->mask_sel = km->sel;
-	km->mask_w = km->img_w;
-	km->mask_h = km->img_h;
+	km->mask_w = km->kv.img_w;
+	km->mask_h = km->kv.img_h;
 }
 
 static void put_px(uint8_t *img, int w, int h, int x, int y, const uint8_t c[3])
@@ -869,7 +291,7 @@ static void put_px(uint8_t *img, int w, int h, int x, int y, const uint8_t c[3])
 /* Marks the selection on the picture (img_w x img_h sRGB). */
 static void km_mark(keymode *km, uint8_t *img)
 {
-	int w = km->img_w, h = km->img_h;
+	int w = km->kv.img_w, h = km->kv.img_h;
 	if (km->sel.kind == KM_SEL_OBJECT) {
 		km_mask(km);
 		if (!km->mask_ok)
@@ -981,93 +403,39 @@ static void km_status_text(keymode *km, char *buf, size_t size)
 	shell *sh = km->sh;
 	char sel[128], spp[64], res[48] = "", fps[32] = "", t[32] = "";
 	km_sel_name(km, sel, sizeof sel);
-	const km_img *im = &km->img;
+	const rsvc_image *im = &km->img;
+	bool refine = im->kind == RSVC_REFINE;
 	if (!km->have_img)
 		snprintf(spp, sizeof spp, "rendering");
-	else if (!im->refine && !km->refined)
+	else if (!refine && !km->refined)
 		snprintf(spp, sizeof spp, "moving");
-	else if (!im->refine)
+	else if (!refine)
 		snprintf(spp, sizeof spp, "1/1 spp");
 	else
 		snprintf(spp, sizeof spp, "%d/%d spp%s", im->spp, im->target,
 		         km->stopped ? " stopped" : im->done ? "" : "…");
-	if (km->have_img && !im->refine && ratios[km->ratio_i] > 1)
+	if (km->have_img && !refine && ratios[km->ratio_i] > 1)
 		snprintf(res, sizeof res, " (1/%g res)", ratios[km->ratio_i]);
 	double f = km_fps(km);
 	if (f > 0)
 		snprintf(fps, sizeof fps, " │ %.0f fps", f);
 	if (km->have_img)
-		snprintf(t, sizeof t, " │ %.0f ms", im->seconds * 1000);
+		snprintf(t, sizeof t, " │ %.0f ms", im->pass_seconds * 1000);
 	/* A message goes right after the selection, where it is not cut off. */
 	bool msg = km->msg[0] && now() < km->msg_until;
 	snprintf(buf, size, " view │ %s │ %s%s%s │ %s │ %s │ depth %d │ %dx%d%s%s%s │ step %.3g", sh->name, sel,
 	         msg ? " │ " : "", msg ? km->msg : "", render_mode_name(sh->set.mode), spp, sh->set.depth,
-	         km->img_w, km->img_h, res, fps, t, km->step);
+	         km->kv.img_w, km->kv.img_h, res, fps, t, km->step);
 }
 
-/* Appends a line of text at row (0-based), cut to the width. */
-static void put_line(abuf *a, int row, int cols, const char *text, bool reverse)
-{
-	abuf_printf(a, "\x1b[%dH%s", row + 1, reverse ? "\x1b[7m" : "");
-	int width = 0, max = reverse ? cols : cols - 1; /* never the last cell of the last row */
-	const char *p = text;
-	for (; *p && width < max; p++) {
-		abuf_char(a, *p);
-		if (((unsigned char)p[1] & 0xc0) != 0x80)
-			width++;
-	}
-	while (((unsigned char)*p & 0xc0) == 0x80)
-		abuf_char(a, *p++);
-	if (reverse)
-		for (; width < cols; width++)
-			abuf_char(a, ' ');
-	abuf_str(a, "\x1b[m");
-	if (!reverse)
-		abuf_str(a, "\x1b[K");
-}
-
-/* Code points in s (the bars hold single-width characters only). */
-static int text_width(const char *s)
-{
-	int n = 0;
-	for (; *s; s++)
-		n += ((unsigned char)*s & 0xc0) != 0x80;
-	return n;
-}
-
-static void put_help(abuf *a, int row, int cols)
-{
-	abuf_printf(a, "\x1b[%dH", row + 1);
-	int used = 0;
-	for (size_t i = 0; i < sizeof help_bar / sizeof help_bar[0]; i++) {
-		int w = 2 + text_width(help_bar[i].keys) + 1 + text_width(help_bar[i].what);
-		if (used + w > cols - 1) /* never the last cell of the last row */
-			break;
-		abuf_printf(a, "  \x1b[1m%s\x1b[22m %s", help_bar[i].keys, help_bar[i].what);
-		used += w;
-	}
-	abuf_str(a, "\x1b[K");
-}
-
-/* Draws the newest image (scaled up to the picture size), the marker and
- * the bars, as one write(). */
+/* Puts the newest image (scaled up to the picture size) with the marks
+ * for the output scheduler, and draws the status line (and all of the
+ * screen after a repaint). */
 static void km_draw(keymode *km)
 {
-	abuf *a = &km->out;
-	abuf_reset(a);
-	abuf_str(a, "\x1b[?2026h");
-	if (km->repaint) {
-		abuf_str(a, "\x1b[r\x1b[m\x1b[2J\x1b[?25l");
-		if (km->fr)
-			frame_invalidate(km->fr);
-		km->status_shown[0] = '\0';
-		if (km->help)
-			put_help(a, km->rows - 1, km->cols);
-		km->repaint = false;
-	}
-	const km_img *im = &km->img;
-	if (km->fr && km->have_img && im->w > 0 && im->h > 0) {
-		int W = km->img_w, H = km->img_h;
+	const rsvc_image *im = &km->img;
+	if (km->kv.enc && km->have_img && im->w > 0 && im->h > 0) {
+		int W = km->kv.img_w, H = km->kv.img_h;
 		size_t n = (size_t)W * H * 3, sn = (size_t)im->w * im->h * 3;
 		if (grow(&km->small, &km->small_cap, sn) && grow(&km->big, &km->big_cap, n)) {
 			frame_srgb_from_linear(im->rgb, (size_t)im->w * im->h, km->sh->set.exposure, km->small);
@@ -1080,20 +448,13 @@ static void km_draw(keymode *km)
 					memcpy(dst + (size_t)x * 3, src + (size_t)((long)x * im->w / W) * 3, 3);
 			}
 			km_mark(km, km->big);
-			frame_put_image(km->fr, km->big, W, H, km->img_x, km->img_y);
-			const abuf *f = frame_update(km->fr);
-			abuf_add(a, f->b, f->len);
+			keyview_picture(&km->kv, km->big, im->kind != RSVC_REFINE || im->done);
 		}
 	}
 	char status[1024];
 	km_status_text(km, status, sizeof status);
-	if (strcmp(status, km->status_shown) != 0 && km->rows >= 1) {
-		put_line(a, km->pic_rows, km->cols, status, true);
-		snprintf(km->status_shown, sizeof km->status_shown, "%s", status);
-	}
-	abuf_str(a, "\x1b[?25l\x1b[?2026l");
-	if (!a->failed)
-		write_all(km->fd, a->b, a->len);
+	keyview_draw(&km->kv, status);
+	termout_pump(km->out, now(), &km->late);
 	km->dirty = false;
 	km->last_draw = now();
 }
@@ -1237,9 +598,9 @@ void keymode_key(keymode *km, int key)
 		break;
 	case KM_UNDO:
 	case KM_REDO:
-		/* The shell's calls below hold and release its preview: nothing
+		/* The shell's calls below hold and release the render service: nothing
 		 * of ours may be rendering then. */
-		wk_hold(&km->wk);
+		rsvc_hold(km->rs);
 		shell_edit_begin(sh);
 		if (!(a.op == KM_UNDO ? editor_undo(sh->ed, &err) : editor_redo(sh->ed, &err)))
 			km_message(km, "%s", err.msg);
@@ -1251,7 +612,7 @@ void keymode_key(keymode *km, int key)
 			km->want_refine = true; /* the render held above goes on */
 		break;
 	case KM_SCENE:
-		wk_hold(&km->wk);
+		rsvc_hold(km->rs);
 		km_shell_command(km, a.n > 0 ? cmd_next : cmd_prev);
 		km_after_replace(km, label_copy);
 		km->want_refine = true;
@@ -1263,8 +624,8 @@ void keymode_key(keymode *km, int key)
 		km_settings(km, &a);
 		break;
 	case KM_STOP:
-		if (wk_busy(&km->wk) || km->want_fast || km->want_refine || !km->refined) {
-			wk_hold(&km->wk);
+		if (rsvc_busy(km->rs) || km->want_fast || km->want_refine || !km->refined) {
+			rsvc_hold(km->rs);
 			km->want_fast = km->want_refine = false;
 			km->refined = true;
 			km->stopped = true;
@@ -1274,7 +635,7 @@ void keymode_key(keymode *km, int key)
 		}
 		break;
 	case KM_REDRAW:
-		km->repaint = true;
+		keyview_repaint(&km->kv);
 		km->dirty = true;
 		break;
 	case KM_HELP:
@@ -1291,35 +652,15 @@ void keymode_key(keymode *km, int key)
 	free(label_copy);
 }
 
-/* Takes the newest image from the thread; true when there is one to show. */
+/* Takes the newest image from the service; true when there is one to show
+ * (images of an older request are dropped). */
 static bool km_take(keymode *km)
 {
-	km_worker *wk = &km->wk;
-	pthread_mutex_lock(&wk->im);
-	/* Images of an older request are dropped. */
-	bool fresh = wk->serial != km->taken && wk->img.seq == km->cur.seq;
-	km->taken = wk->serial;
-	if (fresh) {
-		size_t n = (size_t)wk->img.w * wk->img.h * 3;
-		if (n > km->img.cap) {
-			float *p = realloc(km->img.rgb, n * sizeof *p);
-			if (!p) {
-				pthread_mutex_unlock(&wk->im);
-				return false;
-			}
-			km->img.rgb = p;
-			km->img.cap = n;
-		}
-		float *keep = km->img.rgb;
-		size_t cap = km->img.cap;
-		km->img = wk->img;
-		km->img.rgb = keep;
-		km->img.cap = cap;
-		memcpy(km->img.rgb, wk->img.rgb, n * sizeof *keep);
-	}
-	pthread_mutex_unlock(&wk->im);
-	if (!fresh)
+	if (!rsvc_take(km->rs, &km->spare) || km->spare.seq != km->cur.seq)
 		return false;
+	rsvc_image t = km->img;
+	km->img = km->spare;
+	km->spare = t;
 	km->have_img = true;
 	/* What a pixel costs, for the next fast frame's ratio. */
 	if (km->img.px_cost > 0)
@@ -1337,10 +678,10 @@ int keymode_tick(keymode *km)
 	} else if (km->want_refine || (!km->refined && t - km->last_key >= KEYMODE_IDLE)) {
 		km->want_refine = false;
 		/* A fast frame at full resolution with one sample is final. */
-		const km_req *c = &km->cur;
+		const km_cur *c = &km->cur;
 		bool final = c->seq != 0 && !c->refine && km->ratio_i == 0 && km->sh->set.samples == 1 &&
 		             c->gen == editor_generation(km->sh->ed) && c->set.mode == km->sh->set.mode &&
-		             c->set.depth == km->sh->set.depth && c->w_px == km->img_w && c->h_px == km->img_h;
+		             c->set.depth == km->sh->set.depth && c->w_px == km->kv.img_w && c->h_px == km->kv.img_h;
 		if (final)
 			km->refined = true;
 		else
@@ -1350,7 +691,7 @@ int keymode_tick(keymode *km)
 		km->held = true;
 	/* Fast frames are drawn at once; passes of a refine at most 10 times a
 	 * second (its first and last pass at once). */
-	bool picture = km->held && (!km->img.refine || km->img.done || km->img.spp <= 1 ||
+	bool picture = km->held && (km->img.kind != RSVC_REFINE || km->img.done || km->img.spp <= 1 ||
 	                            t - km->last_draw >= 0.1);
 	if (km->msg[0] && t >= km->msg_until) {
 		km->msg[0] = '\0';
@@ -1360,14 +701,14 @@ int keymode_tick(keymode *km)
 		/* The status line alone may have changed (the fps figure). */
 		char status[1024];
 		km_status_text(km, status, sizeof status);
-		km->dirty = strcmp(status, km->status_shown) != 0;
+		km->dirty = keyview_status_differs(&km->kv, status);
 	}
-	if (picture || km->dirty || km->repaint) {
+	if (picture || km->dirty || km->kv.repaint) {
 		km_draw(km);
 		if (picture) {
 			km->held = false;
 			km->frames++;
-			if (!km->img.refine)
+			if (km->img.kind != RSVC_REFINE)
 				km->fast_times[km->fast_frames++ % 16] = km->last_draw;
 			return 1;
 		}
@@ -1426,14 +767,14 @@ long keymode_frames(const keymode *km)
 
 void keymode_resize(keymode *km, int cols, int rows)
 {
-	km->cols = cols;
-	km->rows = rows;
+	km->kv.cols = cols;
+	km->kv.rows = rows;
 	km_layout(km);
 	km->want_refine = true;
 	km->dirty = true;
 }
 
-keymode *keymode_new(shell *sh, int fd, frame_palette pal, int cols, int rows)
+keymode *keymode_new(shell *sh, termout *out, frame_palette pal, int cols, int rows)
 {
 	keymode *km = calloc(1, sizeof *km);
 	if (!km) {
@@ -1441,14 +782,15 @@ keymode *keymode_new(shell *sh, int fd, frame_palette pal, int cols, int rows)
 		return NULL;
 	}
 	km->sh = sh;
-	km->fd = fd;
-	km->pal = pal;
-	km->cols = cols;
-	km->rows = rows;
+	km->out = out;
+	size_t nbar = keymode_help_bar(km->bar, sizeof km->bar / sizeof km->bar[0]);
+	keyview_init(&km->kv, out, pal, km->bar, nbar);
+	km->kv.cols = cols;
+	km->kv.rows = rows;
 	km->help = true;
-	abuf_init(&km->out);
-	wk_init(&km->wk, sh->wake[1]);
-	preview_hold(sh->pv);
+	abuf_init(&km->late);
+	km->rs = sh->rs;
+	rsvc_hold(km->rs);
 	km->step = keymode_step(editor_scene(sh->ed));
 	km->sel = (km_sel){KM_SEL_CAMERA, 0};
 	km_layout(km);
@@ -1462,12 +804,14 @@ void keymode_free(keymode *km)
 {
 	if (!km)
 		return;
-	wk_hold(&km->wk);
-	wk_free(&km->wk);
+	rsvc_hold(km->rs);
+	world_release(km->w);
 	km_close_run(km);
-	frame_free(km->fr);
-	abuf_free(&km->out);
-	free(km->img.rgb);
+	keyview_end(&km->kv);
+	keyview_free(&km->kv);
+	abuf_free(&km->late);
+	rsvc_image_free(&km->img);
+	rsvc_image_free(&km->spare);
 	free(km->small);
 	free(km->big);
 	free(km->mask);
@@ -1475,7 +819,7 @@ void keymode_free(keymode *km)
 }
 
 /* ------------------------------------------------------------------ */
-/* 3. The terminal                                                     */
+/* 2. The loop                                                         */
 /* ------------------------------------------------------------------ */
 
 static void term_size(int fd, int *cols, int *rows)
@@ -1502,27 +846,52 @@ static void raw_modes(int fd, const struct termios *saved)
 	tcsetattr(fd, TCSANOW, &t);
 }
 
+/* Moves the key bytes in *b to ncurses' pipe (the terminal's input minus
+ * the scheduler's answers). */
+static void feed_keys(int fd, abuf *b)
+{
+	if (b->len && !b->failed) {
+		ssize_t r = write(fd, b->b, b->len);
+		(void)r; /* a full pipe: keys typed faster than 64 KiB ahead are dropped */
+	}
+	abuf_reset(b);
+}
+
 bool keymode_run(shell *sh)
 {
 	screen *scr = sh->scr;
-	if (!sh->interactive || !scr || !scr->active || sh->wake[0] < 0 || sh->wake[1] < 0 ||
-	    !isatty(STDIN_FILENO))
+	evloop *ev = sh->ev;
+	if (!sh->interactive || !scr || !scr->active || !scr->out || !ev || evloop_out(ev) != scr->out ||
+	    !isatty(evloop_in_fd(ev)))
 		return shell_fail(sh, "view: key mode needs the full-screen shell on a terminal");
-	int in = STDIN_FILENO, fd = scr->fd;
+	int in = evloop_in_fd(ev), fd = scr->fd;
+	termout *out = scr->out;
 	fflush(stdout);
 	struct termios saved;
 	if (tcgetattr(in, &saved) != 0)
 		return shell_fail(sh, "view: cannot read the terminal's modes: %s", strerror(errno));
-	/* The answers the terminal owes the shell's output scheduler come in
-	 * before ncurses reads the keys (keys typed meanwhile are dropped). */
-	if (scr->out) {
-		abuf junk;
-		abuf_init(&junk);
-		termout_settle(scr->out, in, 5.0, &junk);
-		abuf_free(&junk);
+	/* The answers the terminal owes the output scheduler come in before
+	 * key mode starts (keys typed meanwhile are dropped). */
+	evloop_settle(ev, 5.0);
+	while (evloop_getc(ev) >= 0)
+		;
+	abuf pend;
+	abuf_init(&pend);
+	/* The shell's event loop reads the terminal: the scheduler takes its
+	 * answers out (they pace the picture), and the keys go on to ncurses
+	 * through a pipe. */
+	int kp[2];
+	if (pipe(kp) != 0) {
+		abuf_free(&pend);
+		return shell_fail(sh, "view: %s", strerror(errno));
 	}
-	keys *k = keys_open(in, 25);
+	for (int i = 0; i < 2; i++)
+		fcntl(kp[i], F_SETFL, fcntl(kp[i], F_GETFL) | O_NONBLOCK);
+	keys *k = keys_open(kp[0], 25);
 	if (!k) {
+		close(kp[0]);
+		close(kp[1]);
+		abuf_free(&pend);
 		return shell_fail(sh, "view: ncurses cannot read the keys of this terminal (TERM=%s)",
 		                  getenv("TERM") ? getenv("TERM") : "");
 	}
@@ -1538,30 +907,13 @@ bool keymode_run(shell *sh)
 	int cols, rows;
 	term_size(fd, &cols, &rows);
 	size_t undo0 = editor_undo_count(sh->ed);
-	keymode *km = keymode_new(sh, fd, scr->pal, cols, rows);
+	keymode *km = keymode_new(sh, out, scr->pal, cols, rows);
 	bool ok = km != NULL;
-	int wake = sh->wake[0];
 	while (km && !keymode_done(km)) {
 		keymode_tick(km);
-		double to = keymode_timeout(km);
-		fd_set rd;
-		FD_ZERO(&rd);
-		FD_SET(in, &rd);
-		FD_SET(wake, &rd);
-		struct timeval tv, *tvp = NULL;
-		if (to >= 0) {
-			tv.tv_sec = (time_t)to;
-			tv.tv_usec = (suseconds_t)((to - (double)tv.tv_sec) * 1e6);
-			tvp = &tv;
-		}
-		int n = select((in > wake ? in : wake) + 1, &rd, NULL, NULL, tvp);
-		if (n < 0 && errno != EINTR)
-			break;
-		if (n > 0 && FD_ISSET(wake, &rd)) {
-			char buf[256];
-			while (read(wake, buf, sizeof buf) > 0)
-				;
-		}
+		/* Keys, wake-ups (a frame, a signal), the scheduler's slices and
+		 * time-outs, or key mode's own timer. */
+		evloop_wait(ev, keymode_timeout(km));
 		if (shell_sig_term)
 			break;
 		if (shell_sig_int) {
@@ -1583,12 +935,18 @@ bool keymode_run(shell *sh)
 			keymode_resize(km, cols, rows);
 		}
 		/* Every key waiting, before the next frame starts. */
-		if (n > 0 && FD_ISSET(in, &rd)) {
-			int c;
-			while (!keymode_done(km) && (c = keys_next(k)) != KEYS_NONE)
-				if (c != KEYS_RESIZE)
-					keymode_key(km, c);
-		}
+		int b;
+		while ((b = evloop_getc(ev)) >= 0)
+			abuf_char(&pend, (char)b);
+		abuf_add(&pend, km->late.b, km->late.len);
+		abuf_reset(&km->late);
+		feed_keys(kp[1], &pend);
+		int c;
+		while (!keymode_done(km) && (c = keys_next(k)) != KEYS_NONE)
+			if (c != KEYS_RESIZE)
+				keymode_key(km, c);
+		if (evloop_eof(ev))
+			break; /* the terminal is gone */
 	}
 	keymode_free(km);
 	size_t steps = editor_undo_count(sh->ed);
@@ -1596,10 +954,13 @@ bool keymode_run(shell *sh)
 	/* Give the terminal and the screen back to the shell. */
 	screen_keypad(fd, NULL, NULL, false);
 	keys_close(k);
+	close(kp[0]);
+	close(kp[1]);
+	abuf_free(&pend);
 	tcsetattr(in, TCSANOW, &saved);
-	write_all(fd, "\x1b[m\x1b[?25h", 9);
 	sh->scr = scr;
 	sh->status_hook = hook;
+	termout_set_picture(out, scr->enc);
 	screen_layout(scr, (double)sh->set.width / sh->set.height, true);
 	rl_set_screen_size(scr->rows - scr->region_top, scr->cols);
 	shell_refresh(sh);

@@ -31,6 +31,8 @@
 #include "rtsh/edit.h"
 #include "rtsh/scene.h"
 #include "shell/shell.h"
+#include "term/keyview.h"
+#include "term/out.h"
 
 /* The fraction of the scene's size one movement key moves by. */
 #define KEYMODE_STEP_FRACTION (1.0 / 40.0)
@@ -46,6 +48,9 @@
  * after the last key before the picture is refined. */
 #define KEYMODE_FRAME_BUDGET 0.025
 #define KEYMODE_IDLE 0.15
+/* Seconds: the length the refine's passes aim at (after a first of one
+ * sample). */
+#define KEYMODE_PASS_SECONDS 0.2
 
 /* What the keys act on: the camera, or an object or a light (0-based). */
 typedef enum km_sel_kind {
@@ -79,6 +84,37 @@ typedef enum km_op {
 	KM_HELP,       /* show or hide the help bar */
 	KM_QUIT,       /* back to the shell */
 } km_op;
+
+/* The key table (keymode_keys.c): each row is the keys of one line of
+ * `help view`, each key with what it does; arg says which way:
+ *   KM_MOVE    +-1 forward / back, +-2 right / left, +-3 up / down
+ *   KM_TURN    +-1 yaw right / left, +-2 pitch up / down
+ *   KM_ROTATE  +-1 about the vertical ([ ]), +-2 roll about the line of sight ({ })
+ *   KM_SCALE, KM_SELECT, KM_SAMPLES, KM_DEPTH, KM_SCENE  +1 / -1
+ * keymode_map, `help view` (keymode_help_text) and the help bar
+ * (keymode_help_bar) are made from it. */
+typedef struct km_key {
+	int key;     /* a character or a KEYS_ code (term/keys.h) */
+	km_op op;    /* KM_NONE ends a row's keys */
+	int arg;
+} km_key;
+
+typedef struct km_keyrow {
+	const char *names;     /* the keys as the help names them */
+	const char *what;      /* what they do ("\n" breaks the line) */
+	const char *bar_keys;  /* in the help bar (NULL: not) ... */
+	const char *bar_what;
+	int bar_rank;          /* ... at this place, from 1 */
+	km_key keys[8];
+} km_keyrow;
+
+extern const km_keyrow keymode_keys[];
+extern const size_t keymode_nkeys;
+
+/* `help view`: the key table as text, one row a line. */
+const char *keymode_help_text(void);
+/* The help bar's items in their order (at most max); returns how many. */
+size_t keymode_help_bar(keyview_item *items, size_t max);
 
 typedef struct km_action {
 	km_op op;
@@ -114,13 +150,15 @@ vec3 keymode_axis_euler(vec3 axis, double deg);
 /* --- the session, without a terminal of its own (bench, tests) --- */
 typedef struct keymode keymode;
 
-/* A key-mode session on sh's scene drawing frames of cols x rows cells to
- * fd in palette pal; the render thread writes a byte to sh->wake[1] when a
- * frame is ready. The shell's preview is held until keymode_free. NULL (the
- * shell's error set) on failure. */
-keymode *keymode_new(shell *sh, int fd, frame_palette pal, int cols, int rows);
-/* Ends the session: stops its thread, closes an open undo group, frees it.
- * The preview stays held (the caller restarts it). */
+/* A key-mode session on sh's scene drawing on a terminal of cols x rows
+ * cells in palette pal, every byte through the output scheduler out
+ * (borrowed; its picture is the session's until keymode_free). Its frames and refines are requests to the shell's
+ * render service (sh->rs), which wakes the wake-up pipe the shell gave it
+ * when a frame is ready; the shell's preview does not run until
+ * keymode_free. NULL (the shell's error set) on failure. */
+keymode *keymode_new(shell *sh, termout *out, frame_palette pal, int cols, int rows);
+/* Ends the session: cancels its render, closes an open undo group, frees
+ * it. The render service stays held (the caller restarts the preview). */
 void keymode_free(keymode *km);
 /* Handles one key (edits go to the editor at once; renders start in
  * keymode_tick). */
@@ -147,8 +185,5 @@ long keymode_frames(const keymode *km);
  * SIGHUP), then gives the shell's screen back as it was. False (error
  * recorded) when there is no full-screen terminal. */
 bool keymode_run(shell *sh);
-
-/* The keys, for `help view` (one per line). */
-extern const char keymode_help[];
 
 #endif

@@ -1,9 +1,9 @@
 /* rtsh — the interactive loop: readline's callback interface on the event
  * loop (term/evloop.h: standard input, the wake-up pipe, the output
  * scheduler), so typing never waits for a render. The render thread
- * (preview.c) writes a byte to the pipe when an image is ready; the signal
- * handlers (signals.c) set a flag and write a byte too; everything else
- * happens here, in the main thread, which alone talks to the terminal.
+ * (render_service.c) writes a byte to the pipe when an image is ready; the
+ * signal handlers (signals.c) set a flag and write a byte too; everything
+ * else happens here, in the main thread, which alone talks to the terminal.
  */
 #include <errno.h>
 #include <locale.h>
@@ -90,7 +90,7 @@ static void draw_picture(shell *sh)
 {
 	sh->redraw = false;
 	screen *scr = sh->scr;
-	const preview_image *im = &sh->img;
+	const rsvc_image *im = &sh->img;
 	if (!scr || !scr->active || im->w != scr->img_w || im->h != scr->img_h || !im->rgb || im->stopped) {
 		/* A stopped render's picture stays as the terminal shows it. */
 		draw_status(sh);
@@ -190,7 +190,7 @@ static void on_line(char *line)
 		tcsetattr(STDIN_FILENO, TCSADRAIN, &modes);
 	shell_sig_int = 0;
 	/* The command may have taken a while: show what came meanwhile. */
-	if (preview_take(sh->pv, &sh->img))
+	if (rsvc_take(sh->rs, &sh->img))
 		sh->redraw = true;
 	draw_status(sh);
 }
@@ -199,8 +199,8 @@ static void on_line(char *line)
 static void interrupt(shell *sh)
 {
 	atomic_store(&sh->cancel, false);
-	if (preview_stop(sh->pv)) {
-		preview_take(sh->pv, &sh->img);
+	if (rsvc_stop(sh->rs)) {
+		rsvc_take(sh->rs, &sh->img);
 		/* The picture stops where the terminal has it: no more of it
 		 * goes out over a slow link. */
 		if (sh->scr && sh->scr->out)
@@ -366,7 +366,7 @@ int shell_interactive(shell *sh, bool use_screen, const int wake[2])
 		}
 		if (sh->scr && sh->scr->out)
 			after_probe(sh);
-		if (preview_take(sh->pv, &sh->img))
+		if (rsvc_take(sh->rs, &sh->img))
 			sh->redraw = true;
 		if (sh->redraw && now() - sh->last_draw >= frame_gap(sh))
 			draw_picture(sh);
@@ -381,7 +381,7 @@ int shell_interactive(shell *sh, bool use_screen, const int wake[2])
 	rl_callback_handler_remove();
 	history_finish(&hist);
 	sh->status_hook = NULL;
-	preview_hold(sh->pv);
+	rsvc_hold(sh->rs);
 	if (sh->scr) {
 		screen_leave(sh->scr);
 		sh->scr = NULL;

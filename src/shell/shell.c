@@ -224,7 +224,7 @@ static double aspect_of(const render_settings *s)
 void shell_refresh(shell *sh)
 {
 	if (!sh->scr || !sh->scr->active) {
-		preview_release(sh->pv);
+		rsvc_release(sh->rs);
 		return;
 	}
 	/* A new pixels setting takes effect here; what the terminal answered
@@ -232,17 +232,23 @@ void shell_refresh(shell *sh)
 	if (sh->set.pixels == sh->scr->pixels || !screen_set_pixels(sh->scr, sh->set.pixels))
 		screen_layout(sh->scr, aspect_of(&sh->set), false);
 	if (sh->scr->img_w <= 0 || sh->scr->img_h <= 0) {
-		preview_release(sh->pv);
+		rsvc_release(sh->rs);
 		return;
 	}
-	preview_request req = {
+	/* A quick pass, then passes of PREVIEW_PASS_SECONDS; path previews are
+	 * denoised unless `set denoise off`. */
+	rsvc_request req = {
 		.s = editor_scene(sh->ed),
 		.gen = editor_generation(sh->ed),
 		.set = sh->set,
 		.w = sh->scr->img_w,
 		.h = sh->scr->img_h,
+		.kind = RSVC_REFINE,
+		.quick = true,
+		.denoise = sh->set.mode == MODE_PATH && sh->set.denoise != DENOISE_OFF,
+		.pass_seconds = PREVIEW_PASS_SECONDS,
 	};
-	preview_start(sh->pv, &req);
+	rsvc_start(sh->rs, &req);
 	sh->redraw = true;
 	if (sh->status_hook)
 		sh->status_hook(sh);
@@ -250,7 +256,7 @@ void shell_refresh(shell *sh)
 
 void shell_edit_begin(shell *sh)
 {
-	preview_hold(sh->pv);
+	rsvc_hold(sh->rs);
 }
 
 void shell_edit_end(shell *sh)
@@ -271,9 +277,9 @@ static void format_seconds(double s, char *buf, size_t size)
 
 void shell_status_text(shell *sh, char *buf, size_t size)
 {
-	const preview_image *im = &sh->img;
+	const rsvc_image *im = &sh->img;
 	char samples[RT_ERROR_MSG_MAX + 16], t[32] = "";
-	bool busy = preview_busy(sh->pv);
+	bool busy = rsvc_busy(sh->rs);
 	if (im->error[0]) {
 		snprintf(samples, sizeof samples, "error: %s", im->error);
 	} else if (im->w == 0) {
@@ -345,10 +351,10 @@ const framebuffer *shell_full_image(shell *sh, bool force)
 	uint64_t gen = editor_generation(sh->ed);
 	if (!force && sh->full && sh->full_gen == gen && same_image_settings(&sh->full_set, &sh->set))
 		return sh->full;
-	preview_hold(sh->pv);
+	rsvc_hold(sh->rs);
 	rt_error err;
 	rt_error_clear(&err);
-	const world *w = preview_world(sh->pv, editor_scene(sh->ed), gen, &err);
+	const world *w = rsvc_world(sh->rs, editor_scene(sh->ed), gen, &err);
 	if (!w) {
 		shell_refresh(sh);
 		shell_fail(sh, "render: %s", err.msg);
@@ -357,6 +363,7 @@ const framebuffer *shell_full_image(shell *sh, bool force)
 	atomic_store(&sh->cancel, false);
 	progress_ctx p = {sh, now(), false, false, sh->set.width, sh->set.height};
 	framebuffer *fb = render_image(w, &sh->set, &sh->cancel, sh->progress ? on_progress : NULL, &p, &err);
+	world_release(w);
 	double seconds = now() - p.t0;
 	if (p.shown)
 		fputc('\n', stderr);
@@ -390,10 +397,10 @@ frame *shell_picture_frame(shell *sh, frame_palette pal, int cols)
 		h = sh->img.h;
 	} else {
 		screen_fit(cols, 1000, aspect_of(&sh->set), pal == PALETTE_NONE, &w, &h);
-		preview_hold(sh->pv);
+		rsvc_hold(sh->rs);
 		rt_error err;
 		rt_error_clear(&err);
-		const world *wd = preview_world(sh->pv, editor_scene(sh->ed), editor_generation(sh->ed), &err);
+		const world *wd = rsvc_world(sh->rs, editor_scene(sh->ed), editor_generation(sh->ed), &err);
 		render_settings s = sh->set;
 		s.width = w;
 		s.height = h;
@@ -401,6 +408,7 @@ frame *shell_picture_frame(shell *sh, frame_palette pal, int cols)
 			atomic_store(&sh->cancel, false);
 			fb = render_image(wd, &s, &sh->cancel, NULL, NULL, &err);
 		}
+		world_release(wd);
 		shell_refresh(sh);
 		if (!fb) {
 			shell_fail(sh, "%s", err.msg);
@@ -488,8 +496,8 @@ bool shell_init(shell *sh, const rtsh_options *o, int wake_fd)
 		return false;
 	}
 	sh->ed = editor_new(s, o->scene);
-	sh->pv = preview_new(wake_fd);
-	if (!sh->ed || !sh->pv) {
+	sh->rs = rsvc_new(wake_fd);
+	if (!sh->ed || !sh->rs) {
 		if (!sh->ed)
 			scene_free(s);
 		fprintf(stderr, "rtsh: out of memory\n");
@@ -504,10 +512,10 @@ bool shell_init(shell *sh, const rtsh_options *o, int wake_fd)
 
 void shell_free(shell *sh)
 {
-	preview_free(sh->pv);
+	rsvc_free(sh->rs);
 	editor_free(sh->ed);
 	fb_free(sh->full);
-	preview_image_free(&sh->img);
+	rsvc_image_free(&sh->img);
 	free(sh->srgb);
 	free(sh->label);
 	free(sh->dir);

@@ -22,7 +22,7 @@
 #include "rtsh/render.h"
 #include "rtsh/rtfile.h"
 #include "shell/options.h"
-#include "shell/preview.h"
+#include "shell/render_service.h"
 #include "shell/signals.h"
 #include "term/frame.h"
 #include "term/abuf.h"
@@ -59,8 +59,8 @@ typedef struct shell {
 	screen *scr;           /* NULL: no picture */
 	abuf *capture;         /* when set, shell_out/shell_info append here (the pager) */
 	abuf *notes;           /* when set, shell_note and load warnings append here (key mode) */
-	preview *pv;           /* the world cache, and the background preview */
-	preview_image img;     /* the newest preview image shown */
+	rsvc *rs;              /* the render service: the preview, key mode, the world cache */
+	rsvc_image img;        /* the newest preview image shown */
 	uint8_t *srgb;         /* img as sRGB bytes */
 	size_t srgb_cap;
 	double last_draw;      /* when the picture was last sent */

@@ -30,6 +30,7 @@ static encoder *hb_open(const encoder_geom *g)
 	}
 	e->fr->x0 = g->x0;
 	e->fr->y0 = g->y0;
+	e->fr->cursor_off = g->cursor_off;
 	return &e->base;
 }
 

@@ -26,6 +26,7 @@ typedef struct encoder_geom {
 	int cols, rows;      /* the picture area in cells */
 	int x0, y0;          /* its top-left cell on the screen, 0-based */
 	int cell_w, cell_h;  /* a cell in pixels, 0 when not known */
+	bool cursor_off;     /* the cursor stays hidden after each part (key mode) */
 	frame_palette pal;   /* the colours the terminal takes */
 } encoder_geom;
 

@@ -498,7 +498,7 @@ static bool update_row(frame *f, update_state *u, int y)
 static void update_end(const frame *f, update_state *u)
 {
 	if (u->out->len > u->start) {
-		abuf_str(u->out, "\x1b[m\x1b" "8\x1b[?25h");
+		abuf_str(u->out, f->cursor_off ? "\x1b[m\x1b" "8" : "\x1b[m\x1b" "8\x1b[?25h");
 		if (f->sync)
 			abuf_str(u->out, "\x1b[?2026l");
 	}

@@ -48,6 +48,7 @@ typedef struct frame {
 	int x0, y0;        /* the top-left cell on the screen, 0-based */
 	frame_palette pal;
 	bool sync;         /* bracket each update with DEC mode 2026 */
+	bool cursor_off;   /* leave the cursor hidden after an update (key mode) */
 	frame_cell *cur;   /* what the next update shows: cols x rows */
 	frame_cell *shown; /* what the terminal shows */
 	bool have_shown;   /* false: the next update sends every cell */

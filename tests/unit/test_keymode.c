@@ -7,6 +7,7 @@
 #include "testutil.h"
 
 #include <fcntl.h>
+#include <stdio.h>
 #include <poll.h>
 #include <time.h>
 #include <unistd.h>
@@ -316,6 +317,7 @@ typedef struct session {
 	int wake[2], out; /* frames go to a file (a pipe would fill up) */
 	rtsh_options opt;
 	shell sh;
+	termout *o; /* unpaced: whole updates at once */
 	keymode *km;
 	char *text; /* everything drawn */
 	size_t len, cap;
@@ -382,13 +384,16 @@ static void session_open(session *ss)
 	ss->sh.wake[0] = ss->wake[0];
 	ss->sh.wake[1] = ss->wake[1];
 	ss->sh.set.threads = 2;
-	ss->km = keymode_new(&ss->sh, ss->out, PALETTE_TRUECOLOR, 160, 48);
+	ss->o = termout_new(ss->out);
+	assert_non_null(ss->o);
+	ss->km = keymode_new(&ss->sh, ss->o, PALETTE_TRUECOLOR, 160, 48);
 	assert_non_null(ss->km);
 }
 
 static void session_close(session *ss)
 {
 	keymode_free(ss->km);
+	termout_free(ss->o);
 	shell_free(&ss->sh);
 	for (int i = 0; i < 2; i++)
 		close(ss->wake[i]);
@@ -457,6 +462,151 @@ static void test_session(void **state)
 	session_close(&ss);
 }
 
+/* The words of a list of key names ("Up Down, w s"): commas after a name
+ * go, a lone comma is a key. */
+static int key_words(const char *names, char words[][32], int max)
+{
+	int n = 0;
+	char buf[256];
+	snprintf(buf, sizeof buf, "%s", names);
+	for (char *save = NULL, *t = strtok_r(buf, " ", &save); t && n < max; t = strtok_r(NULL, " ", &save)) {
+		size_t len = strlen(t);
+		if (len > 1 && t[len - 1] == ',')
+			t[--len] = '\0';
+		snprintf(words[n++], 32, "%s", t);
+	}
+	return n;
+}
+
+/* The key table: no key in two places; every row is a line of `help
+ * view` (its names, then its text at column 31) and the help bar's items
+ * are the table's, Esc first; and the i-th entry of rtsh(1)'s KEY MODE
+ * Keys list names every key the i-th row names (the man page is read from
+ * the source tree; skipped when it is not there). */
+static void test_key_table(void **state)
+{
+	(void)state;
+	scene *s = load(scene_text);
+	int codes[256], seen = 0;
+	for (size_t i = 0; i < keymode_nkeys; i++)
+		for (const km_key *k = keymode_keys[i].keys; k->op != KM_NONE; k++) {
+			for (int j = 0; j < seen; j++)
+				if (codes[j] == k->key)
+					fail_msg("key %d is in the table twice", k->key);
+			assert_true(seen < 256);
+			codes[seen++] = k->key;
+			assert_int_equal(keymode_map(k->key, s, camera_sel, 0.5).op, k->op);
+		}
+	assert_true(seen >= 40);
+	const char *help = keymode_help_text();
+	for (size_t i = 0; i < keymode_nkeys; i++) {
+		char line[512], first[256];
+		snprintf(first, sizeof first, "%.*s", (int)strcspn(keymode_keys[i].what, "\n"), keymode_keys[i].what);
+		snprintf(line, sizeof line, "\n  %-29s%s\n", keymode_keys[i].names, first);
+		if (!strstr(help, line))
+			fail_msg("help view lacks \"%s\"", line + 1);
+	}
+	keyview_item bar[32];
+	size_t nbar = keymode_help_bar(bar, 32);
+	assert_int_equal(nbar, 14);
+	assert_string_equal(bar[0].keys, "Esc");
+	assert_string_equal(bar[0].what, "back");
+	assert_string_equal(bar[nbar - 1].what, "hide this");
+	scene_free(s);
+
+	FILE *f = fopen("man/rtsh.1", "r");
+	if (!f) {
+		printf("man/rtsh.1 not found (run from the source tree): the man page check is skipped\n");
+		return;
+	}
+	char ln[512];
+	bool in_keys = false, after_tp = false;
+	size_t row = 0;
+	while (fgets(ln, sizeof ln, f)) {
+		if (strncmp(ln, ".SS Keys", 8) == 0) {
+			in_keys = true;
+			continue;
+		}
+		if (!in_keys)
+			continue;
+		if (strncmp(ln, ".SS", 3) == 0 || strncmp(ln, ".SH", 3) == 0)
+			break;
+		if (strncmp(ln, ".TP", 3) == 0) {
+			after_tp = true;
+			continue;
+		}
+		if (!after_tp)
+			continue;
+		after_tp = false;
+		/* The key names: \- is -, quotes go. */
+		char man[512];
+		size_t m = 0;
+		for (const char *p = ln; *p && m + 1 < sizeof man; p++) {
+			if (p[0] == '\\' && p[1] == '-')
+				continue;
+			if (*p != '"')
+				man[m++] = *p == '\n' ? ' ' : *p;
+		}
+		man[m] = '\0';
+		assert_true(row < keymode_nkeys);
+		char words[16][32];
+		int nw = key_words(keymode_keys[row].names, words, 16);
+		for (int w = 0; w < nw; w++) {
+			char pad[600];
+			snprintf(pad, sizeof pad, " %s ", words[w]);
+			if (!strstr(man, pad))
+				fail_msg("rtsh(1) KEY MODE entry %zu (%s) does not name %s", row + 1, man, words[w]);
+		}
+		row++;
+	}
+	fclose(f);
+	assert_int_equal(row, keymode_nkeys);
+}
+
+/* Issue 9: after an undo the shell releases the render service, and
+ * something else may queue a request then (here, one for another scene):
+ * the service's kept world is replaced. Key mode holds its own reference,
+ * so its selection marks and its renders never use a freed world (ASan
+ * would report a use after free), and the picture goes on. */
+static void test_undo_then_another_request(void **state)
+{
+	(void)state;
+	session ss;
+	session_open(&ss);
+	assert_true(run_for(&ss, 0.3) >= 1);
+	keymode_key(ss.km, KEYS_UP);
+	run_for(&ss, 0.2);
+	keymode_key(ss.km, 'u');
+	run_for(&ss, 0.3); /* key mode takes the world of the undone scene */
+	scene *other = load("C 0,0,-5 0,0,1 70\nL 0,5,-5 0.7\nsp 0,0,0 2 255,255,0\n");
+	rsvc_request rq = {
+		.s = other,
+		.gen = (uint64_t)1 << 40,
+		.set = ss.sh.set,
+		.w = 32,
+		.h = 18,
+		.kind = RSVC_REFINE,
+	};
+	rq.set.samples = 1;
+	rsvc_start(ss.sh.rs, &rq);
+	for (int i = 0; i < 500 && rsvc_busy(ss.sh.rs); i++)
+		usleep(10000);
+	assert_false(rsvc_busy(ss.sh.rs));
+	rsvc_hold(ss.sh.rs);
+	scene_free(other);
+	/* The marks of a selected object trace key mode's world; Right moves
+	 * it and renders from that world too. */
+	size_t before = ss.len;
+	keymode_key(ss.km, '\t');
+	run_for(&ss, 0.3);
+	assert_true(strstr(ss.text + before, "8;2;255;205;0m") != NULL); /* the gold outline */
+	keymode_key(ss.km, KEYS_RIGHT);
+	assert_true(run_for(&ss, 0.3) >= 1);
+	assert_non_null(strstr(ss.text + before, "object 1 sphere"));
+	assert_vec_near(editor_scene(ss.sh.ed)->objs[0].pos, v3(0.5, 0, 0), 1e-12);
+	session_close(&ss);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -464,6 +614,8 @@ int main(void)
 		cmocka_unit_test(test_movement_keys), cmocka_unit_test(test_other_keys),
 		cmocka_unit_test(test_axis_euler),    cmocka_unit_test(test_apply),
 		cmocka_unit_test(test_turns),         cmocka_unit_test(test_session),
+		cmocka_unit_test(test_key_table),
+		cmocka_unit_test(test_undo_then_another_request),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
