@@ -328,7 +328,8 @@ void surf_inst_finish(const world *w, const prim *p, const ray *r, vec3 nl, hit 
 	mesh_surf s;
 	mesh_surface(m, (uint32_t)nl.x, b, &s);
 	vec3 ng = v3_norm(mat3x4_normal(in->inv, s.ng));
-	vec3 ns = v3_norm(mat3x4_normal(in->inv, s.ns));
+	/* flat faces: the shading normal is the geometric one */
+	vec3 ns = m->n ? v3_norm(mat3x4_normal(in->inv, s.ns)) : ng;
 	mat3x4_point(in->inv, h->p, &h->local);
 	h->front = v3_dot(ng, r->d) < 0.0;
 	h->n = ns;
