@@ -6,11 +6,14 @@
  *     written, the link stays a link;
  *   - an ordinary file is replaced atomically: the content goes to a
  *     temporary file ".NAME.tmp.PID.XXXXXX" in the same folder, is flushed
- *     and synced, takes the old file's mode (and owner and group where
- *     permitted), then is renamed over the old file; an interrupted save
- *     leaves the old file whole;
+ *     and synced, takes the old file's mode, its extended attributes and
+ *     its ACL (system.posix_acl_access is one of them), and its owner and
+ *     group where permitted, then is renamed over the old file; an
+ *     interrupted save leaves the old file whole. A new file gets the mode
+ *     and ACL any new file in its folder gets (umask, default ACL);
  *   - a file with several hard links, a file owned by another user (whose
- *     owner could not be kept), a FIFO or a device is written in place, so
+ *     owner could not be kept), a file with an extended attribute that
+ *     cannot be copied, a FIFO or a device is written in place, so
  *     the links, the owner and the node stay; a folder whose entries cannot
  *     be changed (read-only folder, writable file) is written in place too.
  *     In place, the whole content is made in memory first, so a failing

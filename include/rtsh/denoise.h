@@ -2,16 +2,18 @@
  *
  * A path-mode render job whose framebuffer has feature buffers
  * (denoise_prepare) also records, for every pixel, the mean over its first
- * DENOISE_FEATURE_SAMPLES samples of what the camera ray first sees: the
- * surface's albedo, its normal and its distance. Through perfect mirrors and
- * glass the features are those of the surface seen in them, so reflections
- * keep their own edges. The features are nearly free of noise, so they tell
- * the filter where the picture's edges are.
+ * DENOISE_FEATURE_SAMPLES samples' own camera rays of what they first see:
+ * the surface's albedo, its normal and its distance. Through perfect
+ * mirrors and glass the features are those of the surface seen in them, so
+ * reflections keep their own edges. Where those first rays disagree (an
+ * edge runs through the pixel) DENOISE_EDGE_SAMPLES camera positions are
+ * taken (first hits only), so that the features of an edge pixel are as
+ * well antialiased as that many samples would make its colour.
  *
  * denoise_image filters the noisy radiance with the edge-avoiding a-trous
  * wavelet transform (Dammertz, Sewtz, Hanika & Lensch, "Edge-avoiding
  * A-Trous wavelet transform for fast global illumination filtering", HPG
- * 2010): five passes of a 5x5 B3-spline kernel whose taps lie 1, 2, 4, 8
+ * 2010): five passes of a 3x3 B-spline kernel whose taps lie 1, 2, 4, 8
  * and 16 pixels apart, each tap weighted down by how much its normal,
  * albedo, depth and brightness differ from the centre's. As in SVGF (Schied
  * et al., "Spatiotemporal variance-guided filtering", HPG 2017) the
@@ -19,7 +21,13 @@
  * the lighting), depth is compared along its own gradient (slanted planes
  * are one surface), and brightness differences are measured against a
  * per-pixel estimate of the noise that each pass carries along, so that
- * converged pixels are left alone and shadow edges stay.
+ * converged pixels are left alone and shadow edges stay. From the second
+ * pass on, each pass fits a plane to its weighted taps (first-order
+ * regression) rather than taking their mean, so that where an edge cuts
+ * the taps off on one side a gradient of the lighting is not flattened.
+ * Last, a pixel that is part one surface, part another is regressed on the
+ * features of its 3x3 window: it gets the mix of its neighbours' filtered
+ * colours that its features say.
  *
  * The result depends only on the image and its features, never on the
  * number of threads.

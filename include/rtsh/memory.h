@@ -25,13 +25,22 @@
  * RGB floats, its running sums (doubles) and the 8-bit copy written out. */
 #define MEM_PER_PIXEL 40.0
 
+/* Memory already held that a new request comes on top of: the scenes the
+ * editors keep (each editor's current scene and the whole scenes its undo
+ * and redo history holds after `load` and `generate`, edit.c), as bytes and
+ * a count of scenes. mem_hold adds (or with negative deltas removes). */
+void mem_hold(double bytes, long scenes);
+double mem_held(long *scenes);
+
 /* The most bytes this process may use, and what sets that figure ("physical
  * memory", "RLIMIT_AS", "RLIMIT_DATA" or "the set limit"). */
 double mem_limit(const char **why);
 /* Caps the limit at `bytes` (0: no cap beyond the machine's). */
 void mem_set_limit(size_t bytes);
-/* True when `bytes` fits in the limit; else sets err to
- * "WHAT needs about X of memory; expected at most Y (WHY)" and returns false. */
+/* True when `bytes`, on top of what is held (mem_held), fits in the limit;
+ * else sets err to "WHAT needs about X of memory; expected at most Y (WHY)"
+ * (naming what is held when the request alone would fit) and returns
+ * false. */
 bool mem_check(double bytes, const char *what, rt_error *err);
 
 #endif

@@ -149,6 +149,9 @@ typedef struct scene {
 
 scene *scene_new(void);
 void scene_free(scene *s);
+/* The bytes the scene's model takes: the struct and its three arrays at
+ * their capacity (mesh and texture files are the world's, not counted). */
+size_t scene_bytes(const scene *s);
 /* A deep copy; NULL when out of memory. */
 scene *scene_clone(const scene *s);
 /* True when a and b describe the identical scene, value for value. */

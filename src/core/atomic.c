@@ -5,13 +5,14 @@
  *   2. look at what is there: nothing (create), an ordinary file with one
  *      link (replace atomically), or something whose identity must stay
  *      (hard links, another owner, a FIFO, a device: write in place);
- *   3. replace: remove stale temporary files of our naming, create one with
- *      mkstemp, register it for the signal handlers, fill it, flush, sync,
- *      give it the old mode and owner, rename it over the target, sync the
- *      folder;
+ *   3. replace: remove stale temporary files of our naming, create one
+ *      (O_EXCL), register it for the signal handlers, fill it, flush, sync,
+ *      give it the old owner, mode and extended attributes (the ACL among
+ *      them), rename it over the target, sync the folder;
  *   4. in place: make the whole content in memory, then write it over the
  *      file from its start and cut the file to its new length.
  */
+#define _GNU_SOURCE /* fallocate */
 #include "rtsh/atomic.h"
 
 #include <dirent.h>
@@ -24,6 +25,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/xattr.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -89,16 +91,45 @@ static void guard_on(guard *g)
 	}
 }
 
+/* Creates the temporary file: the template's last six characters ("XXXXXX")
+ * are replaced until the name is new (O_EXCL). `mode` goes through the
+ * umask and the folder's default ACL like any new file's. */
+static int create_exclusive(char *tmp, mode_t mode)
+{
+	static const char digits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789";
+	static _Atomic unsigned long counter;
+	char *x = tmp + strlen(tmp) - 6;
+	struct timespec now;
+	clock_gettime(CLOCK_REALTIME, &now);
+	unsigned long long v = (unsigned long long)now.tv_nsec ^ ((unsigned long long)now.tv_sec << 20) ^
+	                       ((unsigned long long)getpid() << 40);
+	for (int attempt = 0; attempt < 1000; attempt++) {
+		/* splitmix64 of the clock, the pid and a counter: a different
+		 * name for every attempt, thread and process. */
+		unsigned long long z = v + (unsigned long long)(++counter) * 0x9e3779b97f4a7c15ULL;
+		z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+		z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+		z ^= z >> 31;
+		for (int i = 0; i < 6; i++, z /= 62)
+			x[i] = digits[z % 62];
+		int fd = open(tmp, O_RDWR | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, mode);
+		if (fd >= 0 || errno != EEXIST)
+			return fd;
+	}
+	errno = EEXIST;
+	return -1;
+}
+
 /* Creates the temporary file from the template and registers it, with the
  * fatal signals blocked in between, so none can come before it is known. */
-static int create_registered(char *tmp)
+static int create_registered(char *tmp, mode_t mode)
 {
 	sigset_t block, old;
 	sigemptyset(&block);
 	for (size_t i = 0; i < NFATAL; i++)
 		sigaddset(&block, fatal_signals[i]);
 	pthread_sigmask(SIG_BLOCK, &block, &old);
-	int fd = mkstemp(tmp);
+	int fd = create_exclusive(tmp, mode);
 	int e = errno;
 	if (fd >= 0) {
 		size_t n = strlen(tmp);
@@ -294,15 +325,42 @@ static bool write_in_place(const char *path, const char *target, const struct st
 	}
 	if (fifo)
 		fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+	/* A reader that leaves the FIFO before the end: the write fails with
+	 * EPIPE instead of a SIGPIPE ending rtsh (the shell with it). */
+	sigset_t pipe_set, old_mask, pending;
+	sigemptyset(&pipe_set);
+	sigaddset(&pipe_set, SIGPIPE);
+	bool was_pending = sigpending(&pending) == 0 && sigismember(&pending, SIGPIPE);
+	pthread_sigmask(SIG_BLOCK, &pipe_set, &old_mask);
 	bool regular = S_ISREG(st->st_mode);
+	/* The blocks first (beyond the end, the size unchanged): a full disk is
+	 * found before the file's first byte is overwritten. File systems
+	 * without fallocate are written as they are. */
+	if (regular && len > (size_t)st->st_size && fallocate(fd, FALLOC_FL_KEEP_SIZE, 0, (off_t)len) != 0 &&
+	    (errno == ENOSPC || errno == EDQUOT || errno == EFBIG)) {
+		int e = errno;
+		pthread_sigmask(SIG_SETMASK, &old_mask, NULL);
+		close(fd);
+		free(buf);
+		return rt_error_at(err, path, 0, 0, "write failed (%s); the file was left as it was", strerror(e));
+	}
 	bool ok = write_all(fd, buf, len) && (!regular || ftruncate(fd, (off_t)len) == 0) &&
 	          (!regular || fsync(fd) == 0);
 	int e = errno;
+	if (!ok && e == EPIPE && !was_pending) {
+		struct timespec zero = {0, 0};
+		while (sigtimedwait(&pipe_set, NULL, &zero) < 0 && errno == EINTR) {
+		}
+	}
+	pthread_sigmask(SIG_SETMASK, &old_mask, NULL);
 	if (close(fd) != 0 && ok) {
 		ok = false;
 		e = errno;
 	}
 	free(buf);
+	if (!ok && e == EPIPE)
+		return rt_error_at(err, path, 0, 0, "write failed (%s): the program reading it stopped before the end",
+		                   strerror(e));
 	if (!ok)
 		return rt_error_at(err, path, 0, 0, "write failed (%s)", strerror(e));
 	return true;
@@ -318,7 +376,115 @@ static void sync_folder(const char *dir)
 	}
 }
 
-typedef enum replace_result { REPLACED, FAILED, CANNOT_CREATE, CANNOT_KEEP_OWNER } replace_result;
+/* --- extended attributes --- */
+
+/* The names of a file's extended attributes, NUL-separated, in a malloc'ed
+ * buffer (NULL with *n = 0 when it has none or the file system has none);
+ * false on another error. From the path (fd < 0) or the descriptor. */
+static bool xattr_names(const char *path, int fd, char **names, ssize_t *n)
+{
+	*names = NULL;
+	*n = 0;
+	for (int attempt = 0; attempt < 8; attempt++) {
+		ssize_t size = fd < 0 ? llistxattr(path, NULL, 0) : flistxattr(fd, NULL, 0);
+		if (size < 0)
+			return errno == ENOTSUP || errno == ENOSYS;
+		if (size == 0)
+			return true;
+		char *buf = malloc((size_t)size);
+		if (!buf)
+			return false;
+		ssize_t got = fd < 0 ? llistxattr(path, buf, (size_t)size) : flistxattr(fd, buf, (size_t)size);
+		if (got >= 0) {
+			*names = buf;
+			*n = got;
+			return true;
+		}
+		free(buf);
+		if (errno != ERANGE) /* ERANGE: the list grew in between; again */
+			return false;
+	}
+	return false;
+}
+
+static bool name_in(const char *name, const char *names, ssize_t n)
+{
+	for (const char *p = names; p < names + n; p += strlen(p) + 1)
+		if (strcmp(p, name) == 0)
+			return true;
+	return false;
+}
+
+/* The SELinux label is the system's to give (the new file already has the
+ * label its folder's policy gives): not setting it is no loss. */
+static bool system_label(const char *name)
+{
+	return strcmp(name, "security.selinux") == 0;
+}
+
+/* Gives the open temporary file fd the extended attributes of the file
+ * `from` — the access ACL (system.posix_acl_access), user.*, and those
+ * this process may set — and removes those fd has that `from` lacks (an
+ * ACL inherited from the folder's default ACL). Call after fchown and
+ * fchmod: an ACL sets the group bits of the mode, and chown drops
+ * security.capability. False, with the attribute's name in `failed` and
+ * errno set, when one cannot be copied. */
+static bool copy_xattrs(const char *from, int fd, char *failed, size_t fsize)
+{
+	char *names, *have;
+	ssize_t n, nhave;
+	if (!xattr_names(from, -1, &names, &n)) {
+		snprintf(failed, fsize, "(the list)");
+		return false;
+	}
+	bool ok = true;
+	char *value = NULL;
+	for (const char *p = names; ok && p < names + n; p += strlen(p) + 1) {
+		ssize_t size = lgetxattr(from, p, NULL, 0);
+		char *v = size > 0 ? realloc(value, (size_t)size) : value;
+		if (size > 0 && !v) {
+			errno = ENOMEM;
+			size = -1;
+		} else if (size > 0) {
+			value = v;
+			size = lgetxattr(from, p, value, (size_t)size);
+		}
+		if (size == -1 && errno == ENODATA) /* removed in between */
+			continue;
+		if ((size < 0 || fsetxattr(fd, p, value, (size_t)size, 0) != 0) && !system_label(p)) {
+			snprintf(failed, fsize, "%s", p);
+			ok = false;
+		}
+	}
+	free(value);
+	if (ok && !xattr_names(NULL, fd, &have, &nhave)) {
+		snprintf(failed, fsize, "(the list)");
+		ok = false;
+	} else if (ok) {
+		for (const char *p = have; ok && p < have + nhave; p += strlen(p) + 1)
+			if (!name_in(p, names, n) && !system_label(p) && fremovexattr(fd, p) != 0 && errno != ENODATA) {
+				snprintf(failed, fsize, "%s", p);
+				ok = false;
+			}
+		free(have);
+	}
+	int e = errno;
+	free(names);
+	errno = e;
+	return ok;
+}
+
+typedef enum replace_result {
+	REPLACED,
+	FAILED,
+	CANNOT_CREATE,
+	CANNOT_KEEP_OWNER,
+	CANNOT_KEEP_XATTR, /* xattr_failed names it */
+} replace_result;
+
+static _Thread_local char xattr_failed[256];
+static _Thread_local int xattr_errno;
+static _Thread_local int create_errno; /* why the temporary file could not be made */
 
 /* Writes a temporary file beside target and renames it over target. `old`
  * is the file being replaced (NULL: a new file). */
@@ -337,12 +503,16 @@ static replace_result replace(const char *path, const char *target, const struct
 	}
 	guard g;
 	guard_on(&g);
-	int fd = create_registered(tmp);
+	/* A new file is created as any other (0666 through the umask and the
+	 * folder's default ACL); a replacement starts private and takes the old
+	 * file's owner, mode and attributes below. */
+	int fd = create_registered(tmp, old ? 0600 : 0666);
 	if (fd < 0) {
 		int e = errno;
 		guard_off(&g);
 		rt_error_at(err, path, 0, 0, "cannot create a file in that folder (%s); expected a writable folder",
 		            strerror(e));
+		create_errno = e;
 		return e == EACCES || e == EPERM || e == EROFS ? CANNOT_CREATE : FAILED;
 	}
 	replace_result res = FAILED;
@@ -358,11 +528,14 @@ static replace_result replace(const char *path, const char *target, const struct
 		if (old->st_uid == geteuid() && old->st_gid != getegid())
 			(void)!fchown(fd, (uid_t)-1, old->st_gid);
 		fchmod(fd, old->st_mode & 07777);
-	} else {
-		/* mkstemp makes the file 0600; a new file gets the usual mode. */
-		mode_t mask = umask(0);
-		umask(mask);
-		fchmod(fd, 0666 & ~mask);
+		/* Its extended attributes and ACL; one that cannot be copied
+		 * (a file system or a security module refusing it) is kept by
+		 * writing in place instead. */
+		if (!copy_xattrs(target, fd, xattr_failed, sizeof xattr_failed)) {
+			xattr_errno = errno;
+			res = CANNOT_KEEP_XATTR;
+			goto fail_fd;
+		}
 	}
 	FILE *f = fdopen(fd, "wb");
 	if (!f) {
@@ -455,9 +628,22 @@ bool file_write_atomic(const char *path, file_writer_fn write, void *ctx, rt_err
 			snprintf(note, sizeof note, "%s belongs to another user: written in place to keep its owner",
 			         path);
 		break;
+	case CANNOT_KEEP_XATTR:
+		ok = write_in_place(path, target, &st, write, ctx, err);
+		if (ok)
+			snprintf(note, sizeof note,
+			         "%s: its extended attribute %s cannot be copied (%s): written in place to keep it",
+			         path, xattr_failed, strerror(xattr_errno));
+		break;
 	case CANNOT_CREATE:
 		/* The folder is read-only; the file may still be writable. */
-		if (access(target, W_OK) == 0) {
+		if (access(target, W_OK) != 0) {
+			int e = errno;
+			rt_error_at(err, path, 0, 0,
+			            "cannot create a file in that folder (%s) nor write the file in place (%s); expected a "
+			            "writable folder or file",
+			            strerror(create_errno), strerror(e));
+		} else {
 			ok = write_in_place(path, target, &st, write, ctx, err);
 			if (ok)
 				snprintf(note, sizeof note,

@@ -143,8 +143,9 @@ void denoise_features(const world *w, const render_settings *s, int px, int py, 
 
 /* --- the filter ------------------------------------------------------------ */
 
-/* The constants were tuned on scenes/cornell.rt at 160x90, 8 samples,
- * against a 4096-sample reference (tests/unit/test_denoise.c). */
+/* The constants were tuned at 160x90, 8 samples, against 4096-sample
+ * references of scenes/cornell.rt (tests/unit/test_denoise.c),
+ * sky-spheres.rt, final.rt and metal-fuzz.rt, three seeds each. */
 #define LEVELS 5
 /* Edge-stopping strengths: brightness in standard deviations of its noise
  * (SVGF's sigma_l) on the first pass, narrowed on each later pass (Dammertz
@@ -160,12 +161,19 @@ void denoise_features(const world *w, const render_settings *s, int px, int py, 
  * more than this many of their standard deviations is brought down to it. */
 #define FIREFLY_K 4.0f
 
+/* What every tap reads (32 bytes: two to a cache line)... */
 typedef struct guide {
 	float f[6];   /* albedo / sqrt(SIGMA_A2), normal / sqrt(SIGMA_N2) */
 	float z;      /* depth */
-	float gx, gy; /* its gradient per pixel */
-	float am[3];  /* the albedo the radiance was divided by */
+	float unused;
 } guide;
+
+/* ...and what only the pixel itself does. */
+typedef struct pixel_info {
+	float gx, gy; /* the depth's gradient per pixel */
+	float am[3];  /* the albedo the radiance was divided by */
+	bool mixed;   /* its features vary inside the pixel (features_vary) */
+} pixel_info;
 
 /* Radiance over albedo, and its estimated noise variance. */
 typedef struct texel {
@@ -176,6 +184,7 @@ typedef struct texel {
 typedef struct job {
 	const framebuffer *fb;
 	guide *g;
+	pixel_info *px;
 	texel *buf[2];
 	float *out;
 	int threads;            /* workers sharing the rows, this thread included */
@@ -190,22 +199,16 @@ static inline float lum(const float *c)
 	return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
 }
 
-/* exp(-x) for x >= 0, to about 2e-4 relative: 2^(-x log2 e), the integer
- * part in the exponent bits, the fraction by a cubic (no library call in the
- * inner loop). */
-static inline float exp_neg(float x)
+/* exp(-x) for x >= 0 as (1 - x/16)^16 (its limit definition), 0 from
+ * x = 16 on: within 0.03 of it everywhere, four multiplications. */
+static inline float exp_fast(float x)
 {
-	if (!(x < 80.0f))
-		return 0.0f;
-	float t = x * 1.4426950409f;
-	int i = (int)t;
-	float fr = t - (float)i; /* 2^-fr on [0,1) */
-	float p = 1.0f + fr * (-0.6930089f + fr * (0.2368309f + fr * -0.0438220f));
-	union {
-		float f;
-		unsigned u;
-	} s = {.u = (unsigned)(127 - i) << 23};
-	return p * s.f;
+	float t = 1.0f - x * (1.0f / 16);
+	t = t > 0.0f ? t : 0.0f;
+	t *= t;
+	t *= t;
+	t *= t;
+	return t * t;
 }
 
 static float depth_slope(const float *z, int x, int w, int stride)
@@ -227,18 +230,21 @@ static void setup_rows(job *j, int y0, int y1)
 			size_t i = (size_t)y * w + x;
 			const float *f = fb->feat + i * DENOISE_FEATURES;
 			guide *g = &j->g[i];
+			pixel_info *p = &j->px[i];
 			for (int k = 0; k < 3; k++) {
 				g->f[k] = f[k] * (1.0f / sqrtf(SIGMA_A2));
 				g->f[3 + k] = f[3 + k] * (1.0f / sqrtf(SIGMA_N2));
-				g->am[k] = (float)albedo_divisor(f[k]);
+				p->am[k] = (float)albedo_divisor(f[k]);
 			}
 			g->z = f[6];
-			g->gx = depth_slope(f + 6, x, w, DENOISE_FEATURES);
-			g->gy = depth_slope(f + 6, y, h, DENOISE_FEATURES * w);
+			g->unused = 0;
+			p->mixed = features_vary(f);
+			p->gx = depth_slope(f + 6, x, w, DENOISE_FEATURES);
+			p->gy = depth_slope(f + 6, y, h, DENOISE_FEATURES * w);
 			texel *t = &j->buf[0][i];
 			for (int k = 0; k < 3; k++) {
 				float c = fb->rgb[i * 3 + k];
-				t->c[k] = isfinite(c) ? c / g->am[k] : 0.0f;
+				t->c[k] = isfinite(c) ? c / p->am[k] : 0.0f;
 			}
 		}
 }
@@ -293,7 +299,7 @@ static void variance_rows(job *j, int y0, int y1)
 				/* The variance of the pixel's mean, from its own samples,
 				 * over the albedo squared like its radiance. */
 				float m1 = lum(fb->rgb + i * 3), m2 = fb->feat[i * DENOISE_FEATURES + 7];
-				float am = lum(j->g[i].am);
+				float am = lum(j->px[i].am);
 				float v = (m2 - m1 * m1) / (float)(fb->spp - 1) / (am * am);
 				t[i].var = v > 0 ? v : 0;
 				continue;
@@ -338,7 +344,11 @@ static void clamp_rows(job *j, const texel *src, texel *dst, int y0, int y1)
 /* The first-order fit's slopes are held back by a ridge of this share of
  * the weights (a plane through few taps would otherwise swing widely). */
 #define LWR_RIDGE 0.15f
-static const float kernel[2 * KR + 1] = {1.0f / 4, 1.0f / 2, 1.0f / 4};
+/* The first pass (taps next to each other) keeps the weighted mean: a
+ * plane through adjacent noisy pixels follows their noise. */
+#define LWR_STEP 2
+static const float kernel2[2 * KR + 1][2 * KR + 1] = {
+	{1.0f / 16, 1.0f / 8, 1.0f / 16}, {1.0f / 8, 1.0f / 4, 1.0f / 8}, {1.0f / 16, 1.0f / 8, 1.0f / 16}};
 
 /* One a-trous pass with taps `step` pixels apart, rows [y0, y1) from src to
  * dst. */
@@ -356,35 +366,48 @@ static void atrous_rows(job *j, const texel *src, texel *dst, int step, int y0, 
 			const texel *tp = &src[i];
 			/* the variance, smoothed by a 3x3 Gaussian (SVGF) */
 			float gv = 0, gw = 0;
-			for (int dy = -1; dy <= 1; dy++)
-				for (int dx = -1; dx <= 1; dx++) {
-					int qx = x + dx, qy = y + dy;
-					if (qx < 0 || qx >= w || qy < 0 || qy >= h)
-						continue;
-					float k = (dx ? 0.25f : 0.5f) * (dy ? 0.25f : 0.5f);
-					gv += k * src[(size_t)qy * w + qx].var;
-					gw += k;
-				}
+			if (x > 0 && x < w - 1 && y > 0 && y < h - 1) {
+				const texel *a = tp - w, *c = tp + w;
+				gv = 0.0625f * (a[-1].var + a[1].var + c[-1].var + c[1].var) +
+				     0.125f * (a[0].var + c[0].var + tp[-1].var + tp[1].var) + 0.25f * tp->var;
+				gw = 1.0f;
+			} else {
+				for (int dy = -1; dy <= 1; dy++)
+					for (int dx = -1; dx <= 1; dx++) {
+						int qx = x + dx, qy = y + dy;
+						if (qx < 0 || qx >= w || qy < 0 || qy >= h)
+							continue;
+						float k = (dx ? 0.25f : 0.5f) * (dy ? 0.25f : 0.5f);
+						gv += k * src[(size_t)qy * w + qx].var;
+						gw += k;
+					}
+			}
+			if (gv <= 0.0f) {
+				/* no noise around: nothing to filter */
+				dst[i] = *tp;
+				continue;
+			}
 			float lp = lum(tp->c);
 			float inv_l = 1.0f / (sigma_l * sqrtf(gv / gw) + 1e-6f);
 			/* Depth: how far the tap lies off the plane through this pixel
 			 * along its depth gradient, against a share of the depth. */
 			float inv_z = 1.0f / (SIGMA_Z * gp->z + 1e-6f);
-			float gxs = gp->gx * (float)step, gys = gp->gy * (float)step;
+			float gxs = j->px[i].gx * (float)step, gys = j->px[i].gy * (float)step;
 			int lo = -KR, hi = KR;
 			while (x + lo * step < 0)
 				lo++;
 			while (x + hi * step >= w)
 				hi--;
-			float k0 = kernel[KR] * kernel[KR];
-			/* the taps: weight, offset (in steps) and texel */
-			float tw[9], tx[9], ty[9];
+			/* the taps: weight, offset (in steps) and texel; and the
+			 * weights' moments for the first-order fit */
+			float tw[9];
+			int tx[9], ty[9];
 			const texel *tt[9];
-			int nt = 0;
-			tw[0] = k0;
+			tw[0] = kernel2[KR][KR];
 			tx[0] = ty[0] = 0;
 			tt[0] = tp;
-			nt = 1;
+			int nt = 1;
+			float s0 = tw[0], sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
 			for (int dy = -KR; dy <= KR; dy++) {
 				int qy = y + dy * step;
 				if (qy < 0 || qy >= h)
@@ -402,28 +425,27 @@ static void atrous_rows(job *j, const texel *src, texel *dst, int step, int y0, 
 						e += (gp->f[k] - gq->f[k]) * (gp->f[k] - gq->f[k]);
 					e += fabsf(gq->z - (zrow + gxs * (float)dx)) * inv_z;
 					e += fabsf(lp - lum(tq->c)) * inv_l;
-					tw[nt] = kernel[dx + KR] * kernel[dy + KR] * exp_neg(e);
-					tx[nt] = (float)dx;
-					ty[nt] = (float)dy;
+					float wt = kernel2[dy + KR][dx + KR] * exp_fast(e);
+					tw[nt] = wt;
+					tx[nt] = dx;
+					ty[nt] = dy;
 					tt[nt] = tq;
 					nt++;
+					/* offsets are -1, 0 or 1: their squares are 0 or 1 */
+					s0 += wt;
+					sx += (float)dx * wt;
+					sy += (float)dy * wt;
+					sxx += dx ? wt : 0.0f;
+					syy += dy ? wt : 0.0f;
+					sxy += (float)(dx * dy) * wt;
 				}
 			}
 			/* Zero order: the weighted mean. First order (a plane through
 			 * the taps, least squares, its value at the centre): the same
 			 * where the weights are symmetric, unbiased on a slope where an
 			 * edge cuts them off on one side. */
-			float s0 = 0, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
-			for (int t = 0; t < nt; t++) {
-				s0 += tw[t];
-				sx += tw[t] * tx[t];
-				sy += tw[t] * ty[t];
-				sxx += tw[t] * tx[t] * tx[t];
-				syy += tw[t] * ty[t] * ty[t];
-				sxy += tw[t] * tx[t] * ty[t];
-			}
 			float ca = 1.0f / s0, cb = 0, cc = 0;
-			{
+			if (step >= LWR_STEP) {
 				float ridge = LWR_RIDGE * s0;
 				sxx += ridge;
 				syy += ridge;
@@ -435,9 +457,11 @@ static void atrous_rows(job *j, const texel *src, texel *dst, int step, int y0, 
 					cc = c02 / det;
 				}
 			}
+			/* the result: sum l_t c_t with l_t = w_t (ca + cb x_t + cc y_t),
+			 * its variance sum l_t^2 var_t */
 			float sum[3] = {0, 0, 0}, vsum = 0;
 			for (int t = 0; t < nt; t++) {
-				float l = tw[t] * (ca + cb * tx[t] + cc * ty[t]);
+				float l = tw[t] * (ca + cb * (float)tx[t] + cc * (float)ty[t]);
 				sum[0] += l * tt[t]->c[0];
 				sum[1] += l * tt[t]->c[1];
 				sum[2] += l * tt[t]->c[2];
@@ -460,8 +484,8 @@ static void finish_rows(job *j, const texel *src, texel *dst, int y0, int y1)
 		for (int x = 0; x < w; x++) {
 			size_t i = (size_t)y * w + x;
 			for (int k = 0; k < 3; k++)
-				dst[i].c[k] = src[i].c[k] * j->g[i].am[k];
-			float am = lum(j->g[i].am);
+				dst[i].c[k] = src[i].c[k] * j->px[i].am[k];
+			float am = lum(j->px[i].am);
 			dst[i].var = src[i].var * am * am;
 		}
 }
@@ -469,9 +493,8 @@ static void finish_rows(job *j, const texel *src, texel *dst, int y0, int y1)
 /* The regression may move a pixel by at most this many standard
  * deviations of its remaining noise. */
 #define REG_K 1.0f
-#define RR 2        /* the regression's window: (2 RR + 1)^2 pixels */
+#define RR 1        /* the regression's window: (2 RR + 1)^2 pixels */
 #define NR 8        /* its unknowns: a constant and 7 feature slopes */
-#define EDGE_D 0.5f /* a neighbour this far in scaled features: an edge */
 
 /* Cholesky solve of the NR x NR system a x = b (a positive definite; a is
  * overwritten). False when it is not. */
@@ -510,83 +533,74 @@ static bool solve(float a[NR][NR], float b[NR][3], float x[NR][3])
 	return true;
 }
 
-/* Pixels on an edge (their own features or a neighbour's differ): a
- * first-order regression of the filtered radiance on the features over the
- * window around them, each pixel weighted by the inverse of its remaining
- * noise, evaluated at the pixel's own features (a pixel that is part one
- * surface, part another gets the mix its features say). Else copied. */
-static void regress_rows(job *j, const texel *src, int y0, int y1)
+/* A pixel whose features vary inside it (part one surface, part another):
+ * a first-order regression of the filtered radiance on the features over
+ * its 3x3 window, each pixel weighted by the inverse of its remaining
+ * noise, evaluated at the pixel's own features, so that it gets the mix
+ * its features say. False when the system is singular. */
+static bool regress_pixel(const job *j, const texel *src, int x, int y, float o[3])
 {
 	int w = j->fb->w, h = j->fb->h;
+	size_t i = (size_t)y * w + x;
+	const guide *gp = &j->g[i];
+	float a[NR][NR] = {{0}}, b[NR][3] = {{0}}, beta[NR][3];
+	float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {0, 0, 0};
+	float inv_z = 1.0f / (gp->z + 1e-6f);
+	for (int dy = -RR; dy <= RR; dy++)
+		for (int dx = -RR; dx <= RR; dx++) {
+			int qx = x + dx, qy = y + dy;
+			if (qx < 0 || qx >= w || qy < 0 || qy >= h)
+				continue;
+			size_t q = (size_t)qy * w + qx;
+			const guide *gq = &j->g[q];
+			float v[NR];
+			v[0] = 1;
+			for (int k = 0; k < 6; k++)
+				v[1 + k] = gq->f[k] - gp->f[k];
+			v[7] = (gq->z - gp->z) * inv_z * 10.0f;
+			float wt = 1.0f / (src[q].var + 1e-6f);
+			for (int ch = 0; ch < 3; ch++) {
+				float c = src[q].c[ch];
+				lo[ch] = c < lo[ch] ? c : lo[ch];
+				hi[ch] = c > hi[ch] ? c : hi[ch];
+			}
+			for (int r = 0; r < NR; r++) {
+				for (int c = 0; c <= r; c++)
+					a[r][c] += wt * v[r] * v[c];
+				for (int ch = 0; ch < 3; ch++)
+					b[r][ch] += wt * v[r] * src[q].c[ch];
+			}
+		}
+	float ridge = a[0][0] * 1e-3f; /* slopes held back a little */
+	for (int r = 1; r < NR; r++)
+		a[r][r] += ridge;
+	if (!solve(a, b, beta))
+		return false;
+	/* Within the window's range; and a move the pixel's remaining noise
+	 * cannot explain (more than REG_K standard deviations of its
+	 * brightness) is cut down to that. */
+	float r[3];
+	for (int k = 0; k < 3; k++)
+		r[k] = beta[0][k] < lo[k] ? lo[k] : beta[0][k] > hi[k] ? hi[k] : beta[0][k];
+	float d = fabsf(lum(r) - lum(src[i].c));
+	float lim = REG_K * sqrtf(src[i].var), t = d > lim ? lim / d : 1.0f;
+	for (int k = 0; k < 3; k++)
+		o[k] = src[i].c[k] + t * (r[k] - src[i].c[k]);
+	return true;
+}
+
+/* The final radiance into out: mixed pixels regressed, the others as
+ * filtered. */
+static void regress_rows(job *j, const texel *src, int y0, int y1)
+{
+	int w = j->fb->w;
 	for (int y = y0; y < y1; y++)
 		for (int x = 0; x < w; x++) {
 			size_t i = (size_t)y * w + x;
-			const guide *gp = &j->g[i];
 			float *o = j->out + i * 3;
-			bool edge = false;
-			for (int dy = -1; dy <= 1 && !edge; dy++)
-				for (int dx = -1; dx <= 1; dx++) {
-					int qx = x + dx, qy = y + dy;
-					if (qx < 0 || qx >= w || qy < 0 || qy >= h)
-						continue;
-					const guide *gq = &j->g[(size_t)qy * w + qx];
-					float d = 0;
-					for (int k = 0; k < 6; k++)
-						d += (gp->f[k] - gq->f[k]) * (gp->f[k] - gq->f[k]);
-					d += fabsf(gq->z - (gp->z + gp->gx * (float)dx + gp->gy * (float)dy)) /
-					     (SIGMA_Z * gp->z + 1e-6f);
-					if (d > EDGE_D) {
-						edge = true;
-						break;
-					}
-				}
-			float a[NR][NR] = {{0}}, b[NR][3] = {{0}}, beta[NR][3];
-			float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {0, 0, 0};
-			if (edge) {
-				float inv_z = 1.0f / (gp->z + 1e-6f);
-				for (int dy = -RR; dy <= RR; dy++)
-					for (int dx = -RR; dx <= RR; dx++) {
-						int qx = x + dx, qy = y + dy;
-						if (qx < 0 || qx >= w || qy < 0 || qy >= h)
-							continue;
-						size_t q = (size_t)qy * w + qx;
-						const guide *gq = &j->g[q];
-						float v[NR];
-						v[0] = 1;
-						for (int k = 0; k < 6; k++)
-							v[1 + k] = gq->f[k] - gp->f[k];
-						v[7] = (gq->z - gp->z) * inv_z * 10.0f;
-						float wt = 1.0f / (src[q].var + 1e-6f);
-						for (int ch = 0; ch < 3; ch++) {
-							lo[ch] = fminf(lo[ch], src[q].c[ch]);
-							hi[ch] = fmaxf(hi[ch], src[q].c[ch]);
-						}
-						for (int r = 0; r < NR; r++) {
-							for (int c = 0; c <= r; c++)
-								a[r][c] += wt * v[r] * v[c];
-							for (int ch = 0; ch < 3; ch++)
-								b[r][ch] += wt * v[r] * src[q].c[ch];
-						}
-					}
-				float ridge = a[0][0] * 1e-3f;
-				for (int r = 1; r < NR; r++)
-					a[r][r] += ridge;
-			}
-			if (edge && solve(a, b, beta)) {
-				/* A move the pixel's remaining noise cannot explain (more
-				 * than REG_K standard deviations of its brightness) is cut
-				 * down to that. */
-				float r[3], d = 0;
-				for (int k = 0; k < 3; k++)
-					r[k] = fminf(fmaxf(beta[0][k], lo[k]), hi[k]);
-				d = fabsf(lum(r) - lum(src[i].c));
-				float lim = REG_K * sqrtf(src[i].var), t = d > lim ? lim / d : 1.0f;
-				for (int k = 0; k < 3; k++)
-					o[k] = src[i].c[k] + t * (r[k] - src[i].c[k]);
-			} else {
+			if (!j->px[i].mixed || !regress_pixel(j, src, x, y, o))
 				for (int k = 0; k < 3; k++)
 					o[k] = src[i].c[k];
-			}
 		}
 }
 
@@ -652,11 +666,12 @@ bool denoise_image(const framebuffer *fb, float *out, int threads)
 		threads = h;
 	job j = {.fb = fb, .out = out};
 	j.g = malloc(n * sizeof *j.g);
+	j.px = malloc(n * sizeof *j.px);
 	j.buf[0] = malloc(n * sizeof *j.buf[0]);
 	j.buf[1] = malloc(n * sizeof *j.buf[1]);
 	pthread_t *tid = malloc((size_t)threads * sizeof *tid);
 	worker_arg *args = malloc((size_t)threads * sizeof *args);
-	bool ok = j.g && j.buf[0] && j.buf[1] && tid && args;
+	bool ok = j.g && j.px && j.buf[0] && j.buf[1] && tid && args;
 	if (ok) {
 		pthread_mutex_init(&j.lock, NULL);
 		pthread_cond_init(&j.go_cond, NULL);
@@ -686,6 +701,7 @@ bool denoise_image(const framebuffer *fb, float *out, int threads)
 		pthread_cond_destroy(&j.go_cond);
 	}
 	free(j.g);
+	free(j.px);
 	free(j.buf[0]);
 	free(j.buf[1]);
 	free(tid);

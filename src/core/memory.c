@@ -7,6 +7,23 @@
 #include <unistd.h>
 
 static _Atomic size_t set_limit;
+/* What the editors hold (mem_hold): bytes and scenes. */
+static _Atomic long long held_bytes;
+static _Atomic long held_scenes;
+
+void mem_hold(double bytes, long scenes)
+{
+	atomic_fetch_add(&held_bytes, (long long)bytes);
+	atomic_fetch_add(&held_scenes, scenes);
+}
+
+double mem_held(long *scenes)
+{
+	if (scenes)
+		*scenes = atomic_load(&held_scenes);
+	long long b = atomic_load(&held_bytes);
+	return b > 0 ? (double)b : 0;
+}
 
 void mem_set_limit(size_t bytes)
 {
@@ -60,10 +77,19 @@ bool mem_check(double bytes, const char *what, rt_error *err)
 {
 	const char *why;
 	double limit = mem_limit(&why);
-	if (!(bytes > limit))
+	long scenes;
+	double held = mem_held(&scenes);
+	if (!(bytes + held > limit))
 		return true;
-	char need[32], have[32];
+	char need[32], have[32], kept[32];
 	human(bytes, need, sizeof need);
 	human(limit, have, sizeof have);
-	return rt_error_set(err, "%s needs about %s of memory; expected at most %s (%s)", what, need, have, why);
+	/* What is held is named only when it is why the request is refused. */
+	if (held <= 0 || bytes > limit)
+		return rt_error_set(err, "%s needs about %s of memory; expected at most %s (%s)", what, need, have, why);
+	human(held, kept, sizeof kept);
+	return rt_error_set(err,
+	                    "%s needs about %s of memory on top of the %s held by %ld scene%s (the current one and "
+	                    "those kept for undo); expected at most %s in all (%s)",
+	                    what, need, kept, scenes, scenes == 1 ? "" : "s", have, why);
 }

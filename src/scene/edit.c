@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rtsh/memory.h"
 #include "rtsh/num.h"
 #include "rtsh/world.h"
 #include "scene/rtfile_priv.h"
@@ -65,7 +66,28 @@ struct editor {
 	uint64_t group_seq; /* the last group id handed out */
 	uint64_t group;     /* the open group's id while depth > 0 */
 	int depth;
+	/* What this editor told mem_hold it holds: its scenes' bytes and count. */
+	double held;
+	long held_scenes;
 };
+
+/* Tells the memory estimates (memory.h) what the editor holds now: the
+ * current scene and every whole scene in its undo and redo history. */
+static void account(editor *ed)
+{
+	double bytes = (double)scene_bytes(ed->s);
+	long n = 1;
+	const stack *sts[] = {&ed->undo, &ed->redo};
+	for (int k = 0; k < 2; k++)
+		for (size_t i = 0; i < sts[k]->n; i++)
+			if (sts[k]->r[i].kind == REC_SCENE) {
+				bytes += (double)scene_bytes(sts[k]->r[i].u.sc.s);
+				n++;
+			}
+	mem_hold(bytes - ed->held, n - ed->held_scenes);
+	ed->held = bytes;
+	ed->held_scenes = n;
+}
 
 static char *dup_label(const char *label, bool *ok)
 {
@@ -90,6 +112,7 @@ editor *editor_new(scene *s, const char *label)
 	}
 	ed->s = s;
 	ed->gen = 1;
+	account(ed);
 	return ed;
 }
 
@@ -114,6 +137,7 @@ void editor_free(editor *ed)
 {
 	if (!ed)
 		return;
+	mem_hold(-ed->held, -ed->held_scenes);
 	stack_clear(&ed->undo);
 	stack_clear(&ed->redo);
 	free(ed->undo.r);
@@ -346,6 +370,7 @@ static bool commit(editor *ed, record *r, rt_error *err)
 	ed->undo.r[ed->undo.n++] = *r;
 	while (editor_undo_count(ed) > EDITOR_MAX_UNDO || scenes_held(&ed->undo) > EDITOR_MAX_SCENES)
 		drop_oldest(&ed->undo);
+	account(ed);
 	return true;
 }
 
@@ -388,11 +413,14 @@ static bool replay(editor *ed, stack *from, stack *to, const char *what, rt_erro
 	uint64_t g = from->r[from->n - 1].group;
 	while (from->n > 0 && from->r[from->n - 1].group == g) {
 		record r = from->r[from->n - 1];
-		if (!stack_reserve(to, err) || !apply(ed, &r, err))
+		if (!stack_reserve(to, err) || !apply(ed, &r, err)) {
+			account(ed);
 			return false;
+		}
 		from->n--;
 		to->r[to->n++] = r;
 	}
+	account(ed);
 	return true;
 }
 
@@ -612,6 +640,7 @@ bool editor_add_line(editor *ed, const char *line, const char *name, int lineno,
 			apply(ed, r, NULL);
 			record_release(r);
 		}
+		account(ed);
 		return false;
 	}
 	return true;

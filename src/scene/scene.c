@@ -73,6 +73,13 @@ void scene_free(scene *s)
 	free(s);
 }
 
+size_t scene_bytes(const scene *s)
+{
+	return s ? sizeof *s + s->cap_cams * sizeof *s->cams + s->cap_lights * sizeof *s->lights +
+	               s->cap_objs * sizeof *s->objs
+	         : 0;
+}
+
 static void *dup_array(const void *p, size_t n, size_t size, bool *ok)
 {
 	if (n == 0)

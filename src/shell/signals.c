@@ -93,10 +93,23 @@ static void on_crash(int sig)
 }
 
 static const int handled[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGWINCH, SIGTSTP, SIGCONT};
-static const int crashes[] = {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT};
+/* The crashes, then every other signal whose default action ends the
+ * process and that rtsh has no use for (signal(7)): they too give the
+ * terminal back before they end it. SIGPIPE is not among them: a write to a
+ * closed pipe fails with EPIPE where rtsh writes to pipes (atomic.c). */
+static const int crashes[] = {
+	SIGSEGV, SIGBUS,  SIGFPE,    SIGILL,  SIGABRT, SIGTRAP, SIGSYS, SIGXCPU, SIGXFSZ,
+	SIGUSR1, SIGUSR2, SIGALRM, SIGVTALRM, SIGPROF, SIGIO,   SIGPWR,
+#ifdef SIGSTKFLT
+	SIGSTKFLT,
+#endif
+};
 #define NHANDLED (sizeof handled / sizeof handled[0])
 #define NCRASHES (sizeof crashes / sizeof crashes[0])
-static struct sigaction old_handled[NHANDLED], old_crashes[NCRASHES], old_int;
+/* The real-time signals end the process by default too. */
+#define NRT 64
+static struct sigaction old_handled[NHANDLED], old_crashes[NCRASHES], old_rt[NRT], old_int;
+static int rt_first, rt_count;
 
 void signals_interactive_begin(int tty_fd, int wake_fd)
 {
@@ -115,6 +128,12 @@ void signals_interactive_begin(int tty_fd, int wake_fd)
 	sa.sa_flags = SA_RESETHAND;
 	for (size_t i = 0; i < NCRASHES; i++)
 		sigaction(crashes[i], &sa, &old_crashes[i]);
+	rt_first = SIGRTMIN;
+	rt_count = SIGRTMAX - SIGRTMIN + 1;
+	if (rt_count > NRT)
+		rt_count = NRT;
+	for (int i = 0; i < rt_count; i++)
+		sigaction(rt_first + i, &sa, &old_rt[i]);
 }
 
 void signals_interactive_end(void)
@@ -123,6 +142,8 @@ void signals_interactive_end(void)
 		sigaction(handled[i], &old_handled[i], NULL);
 	for (size_t i = 0; i < NCRASHES; i++)
 		sigaction(crashes[i], &old_crashes[i], NULL);
+	for (int i = 0; i < rt_count; i++)
+		sigaction(rt_first + i, &old_rt[i], NULL);
 	wake_write = -1;
 	modes_fd = -1;
 }

@@ -6,8 +6,10 @@
  *   - SIGTSTP (Ctrl-Z) gives the terminal back (every mode reset, the
  *     terminal modes of the start), stops the process, and on SIGCONT puts
  *     back the modes and the alternate screen; the loops repaint;
- *   - crash signals (SIGSEGV SIGBUS SIGFPE SIGILL SIGABRT) give the
- *     terminal back and let the signal kill the process.
+ *   - crash signals (SIGSEGV SIGBUS SIGFPE SIGILL SIGABRT), and every
+ *     other signal whose default ends the process (SIGUSR1, SIGALRM,
+ *     SIGXCPU, the real-time signals...; not SIGPIPE), give the terminal
+ *     back and let the signal kill the process.
  * SIGTERM, SIGHUP and SIGQUIT cancel the render in flight and end the
  * loops, which restore the terminal on their way out; the exit status is
  * 128 + the signal. Nothing catches SIGKILL: `reset` repairs the terminal.

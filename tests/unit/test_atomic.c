@@ -1,14 +1,19 @@
 /* rtsh — tests of file_write_atomic (what a failing writer leaves, the
- * temporary files, links, modes, notes) and of the memory estimates. */
+ * temporary files, links, modes, extended attributes and ACLs, notes) and
+ * of the memory estimates. */
 #include "testutil.h"
 
 #include <dirent.h>
+#include <errno.h>
 #include <fcntl.h>
 #include <time.h>
 #include <sys/stat.h>
+#include <sys/xattr.h>
 #include <unistd.h>
 
 #include "rtsh/atomic.h"
+#include "rtsh/edit.h"
+#include "rtsh/generate.h"
 #include "rtsh/memory.h"
 
 static char dir[] = "/tmp/rtsh-test-atomic-XXXXXX";
@@ -150,6 +155,177 @@ static void test_stale_temporary_files(void **state)
 	assert_int_equal(access(stale, F_OK), 0);
 }
 
+/* --- extended attributes and ACLs --- */
+
+/* A POSIX access or default ACL as the kernel stores it in the
+ * system.posix_acl_* attributes (include/uapi/linux/posix_acl_xattr.h):
+ * a little-endian header (version 2), then entries {tag u16, perm u16,
+ * id u32} in tag order. Tags: 1 owner, 2 named user, 4 owning group,
+ * 8 named group, 0x10 mask, 0x20 others. */
+typedef struct acl_blob {
+	unsigned char b[4 + 8 * 8];
+	size_t n;
+} acl_blob;
+
+static void put_le(unsigned char *p, uint32_t v, int bytes)
+{
+	for (int i = 0; i < bytes; i++)
+		p[i] = (unsigned char)(v >> (8 * i));
+}
+
+static void acl_add(acl_blob *a, unsigned tag, unsigned perm, uint32_t id)
+{
+	if (a->n == 0) {
+		put_le(a->b, 2, 4);
+		a->n = 4;
+	}
+	put_le(a->b + a->n, tag, 2);
+	put_le(a->b + a->n + 2, perm, 2);
+	put_le(a->b + a->n + 4, id, 4);
+	a->n += 8;
+}
+
+/* owner rw-, user 65534 r--, group r--, mask rw-, others ---: the mode's
+ * group bits show the mask, so the file's mode is 0660. */
+static acl_blob acl_example(void)
+{
+	acl_blob a = {.n = 0};
+	acl_add(&a, 0x01, 6, UINT32_MAX);
+	acl_add(&a, 0x02, 4, 65534);
+	acl_add(&a, 0x04, 4, UINT32_MAX);
+	acl_add(&a, 0x10, 6, UINT32_MAX);
+	acl_add(&a, 0x20, 0, UINT32_MAX);
+	return a;
+}
+
+/* The value of attribute name of path (malloc'ed, *n its length), or NULL. */
+static char *xget(const char *path, const char *name, ssize_t *n)
+{
+	*n = getxattr(path, name, NULL, 0);
+	if (*n < 0)
+		return NULL;
+	char *v = malloc((size_t)*n + 1);
+	assert_non_null(v);
+	*n = getxattr(path, name, v, (size_t)*n);
+	assert_true(*n >= 0);
+	return v;
+}
+
+static void expect_xattr(const char *path, const char *name, const void *want, size_t n)
+{
+	ssize_t got;
+	char *v = xget(path, name, &got);
+	if (!v)
+		fail_msg("%s: %s is gone (%s)", path, name, strerror(errno));
+	assert_int_equal(got, (ssize_t)n);
+	assert_memory_equal(v, want, n);
+	free(v);
+}
+
+/* In folder `in`: a file with user attributes (one empty) and an access ACL
+ * is replaced atomically (a new inode, no note) and the new file has the
+ * same attributes, the same ACL and the mode the ACL gives. False when the
+ * file system refuses user attributes or ACLs (the caller says so). */
+static bool xattrs_kept_in(const char *in)
+{
+	char path[256];
+	snprintf(path, sizeof path, "%s/x.rt", in);
+	rt_error err;
+	assert_true(file_write_atomic(path, write_text, "old\n", &err));
+	if (setxattr(path, "user.rtsh.colour", "blue", 4, 0) != 0 || setxattr(path, "user.rtsh.empty", "", 0, 0) != 0) {
+		print_message("skipped in %s: the file system refuses user extended attributes (%s)\n", in,
+		              strerror(errno));
+		return false;
+	}
+	acl_blob acl = acl_example();
+	if (setxattr(path, "system.posix_acl_access", acl.b, acl.n, 0) != 0) {
+		print_message("skipped in %s: the file system refuses ACLs (%s)\n", in, strerror(errno));
+		return false;
+	}
+	struct stat before, after;
+	assert_int_equal(stat(path, &before), 0);
+	assert_int_equal(before.st_mode & 07777, 0660); /* what the ACL says */
+	assert_true(file_write_atomic(path, write_text, "new\n", &err));
+	assert_string_equal(file_write_note(), ""); /* replaced, not in place */
+	assert_int_equal(stat(path, &after), 0);
+	assert_true(after.st_ino != before.st_ino);
+	assert_string_equal(slurp(path), "new\n");
+	expect_xattr(path, "user.rtsh.colour", "blue", 4);
+	expect_xattr(path, "user.rtsh.empty", "", 0);
+	expect_xattr(path, "system.posix_acl_access", acl.b, acl.n);
+	assert_int_equal(after.st_mode & 07777, 0660);
+	/* An attribute removed from the file is not brought back. */
+	assert_int_equal(removexattr(path, "user.rtsh.colour"), 0);
+	assert_true(file_write_atomic(path, write_text, "newer\n", &err));
+	ssize_t n;
+	assert_null(xget(path, "user.rtsh.colour", &n));
+	expect_xattr(path, "user.rtsh.empty", "", 0);
+	return true;
+}
+
+/* In a folder with a default ACL: replacing a file that has no ACL gives no
+ * ACL (the temporary file inherited one; it is removed) and keeps the mode;
+ * a new file gets what any new file there gets (compared with one made by
+ * open(O_CREAT, 0666)). */
+static bool default_acl_in(const char *in)
+{
+	char sub[256], path[300], fresh[300], ref[300];
+	snprintf(sub, sizeof sub, "%s/defacl", in);
+	assert_int_equal(mkdir(sub, 0755), 0);
+	snprintf(path, sizeof path, "%s/old.rt", sub);
+	rt_error err;
+	assert_true(file_write_atomic(path, write_text, "old\n", &err));
+	assert_int_equal(chmod(path, 0604), 0);
+	acl_blob def = acl_example();
+	if (setxattr(sub, "system.posix_acl_default", def.b, def.n, 0) != 0) {
+		print_message("skipped in %s: the file system refuses default ACLs (%s)\n", in, strerror(errno));
+		return false;
+	}
+	assert_true(file_write_atomic(path, write_text, "new\n", &err));
+	ssize_t n;
+	assert_null(xget(path, "system.posix_acl_access", &n));
+	struct stat st, rst;
+	assert_int_equal(stat(path, &st), 0);
+	assert_int_equal(st.st_mode & 07777, 0604);
+	snprintf(fresh, sizeof fresh, "%s/fresh.rt", sub);
+	snprintf(ref, sizeof ref, "%s/reference", sub);
+	int fd = open(ref, O_WRONLY | O_CREAT | O_EXCL, 0666);
+	assert_true(fd >= 0);
+	close(fd);
+	assert_true(file_write_atomic(fresh, write_text, "fresh\n", &err));
+	assert_int_equal(stat(fresh, &st), 0);
+	assert_int_equal(stat(ref, &rst), 0);
+	assert_int_equal(st.st_mode & 07777, rst.st_mode & 07777);
+	ssize_t rn;
+	char *want = xget(ref, "system.posix_acl_access", &rn);
+	assert_non_null(want); /* inherited from the default ACL */
+	expect_xattr(fresh, "system.posix_acl_access", want, (size_t)rn);
+	free(want);
+	return true;
+}
+
+static void test_xattrs_and_acls_are_kept(void **state)
+{
+	(void)state;
+	/* The test folder (under /tmp) and, where there is one, a tmpfs. */
+	char shm[] = "/dev/shm/rtsh-test-atomic-XXXXXX";
+	const char *folders[] = {dir, mkdtemp(shm)};
+	int ran = 0;
+	for (int i = 0; i < 2; i++) {
+		if (!folders[i])
+			continue;
+		ran += xattrs_kept_in(folders[i]);
+		ran += default_acl_in(folders[i]);
+	}
+	if (folders[1]) {
+		char cmd[128];
+		snprintf(cmd, sizeof cmd, "rm -rf %s", shm);
+		assert_int_equal(system(cmd), 0);
+	}
+	if (ran == 0)
+		skip();
+}
+
 static void test_memory_check(void **state)
 {
 	(void)state;
@@ -170,13 +346,119 @@ static void test_memory_check(void **state)
 	assert_false(mem_check(phys * 2, "twice the machine", &err));
 }
 
+/* Bytes as the messages give them (memory.h): in the largest unit of 1024
+ * that leaves at least 1, one decimal below 10. */
+static void human_test(double b, char *buf, size_t size)
+{
+	const char *units[] = {"bytes", "KiB", "MiB", "GiB"};
+	int u = 0;
+	for (; b >= 1024 && u < 3; u++)
+		b /= 1024;
+	snprintf(buf, size, u && b < 10 ? "%.1f %s" : "%.0f %s", b, units[u]);
+}
+
+/* The bytes a scene's model takes, from its arrays' capacities and the
+ * element sizes. */
+static double model_bytes(const scene *s)
+{
+	return (double)(sizeof(scene) + s->cap_cams * sizeof(camera) + s->cap_lights * sizeof(light) +
+	                s->cap_objs * sizeof(object));
+}
+
+/* The scenes an editor holds (its current one and those its undo and redo
+ * history keep after load/generate) are counted by the memory estimates: a
+ * request that fits alone is refused when it does not fit with them. */
+static void test_memory_counts_the_undo_scenes(void **state)
+{
+	(void)state;
+	rt_error err;
+	long n;
+	assert_true(mem_held(&n) == 0.0);
+	assert_int_equal(n, 0);
+	scene *a = scene_generate(1000, 1, NULL, &err);
+	assert_non_null(a);
+	assert_int_equal(a->cap_objs, 1001); /* 1000 and the ground plane, allocated at once */
+	double wa = model_bytes(a);
+	editor *ed = editor_new(a, "a");
+	assert_non_null(ed);
+	assert_true(mem_held(&n) == wa);
+	assert_int_equal(n, 1);
+	/* Three more scenes replace it in turn; each old one is kept for undo. */
+	double want = wa;
+	const size_t sizes[] = {2000, 3000, 4000};
+	for (int i = 0; i < 3; i++) {
+		scene *s = scene_generate(sizes[i], 2, NULL, &err);
+		assert_non_null(s);
+		want += model_bytes(s);
+		assert_true(editor_replace(ed, s, NULL, &err));
+		assert_true(mem_held(&n) == want);
+		assert_int_equal(n, i + 2);
+	}
+	/* Undo and redo move scenes between the stacks: the same are held. */
+	assert_true(editor_undo(ed, &err));
+	assert_true(editor_undo(ed, &err));
+	assert_true(mem_held(&n) == want);
+	assert_int_equal(n, 4);
+	/* A new edit drops the redo history (2 scenes of 3000 and 4000). */
+	double w3 = 0, w4 = 0;
+	{
+		scene *s3 = scene_generate(3000, 2, NULL, &err), *s4 = scene_generate(4000, 2, NULL, &err);
+		w3 = model_bytes(s3);
+		w4 = model_bytes(s4);
+		scene_free(s3);
+		scene_free(s4);
+	}
+	assert_true(editor_object_move(ed, 0, v3(1, 0, 0), &err));
+	want -= w3 + w4;
+	assert_true(mem_held(&n) == want);
+	assert_int_equal(n, 2);
+
+	/* A request of 100 objects: about 101 x MEM_PER_OBJECT alone. With a
+	 * limit between that alone and that on top of what is held, it is
+	 * refused, saying what is held; alone (no editor) it fits. */
+	double alone = 101 * MEM_PER_OBJECT;
+	assert_true(want > 1000); /* a clear gap */
+	mem_set_limit((size_t)(alone + want / 2));
+	assert_null(scene_generate(100, 3, NULL, &err));
+	char expect[512], need[32], held[32], limit[32];
+	human_test(alone, need, sizeof need);
+	human_test(want, held, sizeof held);
+	human_test((double)(size_t)(alone + want / 2), limit, sizeof limit);
+	snprintf(expect, sizeof expect,
+	         "generating 100 objects needs about %s of memory on top of the %s held by 2 scenes (the current "
+	         "one and those kept for undo); expected at most %s in all (the set limit)",
+	         need, held, limit);
+	assert_string_equal(err.msg, expect);
+	/* A request too big on its own is refused as such. */
+	double lim2 = (double)(size_t)(alone + want / 2);
+	assert_false(mem_check(lim2 + 1, "this", &err));
+	human_test(lim2 + 1, need, sizeof need);
+	snprintf(expect, sizeof expect, "this needs about %s of memory; expected at most %s (the set limit)", need,
+	         limit);
+	assert_string_equal(err.msg, expect);
+	mem_set_limit((size_t)(alone + want)); /* exactly fits */
+	scene *fits = scene_generate(100, 3, NULL, &err);
+	assert_non_null(fits);
+	scene_free(fits);
+	mem_set_limit((size_t)(alone + want / 2));
+	editor_free(ed);
+	assert_true(mem_held(&n) == 0.0);
+	assert_int_equal(n, 0);
+	fits = scene_generate(100, 3, NULL, &err);
+	assert_non_null(fits);
+	scene_free(fits);
+	mem_set_limit(0);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_failing_writer_keeps_the_old_file),
 		cmocka_unit_test(test_mode_is_kept),
 		cmocka_unit_test(test_stale_temporary_files),
+		cmocka_unit_test(test_xattrs_and_acls_are_kept),
 		cmocka_unit_test(test_memory_check),
+		cmocka_unit_test(test_memory_counts_the_undo_scenes),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
 }
