@@ -230,6 +230,7 @@ void render_rect(const world *w, const render_settings *s, int x0, int y0, int x
                  float *out)
 {
 	double inv = 1.0 / s->samples;
+	texture_set_pixel_angle(2.0 * w->cam.tan_half / s->width); /* as render_tile */
 	for (int y = y0; y < y1; y++)
 		for (int x = x0; x < x1; x++) {
 			double acc[3] = {0.0, 0.0, 0.0};

@@ -1,6 +1,7 @@
 /* rtsh-mpi — the files a scene needs, in memory (fileset.h). */
 #include "mpi/fileset.h"
 
+#include <errno.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -93,6 +94,78 @@ char *fileset_serve(void *ctx, const char *path, size_t *len, rt_error *err)
 	}
 	*len = e->len;
 	return c;
+}
+
+/* Keeps a copy of data under path (when it is not kept yet). */
+static bool keep(fileset *fs, const char *path, const char *data, size_t len)
+{
+	if (find(fs, path))
+		return true;
+	char *copy = dup_bytes(data, len), *name = dup_bytes(path, strlen(path));
+	if (!copy || !name) {
+		free(copy);
+		free(name);
+		return false;
+	}
+	return add(fs, name, copy, len);
+}
+
+static char *src_record(void *ctx, const char *path, const char *what, size_t *len, rt_error *err)
+{
+	fileset *fs = ctx;
+	const file_entry *e = find(fs, path);
+	if (e) {
+		*len = e->len;
+		return dup_bytes(e->data, e->len);
+	}
+	char *data = rt_file_read_disk(path, what, len, err);
+	if (data && !keep(fs, path, data, *len)) {
+		free(data);
+		rt_error_set(err, "%s: out of memory keeping the %s for the other ranks", path, what);
+		return NULL;
+	}
+	return data;
+}
+
+static int src_stat_disk(void *ctx, const char *path, struct stat *st)
+{
+	(void)ctx;
+	return stat(path, st);
+}
+
+static char *src_serve(void *ctx, const char *path, const char *what, size_t *len, rt_error *err)
+{
+	const file_entry *e = find(ctx, path);
+	if (!e) {
+		rt_error_set(err, "%s: cannot read the %s: not among the files rank 0 sent", path, what);
+		return NULL;
+	}
+	char *c = dup_bytes(e->data, e->len);
+	if (!c) {
+		rt_error_set(err, "%s: out of memory reading the %s", path, what);
+		return NULL;
+	}
+	*len = e->len;
+	return c;
+}
+
+static int src_stat_kept(void *ctx, const char *path, struct stat *st)
+{
+	const file_entry *e = find(ctx, path);
+	if (!e) {
+		errno = ENOENT;
+		return -1;
+	}
+	memset(st, 0, sizeof *st);
+	st->st_mode = S_IFREG | 0444;
+	st->st_size = (off_t)e->len;
+	return 0;
+}
+
+rt_file_source fileset_source(fileset *fs, bool record)
+{
+	return record ? (rt_file_source){src_record, src_stat_disk, fs}
+	              : (rt_file_source){src_serve, src_stat_kept, fs};
 }
 
 static char *put_u64(char *p, uint64_t v)

@@ -176,6 +176,10 @@ static void setup(int argc, char **argv, job_config *c, fileset *files, world **
 	rt_warnings warn = {print_warning, NULL};
 	rt_load_opts lo = {.strict = o.strict, .warn = o.quiet ? NULL : &warn,
 	                   .read = fileset_record, .read_ctx = files};
+	/* the models, textures and sky, read while loading and building */
+	static rt_file_source src;
+	src = fileset_source(files, true);
+	rt_file_source_set(&src);
 	scene *s = rt_load_file(o.scene, &lo, &err);
 	if (!s) {
 		rt_error_format(&err, msg, sizeof msg);
@@ -189,6 +193,7 @@ static void setup(int argc, char **argv, job_config *c, fileset *files, world **
 	options_apply_settings(&o, &c->set);
 	*w = world_build(s, &err);
 	scene_free(s);
+	rt_file_source_set(NULL);
 	if (!*w) {
 		rt_error_format(&err, msg, sizeof msg);
 		fprintf(stderr, "%s: %s\n", o.scene, msg);
@@ -213,6 +218,7 @@ static void setup(int argc, char **argv, job_config *c, fileset *files, world **
 	*output = o.output;
 	c->status = -1;
 out:
+	rt_file_source_set(NULL);
 	free(args);
 }
 
@@ -465,6 +471,8 @@ int main(int argc, char **argv)
 	bcast_bytes(packed, c.files);
 	if (rank != 0) {
 		rt_load_opts lo = {.strict = c.strict, .read = fileset_serve, .read_ctx = &files};
+		rt_file_source src = fileset_source(&files, false);
+		rt_file_source_set(&src);
 		if (!fileset_unpack(&files, packed, c.files) || files.n == 0) {
 			rt_error_set(&err, "the scene's files arrived damaged or memory ran out");
 			die(rank, host, "", &err);
@@ -474,6 +482,7 @@ int main(int argc, char **argv)
 			die(rank, host, "loading the scene rank 0 sent", &err);
 		w = world_build(s, &err);
 		scene_free(s);
+		rt_file_source_set(NULL);
 		if (!w)
 			die(rank, host, "building the world", &err);
 	}

@@ -254,6 +254,18 @@ static bool xattrs_kept_in(const char *in)
 	expect_xattr(path, "user.rtsh.empty", "", 0);
 	expect_xattr(path, "system.posix_acl_access", acl.b, acl.n);
 	assert_int_equal(after.st_mode & 07777, 0660);
+	/* Through a symbolic link: the file it points to is replaced and keeps
+	 * them; the link stays a link. */
+	char lpath[300];
+	snprintf(lpath, sizeof lpath, "%s/x-link.rt", in);
+	assert_int_equal(symlink("x.rt", lpath), 0);
+	assert_true(file_write_atomic(lpath, write_text, "via link\n", &err));
+	struct stat lst;
+	assert_int_equal(lstat(lpath, &lst), 0);
+	assert_true(S_ISLNK(lst.st_mode));
+	assert_string_equal(slurp(path), "via link\n");
+	expect_xattr(path, "user.rtsh.colour", "blue", 4);
+	expect_xattr(path, "system.posix_acl_access", acl.b, acl.n);
 	/* An attribute removed from the file is not brought back. */
 	assert_int_equal(removexattr(path, "user.rtsh.colour"), 0);
 	assert_true(file_write_atomic(path, write_text, "newer\n", &err));

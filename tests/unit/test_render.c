@@ -11,6 +11,7 @@
 
 #include "rtsh/image.h"
 #include "rtsh/render.h"
+#include "rtsh/rtfile.h"
 #include "rtsh/scene.h"
 #include "rtsh/world.h"
 
@@ -246,32 +247,43 @@ static void test_progressive_equals_batch(void **state)
 static void test_rect_equals_image(void **state)
 {
 	(void)state;
-	scene *s = busy_scene();
-	world *w = world_build(s, NULL);
-	for (int mode = MODE_WHITTED; mode <= MODE_PATH; mode++) {
-		render_settings set = render_settings_default();
-		set.width = 53;
-		set.height = 37;
-		set.samples = 3;
-		set.threads = 2;
-		set.mode = (render_mode)mode;
-		framebuffer *fb = render_image(w, &set, NULL, NULL, NULL, NULL);
-		const int rects[][4] = {{0, 0, 53, 37}, {0, 0, 1, 1}, {17, 5, 40, 22}, {48, 30, 53, 37}};
-		for (size_t r = 0; r < sizeof rects / sizeof rects[0]; r++) {
-			const int *q = rects[r];
-			int rw = q[2] - q[0], rh = q[3] - q[1];
-			float *out = malloc(sizeof(float) * 3 * (size_t)(rw * rh));
-			render_rect(w, &set, q[0], q[1], q[2], q[3], out);
-			for (int y = 0; y < rh; y++)
-				assert_memory_equal(out + (size_t)y * rw * 3,
-				                    fb->rgb + ((size_t)(q[1] + y) * 53 + q[0]) * 3,
-				                    sizeof(float) * 3 * (size_t)rw);
-			free(out);
+	/* the busy scene, then textures (their footprints) and an HDR sky */
+	static const char textured[] = "C 0,1,-6 0,0,1 60\nL 2,5,-4 0.7 255,255,255\n"
+	                               "sky textures/sky.hdr 1 20\n"
+	                               "sp -1,1,0 2.5 255,255,255 texture=textures/earth.png\n"
+	                               "pl 0,0,0 0,1,0 200,200,200 texture=textures/earth.png\n";
+	for (int which = 0; which < 2; which++) {
+		rt_error err = {0};
+		scene *s = which == 0 ? busy_scene()
+		                      : rt_load_string(textured, sizeof textured - 1, "scenes/t.rt", NULL, &err);
+		if (!s)
+			fail_msg("%s", err.msg);
+		world *w = world_build(s, NULL);
+		for (int mode = MODE_WHITTED; mode <= MODE_PATH; mode++) {
+			render_settings set = render_settings_default();
+			set.width = 53;
+			set.height = 37;
+			set.samples = 3;
+			set.threads = 2;
+			set.mode = (render_mode)mode;
+			framebuffer *fb = render_image(w, &set, NULL, NULL, NULL, NULL);
+			const int rects[][4] = {{0, 0, 53, 37}, {0, 0, 1, 1}, {17, 5, 40, 22}, {48, 30, 53, 37}};
+			for (size_t r = 0; r < sizeof rects / sizeof rects[0]; r++) {
+				const int *q = rects[r];
+				int rw = q[2] - q[0], rh = q[3] - q[1];
+				float *out = malloc(sizeof(float) * 3 * (size_t)(rw * rh));
+				render_rect(w, &set, q[0], q[1], q[2], q[3], out);
+				for (int y = 0; y < rh; y++)
+					assert_memory_equal(out + (size_t)y * rw * 3,
+					                    fb->rgb + ((size_t)(q[1] + y) * 53 + q[0]) * 3,
+					                    sizeof(float) * 3 * (size_t)rw);
+				free(out);
+			}
+			fb_free(fb);
 		}
-		fb_free(fb);
+		world_free(w);
+		scene_free(s);
 	}
-	world_free(w);
-	scene_free(s);
 }
 
 static void test_cancel(void **state)

@@ -12,6 +12,7 @@
 #include <sys/stat.h>
 
 #include "core/bvh.h"
+#include "rtsh/filesrc.h"
 #include "rtsh/texture.h"
 
 /* --- the builder --- */
@@ -585,7 +586,7 @@ static size_t ncache, ccache;
 mesh *mesh_cache_get(const char *path, bool smooth, double crease_deg, rt_error *err)
 {
 	struct stat st;
-	if (stat(path, &st) != 0) {
+	if (rt_file_stat(path, &st) != 0) {
 		rt_error_set(err, "%s: cannot read the model: %s", path, strerror(errno));
 		return NULL;
 	}

@@ -23,6 +23,7 @@
 #include <assimp/scene.h>
 
 #include "core/mesh/mesh_io.h"
+#include "rtsh/filesrc.h"
 #include "rtsh/image.h"
 #include "rtsh/mesh.h"
 #include "rtsh/texture.h"
@@ -141,18 +142,11 @@ static bool material_texture(const struct aiScene *sc, const struct aiMaterial *
 
 mesh *mesh_read_assimp(const char *path, rt_error *err)
 {
-	FILE *f = fopen(path, "rb");
-	if (!f) {
-		rt_error_set(err, "%s: cannot read the model: %s", path, strerror(errno));
+	/* every file assimp opens is read through the file source */
+	const struct aiScene *sc = rt_file_ai_import(
+	    path, aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType, err);
+	if (!sc)
 		return NULL;
-	}
-	fclose(f);
-	const struct aiScene *sc =
-	    aiImportFile(path, aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType);
-	if (!sc) {
-		rt_error_set(err, "%s: cannot read the model: %s", path, aiGetErrorString());
-		return NULL;
-	}
 	mesh_builder b = {.name = path};
 	char *dir = path_dir(path);
 	bool ok = dir != NULL;

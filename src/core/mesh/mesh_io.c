@@ -9,10 +9,19 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "rtsh/filesrc.h"
+
 /* Files larger than this are refused rather than read. */
 #define SLURP_MAX ((size_t)4 << 30)
 
+/* Through the process's file source (rtsh/filesrc.h): rtsh-mpi serves the
+ * bytes rank 0 read. */
 char *file_slurp(const char *path, const char *what, size_t *len, rt_error *err)
+{
+	return rt_file_read(path, what, len, err);
+}
+
+char *rt_file_read_disk(const char *path, const char *what, size_t *len, rt_error *err)
 {
 	FILE *f = fopen(path, "rb");
 	if (!f) {

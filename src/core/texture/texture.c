@@ -7,6 +7,8 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "rtsh/filesrc.h"
+
 static _Thread_local double pixel_angle;
 
 void texture_set_pixel_angle(double a)
@@ -146,7 +148,7 @@ static size_t ncache, ccache;
 texture *texture_cache_get(const char *path, bool srgb, rt_error *err)
 {
 	struct stat st;
-	if (stat(path, &st) != 0) {
+	if (rt_file_stat(path, &st) != 0) {
 		rt_error_set(err, "%s: cannot read the image: %s", path, strerror(errno));
 		return NULL;
 	}

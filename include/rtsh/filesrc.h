@@ -1,0 +1,49 @@
+/* rtsh — where the core reads the files a scene references: models,
+ * material libraries, textures, the sky.
+ *
+ * By default they are read from disk. A program may set one process-wide
+ * source instead, before any thread starts: rtsh-mpi does, so that rank 0
+ * keeps every file it reads and the other ranks read the bytes rank 0
+ * broadcast (src/mpi/fileset.h). The .rt file itself goes through the
+ * loader's per-load hook (rt_load_opts.read, rt_read_file); these files are
+ * read later, while the world is built, where no load options exist.
+ *
+ * Every reader in src/core reads such a file through rt_file_read (the
+ * model readers' file_slurp), checks it through rt_file_stat (the caches),
+ * and assimp opens its files through rt_file_ai_import.
+ */
+#ifndef RTSH_FILESRC_H
+#define RTSH_FILESRC_H
+
+#include <stddef.h>
+#include <sys/stat.h>
+
+#include "rtsh/error.h"
+
+typedef struct rt_file_source {
+	/* The whole file, NUL-terminated (*len without the NUL), or NULL with
+	 * err set as rt_file_read_disk words it. what: "model", "image"... */
+	char *(*read)(void *ctx, const char *path, const char *what, size_t *len, rt_error *err);
+	/* As stat(2): 0, or -1 with errno set. */
+	int (*stat)(void *ctx, const char *path, struct stat *st);
+	void *ctx;
+} rt_file_source;
+
+/* Sets the source (NULL: disk again). src must outlive its use. Call it
+ * while no other thread reads files. */
+void rt_file_source_set(const rt_file_source *src);
+/* Reads through the source, or from disk when none is set. */
+char *rt_file_read(const char *path, const char *what, size_t *len, rt_error *err);
+/* stat(2) through the source, or on disk. */
+int rt_file_stat(const char *path, struct stat *st);
+/* Reads from disk: "PATH: cannot read the WHAT: reason" on failure (files
+ * larger than 4 GiB are refused). Defined with the model readers. */
+char *rt_file_read_disk(const char *path, const char *what, size_t *len, rt_error *err);
+
+/* assimp's aiImportFile, with every file assimp opens (the model, and a
+ * .gltf's buffers) read through rt_file_read. NULL with err set ("PATH:
+ * cannot read the model: reason") on failure; free with aiReleaseImport. */
+struct aiScene;
+const struct aiScene *rt_file_ai_import(const char *path, unsigned flags, rt_error *err);
+
+#endif

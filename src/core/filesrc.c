@@ -1,0 +1,152 @@
+/* rtsh — where the core reads the files a scene references (filesrc.h). */
+#include "rtsh/filesrc.h"
+
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <assimp/cfileio.h>
+#include <assimp/cimport.h>
+#include <assimp/scene.h>
+
+static _Atomic(const rt_file_source *) source;
+
+void rt_file_source_set(const rt_file_source *src)
+{
+	atomic_store(&source, src);
+}
+
+char *rt_file_read(const char *path, const char *what, size_t *len, rt_error *err)
+{
+	const rt_file_source *s = atomic_load(&source);
+	if (s && s->read)
+		return s->read(s->ctx, path, what, len, err);
+	return rt_file_read_disk(path, what, len, err);
+}
+
+int rt_file_stat(const char *path, struct stat *st)
+{
+	const rt_file_source *s = atomic_load(&source);
+	if (s && s->stat)
+		return s->stat(s->ctx, path, st);
+	return stat(path, st);
+}
+
+/* --- assimp's files through rt_file_read --- */
+
+/* One import: the model's bytes, read once before assimp starts. */
+typedef struct ai_job {
+	const char *path;
+	const char *bytes;
+	size_t len;
+} ai_job;
+
+/* One file assimp opened. */
+typedef struct ai_open {
+	const char *bytes;
+	char *owned; /* bytes when this file read them (not the model's) */
+	size_t len, pos;
+} ai_open;
+
+static ai_open *open_of(struct aiFile *f)
+{
+	return (ai_open *)(void *)f->UserData;
+}
+
+static size_t ai_read(struct aiFile *f, char *buf, size_t size, size_t count)
+{
+	ai_open *o = open_of(f);
+	if (size == 0 || o->pos >= o->len)
+		return 0;
+	size_t n = (o->len - o->pos) / size;
+	if (n > count)
+		n = count;
+	memcpy(buf, o->bytes + o->pos, n * size);
+	o->pos += n * size;
+	return n;
+}
+
+static size_t ai_write(struct aiFile *f, const char *buf, size_t size, size_t count)
+{
+	(void)f, (void)buf, (void)size, (void)count;
+	return 0;
+}
+
+static size_t ai_tell(struct aiFile *f)
+{
+	return open_of(f)->pos;
+}
+
+static size_t ai_size(struct aiFile *f)
+{
+	return open_of(f)->len;
+}
+
+static enum aiReturn ai_seek(struct aiFile *f, size_t off, enum aiOrigin from)
+{
+	ai_open *o = open_of(f);
+	size_t base = from == aiOrigin_SET ? 0 : from == aiOrigin_CUR ? o->pos : from == aiOrigin_END ? o->len
+	                                                                                             : SIZE_MAX;
+	if (base == SIZE_MAX || off > o->len - base)
+		return aiReturn_FAILURE;
+	o->pos = base + off;
+	return aiReturn_SUCCESS;
+}
+
+static void ai_flush(struct aiFile *f)
+{
+	(void)f;
+}
+
+static struct aiFile *ai_open_file(struct aiFileIO *io, const char *name, const char *mode)
+{
+	const ai_job *job = (const ai_job *)(void *)io->UserData;
+	if (strpbrk(mode, "wa+"))
+		return NULL;
+	struct aiFile *f = calloc(1, sizeof *f);
+	ai_open *o = calloc(1, sizeof *o);
+	if (!f || !o)
+		goto fail;
+	if (strcmp(name, job->path) == 0) {
+		o->bytes = job->bytes;
+		o->len = job->len;
+	} else {
+		rt_error ignored;
+		o->owned = rt_file_read(name, "model", &o->len, &ignored);
+		if (!o->owned)
+			goto fail;
+		o->bytes = o->owned;
+	}
+	*f = (struct aiFile){ai_read, ai_write, ai_tell, ai_size, ai_seek, ai_flush, (aiUserData)(void *)o};
+	return f;
+fail:
+	free(o);
+	free(f);
+	return NULL;
+}
+
+static void ai_close_file(struct aiFileIO *io, struct aiFile *f)
+{
+	(void)io;
+	if (!f)
+		return;
+	ai_open *o = open_of(f);
+	free(o->owned);
+	free(o);
+	free(f);
+}
+
+const struct aiScene *rt_file_ai_import(const char *path, unsigned flags, rt_error *err)
+{
+	size_t len;
+	char *bytes = rt_file_read(path, "model", &len, err);
+	if (!bytes)
+		return NULL;
+	ai_job job = {path, bytes, len};
+	struct aiFileIO io = {ai_open_file, ai_close_file, (aiUserData)(void *)&job};
+	const struct aiScene *sc = aiImportFileEx(path, flags, &io);
+	free(bytes);
+	if (!sc)
+		rt_error_set(err, "%s: cannot read the model: %s", path, aiGetErrorString());
+	return sc;
+}
