@@ -307,13 +307,22 @@ static void put_int(char *buf, size_t *n, size_t cap, int v)
  * (those on other hosts it cannot see) and that no image was written, then
  * ends by the signal. The launcher follows with SIGKILL within about a
  * second and rank 0 may be inside a blocking MPI call, so this is done here,
- * with async-signal-safe calls only (kill, write, strcmp, raise). */
+ * with async-signal-safe calls only (kill, write, strcmp, raise, alarm). */
 static _Atomic int stop_rank = -1; /* this process's rank once known */
 
 static void on_stop(int sig)
 {
-	if (atomic_load(&stop_rank) != 0) {
-		/* another rank, or MPI not started yet: end quietly */
+	int me = atomic_load(&stop_rank);
+	if (me > 0) {
+		/* another rank: end quietly, but a second later (SIGALRM's
+		 * default action), so that rank 0 speaks first: the launcher
+		 * takes a rank that ends at once for a new failure and may
+		 * kill rank 0 before it has run this handler */
+		alarm(1);
+		return;
+	}
+	if (me != 0) {
+		/* MPI not started yet, or all is said: end quietly */
 		signal(sig, SIG_DFL);
 		raise(sig);
 		return;
