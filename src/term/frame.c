@@ -18,6 +18,10 @@
 
 #define UNKNOWN 0xffffffffu /* SGR state not known */
 #define GAP_FILL 3
+/* A run of changed cells is drawn in pieces of at most this many cells, so
+ * that a part (frame_update_part) ends close to its budget; the SGR state
+ * and the cursor carry over, so a piece costs no byte more. */
+#define RUN_MAX 16
 
 frame *frame_new(int cols, int rows, frame_palette pal)
 {
@@ -432,8 +436,6 @@ static void update_begin(const frame *f, update_state *u, abuf *out)
 	(void)f;
 }
 
-/* Appends the changed runs of row y; true when it sent anything. The row
- * then counts as shown. */
 /* True when the terminal's cell b may stay for a: equal, or in truecolor
  * within f->tol in every channel of both pixels. */
 static bool cell_close(const frame *f, frame_cell a, frame_cell b)
@@ -452,12 +454,14 @@ static bool cell_close(const frame *f, frame_cell a, frame_cell b)
 	return true;
 }
 
-static bool update_row(frame *f, update_state *u, int y)
+/* Appends the changed runs of row y, the cells sent then counting as
+ * shown; stops after a run once the update holds budget bytes. True when
+ * the row is done. */
+static bool update_row(frame *f, update_state *u, int y, size_t budget)
 {
 	abuf *out = u->out;
 	const frame_cell *row = f->cur + (size_t)y * f->cols;
 	frame_cell *old = f->shown + (size_t)y * f->cols;
-	bool sent = false;
 	int x = 0;
 	for (;;) {
 		while (x < f->cols && cell_close(f, row[x], old[x]))
@@ -466,7 +470,7 @@ static bool update_row(frame *f, update_state *u, int y)
 			break;
 		/* A run from x: extend over changed cells and short gaps. */
 		int end = x + 1;
-		for (int k = end; k < f->cols; k++) {
+		for (int k = end; k < f->cols && k - x < RUN_MAX; k++) {
 			if (!cell_close(f, row[k], old[k]))
 				end = k + 1;
 			else if (k - end >= GAP_FILL)
@@ -490,9 +494,10 @@ static bool update_row(frame *f, update_state *u, int y)
 		u->row = y;
 		u->col = end;
 		x = end;
-		sent = true;
+		if (out->len - u->start >= budget)
+			return false; /* the rest of the row in the next part */
 	}
-	return sent;
+	return true;
 }
 
 static void update_end(const frame *f, update_state *u)
@@ -513,7 +518,7 @@ const abuf *frame_update(frame *f)
 	update_state u;
 	update_begin(f, &u, out);
 	for (int y = 0; y < f->rows; y++)
-		update_row(f, &u, y);
+		update_row(f, &u, y, SIZE_MAX);
 	update_end(f, &u);
 	f->next_row = 0;
 	if (out->failed) {
@@ -542,7 +547,8 @@ bool frame_update_part(frame *f, abuf *out, size_t budget)
 	update_begin(f, &u, out);
 	int y = f->next_row % f->rows;
 	for (int i = 0; i < f->rows && out->len - u.start < budget; i++) {
-		update_row(f, &u, y);
+		if (!update_row(f, &u, y, budget))
+			break; /* y again next time: its cells sent are shown */
 		y = (y + 1) % f->rows;
 	}
 	f->next_row = y;

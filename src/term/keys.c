@@ -2,6 +2,7 @@
 #include "term/keys.h"
 
 #include <curses.h>
+#include <fcntl.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -13,6 +14,7 @@ struct keys {
 	SCREEN *scr;
 	WINDOW *pad;
 	FILE *in, *out;
+	int feed_fd;          /* keys_open_fed: the write end of ncurses' input; -1: none */
 	TERMINAL *saved_term; /* readline's (terminfo's current terminal) */
 	char smkx[64], rmkx[64];
 	/* Codes ncurses gives to terminfo's extended shift+arrow keys. */
@@ -50,6 +52,7 @@ keys *keys_open(int in_fd, int esc_ms)
 	keys *k = calloc(1, sizeof *k);
 	if (!k)
 		return NULL;
+	k->feed_fd = -1;
 	struct sigaction old[NKEPT];
 	for (size_t i = 0; i < NKEPT; i++)
 		sigaction(kept[i], NULL, &old[i]);
@@ -156,6 +159,39 @@ int keys_next(keys *k)
 	}
 }
 
+keys *keys_open_fed(int esc_ms)
+{
+	int p[2];
+	if (pipe(p) != 0)
+		return NULL;
+	/* A full pipe drops keys rather than blocking the loop. */
+	fcntl(p[1], F_SETFL, fcntl(p[1], F_GETFL) | O_NONBLOCK);
+	fcntl(p[0], F_SETFD, FD_CLOEXEC);
+	fcntl(p[1], F_SETFD, FD_CLOEXEC);
+	keys *k = keys_open(p[0], esc_ms); /* ncurses reads a dup of p[0] */
+	close(p[0]);
+	if (!k) {
+		close(p[1]);
+		return NULL;
+	}
+	k->feed_fd = p[1];
+	return k;
+}
+
+bool keys_feed(keys *k, const char *b, size_t n)
+{
+	if (k->feed_fd < 0)
+		return false;
+	while (n > 0) {
+		ssize_t w = write(k->feed_fd, b, n);
+		if (w <= 0)
+			return false;
+		b += w;
+		n -= (size_t)w;
+	}
+	return true;
+}
+
 const char *keys_keypad_on(const keys *k)
 {
 	return k->smkx;
@@ -181,5 +217,7 @@ void keys_close(keys *k)
 		fclose(k->in);
 	if (k->out)
 		fclose(k->out);
+	if (k->feed_fd >= 0)
+		close(k->feed_fd);
 	free(k);
 }

@@ -16,6 +16,7 @@
 #define RTSH_KEYS_H
 
 #include <stdbool.h>
+#include <stddef.h>
 
 enum {
 	KEYS_NONE = -1,      /* no key waiting */
@@ -45,6 +46,13 @@ typedef struct keys keys;
  * milliseconds. The process's signal handlers are kept as they were. NULL
  * when ncurses cannot use the terminal (TERM unknown, out of memory). */
 keys *keys_open(int in_fd, int esc_ms);
+/* The same, but ncurses reads only what keys_feed gives it (the key bytes
+ * the event loop, term/evloop.h, read from the terminal with the answers
+ * taken out); the terminal's fd is never read here. */
+keys *keys_open_fed(int esc_ms);
+/* Gives ncurses key bytes (keys_open_fed); false when they could not all
+ * be taken (more than a pipe holds unread) or k is not fed. */
+bool keys_feed(keys *k, const char *b, size_t n);
 /* The next key waiting, or KEYS_NONE; never blocks longer than the Esc
  * delay (to tell Esc from the start of a sequence). */
 int keys_next(keys *k);

@@ -23,6 +23,7 @@
 #define SLICE_FIRST 4096    /* before the link is measured */
 #define SLICE_MAX (4u << 20)
 #define SLICE_TIMEOUT_MIN 10.0
+#define SAMPLE_SECONDS 0.1 /* the least link time one throughput figure spans */
 
 typedef enum query_kind { Q_DSR, Q_DA1, Q_RQSS, Q_TCAP } query_kind;
 
@@ -42,6 +43,9 @@ struct termout {
 	query q[MAX_QUERIES]; /* awaited answers, oldest first (a ring) */
 	int qhead, qlen;
 	double probe_sent;
+	double last_dsr;   /* when the last slice's answer (DSR or DA1) came (0: none yet) */
+	double acc_bytes, acc_seconds; /* slices answered since the last figure */
+	double link_free;  /* when the link will have sent the slices out, at bps (estimate) */
 
 	/* Input held: an escape sequence cut at the end of a read. */
 	char hold[HOLD_MAX];
@@ -52,6 +56,7 @@ struct termout {
 	bool ask_pixels;   /* the pixel questions go with the probe */
 	pixels_caps pix;   /* their answers */
 	bool final;         /* the picture is not a refinement pass */
+	bool fresh;         /* a new picture was put and has not gone whole yet */
 	bool notice_given;
 	const char *notice;
 	termout_stats st;
@@ -91,13 +96,26 @@ void termout_set_picture(termout *o, encoder *e)
 	set_lossy(o);
 }
 
-/* Lossy damage for refinement passes on a slow link. */
+/* Lossy damage for refinement passes on a slow link: the changes beyond
+ * the JND go first; once none is left, the exact remainder goes while the
+ * link has nothing better to carry (a new pass makes it lossy again). */
 static void set_lossy(termout *o)
 {
 	if (!o->pic || !o->pic->ops->set_lossy)
 		return;
 	bool slow = o->state == TERMOUT_PACED && o->st.bps > 0 && o->st.bps < TERMOUT_SLOW_BPS;
-	o->pic->ops->set_lossy(o->pic, slow && !o->final ? TERMOUT_JND : 0);
+	if (!slow || o->final) {
+		o->pic->ops->set_lossy(o->pic, 0);
+		return;
+	}
+	o->pic->ops->set_lossy(o->pic, TERMOUT_JND);
+	if (!encoder_dirty(o->pic))
+		o->pic->ops->set_lossy(o->pic, 0);
+}
+
+void termout_picture_new(termout *o)
+{
+	o->fresh = true;
 }
 
 void termout_picture_final(termout *o, bool final)
@@ -122,8 +140,7 @@ static bool push_query(termout *o, query_kind k, double now, size_t bytes)
 	if (o->qlen == MAX_QUERIES)
 		return false;
 	o->q[(o->qhead + o->qlen++) % MAX_QUERIES] = (query){k, now, bytes, false};
-	if (k == Q_DSR)
-		o->st.in_flight += bytes;
+	o->st.in_flight += bytes;
 	return true;
 }
 
@@ -164,9 +181,15 @@ void termout_probe(termout *o, bool ask_color, double now)
 		write_all(o->fd, a->b, a->len);
 }
 
-/* The link figures from an answer that came `t` seconds after its query
- * was sent, `bytes` (a slice) before it. */
-static void learn(termout *o, double t, size_t bytes)
+/* The link figures from an answer that came at `now`, `t` seconds after
+ * its query was sent, `bytes` (a slice) before it. With slices pipelined,
+ * a slice's bytes start down the link when it was sent or when the one
+ * before it had gone (its answer, less the round trip), whichever is later:
+ * they took min(t - rtt, now - last answer) seconds. Answers read in a
+ * bunch (the loop was slow to read them) would make that tiny: the bytes
+ * and seconds are summed until they span SAMPLE_SECONDS, which the sum of
+ * those minimums does over a busy stretch of the link. */
+static void learn(termout *o, double now, double t, size_t bytes, bool slice)
 {
 	if (t <= 0)
 		t = 1e-6;
@@ -174,11 +197,18 @@ static void learn(termout *o, double t, size_t bytes)
 		o->st.rtt = t;
 	if (bytes >= 512) {
 		double d = t - o->st.rtt;
-		if (d < 0.002)
-			d = 0.002;
-		double bps = (double)bytes / d;
-		o->st.bps = o->st.bps > 0 ? 0.6 * o->st.bps + 0.4 * bps : bps;
+		if (o->last_dsr > 0 && now - o->last_dsr < d)
+			d = now - o->last_dsr;
+		o->acc_bytes += (double)bytes;
+		o->acc_seconds += d > 0 ? d : 0;
+		if (o->acc_seconds >= SAMPLE_SECONDS) {
+			double bps = o->acc_bytes / o->acc_seconds;
+			o->st.bps = o->st.bps > 0 ? 0.6 * o->st.bps + 0.4 * bps : bps;
+			o->acc_bytes = o->acc_seconds = 0;
+		}
 	}
+	if (slice)
+		o->last_dsr = now;
 }
 
 /* An answer of kind k: the queries before the first of that kind were not
@@ -194,11 +224,12 @@ static void answered(termout *o, query_kind k, double now)
 		query q = o->q[o->qhead];
 		o->qhead = (o->qhead + 1) % MAX_QUERIES;
 		o->qlen--;
-		if (q.kind == Q_DSR)
-			o->st.in_flight -= q.bytes;
+		o->st.in_flight -= q.bytes;
 		if (i == n) {
 			if (!q.stale)
-				learn(o, now - q.sent, q.bytes);
+				learn(o, now, now - q.sent, q.bytes, q.bytes > 0);
+			else if (q.bytes > 0)
+				o->last_dsr = 0; /* read late: no start time from it */
 			if (q.kind == Q_DA1 && o->state == TERMOUT_PROBING)
 				o->state = TERMOUT_PACED;
 		}
@@ -372,6 +403,26 @@ static size_t slice_budget(const termout *o)
 	return b < SLICE_MIN ? SLICE_MIN : b > SLICE_MAX ? SLICE_MAX : (size_t)b;
 }
 
+/* When another slice may go (now or later; < 0: only after an answer).
+ * Two bounds: the slices not yet down the link, at the measured rate,
+ * stay within TERMOUT_QUEUE_SECONDS, which is all text (an echo) waits
+ * behind; and the bytes unanswered stay within what the link holds in a
+ * round trip plus that queue, should the rate be overestimated. Within
+ * them the link never waits for an answer. Before the link is measured:
+ * one slice at a time. */
+static double slice_time(const termout *o, double now)
+{
+	if (o->st.in_flight == 0)
+		return now;
+	if (!(o->st.bps > 0) || o->last_dsr == 0)
+		return -1;
+	double budget = (double)slice_budget(o);
+	if ((double)o->st.in_flight + budget > o->st.bps * (o->st.rtt + TERMOUT_QUEUE_SECONDS))
+		return -1;
+	double at = o->link_free - (TERMOUT_QUEUE_SECONDS - budget / o->st.bps);
+	return at > now ? at : now;
+}
+
 /* How long an answer to the oldest slice may take before the terminal
  * counts as one that does not answer. */
 static double slice_timeout(const termout *o)
@@ -409,18 +460,29 @@ void termout_pump(termout *o, double now, abuf *keys)
 		 * sends the next when the terminal can take it. */
 		encoder_update(o->pic, a, TERMOUT_UNPACED_PART);
 	} else {
-		if (o->st.in_flight > 0 || awaiting(o, Q_DSR))
-			return; /* one slice in flight at most */
+		double at = slice_time(o, now);
+		if (at < 0 || at > now || o->qlen == MAX_QUERIES)
+			return;
 		encoder_update(o->pic, a, slice_budget(o));
 		if (a->len == 0)
 			return;
-		abuf_str(a, DSR_QUERY);
-		if (!push_query(o, Q_DSR, now, a->len))
-			return;
+		/* The slice that ends a new picture (its changes beyond the
+		 * tolerance all sent) asks DA1, the others DSR: both are
+		 * answered in order, and the terminal's side can count the
+		 * pictures it was shown. */
+		bool whole = o->fresh && !encoder_dirty(o->pic);
+		if (whole)
+			o->fresh = false;
+		abuf_str(a, whole ? DA1_QUERY : DSR_QUERY);
+		push_query(o, whole ? Q_DA1 : Q_DSR, now, a->len);
+		if (whole)
+			o->st.pictures++;
 	}
 	if (a->len && !a->failed) {
 		write_all(o->fd, a->b, a->len);
 		o->st.slices++;
+		if (o->st.bps > 0)
+			o->link_free = (o->link_free > now ? o->link_free : now) + (double)a->len / o->st.bps;
 	}
 }
 
@@ -440,8 +502,11 @@ double termout_wait(const termout *o, double now)
 		CONSIDER(o->probe_sent + TERMOUT_PROBE_TIMEOUT);
 	if (o->state == TERMOUT_PACED && o->qlen > 0 && o->st.in_flight > 0)
 		CONSIDER(o->q[o->qhead].sent + slice_timeout(o));
-	if (o->pic && o->state == TERMOUT_PACED && encoder_dirty(o->pic) && o->st.in_flight == 0)
-		CONSIDER(now);
+	if (o->pic && o->state == TERMOUT_PACED && encoder_dirty(o->pic)) {
+		double at = slice_time(o, now);
+		if (at >= 0)
+			CONSIDER(at);
+	}
 #undef CONSIDER
 	return best;
 }

@@ -4,14 +4,23 @@
  * Text (the status line, the screen's frame, messages) is written at once.
  * The picture is an encoder (encoder.h) whose damage is sent in slices:
  * after each slice a Device Status Report query, CSI 5 n, which the
- * terminal answers with CSI 0 n once it has read everything before it. The
- * next slice goes only after the answer, so at most about one slice is in
- * flight however deep the buffers between rtsh and the terminal are (sshd,
- * the network). Slices are sized to about SLICE_SECONDS of the link, from
- * the throughput and round-trip time measured on the answers; text never
- * waits behind more than the slice in flight. A picture that changes while
- * slices are out is not finished: the next slice starts from what the
- * terminal really shows (the encoder's damage).
+ * terminal answers with CSI 0 n once it has read everything before it
+ * (after the slice that ends a picture, DA1 instead: answered in order
+ * too, it tells the far side a picture is whole). The
+ * bytes sent and not yet answered stay within a window: what the link
+ * carries in a round trip plus QUEUE_SECONDS of it, however deep the
+ * buffers between rtsh and the terminal are (sshd, the network). So the
+ * link never idles waiting for an answer, and text (echo, the prompt)
+ * never waits behind more than QUEUE_SECONDS of picture. Slices are about
+ * SLICE_SECONDS of the link; the throughput and round-trip time are
+ * measured on the answers. A picture that changes while slices are out is
+ * not finished: the next slice starts from what the terminal really shows
+ * (the encoder's damage).
+ *
+ * On a slow link a refinement pass is lossy: cells whose colour moved by at
+ * most TERMOUT_JND levels stay; once no bigger change is left, the exact
+ * remainder goes while the link has nothing better to carry. The final
+ * picture is exact.
  *
  * At start the scheduler asks (termout_probe): DECRQSS of a 24-bit SGR and
  * XTGETTCAP of RGB and Tc (is there truecolor?), then DA1 (CSI c), which
@@ -25,8 +34,9 @@
  * termout_input takes them out and gives back the keys alone.
  *
  * Escape sequences sent here:
- *   \e[5n                  DSR: status report (answer \e[0n)
- *   \e[c                   DA1: primary device attributes (answer \e[?...c)
+ *   \e[5n                  DSR: status report (answer \e[0n), after a slice
+ *   \e[c                   DA1: primary device attributes (answer \e[?...c):
+ *                          the start-up fence, and after a picture's last slice
  *   \e7 \e[48;2;1;2;3m \eP$qm\e\\ \e[m \e8
  *                          DECRQSS of the SGR with a 24-bit background
  *                          (answer \eP1$r...48:2:...1:2:3m\e\\ when kept)
@@ -42,7 +52,8 @@
 #include "term/encoder.h"
 #include "term/pixels.h"
 
-#define TERMOUT_SLICE_SECONDS 0.08
+#define TERMOUT_SLICE_SECONDS 0.05
+#define TERMOUT_QUEUE_SECONDS 0.08
 #define TERMOUT_PROBE_TIMEOUT 2.0
 #define TERMOUT_SLOW_BPS 2e6
 #define TERMOUT_JND 4
@@ -62,6 +73,7 @@ typedef struct termout_stats {
 	double rtt;        /* seconds, the smallest round trip seen (0: none yet) */
 	double bps;        /* bytes a second the link carries (0: not known) */
 	long slices;       /* picture slices sent */
+	long pictures;     /* pictures sent whole (their changes beyond the tolerance) */
 	long answers;      /* answers taken out of the input */
 	size_t in_flight;  /* picture bytes sent and not yet answered */
 } termout_stats;
@@ -74,6 +86,10 @@ void termout_free(termout *o);
 void termout_text(termout *o, const void *b, size_t n);
 /* The picture to send (NULL: none); the scheduler does not own it. */
 void termout_set_picture(termout *o, encoder *e);
+/* The picture's encoder was given a new picture (screen_picture): the
+ * slice that sends the last of its changes ends with DA1 (counted in
+ * termout_stats.pictures). */
+void termout_picture_new(termout *o);
 /* Drops the picture's changes not yet sent (Ctrl-C): the terminal keeps
  * what it shows. */
 void termout_drop_picture(termout *o);
@@ -81,8 +97,9 @@ void termout_drop_picture(termout *o);
 bool termout_picture_pending(const termout *o);
 /* Whether the picture is final (the render is done) or a refinement pass.
  * On a slow link (paced, under TERMOUT_SLOW_BPS) a refinement pass is sent
- * with lossy damage: cells whose colour moved by at most TERMOUT_JND sRGB
- * levels in every channel stay as they are; a final picture is exact. */
+ * with lossy damage first: cells whose colour moved by at most TERMOUT_JND
+ * sRGB levels in every channel wait until no bigger change is left; a
+ * final picture is exact. */
 void termout_picture_final(termout *o, bool final);
 
 /* Also asks, in the next termout_probe, what pixels the terminal shows

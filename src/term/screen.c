@@ -414,4 +414,6 @@ void screen_picture(screen *s, const uint8_t *rgb, int w, int h)
 	if (!s->active || !s->enc || w != s->img_w || h != s->img_h)
 		return;
 	encoder_put(s->enc, rgb, w, h, s->img_x, s->img_y);
+	if (s->out)
+		termout_picture_new(s->out);
 }

@@ -17,8 +17,10 @@
  *           the echo latency of the keys (p50, p95, max; from the key
  *           press at the terminal to its echo there), the seconds from the
  *           end of the render (as the program wrote it) to the last byte
- *           at the terminal, and the picture updates a second (ends of
- *           synchronized updates, CSI ? 2026 l) while it refined.
+ *           at the terminal, the picture updates a second (ends of
+ *           synchronized updates, CSI ? 2026 l: slices) and the whole
+ *           pictures a second (rtsh ends a picture's last slice with DA1,
+ *           the others with DSR) while it refined.
  *   ctrlc   presses Ctrl-C 2 s after the first picture; prints the seconds
  *           from the key press to the last byte at the terminal.
  * The result is one line of key=value pairs on standard output.
@@ -126,6 +128,7 @@ typedef struct term {
 	long zs;           /* 'Z' seen in text */
 	double *z_at;
 	long updates;      /* CSI ? 2026 l seen */
+	long pictures;     /* DA1 queries after the first picture: rtsh asks one after a picture's last slice */
 	long sgr24;        /* SGRs with a 24-bit colour */
 	long picture_bytes;
 	bool picture;      /* a half block has arrived */
@@ -145,8 +148,11 @@ static void csi_done(term *tm, wire *up)
 	const char *p = tm->seq + 2; /* after ESC [ */
 	if (fin == 'n' && strcmp(p, "5n") == 0)
 		answer(up, "\x1b[0n");
-	else if (fin == 'c' && (strcmp(p, "c") == 0 || strcmp(p, "0c") == 0))
+	else if (fin == 'c' && (strcmp(p, "c") == 0 || strcmp(p, "0c") == 0)) {
 		answer(up, "\x1b[?62;22c");
+		if (tm->picture)
+			tm->pictures++;
+	}
 	else if (fin == 'l' && strcmp(p, "?2026l") == 0)
 		tm->updates++;
 	else if (fin == 'm') {
@@ -300,7 +306,7 @@ int main(int argc, char **argv)
 	double t0 = now(), render_end = -1, key_at = -1, next_key = -1, first_pic_written = -1;
 	down.last = up.last = t0;
 	bool child_done = false;
-	long pic_updates_at_end = -1;
+	long pic_updates_at_end = -1, pictures_at_end = -1;
 	for (;;) {
 		double t = now();
 		if (t - t0 > timeout)
@@ -354,6 +360,7 @@ int main(int argc, char **argv)
 		}
 		if (render_end >= 0 && pic_updates_at_end < 0) {
 			pic_updates_at_end = tm.updates;
+			pictures_at_end = tm.pictures;
 			if (!ctrlc && z_typed)
 				answer(&up, "\x15"); /* Ctrl-U: the line cleared */
 		}
@@ -403,6 +410,8 @@ int main(int argc, char **argv)
 		       render_end > 0 ? tm.last_byte - render_end : -1.0);
 		printf(" updates_per_s=%.1f",
 		       refine_s > 0 && first_pic_written > 0 && pic_updates_at_end >= 0 ? (double)pic_updates_at_end / (render_end - first_pic_written) : -1.0);
+		printf(" pictures_per_s=%.1f",
+		       refine_s > 0 && first_pic_written > 0 && pictures_at_end >= 0 ? (double)pictures_at_end / (render_end - first_pic_written) : -1.0);
 	} else {
 		printf(" idle_after_ctrlc=%.2f", key_at > 0 ? tm.last_byte - key_at : -1.0);
 	}

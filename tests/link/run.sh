@@ -3,12 +3,17 @@
 # terminal that answers DSR, DA1, DECRQSS and XTGETTCAP only when the
 # query arrives. Checks, on cornell.rt refining in path mode at 200x60:
 #   - 30 KB/s, 100 ms round trip: every typed key echoes, the 95th
-#     percentile within 5x the 300 ms target (the machine may be loaded; before pacing it was 67 s);
-#     after the render ends, the wire falls idle within the time of one
-#     full frame (200x60 cells at 40 bytes a cell at most) + 2 s, that is no
-#     backlog of stale frames; Ctrl-C: idle within 1.5 s; the terminal,
-#     with no COLORTERM, said it has truecolor: the picture is 24-bit;
-#   - 1 MB/s, 20 ms: no backlog either (the same bound).
+#     percentile within 0.5 s (the target is 0.3 s, measured 0.18-0.26 s;
+#     the margin is for a loaded machine; before pacing it was 67 s);
+#     after the render ends, the wire falls idle within the time one exact
+#     picture takes on the wire (cornell at this size: at most 140 KB, 17-18
+#     bytes a cell) + 1.5 s: no backlog of stale frames, and the link kept
+#     busy (measured 3.3-3.7 s; the final pass alone changes about 70 KB of
+#     cells, so 1 s cannot be reached at 30 KB/s); Ctrl-C: idle within 1 s;
+#     the terminal, with no COLORTERM, said it has truecolor: 24-bit SGR;
+#   - 1 MB/s, 20 ms: idle within 1 s after the render; whole pictures
+#     reach the terminal while it refines (at least 2 a second; measured
+#     7.2, the preview itself made 7.8 on the loaded machine).
 # Usage: run.sh RTSH LINKSIM. The figures go to $RTSH_TEST_RESULTS/link.txt.
 set -u
 rtsh=$1; sim=$2
@@ -29,19 +34,19 @@ check() {
 		failed=$((failed + 1)); echo "[  FAILED  ] link: $1"; echo "    $line"
 	fi
 }
-full_frame_s() { awk -v r="$1" 'BEGIN { print 200 * 60 * 40 / r + 2 }'; }
+full_frame_s() { awk -v r="$1" 'BEGIN { print 140000 / r + 1.5 }'; }
 
 line=$(run 30000 0.1 refine); echo "$line" >"$results/link.txt"
 b=$(full_frame_s 30000)
 check "30 KB/s: every key echoes" 'v["keys"] >= 1 && v["echoed"] == v["keys"]'
-check "30 KB/s: echo p95 <= 1.5 s" 'v["echo_p95"] >= 0 && v["echo_p95"] <= 1.5'
+check "30 KB/s: echo p95 <= 0.5 s" 'v["echo_p95"] >= 0 && v["echo_p95"] <= 0.5'
 check "30 KB/s: idle <= $b s after the render" "v[\"render_end\"] > 0 && v[\"idle_after_end\"] <= $b"
 check "30 KB/s: truecolor from the terminal's answer" 'v["sgr24"] > 0'
 line=$(run 30000 0.1 ctrlc); echo "$line" >>"$results/link.txt"
-check "30 KB/s: idle <= 1.5 s after Ctrl-C" 'v["idle_after_ctrlc"] >= 0 && v["idle_after_ctrlc"] <= 1.5'
+check "30 KB/s: idle <= 1 s after Ctrl-C" 'v["idle_after_ctrlc"] >= 0 && v["idle_after_ctrlc"] <= 1'
 line=$(run 1000000 0.02 refine); echo "$line" >>"$results/link.txt"
-b=$(full_frame_s 1000000)
-check "1 MB/s: idle <= $b s after the render" "v[\"render_end\"] > 0 && v[\"idle_after_end\"] <= $b"
+check "1 MB/s: idle <= 1 s after the render" 'v["render_end"] > 0 && v["idle_after_end"] <= 1'
+check "1 MB/s: whole pictures while refining" 'v["pictures_per_s"] >= 2'
 rm -rf "$tmp"
 echo "[==========] link simulator: $passed passed, $failed failed"
 echo "$passed $failed" >"$results/link.count"

@@ -145,12 +145,28 @@ static void fill(uint8_t *img, int w, int h, unsigned seed)
 		img[i] = (uint8_t)(trand(&r) * 256);
 }
 
-/* Feeds a slice to the emulator, checking it ends with the DSR query. */
+/* The query a slice ends with: DSR, or DA1 after the slice that ends a
+ * picture; the length of the query, and the terminal's answer in *ans. */
+static size_t slice_query(const char *b, size_t n, const char **ans)
+{
+	if (n >= 4 && memcmp(b + n - 4, "\x1b[5n", 4) == 0) {
+		*ans = "\x1b[0n";
+		return 4;
+	}
+	assert_true(n >= 3);
+	assert_memory_equal(b + n - 3, "\x1b[c", 3);
+	*ans = "\x1b[?62;22c";
+	return 3;
+}
+
+/* What the terminal answers to the last slice applied. */
+static const char *answer = "\x1b[0n";
+
+/* Feeds a slice to the emulator, checking it ends with a query. */
 static void apply_slice(emu *e, const char *b, size_t n)
 {
-	assert_true(n >= 4);
-	assert_memory_equal(b + n - 4, "\x1b[5n", 4);
-	emu_feed(e, b, n - 4);
+	size_t q = slice_query(b, n, &answer);
+	emu_feed(e, b, n - q);
 }
 
 /* The screen shows exactly the encoder's picture of img (truecolor). */
@@ -210,9 +226,10 @@ static void test_paced_slices_and_overtaking(void **state)
 	assert_true(termout_get_stats(o).in_flight > 0);
 	/* A newer picture overtakes the half-sent one. */
 	encoder_put(enc, b, W, H, 0, 0);
+	termout_picture_new(o);
 	double t = 1.1;
 	for (int i = 0; i < 100 && encoder_dirty(enc); i++) {
-		feed(o, "\x1b[0n", t, &keys);
+		feed(o, answer, t, &keys);
 		termout_pump(o, t, &keys);
 		n = drain(rd, buf, sizeof buf);
 		if (n)
@@ -221,13 +238,16 @@ static void test_paced_slices_and_overtaking(void **state)
 	}
 	assert_false(encoder_dirty(enc));
 	assert_screen_shows(&e, b, W, H, 0);
+	/* The slice that ended the picture asked DA1 (the others DSR). */
+	assert_string_equal(answer, "\x1b[?62;22c");
+	assert_int_equal(termout_get_stats(o).pictures, 1);
 	assert_int_equal(keys.len, 0);
 	/* The link was measured from the answers. */
 	assert_true(termout_get_stats(o).bps > 0);
 
 	/* A refinement pass on this slow link: cells within the JND stay, the
 	 * others go; the final picture is exact. */
-	feed(o, "\x1b[0n", t, &keys);
+	feed(o, answer, t, &keys);
 	uint8_t c[W * H * 3];
 	memcpy(c, b, sizeof c);
 	for (int i = 0; i < W * H * 3; i++)
@@ -244,9 +264,20 @@ static void test_paced_slices_and_overtaking(void **state)
 	assert_false(encoder_dirty(enc));
 	assert_true(n < 40 * 10); /* a run of five cells, not the picture */
 	assert_screen_shows(&e, c, W, H, TERMOUT_JND);
+	/* With no bigger change left, the exact remainder goes while the link
+	 * is free: the terminal ends showing the pass exactly. */
+	for (int i = 0; i < 100 && (termout_picture_pending(o) || termout_get_stats(o).in_flight); i++) {
+		feed(o, answer, t, &keys);
+		termout_pump(o, t, &keys);
+		n = drain(rd, buf, sizeof buf);
+		if (n)
+			apply_slice(&e, buf, n);
+		t += 0.1;
+	}
+	assert_screen_shows(&e, c, W, H, 0);
 	termout_picture_final(o, true);
 	for (int i = 0; i < 100 && encoder_dirty(enc); i++) {
-		feed(o, "\x1b[0n", t, &keys);
+		feed(o, answer, t, &keys);
 		termout_pump(o, t, &keys);
 		n = drain(rd, buf, sizeof buf);
 		if (n)
@@ -256,7 +287,7 @@ static void test_paced_slices_and_overtaking(void **state)
 	assert_screen_shows(&e, c, W, H, 0);
 
 	/* Ctrl-C: what is not sent is dropped. */
-	feed(o, "\x1b[0n", t, &keys);
+	feed(o, answer, t, &keys);
 	encoder_put(enc, a, W, H, 0, 0);
 	termout_drop_picture(o);
 	assert_false(encoder_dirty(enc));
@@ -267,12 +298,117 @@ static void test_paced_slices_and_overtaking(void **state)
 	close_out(o, rd);
 }
 
+/* A link of `rate` bytes a second and round trip `rtt` in virtual time:
+ * a slice written at s goes down once the link is free, for its bytes'
+ * time; the terminal answers its DSR as it arrives, the answer is back
+ * rtt after the slice's last byte went out. The program reads its input
+ * every `read_every` seconds (answers pile up in between). A new
+ * refinement pass of random colours every 0.1 s keeps the picture dirty. */
+typedef struct sim_result {
+	double bps;        /* the scheduler's figure at the end */
+	double util;       /* bytes carried / what the link could carry since the first slice */
+	double max_queue;  /* the most link time ahead of a key's echo written right after a slice
+	                    * (once the link is measured) */
+	long slices;
+} sim_result;
+
+static sim_result simulate(double rate, double rtt, double read_every, double seconds)
+{
+	enum { COLS = 100, ROWS = 30, W = COLS, H = 2 * ROWS, MAXQ = 4096 };
+	int rd;
+	termout *o = open_out(&rd);
+	static char buf[1 << 22];
+	abuf keys;
+	abuf_init(&keys);
+	encoder_geom g = {.cols = COLS, .rows = ROWS, .pal = PALETTE_TRUECOLOR};
+	encoder *enc = encoder_halfblock.open(&g);
+	assert_non_null(enc);
+	termout_set_picture(o, enc);
+	termout_picture_final(o, false);
+	double t = 0, busy_until = 0, first = -1, carried = 0;
+	termout_probe(o, false, t);
+	drain(rd, buf, sizeof buf);
+	double answers[MAXQ];
+	const char *kinds[MAXQ];
+	int qa = 0, qn = 0;
+	kinds[qn] = "\x1b[?62c";
+	answers[qn++] = rtt; /* the probe's DA1 */
+	sim_result r = {0};
+	static uint8_t img[W * H * 3];
+	double next_pass = 0, next_read = 0;
+	const double dt = 0.001;
+	for (; t < seconds; t += dt) {
+		if (t >= next_pass) {
+			fill(img, W, H, (unsigned)(t * 1000) + 3);
+			encoder_put(enc, img, W, H, 0, 0);
+			termout_picture_new(o);
+			next_pass += 0.1;
+		}
+		if (t >= next_read) {
+			while (qa < qn && answers[qa] <= t) {
+				feed(o, kinds[qa], t, &keys);
+				qa++;
+			}
+			next_read += read_every;
+		}
+		bool measured = termout_get_stats(o).bps > 0; /* the slices after the first figure */
+		termout_pump(o, t, &keys);
+		size_t n = drain(rd, buf, sizeof buf);
+		if (n) {
+			assert_true(qn < MAXQ);
+			slice_query(buf, n, &kinds[qn]);
+			if (first < 0)
+				first = t;
+			double start = busy_until > t ? busy_until : t;
+			busy_until = start + (double)n / rate;
+			double q = busy_until - t; /* an echo written now waits this long */
+			if (measured && q > r.max_queue)
+				r.max_queue = q;
+			answers[qn++] = busy_until + rtt; /* kinds[qn] set above */
+			carried += (double)n;
+			r.slices++;
+		}
+	}
+	/* The bytes still queued at the end were not carried yet. */
+	if (busy_until > t)
+		carried -= (busy_until - t) * rate;
+	r.util = carried / (rate * (t - first));
+	r.bps = termout_get_stats(o).bps;
+	abuf_free(&keys);
+	encoder_close(enc);
+	drain(rd, buf, sizeof buf);
+	close_out(o, rd);
+	return r;
+}
+
+/* Slices are pipelined: the link stays busy (no waiting a round trip for
+ * each answer), the throughput figure is the link's, and an echo never
+ * waits behind much more than TERMOUT_QUEUE_SECONDS of picture. Also when
+ * the answers are read in bunches. */
+static void test_pipelined_slices(void **state)
+{
+	(void)state;
+	const double rate = 30000, rtt = 0.1;
+	for (int k = 0; k < 2; k++) {
+		double read_every = k == 0 ? 0.001 : 0.03;
+		sim_result r = simulate(rate, rtt, read_every, 6.0);
+		print_message("read every %.3f s: bps %.0f, link used %.2f, queue max %.3f s, %ld slices\n", read_every,
+		              r.bps, r.util, r.max_queue, r.slices);
+		assert_true(r.bps > 0.85 * rate && r.bps < 1.2 * rate);
+		assert_true(r.util > 0.85);
+		/* the queue, the slice just written, and what one row's run may
+		 * add past the budget (16 cells of about 40 bytes) */
+		assert_true(r.max_queue <= TERMOUT_QUEUE_SECONDS + TERMOUT_SLICE_SECONDS + 16 * 40 / rate + 0.02);
+	}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_answers_out_of_keys),
 		cmocka_unit_test(test_probe_without_color_and_timeout),
 		cmocka_unit_test(test_paced_slices_and_overtaking),
+		cmocka_unit_test(test_pipelined_slices),
 	};
 	return cmocka_run_group_tests_name("out", tests, NULL, NULL);
 }
