@@ -22,18 +22,18 @@ enum {
 	KIND_UNBOUNDED = 1, /* no size: scale is unused (the plane) */
 	KIND_VERTICES = 2,  /* three world-space vertices in tri[], no transform (the triangle) */
 	KIND_TUBE = 4,      /* uses object.tube (the torus) */
+	KIND_MODEL = 8,     /* a model file placed like a unit shape: file, file_colors, smooth,
+	                     * crease (the mesh; its triangles are the world's instances, mesh.h) */
 };
 
 typedef enum obj_kind {
 #define RT_KIND(e, id, name, desc, flags) OBJ_##e,
 #include "rtsh/kinds.def"
 #undef RT_KIND
-	OBJ_KIND_COUNT, /* the kinds drawn from the unit shapes (shape.h, kinds.def) */
-	OBJ_MESH = OBJ_KIND_COUNT, /* a model file (mesh.h), placed like a unit shape */
-	OBJ_KIND_ALL
+	OBJ_KIND_COUNT
 } obj_kind;
 
-/* The KIND_* flags of a kind (0 for OBJ_MESH). */
+/* The KIND_* flags of a kind (kinds.def). */
 unsigned obj_kind_flags(obj_kind k);
 
 /* One shared copy of the string s[0..n) that lives as long as the process:
@@ -88,7 +88,7 @@ typedef struct object {
 	vec3 tri[3];      /* KIND_VERTICES: the vertices (pos/dir/scale unused) */
 	double tube;      /* the torus: tube-to-ring diameter ratio (tube=), > 0; 0.5 by default */
 	material mat;
-	/* OBJ_MESH: the model file (rt_intern'ed, as the reader resolved it:
+	/* KIND_MODEL: the model file (rt_intern'ed, as the reader resolved it:
 	 * relative to the .rt file's folder, or absolute), whether the colour
 	 * was left out (the model's own materials are used), and the normals. */
 	const char *file;

@@ -29,7 +29,8 @@
  * (42) form between the identifier and R,G,B, and whether the extended form
  * `ID POS ROT SCALE R,G,B ...` is read under the same identifier. */
 typedef struct shape_form {
-	const char *id;        /* "sp"; NULL: no such form */
+	const char *id;        /* "sp"; NULL: no such form (a kind's own form is NULL
+	                        * when the reader has an element of its own for it: mesh) */
 	const char *name;      /* in messages: "sphere" */
 	bool strict;           /* allowed by --strict (the 42 subject's elements) */
 	bool extended;         /* ID POS ROT SCALE ... is read under this id too */
@@ -63,7 +64,7 @@ typedef struct shape_kind {
 	/* Nearest hit with tmin < t < tmax in object space: sets *t and the
 	 * outward object-space normal *n (not normalised). `tube` is the
 	 * object's tube ratio (kinds with KIND_TUBE; others ignore it). NULL for
-	 * KIND_VERTICES (tri_intersect). */
+	 * KIND_VERTICES (tri_intersect) and KIND_MODEL (mesh.h, surface.c). */
 	bool (*intersect)(vec3 o, vec3 d, double tube, double tmin, double tmax, double *t, vec3 *n);
 	/* Any hit with tmin < t < tmax (shadow rays). */
 	bool (*occluded)(vec3 o, vec3 d, double tube, double tmin, double tmax);

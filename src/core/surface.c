@@ -53,7 +53,7 @@ bool surf_begin(world *w, const scene *s, rt_error *err)
 	size_t n = 0, ntx = 0;
 	for (size_t i = 0; i < s->nobjs; i++) {
 		const material *om = &s->objs[i].mat;
-		n += s->objs[i].kind == OBJ_MESH;
+		n += (obj_kind_flags(s->objs[i].kind) & KIND_MODEL) != 0;
 		ntx += om->texture || om->normalmap || om->bump;
 	}
 	w->mtex = NULL;
@@ -69,7 +69,7 @@ bool surf_begin(world *w, const scene *s, rt_error *err)
 	size_t extra = 0;
 	for (size_t i = 0; i < s->nobjs; i++) {
 		const object *o = &s->objs[i];
-		if (o->kind != OBJ_MESH)
+		if (!(obj_kind_flags(o->kind) & KIND_MODEL))
 			continue;
 		mesh *m = mesh_cache_get(o->file ? o->file : "", o->smooth != 0, o->crease, err);
 		if (!m) {
@@ -121,7 +121,7 @@ bool surf_material(world *w, const object *o, uint32_t i, rt_error *err)
 		w->mtex[w->nmtex] = own;
 		m->tx = &w->mtex[w->nmtex++];
 	}
-	if (o->kind != OBJ_MESH || !o->file_colors)
+	if (!(obj_kind_flags(o->kind) & KIND_MODEL) || !o->file_colors)
 		return true;
 	/* the model's own materials, after the object's: its keys (fuzz,
 	 * metal, ...) and textures apply unless the file has its own */
@@ -328,7 +328,8 @@ void surf_inst_finish(const world *w, const prim *p, const ray *r, vec3 nl, hit 
 	mesh_surf s;
 	mesh_surface(m, (uint32_t)nl.x, b, &s);
 	vec3 ng = v3_norm(mat3x4_normal(in->inv, s.ng));
-	vec3 ns = v3_norm(mat3x4_normal(in->inv, s.ns));
+	/* flat faces: the shading normal is the geometric one */
+	vec3 ns = m->n ? v3_norm(mat3x4_normal(in->inv, s.ns)) : ng;
 	mat3x4_point(in->inv, h->p, &h->local);
 	h->front = v3_dot(ng, r->d) < 0.0;
 	h->n = ns;

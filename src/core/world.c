@@ -102,7 +102,7 @@ static bool is_fast_sphere(const object *o)
  * *b (planes: see make_plane). */
 static bool make_prim(world *w, const object *o, uint32_t index, prim *p, box *b, rt_error *err)
 {
-	if (o->kind == OBJ_MESH)
+	if (obj_kind_flags(o->kind) & KIND_MODEL)
 		return surf_make_inst(w, o, index, p, b, err);
 	memset(p, 0, sizeof *p);
 	p->object = index;
@@ -225,7 +225,7 @@ world *world_build(const scene *s, rt_error *err)
 		unsigned f = obj_kind_flags(o->kind);
 		nplanes += (f & KIND_UNBOUNDED) != 0;
 		ntris += (f & KIND_VERTICES) != 0;
-		nshapes += !(f & KIND_VERTICES) && o->kind != OBJ_MESH && !is_fast_sphere(o);
+		nshapes += !(f & (KIND_VERTICES | KIND_MODEL)) && !is_fast_sphere(o);
 	}
 	size_t nbounded = s->nobjs - nplanes;
 	w->lights = calloc(s->nlights ? s->nlights : 1, sizeof *w->lights);
@@ -297,8 +297,7 @@ world *world_build(const scene *s, rt_error *err)
 	for (size_t i = 0; i < w->nprims; i++)
 		costs[i] = w->prims[i].tag == PRIM_SPHERE     ? 1.0f
 		           : w->prims[i].tag == PRIM_TRIANGLE ? 2.0f
-		           : w->prims[i].tag == PRIM_MESH     ? 32.0f
-		                                              : shape_kinds[w->shapes[w->prims[i].u.index].kind]->cost;
+		                                              : shape_kinds[s->objs[w->prims[i].object].kind]->cost;
 	w->tree = bvh_build(bounds, costs, w->nprims, order, err);
 	free(costs);
 	free(bounds);

@@ -63,7 +63,7 @@ const char *rt_key_info(size_t i, const char **help)
 bool rt_key_applies(const rt_key *k, obj_kind kind)
 {
 	unsigned f = obj_kind_flags(kind);
-	if (k->mesh_only && kind != OBJ_MESH)
+	if (k->mesh_only && !(f & KIND_MODEL))
 		return false;
 	if ((f & KIND_VERTICES) && !k->triangles)
 		return false;

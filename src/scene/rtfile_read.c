@@ -707,7 +707,7 @@ static bool parse_keys(parser *p, const elem_def *e, object *o)
 			return fail_tok(p, t, e->name, "key", k == rt_nkeys ? "is unknown" : what, list);
 		}
 		const rt_key *key = &rt_keys[k];
-		if (key->mesh_only && o->kind != OBJ_MESH)
+		if (key->mesh_only && !(obj_kind_flags(o->kind) & KIND_MODEL))
 			return fail_tok(p, t, e->name, "key", "applies to meshes only",
 			                "smooth= and crease= on mesh lines");
 		if (seen & (1u << k))
@@ -1043,7 +1043,8 @@ static void element_list(const parser *p, char *list, size_t size)
 		ADD(elements_head[i].id, elements_head[i].strict);
 	for (int k = 0; k < OBJ_KIND_COUNT; k++) {
 		const shape_kind *d = shape_kinds[k];
-		ADD(d->form.id, d->form.strict);
+		if (d->form.id)
+			ADD(d->form.id, d->form.strict);
 		if (d->alias.id)
 			ADD(d->alias.id, d->alias.strict);
 	}

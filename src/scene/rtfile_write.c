@@ -181,8 +181,9 @@ static void fmt_object(sbuf *b, const object *o, bool extended)
 	const shape_kind *d = o->kind < OBJ_KIND_COUNT ? shape_kinds[o->kind] : NULL;
 	double sizes[4];
 	const shape_form *f = NULL;
-	if (o->kind == OBJ_MESH) {
-		sb_put(b, "mesh ");
+	if (obj_kind_flags(o->kind) & KIND_MODEL) {
+		sb_put(b, obj_kind_id(o->kind));
+		sb_put(b, " ");
 		sb_file(b, o->file ? o->file : "");
 		sb_vec(b, o->pos);
 		sb_vec(b, o->dir);

@@ -10,31 +10,30 @@
 static const struct {
 	const char *id, *name;
 	unsigned flags;
-} kind_names[OBJ_KIND_ALL] = {
+} kind_names[OBJ_KIND_COUNT] = {
 #define RT_KIND(e, i, n, desc, f) [OBJ_##e] = {i, n, f},
 #include "rtsh/kinds.def"
 #undef RT_KIND
-	[OBJ_MESH] = {"mesh", "mesh", 0},
 };
 
 const char *obj_kind_id(obj_kind k)
 {
-	return (unsigned)k < OBJ_KIND_ALL ? kind_names[k].id : "?";
+	return (unsigned)k < OBJ_KIND_COUNT ? kind_names[k].id : "?";
 }
 
 const char *obj_kind_name(obj_kind k)
 {
-	return (unsigned)k < OBJ_KIND_ALL ? kind_names[k].name : "object";
+	return (unsigned)k < OBJ_KIND_COUNT ? kind_names[k].name : "object";
 }
 
 unsigned obj_kind_flags(obj_kind k)
 {
-	return (unsigned)k < OBJ_KIND_ALL ? kind_names[k].flags : 0;
+	return (unsigned)k < OBJ_KIND_COUNT ? kind_names[k].flags : 0;
 }
 
 int obj_kind_from_id(const char *id)
 {
-	for (int k = 0; k < OBJ_KIND_ALL; k++)
+	for (int k = 0; k < OBJ_KIND_COUNT; k++)
 		if (strcmp(id, kind_names[k].id) == 0)
 			return k;
 	return -1;

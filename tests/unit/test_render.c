@@ -167,6 +167,8 @@ static scene *busy_scene(void)
 	add_light(s, v3(4, 3, -3), 0.4);
 	test_rng r = {11};
 	for (int k = 0; k < OBJ_KIND_COUNT * 3; k++) {
+		if (obj_kind_flags((obj_kind)(k % OBJ_KIND_COUNT)) & KIND_MODEL)
+			continue; /* a model needs a file (test_mesh) */
 		object o = object_make((obj_kind)(k % OBJ_KIND_COUNT),
 		                       v3(trange(&r, 0, 255), trange(&r, 0, 255), trange(&r, 0, 255)));
 		o.pos = v3(trange(&r, -4, 4), trange(&r, 0, 3), trange(&r, -2, 4));

@@ -1079,6 +1079,8 @@ static vec3 rand_dir(test_rng *r)
 static object rand_object(test_rng *r)
 {
 	obj_kind k = (obj_kind)(int)trange(r, 0, OBJ_KIND_COUNT);
+	if (obj_kind_flags(k) & KIND_MODEL)
+		k = OBJ_SPHERE; /* a model needs a file (test_mesh round-trips mesh lines) */
 	object o = object_make(k, rand_color(r));
 	bool simple = trand(r) < 0.4; /* something a short form can say */
 	if (k == OBJ_TRIANGLE) {

@@ -18,7 +18,7 @@ const shape_kind *shape_kind_find(const char *id, obj_kind *k, const shape_form 
 {
 	for (int i = 0; i < OBJ_KIND_COUNT; i++) {
 		const shape_kind *d = shape_kinds[i];
-		const shape_form *f = strcmp(d->form.id, id) == 0                    ? &d->form
+		const shape_form *f = d->form.id && strcmp(d->form.id, id) == 0     ? &d->form
 		                      : d->alias.id && strcmp(d->alias.id, id) == 0 ? &d->alias
 		                                                                    : NULL;
 		if (f) {
@@ -36,6 +36,19 @@ const shape_kind triangle_kind = {
 	         {"first point", "second point", "third point"}, "ppp", NULL, NULL},
 	.bounds = unit_cube_bounds,
 	.recipe = {.use = true}, /* generate.c places the vertices */
+};
+
+/* A mesh is a model file (mesh.h) placed like a unit shape: in object
+ * space the model's box is centred on the origin with its longest side 2,
+ * so within the unit cube. Its .rt line (FILE, a size of one or three
+ * numbers, a colour that may be left out) is no short or extended form:
+ * the reader's `mesh` element reads it, and the world traces its triangles
+ * as an instance of the shared mesh (surface.c), not by a unit-shape test. */
+const shape_kind mesh_kind = {
+	.form = {NULL, "mesh", false, false, true, 0, NULL, {NULL}, "", NULL, NULL},
+	.bounds = unit_cube_bounds,
+	.cost = 32, /* a ray into its object space and down its own tree */
+	.recipe = {.use = false},
 };
 
 box shape_local_bounds(obj_kind k, double tube)
