@@ -15,7 +15,6 @@
 #include "shell/keymode.h"
 
 #include <errno.h>
-#include <fcntl.h>
 #include <math.h>
 #include <signal.h>
 #include <stdarg.h>
@@ -221,6 +220,8 @@ static void km_start(keymode *km, bool refine)
 		r.kind = RSVC_REFINE;
 		r.accumulate = true;
 		r.pass_seconds = KEYMODE_PASS_SECONDS;
+		/* Path passes denoised, as the shell's previews (set denoise). */
+		r.denoise = sh->set.mode == MODE_PATH && sh->set.denoise != DENOISE_OFF;
 	} else {
 		km->ratio_i = km_pick_ratio(km);
 		r.kind = RSVC_FRAME;
@@ -412,8 +413,8 @@ static void km_status_text(keymode *km, char *buf, size_t size)
 	else if (!refine)
 		snprintf(spp, sizeof spp, "1/1 spp");
 	else
-		snprintf(spp, sizeof spp, "%d/%d spp%s", im->spp, im->target,
-		         km->stopped ? " stopped" : im->done ? "" : "…");
+		snprintf(spp, sizeof spp, "%d/%d spp%s%s", im->spp, im->target,
+		         km->stopped ? " stopped" : im->done ? "" : "…", im->denoised ? " │ denoised" : "");
 	if (km->have_img && !refine && ratios[km->ratio_i] > 1)
 		snprintf(res, sizeof res, " (1/%g res)", ratios[km->ratio_i]);
 	double f = km_fps(km);
@@ -454,7 +455,6 @@ static void km_draw(keymode *km)
 	char status[1024];
 	km_status_text(km, status, sizeof status);
 	keyview_draw(&km->kv, status);
-	termout_pump(km->out, now(), &km->late);
 	km->dirty = false;
 	km->last_draw = now();
 }
@@ -703,6 +703,7 @@ int keymode_tick(keymode *km)
 		km_status_text(km, status, sizeof status);
 		km->dirty = keyview_status_differs(&km->kv, status);
 	}
+	int drawn = 0;
 	if (picture || km->dirty || km->kv.repaint) {
 		km_draw(km);
 		if (picture) {
@@ -710,10 +711,13 @@ int keymode_tick(keymode *km)
 			km->frames++;
 			if (km->img.kind != RSVC_REFINE)
 				km->fast_times[km->fast_frames++ % 16] = km->last_draw;
-			return 1;
+			drawn = 1;
 		}
 	}
-	return 0;
+	/* What the pacing allows of the picture now (the rest at the next
+	 * ticks, or by the event loop's turns). */
+	termout_pump(km->out, now(), &km->late);
+	return drawn;
 }
 
 double keymode_timeout(const keymode *km)
@@ -846,17 +850,6 @@ static void raw_modes(int fd, const struct termios *saved)
 	tcsetattr(fd, TCSANOW, &t);
 }
 
-/* Moves the key bytes in *b to ncurses' pipe (the terminal's input minus
- * the scheduler's answers). */
-static void feed_keys(int fd, abuf *b)
-{
-	if (b->len && !b->failed) {
-		ssize_t r = write(fd, b->b, b->len);
-		(void)r; /* a full pipe: keys typed faster than 64 KiB ahead are dropped */
-	}
-	abuf_reset(b);
-}
-
 bool keymode_run(shell *sh)
 {
 	screen *scr = sh->scr;
@@ -879,18 +872,9 @@ bool keymode_run(shell *sh)
 	abuf_init(&pend);
 	/* The shell's event loop reads the terminal: the scheduler takes its
 	 * answers out (they pace the picture), and the keys go on to ncurses
-	 * through a pipe. */
-	int kp[2];
-	if (pipe(kp) != 0) {
-		abuf_free(&pend);
-		return shell_fail(sh, "view: %s", strerror(errno));
-	}
-	for (int i = 0; i < 2; i++)
-		fcntl(kp[i], F_SETFL, fcntl(kp[i], F_GETFL) | O_NONBLOCK);
-	keys *k = keys_open(kp[0], 25);
+	 * (keys_feed), which never reads the terminal itself. */
+	keys *k = keys_open_fed(25);
 	if (!k) {
-		close(kp[0]);
-		close(kp[1]);
 		abuf_free(&pend);
 		return shell_fail(sh, "view: ncurses cannot read the keys of this terminal (TERM=%s)",
 		                  getenv("TERM") ? getenv("TERM") : "");
@@ -940,7 +924,9 @@ bool keymode_run(shell *sh)
 			abuf_char(&pend, (char)b);
 		abuf_add(&pend, km->late.b, km->late.len);
 		abuf_reset(&km->late);
-		feed_keys(kp[1], &pend);
+		if (pend.len && !pend.failed)
+			keys_feed(k, pend.b, pend.len); /* a full pipe: keys typed far ahead are dropped */
+		abuf_reset(&pend);
 		int c;
 		while (!keymode_done(km) && (c = keys_next(k)) != KEYS_NONE)
 			if (c != KEYS_RESIZE)
@@ -954,8 +940,6 @@ bool keymode_run(shell *sh)
 	/* Give the terminal and the screen back to the shell. */
 	screen_keypad(fd, NULL, NULL, false);
 	keys_close(k);
-	close(kp[0]);
-	close(kp[1]);
 	abuf_free(&pend);
 	tcsetattr(in, TCSANOW, &saved);
 	sh->scr = scr;

@@ -63,6 +63,7 @@ void keyview_picture(keyview *v, const uint8_t *rgb, bool final)
 	if (!v->enc)
 		return;
 	encoder_put(v->enc, rgb, v->img_w, v->img_h, v->img_x, v->img_y);
+	termout_picture_new(v->out);
 	termout_picture_final(v->out, final);
 }
 
