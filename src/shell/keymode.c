@@ -220,6 +220,8 @@ static void km_start(keymode *km, bool refine)
 		r.kind = RSVC_REFINE;
 		r.accumulate = true;
 		r.pass_seconds = KEYMODE_PASS_SECONDS;
+		/* Path passes denoised, as the shell's previews (set denoise). */
+		r.denoise = sh->set.mode == MODE_PATH && sh->set.denoise != DENOISE_OFF;
 	} else {
 		km->ratio_i = km_pick_ratio(km);
 		r.kind = RSVC_FRAME;
@@ -411,8 +413,8 @@ static void km_status_text(keymode *km, char *buf, size_t size)
 	else if (!refine)
 		snprintf(spp, sizeof spp, "1/1 spp");
 	else
-		snprintf(spp, sizeof spp, "%d/%d spp%s", im->spp, im->target,
-		         km->stopped ? " stopped" : im->done ? "" : "…");
+		snprintf(spp, sizeof spp, "%d/%d spp%s%s", im->spp, im->target,
+		         km->stopped ? " stopped" : im->done ? "" : "…", im->denoised ? " │ denoised" : "");
 	if (km->have_img && !refine && ratios[km->ratio_i] > 1)
 		snprintf(res, sizeof res, " (1/%g res)", ratios[km->ratio_i]);
 	double f = km_fps(km);

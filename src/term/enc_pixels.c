@@ -2,9 +2,10 @@
  * encoder interface.
  *
  * The canvas is the picture area at the terminal's own pixel size (cols x
- * cell_w by rows x cell_h). It is sent in strips of STRIP_ROWS cell rows,
- * each a picture of its own placed at its first cell (kitty: its own image
- * id, replaced in place), so that every part of an update stands alone
+ * cell_w by rows x cell_h). It is sent in strips of STRIP_ROWS cell rows
+ * (sixel: smaller tiles, SIXEL_TILE_W), each a picture of its own placed at
+ * its first cell (kitty: its own image id, replaced in place), so that
+ * every part of an update stands alone
  * and a slow link carries one strip at a time: a newer picture is never
  * queued behind an older one, the strips still to send simply come from
  * it. A strip whose pixels the terminal already shows is not sent (a hash
@@ -19,15 +20,27 @@
 #include "term/encoder.h"
 #include "term/pixels.h"
 
-/* Cell rows per strip. */
+/* Cell rows per strip (kitty, iTerm2: a strip is the picture's width). */
 #define STRIP_ROWS 2
+/* Sixel sends tiles of one cell row and at most this many pixels across
+ * (and never more than the terminal's largest sixel image): a sixel image
+ * carries its own palette and cannot be cut, so a tile must be small
+ * enough to fit the output scheduler's slice on a slow link (30 KB/s:
+ * 2.4 KB a slice). */
+#define SIXEL_TILE_W 256
+/* The largest sixel image when the terminal does not say (xterm's default
+ * maxGraphicSize). */
+#define SIXEL_SAFE_MAX 1000
 
 typedef struct pix_enc {
 	encoder base;
 	pixels_mode mode;
 	int w, h;          /* the canvas in pixels */
 	uint8_t *rgb;      /* w*h*3, sRGB */
-	int nstrips;
+	int nstrips;       /* tiles: nrows x ncols */
+	int tile_rows, tile_cols; /* a tile in cells */
+	int ncols;         /* tiles across */
+	uint8_t *tmp;      /* one tile's pixels when it is narrower than the canvas */
 	uint64_t *want;    /* the hash of each strip of the canvas */
 	uint64_t *shown;   /* the hash of what the terminal shows there; 0: not known */
 	bool *stale;       /* given up by keep_shown: the terminal shows an older picture */
@@ -42,15 +55,29 @@ static void pix_canvas(const encoder_geom *g, int *w, int *h)
 	*h = g->rows * g->cell_h;
 }
 
+/* Tile k in pixels. */
+static void tile_rect(const pix_enc *e, int k, int *x, int *y, int *w, int *h)
+{
+	const encoder_geom *g = &e->base.geom;
+	int r = k / e->ncols, c = k % e->ncols;
+	int rows = g->rows - r * e->tile_rows, cols = g->cols - c * e->tile_cols;
+	*x = c * e->tile_cols * g->cell_w;
+	*y = r * e->tile_rows * g->cell_h;
+	*w = (cols < e->tile_cols ? cols : e->tile_cols) * g->cell_w;
+	*h = (rows < e->tile_rows ? rows : e->tile_rows) * g->cell_h;
+}
+
 static uint64_t strip_hash(const pix_enc *e, int k)
 {
-	int sh = STRIP_ROWS * e->base.geom.cell_h;
-	int y0 = k * sh, y1 = y0 + sh < e->h ? y0 + sh : e->h;
-	const uint8_t *p = e->rgb + (size_t)y0 * e->w * 3, *end = e->rgb + (size_t)y1 * e->w * 3;
-	uint64_t x = 0xcbf29ce484222325ULL; /* FNV-1a */
-	for (; p < end; p++)
-		x = (x ^ *p) * 0x100000001b3ULL;
-	return x | 1; /* never 0, which means "not known" */
+	int x, y, w, h;
+	tile_rect(e, k, &x, &y, &w, &h);
+	uint64_t v = 0xcbf29ce484222325ULL; /* FNV-1a */
+	for (int row = y; row < y + h; row++) {
+		const uint8_t *p = e->rgb + ((size_t)row * e->w + x) * 3, *end = p + (size_t)w * 3;
+		for (; p < end; p++)
+			v = (v ^ *p) * 0x100000001b3ULL;
+	}
+	return v | 1; /* never 0, which means "not known" */
 }
 
 static encoder *pix_open_mode(const encoder_geom *g, const encoder_ops *ops, pixels_mode mode)
@@ -67,13 +94,26 @@ static encoder *pix_open_mode(const encoder_geom *g, const encoder_ops *ops, pix
 	e->mode = mode;
 	e->w = w;
 	e->h = h;
-	e->nstrips = (g->rows + STRIP_ROWS - 1) / STRIP_ROWS;
+	e->tile_rows = STRIP_ROWS;
+	e->tile_cols = g->cols;
+	if (mode == PIXELS_SIXEL) {
+		int max_w = g->max_w > 0 ? g->max_w : SIXEL_SAFE_MAX;
+		max_w = max_w < SIXEL_TILE_W ? max_w : SIXEL_TILE_W;
+		e->tile_rows = 1;
+		e->tile_cols = max_w / g->cell_w > 0 ? max_w / g->cell_w : 1;
+		if (e->tile_cols > g->cols)
+			e->tile_cols = g->cols;
+	}
+	e->ncols = (g->cols + e->tile_cols - 1) / e->tile_cols;
+	e->nstrips = (g->rows + e->tile_rows - 1) / e->tile_rows * e->ncols;
 	e->rgb = calloc((size_t)w * h * 3, 1);
+	e->tmp = e->ncols > 1 ? malloc((size_t)e->tile_cols * g->cell_w * e->tile_rows * g->cell_h * 3) : NULL;
 	e->want = calloc((size_t)e->nstrips, sizeof *e->want);
 	e->shown = calloc((size_t)e->nstrips, sizeof *e->shown);
 	e->stale = calloc((size_t)e->nstrips, sizeof *e->stale);
-	if (!e->rgb || !e->want || !e->shown || !e->stale) {
+	if (!e->rgb || !e->want || !e->shown || !e->stale || (e->ncols > 1 && !e->tmp)) {
 		free(e->rgb);
+		free(e->tmp);
 		free(e->want);
 		free(e->shown);
 		free(e->stale);
@@ -90,6 +130,7 @@ static void pix_close(encoder *b)
 {
 	pix_enc *e = (pix_enc *)b;
 	free(e->rgb);
+	free(e->tmp);
 	free(e->want);
 	free(e->shown);
 	free(e->stale);
@@ -106,8 +147,11 @@ static void pix_put(encoder *b, const uint8_t *rgb, int w, int h, int ox, int oy
 	for (int y = y0; y < y1; y++)
 		memcpy(e->rgb + ((size_t)y * e->w + x0) * 3, rgb + ((size_t)(y - oy) * w + (x0 - ox)) * 3,
 		       (size_t)(x1 - x0) * 3);
-	int sh = STRIP_ROWS * e->base.geom.cell_h;
-	for (int k = y0 / sh; k <= (y1 - 1) / sh && k < e->nstrips; k++) {
+	int th = e->tile_rows * e->base.geom.cell_h, tw = e->tile_cols * e->base.geom.cell_w;
+	for (int k = 0; k < e->nstrips; k++) {
+		int r = k / e->ncols, c = k % e->ncols;
+		if ((r + 1) * th <= y0 || r * th >= y1 || (c + 1) * tw <= x0 || c * tw >= x1)
+			continue;
 		e->want[k] = strip_hash(e, k);
 		if (e->stale[k]) {
 			e->shown[k] = 0;
@@ -136,22 +180,28 @@ static void pix_invalidate(encoder *b)
 	memset(e->stale, 0, (size_t)e->nstrips * sizeof *e->stale);
 }
 
-/* Appends strip k, placed at its cell with the cursor saved and restored. */
+/* Appends tile k, placed at its cell with the cursor saved and restored. */
 static bool send_strip(pix_enc *e, int k, abuf *out)
 {
 	const encoder_geom *g = &e->base.geom;
-	int rows = g->rows - k * STRIP_ROWS < STRIP_ROWS ? g->rows - k * STRIP_ROWS : STRIP_ROWS;
-	int y0 = k * STRIP_ROWS * g->cell_h, h = rows * g->cell_h;
+	int x, y, w, h;
+	tile_rect(e, k, &x, &y, &w, &h);
+	int rows = h / g->cell_h, cols = w / g->cell_w;
 	size_t len0 = out->len;
-	abuf_printf(out, "\x1b" "7\x1b[%d;%dH", g->y0 + k * STRIP_ROWS + 1, g->x0 + 1);
-	const uint8_t *p = e->rgb + (size_t)y0 * e->w * 3;
+	abuf_printf(out, "\x1b" "7\x1b[%d;%dH", g->y0 + y / g->cell_h + 1, g->x0 + x / g->cell_w + 1);
+	const uint8_t *p = e->rgb + ((size_t)y * e->w + x) * 3;
+	if (w < e->w) { /* a tile narrower than the canvas: its rows together */
+		for (int row = 0; row < h; row++)
+			memcpy(e->tmp + (size_t)row * w * 3, p + (size_t)row * e->w * 3, (size_t)w * 3);
+		p = e->tmp;
+	}
 	bool ok;
 	if (e->mode == PIXELS_KITTY) {
-		ok = k < PIXELS_KITTY_IDS && pixels_kitty(out, p, e->w, h, g->cols, rows, PIXELS_KITTY_ID + k);
+		ok = k < PIXELS_KITTY_IDS && pixels_kitty(out, p, w, h, cols, rows, PIXELS_KITTY_ID + k);
 		if (ok && k + 1 > e->kitty_used)
 			e->kitty_used = k + 1;
 	} else {
-		ok = pixels_encode(e->mode, out, p, e->w, h, g->cols, rows);
+		ok = pixels_encode(e->mode, out, p, w, h, cols, rows);
 	}
 	abuf_str(out, "\x1b" "8");
 	if (!ok || out->failed) {

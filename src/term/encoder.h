@@ -27,6 +27,8 @@ typedef struct encoder_geom {
 	int x0, y0;          /* its top-left cell on the screen, 0-based */
 	int cell_w, cell_h;  /* a cell in pixels, 0 when not known */
 	bool cursor_off;     /* the cursor stays hidden after each part (key mode) */
+	int max_w, max_h;    /* the largest image the terminal takes in pixels
+	                      * (sixel: XTSMGRAPHICS); 0 when not known */
 	frame_palette pal;   /* the colours the terminal takes */
 } encoder_geom;
 

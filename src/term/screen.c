@@ -180,6 +180,11 @@ static void open_encoder(screen *s)
 	if (s->pic_rows > 0) {
 		encoder_geom g = {.cols = s->cols, .rows = s->pic_rows, .pal = s->pal,
 		                  .cell_w = s->cell_w, .cell_h = s->cell_h};
+		const pixels_caps *caps = s->out ? termout_pixels(s->out) : NULL;
+		if (caps && s->pix_ops == &encoder_sixel) { /* XTSMGRAPHICS' answer */
+			g.max_w = caps->sixel_w;
+			g.max_h = caps->sixel_h;
+		}
 		if (s->pix_ops)
 			s->enc = s->pix_ops->open(&g);
 		if (s->pix_ops == &encoder_kitty)

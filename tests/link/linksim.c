@@ -9,6 +9,9 @@
  * arrives: DSR (CSI 5 n -> CSI 0 n), DA1 (CSI c -> CSI ? 62 ; 22 c),
  * DECRQSS of SGR (with the 24-bit background it was last given) and
  * XTGETTCAP (RGB: yes). Answers and typed keys go up the same kind of wire.
+ * --cell WxH gives the pty cells of W x H pixels (TIOCGWINSZ); --sixel
+ * makes the terminal draw sixel: DA1 says 4, XTSMGRAPHICS answers xterm's
+ * default 1000x1000, and a sixel image counts as the picture.
  *
  * Scenarios (--scenario):
  *   refine  types 'Z' every 250 ms from the first picture until the render
@@ -131,7 +134,8 @@ typedef struct term {
 	long pictures;     /* DA1 queries after the first picture: rtsh asks one after a picture's last slice */
 	long sgr24;        /* SGRs with a 24-bit colour */
 	long picture_bytes;
-	bool picture;      /* a half block has arrived */
+	bool picture;      /* a half block (or a sixel image) has arrived */
+	bool sixel;        /* --sixel: answers DA1 with attribute 4, XTSMGRAPHICS */
 	double first_picture;
 	double last_byte;
 } term;
@@ -149,10 +153,11 @@ static void csi_done(term *tm, wire *up)
 	if (fin == 'n' && strcmp(p, "5n") == 0)
 		answer(up, "\x1b[0n");
 	else if (fin == 'c' && (strcmp(p, "c") == 0 || strcmp(p, "0c") == 0)) {
-		answer(up, "\x1b[?62;22c");
+		answer(up, tm->sixel ? "\x1b[?62;4;22c" : "\x1b[?62;22c");
 		if (tm->picture)
 			tm->pictures++;
-	}
+	} else if (fin == 'S' && tm->sixel && strcmp(p, "?2;1;0S") == 0)
+		answer(up, "\x1b[?2;0;1000;1000S"); /* XTSMGRAPHICS: xterm's default */
 	else if (fin == 'l' && strcmp(p, "?2026l") == 0)
 		tm->updates++;
 	else if (fin == 'm') {
@@ -170,6 +175,11 @@ static void dcs_done(term *tm, wire *up)
 		answer(up, tm->bg24 ? "\x1bP1$r0;48:2::1:2:3m\x1b\\" : "\x1bP1$r0m\x1b\\");
 	else if (strncmp(p, "+q", 2) == 0)
 		answer(up, "\x1bP1+r524742=382F382F38\x1b\\");
+	else if (tm->sixel && strspn(p, "0123456789;") < 16 && p[strspn(p, "0123456789;")] == 'q') {
+		if (!tm->picture) /* a sixel image counts as the picture */
+			tm->first_picture = tm->last_byte;
+		tm->picture = true;
+	}
 }
 
 static void term_feed(term *tm, wire *up, const char *b, size_t n, double t, long expect_z)
@@ -237,7 +247,7 @@ static int cmp_double(const void *a, const void *b)
 static void usage(void)
 {
 	fputs("usage: linksim [--rate B/s] [--rtt S] [--cols N] [--rows N] [--samples N] [--scenario refine|ctrlc]\n"
-	      "               [--timeout S] -- COMMAND ARGS...\n",
+	      "               [--timeout S] [--cell WxH] [--sixel] -- COMMAND ARGS...\n",
 	      stderr);
 	exit(2);
 }
@@ -245,7 +255,8 @@ static void usage(void)
 int main(int argc, char **argv)
 {
 	double rate = 30000, rtt = 0.1, timeout = 120;
-	int cols = 200, rows = 60, samples = 128;
+	int cols = 200, rows = 60, samples = 128, cell_w = 0, cell_h = 0;
+	bool sixel = false;
 	const char *scenario = "refine";
 	int i = 1;
 	for (; i < argc; i++) {
@@ -269,6 +280,10 @@ int main(int argc, char **argv)
 			scenario = argv[++i];
 		else if (strcmp(argv[i], "--timeout") == 0)
 			timeout = atof(argv[++i]);
+		else if (strcmp(argv[i], "--cell") == 0 && sscanf(argv[++i], "%dx%d", &cell_w, &cell_h) == 2)
+			;
+		else if (strcmp(argv[i], "--sixel") == 0)
+			sixel = true;
 		else
 			usage();
 	}
@@ -276,7 +291,8 @@ int main(int argc, char **argv)
 		usage();
 	bool ctrlc = strcmp(scenario, "ctrlc") == 0;
 
-	struct winsize ws = {.ws_row = (unsigned short)rows, .ws_col = (unsigned short)cols};
+	struct winsize ws = {.ws_row = (unsigned short)rows, .ws_col = (unsigned short)cols,
+	                     .ws_xpixel = (unsigned short)(cols * cell_w), .ws_ypixel = (unsigned short)(rows * cell_h)};
 	int master;
 	pid_t pid = forkpty(&master, NULL, NULL, &ws);
 	if (pid < 0) {
@@ -291,7 +307,7 @@ int main(int argc, char **argv)
 	fcntl(master, F_SETFL, fcntl(master, F_GETFL) | O_NONBLOCK);
 
 	wire down = {.rate = rate, .delay = rtt / 2}, up = {.rate = rate, .delay = rtt / 2};
-	term tm = {0};
+	term tm = {.sixel = sixel};
 	const long max_z = 4096;
 	tm.z_at = calloc((size_t)max_z, sizeof *tm.z_at);
 	double *z_sent = calloc((size_t)max_z, sizeof *z_sent);

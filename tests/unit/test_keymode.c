@@ -462,6 +462,42 @@ static void test_session(void **state)
 	session_close(&ss);
 }
 
+/* Ticks until the output after `from` holds `want` (at most `secs`). */
+static bool run_until(session *ss, size_t from, const char *want, double secs)
+{
+	double end = seconds() + secs;
+	while (seconds() < end) {
+		run_for(ss, 0.05);
+		if (ss->len > from && strstr(ss->text + from, want))
+			return true;
+	}
+	return false;
+}
+
+/* Path mode's refine passes are denoised as the shell's previews are (the
+ * status line says so), and not with `set denoise off`. */
+static void test_path_denoised(void **state)
+{
+	(void)state;
+	session ss;
+	session_open(&ss);
+	ss.sh.set.samples = 4;
+	ss.sh.set.depth = 3;
+	run_for(&ss, 0.2);
+	keymode_key(ss.km, 'm');
+	assert_int_equal(ss.sh.set.mode, MODE_PATH);
+	assert_true(run_until(&ss, 0, "4/4 spp │ denoised", 20.0));
+	ss.sh.set.denoise = DENOISE_OFF;
+	keymode_key(ss.km, 'm');
+	run_for(&ss, 0.2);
+	size_t from = ss.len;
+	keymode_key(ss.km, 'm');
+	assert_int_equal(ss.sh.set.mode, MODE_PATH);
+	assert_true(run_until(&ss, from, "4/4 spp", 20.0));
+	assert_null(strstr(ss.text + from, "denoised"));
+	session_close(&ss);
+}
+
 /* The words of a list of key names ("Up Down, w s"): commas after a name
  * go, a lone comma is a key. */
 static int key_words(const char *names, char words[][32], int max)
@@ -616,6 +652,7 @@ int main(void)
 		cmocka_unit_test(test_turns),         cmocka_unit_test(test_session),
 		cmocka_unit_test(test_key_table),
 		cmocka_unit_test(test_undo_then_another_request),
+		cmocka_unit_test(test_path_denoised),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

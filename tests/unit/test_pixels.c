@@ -26,6 +26,7 @@
 #include <png.h>
 #include <zlib.h>
 
+#include "term/encoder.h"
 #include "term/pixels.h"
 
 /* --- a picture --------------------------------------------------------------- */
@@ -409,6 +410,71 @@ static void test_sixel(void **state)
 	free(rgb);
 }
 
+/* The sixel encoder sends the picture in tiles of one cell row, at most
+ * 256 pixels (and the terminal's largest sixel) across, each placed at its
+ * own cell: decoded and put together they give the picture back; a slice
+ * of budget 1 holds one tile. */
+static void test_sixel_tiles(void **state)
+{
+	(void)state;
+	const int cols = 70, rows = 5, cw = 8, ch = 16, w = cols * cw, h = rows * ch;
+	const int max_w[2] = {0, 100}, tile_px[2] = {256, 96}; /* 256 / 8 and 100 / 8 cells */
+	uint8_t *rgb = picture(w, h, 0);
+	for (int m = 0; m < 2; m++) {
+		encoder_geom g = {.cols = cols, .rows = rows, .x0 = 3, .y0 = 2, .cell_w = cw, .cell_h = ch,
+		                  .max_w = max_w[m]};
+		encoder *e = encoder_sixel.open(&g);
+		assert_non_null(e);
+		encoder_put(e, rgb, w, h, 0, 0);
+		uint8_t *back = calloc((size_t)w * h * 3, 1), *tile = malloc((size_t)256 * ch * 3);
+		bool *drawn = calloc((size_t)w * h, 1);
+		assert_true(back && tile && drawn);
+		int tiles = 0, slices = 0;
+		for (bool more = true; more; slices++) {
+			abuf a;
+			abuf_init(&a);
+			more = encoder_update(e, &a, 1);
+			/* one tile: ESC 7, ESC [ row ; col H, the image, ESC 8 */
+			int r, c, used = 0;
+			assert_int_equal(sscanf(a.b, "\x1b" "7\x1b[%d;%dH%n", &r, &c, &used), 2);
+			assert_true(used > 0 && a.b[used] == 0x1b && a.b[used + 1] == 'P');
+			int x0 = (c - 1 - g.x0) * cw, y0 = (r - 1 - g.y0) * ch;
+			int tw = w - x0 < tile_px[m] ? w - x0 : tile_px[m];
+			assert_true(x0 >= 0 && x0 % tile_px[m] == 0 && y0 >= 0 && y0 < h);
+			sixel_decode(a.b + used, a.len - (size_t)used, tile, tw, ch); /* checks its size */
+			for (int y = 0; y < ch; y++)
+				for (int x = 0; x < tw; x++) {
+					size_t i = (size_t)(y0 + y) * w + x0 + x;
+					assert_false(drawn[i]);
+					drawn[i] = true;
+					memcpy(back + i * 3, tile + ((size_t)y * tw + x) * 3, 3);
+				}
+			assert_memory_equal(a.b + a.len - 2, "\x1b" "8", 2);
+			assert_null(strstr(a.b + used + 2, "\x1bP")); /* one image a slice */
+			tiles++;
+			abuf_free(&a);
+		}
+		int across = (w + tile_px[m] - 1) / tile_px[m];
+		assert_int_equal(tiles, across * rows);
+		assert_false(encoder_dirty(e));
+		double err = 0;
+		for (size_t i = 0; i < (size_t)w * h; i++) {
+			assert_true(drawn[i]);
+			for (int k = 0; k < 3; k++)
+				err += abs(back[i * 3 + k] - rgb[i * 3 + k]);
+		}
+		err /= (double)w * h * 3;
+		print_message("sixel tiles of %d px across: %d tiles, mean error %.2f levels of 255\n",
+		              tile_px[m], tiles, err);
+		assert_true(err < 8.0);
+		free(back);
+		free(tile);
+		free(drawn);
+		encoder_close(e);
+	}
+	free(rgb);
+}
+
 /* --- answers ----------------------------------------------------------------- */
 
 static void test_answers(void **state)
@@ -616,6 +682,7 @@ int main(void)
 		cmocka_unit_test(test_kitty),
 		cmocka_unit_test(test_iterm),
 		cmocka_unit_test(test_sixel),
+		cmocka_unit_test(test_sixel_tiles),
 		cmocka_unit_test(test_answers),
 		cmocka_unit_test(test_silent_terminal),
 		cmocka_unit_test(test_sixel_terminal),
