@@ -124,6 +124,13 @@ $(BUILD)/tests/%: tests/unit/%.c $(FRONTLIB) $(LIB)
 	@echo "  TEST    $@"
 	@$(CC) $(CPPFLAGS) -Itests/unit $(CFLAGS) $(LDFLAGS) -o $@ $< $(FRONTLIB) $(LIB) -lcmocka $(LDLIBS_FRONT)
 
+# rtsh-mpi's configuration encoder holds no MPI: its test links it alone.
+$(BUILD)/tests/test_mpi_wire: tests/unit/test_mpi_wire.c src/mpi/wire.c $(FRONTLIB) $(LIB)
+	@mkdir -p $(@D)
+	@echo "  TEST    $@"
+	@$(CC) $(CPPFLAGS) -Itests/unit $(CFLAGS) $(LDFLAGS) -o $@ $< src/mpi/wire.c $(FRONTLIB) $(LIB) \
+		-lcmocka $(LDLIBS_FRONT)
+
 $(BENCH_BIN): $(BENCH_SRC) $(FRONTLIB) $(LIB)
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -o $@ $< $(FRONTLIB) $(LIB) $(LDLIBS_FRONT)

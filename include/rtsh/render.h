@@ -31,6 +31,8 @@ typedef enum denoise_mode {
 	DENOISE_OFF,
 } denoise_mode;
 
+/* rtsh-mpi sends these field by field (src/mpi/wire.c; a static assertion
+ * there stops the build when a field is added here and not there). */
 typedef struct render_settings {
 	int width, height; /* full resolution */
 	int samples;       /* per pixel */

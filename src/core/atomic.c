@@ -409,8 +409,9 @@ static bool xattr_names(const char *path, int fd, char **names, ssize_t *n)
 
 static bool name_in(const char *name, const char *names, ssize_t n)
 {
-	for (const char *p = names; p < names + n; p += strlen(p) + 1)
-		if (strcmp(p, name) == 0)
+	/* by offset: names is NULL when the list is empty */
+	for (ssize_t off = 0; off < n; off += (ssize_t)strlen(names + off) + 1)
+		if (strcmp(names + off, name) == 0)
 			return true;
 	return false;
 }
@@ -439,7 +440,8 @@ static bool copy_xattrs(const char *from, int fd, char *failed, size_t fsize)
 	}
 	bool ok = true;
 	char *value = NULL;
-	for (const char *p = names; ok && p < names + n; p += strlen(p) + 1) {
+	for (ssize_t off = 0; ok && off < n; off += (ssize_t)strlen(names + off) + 1) {
+		const char *p = names + off;
 		ssize_t size = lgetxattr(from, p, NULL, 0);
 		char *v = size > 0 ? realloc(value, (size_t)size) : value;
 		if (size > 0 && !v) {
@@ -461,11 +463,13 @@ static bool copy_xattrs(const char *from, int fd, char *failed, size_t fsize)
 		snprintf(failed, fsize, "(the list)");
 		ok = false;
 	} else if (ok) {
-		for (const char *p = have; ok && p < have + nhave; p += strlen(p) + 1)
+		for (ssize_t off = 0; ok && off < nhave; off += (ssize_t)strlen(have + off) + 1) {
+			const char *p = have + off;
 			if (!name_in(p, names, n) && !system_label(p) && fremovexattr(fd, p) != 0 && errno != ENODATA) {
 				snprintf(failed, fsize, "%s", p);
 				ok = false;
 			}
+		}
 		free(have);
 	}
 	int e = errno;

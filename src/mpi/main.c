@@ -24,6 +24,7 @@
 
 #include "mpi/farm.h"
 #include "mpi/fileset.h"
+#include "mpi/wire.h"
 #include "rtsh/image.h"
 #include "rtsh/render.h"
 #include "rtsh/rtfile.h"
@@ -34,15 +35,6 @@
 #define MSG_MAX (RT_ERROR_MSG_MAX + RT_ERROR_FILE_MAX + 32)
 /* MPI counts are ints: large buffers go in pieces of 1 GiB. */
 #define BCAST_PIECE (1 << 30)
-
-/* What rank 0 tells every rank before the render. */
-typedef struct job_config {
-	int32_t status;   /* -1: render; else every rank exits with it */
-	int32_t verbose, progress, strict;
-	int32_t tile, prefetch, delay_us;
-	render_settings set;
-	uint64_t files;   /* bytes of the packed file set */
-} job_config;
 
 static void usage(FILE *f)
 {
@@ -315,13 +307,22 @@ static void put_int(char *buf, size_t *n, size_t cap, int v)
  * (those on other hosts it cannot see) and that no image was written, then
  * ends by the signal. The launcher follows with SIGKILL within about a
  * second and rank 0 may be inside a blocking MPI call, so this is done here,
- * with async-signal-safe calls only (kill, write, strcmp, raise). */
+ * with async-signal-safe calls only (kill, write, strcmp, raise, alarm). */
 static _Atomic int stop_rank = -1; /* this process's rank once known */
 
 static void on_stop(int sig)
 {
-	if (atomic_load(&stop_rank) != 0) {
-		/* another rank, or MPI not started yet: end quietly */
+	int me = atomic_load(&stop_rank);
+	if (me > 0) {
+		/* another rank: end quietly, but a second later (SIGALRM's
+		 * default action), so that rank 0 speaks first: the launcher
+		 * takes a rank that ends at once for a new failure and may
+		 * kill rank 0 before it has run this handler */
+		alarm(1);
+		return;
+	}
+	if (me != 0) {
+		/* MPI not started yet, or all is said: end quietly */
 		signal(sig, SIG_DFL);
 		raise(sig);
 		return;
@@ -440,7 +441,18 @@ int main(int argc, char **argv)
 			c.files = packed_size;
 		}
 	}
-	bcast(&c, (int)sizeof c, MPI_BYTE);
+	/* the configuration, field by field (wire.h): every rank, rank 0 too,
+	 * works from the decoded values */
+	unsigned char wire[WIRE_CONFIG_SIZE];
+	if (rank == 0)
+		wire_put_config(&c, wire);
+	bcast(wire, WIRE_CONFIG_SIZE, MPI_BYTE);
+	char why[RT_ERROR_MSG_MAX];
+	if (!wire_get_config(&c, wire, why, sizeof why)) {
+		rt_error e;
+		rt_error_set(&e, "%s", why);
+		die(rank, host, "", &e);
+	}
 	if (c.status >= 0) {
 		/* a usage or scene error: rank 0 said it once; all end alike (and
 		 * the launcher may stop the last ones: quietly) */

@@ -30,9 +30,9 @@ scene *rt_load_model(const char *path, const rt_load_opts *opts, rt_error *err)
 	double fov = 50, vhalf = atan(tan(fov * M_PI / 360) * 9.0 / 16.0);
 	double dist = 0.85 * radius / sin(vhalf);
 	vec3 target = v3(0, e.y / 2, 0);
-	vec3 dir = v3_norm(v3(-0.45, -0.35, -1)); /* from the camera to the model */
+	vec3 dir = v3_norm(v3(0.45, -0.35, -1)); /* from the camera to the model */
 	vec3 cam = v3_sub(target, v3_scale(dir, dist));
-	vec3 lamp = v3_add(target, v3(-1.2 * dist, 2.0 * dist, 1.5 * dist));
+	vec3 lamp = v3_add(target, v3(1.2 * dist, 2.0 * dist, 1.5 * dist));
 	const char *slash = strrchr(path, '/');
 	const char *base = slash ? slash + 1 : path;
 	bool quote = strpbrk(base, " \t,#\"") != NULL;

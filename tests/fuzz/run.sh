@@ -9,6 +9,8 @@ set -u
 build=$1 seconds=$2
 case $build in /*) ;; *) build=$PWD/$build ;; esac
 results=${RTSH_TEST_RESULTS:-}
+# a leak inside libXpm on malformed XPM files (lsan.supp says which)
+export LSAN_OPTIONS="suppressions=$PWD/tests/fuzz/lsan.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
 status=0
 for src in tests/fuzz/fuzz_*.c; do
 	name=$(basename "$src" .c); name=${name#fuzz_}

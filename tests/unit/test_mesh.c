@@ -78,10 +78,11 @@ static void test_obj_polygons_and_indices(void **state)
 	rt_error err = {0};
 	mesh *m = mesh_parse_obj("cube.obj", "", obj, strlen(obj), &err);
 	assert_non_null(m);
-	/* 6 quads = 12 triangles; the box is the unit cube */
+	/* 6 quads = 12 triangles; the box is the unit cube, X mirrored into the
+	 * scene's left-handed frame */
 	assert_int_equal(m->ntris, 12);
-	assert_vec_near(m->bounds.lo, v3(0, 0, 0), 0);
-	assert_vec_near(m->bounds.hi, v3(1, 1, 1), 0);
+	assert_vec_near(m->bounds.lo, v3(-1, 0, 0), 0);
+	assert_vec_near(m->bounds.hi, v3(0, 1, 1), 0);
 	/* faces mix corners with and without uv/normals: positions only */
 	assert_null(m->uv);
 	assert_int_equal(m->nmats, 1);
@@ -234,8 +235,9 @@ static void test_gltf_and_stl(void **state)
 	if (!m)
 		fail_msg("%s", err.msg);
 	assert_int_equal(m->ntris, 2);
-	assert_vec_near(m->bounds.lo, v3(5, 0, 0), 1e-6);
-	assert_vec_near(m->bounds.hi, v3(7, 2, 0), 1e-6);
+	/* [0,1]^2 scaled 2, moved 5 along X, then X mirrored */
+	assert_vec_near(m->bounds.lo, v3(-7, 0, 0), 1e-6);
+	assert_vec_near(m->bounds.hi, v3(-5, 2, 0), 1e-6);
 	mesh_surf sf;
 	float b[3] = {1.0f / 3, 1.0f / 3, 1.0f / 3};
 	assert_true(mesh_prepare(m, false, 0, &err));
@@ -248,7 +250,8 @@ static void test_gltf_and_stl(void **state)
 	                                "vertex 0 3 0\nendloop\nendfacet\nendsolid t\n"), &err);
 	assert_non_null(m);
 	assert_int_equal(m->ntris, 1);
-	assert_vec_near(m->bounds.hi, v3(2, 3, 0), 0);
+	assert_vec_near(m->bounds.lo, v3(-2, 0, 0), 0); /* X mirrored */
+	assert_vec_near(m->bounds.hi, v3(0, 3, 0), 0);
 	mesh_free(m);
 	expect_error(mesh_load(tmp_text("bad.gltf", "garbage"), &err), &err, "bad.gltf", "cannot read the model");
 }
@@ -344,7 +347,10 @@ static void test_glb_embedded_texture(void **state)
 {
 	(void)state;
 	textured_glb("quad.glb", false);
-	/* size 2 about the origin: the quad spans x, y in [-1, 1] at z = 0 */
+	/* size 2 about the origin: the quad spans x, y in [-1, 1] at z = 0. The
+	 * image's top left texel (red) sits at the file's x = 0, y = 1; X is
+	 * mirrored on reading, so it lands at scene x > 0, which a camera looking
+	 * down -Z shows on its left: the picture reads as it does in the file. */
 	scene *s = load_text("C 0,0,5 0,0,-1 60\nmesh quad.glb 0,0,0 0,1,0 2\n");
 	rt_error err = {0};
 	world *w = world_build(s, &err);
@@ -352,7 +358,7 @@ static void test_glb_embedded_texture(void **state)
 	struct {
 		double x, y;
 		vec3 c;
-	} probes[] = {{-0.5, 0.5, {1, 0, 0}}, {0.5, 0.5, {0, 1, 0}}, {-0.5, -0.5, {0, 0, 1}}, {0.5, -0.5, {1, 1, 1}}};
+	} probes[] = {{0.5, 0.5, {1, 0, 0}}, {-0.5, 0.5, {0, 1, 0}}, {0.5, -0.5, {0, 0, 1}}, {-0.5, -0.5, {1, 1, 1}}};
 	for (size_t i = 0; i < 4; i++) {
 		hit h;
 		assert_true(world_intersect(w, &(ray){v3(probes[i].x, probes[i].y, 5), v3(0, 0, -1)}, 0, INFINITY, &h));
@@ -658,7 +664,8 @@ static void test_tetrahedron_projected_area(void **state)
 	world *wd = world_build(s, &err);
 	assert_non_null(wd);
 	vec3 d = v3_norm(v3(0.3, -0.5, 1));
-	vec3 vtx[4] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+	/* the file's corners with X mirrored, as the reader puts them in the scene */
+	vec3 vtx[4] = {{0, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
 	int faces[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
 	double want = 0;
 	for (int f = 0; f < 4; f++) {
@@ -790,7 +797,7 @@ static void test_bunny_counts(void **state)
 	while (fgets(line, sizeof line, f)) {
 		double x, y, z;
 		if (sscanf(line, "v %lf %lf %lf", &x, &y, &z) == 3)
-			b = box_add(b, v3((float)x, (float)y, (float)z));
+			b = box_add(b, v3(-(float)x, (float)y, (float)z)); /* X mirrored */
 	}
 	fclose(f);
 	assert_vec_near(m->bounds.lo, b.lo, 0);

@@ -216,6 +216,20 @@ mesh *mb_finish(mesh_builder *b, rt_error *err)
 		m->tmat = b->fm;
 		b->fm = NULL;
 	}
+	/* Model files are right-handed (OBJ, PLY, glTF and STL alike); the scene
+	 * frame is left-handed (looking down +Z, +X is on the right). Mirroring X
+	 * makes a model look as it does in the tools that made it; swapping two
+	 * corners keeps each face's geometric normal on the side it faced. */
+	for (uint32_t i = 0; i < m->nverts; i++) {
+		m->p[i][0] = -m->p[i][0];
+		if (m->n)
+			m->n[i][0] = -m->n[i][0];
+	}
+	for (uint32_t t = 0; t < m->ntris; t++) {
+		uint32_t k = m->tri[t][1];
+		m->tri[t][1] = m->tri[t][2];
+		m->tri[t][2] = k;
+	}
 	m->bounds = box_empty();
 	for (uint32_t i = 0; i < m->nverts; i++)
 		m->bounds = box_add(m->bounds, v3(m->p[i][0], m->p[i][1], m->p[i][2]));
