@@ -91,29 +91,36 @@ static float *read_stb(const char *path, const unsigned char *buf, size_t len, b
 	}
 	if (!size_ok(path, x, y, err))
 		return NULL;
-	float *out = malloc((size_t)x * (size_t)y * 3 * sizeof *out);
-	if (!out) {
-		rt_error_set(err, "%s: out of memory (%dx%d image)", path, x, y);
-		return NULL;
-	}
+	/* decoded first, our floats after: a header that promises more than the
+	 * file holds fails in the decoder before the big float buffer exists */
+	size_t n;
+	float *out = NULL;
 	if (stbi_is_hdr_from_memory(buf, (int)len)) {
 		float *f = stbi_loadf_from_memory(buf, (int)len, &x, &y, &comp, 3);
 		if (!f) {
-			free(out);
 			rt_error_set(err, "%s: cannot decode the image: %s", path, stbi_failure_reason());
 			return NULL;
 		}
-		memcpy(out, f, (size_t)x * (size_t)y * 3 * sizeof *out);
+		n = (size_t)x * (size_t)y * 3; /* the decoder's own size */
+		out = malloc(n * sizeof *out);
+		if (out)
+			memcpy(out, f, n * sizeof *out);
 		stbi_image_free(f);
 	} else {
 		unsigned char *c = stbi_load_from_memory(buf, (int)len, &x, &y, &comp, 3);
 		if (!c) {
-			free(out);
 			rt_error_set(err, "%s: cannot decode the image: %s", path, stbi_failure_reason());
 			return NULL;
 		}
-		codes_to_float(c, (size_t)x * (size_t)y, 3, srgb, out);
+		n = (size_t)x * (size_t)y * 3;
+		out = malloc(n * sizeof *out);
+		if (out)
+			codes_to_float(c, n / 3, 3, srgb, out);
 		stbi_image_free(c);
+	}
+	if (!out) {
+		rt_error_set(err, "%s: out of memory (%dx%d image)", path, x, y);
+		return NULL;
 	}
 	*w = x;
 	*h = y;
