@@ -412,7 +412,9 @@ int main(int argc, char **argv)
 		if (tm.picture && !ctrlc && !user && render_end < 0) {
 			if (next_key < 0)
 				next_key = t + 0.5;
-			if (t >= next_key && z_typed < max_z) {
+			/* no key in the last second before the time-out: each key typed
+			 * has had a second to echo when the run is cut off */
+			if (t >= next_key && z_typed < max_z && t - t0 < timeout - 1.0) {
 				z_sent[z_typed++] = t;
 				answer(&up, "Z");
 				next_key = t + 0.25;
