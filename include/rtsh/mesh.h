@@ -40,12 +40,29 @@ typedef struct mesh_mat {
 } mesh_mat;
 
 /* Four triangles of a leaf laid out for the leaf test (mesh_trace.c):
- * v[3 * corner + axis][lane] is a vertex coordinate, the same float as in
- * mesh.p, so both tests see the same triangle. Lanes past a leaf's count
- * repeat its last triangle and are masked off. */
+ * v[3 * corner + axis][lane] is a vertex coordinate, the same float as the
+ * file's, so every test sees the same triangle. A leaf's last block repeats
+ * its last triangle in the lanes past its count: a repeat finds the same
+ * hit as the lane it copies, and a tie goes to the lower lane. */
 typedef struct mesh_tri4 {
 	_Alignas(16) float v[9][4];
 } mesh_tri4;
+
+/* A node of a mesh's triangle tree (mesh_tree.c): eight children, their
+ * boxes b[row][k] as floats rounded outward (rows: low x, y, z, then high
+ * x, y, z, as in bvh.h), and a reference each: an inner node's index, or
+ * MESH_LEAF | (blocks - 1) << MESH_LEAF_SHIFT | the leaf's first block.
+ * An unused child has an empty box (lo = +inf, hi = -inf). 224 bytes: four
+ * cache lines, read by one AVX2 slab test or two SSE ones. */
+#define MESH_WIDTH 8
+#define MESH_LEAF 0x80000000u
+#define MESH_LEAF_SHIFT 28
+#define MESH_LEAF_BLOCKS 8u               /* blocks a leaf holds at most */
+#define MESH_MAX_BLOCKS (1u << MESH_LEAF_SHIFT)
+typedef struct mesh_node {
+	_Alignas(32) float b[6][MESH_WIDTH];
+	uint32_t child[MESH_WIDTH];
+} mesh_node;
 
 typedef struct mesh {
 	char *path;
@@ -53,16 +70,19 @@ typedef struct mesh {
 	float (*p)[3];     /* positions; NULL once prepared (blk holds them) */
 	float (*n)[3];     /* unit normals, NULL: flat shading */
 	float (*uv)[2];    /* texture coordinates, NULL: none */
-	uint32_t (*tri)[3];
+	uint32_t (*tri)[3]; /* NULL once prepared when there are neither
+	                       normals nor uv to interpolate */
 	uint16_t *tmat;    /* material per triangle, NULL when nmats <= 1 */
 	mesh_mat *mats;
 	uint32_t nmats;
 	box bounds;        /* of the positions */
-	struct bvh *tree;  /* over tri, in tree order (mesh_prepare); a leaf's
-	                      child is its first block in blk */
+	mesh_node *nodes;  /* the tree (mesh_prepare): node 0 is the root */
+	uint32_t nnodes;
 	mesh_tri4 *blk;    /* the leaves' triangles, 4 to a block */
-	uint32_t *bfirst;  /* the triangle in lane 0 of each block */
+	uint32_t (*btri)[4]; /* the triangle (index in tri) in each lane */
 	uint32_t nblk;
+	uint32_t nrefs;    /* triangles in leaves: ntris, more where spatial
+	                      splits put one triangle in several leaves */
 	float eps;         /* self-hit guard in object units */
 	size_t refs;       /* users in the cache (mesh_cache_get) */
 } mesh;
@@ -127,15 +147,22 @@ void mb_free(mesh_builder *b);
  * lane: what mesh_intersect returns and mesh_surface takes. */
 static inline uint32_t mesh_slot_tri(const mesh *m, uint32_t slot)
 {
-	return m->bfirst[slot >> 2] + (slot & 3); /* its index in tri and tmat */
+	return m->btri[slot >> 2][slot & 3]; /* its index in tri and tmat */
 }
 /* The corners of the triangle in a slot. */
-void mesh_corners(const mesh *m, uint32_t slot, vec3 c[3]);
+static inline void mesh_corners(const mesh *m, uint32_t slot, vec3 c[3])
+{
+	const mesh_tri4 *q = &m->blk[slot >> 2];
+	uint32_t l = slot & 3;
+	for (int k = 0; k < 3; k++)
+		c[k] = v3(q->v[3 * k][l], q->v[3 * k + 1][l], q->v[3 * k + 2][l]);
+}
 
 typedef struct mesh_ray {
 	float o[3], d[3];
+	float inv[3];        /* 1 / d: the slab tests */
 	int kx, ky, kz;      /* watertight test: axes, kz the largest |d| */
-	float sx, sy, sz;    /* shear constants */
+	float sx, sy, sz;    /* shear constants: d[kx] / d[kz], d[ky] / d[kz], 1 / d[kz] */
 } mesh_ray;
 
 void mesh_ray_make(mesh_ray *r, vec3 o, vec3 d);
@@ -143,23 +170,41 @@ void mesh_ray_make(mesh_ray *r, vec3 o, vec3 d);
  * and the barycentric weights b[3] of its corners. */
 bool mesh_intersect(const mesh *m, const mesh_ray *r, float tmin, float *tmax, uint32_t *tri, float b[3]);
 bool mesh_occluded(const mesh *m, const mesh_ray *r, float tmin, float tmax);
+/* The same for a world-space ray r on an instance of m, `inv` taking world
+ * space to the model's coordinates (3x4, row-major): t in (tmin, tmax) in
+ * the ray's own units. The ray is traced in the model's coordinates in
+ * single precision, and tmin is raised past the model's rounding (m->eps)
+ * so that a ray leaving its surface does not find it again. */
+bool mesh_intersect_world(const mesh *m, const double (*inv)[4], const ray *r, double tmin, double tmax, double *t,
+                          uint32_t *slot, float b[3]);
+bool mesh_occluded_world(const mesh *m, const double (*inv)[4], const ray *r, double tmin, double tmax);
+/* The vector unit the walk uses: AVX2 where the processor has it (one slab
+ * test for a node's eight children), else SSE2 (two), else scalar code.
+ * Each finds the very same hits. mesh_isa_force picks one for tests and
+ * benchmarks (false when the machine lacks it); MESH_ISA_BEST goes back to
+ * the best one. */
+typedef enum mesh_isa { MESH_ISA_SCALAR, MESH_ISA_SSE2, MESH_ISA_AVX2, MESH_ISA_BEST } mesh_isa;
+mesh_isa mesh_isa_active(void);
+bool mesh_isa_force(mesh_isa isa);
 /* The same walk with each leaf block tested one lane at a time in scalar
  * code (on machines without SSE2 it is the only path); tests check that it
  * finds the very same hits as the SSE path. */
 bool mesh_intersect_scalar(const mesh *m, const mesh_ray *r, float tmin, float *tmax, uint32_t *tri, float b[3]);
 bool mesh_occluded_scalar(const mesh *m, const mesh_ray *r, float tmin, float tmax);
-/* Lays the leaves' triangles out in blocks of four (mesh_prepare calls it
- * once the tree and the triangle order are final). False when out of
- * memory. */
-bool mesh_make_blocks(mesh *m);
+/* Builds the tree and its blocks from p and tri (mesh_prepare calls it).
+ * False (err set) when out of memory or the mesh is too large. */
+bool mesh_build_tree(mesh *m, rt_error *err);
 /* The same without the tree, on a mesh not prepared (positions and
  * triangles as read; *tri an index in tri): the tests' reference. */
 bool mesh_intersect_brute(const mesh *m, const mesh_ray *r, float tmin, float *tmax, uint32_t *tri, float b[3]);
 
 /* What shading needs at a hit on a prepared mesh (object space, the
- * triangle by its slot): geometric normal (unit),
- * shading normal (unit, the same side as ng), texture coordinates and the
- * tangents along u and v (zero when there are none). */
+ * triangle by its slot): the geometric normal (not unit: twice the
+ * triangle's area long, the side its corners' order gives), the shading
+ * normal (not unit either, on ng's side; ng itself for flat faces),
+ * texture coordinates and the tangents along u and v (zero when there are
+ * none). The caller transforms the normals first and then makes them unit,
+ * once. */
 typedef struct mesh_surf {
 	vec3 ng, ns, dpdu, dpdv;
 	double u, v;

@@ -3,7 +3,7 @@
  * The builder works on 32-byte references (a float box rounded outward) and
  * a parallel array of primitive indices, rather than on the primitives, so
  * that partitioning moves little memory; the caller reorders its primitives
- * once at the end from `order`. Each node bins the centroids of its
+ * once at the end from the ids. Each node bins the centroids of its
  * references on all three axes in one pass (Wald, "On fast construction of
  * SAH-based bounding volume hierarchies", 2007; 16 bins per axis, fewer for
  * small nodes), sweeps the bins for the split of least surface area
@@ -11,8 +11,21 @@
  * partitions in place, gathering the children's centroid bounds on the way,
  * so every level costs two passes over its references. The boxes are kept
  * as four floats (the fourth unused) so that a box union is one SSE min and
- * one max; a scalar version of each helper serves other machines. The binary
- * tree is then collapsed into 4-wide nodes (collapse, bvh.h).
+ * one max; a scalar version of each helper serves other machines.
+ *
+ * With a clip function (a mesh's triangles) a node also tries spatial
+ * splits where its object split's children overlap (Stich, Friedrich &
+ * Dietrich 2009): 16 bins across the node's box, each reference clipped to
+ * every bin it spans, and a reference cut by the chosen plane goes to both
+ * sides unless sending it whole to one side costs less ("unsplitting").
+ * The references live in one array with room for split_budget x n more;
+ * each node's range is followed by its share of the free room, given to
+ * its children in proportion to their sizes, so a subtree never writes
+ * outside its own range. When a node's share is used up, it makes object
+ * splits only.
+ *
+ * The binary tree is then made wide: bvh2_gather lists a wide node's
+ * children (world.c's trees are 4 wide, a mesh's 8, mesh_tree.c).
  */
 #include "bvh.h"
 
@@ -32,29 +45,27 @@
  * primitive brings its own cost, bvh_build); measured: 4 gave the fastest
  * renders of 100k and 1M spheres (1 built twice as many nodes). */
 #define COST_TRAVERSE 4.0
+/* Spatial splits are tried where the object split's children overlap by
+ * more than this share of the root's area (Stich et al.'s alpha). */
+#define SPATIAL_ALPHA 1e-5
 
-/* A box of floats. Lane 3 is not part of the box: a reference keeps its
- * primitive's intersection cost in lo[3] (hi[3] = 0), which the centroid
- * lane ignores; bins and node boxes carry whatever min/max made of it. */
-typedef struct fbox {
-	float lo[4], hi[4];
-} fbox;
-
-/* A node of the binary tree, before the collapse to 4-wide nodes. */
-typedef struct node2 {
-	fbox box[2];
-	uint32_t child[2], meta[2];
-} node2;
+typedef bvh_fbox fbox;
+typedef bvh2_node node2;
 
 typedef struct builder {
-	fbox *refs;    /* the primitives' boxes, rounded outward */
+	const bvh_build_opts *o;
+	fbox *refs;    /* the references' boxes, rounded outward */
 	uint32_t *ids; /* the primitive of each reference */
+	fbox *tmp;     /* spatial partitions: a node's refs on their way */
+	uint32_t *tmp_ids;
 	node2 *nodes;
 	size_t used, cap;
 	int depth;
-	size_t leaves;
+	size_t leaves, nrefs;
 	double trav;    /* SAH cost of a node visit */
-	unsigned block; /* primitives tested together (bvh_build_blocks), 1 */
+	unsigned block; /* primitives tested together (1: each its own cost) */
+	unsigned leaf_max;
+	double root_area; /* for the spatial splits' overlap test */
 } builder;
 
 /* The SAH cost of testing primitives of summed cost `sum` in a leaf: the
@@ -117,8 +128,7 @@ static inline void fbox_add_point(fbox *a, const float p[4])
 }
 #endif
 
-/* Half the surface area, in double (no overflow); 0 when empty. */
-static inline double fbox_half_area(const fbox *b)
+double bvh_fbox_half_area(const fbox *b)
 {
 	double e[3];
 	for (int i = 0; i < 3; i++) {
@@ -128,6 +138,8 @@ static inline double fbox_half_area(const fbox *b)
 	}
 	return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
 }
+
+#define fbox_half_area bvh_fbox_half_area
 
 /* The nearest floats below and above a double. */
 static float float_down(double v)
@@ -167,9 +179,12 @@ static inline void bin_index(const float c[4], const float lo[4], const float sc
 }
 
 typedef struct split {
-	int axis, at; /* bins [0, at) go left */
+	int axis, at; /* object split: bins [0, at) go left */
+	bool spatial; /* a spatial split at the plane `pos` on `axis` */
+	float pos;
 	double cost;  /* SAH: area-weighted costs, not yet divided by the parent's area */
 	double total; /* the cost of testing every primitive of the node */
+	double nl, nr; /* spatial: the summed costs on each side */
 	fbox lb, rb;  /* the children's boxes */
 } split;
 
@@ -203,6 +218,10 @@ static split find_split(const builder *b, size_t begin, size_t end, const fbox *
 {
 	split best = {.axis = -1, .cost = INFINITY};
 	binning bn;
+	best.total = 0.0;
+	for (size_t i = begin; i < end; i++)
+		best.total += b->refs[i].lo[3];
+	best.total = leaf_cost(b, best.total);
 	if (!binning_make(cb, end - begin, &bn))
 		return best;
 	int nbins = bn.nbins;
@@ -226,10 +245,6 @@ static split find_split(const builder *b, size_t begin, size_t end, const fbox *
 			fbox_union(&bbox[a][k[a]], r);
 		}
 	}
-	best.total = 0.0;
-	for (int k = 0; k < nbins; k++)
-		best.total += bcost[0][k];
-	best.total = leaf_cost(b, best.total);
 	for (int a = 0; a < 3; a++) {
 		if (!bn.usable[a])
 			continue;
@@ -267,6 +282,107 @@ static split find_split(const builder *b, size_t begin, size_t end, const fbox *
 	return best;
 }
 
+/* The planes between the spatial bins of axis a of box bb: pos[0] = lo,
+ * pos[BINS] = hi. */
+static void spatial_planes(const fbox *bb, int a, float pos[BINS + 1])
+{
+	double lo = bb->lo[a], hi = bb->hi[a];
+	for (int k = 0; k <= BINS; k++)
+		pos[k] = (float)(lo + (hi - lo) * k / BINS);
+	pos[0] = bb->lo[a];
+	pos[BINS] = bb->hi[a];
+}
+
+/* The spatial bin of coordinate x: the last k with pos[k] <= x. */
+static inline int spatial_bin(const float pos[BINS + 1], float x)
+{
+	int k = 0;
+	while (k < BINS - 1 && pos[k + 1] <= x)
+		k++;
+	return k;
+}
+
+/* The cheapest spatial split of refs[begin, end) (box bb), if cheaper
+ * than best: each reference clipped into every bin it spans, counted where
+ * it enters and where it leaves. */
+static void find_spatial(const builder *b, size_t begin, size_t end, const fbox *bb, split *best)
+{
+	const bvh_build_opts *o = b->o;
+	for (int a = 0; a < 3; a++) {
+		if (!(bb->hi[a] > bb->lo[a]))
+			continue;
+		float pos[BINS + 1];
+		spatial_planes(bb, a, pos);
+		fbox bins[BINS];
+		double enter[BINS] = {0}, leave[BINS] = {0};
+		for (int k = 0; k < BINS; k++)
+			bins[k] = fbox_empty();
+		for (size_t i = begin; i < end; i++) {
+			const fbox *r = &b->refs[i];
+			int k0 = spatial_bin(pos, r->lo[a]), k1 = spatial_bin(pos, r->hi[a]);
+			enter[k0] += r->lo[3];
+			leave[k1] += r->lo[3];
+			if (k0 == k1) {
+				fbox_union(&bins[k0], r);
+				continue;
+			}
+			for (int k = k0; k <= k1; k++) {
+				fbox part = *r;
+				if (o->clip(o->ctx, b->ids[i], a, pos[k], pos[k + 1], &part))
+					fbox_union(&bins[k], &part);
+			}
+		}
+		double right_area[BINS], right_cost[BINS];
+		fbox acc = fbox_empty();
+		double sum = 0.0;
+		for (int k = BINS - 1; k > 0; k--) {
+			fbox_union(&acc, &bins[k]);
+			sum += leave[k];
+			right_area[k] = fbox_half_area(&acc);
+			right_cost[k] = sum;
+		}
+		acc = fbox_empty();
+		sum = 0.0;
+		for (int k = 0; k < BINS - 1; k++) {
+			fbox_union(&acc, &bins[k]);
+			sum += enter[k];
+			if (sum == 0.0 || right_cost[k + 1] == 0.0)
+				continue;
+			double cost = fbox_half_area(&acc) * leaf_cost(b, sum) +
+			              right_area[k + 1] * leaf_cost(b, right_cost[k + 1]);
+			if (cost < best->cost) {
+				best->cost = cost;
+				best->axis = a;
+				best->spatial = true;
+				best->pos = pos[k + 1];
+				best->nl = sum;
+				best->nr = right_cost[k + 1];
+			}
+		}
+	}
+	if (best->spatial) {
+		float pos[BINS + 1];
+		spatial_planes(bb, best->axis, pos);
+		/* the children's boxes again, for the unsplitting tests */
+		best->lb = best->rb = fbox_empty();
+		for (size_t i = begin; i < end; i++) {
+			const fbox *r = &b->refs[i];
+			fbox part = *r;
+			if (r->hi[best->axis] <= best->pos)
+				fbox_union(&best->lb, r);
+			else if (r->lo[best->axis] >= best->pos)
+				fbox_union(&best->rb, r);
+			else {
+				if (o->clip(o->ctx, b->ids[i], best->axis, r->lo[best->axis], best->pos, &part))
+					fbox_union(&best->lb, &part);
+				part = *r;
+				if (o->clip(o->ctx, b->ids[i], best->axis, best->pos, r->hi[best->axis], &part))
+					fbox_union(&best->rb, &part);
+			}
+		}
+	}
+}
+
 static inline void swap_refs(builder *b, size_t i, size_t j)
 {
 	fbox t = b->refs[i];
@@ -277,8 +393,9 @@ static inline void swap_refs(builder *b, size_t i, size_t j)
 	b->ids[j] = id;
 }
 
-/* Partitions by the split, returning the middle; *lcb, *rcb: the children's
- * centroid bounds. The bins are computed exactly as find_split did. */
+/* Partitions by an object split, returning the middle; *lcb, *rcb: the
+ * children's centroid bounds. The bins are computed exactly as find_split
+ * did. */
 static size_t partition(builder *b, size_t begin, size_t end, const fbox *cb, const split *s, fbox *lcb,
                         fbox *rcb)
 {
@@ -315,16 +432,81 @@ static void bounds_of(const builder *b, size_t begin, size_t end, fbox *bb, fbox
 	}
 }
 
-/* Builds the subtree over refs[begin, end) (box bb, centroid bounds cb) and
- * returns its reference in *child, *meta. */
-static void build(builder *b, size_t begin, size_t end, const fbox *bb, const fbox *cb, int depth,
+static double area_with(const fbox *a, const fbox *r)
+{
+	fbox u = *a;
+	fbox_union(&u, r);
+	return fbox_half_area(&u);
+}
+
+/* Partitions refs[begin, end) by spatial split s into tmp: the left
+ * references from tmp[0] up, the right ones from tmp[room - 1] down. A
+ * reference the plane cuts goes to both sides, or whole to one side where
+ * that costs less by the SAH (Stich et al.'s unsplitting), or whole where
+ * no room is left. Returns the count on the left in *nl and on the right
+ * in *nr. */
+static void partition_spatial(builder *b, size_t begin, size_t end, size_t room, const split *s, size_t *nl,
+                              size_t *nr)
+{
+	const bvh_build_opts *o = b->o;
+	int a = s->axis;
+	size_t l = 0, r = room;
+	double al = fbox_half_area(&s->lb), ar = fbox_half_area(&s->rb);
+	double cl = leaf_cost(b, s->nl), cr = leaf_cost(b, s->nr);
+	double cl1 = leaf_cost(b, s->nl - 1), cr1 = leaf_cost(b, s->nr - 1);
+	for (size_t i = begin; i < end; i++) {
+		const fbox *ref = &b->refs[i];
+		uint32_t id = b->ids[i];
+		int side; /* -1 left, 1 right, 0 both */
+		if (ref->hi[a] <= s->pos)
+			side = -1;
+		else if (ref->lo[a] >= s->pos)
+			side = 1;
+		else {
+			double both = al * cl + ar * cr;
+			double left = area_with(&s->lb, ref) * cl + ar * cr1;
+			double right = al * cl1 + area_with(&s->rb, ref) * cr;
+			side = left < both && left <= right ? -1 : right < both ? 1 : 0;
+			/* both sides take one more slot than the reference had */
+			if (side == 0 && r - l < (end - i) + 1)
+				side = left <= right ? -1 : 1;
+		}
+		if (side == 0) {
+			fbox lp = *ref, rp = *ref;
+			bool okl = o->clip(o->ctx, id, a, ref->lo[a], s->pos, &lp);
+			bool okr = o->clip(o->ctx, id, a, s->pos, ref->hi[a], &rp);
+			if (okl && okr) {
+				b->tmp[l] = lp;
+				b->tmp_ids[l++] = id;
+				b->tmp[--r] = rp;
+				b->tmp_ids[r] = id;
+				continue;
+			}
+			side = okl ? -1 : 1;
+		}
+		if (side < 0) {
+			b->tmp[l] = *ref;
+			b->tmp_ids[l++] = id;
+		} else {
+			b->tmp[--r] = *ref;
+			b->tmp_ids[r] = id;
+		}
+	}
+	*nl = l;
+	*nr = room - r;
+}
+
+/* Builds the subtree over refs[begin, end) (box bb, centroid bounds cb),
+ * with refs[end, cap_end) free for its spatial splits, and returns its
+ * reference in *child, *meta. */
+static void build(builder *b, size_t begin, size_t end, size_t cap_end, const fbox *bb, const fbox *cb, int depth,
                   uint32_t *child, uint32_t *meta)
 {
 	size_t n = end - begin;
 	if (depth > b->depth)
 		b->depth = depth;
-	bool leaf = n <= 1 || (depth >= BALANCED_DEPTH && n <= LEAF_MAX);
-	if (!leaf && n <= LEAF_MAX) {
+	bool leaf = n <= 1 || (depth >= BALANCED_DEPTH && n <= b->leaf_max);
+	if (!leaf && n <= b->leaf_max) {
 		/* A split costs at least a node visit: a node that costs no more
 		 * to test whole is a leaf without binning (most small nodes). */
 		double total = 0.0;
@@ -332,10 +514,21 @@ static void build(builder *b, size_t begin, size_t end, const fbox *bb, const fb
 			total += b->refs[i].lo[3];
 		leaf = leaf_cost(b, total) <= b->trav;
 	}
-	split s = {.axis = -1};
-	if (!leaf && depth < BALANCED_DEPTH)
-		s = find_split(b, begin, end, cb);
-	if (!leaf && n <= LEAF_MAX && depth < BALANCED_DEPTH) {
+	split s = {.axis = -1}, obj = s;
+	if (!leaf && depth < BALANCED_DEPTH) {
+		s = obj = find_split(b, begin, end, cb);
+		if (b->o->clip && cap_end > end) {
+			/* a spatial split where the object split's children overlap */
+			fbox ov = s.lb;
+			for (int a = 0; a < 3; a++) {
+				ov.lo[a] = ov.lo[a] > s.rb.lo[a] ? ov.lo[a] : s.rb.lo[a];
+				ov.hi[a] = ov.hi[a] < s.rb.hi[a] ? ov.hi[a] : s.rb.hi[a];
+			}
+			if (s.axis < 0 || fbox_half_area(&ov) > SPATIAL_ALPHA * b->root_area)
+				find_spatial(b, begin, end, bb, &s);
+		}
+	}
+	if (!leaf && n <= b->leaf_max && depth < BALANCED_DEPTH) {
 		double area = fbox_half_area(bb);
 		double split_cost = area > 0.0 && s.axis >= 0 ? b->trav + s.cost / area : INFINITY;
 		leaf = s.total <= split_cost;
@@ -344,29 +537,63 @@ static void build(builder *b, size_t begin, size_t end, const fbox *bb, const fb
 		*child = (uint32_t)begin;
 		*meta = BVH_LEAF | (uint32_t)n;
 		b->leaves++;
+		b->nrefs += n;
 		return;
 	}
 
-	size_t mid = begin;
+	size_t mid = begin, lend, rbegin, rend, lcap;
 	fbox lb, rb, lcb, rcb;
-	if (s.axis >= 0) {
-		mid = partition(b, begin, end, cb, &s, &lcb, &rcb);
-		lb = s.lb;
-		rb = s.rb;
+	size_t nl = 0, nr = 0, room = cap_end - begin;
+	if (s.spatial) {
+		partition_spatial(b, begin, end, room, &s, &nl, &nr);
+		/* every reference whole on one side: the object split instead */
+		if (nl == 0 || nr == 0)
+			s = obj;
 	}
-	if (mid == begin || mid == end) {
-		/* no useful split (equal centroids, or past BALANCED_DEPTH): halve */
-		mid = begin + n / 2;
-		bounds_of(b, begin, mid, &lb, &lcb);
-		bounds_of(b, mid, end, &rb, &rcb);
+	if (s.spatial) {
+		/* the free room left, shared in proportion to the sizes */
+		size_t freed = room - nl - nr, lfree = (size_t)((double)freed * (double)nl / (double)(nl + nr));
+		lend = begin + nl;
+		lcap = lend + lfree;
+		rbegin = lcap;
+		rend = rbegin + nr;
+		memcpy(&b->refs[begin], b->tmp, nl * sizeof *b->refs);
+		memcpy(&b->ids[begin], b->tmp_ids, nl * sizeof *b->ids);
+		memcpy(&b->refs[rbegin], &b->tmp[room - nr], nr * sizeof *b->refs);
+		memcpy(&b->ids[rbegin], &b->tmp_ids[room - nr], nr * sizeof *b->ids);
+		bounds_of(b, begin, lend, &lb, &lcb);
+		bounds_of(b, rbegin, rend, &rb, &rcb);
+	} else {
+		if (s.axis >= 0) {
+			mid = partition(b, begin, end, cb, &s, &lcb, &rcb);
+			lb = s.lb;
+			rb = s.rb;
+		}
+		if (mid == begin || mid == end) {
+			/* no useful split (equal centroids, or past BALANCED_DEPTH): halve */
+			mid = begin + n / 2;
+			bounds_of(b, begin, mid, &lb, &lcb);
+			bounds_of(b, mid, end, &rb, &rcb);
+		}
+		/* the free room after end, shared in proportion: the right
+		 * references move up by the left child's share */
+		size_t freed = cap_end - end, lfree = (size_t)((double)freed * (double)(mid - begin) / (double)n);
+		lend = mid;
+		lcap = mid + lfree;
+		rbegin = lcap;
+		rend = end + lfree;
+		if (lfree) {
+			memmove(&b->refs[rbegin], &b->refs[mid], (end - mid) * sizeof *b->refs);
+			memmove(&b->ids[rbegin], &b->ids[mid], (end - mid) * sizeof *b->ids);
+		}
 	}
 	size_t ni = b->used++;
 	node2 *node = &b->nodes[ni];
 	node->box[0] = lb;
 	node->box[1] = rb;
 	uint32_t c0, m0, c1, m1;
-	build(b, begin, mid, &lb, &lcb, depth + 1, &c0, &m0);
-	build(b, mid, end, &rb, &rcb, depth + 1, &c1, &m1);
+	build(b, begin, lend, lcap, &lb, &lcb, depth + 1, &c0, &m0);
+	build(b, rbegin, rend, cap_end, &rb, &rcb, depth + 1, &c1, &m1);
 	node = &b->nodes[ni];
 	node->child[0] = c0;
 	node->meta[0] = m0;
@@ -376,20 +603,83 @@ static void build(builder *b, size_t begin, size_t end, const fbox *bb, const fb
 	*meta = 0;
 }
 
-/* A child of a 4-wide node being collected from the binary tree. */
-typedef struct slot {
-	fbox box;
-	uint32_t child, meta;
-} slot;
-
-/* Makes the 4-wide node for binary node n2 (and, depth first, the nodes
- * below it) in out[*used ...]; returns its index. */
-static uint32_t collapse(const builder *b, uint32_t n2, bvh_node *out, size_t *used)
+void bvh2_free(bvh2 *t)
 {
-	const node2 *src = &b->nodes[n2];
-	slot s[BVH_WIDTH] = {{src->box[0], src->child[0], src->meta[0]}, {src->box[1], src->child[1], src->meta[1]}};
+	free(t->nodes);
+	free(t->ids);
+	memset(t, 0, sizeof *t);
+}
+
+bool bvh2_build(const box *bounds, size_t n, const bvh_build_opts *o, bvh2 *t, rt_error *err)
+{
+	memset(t, 0, sizeof *t);
+	t->root_meta = BVH_LEAF; /* an empty leaf */
+	t->bounds = fbox_empty();
+	if (n == 0)
+		return true;
+	double budget = o->clip && o->split_budget > 0 ? o->split_budget : 0;
+	size_t cap = n + (size_t)((double)n * budget);
+	if (n > BVH_MAX_PRIMS || cap > BVH_MAX_PRIMS)
+		return rt_error_set(err, "too many objects (%zu); expected at most %u", n, BVH_MAX_PRIMS);
+	builder b = {.o = o, .trav = o->trav, .block = o->block ? o->block : 1,
+	             .leaf_max = o->leaf_max ? o->leaf_max : LEAF_MAX};
+	b.refs = malloc(cap * sizeof *b.refs);
+	b.ids = malloc(cap * sizeof *b.ids);
+	/* a binary tree with leaves folded in has fewer inner nodes than leaves,
+	 * and a leaf holds at least one reference */
+	b.nodes = malloc(cap * sizeof *b.nodes);
+	if (cap > n) {
+		b.tmp = malloc(cap * sizeof *b.tmp);
+		b.tmp_ids = malloc(cap * sizeof *b.tmp_ids);
+	}
+	if (!b.refs || !b.ids || !b.nodes || (cap > n && (!b.tmp || !b.tmp_ids))) {
+		free(b.refs);
+		free(b.ids);
+		free(b.nodes);
+		free(b.tmp);
+		free(b.tmp_ids);
+		return rt_error_set(err, "out of memory building the BVH (%zu objects)", n);
+	}
+	fbox bb = fbox_empty(), cb = fbox_empty();
+	for (size_t i = 0; i < n; i++) {
+		fbox *r = &b.refs[i];
+		const box *x = &bounds[i];
+		*r = (fbox){{float_down(x->lo.x), float_down(x->lo.y), float_down(x->lo.z), o->costs ? o->costs[i] : 1.0f},
+		            {float_up(x->hi.x), float_up(x->hi.y), float_up(x->hi.z), 0}};
+		b.ids[i] = (uint32_t)i;
+		float c[4];
+		centroid2(r, c);
+		fbox_union(&bb, r);
+		fbox_add_point(&cb, c);
+	}
+	b.root_area = fbox_half_area(&bb);
+	build(&b, 0, n, cap, &bb, &cb, 0, &t->root, &t->root_meta);
+	free(b.refs);
+	free(b.tmp);
+	free(b.tmp_ids);
+	t->nodes = b.nodes;
+	t->nnodes = b.used;
+	t->ids = b.ids;
+	t->nids = cap;
+	t->nrefs = b.nrefs;
+	t->bounds = bb;
+	t->depth = b.depth;
+	t->leaves = b.leaves;
+	if (b.used && b.used < cap) {
+		node2 *fit = realloc(b.nodes, b.used * sizeof *fit);
+		if (fit)
+			t->nodes = fit;
+	}
+	return true;
+}
+
+int bvh2_gather(const bvh2 *t, uint32_t n2, int width, bvh_slot *s)
+{
+	const node2 *src = &t->nodes[n2];
+	s[0] = (bvh_slot){src->box[0], src->child[0], src->meta[0]};
+	s[1] = (bvh_slot){src->box[1], src->child[1], src->meta[1]};
 	int cnt = 2;
-	while (cnt < BVH_WIDTH) {
+	while (cnt < width) {
 		/* open the inner child of largest area (the likeliest to be hit) */
 		int best = -1;
 		double best_area = -1.0;
@@ -400,10 +690,19 @@ static uint32_t collapse(const builder *b, uint32_t n2, bvh_node *out, size_t *u
 			}
 		if (best < 0)
 			break;
-		const node2 *c = &b->nodes[s[best].child];
-		s[best] = (slot){c->box[0], c->child[0], c->meta[0]};
-		s[cnt++] = (slot){c->box[1], c->child[1], c->meta[1]};
+		const node2 *c = &t->nodes[s[best].child];
+		s[best] = (bvh_slot){c->box[0], c->child[0], c->meta[0]};
+		s[cnt++] = (bvh_slot){c->box[1], c->child[1], c->meta[1]};
 	}
+	return cnt;
+}
+
+/* Makes the 4-wide node for binary node n2 (and, depth first, the nodes
+ * below it) in out[*used ...]; returns its index. */
+static uint32_t collapse(const bvh2 *t, uint32_t n2, bvh_node *out, size_t *used)
+{
+	bvh_slot s[BVH_WIDTH];
+	int cnt = bvh2_gather(t, n2, BVH_WIDTH, s);
 	uint32_t ni = (uint32_t)(*used)++;
 	for (int k = 0; k < BVH_WIDTH; k++) {
 		fbox fb = k < cnt ? s[k].box : fbox_empty();
@@ -416,76 +715,54 @@ static uint32_t collapse(const builder *b, uint32_t n2, bvh_node *out, size_t *u
 			out[ni].meta[k] = BVH_LEAF; /* empty: its empty box is never entered */
 		} else {
 			out[ni].meta[k] = s[k].meta;
-			out[ni].child[k] = s[k].meta ? s[k].child : collapse(b, s[k].child, out, used);
+			out[ni].child[k] = s[k].meta ? s[k].child : collapse(t, s[k].child, out, used);
 		}
 	}
 	return ni;
 }
 
-static bvh *build_tree(const box *bounds, const float *costs, size_t n, unsigned block, double trav,
-                       uint32_t *order, rt_error *err)
+bvh *bvh_build(const box *bounds, const float *costs, size_t n, uint32_t *order, rt_error *err)
 {
 	bvh *t = calloc(1, sizeof *t);
 	if (!t) {
 		rt_error_set(err, "out of memory building the BVH");
 		return NULL;
 	}
-	t->root_meta = BVH_LEAF; /* an empty leaf */
-	if (n == 0)
-		return t;
-	if (n > BVH_MAX_PRIMS) {
+	bvh_build_opts o = {.costs = costs, .block = 1, .trav = COST_TRAVERSE};
+	bvh2 b;
+	if (!bvh2_build(bounds, n, &o, &b, err)) {
 		free(t);
-		rt_error_set(err, "too many objects (%zu); expected at most %u", n, BVH_MAX_PRIMS);
 		return NULL;
 	}
-	builder b = {.trav = trav, .block = block};
-	b.refs = malloc(n * sizeof *b.refs);
-	b.ids = order; /* partitioned along with the references */
-	b.cap = n > 1 ? n - 1 : 1; /* a binary tree with leaves folded in: < n inner nodes */
-	b.nodes = malloc(b.cap * sizeof *b.nodes);
-	if (!b.refs || !b.nodes) {
-		free(b.refs);
-		free(b.nodes);
-		free(t);
-		rt_error_set(err, "out of memory building the BVH (%zu objects)", n);
-		return NULL;
-	}
-	fbox bb = fbox_empty(), cb = fbox_empty();
-	for (size_t i = 0; i < n; i++) {
-		fbox *r = &b.refs[i];
-		const box *x = &bounds[i];
-		*r = (fbox){{float_down(x->lo.x), float_down(x->lo.y), float_down(x->lo.z), costs ? costs[i] : 1.0f},
-		            {float_up(x->hi.x), float_up(x->hi.y), float_up(x->hi.z), 0}};
-		b.ids[i] = (uint32_t)i;
-		float c[4];
-		centroid2(r, c);
-		fbox_union(&bb, r);
-		fbox_add_point(&cb, c);
-	}
-	uint32_t root2, meta2;
-	build(&b, 0, n, &bb, &cb, 0, &root2, &meta2);
-	free(b.refs);
+	t->root_meta = b.root_meta;
+	t->root = b.root;
 	t->depth = b.depth;
 	t->leaves = b.leaves;
-	if (meta2) {
+	if (n == 0) {
+		bvh2_free(&b);
+		return t;
+	}
+	memcpy(order, b.ids, n * sizeof *order); /* no spatial splits: a permutation */
+	if (b.root_meta) {
 		/* one leaf: a root node holding it alone, so that a ray that
 		 * misses the box of everything stops at one slab test */
-		free(b.nodes);
 		bvh_node *one = aligned_alloc(64, (sizeof *one + 63) / 64 * 64);
 		if (!one) {
+			bvh2_free(&b);
 			free(t);
 			rt_error_set(err, "out of memory building the BVH (%zu objects)", n);
 			return NULL;
 		}
 		for (int k = 0; k < BVH_WIDTH; k++) {
-			fbox fb = k == 0 ? bb : fbox_empty();
+			fbox fb = k == 0 ? b.bounds : fbox_empty();
 			for (int a = 0; a < 3; a++) {
 				one->b[BVH_LO_X + a][k] = fb.lo[a];
 				one->b[BVH_HI_X + a][k] = fb.hi[a];
 			}
-			one->child[k] = k == 0 ? root2 : 0;
-			one->meta[k] = k == 0 ? meta2 : BVH_LEAF;
+			one->child[k] = k == 0 ? b.root : 0;
+			one->meta[k] = k == 0 ? b.root_meta : BVH_LEAF;
 		}
+		bvh2_free(&b);
 		t->nodes = one;
 		t->nnodes = 1;
 		t->root = 0;
@@ -493,18 +770,18 @@ static bvh *build_tree(const box *bounds, const float *costs, size_t n, unsigned
 		return t;
 	}
 	/* each 4-wide node takes at least one binary node */
-	size_t bytes = (b.used * sizeof(bvh_node) + 63) / 64 * 64;
+	size_t bytes = (b.nnodes * sizeof(bvh_node) + 63) / 64 * 64;
 	bvh_node *wide = aligned_alloc(64, bytes);
 	if (!wide) {
-		free(b.nodes);
+		bvh2_free(&b);
 		free(t);
 		rt_error_set(err, "out of memory building the BVH (%zu objects)", n);
 		return NULL;
 	}
 	size_t used = 0;
-	t->root = collapse(&b, root2, wide, &used);
+	t->root = collapse(&b, b.root, wide, &used);
 	t->root_meta = 0;
-	free(b.nodes);
+	bvh2_free(&b);
 	bytes = (used * sizeof(bvh_node) + 63) / 64 * 64;
 	bvh_node *fit = aligned_alloc(64, bytes);
 	if (fit) {
@@ -515,16 +792,6 @@ static bvh *build_tree(const box *bounds, const float *costs, size_t n, unsigned
 	t->nodes = wide;
 	t->nnodes = used;
 	return t;
-}
-
-bvh *bvh_build(const box *bounds, const float *costs, size_t n, uint32_t *order, rt_error *err)
-{
-	return build_tree(bounds, costs, n, 1, COST_TRAVERSE, order, err);
-}
-
-bvh *bvh_build_blocks(const box *bounds, size_t n, unsigned block, double trav, uint32_t *order, rt_error *err)
-{
-	return build_tree(bounds, NULL, n, block, trav, order, err);
 }
 
 void bvh_free(bvh *t)

@@ -104,6 +104,71 @@ struct bvh {
 	size_t leaves;
 };
 
+/* --- the binary tree the builder makes, before it is made wide --- */
+
+/* A box of floats. Lane 3 is not part of the box: the builder keeps a
+ * reference's cost in lo[3] (hi[3] = 0), which min/max carry along. */
+typedef struct bvh_fbox {
+	float lo[4], hi[4];
+} bvh_fbox;
+
+/* A binary node: two children, each an inner node (meta 0, child its
+ * index) or a leaf (meta BVH_LEAF | count, child the first of its
+ * references in bvh2.ids). */
+typedef struct bvh2_node {
+	bvh_fbox box[2];
+	uint32_t child[2], meta[2];
+} bvh2_node;
+
+typedef struct bvh2 {
+	bvh2_node *nodes;
+	size_t nnodes;
+	uint32_t root, root_meta; /* as a child reference */
+	bvh_fbox bounds;          /* of everything */
+	uint32_t *ids;            /* the primitive of each reference */
+	size_t nids;              /* ids' length (spatial splits leave gaps) */
+	size_t nrefs;             /* references in leaves: n, more after spatial splits */
+	int depth;
+	size_t leaves;
+} bvh2;
+
+/* How to build. Spatial splits (Stich, Friedrich & Dietrich, "Spatial
+ * splits in bounding volume hierarchies", 2009) let one primitive be
+ * referenced by several leaves, each with the part of it inside the leaf's
+ * box: `clip` narrows *box (which holds part of primitive id) to the part
+ * within [lo, hi] on an axis, keeping lane 3, and returns false when
+ * nothing is left. */
+typedef struct bvh_build_opts {
+	const float *costs; /* per primitive, relative to a sphere; NULL: all 1 */
+	unsigned block;     /* > 1: unit-cost primitives tested `block` at a time */
+	double trav;        /* SAH cost of a node visit */
+	unsigned leaf_max;  /* the largest leaf made while a split pays */
+	bool (*clip)(const void *ctx, uint32_t id, int axis, float lo, float hi, bvh_fbox *box);
+	const void *ctx;
+	double split_budget; /* references allowed beyond n, a fraction of n */
+} bvh_build_opts;
+
+/* Builds the binary tree over n primitives of world bounds bounds[0..n)
+ * (binned SAH, and spatial splits when o->clip is set). False (err set)
+ * when out of memory or n is too large. */
+bool bvh2_build(const box *bounds, size_t n, const bvh_build_opts *o, bvh2 *t, rt_error *err);
+void bvh2_free(bvh2 *t);
+
+/* A child of a wide node: a box and a child reference of the binary tree. */
+typedef struct bvh_slot {
+	bvh_fbox box;
+	uint32_t child, meta;
+} bvh_slot;
+
+/* The up to `width` children of the wide node made for binary node `n`:
+ * its two, then the inner child of largest area replaced by its own two,
+ * until there are `width` or none is inner (Wald, Benthin & Boulos 2008).
+ * Returns how many. */
+int bvh2_gather(const bvh2 *t, uint32_t n, int width, bvh_slot *out);
+
+/* Half the surface area of a float box, in double; 0 when empty. */
+double bvh_fbox_half_area(const bvh_fbox *b);
+
 /* Builds the tree over n primitives with world bounds bounds[0..n) and
  * intersection costs costs[0..n) (relative to a world-space sphere; NULL:
  * all 1): binned SAH (Wald, "On fast construction of SAH-based bounding
@@ -111,10 +176,6 @@ struct bvh {
  * place i of tree order (leaves index primitives in that order). NULL (err
  * set) when out of memory or n is too large. */
 bvh *bvh_build(const box *bounds, const float *costs, size_t n, uint32_t *order, rt_error *err);
-/* The same for primitives of equal cost tested `block` at a time (a mesh's
- * triangles, 4 per SSE test): a leaf costs one unit per started block, a
- * node visit `trav` units. */
-bvh *bvh_build_blocks(const box *bounds, size_t n, unsigned block, double trav, uint32_t *order, rt_error *err);
 void bvh_free(bvh *t);
 
 /* For the benchmark (bench/bench.c): the rays world_intersect and

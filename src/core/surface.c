@@ -166,14 +166,14 @@ bool surf_material(world *w, const object *o, uint32_t i, rt_error *err)
 	return true;
 }
 
-static void mat3x4_point(const double (*m)[4], vec3 p, vec3 *out)
+static inline void mat3x4_point(const double (*m)[4], vec3 p, vec3 *out)
 {
 	*out = v3(m[0][0] * p.x + m[0][1] * p.y + m[0][2] * p.z + m[0][3],
 	          m[1][0] * p.x + m[1][1] * p.y + m[1][2] * p.z + m[1][3],
 	          m[2][0] * p.x + m[2][1] * p.y + m[2][2] * p.z + m[2][3]);
 }
 
-static vec3 mat3x4_vector(const double (*m)[4], vec3 v)
+static inline vec3 mat3x4_vector(const double (*m)[4], vec3 v)
 {
 	return v3(m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z, m[1][0] * v.x + m[1][1] * v.y + m[1][2] * v.z,
 	          m[2][0] * v.x + m[2][1] * v.y + m[2][2] * v.z);
@@ -215,38 +215,21 @@ bool surf_make_inst(world *w, const object *o, uint32_t index, prim *p, box *b, 
 	return true;
 }
 
-static inline void inst_ray(const prim_inst *in, const ray *r, mesh_ray *mr, double tmin, float *ftmin)
-{
-	vec3 o, d;
-	mat3x4_point(in->inv, r->o, &o);
-	d = mat3x4_vector(in->inv, r->d);
-	mesh_ray_make(mr, o, d);
-	/* float triangles: a ray leaving the surface must not find it again */
-	double guard = in->mesh->eps / v3_len(d);
-	*ftmin = (float)fmax(tmin, guard);
-}
-
 bool surf_inst_hit(const world *w, const prim *p, const ray *r, double tmin, double tmax, double *t, vec3 *nl)
 {
 	const prim_inst *in = &w->insts[p->u.index];
-	mesh_ray mr;
-	float ftmin, ft = tmax < 3e38 ? (float)tmax : INFINITY, b[3];
-	inst_ray(in, r, &mr, tmin, &ftmin);
-	uint32_t tri;
-	if (!mesh_intersect(in->mesh, &mr, ftmin, &ft, &tri, b) || !((double)ft < tmax))
+	uint32_t slot;
+	float b[3];
+	if (!mesh_intersect_world(in->mesh, in->inv, r, tmin, tmax, t, &slot, b))
 		return false;
-	*t = ft;
-	*nl = v3((double)tri, b[1], b[2]);
+	*nl = v3((double)slot, b[1], b[2]);
 	return true;
 }
 
 bool surf_inst_occluded(const world *w, const prim *p, const ray *r, double tmin, double tmax)
 {
 	const prim_inst *in = &w->insts[p->u.index];
-	mesh_ray mr;
-	float ftmin;
-	inst_ray(in, r, &mr, tmin, &ftmin);
-	return mesh_occluded(in->mesh, &mr, ftmin, tmax < 3e38 ? (float)tmax : INFINITY);
+	return mesh_occluded_world(in->mesh, in->inv, r, tmin, tmax);
 }
 
 /* --- textures at the hit --- */

@@ -421,6 +421,8 @@ static inline bool prim_hit(const world *w, const prim *p, const ray *r, double 
 {
 	if (p->tag == PRIM_SPHERE)
 		return sphere_hit(p, r, tmin, tmax, t);
+	if (p->tag == PRIM_MESH)
+		return surf_inst_hit(w, p, r, tmin, tmax, t, nl);
 	return other_hit(w, p, r, tmin, tmax, t, nl);
 }
 
@@ -575,27 +577,51 @@ static inline float to_float_up(double v)
 
 static inline void ray_prepare(const ray *r, bvh_ray *q)
 {
+#if defined(__SSE2__)
+	/* the three axes at once, without a branch (ray directions are random
+	 * in path mode, and a branch on each sign would be guessed wrong half
+	 * the time): [x, y, z, 1] */
+	const __m128d one = _mm_set1_pd(1.0);
+	__m128 inv = _mm_movelh_ps(_mm_cvtpd_ps(_mm_div_pd(one, _mm_loadu_pd(&r->d.x))),
+	                           _mm_cvtpd_ps(_mm_div_sd(one, _mm_load_sd(&r->d.z))));
+	__m128 f = _mm_movelh_ps(_mm_cvtpd_ps(_mm_loadu_pd(&r->o.x)), _mm_cvtpd_ps(_mm_load_sd(&r->o.z)));
+	/* the rounded origin is within half a step of o: one step |f| 2^-23
+	 * (and the smallest subnormal) each way brackets o (overflow to +-inf
+	 * only widens the box); the near plane's origin is the one that can
+	 * only bring its distance down: f + e along +d, f - e along -d */
+	const __m128 sign = _mm_set1_ps(-0.0f);
+	__m128 e = _mm_add_ps(_mm_mul_ps(_mm_andnot_ps(sign, f), _mm_set1_ps(0x1p-23f)), _mm_set1_ps(0x1p-149f));
+	__m128 es = _mm_xor_ps(e, _mm_and_ps(inv, sign));
+	__m128 on = _mm_add_ps(f, es), of = _mm_sub_ps(f, es);
+	q->on[0] = _mm_shuffle_ps(on, on, 0x00);
+	q->on[1] = _mm_shuffle_ps(on, on, 0x55);
+	q->on[2] = _mm_shuffle_ps(on, on, 0xaa);
+	q->of[0] = _mm_shuffle_ps(of, of, 0x00);
+	q->of[1] = _mm_shuffle_ps(of, of, 0x55);
+	q->of[2] = _mm_shuffle_ps(of, of, 0xaa);
+	q->inv[0] = _mm_shuffle_ps(inv, inv, 0x00);
+	q->inv[1] = _mm_shuffle_ps(inv, inv, 0x55);
+	q->inv[2] = _mm_shuffle_ps(inv, inv, 0xaa);
+	unsigned neg = (unsigned)_mm_movemask_ps(inv);
+	for (int a = 0; a < 3; a++) {
+		int n = (int)(neg >> a & 1u);
+		q->near[a] = a + 3 * n;
+		q->far[a] = a + 3 - 3 * n;
+	}
+#else
 	double o[3] = {r->o.x, r->o.y, r->o.z}, d[3] = {r->d.x, r->d.y, r->d.z};
 	for (int a = 0; a < 3; a++) {
 		float inv = (float)(1.0 / d[a]);
 		bool neg = signbit(inv);
 		q->near[a] = (neg ? BVH_HI_X : BVH_LO_X) + a;
 		q->far[a] = (neg ? BVH_LO_X : BVH_HI_X) + a;
-		/* the rounded origin is within half a step of o: one step
-		 * |f| 2^-23 (and the smallest subnormal) each way brackets o
-		 * without a branch (overflow to +-inf only widens the box) */
 		float f = (float)o[a], e = fabsf(f) * 0x1p-23f + 0x1p-149f;
 		float up = f + e, down = f - e;
-#if defined(__SSE2__)
-		q->on[a] = _mm_set1_ps(neg ? down : up);
-		q->of[a] = _mm_set1_ps(neg ? up : down);
-		q->inv[a] = _mm_set1_ps(inv);
-#else
 		q->on[a] = neg ? down : up;
 		q->of[a] = neg ? up : down;
 		q->inv[a] = inv;
-#endif
 	}
+#endif
 }
 
 typedef struct walk_entry {
@@ -638,7 +664,15 @@ bool world_intersect(const world *w, const ray *r, double tmin, double tmax, hit
 			tmax = t;
 			best_plane = &w->planes[i];
 		}
-	if (w->nprims) {
+	if (w->nprims == 1 && w->prims[0].tag == PRIM_MESH) {
+		/* a lone model (the model viewer's world): the root of its own
+		 * tree is the box test the world's would make first */
+		if (surf_inst_hit(w, &w->prims[0], r, tmin, tmax, &t, &nl)) {
+			tmax = t;
+			best = &w->prims[0];
+			best_n = nl;
+		}
+	} else if (w->nprims) {
 		const bvh *tree = w->tree;
 		const bvh_node *nodes = tree->nodes;
 		bvh_ray q;
@@ -702,6 +736,8 @@ bool world_occluded(const world *w, const ray *r, double tmin, double tmax)
 			return true;
 	if (!w->nprims)
 		return false;
+	if (w->nprims == 1 && w->prims[0].tag == PRIM_MESH)
+		return surf_inst_occluded(w, &w->prims[0], r, tmin, tmax); /* as in world_intersect */
 	const bvh *tree = w->tree;
 	const bvh_node *nodes = tree->nodes;
 	bvh_ray q;

@@ -257,9 +257,9 @@ void mesh_free(mesh *m)
 	for (uint32_t i = 0; i < m->nmats; i++)
 		mat_free(&m->mats[i]);
 	free(m->mats);
-	bvh_free(m->tree);
+	free(m->nodes);
 	free(m->blk);
-	free(m->bfirst);
+	free(m->btri);
 	free(m);
 }
 
@@ -273,7 +273,9 @@ static size_t tex_bytes(const texture *t)
 
 size_t mesh_memory(const mesh *m)
 {
-	size_t n = sizeof *m + (size_t)m->ntris * sizeof *m->tri;
+	size_t n = sizeof *m;
+	if (m->tri)
+		n += (size_t)m->ntris * sizeof *m->tri;
 	if (m->p)
 		n += (size_t)m->nverts * sizeof *m->p;
 	if (m->n)
@@ -282,9 +284,8 @@ size_t mesh_memory(const mesh *m)
 		n += (size_t)m->nverts * sizeof *m->uv;
 	if (m->tmat)
 		n += (size_t)m->ntris * sizeof *m->tmat;
-	if (m->tree)
-		n += sizeof *m->tree + m->tree->nnodes * sizeof *m->tree->nodes;
-	n += (size_t)m->nblk * (sizeof *m->blk + sizeof *m->bfirst);
+	n += (size_t)m->nnodes * sizeof *m->nodes;
+	n += (size_t)m->nblk * (sizeof *m->blk + sizeof *m->btri);
 	for (uint32_t i = 0; i < m->nmats; i++)
 		n += tex_bytes(m->mats[i].tex_kd) + tex_bytes(m->mats[i].tex_norm);
 	return n;
@@ -417,50 +418,43 @@ bool mesh_prepare(mesh *m, bool smooth, double crease_deg, rt_error *err)
 	} else if (!m->n && !smooth_normals(m, crease_deg, err)) {
 		return false;
 	}
-	box *bounds = malloc((size_t)m->ntris * sizeof *bounds);
-	uint32_t *order = malloc((size_t)m->ntris * sizeof *order);
+	if (!mesh_build_tree(m, err))
+		return false;
+	/* triangles, then vertices, in the order the blocks first use them, so
+	 * that shading a leaf's triangles finds their data close together */
+	uint32_t *newt = malloc((size_t)m->ntris * sizeof *newt);
 	uint32_t(*tri)[3] = malloc((size_t)m->ntris * sizeof *tri);
 	uint16_t *tmat = m->tmat ? malloc((size_t)m->ntris * sizeof *tmat) : NULL;
-	if (!bounds || !order || !tri || (m->tmat && !tmat)) {
-		free(bounds);
-		free(order);
+	if (newt && tri && (!m->tmat || tmat)) {
+		memset(newt, 0xff, (size_t)m->ntris * sizeof *newt);
+		uint32_t next = 0;
+		for (uint32_t k = 0; k < m->nblk; k++)
+			for (int l = 0; l < 4; l++) {
+				uint32_t t = m->btri[k][l];
+				if (newt[t] == UINT32_MAX)
+					newt[t] = next++;
+				m->btri[k][l] = newt[t];
+			}
+		for (uint32_t t = 0; t < m->ntris; t++) {
+			if (newt[t] == UINT32_MAX)
+				newt[t] = next++; /* in no leaf (none: every triangle has one) */
+			memcpy(tri[newt[t]], m->tri[t], sizeof *tri);
+			if (tmat)
+				tmat[newt[t]] = m->tmat[t];
+		}
+		free(m->tri);
+		free(m->tmat);
+		m->tri = tri;
+		m->tmat = tmat;
+	} else {
 		free(tri);
 		free(tmat);
-		return rt_error_set(err, "%s: out of memory building the triangle tree", m->path);
 	}
-	for (uint32_t t = 0; t < m->ntris; t++) {
-		box b = box_point(vtx(m, m->tri[t][0]));
-		b = box_add(b, vtx(m, m->tri[t][1]));
-		bounds[t] = box_add(b, vtx(m, m->tri[t][2]));
-	}
-	/* leaves in blocks of 4 (mesh_trace.c); a node visit costs about one
-	 * and a half block tests (1, 1.5 and 2 traced the bunny alike; 1.5
-	 * makes 18% fewer nodes than 1) */
-	m->tree = bvh_build_blocks(bounds, m->ntris, 4, 1.5, order, err);
-	free(bounds);
-	if (!m->tree) {
-		free(order);
-		free(tri);
-		free(tmat);
-		return false;
-	}
-	for (uint32_t i = 0; i < m->ntris; i++) {
-		memcpy(tri[i], m->tri[order[i]], sizeof *tri);
-		if (tmat)
-			tmat[i] = m->tmat[order[i]];
-	}
-	free(order);
-	free(m->tri);
-	free(m->tmat);
-	m->tri = tri;
-	m->tmat = tmat;
-	/* vertices in the order the tree's leaves first use them, so that a
-	 * leaf's triangles find theirs close together in memory */
+	free(newt);
 	uint32_t *newid = malloc((size_t)m->nverts * sizeof *newid);
-	float(*p)[3] = malloc((size_t)m->nverts * sizeof *p);
 	float(*n)[3] = m->n ? malloc((size_t)m->nverts * sizeof *n) : NULL;
 	float(*uv)[2] = m->uv ? malloc((size_t)m->nverts * sizeof *uv) : NULL;
-	if (newid && p && (!m->n || n) && (!m->uv || uv)) {
+	if (newid && (!m->n || n) && (!m->uv || uv)) {
 		memset(newid, 0xff, (size_t)m->nverts * sizeof *newid);
 		uint32_t next = 0;
 		for (uint32_t t = 0; t < m->ntris; t++)
@@ -473,29 +467,28 @@ bool mesh_prepare(mesh *m, bool smooth, double crease_deg, rt_error *err)
 		for (uint32_t v = 0; v < m->nverts; v++) {
 			if (newid[v] == UINT32_MAX)
 				newid[v] = next++; /* unused by any triangle */
-			memcpy(p[newid[v]], m->p[v], sizeof *p);
 			if (n)
 				memcpy(n[newid[v]], m->n[v], sizeof *n);
 			if (uv)
 				memcpy(uv[newid[v]], m->uv[v], sizeof *uv);
 		}
-		free(m->p);
 		free(m->n);
 		free(m->uv);
-		m->p = p;
 		m->n = n;
 		m->uv = uv;
 	} else {
-		free(p);
 		free(n);
 		free(uv);
 	}
 	free(newid);
-	if (!mesh_make_blocks(m))
-		return rt_error_set(err, "%s: out of memory building the triangle tree", m->path);
-	/* the blocks hold the positions from now on */
+	/* the blocks hold the positions from now on, and the corners' indices
+	 * serve only to interpolate normals and uv */
 	free(m->p);
 	m->p = NULL;
+	if (!m->n && !m->uv) {
+		free(m->tri);
+		m->tri = NULL;
+	}
 	double ext = fmax(v3_max_abs(m->bounds.lo), v3_max_abs(m->bounds.hi));
 	m->eps = (float)(ext * 0x1p-19);
 	return true;
@@ -505,26 +498,26 @@ bool mesh_prepare(mesh *m, bool smooth, double crease_deg, rt_error *err)
 
 void mesh_surface(const mesh *m, uint32_t slot, const float b[3], mesh_surf *s)
 {
-	uint32_t t = mesh_slot_tri(m, slot);
-	const uint32_t *i = m->tri[t];
 	vec3 pc[3];
 	mesh_corners(m, slot, pc);
 	vec3 e1 = v3_sub(pc[1], pc[0]), e2 = v3_sub(pc[2], pc[0]);
-	s->ng = v3_norm(v3_cross(e1, e2));
+	s->ng = v3_cross(e1, e2);
 	s->ns = s->ng;
+	s->u = s->v = 0;
+	s->dpdu = s->dpdv = v3(0, 0, 0);
+	uint32_t t = mesh_slot_tri(m, slot);
+	s->mat = m->nmats == 0 ? -1 : m->tmat ? m->tmat[t] : 0;
+	if (!m->tri)
+		return; /* neither normals nor uv */
+	const uint32_t *i = m->tri[t];
 	if (m->n) {
 		vec3 n = v3(0, 0, 0);
 		for (int k = 0; k < 3; k++)
 			n = v3_madd(n, v3(m->n[i[k]][0], m->n[i[k]][1], m->n[i[k]][2]), b[k]);
-		double l = v3_len(n);
-		if (l > 0) {
-			n = v3_scale(n, 1.0 / l);
-			/* a normal on the far side of the face would shade it black */
+		/* a normal on the far side of the face would shade it black */
+		if (v3_dot(n, n) > 0)
 			s->ns = v3_dot(n, s->ng) >= 0 ? n : v3_neg(n);
-		}
 	}
-	s->u = s->v = 0;
-	s->dpdu = s->dpdv = v3(0, 0, 0);
 	if (m->uv) {
 		const float *a = m->uv[i[0]], *bb = m->uv[i[1]], *c = m->uv[i[2]];
 		s->u = b[0] * a[0] + b[1] * bb[0] + b[2] * c[0];
@@ -536,7 +529,6 @@ void mesh_surface(const mesh *m, uint32_t slot, const float b[3], mesh_surf *s)
 			s->dpdv = v3_scale(v3_sub(v3_scale(e2, du1), v3_scale(e1, du2)), 1.0 / det);
 		}
 	}
-	s->mat = m->nmats == 0 ? -1 : m->tmat ? m->tmat[t] : 0;
 }
 
 /* --- loading by extension, and the cache --- */

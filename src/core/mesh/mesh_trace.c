@@ -1,58 +1,81 @@
 /* rtsh — rays against a mesh's triangles (mesh.h).
  *
- * The tree is bvh.c's 4-wide BVH, walked here in object space in single
- * precision: the slab tests are those of world.c (the far distance widened
- * by 1 + 2 gamma(3), Ize, "Robust BVH ray traversal", JCGT 2013), four
- * children at a time in SSE. Triangles are tested watertight (Woop, Benthin
- * & Wald, "Watertight ray/triangle intersection", JCGT 2013): the ray is
- * sheared so it runs along +z through the origin, and the three 2D edge
- * functions of the sheared vertices decide the hit; an edge function that
- * rounds to zero is recomputed in double, so a ray through a shared edge or
- * vertex hits exactly one of the triangles meeting there (no cracks).
+ * The tree is mesh_tree.c's 8-wide BVH, walked in object space in single
+ * precision. A node's eight slab tests run at once in one AVX2 register,
+ * or two SSE2 ones, or one by one in scalar code; the far distances are
+ * widened by 1 + 2 gamma(3) (Ize, "Robust BVH ray traversal", JCGT 2013)
+ * and so is the nearest hit where the walk prunes, so no box the ray
+ * enters is skipped. The walk goes to the nearest child the ray enters and
+ * keeps the others on a stack with their entry distances, nearest on top.
  *
- * A leaf's triangles are laid out in blocks of four (mesh_tri4: each
- * coordinate of each corner a row of four floats, the same floats as the
- * vertices), and the watertight test runs on the four at once in SSE,
- * doing wt_test's operations in its order so that it finds the very same
- * floats; a lane whose edge function is zero falls back to double alone.
- * The tree is built for these blocks (bvh_build_blocks: a leaf costs what
- * its blocks cost), and a hit names its triangle by its slot, 4 * block +
- * lane, whose corners the block holds (mesh_surface reads them there).
+ * Triangles are tested watertight (Woop, Benthin & Wald, "Watertight
+ * ray/triangle intersection", JCGT 2013): the ray is sheared so it runs
+ * along +z through the origin, and the three 2D edge functions of the
+ * sheared vertices decide the hit; an edge function that rounds to zero is
+ * recomputed in double, so a ray through a shared edge or vertex hits
+ * exactly one of the triangles meeting there (no cracks). A leaf's
+ * triangles are laid out in blocks of four (mesh_tri4), tested together
+ * in SSE with wt_test's operations in its order, so that the vector and
+ * scalar walks find the very same floats; a hit names its triangle by its
+ * slot, 4 * block + lane.
+ *
+ * The walk is written once (mesh_walk.h) and compiled for each vector
+ * unit; mesh_intersect and mesh_occluded take the best the processor has.
  */
 #include <float.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#define HAVE_AVX2_WALK 1
+#endif
 
 #include "core/bvh.h"
 #include "rtsh/mesh.h"
 
-
-void mesh_ray_make(mesh_ray *r, vec3 o, vec3 d)
+/* The ray o + t d, in floats, made ready for the walk: written once and
+ * inlined into every entry so that the compiler keeps it in registers. */
+static inline __attribute__((always_inline)) void ray_setup(mesh_ray *r, float ox, float oy, float oz, float dx,
+                                                            float dy, float dz)
 {
-	r->o[0] = (float)o.x;
-	r->o[1] = (float)o.y;
-	r->o[2] = (float)o.z;
-	r->d[0] = (float)d.x;
-	r->d[1] = (float)d.y;
-	r->d[2] = (float)d.z;
-	float ax = fabsf(r->d[0]), ay = fabsf(r->d[1]), az = fabsf(r->d[2]);
-	int kz = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
-	int kx = (kz + 1) % 3, ky = (kx + 1) % 3;
-	if (r->d[kz] < 0.0f) {
-		int s = kx;
-		kx = ky;
-		ky = s;
-	}
+	r->o[0] = ox;
+	r->o[1] = oy;
+	r->o[2] = oz;
+	r->d[0] = dx;
+	r->d[1] = dy;
+	r->d[2] = dz;
+	r->inv[0] = 1.0f / dx;
+	r->inv[1] = 1.0f / dy;
+	r->inv[2] = 1.0f / dz;
+	/* kz: the axis of the largest |d| (y before x on a tie, z before
+	 * both), then kx, ky the next two, swapped when d runs down kz so the
+	 * triangles' winding is kept; written without branches, which random
+	 * directions would make guesses of */
+	float ax = fabsf(dx), ay = fabsf(dy), az = fabsf(dz);
+	int kxy = !(ax > ay);
+	float axy = ax > ay ? ax : ay;
+	int kz = axy > az ? kxy : 2;
+	int kx = kz == 2 ? 0 : kz + 1, ky = kx == 2 ? 0 : kx + 1;
+	float dkz = kz == 0 ? dx : kz == 1 ? dy : dz;
+	int swap = (kx ^ ky) & -(int)(dkz < 0.0f);
+	kx ^= swap;
+	ky ^= swap;
 	r->kx = kx;
 	r->ky = ky;
 	r->kz = kz;
-	r->sx = r->d[kx] / r->d[kz];
-	r->sy = r->d[ky] / r->d[kz];
-	r->sz = 1.0f / r->d[kz];
+	r->sz = kz == 0 ? r->inv[0] : kz == 1 ? r->inv[1] : r->inv[2];
+	r->sx = (kx == 0 ? dx : kx == 1 ? dy : dz) * r->sz;
+	r->sy = (ky == 0 ? dx : ky == 1 ? dy : dz) * r->sz;
+}
+
+void mesh_ray_make(mesh_ray *r, vec3 o, vec3 d)
+{
+	ray_setup(r, (float)o.x, (float)o.y, (float)o.z, (float)d.x, (float)d.y, (float)d.z);
 }
 
 /* The watertight test of one triangle, given its corners' coordinates on
@@ -103,69 +126,16 @@ static bool tri_test(const mesh *m, const mesh_ray *r, uint32_t t, float tmin, f
 
 /* --- the leaf blocks --- */
 
-bool mesh_make_blocks(mesh *m)
-{
-	bvh *tree = m->tree;
-	free(m->blk);
-	free(m->bfirst);
-	m->blk = NULL;
-	m->bfirst = NULL;
-	m->nblk = 0;
-	/* count the blocks: every leaf starts a new one */
-	size_t n = 0;
-	if (tree->root_meta)
-		n = ((tree->root_meta & ~BVH_LEAF) + 3) / 4;
-	else
-		for (size_t i = 0; i < tree->nnodes; i++)
-			for (int k = 0; k < BVH_WIDTH; k++)
-				if (tree->nodes[i].meta[k])
-					n += ((tree->nodes[i].meta[k] & ~BVH_LEAF) + 3) / 4;
-	if (n > UINT32_MAX)
-		return false;
-	mesh_tri4 *blk = aligned_alloc(64, (n * sizeof *blk + 63) / 64 * 64 + 64);
-	uint32_t *first = malloc((n ? n : 1) * sizeof *first);
-	if (!blk || !first) {
-		free(blk);
-		free(first);
-		return false;
-	}
-	uint32_t next = 0;
-	size_t nodes = tree->root_meta ? 1 : tree->nnodes;
-	for (size_t i = 0; i < nodes; i++)
-		for (int k = 0; k < (tree->root_meta ? 1 : BVH_WIDTH); k++) {
-			uint32_t *child = tree->root_meta ? &tree->root : &tree->nodes[i].child[k];
-			uint32_t meta = tree->root_meta ? tree->root_meta : tree->nodes[i].meta[k];
-			if (!meta)
-				continue;
-			uint32_t count = meta & ~BVH_LEAF, t0 = *child;
-			*child = next;
-			for (uint32_t j = 0; j < count; j += 4, next++) {
-				first[next] = t0 + j;
-				for (int l = 0; l < 4; l++) {
-					/* a lane past the end repeats the last triangle */
-					const uint32_t *ti = m->tri[t0 + (j + (uint32_t)l < count ? j + (uint32_t)l : count - 1)];
-					for (int c = 0; c < 3; c++)
-						for (int a = 0; a < 3; a++)
-							blk[next].v[3 * c + a][l] = m->p[ti[c]][a];
-				}
-			}
-		}
-	m->blk = blk;
-	m->bfirst = first;
-	m->nblk = next;
-	return true;
-}
-
-/* Lanes 0..n-1 of block q one at a time: the nearest hit in (tmin, *best)
+/* The four lanes of block q one at a time: the nearest hit in (tmin, *best)
  * sets *best and b and returns its lane, else -1. */
-static inline __attribute__((always_inline)) int block_scalar(const mesh_tri4 *q, uint32_t n, const mesh_ray *r,
-                                                              float tmin, float *best, float b[3])
+static inline __attribute__((always_inline)) int block_scalar(const mesh_tri4 *q, const mesh_ray *r, float tmin,
+                                                              float *best, float b[3])
 {
 	int kx = r->kx, ky = r->ky, kz = r->kz, found = -1;
-	for (uint32_t l = 0; l < n && l < 4; l++)
+	for (int l = 0; l < 4; l++)
 		if (wt_test(r, q->v[kx][l], q->v[ky][l], q->v[kz][l], q->v[3 + kx][l], q->v[3 + ky][l], q->v[3 + kz][l],
 		            q->v[6 + kx][l], q->v[6 + ky][l], q->v[6 + kz][l], tmin, best, b))
-			found = (int)l;
+			found = l;
 	return found;
 }
 
@@ -175,7 +145,7 @@ typedef struct ray4 {
 	__m128 ox, oy, oz, sx, sy, sz;
 } ray4;
 
-static inline void ray4_make(const mesh_ray *r, ray4 *q)
+static inline __attribute__((always_inline)) void ray4_make(const mesh_ray *r, ray4 *q)
 {
 	q->ox = _mm_set1_ps(r->o[r->kx]);
 	q->oy = _mm_set1_ps(r->o[r->ky]);
@@ -188,8 +158,8 @@ static inline void ray4_make(const mesh_ray *r, ray4 *q)
 /* block_scalar's test on the four lanes at once (wt_test's operations in
  * its order; an edge function that is zero in some lane is recomputed in
  * double for that lane, as wt_test does). */
-static inline __attribute__((always_inline)) int block_sse(const mesh_tri4 *q, uint32_t n, const mesh_ray *r,
-                                                           const ray4 *rq, float tmin, float *best, float b[3])
+static inline __attribute__((always_inline)) int block_sse(const mesh_tri4 *q, const mesh_ray *r, const ray4 *rq,
+                                                           float tmin, float *best, float b[3])
 {
 	int kx = r->kx, ky = r->ky, kz = r->kz;
 	__m128 az = _mm_sub_ps(_mm_load_ps(q->v[kz]), rq->oz);
@@ -205,10 +175,8 @@ static inline __attribute__((always_inline)) int block_sse(const mesh_tri4 *q, u
 	__m128 v = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
 	__m128 w = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
 	const __m128 zero = _mm_setzero_ps();
-	unsigned lanes = (1u << (n < 4 ? n : 4)) - 1;
 	unsigned zm = (unsigned)_mm_movemask_ps(
-	                  _mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(u, zero), _mm_cmpeq_ps(v, zero)), _mm_cmpeq_ps(w, zero))) &
-	              lanes;
+	    _mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(u, zero), _mm_cmpeq_ps(v, zero)), _mm_cmpeq_ps(w, zero)));
 	if (zm) {
 		_Alignas(16) float fu[4], fv[4], fw[4], fax[4], fay[4], fbx[4], fby[4], fcx[4], fcy[4];
 		_mm_store_ps(fu, u);
@@ -234,13 +202,13 @@ static inline __attribute__((always_inline)) int block_sse(const mesh_tri4 *q, u
 	__m128 pos = _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(v, zero)), _mm_cmpgt_ps(w, zero));
 	__m128 det = _mm_add_ps(_mm_add_ps(u, v), w);
 	__m128 ok = _mm_andnot_ps(_mm_and_ps(neg, pos), _mm_cmpneq_ps(det, zero));
-	if (!(_mm_movemask_ps(ok) & lanes))
+	if (!_mm_movemask_ps(ok))
 		return -1;
 	__m128 tt = _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(u, az), _mm_mul_ps(v, bz)), _mm_mul_ps(w, cz)), rq->sz);
 	__m128 inv = _mm_div_ps(_mm_set1_ps(1.0f), det);
 	__m128 th = _mm_mul_ps(tt, inv);
 	ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmpgt_ps(th, _mm_set1_ps(tmin)), _mm_cmplt_ps(th, _mm_set1_ps(*best))));
-	unsigned hm = (unsigned)_mm_movemask_ps(ok) & lanes;
+	unsigned hm = (unsigned)_mm_movemask_ps(ok);
 	if (!hm)
 		return -1;
 	_Alignas(16) float fth[4];
@@ -267,159 +235,253 @@ static inline __attribute__((always_inline)) int block_sse(const mesh_tri4 *q, u
 
 /* --- the walk --- */
 
+/* A child waiting on the walk's stack: its reference and entry distance. */
 typedef struct entry {
-	uint32_t child, meta;
+	uint32_t ref;
 	float t;
-	uint32_t pad;
 } entry;
 
-static inline void prepare(const mesh_ray *r, bvh_ray *q)
+/* The deepest stack a walk needs: at most seven children wait per level. */
+#define MESH_STACK (7 * BVH_MAX_DEPTH + 8)
+
+/* What the slab tests need of a ray: per axis the rows of mesh_node.b
+ * that hold the near and far planes (by the direction's sign, Williams et
+ * al. 2005). The origin is a float already: no rounding to allow for. */
+typedef struct slab_rows {
+	int near[3], far[3];
+} slab_rows;
+
+static inline __attribute__((always_inline)) void slab_rows_make(const mesh_ray *r, slab_rows *q)
 {
 	for (int a = 0; a < 3; a++) {
-		float inv = 1.0f / r->d[a];
-		bool neg = signbit(inv);
-		q->near[a] = (neg ? BVH_HI_X : BVH_LO_X) + a;
-		q->far[a] = (neg ? BVH_LO_X : BVH_HI_X) + a;
-		float f = r->o[a];
-#if defined(__SSE2__)
-		q->on[a] = _mm_set1_ps(f);
-		q->of[a] = _mm_set1_ps(f);
-		q->inv[a] = _mm_set1_ps(inv);
-#else
-		q->on[a] = f;
-		q->of[a] = f;
-		q->inv[a] = inv;
-#endif
+		int neg = signbit(r->inv[a]) != 0;
+		q->near[a] = BVH_LO_X + a + 3 * neg;
+		q->far[a] = BVH_HI_X + a - 3 * neg;
 	}
 }
 
-/* The nearest hit (any = false) or any hit (any = true) in (tmin, *tmax),
- * with SSE leaf tests or scalar ones. */
-static inline __attribute__((always_inline)) bool walk(const mesh *m, const mesh_ray *r, float tmin, float *tmax,
-                                                       uint32_t *tri, float b[3], bool any, bool sse)
+/* Pushes the children of n in mask hm (at least two) with their entry
+ * distances, nearest on top, and returns the nearest, popped. */
+static inline __attribute__((always_inline)) uint32_t push_sorted(const mesh_node *n, unsigned hm, const float *tn,
+                                                                  entry *stack, int *sp)
 {
-	const bvh *tree = m->tree;
-	bvh_ray q;
-	prepare(r, &q);
-#if defined(__SSE2__)
-	ray4 rq;
-	if (sse)
-		ray4_make(r, &rq);
-#else
-	(void)sse;
-#endif
-	entry stack[BVH_STACK];
-	int sp = 0;
-	bool found = false;
-	float best = *tmax;
-	uint32_t child = tree->root, meta = tree->root_meta;
-	for (;;) {
-		if (meta) {
-			uint32_t count = meta & ~BVH_LEAF;
-			for (uint32_t k = 0; k < count; k += 4) {
-				const mesh_tri4 *blk = &m->blk[child + k / 4];
-				int l;
-#if defined(__SSE2__)
-				if (sse)
-					l = block_sse(blk, count - k, r, &rq, tmin, &best, b);
-				else
-#endif
-					l = block_scalar(blk, count - k, r, tmin, &best, b);
-				if (l >= 0) {
-					*tri = 4 * (child + k / 4) + (uint32_t)l;
-					found = true;
-					if (any)
-						goto done;
-				}
-			}
-		} else {
-			const bvh_node *n = &tree->nodes[child];
-			float tn[BVH_WIDTH];
-			unsigned hm = bvh_slab4(n, &q, tmin, best, tn);
-			if (hm) {
-				if (any) {
-					int k = __builtin_ctz(hm);
-					for (unsigned rest = hm & (hm - 1); rest; rest &= rest - 1) {
-						int j = __builtin_ctz(rest);
-						stack[sp++] = (entry){n->child[j], n->meta[j], tn[j], 0};
-					}
-					child = n->child[k];
-					meta = n->meta[k];
-					continue;
-				}
-				/* the nearest child next, the others on the stack */
-				int k = __builtin_ctz(hm);
-				unsigned rest = hm & (hm - 1);
-				if (rest) {
-					int k2 = __builtin_ctz(rest);
-					rest &= rest - 1;
-					if (!rest) {
-						if (tn[k2] < tn[k]) {
-							int x = k;
-							k = k2;
-							k2 = x;
-						}
-						stack[sp++] = (entry){n->child[k2], n->meta[k2], tn[k2], 0};
-					} else {
-						int idx[BVH_WIDTH], c = 0;
-						for (int j = 0; j < BVH_WIDTH; j++) {
-							if (!(hm >> j & 1))
-								continue;
-							int i = c++;
-							while (i > 0 && tn[idx[i - 1]] < tn[j]) {
-								idx[i] = idx[i - 1];
-								i--;
-							}
-							idx[i] = j;
-						}
-						for (int i = 0; i < c - 1; i++)
-							stack[sp++] = (entry){n->child[idx[i]], n->meta[idx[i]], tn[idx[i]], 0};
-						k = idx[c - 1];
-					}
-				}
-				child = n->child[k];
-				meta = n->meta[k];
-				continue;
-			}
+	int k = __builtin_ctz(hm);
+	hm &= hm - 1;
+	int k2 = __builtin_ctz(hm);
+	hm &= hm - 1;
+	if (!hm) {
+		if (tn[k2] < tn[k]) {
+			int x = k;
+			k = k2;
+			k2 = x;
 		}
-		if (!any)
-			while (sp > 0 && stack[sp - 1].t > BVH_SLAB_SLACK * best)
-				sp--;
-		if (sp == 0)
-			break;
-		sp--;
-		child = stack[sp].child;
-		meta = stack[sp].meta;
+		stack[(*sp)++] = (entry){n->child[k2], tn[k2]};
+		return n->child[k];
 	}
-done:
-	/* every hit found was nearer than the last, so b holds the best's */
-	if (found)
-		*tmax = best;
-	return found;
+	/* three or more: an insertion sort of the new entries, farthest first */
+	int base = *sp, top = base;
+	stack[top++] = (entry){n->child[k], tn[k]};
+	for (unsigned rest = hm | 1u << k2; rest; rest &= rest - 1) {
+		int j = __builtin_ctz(rest);
+		entry e = {n->child[j], tn[j]};
+		int i = top++;
+		while (i > base && stack[i - 1].t < e.t) {
+			stack[i] = stack[i - 1];
+			i--;
+		}
+		stack[i] = e;
+	}
+	*sp = top - 1;
+	return stack[top - 1].ref;
+}
+
+#ifdef MESH_STATS
+_Thread_local unsigned long mesh_stat_nodes, mesh_stat_blocks, mesh_stat_leaves;
+#endif
+
+/* The walk for each vector unit: walk_scalar, walk_sse, walk_avx2. */
+#define WALK walk_scalar
+#define WALK_ISA 0
+#define WALK_TARGET
+#include "mesh_walk.h"
+
+#if defined(__SSE2__)
+#define WALK walk_sse
+#define WALK_ISA 1
+#define WALK_TARGET
+#include "mesh_walk.h"
+#endif
+
+#if defined(HAVE_AVX2_WALK)
+#define WALK walk_avx2
+#define WALK_ISA 2
+#define WALK_TARGET __attribute__((target("avx2")))
+#include "mesh_walk.h"
+#endif
+
+/* The world ray r taken into the model's coordinates by the 3x4 matrix M
+ * (in double, then rounded to floats), its tmin raised past the model's
+ * rounding (m->eps, in the ray's units), then the walk: the entry for
+ * instances (world.c), one per vector unit. The triangles see the raised
+ * tmin; the boxes the caller's, which is no larger (they are visited a
+ * little more, never less, and this keeps a square root off the path to
+ * the first box test). */
+#define INST_ENTRY(name, walk, target)                                                                              \
+	static target __attribute__((noinline)) bool name(const mesh *m, const double (*M)[4], const ray *wr,           \
+	                                                  double tmin, double tmax, double *t, uint32_t *slot,         \
+	                                                  float b[3], bool any)                                        \
+	{                                                                                                             \
+		double px = wr->o.x, py = wr->o.y, pz = wr->o.z, vx = wr->d.x, vy = wr->d.y, vz = wr->d.z;            \
+		mesh_ray r;                                                                                           \
+		ray_setup(&r, (float)(M[0][0] * px + M[0][1] * py + M[0][2] * pz + M[0][3]),                          \
+		          (float)(M[1][0] * px + M[1][1] * py + M[1][2] * pz + M[1][3]),                              \
+		          (float)(M[2][0] * px + M[2][1] * py + M[2][2] * pz + M[2][3]),                              \
+		          (float)(M[0][0] * vx + M[0][1] * vy + M[0][2] * vz),                                        \
+		          (float)(M[1][0] * vx + M[1][1] * vy + M[1][2] * vz),                                        \
+		          (float)(M[2][0] * vx + M[2][1] * vy + M[2][2] * vz));                                       \
+		float guard = m->eps / sqrtf(r.d[0] * r.d[0] + r.d[1] * r.d[1] + r.d[2] * r.d[2]);                   \
+		float box_tmin = (float)tmin, tri_tmin = tmin > guard ? box_tmin : guard;                            \
+		float ft = tmax < 3e38 ? (float)tmax : INFINITY;                                                      \
+		if (!walk(m, &r, box_tmin, tri_tmin, &ft, slot, b, any) || !((double)ft < tmax))                     \
+			return false;                                                                                 \
+		*t = ft;                                                                                              \
+		return true;                                                                                          \
+	}
+
+INST_ENTRY(inst_scalar, walk_scalar, )
+#if defined(__SSE2__)
+INST_ENTRY(inst_sse, walk_sse, )
+#endif
+#if defined(HAVE_AVX2_WALK)
+INST_ENTRY(inst_avx2, walk_avx2, __attribute__((target("avx2"))))
+
+static __attribute__((target("avx2"), noinline)) bool intersect_avx2(const mesh *m, const mesh_ray *r, float tmin,
+                                                                     float *tmax, uint32_t *tri, float b[3])
+{
+	return walk_avx2(m, r, tmin, tmin, tmax, tri, b, false);
+}
+
+static __attribute__((target("avx2"), noinline)) bool occluded_avx2(const mesh *m, const mesh_ray *r, float tmin,
+                                                                    float tmax)
+{
+	uint32_t tri;
+	float b[3];
+	return walk_avx2(m, r, tmin, tmin, &tmax, &tri, b, true);
+}
+#endif
+
+/* The vector unit in use: -1 until the first walk asks the processor. */
+static atomic_int isa_now = -1;
+
+static mesh_isa isa_best(void)
+{
+#if defined(HAVE_AVX2_WALK)
+	if (__builtin_cpu_supports("avx2"))
+		return MESH_ISA_AVX2;
+#endif
+#if defined(__SSE2__)
+	return MESH_ISA_SSE2;
+#else
+	return MESH_ISA_SCALAR;
+#endif
+}
+
+mesh_isa mesh_isa_active(void)
+{
+	int isa = atomic_load_explicit(&isa_now, memory_order_relaxed);
+	if (isa < 0) {
+		isa = (int)isa_best();
+		atomic_store_explicit(&isa_now, isa, memory_order_relaxed);
+	}
+	return (mesh_isa)isa;
+}
+
+bool mesh_isa_force(mesh_isa isa)
+{
+	mesh_isa best = isa_best();
+	if (isa == MESH_ISA_BEST)
+		isa = best;
+	if (isa > best)
+		return false;
+	atomic_store_explicit(&isa_now, (int)isa, memory_order_relaxed);
+	return true;
 }
 
 bool mesh_intersect(const mesh *m, const mesh_ray *r, float tmin, float *tmax, uint32_t *tri, float b[3])
 {
-	return walk(m, r, tmin, tmax, tri, b, false, true);
+	switch (mesh_isa_active()) {
+#if defined(HAVE_AVX2_WALK)
+	case MESH_ISA_AVX2:
+		return intersect_avx2(m, r, tmin, tmax, tri, b);
+#endif
+#if defined(__SSE2__)
+	case MESH_ISA_SSE2:
+		return walk_sse(m, r, tmin, tmin, tmax, tri, b, false);
+#endif
+	default:
+		return walk_scalar(m, r, tmin, tmin, tmax, tri, b, false);
+	}
 }
 
 bool mesh_occluded(const mesh *m, const mesh_ray *r, float tmin, float tmax)
 {
 	uint32_t tri;
 	float b[3];
-	return walk(m, r, tmin, &tmax, &tri, b, true, true);
+	switch (mesh_isa_active()) {
+#if defined(HAVE_AVX2_WALK)
+	case MESH_ISA_AVX2:
+		return occluded_avx2(m, r, tmin, tmax);
+#endif
+#if defined(__SSE2__)
+	case MESH_ISA_SSE2:
+		return walk_sse(m, r, tmin, tmin, &tmax, &tri, b, true);
+#endif
+	default:
+		return walk_scalar(m, r, tmin, tmin, &tmax, &tri, b, true);
+	}
+}
+
+static bool inst_walk(const mesh *m, const double (*inv)[4], const ray *r, double tmin, double tmax, double *t,
+                      uint32_t *slot, float b[3], bool any)
+{
+	switch (mesh_isa_active()) {
+#if defined(HAVE_AVX2_WALK)
+	case MESH_ISA_AVX2:
+		return inst_avx2(m, inv, r, tmin, tmax, t, slot, b, any);
+#endif
+#if defined(__SSE2__)
+	case MESH_ISA_SSE2:
+		return inst_sse(m, inv, r, tmin, tmax, t, slot, b, any);
+#endif
+	default:
+		return inst_scalar(m, inv, r, tmin, tmax, t, slot, b, any);
+	}
+}
+
+bool mesh_intersect_world(const mesh *m, const double (*inv)[4], const ray *r, double tmin, double tmax, double *t,
+                          uint32_t *slot, float b[3])
+{
+	return inst_walk(m, inv, r, tmin, tmax, t, slot, b, false);
+}
+
+bool mesh_occluded_world(const mesh *m, const double (*inv)[4], const ray *r, double tmin, double tmax)
+{
+	double t;
+	uint32_t slot;
+	float b[3];
+	return inst_walk(m, inv, r, tmin, tmax, &t, &slot, b, true);
 }
 
 bool mesh_intersect_scalar(const mesh *m, const mesh_ray *r, float tmin, float *tmax, uint32_t *tri, float b[3])
 {
-	return walk(m, r, tmin, tmax, tri, b, false, false);
+	return walk_scalar(m, r, tmin, tmin, tmax, tri, b, false);
 }
 
 bool mesh_occluded_scalar(const mesh *m, const mesh_ray *r, float tmin, float tmax)
 {
 	uint32_t tri;
 	float b[3];
-	return walk(m, r, tmin, &tmax, &tri, b, true, false);
+	return walk_scalar(m, r, tmin, tmin, &tmax, &tri, b, true);
 }
 
 bool mesh_intersect_brute(const mesh *m, const mesh_ray *r, float tmin, float *tmax, uint32_t *tri, float b[3])
@@ -433,12 +495,4 @@ bool mesh_intersect_brute(const mesh *m, const mesh_ray *r, float tmin, float *t
 			found = true;
 		}
 	return found;
-}
-
-void mesh_corners(const mesh *m, uint32_t slot, vec3 c[3])
-{
-	const mesh_tri4 *q = &m->blk[slot >> 2];
-	int l = (int)(slot & 3);
-	for (int k = 0; k < 3; k++)
-		c[k] = v3(q->v[3 * k][l], q->v[3 * k + 1][l], q->v[3 * k + 2][l]);
 }

@@ -1,0 +1,159 @@
+/* rtsh — the walk of a mesh's tree, written once and included by
+ * mesh_trace.c for each vector unit: WALK names the function, WALK_ISA is
+ * 0 (scalar), 1 (SSE2) or 2 (AVX2), WALK_TARGET its target attribute.
+ *
+ * WALK(m, r, box_tmin, tmin, tmax, tri, b, any): the nearest hit in (tmin,
+ * *tmax) (any = false: sets *tmax, *tri and b) or whether there is any
+ * (any = true). The boxes are tested from box_tmin <= tmin. Every unit runs the same float operations in the same order, so
+ * each finds the same hits.
+ */
+
+static inline __attribute__((always_inline)) WALK_TARGET bool WALK(const mesh *m, const mesh_ray *r, float box_tmin,
+                                                                   float tmin, float *tmax, uint32_t *tri, float b[3],
+                                                                   bool any)
+{
+	const mesh_node *nodes = m->nodes;
+	slab_rows q;
+	slab_rows_make(r, &q);
+	/* byte offsets in a node of the near and far rows of each axis, and
+	 * the ray's slab constants in registers of their own (GCC keeps arrays
+	 * of vectors on the stack) */
+	const size_t rn0 = (size_t)q.near[0] * sizeof nodes->b[0], rn1 = (size_t)q.near[1] * sizeof nodes->b[0],
+	             rn2 = (size_t)q.near[2] * sizeof nodes->b[0], rf0 = (size_t)q.far[0] * sizeof nodes->b[0],
+	             rf1 = (size_t)q.far[1] * sizeof nodes->b[0], rf2 = (size_t)q.far[2] * sizeof nodes->b[0];
+	float best = *tmax;
+#define ROW(n, off) ((const float *)((const char *)(n)->b + (off)))
+#if WALK_ISA == 2
+	const __m256 ox = _mm256_set1_ps(r->o[0]), oy = _mm256_set1_ps(r->o[1]), oz = _mm256_set1_ps(r->o[2]);
+	const __m256 ix = _mm256_set1_ps(r->inv[0]), iy = _mm256_set1_ps(r->inv[1]), iz = _mm256_set1_ps(r->inv[2]);
+	const __m256 t0_8 = _mm256_set1_ps(box_tmin), slack8 = _mm256_set1_ps(BVH_SLAB_SLACK);
+	__m256 best8 = _mm256_set1_ps(best);
+#elif WALK_ISA == 1
+	const __m128 ox = _mm_set1_ps(r->o[0]), oy = _mm_set1_ps(r->o[1]), oz = _mm_set1_ps(r->o[2]);
+	const __m128 ix = _mm_set1_ps(r->inv[0]), iy = _mm_set1_ps(r->inv[1]), iz = _mm_set1_ps(r->inv[2]);
+	const __m128 t0_4 = _mm_set1_ps(box_tmin), slack4 = _mm_set1_ps(BVH_SLAB_SLACK);
+	__m128 best4 = _mm_set1_ps(best);
+#endif
+#if WALK_ISA >= 1
+	ray4 rq;
+	ray4_make(r, &rq);
+#endif
+	entry stack[MESH_STACK];
+	int sp = 0;
+	bool found = false;
+	uint32_t ref = 0; /* the root node */
+	for (;;) {
+		while (!(ref & MESH_LEAF)) {
+			const mesh_node *n = &nodes[ref];
+			_Alignas(32) float tn[MESH_WIDTH];
+#ifdef MESH_STATS
+			mesh_stat_nodes++;
+#endif
+			unsigned hm;
+#if WALK_ISA == 2
+			{
+				/* max(x, acc) and min(x, acc) return acc when x is NaN */
+				__m256 t0 = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(ROW(n, rn0)), ox), ix), t0_8);
+				__m256 t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(ROW(n, rf0)), ox), ix), best8);
+				t0 = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(ROW(n, rn1)), oy), iy), t0);
+				t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(ROW(n, rf1)), oy), iy), t1);
+				t0 = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(ROW(n, rn2)), oz), iz), t0);
+				t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(ROW(n, rf2)), oz), iz), t1);
+				_mm256_store_ps(tn, t0);
+				hm = (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(t0, _mm256_mul_ps(t1, slack8), _CMP_LE_OQ));
+			}
+#elif WALK_ISA == 1
+			hm = 0;
+			for (int h = 0; h < 2; h++) {
+				__m128 t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(ROW(n, rn0) + 4 * h), ox), ix), t0_4);
+				__m128 t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(ROW(n, rf0) + 4 * h), ox), ix), best4);
+				t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(ROW(n, rn1) + 4 * h), oy), iy), t0);
+				t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(ROW(n, rf1) + 4 * h), oy), iy), t1);
+				t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(ROW(n, rn2) + 4 * h), oz), iz), t0);
+				t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(ROW(n, rf2) + 4 * h), oz), iz), t1);
+				_mm_store_ps(&tn[4 * h], t0);
+				hm |= (unsigned)_mm_movemask_ps(_mm_cmple_ps(t0, _mm_mul_ps(t1, slack4))) << (4 * h);
+			}
+#else
+			hm = 0;
+			for (int k = 0; k < MESH_WIDTH; k++) {
+				float t0 = box_tmin, t1 = best;
+				const size_t rn[3] = {rn0, rn1, rn2}, rf[3] = {rf0, rf1, rf2};
+				for (int a = 0; a < 3; a++) {
+					float tnear = (ROW(n, rn[a])[k] - r->o[a]) * r->inv[a];
+					float tfar = (ROW(n, rf[a])[k] - r->o[a]) * r->inv[a];
+					t0 = tnear > t0 ? tnear : t0;
+					t1 = tfar < t1 ? tfar : t1;
+				}
+				tn[k] = t0;
+				hm |= (unsigned)(t0 <= t1 * BVH_SLAB_SLACK) << k;
+			}
+#endif
+			if (!hm)
+				goto pop;
+			if (!(hm & (hm - 1))) {
+				ref = n->child[__builtin_ctz(hm)];
+				continue;
+			}
+			if (any) {
+				/* any hit will do: no sorting, the first child now */
+				int k = __builtin_ctz(hm);
+				for (unsigned rest = hm & (hm - 1); rest; rest &= rest - 1) {
+					int j = __builtin_ctz(rest);
+					stack[sp++] = (entry){n->child[j], tn[j]};
+				}
+				ref = n->child[k];
+				continue;
+			}
+			ref = push_sorted(n, hm, tn, stack, &sp);
+		}
+		{
+			/* a leaf: its blocks */
+			uint32_t first = ref & (MESH_MAX_BLOCKS - 1), nb = ((ref & ~MESH_LEAF) >> MESH_LEAF_SHIFT) + 1;
+#ifdef MESH_STATS
+			mesh_stat_leaves++;
+#endif
+			for (uint32_t k = 0; k < nb; k++) {
+				const mesh_tri4 *blk = &m->blk[first + k];
+#ifdef MESH_STATS
+				mesh_stat_blocks++;
+#endif
+#if WALK_ISA >= 1
+				int l = block_sse(blk, r, &rq, tmin, &best, b);
+#else
+				int l = block_scalar(blk, r, tmin, &best, b);
+#endif
+				if (l >= 0) {
+					*tri = 4 * (first + k) + (uint32_t)l;
+					found = true;
+					if (any)
+						goto done;
+				}
+			}
+			if (found) {
+#if WALK_ISA == 2
+				best8 = _mm256_set1_ps(best);
+#elif WALK_ISA == 1
+				best4 = _mm_set1_ps(best);
+#endif
+			}
+		}
+	pop:
+		if (!any)
+			while (sp > 0 && stack[sp - 1].t > BVH_SLAB_SLACK * best)
+				sp--;
+		if (sp == 0)
+			break;
+		ref = stack[--sp].ref;
+	}
+done:
+	/* every hit found was nearer than the last, so b holds the best's */
+	if (found)
+		*tmax = best;
+	return found;
+}
+
+#undef ROW
+#undef WALK
+#undef WALK_ISA
+#undef WALK_TARGET
