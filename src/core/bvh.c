@@ -13,10 +13,10 @@
  * as four floats (the fourth unused) so that a box union is one SSE min and
  * one max; a scalar version of each helper serves other machines.
  *
- * With a clip function (a mesh's triangles) a node also tries spatial
+ * With a chop function (a mesh's triangles) a node also tries spatial
  * splits where its object split's children overlap (Stich, Friedrich &
- * Dietrich 2009): 16 bins across the node's box, each reference clipped to
- * every bin it spans, and a reference cut by the chosen plane goes to both
+ * Dietrich 2009): 16 bins across the node's box, each reference cut into
+ * the bins it spans, and a reference cut by the chosen plane goes to both
  * sides unless sending it whole to one side costs less ("unsplitting").
  * The references live in one array with room for split_budget x n more;
  * each node's range is followed by its share of the free room, given to
@@ -47,7 +47,7 @@
 #define COST_TRAVERSE 4.0
 /* Spatial splits are tried where the object split's children overlap by
  * more than this share of the root's area (Stich et al.'s alpha). */
-#define SPATIAL_ALPHA 1e-5
+#define SPATIAL_ALPHA 1e-2
 
 typedef bvh_fbox fbox;
 typedef bvh2_node node2;
@@ -293,17 +293,35 @@ static void spatial_planes(const fbox *bb, int a, float pos[BINS + 1])
 	pos[BINS] = bb->hi[a];
 }
 
-/* The spatial bin of coordinate x: the last k with pos[k] <= x. */
-static inline int spatial_bin(const float pos[BINS + 1], float x)
+/* The spatial bin of coordinate x: the last k < BINS with pos[k] <= x (or
+ * 0), guessed from the scale and then put right against the planes. */
+static inline int spatial_bin(const float pos[BINS + 1], float scale, float x)
 {
-	int k = 0;
+	float g = (x - pos[0]) * scale;
+	int k = g > 0.0f ? (g < (float)(BINS - 1) ? (int)g : BINS - 1) : 0;
+	while (k > 0 && pos[k] > x)
+		k--;
 	while (k < BINS - 1 && pos[k + 1] <= x)
 		k++;
 	return k;
 }
 
+static bool fbox_is_empty(const fbox *x)
+{
+	return !(x->lo[0] <= x->hi[0] && x->lo[1] <= x->hi[1] && x->lo[2] <= x->hi[2]);
+}
+
+/* The parts of reference r (of primitive id) below and above the plane at
+ * pos across axis a. */
+static void cut(const builder *b, uint32_t id, int a, float pos, const fbox *r, fbox parts[2])
+{
+	float planes[3] = {r->lo[a], pos, r->hi[a]};
+	parts[0] = parts[1] = *r;
+	b->o->chop(b->o->ctx, id, a, planes, 2, parts);
+}
+
 /* The cheapest spatial split of refs[begin, end) (box bb), if cheaper
- * than best: each reference clipped into every bin it spans, counted where
+ * than best: each reference cut into the bins it spans, counted where
  * it enters and where it leaves. */
 static void find_spatial(const builder *b, size_t begin, size_t end, const fbox *bb, split *best)
 {
@@ -313,24 +331,26 @@ static void find_spatial(const builder *b, size_t begin, size_t end, const fbox 
 			continue;
 		float pos[BINS + 1];
 		spatial_planes(bb, a, pos);
+		float scale = (float)BINS / (bb->hi[a] - bb->lo[a]);
 		fbox bins[BINS];
 		double enter[BINS] = {0}, leave[BINS] = {0};
 		for (int k = 0; k < BINS; k++)
 			bins[k] = fbox_empty();
 		for (size_t i = begin; i < end; i++) {
 			const fbox *r = &b->refs[i];
-			int k0 = spatial_bin(pos, r->lo[a]), k1 = spatial_bin(pos, r->hi[a]);
+			int k0 = spatial_bin(pos, scale, r->lo[a]), k1 = spatial_bin(pos, scale, r->hi[a]);
 			enter[k0] += r->lo[3];
 			leave[k1] += r->lo[3];
 			if (k0 == k1) {
 				fbox_union(&bins[k0], r);
 				continue;
 			}
-			for (int k = k0; k <= k1; k++) {
-				fbox part = *r;
-				if (o->clip(o->ctx, b->ids[i], a, pos[k], pos[k + 1], &part))
-					fbox_union(&bins[k], &part);
-			}
+			fbox parts[BINS];
+			for (int k = k0; k <= k1; k++)
+				parts[k - k0] = *r;
+			o->chop(o->ctx, b->ids[i], a, &pos[k0], k1 - k0 + 1, parts);
+			for (int k = k0; k <= k1; k++)
+				fbox_union(&bins[k], &parts[k - k0]);
 		}
 		double right_area[BINS], right_cost[BINS];
 		fbox acc = fbox_empty();
@@ -367,17 +387,15 @@ static void find_spatial(const builder *b, size_t begin, size_t end, const fbox 
 		best->lb = best->rb = fbox_empty();
 		for (size_t i = begin; i < end; i++) {
 			const fbox *r = &b->refs[i];
-			fbox part = *r;
 			if (r->hi[best->axis] <= best->pos)
 				fbox_union(&best->lb, r);
 			else if (r->lo[best->axis] >= best->pos)
 				fbox_union(&best->rb, r);
 			else {
-				if (o->clip(o->ctx, b->ids[i], best->axis, r->lo[best->axis], best->pos, &part))
-					fbox_union(&best->lb, &part);
-				part = *r;
-				if (o->clip(o->ctx, b->ids[i], best->axis, best->pos, r->hi[best->axis], &part))
-					fbox_union(&best->rb, &part);
+				fbox parts[2];
+				cut(b, b->ids[i], best->axis, best->pos, r, parts);
+				fbox_union(&best->lb, &parts[0]);
+				fbox_union(&best->rb, &parts[1]);
 			}
 		}
 	}
@@ -448,7 +466,6 @@ static double area_with(const fbox *a, const fbox *r)
 static void partition_spatial(builder *b, size_t begin, size_t end, size_t room, const split *s, size_t *nl,
                               size_t *nr)
 {
-	const bvh_build_opts *o = b->o;
 	int a = s->axis;
 	size_t l = 0, r = room;
 	double al = fbox_half_area(&s->lb), ar = fbox_half_area(&s->rb);
@@ -472,13 +489,13 @@ static void partition_spatial(builder *b, size_t begin, size_t end, size_t room,
 				side = left <= right ? -1 : 1;
 		}
 		if (side == 0) {
-			fbox lp = *ref, rp = *ref;
-			bool okl = o->clip(o->ctx, id, a, ref->lo[a], s->pos, &lp);
-			bool okr = o->clip(o->ctx, id, a, s->pos, ref->hi[a], &rp);
+			fbox parts[2];
+			cut(b, id, a, s->pos, ref, parts);
+			bool okl = !fbox_is_empty(&parts[0]), okr = !fbox_is_empty(&parts[1]);
 			if (okl && okr) {
-				b->tmp[l] = lp;
+				b->tmp[l] = parts[0];
 				b->tmp_ids[l++] = id;
-				b->tmp[--r] = rp;
+				b->tmp[--r] = parts[1];
 				b->tmp_ids[r] = id;
 				continue;
 			}
@@ -517,7 +534,7 @@ static void build(builder *b, size_t begin, size_t end, size_t cap_end, const fb
 	split s = {.axis = -1}, obj = s;
 	if (!leaf && depth < BALANCED_DEPTH) {
 		s = obj = find_split(b, begin, end, cb);
-		if (b->o->clip && cap_end > end) {
+		if (b->o->chop && cap_end > end) {
 			/* a spatial split where the object split's children overlap */
 			fbox ov = s.lb;
 			for (int a = 0; a < 3; a++) {
@@ -617,7 +634,7 @@ bool bvh2_build(const box *bounds, size_t n, const bvh_build_opts *o, bvh2 *t, r
 	t->bounds = fbox_empty();
 	if (n == 0)
 		return true;
-	double budget = o->clip && o->split_budget > 0 ? o->split_budget : 0;
+	double budget = o->chop && o->split_budget > 0 ? o->split_budget : 0;
 	size_t cap = n + (size_t)((double)n * budget);
 	if (n > BVH_MAX_PRIMS || cap > BVH_MAX_PRIMS)
 		return rt_error_set(err, "too many objects (%zu); expected at most %u", n, BVH_MAX_PRIMS);

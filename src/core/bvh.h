@@ -135,21 +135,22 @@ typedef struct bvh2 {
 /* How to build. Spatial splits (Stich, Friedrich & Dietrich, "Spatial
  * splits in bounding volume hierarchies", 2009) let one primitive be
  * referenced by several leaves, each with the part of it inside the leaf's
- * box: `clip` narrows *box (which holds part of primitive id) to the part
- * within [lo, hi] on an axis, keeping lane 3, and returns false when
- * nothing is left. */
+ * box: `chop` cuts primitive id by the planes pos[0..n] across an axis;
+ * on entry box[0..n) each hold the reference's box, on return box[i] holds
+ * the part of it between pos[i] and pos[i + 1] (lane 3 kept), or an empty
+ * box (lo > hi) where there is none. */
 typedef struct bvh_build_opts {
 	const float *costs; /* per primitive, relative to a sphere; NULL: all 1 */
 	unsigned block;     /* > 1: unit-cost primitives tested `block` at a time */
 	double trav;        /* SAH cost of a node visit */
 	unsigned leaf_max;  /* the largest leaf made while a split pays */
-	bool (*clip)(const void *ctx, uint32_t id, int axis, float lo, float hi, bvh_fbox *box);
+	void (*chop)(const void *ctx, uint32_t id, int axis, const float *pos, int n, bvh_fbox *box);
 	const void *ctx;
 	double split_budget; /* references allowed beyond n, a fraction of n */
 } bvh_build_opts;
 
 /* Builds the binary tree over n primitives of world bounds bounds[0..n)
- * (binned SAH, and spatial splits when o->clip is set). False (err set)
+ * (binned SAH, and spatial splits when o->chop is set). False (err set)
  * when out of memory or n is too large. */
 bool bvh2_build(const box *bounds, size_t n, const bvh_build_opts *o, bvh2 *t, rt_error *err);
 void bvh2_free(bvh2 *t);

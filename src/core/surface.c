@@ -180,7 +180,7 @@ static inline vec3 mat3x4_vector(const double (*m)[4], vec3 v)
 }
 
 /* n by the inverse transpose, given the inverse */
-static vec3 mat3x4_normal(const double (*inv)[4], vec3 n)
+static inline vec3 mat3x4_normal(const double (*inv)[4], vec3 n)
 {
 	return v3(inv[0][0] * n.x + inv[1][0] * n.y + inv[2][0] * n.z, inv[0][1] * n.x + inv[1][1] * n.y + inv[2][1] * n.z,
 	          inv[0][2] * n.x + inv[1][2] * n.y + inv[2][2] * n.z);
@@ -306,10 +306,24 @@ void surf_inst_finish(const world *w, const prim *p, const ray *r, vec3 nl, hit 
 {
 	const prim_inst *in = &w->insts[p->u.index];
 	const mesh *m = in->mesh;
-	float b[3] = {0, (float)nl.y, (float)nl.z};
-	b[0] = 1.0f - b[1] - b[2];
+	uint32_t slot = (uint32_t)nl.x;
 	mesh_surf s;
-	mesh_surface(m, (uint32_t)nl.x, b, &s);
+	if (m->tri) {
+		float b[3] = {0, (float)nl.y, (float)nl.z};
+		b[0] = 1.0f - b[1] - b[2];
+		mesh_surface(m, slot, b, &s);
+	} else {
+		/* flat and without uv (most models): the face's normal from the
+		 * corners in its block, and its material */
+		const mesh_tri4 *q = &m->blk[slot >> 2];
+		uint32_t l = slot & 3;
+		double e1x = (double)q->v[3][l] - q->v[0][l], e1y = (double)q->v[4][l] - q->v[1][l],
+		       e1z = (double)q->v[5][l] - q->v[2][l];
+		double e2x = (double)q->v[6][l] - q->v[0][l], e2y = (double)q->v[7][l] - q->v[1][l],
+		       e2z = (double)q->v[8][l] - q->v[2][l];
+		s.ng = v3(e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x);
+		s.mat = m->nmats == 0 ? -1 : m->tmat ? m->tmat[mesh_slot_tri(m, slot)] : 0;
+	}
 	vec3 ng = v3_norm(mat3x4_normal(in->inv, s.ng));
 	/* flat faces: the shading normal is the geometric one */
 	vec3 ns = m->n ? v3_norm(mat3x4_normal(in->inv, s.ns)) : ng;

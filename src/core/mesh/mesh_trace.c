@@ -38,10 +38,11 @@
 #include "core/bvh.h"
 #include "rtsh/mesh.h"
 
-/* The ray o + t d, in floats, made ready for the walk: written once and
- * inlined into every entry so that the compiler keeps it in registers. */
-static inline __attribute__((always_inline)) void ray_setup(mesh_ray *r, float ox, float oy, float oz, float dx,
-                                                            float dy, float dz)
+/* The ray o + t d, in floats, made ready for the walk's box tests: written
+ * once and inlined into every entry so that the compiler keeps it in
+ * registers. */
+static inline __attribute__((always_inline)) void ray_node_setup(mesh_ray *r, float ox, float oy, float oz,
+                                                                 float dx, float dy, float dz)
 {
 	r->o[0] = ox;
 	r->o[1] = oy;
@@ -52,10 +53,17 @@ static inline __attribute__((always_inline)) void ray_setup(mesh_ray *r, float o
 	r->inv[0] = 1.0f / dx;
 	r->inv[1] = 1.0f / dy;
 	r->inv[2] = 1.0f / dz;
-	/* kz: the axis of the largest |d| (y before x on a tie, z before
-	 * both), then kx, ky the next two, swapped when d runs down kz so the
-	 * triangles' winding is kept; written without branches, which random
-	 * directions would make guesses of */
+}
+
+/* The rest, for the triangle tests: the walk makes it at its first leaf
+ * (most rays that miss a model never reach one). kz: the axis of the
+ * largest |d| (y before x on a tie, z before both), then kx, ky the next
+ * two, swapped when d runs down kz so the triangles' winding is kept;
+ * written without branches, which random directions would make guesses
+ * of. */
+static inline __attribute__((always_inline)) void ray_leaf_setup(mesh_ray *r)
+{
+	float dx = r->d[0], dy = r->d[1], dz = r->d[2];
 	float ax = fabsf(dx), ay = fabsf(dy), az = fabsf(dz);
 	int kxy = !(ax > ay);
 	float axy = ax > ay ? ax : ay;
@@ -75,7 +83,8 @@ static inline __attribute__((always_inline)) void ray_setup(mesh_ray *r, float o
 
 void mesh_ray_make(mesh_ray *r, vec3 o, vec3 d)
 {
-	ray_setup(r, (float)o.x, (float)o.y, (float)o.z, (float)d.x, (float)d.y, (float)d.z);
+	ray_node_setup(r, (float)o.x, (float)o.y, (float)o.z, (float)d.x, (float)d.y, (float)d.z);
+	ray_leaf_setup(r);
 }
 
 /* The watertight test of one triangle, given its corners' coordinates on
@@ -320,12 +329,11 @@ _Thread_local unsigned long mesh_stat_nodes, mesh_stat_blocks, mesh_stat_leaves;
 #endif
 
 /* The world ray r taken into the model's coordinates by the 3x4 matrix M
- * (in double, then rounded to floats), its tmin raised past the model's
- * rounding (m->eps, in the ray's units), then the walk: the entry for
- * instances (world.c), one per vector unit. The triangles see the raised
- * tmin; the boxes the caller's, which is no larger (they are visited a
- * little more, never less, and this keeps a square root off the path to
- * the first box test). */
+ * (in double, then rounded to floats), then the walk: the entry for
+ * instances (world.c), one per vector unit. The triangles are tested from
+ * tmin raised past the model's rounding (m->eps in the model's units, made
+ * the ray's at the first leaf); the boxes from the caller's tmin, which is
+ * no larger (they are visited a little more, never less). */
 #define INST_ENTRY(name, walk, target)                                                                              \
 	static target __attribute__((noinline)) bool name(const mesh *m, const double (*M)[4], const ray *wr,           \
 	                                                  double tmin, double tmax, double *t, uint32_t *slot,         \
@@ -333,16 +341,14 @@ _Thread_local unsigned long mesh_stat_nodes, mesh_stat_blocks, mesh_stat_leaves;
 	{                                                                                                             \
 		double px = wr->o.x, py = wr->o.y, pz = wr->o.z, vx = wr->d.x, vy = wr->d.y, vz = wr->d.z;            \
 		mesh_ray r;                                                                                           \
-		ray_setup(&r, (float)(M[0][0] * px + M[0][1] * py + M[0][2] * pz + M[0][3]),                          \
-		          (float)(M[1][0] * px + M[1][1] * py + M[1][2] * pz + M[1][3]),                              \
-		          (float)(M[2][0] * px + M[2][1] * py + M[2][2] * pz + M[2][3]),                              \
-		          (float)(M[0][0] * vx + M[0][1] * vy + M[0][2] * vz),                                        \
-		          (float)(M[1][0] * vx + M[1][1] * vy + M[1][2] * vz),                                        \
-		          (float)(M[2][0] * vx + M[2][1] * vy + M[2][2] * vz));                                       \
-		float guard = m->eps / sqrtf(r.d[0] * r.d[0] + r.d[1] * r.d[1] + r.d[2] * r.d[2]);                   \
-		float box_tmin = (float)tmin, tri_tmin = tmin > guard ? box_tmin : guard;                            \
+		ray_node_setup(&r, (float)(M[0][0] * px + M[0][1] * py + M[0][2] * pz + M[0][3]),                     \
+		               (float)(M[1][0] * px + M[1][1] * py + M[1][2] * pz + M[1][3]),                         \
+		               (float)(M[2][0] * px + M[2][1] * py + M[2][2] * pz + M[2][3]),                         \
+		               (float)(M[0][0] * vx + M[0][1] * vy + M[0][2] * vz),                                   \
+		               (float)(M[1][0] * vx + M[1][1] * vy + M[1][2] * vz),                                   \
+		               (float)(M[2][0] * vx + M[2][1] * vy + M[2][2] * vz));                                  \
 		float ft = tmax < 3e38 ? (float)tmax : INFINITY;                                                      \
-		if (!walk(m, &r, box_tmin, tri_tmin, &ft, slot, b, any) || !((double)ft < tmax))                     \
+		if (!walk(m, &r, false, (float)tmin, m->eps, &ft, slot, b, any) || !((double)ft < tmax))              \
 			return false;                                                                                 \
 		*t = ft;                                                                                              \
 		return true;                                                                                          \
@@ -358,7 +364,8 @@ INST_ENTRY(inst_avx2, walk_avx2, __attribute__((target("avx2"))))
 static __attribute__((target("avx2"), noinline)) bool intersect_avx2(const mesh *m, const mesh_ray *r, float tmin,
                                                                      float *tmax, uint32_t *tri, float b[3])
 {
-	return walk_avx2(m, r, tmin, tmin, tmax, tri, b, false);
+	mesh_ray lr = *r;
+	return walk_avx2(m, &lr, true, tmin, 0, tmax, tri, b, false);
 }
 
 static __attribute__((target("avx2"), noinline)) bool occluded_avx2(const mesh *m, const mesh_ray *r, float tmin,
@@ -366,7 +373,8 @@ static __attribute__((target("avx2"), noinline)) bool occluded_avx2(const mesh *
 {
 	uint32_t tri;
 	float b[3];
-	return walk_avx2(m, r, tmin, tmin, &tmax, &tri, b, true);
+	mesh_ray lr = *r;
+	return walk_avx2(m, &lr, true, tmin, 0, &tmax, &tri, b, true);
 }
 #endif
 
@@ -409,6 +417,7 @@ bool mesh_isa_force(mesh_isa isa)
 
 bool mesh_intersect(const mesh *m, const mesh_ray *r, float tmin, float *tmax, uint32_t *tri, float b[3])
 {
+	mesh_ray lr = *r;
 	switch (mesh_isa_active()) {
 #if defined(HAVE_AVX2_WALK)
 	case MESH_ISA_AVX2:
@@ -416,10 +425,10 @@ bool mesh_intersect(const mesh *m, const mesh_ray *r, float tmin, float *tmax, u
 #endif
 #if defined(__SSE2__)
 	case MESH_ISA_SSE2:
-		return walk_sse(m, r, tmin, tmin, tmax, tri, b, false);
+		return walk_sse(m, &lr, true, tmin, 0, tmax, tri, b, false);
 #endif
 	default:
-		return walk_scalar(m, r, tmin, tmin, tmax, tri, b, false);
+		return walk_scalar(m, &lr, true, tmin, 0, tmax, tri, b, false);
 	}
 }
 
@@ -427,6 +436,7 @@ bool mesh_occluded(const mesh *m, const mesh_ray *r, float tmin, float tmax)
 {
 	uint32_t tri;
 	float b[3];
+	mesh_ray lr = *r;
 	switch (mesh_isa_active()) {
 #if defined(HAVE_AVX2_WALK)
 	case MESH_ISA_AVX2:
@@ -434,10 +444,10 @@ bool mesh_occluded(const mesh *m, const mesh_ray *r, float tmin, float tmax)
 #endif
 #if defined(__SSE2__)
 	case MESH_ISA_SSE2:
-		return walk_sse(m, r, tmin, tmin, &tmax, &tri, b, true);
+		return walk_sse(m, &lr, true, tmin, 0, &tmax, &tri, b, true);
 #endif
 	default:
-		return walk_scalar(m, r, tmin, tmin, &tmax, &tri, b, true);
+		return walk_scalar(m, &lr, true, tmin, 0, &tmax, &tri, b, true);
 	}
 }
 
@@ -474,14 +484,16 @@ bool mesh_occluded_world(const mesh *m, const double (*inv)[4], const ray *r, do
 
 bool mesh_intersect_scalar(const mesh *m, const mesh_ray *r, float tmin, float *tmax, uint32_t *tri, float b[3])
 {
-	return walk_scalar(m, r, tmin, tmin, tmax, tri, b, false);
+	mesh_ray lr = *r;
+	return walk_scalar(m, &lr, true, tmin, 0, tmax, tri, b, false);
 }
 
 bool mesh_occluded_scalar(const mesh *m, const mesh_ray *r, float tmin, float tmax)
 {
 	uint32_t tri;
 	float b[3];
-	return walk_scalar(m, r, tmin, tmin, &tmax, &tri, b, true);
+	mesh_ray lr = *r;
+	return walk_scalar(m, &lr, true, tmin, 0, &tmax, &tri, b, true);
 }
 
 bool mesh_intersect_brute(const mesh *m, const mesh_ray *r, float tmin, float *tmax, uint32_t *tri, float b[3])

@@ -2,7 +2,7 @@
  *
  * bvh.c builds a binary tree over the triangles with binned SAH and
  * spatial splits (a triangle cut by a split plane goes to both sides, each
- * with the box of its part there: tri_clip), costing a leaf by the blocks
+ * with the box of its part there: tri_chop), costing a leaf by the blocks
  * of four it needs and a node visit by MESH_TRAVERSE blocks. The tree is
  * then made 8 wide (bvh2_gather) and laid out depth first: each node, then
  * its subtrees in order, and each leaf's triangles as blocks of four
@@ -24,11 +24,13 @@
 /* References spatial splits may add, a share of the triangles. */
 #define MESH_SPLIT_BUDGET 0.25
 
+/* A float <= v and a float >= v, and one float step further out: the
+ * bounds of a point computed in double. */
 static float down(double v)
 {
 	float f = (float)v;
 	if ((double)f > v)
-		f = nextafterf(f, -INFINITY);
+		f -= fabsf(f) * 0x1p-23f + 0x1p-149f;
 	return f;
 }
 
@@ -36,11 +38,11 @@ static float up(double v)
 {
 	float f = (float)v;
 	if ((double)f < v)
-		f = nextafterf(f, INFINITY);
+		f += fabsf(f) * 0x1p-23f + 0x1p-149f;
 	return f;
 }
 
-static void grow(double lo[3], double hi[3], const double q[3])
+static inline void grow(double lo[3], double hi[3], const double q[3])
 {
 	for (int i = 0; i < 3; i++) {
 		lo[i] = q[i] < lo[i] ? q[i] : lo[i];
@@ -48,46 +50,80 @@ static void grow(double lo[3], double hi[3], const double q[3])
 	}
 }
 
-/* The part of triangle id within [lo, hi] on axis a: its corners there and
- * where its edges cross the two planes, in double, rounded outward and (off
- * axis a) one float step more; then intersected with *bx (what the triangle's
- * reference already held). */
-static bool tri_clip(const void *ctx, uint32_t id, int a, float lo, float hi, bvh_fbox *bx)
+/* Where the plane x[a] = c crosses the segment u v (u[a] != v[a]). */
+static void cross_at(const double *u, const double *v, int a, double c, double q[3])
+{
+	double f = (c - u[a]) / (v[a] - u[a]);
+	for (int i = 0; i < 3; i++)
+		q[i] = u[i] + (v[i] - u[i]) * f;
+	q[a] = c;
+}
+
+/* The parts of triangle id between consecutive planes pos[0..n] across
+ * axis a (bvh.h's chop). Its corners sorted along a, each plane strictly
+ * inside the triangle crosses the long edge and one of the short ones
+ * (computed once, shared by the parts on both sides); a part is bounded by
+ * the crossings of its two planes and the corners between them. The
+ * crossings are computed in double, rounded outward and one float step
+ * more off axis a (on a they are the planes themselves, and the corners'
+ * own floats), then each part is intersected with its box on entry. */
+static void tri_chop(const void *ctx, uint32_t id, int a, const float *pos, int n, bvh_fbox *part)
 {
 	const mesh *m = ctx;
 	const uint32_t *t = m->tri[id];
-	double p[3][3];
+	double c[3][3];
 	for (int k = 0; k < 3; k++)
-		for (int c = 0; c < 3; c++)
-			p[k][c] = m->p[t[k]][c];
-	double blo[3] = {INFINITY, INFINITY, INFINITY}, bhi[3] = {-INFINITY, -INFINITY, -INFINITY};
-	for (int k = 0; k < 3; k++) {
-		const double *u = p[k], *v = p[(k + 1) % 3];
-		if (u[a] >= lo && u[a] <= hi)
-			grow(blo, bhi, u);
-		for (int s = 0; s < 2; s++) {
-			double c = s ? hi : lo;
-			if (!((u[a] < c && v[a] > c) || (u[a] > c && v[a] < c)))
-				continue;
-			double f = (c - u[a]) / (v[a] - u[a]), q[3];
-			for (int i = 0; i < 3; i++)
-				q[i] = u[i] + (v[i] - u[i]) * f;
-			q[a] = c;
-			grow(blo, bhi, q);
+		for (int i = 0; i < 3; i++)
+			c[k][i] = m->p[t[k]][i];
+	/* sort the corners along a */
+	int o0 = 0, o1 = 1, o2 = 2, x;
+	if (c[o1][a] < c[o0][a])
+		x = o0, o0 = o1, o1 = x;
+	if (c[o2][a] < c[o1][a])
+		x = o1, o1 = o2, o2 = x;
+	if (c[o1][a] < c[o0][a])
+		x = o0, o0 = o1, o1 = x;
+	const double *v0 = c[o0], *v1 = c[o1], *v2 = c[o2];
+	double lo[3], hi[3], q[3];
+	for (int i = 0; i < n; i++) {
+		double p0 = pos[i], p1 = pos[i + 1];
+		for (int j = 0; j < 3; j++) {
+			lo[j] = INFINITY;
+			hi[j] = -INFINITY;
 		}
+		for (int k = 0; k < 3; k++)
+			if (c[k][a] >= p0 && c[k][a] <= p1)
+				grow(lo, hi, c[k]);
+		for (int e = 0; e < 2; e++) {
+			double pl = e ? p1 : p0;
+			if (!(v0[a] < pl && pl < v2[a]))
+				continue;
+			cross_at(v0, v2, a, pl, q);
+			grow(lo, hi, q);
+			if (pl < v1[a])
+				cross_at(v0, v1, a, pl, q);
+			else if (pl > v1[a])
+				cross_at(v1, v2, a, pl, q);
+			else
+				continue; /* the corner v1 itself, counted above */
+			grow(lo, hi, q);
+		}
+		bvh_fbox *bx = &part[i];
+		for (int j = 0; j < 3; j++) {
+			float l = down(lo[j]), h = up(hi[j]);
+			if (j != a) {
+				l -= fabsf(l) * 0x1p-23f + 0x1p-149f;
+				h += fabsf(h) * 0x1p-23f + 0x1p-149f;
+			}
+			bx->lo[j] = l > bx->lo[j] ? l : bx->lo[j];
+			bx->hi[j] = h < bx->hi[j] ? h : bx->hi[j];
+		}
+		if (!(lo[0] <= hi[0])) /* nothing of the triangle here */
+			for (int j = 0; j < 3; j++) {
+				bx->lo[j] = INFINITY;
+				bx->hi[j] = -INFINITY;
+			}
 	}
-	if (!(blo[0] <= bhi[0]))
-		return false;
-	for (int i = 0; i < 3; i++) {
-		/* on axis a the bounds are corners' floats or the planes: exact */
-		float l = i == a ? down(blo[i]) : nextafterf(down(blo[i]), -INFINITY);
-		float h = i == a ? up(bhi[i]) : nextafterf(up(bhi[i]), INFINITY);
-		bx->lo[i] = l > bx->lo[i] ? l : bx->lo[i];
-		bx->hi[i] = h < bx->hi[i] ? h : bx->hi[i];
-		if (!(bx->lo[i] <= bx->hi[i]))
-			return false;
-	}
-	return true;
 }
 
 typedef struct emitter_state {
@@ -173,7 +209,7 @@ bool mesh_build_tree(mesh *m, rt_error *err)
 		}
 		bounds[t] = b;
 	}
-	bvh_build_opts o = {.block = 4, .trav = MESH_TRAVERSE, .leaf_max = MESH_LEAF_MAX, .clip = tri_clip, .ctx = m,
+	bvh_build_opts o = {.block = 4, .trav = MESH_TRAVERSE, .leaf_max = MESH_LEAF_MAX, .chop = tri_chop, .ctx = m,
 	                    .split_budget = MESH_SPLIT_BUDGET};
 	bvh2 t;
 	rt_error e2 = {0};

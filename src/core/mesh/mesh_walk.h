@@ -2,15 +2,18 @@
  * mesh_trace.c for each vector unit: WALK names the function, WALK_ISA is
  * 0 (scalar), 1 (SSE2) or 2 (AVX2), WALK_TARGET its target attribute.
  *
- * WALK(m, r, box_tmin, tmin, tmax, tri, b, any): the nearest hit in (tmin,
- * *tmax) (any = false: sets *tmax, *tri and b) or whether there is any
- * (any = true). The boxes are tested from box_tmin <= tmin. Every unit runs the same float operations in the same order, so
+ * WALK(m, r, leaf_ready, tmin, guard, tmax, tri, b, any): the nearest hit
+ * in (tmin, *tmax) (any = false: sets *tmax, *tri and b) or whether there
+ * is any (any = true). r holds the ray's box part (ray_node_setup); its
+ * triangle part (ray_leaf_setup) too when leaf_ready, else the walk makes
+ * it at the first leaf, and tests the triangles from tmin raised to
+ * guard / |d| (guard 0: tmin itself). Every unit runs the same float operations in the same order, so
  * each finds the same hits.
  */
 
-static inline __attribute__((always_inline)) WALK_TARGET bool WALK(const mesh *m, const mesh_ray *r, float box_tmin,
-                                                                   float tmin, float *tmax, uint32_t *tri, float b[3],
-                                                                   bool any)
+static inline __attribute__((always_inline)) WALK_TARGET bool WALK(const mesh *m, mesh_ray *r, bool leaf_ready,
+                                                                   float box_tmin, float guard, float *tmax,
+                                                                   uint32_t *tri, float b[3], bool any)
 {
 	const mesh_node *nodes = m->nodes;
 	slab_rows q;
@@ -34,9 +37,12 @@ static inline __attribute__((always_inline)) WALK_TARGET bool WALK(const mesh *m
 	const __m128 t0_4 = _mm_set1_ps(box_tmin), slack4 = _mm_set1_ps(BVH_SLAB_SLACK);
 	__m128 best4 = _mm_set1_ps(best);
 #endif
+	float tmin = box_tmin; /* the triangles' (raised at the first leaf) */
 #if WALK_ISA >= 1
-	ray4 rq;
-	ray4_make(r, &rq);
+	ray4 rq = {_mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps(),
+	           _mm_setzero_ps()};
+	if (leaf_ready)
+		ray4_make(r, &rq);
 #endif
 	entry stack[MESH_STACK];
 	int sp = 0;
@@ -109,6 +115,17 @@ static inline __attribute__((always_inline)) WALK_TARGET bool WALK(const mesh *m
 		}
 		{
 			/* a leaf: its blocks */
+			if (!leaf_ready) {
+				ray_leaf_setup(r);
+				if (guard > 0.0f) {
+					float g = guard / sqrtf(r->d[0] * r->d[0] + r->d[1] * r->d[1] + r->d[2] * r->d[2]);
+					tmin = tmin > g ? tmin : g;
+				}
+#if WALK_ISA >= 1
+				ray4_make(r, &rq);
+#endif
+				leaf_ready = true;
+			}
 			uint32_t first = ref & (MESH_MAX_BLOCKS - 1), nb = ((ref & ~MESH_LEAF) >> MESH_LEAF_SHIFT) + 1;
 #ifdef MESH_STATS
 			mesh_stat_leaves++;
