@@ -49,8 +49,10 @@ typedef struct mesh_tri4 {
 } mesh_tri4;
 
 /* A node of a mesh's triangle tree (mesh_tree.c): eight children, their
- * boxes b[row][k] as floats rounded outward (rows: low x, y, z, then high
- * x, y, z, as in bvh.h), and a reference each: an inner node's index, or
+ * boxes b[row][k] as floats rounded outward (rows MESH_LO(axis) and
+ * MESH_HI(axis): low x, high x, low y, high y, low z, high z, so that a
+ * ray's far row is its near row's neighbour, one bit apart), and a
+ * reference each: an inner node's index, or
  * MESH_LEAF | (blocks - 1) << MESH_LEAF_SHIFT | the leaf's first block.
  * An unused child has an empty box (lo = +inf, hi = -inf). 224 bytes: four
  * cache lines, read by one AVX2 slab test or two SSE ones. */
@@ -59,6 +61,8 @@ typedef struct mesh_tri4 {
 #define MESH_LEAF_SHIFT 28
 #define MESH_LEAF_BLOCKS 8u               /* blocks a leaf holds at most */
 #define MESH_MAX_BLOCKS (1u << MESH_LEAF_SHIFT)
+#define MESH_LO(axis) (2 * (axis))
+#define MESH_HI(axis) (2 * (axis) + 1)
 typedef struct mesh_node {
 	_Alignas(32) float b[6][MESH_WIDTH];
 	uint32_t child[MESH_WIDTH];
@@ -179,11 +183,11 @@ bool mesh_intersect_world(const mesh *m, const double (*inv)[4], const ray *r, d
                           uint32_t *slot, float b[3]);
 bool mesh_occluded_world(const mesh *m, const double (*inv)[4], const ray *r, double tmin, double tmax);
 /* The vector unit the walk uses: AVX2 where the processor has it (one slab
- * test for a node's eight children), else SSE2 (two), else scalar code.
- * Each finds the very same hits. mesh_isa_force picks one for tests and
- * benchmarks (false when the machine lacks it); MESH_ISA_BEST goes back to
- * the best one. */
-typedef enum mesh_isa { MESH_ISA_SCALAR, MESH_ISA_SSE2, MESH_ISA_AVX2, MESH_ISA_BEST } mesh_isa;
+ * test for a node's eight children; with AVX-512's registers where it has
+ * those too), else SSE2 (two), else scalar code. Each finds the very same
+ * hits. mesh_isa_force picks one for tests and benchmarks (false when the
+ * machine lacks it); MESH_ISA_BEST goes back to the best one. */
+typedef enum mesh_isa { MESH_ISA_SCALAR, MESH_ISA_SSE2, MESH_ISA_AVX2, MESH_ISA_AVX512, MESH_ISA_BEST } mesh_isa;
 mesh_isa mesh_isa_active(void);
 bool mesh_isa_force(mesh_isa isa);
 /* The same walk with each leaf block tested one lane at a time in scalar

@@ -253,20 +253,17 @@ typedef struct entry {
 /* The deepest stack a walk needs: at most seven children wait per level. */
 #define MESH_STACK (7 * BVH_MAX_DEPTH + 8)
 
-/* What the slab tests need of a ray: per axis the rows of mesh_node.b
- * that hold the near and far planes (by the direction's sign, Williams et
- * al. 2005). The origin is a float already: no rounding to allow for. */
-typedef struct slab_rows {
-	int near[3], far[3];
-} slab_rows;
+/* What the slab tests need of a ray: per axis the byte offset in a node of
+ * the row that holds its near planes (by the direction's sign, Williams et
+ * al. 2005); the far planes' row is the next one along, or the one before:
+ * offset ^ MESH_ROW. The origin is a float already: no rounding to allow
+ * for. */
+#define MESH_ROW (MESH_WIDTH * sizeof(float))
 
-static inline __attribute__((always_inline)) void slab_rows_make(const mesh_ray *r, slab_rows *q)
+static inline __attribute__((always_inline)) size_t near_row(const mesh_ray *r, int a)
 {
-	for (int a = 0; a < 3; a++) {
-		int neg = signbit(r->inv[a]) != 0;
-		q->near[a] = BVH_LO_X + a + 3 * neg;
-		q->far[a] = BVH_HI_X + a - 3 * neg;
-	}
+	size_t neg = signbit(r->inv[a]) != 0;
+	return (size_t)(MESH_LO(a) + neg) * MESH_ROW;
 }
 
 /* Pushes the children of n in mask hm (at least two) with their entry
@@ -308,7 +305,9 @@ static inline __attribute__((always_inline)) uint32_t push_sorted(const mesh_nod
 _Thread_local unsigned long mesh_stat_nodes, mesh_stat_blocks, mesh_stat_leaves;
 #endif
 
-/* The walk for each vector unit: walk_scalar, walk_sse, walk_avx2. */
+/* The walk for each vector unit: walk_scalar, walk_sse, walk_avx2 and
+ * walk_avx512 (the AVX2 code given AVX-512's 32 vector registers, so that
+ * the walk keeps the ray in registers through the leaf tests). */
 #define WALK walk_scalar
 #define WALK_ISA 0
 #define WALK_TARGET
@@ -322,22 +321,45 @@ _Thread_local unsigned long mesh_stat_nodes, mesh_stat_blocks, mesh_stat_leaves;
 #endif
 
 #if defined(HAVE_AVX2_WALK)
+#define AVX2 __attribute__((target("avx2")))
+#define AVX512 __attribute__((target("avx2,avx512f,avx512vl")))
 #define WALK walk_avx2
 #define WALK_ISA 2
-#define WALK_TARGET __attribute__((target("avx2")))
+#define WALK_TARGET AVX2
+#include "mesh_walk.h"
+#define WALK walk_avx512
+#define WALK_ISA 2
+#define WALK_TARGET AVX512
 #include "mesh_walk.h"
 #endif
 
-/* The world ray r taken into the model's coordinates by the 3x4 matrix M
- * (in double, then rounded to floats), then the walk: the entry for
- * instances (world.c), one per vector unit. The triangles are tested from
- * tmin raised past the model's rounding (m->eps in the model's units, made
- * the ray's at the first leaf); the boxes from the caller's tmin, which is
- * no larger (they are visited a little more, never less). */
-#define INST_ENTRY(name, walk, target)                                                                              \
-	static target __attribute__((noinline)) bool name(const mesh *m, const double (*M)[4], const ray *wr,           \
-	                                                  double tmin, double tmax, double *t, uint32_t *slot,         \
-	                                                  float b[3], bool any)                                        \
+/* The entries of one vector unit's walk: a mesh_ray in the model's
+ * coordinates (mesh_intersect, mesh_occluded), or a world ray and an
+ * instance's world-to-model matrix M (mesh_intersect_world, ..._occluded_
+ * world): M takes it into the model's coordinates in double, then it is
+ * rounded to floats. The triangles are then tested from tmin raised past
+ * the model's rounding (m->eps in the model's units, made the ray's at the
+ * first leaf); the boxes from the caller's tmin, which is no larger (they
+ * are visited a little more, never less). */
+#define WALK_ENTRIES(isa, walk, target)                                                                             \
+	static target __attribute__((noinline)) bool isa##_hit(const mesh *m, const mesh_ray *r, float tmin,           \
+	                                                       float *tmax, uint32_t *tri, float b[3])                \
+	{                                                                                                             \
+		mesh_ray lr = *r;                                                                                     \
+		return walk(m, &lr, true, tmin, 0, tmax, tri, b, false);                                              \
+	}                                                                                                             \
+	static target __attribute__((noinline)) bool isa##_any(const mesh *m, const mesh_ray *r, float tmin,           \
+	                                                       float tmax)                                            \
+	{                                                                                                             \
+		uint32_t tri;                                                                                         \
+		float b[3];                                                                                           \
+		mesh_ray lr = *r;                                                                                     \
+		return walk(m, &lr, true, tmin, 0, &tmax, &tri, b, true);                                             \
+	}                                                                                                             \
+	static target inline __attribute__((always_inline)) bool isa##_world(const mesh *m, const double (*M)[4],     \
+	                                                                     const ray *wr, double tmin, double tmax, \
+	                                                                     double *t, uint32_t *slot, float b[3],   \
+	                                                                     bool any)                                \
 	{                                                                                                             \
 		double px = wr->o.x, py = wr->o.y, pz = wr->o.z, vx = wr->d.x, vy = wr->d.y, vz = wr->d.z;            \
 		mesh_ray r;                                                                                           \
@@ -352,31 +374,49 @@ _Thread_local unsigned long mesh_stat_nodes, mesh_stat_blocks, mesh_stat_leaves;
 			return false;                                                                                 \
 		*t = ft;                                                                                              \
 		return true;                                                                                          \
+	}                                                                                                             \
+	static target __attribute__((noinline)) bool isa##_hit_world(const mesh *m, const double (*M)[4],             \
+	                                                             const ray *wr, double tmin, double tmax,         \
+	                                                             double *t, uint32_t *slot, float b[3])           \
+	{                                                                                                             \
+		return isa##_world(m, M, wr, tmin, tmax, t, slot, b, false);                                          \
+	}                                                                                                             \
+	static target __attribute__((noinline)) bool isa##_any_world(const mesh *m, const double (*M)[4],             \
+	                                                             const ray *wr, double tmin, double tmax)         \
+	{                                                                                                             \
+		double t;                                                                                             \
+		uint32_t slot;                                                                                        \
+		float b[3];                                                                                           \
+		return isa##_world(m, M, wr, tmin, tmax, &t, &slot, b, true);                                         \
 	}
 
-INST_ENTRY(inst_scalar, walk_scalar, )
+typedef struct walker {
+	bool (*hit)(const mesh *m, const mesh_ray *r, float tmin, float *tmax, uint32_t *tri, float b[3]);
+	bool (*any)(const mesh *m, const mesh_ray *r, float tmin, float tmax);
+	bool (*hit_world)(const mesh *m, const double (*M)[4], const ray *wr, double tmin, double tmax, double *t,
+	                  uint32_t *slot, float b[3]);
+	bool (*any_world)(const mesh *m, const double (*M)[4], const ray *wr, double tmin, double tmax);
+} walker;
+
+WALK_ENTRIES(scalar, walk_scalar, )
 #if defined(__SSE2__)
-INST_ENTRY(inst_sse, walk_sse, )
+WALK_ENTRIES(sse, walk_sse, )
 #endif
 #if defined(HAVE_AVX2_WALK)
-INST_ENTRY(inst_avx2, walk_avx2, __attribute__((target("avx2"))))
-
-static __attribute__((target("avx2"), noinline)) bool intersect_avx2(const mesh *m, const mesh_ray *r, float tmin,
-                                                                     float *tmax, uint32_t *tri, float b[3])
-{
-	mesh_ray lr = *r;
-	return walk_avx2(m, &lr, true, tmin, 0, tmax, tri, b, false);
-}
-
-static __attribute__((target("avx2"), noinline)) bool occluded_avx2(const mesh *m, const mesh_ray *r, float tmin,
-                                                                    float tmax)
-{
-	uint32_t tri;
-	float b[3];
-	mesh_ray lr = *r;
-	return walk_avx2(m, &lr, true, tmin, 0, &tmax, &tri, b, true);
-}
+WALK_ENTRIES(avx2, walk_avx2, AVX2)
+WALK_ENTRIES(avx512, walk_avx512, AVX512)
 #endif
+
+static const walker walkers[MESH_ISA_BEST] = {
+	[MESH_ISA_SCALAR] = {scalar_hit, scalar_any, scalar_hit_world, scalar_any_world},
+#if defined(__SSE2__)
+	[MESH_ISA_SSE2] = {sse_hit, sse_any, sse_hit_world, sse_any_world},
+#endif
+#if defined(HAVE_AVX2_WALK)
+	[MESH_ISA_AVX2] = {avx2_hit, avx2_any, avx2_hit_world, avx2_any_world},
+	[MESH_ISA_AVX512] = {avx512_hit, avx512_any, avx512_hit_world, avx512_any_world},
+#endif
+};
 
 /* The vector unit in use: -1 until the first walk asks the processor. */
 static atomic_int isa_now = -1;
@@ -384,6 +424,8 @@ static atomic_int isa_now = -1;
 static mesh_isa isa_best(void)
 {
 #if defined(HAVE_AVX2_WALK)
+	if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl"))
+		return MESH_ISA_AVX512;
 	if (__builtin_cpu_supports("avx2"))
 		return MESH_ISA_AVX2;
 #endif
@@ -417,83 +459,33 @@ bool mesh_isa_force(mesh_isa isa)
 
 bool mesh_intersect(const mesh *m, const mesh_ray *r, float tmin, float *tmax, uint32_t *tri, float b[3])
 {
-	mesh_ray lr = *r;
-	switch (mesh_isa_active()) {
-#if defined(HAVE_AVX2_WALK)
-	case MESH_ISA_AVX2:
-		return intersect_avx2(m, r, tmin, tmax, tri, b);
-#endif
-#if defined(__SSE2__)
-	case MESH_ISA_SSE2:
-		return walk_sse(m, &lr, true, tmin, 0, tmax, tri, b, false);
-#endif
-	default:
-		return walk_scalar(m, &lr, true, tmin, 0, tmax, tri, b, false);
-	}
+	return walkers[mesh_isa_active()].hit(m, r, tmin, tmax, tri, b);
 }
 
 bool mesh_occluded(const mesh *m, const mesh_ray *r, float tmin, float tmax)
 {
-	uint32_t tri;
-	float b[3];
-	mesh_ray lr = *r;
-	switch (mesh_isa_active()) {
-#if defined(HAVE_AVX2_WALK)
-	case MESH_ISA_AVX2:
-		return occluded_avx2(m, r, tmin, tmax);
-#endif
-#if defined(__SSE2__)
-	case MESH_ISA_SSE2:
-		return walk_sse(m, &lr, true, tmin, 0, &tmax, &tri, b, true);
-#endif
-	default:
-		return walk_scalar(m, &lr, true, tmin, 0, &tmax, &tri, b, true);
-	}
-}
-
-static bool inst_walk(const mesh *m, const double (*inv)[4], const ray *r, double tmin, double tmax, double *t,
-                      uint32_t *slot, float b[3], bool any)
-{
-	switch (mesh_isa_active()) {
-#if defined(HAVE_AVX2_WALK)
-	case MESH_ISA_AVX2:
-		return inst_avx2(m, inv, r, tmin, tmax, t, slot, b, any);
-#endif
-#if defined(__SSE2__)
-	case MESH_ISA_SSE2:
-		return inst_sse(m, inv, r, tmin, tmax, t, slot, b, any);
-#endif
-	default:
-		return inst_scalar(m, inv, r, tmin, tmax, t, slot, b, any);
-	}
+	return walkers[mesh_isa_active()].any(m, r, tmin, tmax);
 }
 
 bool mesh_intersect_world(const mesh *m, const double (*inv)[4], const ray *r, double tmin, double tmax, double *t,
                           uint32_t *slot, float b[3])
 {
-	return inst_walk(m, inv, r, tmin, tmax, t, slot, b, false);
+	return walkers[mesh_isa_active()].hit_world(m, inv, r, tmin, tmax, t, slot, b);
 }
 
 bool mesh_occluded_world(const mesh *m, const double (*inv)[4], const ray *r, double tmin, double tmax)
 {
-	double t;
-	uint32_t slot;
-	float b[3];
-	return inst_walk(m, inv, r, tmin, tmax, &t, &slot, b, true);
+	return walkers[mesh_isa_active()].any_world(m, inv, r, tmin, tmax);
 }
 
 bool mesh_intersect_scalar(const mesh *m, const mesh_ray *r, float tmin, float *tmax, uint32_t *tri, float b[3])
 {
-	mesh_ray lr = *r;
-	return walk_scalar(m, &lr, true, tmin, 0, tmax, tri, b, false);
+	return scalar_hit(m, r, tmin, tmax, tri, b);
 }
 
 bool mesh_occluded_scalar(const mesh *m, const mesh_ray *r, float tmin, float tmax)
 {
-	uint32_t tri;
-	float b[3];
-	mesh_ray lr = *r;
-	return walk_scalar(m, &lr, true, tmin, 0, &tmax, &tri, b, true);
+	return scalar_any(m, r, tmin, tmax);
 }
 
 bool mesh_intersect_brute(const mesh *m, const mesh_ray *r, float tmin, float *tmax, uint32_t *tri, float b[3])

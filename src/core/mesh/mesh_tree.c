@@ -135,8 +135,8 @@ typedef struct emitter_state {
 static void empty_child(mesh_node *n, int k)
 {
 	for (int a = 0; a < 3; a++) {
-		n->b[BVH_LO_X + a][k] = INFINITY;
-		n->b[BVH_HI_X + a][k] = -INFINITY;
+		n->b[MESH_LO(a)][k] = INFINITY;
+		n->b[MESH_HI(a)][k] = -INFINITY;
 	}
 	n->child[k] = MESH_LEAF; /* never entered: no blocks are read */
 }
@@ -163,8 +163,8 @@ static uint32_t emit_leaf(emitter_state *e, uint32_t first, uint32_t count)
 static void set_child(mesh_node *n, int k, const bvh_fbox *bx)
 {
 	for (int a = 0; a < 3; a++) {
-		n->b[BVH_LO_X + a][k] = bx->lo[a];
-		n->b[BVH_HI_X + a][k] = bx->hi[a];
+		n->b[MESH_LO(a)][k] = bx->lo[a];
+		n->b[MESH_HI(a)][k] = bx->hi[a];
 	}
 }
 

@@ -16,17 +16,16 @@ static inline __attribute__((always_inline)) WALK_TARGET bool WALK(const mesh *m
                                                                    uint32_t *tri, float b[3], bool any)
 {
 	const mesh_node *nodes = m->nodes;
-	slab_rows q;
-	slab_rows_make(r, &q);
-	/* byte offsets in a node of the near and far rows of each axis, and
-	 * the ray's slab constants in registers of their own (GCC keeps arrays
-	 * of vectors on the stack) */
-	const size_t rn0 = (size_t)q.near[0] * sizeof nodes->b[0], rn1 = (size_t)q.near[1] * sizeof nodes->b[0],
-	             rn2 = (size_t)q.near[2] * sizeof nodes->b[0], rf0 = (size_t)q.far[0] * sizeof nodes->b[0],
-	             rf1 = (size_t)q.far[1] * sizeof nodes->b[0], rf2 = (size_t)q.far[2] * sizeof nodes->b[0];
+	/* byte offsets in a node of the near rows of each axis (the far rows
+	 * one bit away), and the ray's slab constants in registers of their
+	 * own (GCC keeps arrays of vectors on the stack) */
+	const size_t rn0 = near_row(r, 0), rn1 = near_row(r, 1), rn2 = near_row(r, 2);
+#define rf0 (rn0 ^ MESH_ROW)
+#define rf1 (rn1 ^ MESH_ROW)
+#define rf2 (rn2 ^ MESH_ROW)
 	float best = *tmax;
 #define ROW(n, off) ((const float *)((const char *)(n)->b + (off)))
-#if WALK_ISA == 2
+#if WALK_ISA >= 2
 	const __m256 ox = _mm256_set1_ps(r->o[0]), oy = _mm256_set1_ps(r->o[1]), oz = _mm256_set1_ps(r->o[2]);
 	const __m256 ix = _mm256_set1_ps(r->inv[0]), iy = _mm256_set1_ps(r->inv[1]), iz = _mm256_set1_ps(r->inv[2]);
 	const __m256 t0_8 = _mm256_set1_ps(box_tmin), slack8 = _mm256_set1_ps(BVH_SLAB_SLACK);
@@ -56,7 +55,7 @@ static inline __attribute__((always_inline)) WALK_TARGET bool WALK(const mesh *m
 			mesh_stat_nodes++;
 #endif
 			unsigned hm;
-#if WALK_ISA == 2
+#if WALK_ISA >= 2
 			{
 				/* max(x, acc) and min(x, acc) return acc when x is NaN */
 				__m256 t0 = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(ROW(n, rn0)), ox), ix), t0_8);
@@ -148,7 +147,7 @@ static inline __attribute__((always_inline)) WALK_TARGET bool WALK(const mesh *m
 				}
 			}
 			if (found) {
-#if WALK_ISA == 2
+#if WALK_ISA >= 2
 				best8 = _mm256_set1_ps(best);
 #elif WALK_ISA == 1
 				best4 = _mm_set1_ps(best);
@@ -171,6 +170,9 @@ done:
 }
 
 #undef ROW
+#undef rf0
+#undef rf1
+#undef rf2
 #undef WALK
 #undef WALK_ISA
 #undef WALK_TARGET
