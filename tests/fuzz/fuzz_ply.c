@@ -3,6 +3,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "mesh_check.h"
 #include "rtsh/mesh.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -11,8 +12,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
 	rt_error err;
 	mesh *m = mesh_parse_ply("fuzz.ply", (const char *)data, size, &err);
-	if (m && m->ntris < 100000)
-		mesh_prepare(m, true, 60, &err);
+	if (m && m->ntris < 100000 && mesh_prepare(m, true, 60, &err)) {
+		/* the tree against every triangle (mesh_check.h), on small meshes */
+		mesh *raw = m->ntris <= 4096 ? mesh_parse_ply("fuzz.ply", (const char *)data, size, &err) : NULL;
+		if (raw)
+			mesh_check(raw, m, data, size);
+		mesh_free(raw);
+	}
 	mesh_free(m);
 	return 0;
 }
