@@ -468,27 +468,35 @@ static void test_watertight(void **state)
 	mesh_free(raw);
 }
 
-/* The SSE leaf test and the scalar one find the same hit: the same
- * triangle, distance and weights to the bit, and the same occlusion. */
+/* Every vector unit the machine has (AVX-512, AVX2, SSE2) finds the hit
+ * the scalar walk finds: the same triangle, distance and weights to the
+ * bit, and the same occlusion. */
 static void same_hits(const mesh *m, vec3 o, vec3 d, float tmin, float tmax)
 {
 	mesh_ray mr;
 	mesh_ray_make(&mr, o, d);
-	float t1 = tmax, t2 = tmax, b1[3] = {0}, b2[3] = {0};
-	uint32_t k1 = UINT32_MAX, k2 = UINT32_MAX;
-	bool h1 = mesh_intersect(m, &mr, tmin, &t1, &k1, b1);
+	float t2 = tmax, b2[3] = {0};
+	uint32_t k2 = UINT32_MAX;
 	bool h2 = mesh_intersect_scalar(m, &mr, tmin, &t2, &k2, b2);
-	assert_int_equal(h1, h2);
-	assert_int_equal(mesh_occluded(m, &mr, tmin, tmax), h2);
 	assert_int_equal(mesh_occluded_scalar(m, &mr, tmin, tmax), h2);
-	if (h1) {
-		assert_int_equal(k1, k2);
-		assert_memory_equal(&t1, &t2, sizeof t1);
-		assert_memory_equal(b1, b2, sizeof b1);
+	for (int isa = MESH_ISA_SSE2; isa < MESH_ISA_BEST; isa++) {
+		if (!mesh_isa_force((mesh_isa)isa))
+			continue;
+		float t1 = tmax, b1[3] = {0};
+		uint32_t k1 = UINT32_MAX;
+		bool h1 = mesh_intersect(m, &mr, tmin, &t1, &k1, b1);
+		assert_int_equal(h1, h2);
+		assert_int_equal(mesh_occluded(m, &mr, tmin, tmax), h2);
+		if (h1) {
+			assert_int_equal(k1, k2);
+			assert_memory_equal(&t1, &t2, sizeof t1);
+			assert_memory_equal(b1, b2, sizeof b1);
+		}
 	}
+	assert_true(mesh_isa_force(MESH_ISA_BEST));
 }
 
-static void test_sse_leaves_match_scalar(void **state)
+static void test_vector_walks_match_scalar(void **state)
 {
 	(void)state;
 	mesh *m = sphere_mesh(40, 20), *raw = sphere_mesh_as(40, 20, false);
@@ -527,6 +535,114 @@ static void test_sse_leaves_match_scalar(void **state)
 		}
 		mesh_free(m);
 	}
+}
+
+/* 300 long slivers, each from a random point on the face x = -50 of a box
+ * to a random point on its face x = 50: every sliver's box spans the whole
+ * box along x and overlaps most others, so object splits cannot separate
+ * them and the builder cuts them across x (spatial splits, more references
+ * than triangles). Made twice by the same random numbers, one prepared and
+ * one as read (brute force). */
+static mesh *slivers_mesh(bool prepare)
+{
+	mesh_builder b = {.name = "slivers"};
+	test_rng r = {17};
+	for (int k = 0; k < 300; k++) {
+		vec3 p = v3(-50, 10 * tdir(&r).y, 10 * tdir(&r).z), q = v3(50, 10 * tdir(&r).y, 10 * tdir(&r).z);
+		vec3 w = v3_scale(tdir(&r), 0.3);
+		float c[3][3] = {{(float)p.x, (float)p.y, (float)p.z},
+		                 {(float)q.x, (float)q.y, (float)q.z},
+		                 {(float)(q.x + w.x), (float)(q.y + w.y), (float)(q.z + w.z)}};
+		for (int i = 0; i < 3; i++)
+			assert_true(mb_vertex(&b, c[i]));
+		int32_t t[3][3] = {{3 * k, -1, -1}, {3 * k + 1, -1, -1}, {3 * k + 2, -1, -1}};
+		assert_true(mb_triangle(&b, t));
+	}
+	rt_error err = {0};
+	mesh *m = mb_finish(&b, &err);
+	assert_non_null(m);
+	if (prepare)
+		assert_true(mesh_prepare(m, false, 0, &err));
+	return m;
+}
+
+/* The tree with spatial splits finds every hit brute force finds, at the
+ * same distance, on the same triangle, with every vector unit. */
+static void test_spatial_splits(void **state)
+{
+	(void)state;
+	mesh *m = slivers_mesh(true), *raw = slivers_mesh(false);
+	assert_true(m->nrefs > m->ntris); /* it did cut */
+	test_rng r = {5};
+	int hits = 0;
+	for (int i = 0; i < 4000; i++) {
+		vec3 o = v3_scale(tdir(&r), 80);
+		vec3 target = v3(45 * tdir(&r).x, 8 * tdir(&r).y, 8 * tdir(&r).z);
+		vec3 d = v3_sub(target, o);
+		mesh_ray mr;
+		mesh_ray_make(&mr, o, d);
+		float t1 = INFINITY, t2 = INFINITY, b1[3], b2[3];
+		uint32_t k1 = 0, k2 = 0;
+		bool h1 = mesh_intersect(m, &mr, 0, &t1, &k1, b1), h2 = mesh_intersect_brute(raw, &mr, 0, &t2, &k2, b2);
+		assert_int_equal(h1, h2);
+		if (h1) {
+			hits++;
+			assert_true(t1 == t2);
+			vec3 c[3];
+			mesh_corners(m, k1, c);
+			for (int k = 0; k < 3; k++)
+				assert_vec_near(c[k], v3(raw->p[raw->tri[k2][k]][0], raw->p[raw->tri[k2][k]][1], raw->p[raw->tri[k2][k]][2]), 0);
+		}
+		same_hits(m, o, d, 0, INFINITY);
+	}
+	assert_true(hits > 400);
+	mesh_free(m);
+	mesh_free(raw);
+}
+
+/* An instance's entry (mesh_intersect_world: the world ray, the world-to-
+ * model matrix) finds what the ray taken into the model's coordinates by
+ * hand finds: the same triangle at the same distance (the ray's parameter
+ * is the same in both spaces: the direction is not made unit). */
+static void test_world_ray_entry(void **state)
+{
+	(void)state;
+	mesh *m = sphere_mesh(24, 12);
+	/* world to model: a rotation about y by 0.3, a scale of 0.5, a shift */
+	double c = cos(0.3), sn = sin(0.3);
+	double M[3][4] = {{0.5 * c, 0, 0.5 * sn, -1}, {0, 0.5, 0, 2}, {-0.5 * sn, 0, 0.5 * c, 0.25}};
+	test_rng r = {9};
+	int hits = 0;
+	for (int i = 0; i < 2000; i++) {
+		vec3 o = v3_add(v3(2, -4, -0.5), v3_scale(tdir(&r), 8));
+		vec3 d = v3_norm(v3_sub(v3_add(v3(2, -4, -0.5), v3_scale(tdir(&r), 1.5)), o));
+		ray wr = {o, d};
+		vec3 mo = v3(M[0][0] * o.x + M[0][1] * o.y + M[0][2] * o.z + M[0][3],
+		             M[1][0] * o.x + M[1][1] * o.y + M[1][2] * o.z + M[1][3],
+		             M[2][0] * o.x + M[2][1] * o.y + M[2][2] * o.z + M[2][3]);
+		vec3 md = v3(M[0][0] * d.x + M[0][1] * d.y + M[0][2] * d.z, M[1][0] * d.x + M[1][1] * d.y + M[1][2] * d.z,
+		             M[2][0] * d.x + M[2][1] * d.y + M[2][2] * d.z);
+		mesh_ray mr;
+		mesh_ray_make(&mr, mo, md);
+		float ft = INFINITY, fb[3];
+		uint32_t fk;
+		bool h1 = mesh_intersect(m, &mr, 0, &ft, &fk, fb);
+		double t;
+		uint32_t k;
+		float b[3];
+		bool h2 = mesh_intersect_world(m, (const double(*)[4])M, &wr, 0, INFINITY, &t, &k, b);
+		assert_int_equal(h1, h2);
+		assert_int_equal(mesh_occluded_world(m, (const double(*)[4])M, &wr, 0, INFINITY), h1);
+		if (h1) {
+			hits++;
+			assert_true(t == (double)ft);
+			assert_int_equal(k, fk);
+			/* and nothing in front of the hit */
+			assert_false(mesh_occluded_world(m, (const double(*)[4])M, &wr, 0, t * 0.999));
+		}
+	}
+	assert_true(hits > 500);
+	mesh_free(m);
 }
 
 /* Parallel squares at z = 1..6 (two triangles each, 12 in all: whole blocks
@@ -831,7 +947,9 @@ int main(void)
 		cmocka_unit_test(test_glb_embedded_texture),
 		cmocka_unit_test(test_tree_matches_brute_force),
 		cmocka_unit_test(test_watertight),
-		cmocka_unit_test(test_sse_leaves_match_scalar),
+		cmocka_unit_test(test_vector_walks_match_scalar),
+		cmocka_unit_test(test_spatial_splits),
+		cmocka_unit_test(test_world_ray_entry),
 		cmocka_unit_test(test_hit_distances_by_hand),
 		cmocka_unit_test(test_cube_obj_silhouette_is_cu),
 		cmocka_unit_test(test_tetrahedron_projected_area),
