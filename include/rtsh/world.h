@@ -184,6 +184,23 @@ void world_free(world *w);
 
 /* Nearest hit with tmin < t < tmax. */
 bool world_intersect(const world *w, const ray *r, double tmin, double tmax, hit *h);
+/* world_intersect in its two stages. world_trace finds the nearest hit:
+ * its distance, primitive and what the primitive's test left (a shape's
+ * normal in its own space; on a model, the triangle and its barycentric
+ * weights), what a ray-tracing kernel such as Embree's rtcIntersect1
+ * returns; world_finish makes the hit record shading needs from it (point,
+ * unit normals, side, object-space point, material, texture coordinates).
+ * world_trace_ng is the hit's geometric normal in world space, not unit
+ * (Embree's Ng). The benchmark times both stages (bench/README.md). */
+typedef struct trace_hit {
+	double t;
+	const prim *prim;        /* NULL when the hit is on a plane */
+	const prim_plane *plane; /* NULL when on a primitive */
+	vec3 nl;
+} trace_hit;
+bool world_trace(const world *w, const ray *r, double tmin, double tmax, trace_hit *th);
+void world_finish(const world *w, const ray *r, const trace_hit *th, hit *h);
+vec3 world_trace_ng(const world *w, const ray *r, const trace_hit *th);
 /* Any hit with tmin < t < tmax (shadow rays). */
 bool world_occluded(const world *w, const ray *r, double tmin, double tmax);
 /* The same queries without the tree: every primitive tested (tests, bench). */

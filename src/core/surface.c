@@ -302,6 +302,14 @@ static bool wants_uv(const world *w, const hit *h)
 	return w->mats[h->mat].tx != NULL;
 }
 
+vec3 surf_inst_ng(const world *w, const prim *p, vec3 nl)
+{
+	const prim_inst *in = &w->insts[p->u.index];
+	vec3 c[3];
+	mesh_corners(in->mesh, (uint32_t)nl.x, c);
+	return mat3x4_normal(in->inv, v3_cross(v3_sub(c[1], c[0]), v3_sub(c[2], c[0])));
+}
+
 void surf_inst_finish(const world *w, const prim *p, const ray *r, vec3 nl, hit *h)
 {
 	const prim_inst *in = &w->insts[p->u.index];

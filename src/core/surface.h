@@ -18,6 +18,8 @@ bool surf_make_inst(world *w, const object *o, uint32_t i, prim *p, box *b, rt_e
 bool surf_inst_hit(const world *w, const prim *p, const ray *r, double tmin, double tmax, double *t, vec3 *nl);
 bool surf_inst_occluded(const world *w, const prim *p, const ray *r, double tmin, double tmax);
 void surf_inst_finish(const world *w, const prim *p, const ray *r, vec3 nl, hit *h);
+/* The geometric normal of that hit in world space, not unit. */
+vec3 surf_inst_ng(const world *w, const prim *p, vec3 nl);
 /* Texture coordinates of a unit shape of kind `kind` (or a world-space
  * triangle: its vertex, edges) at h, when its material has a texture;
  * inv is the world-to-object matrix (NULL for triangles). */

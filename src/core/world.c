@@ -651,7 +651,9 @@ static inline int push_hits(const bvh_node *n, unsigned m, const float tn[4], wa
 	return sp;
 }
 
-bool world_intersect(const world *w, const ray *r, double tmin, double tmax, hit *h)
+/* The nearest hit's primitive, distance and local data (world.h). */
+static inline __attribute__((always_inline)) bool trace(const world *w, const ray *r, double tmin, double tmax,
+                                                        trace_hit *th)
 {
 	const prim *best = NULL;
 	const prim_plane *best_plane = NULL;
@@ -720,11 +722,60 @@ bool world_intersect(const world *w, const ray *r, double tmin, double tmax, hit
 		}
 	}
 	/* a primitive hit after the planes is nearer than all of them */
-	if (best)
-		finish_hit(w, best, r, tmax, best_n, h);
-	else if (best_plane)
-		finish_plane(w, best_plane, r, tmax, h);
+	th->t = tmax;
+	th->prim = best;
+	th->plane = best ? NULL : best_plane;
+	th->nl = best_n;
 	return best || best_plane;
+}
+
+static inline __attribute__((always_inline)) void finish(const world *w, const ray *r, const trace_hit *th, hit *h)
+{
+	if (th->prim)
+		finish_hit(w, th->prim, r, th->t, th->nl, h);
+	else
+		finish_plane(w, th->plane, r, th->t, h);
+}
+
+bool world_trace(const world *w, const ray *r, double tmin, double tmax, trace_hit *th)
+{
+	return trace(w, r, tmin, tmax, th);
+}
+
+void world_finish(const world *w, const ray *r, const trace_hit *th, hit *h)
+{
+	finish(w, r, th, h);
+}
+
+vec3 world_trace_ng(const world *w, const ray *r, const trace_hit *th)
+{
+	if (th->plane)
+		return th->plane->n;
+	const prim *p = th->prim;
+	switch (p->tag) {
+	case PRIM_SPHERE:
+		return v3_sub(ray_at(*r, th->t), p->u.sph.c);
+	case PRIM_TRIANGLE:
+		return v3_cross(w->tris[p->u.index].e1, w->tris[p->u.index].e2);
+	case PRIM_MESH:
+		return surf_inst_ng(w, p, th->nl);
+	default: {
+		const prim_shape *sh = &w->shapes[p->u.index];
+		const double(*m)[4] = (const double(*)[4])sh->inv;
+		vec3 nl = th->nl;
+		return (vec3){m[0][0] * nl.x + m[1][0] * nl.y + m[2][0] * nl.z, m[0][1] * nl.x + m[1][1] * nl.y + m[2][1] * nl.z,
+		              m[0][2] * nl.x + m[1][2] * nl.y + m[2][2] * nl.z};
+	}
+	}
+}
+
+bool world_intersect(const world *w, const ray *r, double tmin, double tmax, hit *h)
+{
+	trace_hit th;
+	if (!trace(w, r, tmin, tmax, &th))
+		return false;
+	finish(w, r, &th, h);
+	return true;
 }
 
 bool world_occluded(const world *w, const ray *r, double tmin, double tmax)

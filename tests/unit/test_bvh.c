@@ -131,6 +131,18 @@ static void check_ray(const world *w, const ray *r, double tmin, double tmax)
 			fail_msg("ray o=(%.17g,%.17g,%.17g) d=(%.17g,%.17g,%.17g): tree object %u t=%.17g, brute object %u t=%.17g",
 			         r->o.x, r->o.y, r->o.z, r->d.x, r->d.y, r->d.z, a.object + 1, a.t, b.object + 1, b.t);
 		assert_true(v3_eq(a.n, b.n));
+		/* the same hit in two stages, and its geometric normal along the
+		 * hit's (these scenes have no smooth normals) */
+		trace_hit th;
+		assert_true(world_trace(w, r, tmin, tmax, &th));
+		hit c;
+		world_finish(w, r, &th, &c);
+		assert_true(c.t == a.t && c.object == a.object && v3_eq(c.n, a.n) && v3_eq(c.p, a.p));
+		vec3 ng = world_trace_ng(w, r, &th);
+		assert_true(fabs(fabs(v3_dot(v3_norm(ng), a.n)) - 1) < 1e-9);
+	} else {
+		trace_hit th;
+		assert_false(world_trace(w, r, tmin, tmax, &th));
 	}
 	bool oa = world_occluded(w, r, tmin, tmax), ob = world_occluded_brute(w, r, tmin, tmax);
 	if (oa != ob)
