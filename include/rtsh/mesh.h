@@ -6,8 +6,8 @@
  * readers (mesh_obj.c, mesh_ply.c, and assimp for glTF 2.0 and STL in
  * mesh_assimp.c) fill one through the builder below; mesh_prepare then
  * derives normals (angle-weighted, split at creases) and builds the BVH
- * (bvh.c's 4-wide tree over the triangles, in object space), after which a
- * mesh is immutable and may be shared by any number of objects and
+ * (mesh_tree.c: an 8-wide tree over the triangles, in object space), after
+ * which a mesh is immutable and may be shared by any number of objects and
  * threads: an instance is a transform and a pointer (world.c).
  *
  * Errors name the file and, where the reader knows it, the line (text

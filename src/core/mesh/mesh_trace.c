@@ -1,8 +1,9 @@
 /* rtsh — rays against a mesh's triangles (mesh.h).
  *
  * The tree is mesh_tree.c's 8-wide BVH, walked in object space in single
- * precision. A node's eight slab tests run at once in one AVX2 register,
- * or two SSE2 ones, or one by one in scalar code; the far distances are
+ * precision. A node's eight slab tests run at once in one AVX2 register
+ * (built twice: for AVX2, and with AVX-512's 32 registers), or two SSE2
+ * ones, or one by one in scalar code; the far distances are
  * widened by 1 + 2 gamma(3) (Ize, "Robust BVH ray traversal", JCGT 2013)
  * and so is the nearest hit where the walk prunes, so no box the ray
  * enters is skipped. The walk goes to the nearest child the ray enters and
@@ -12,15 +13,18 @@
  * ray/triangle intersection", JCGT 2013): the ray is sheared so it runs
  * along +z through the origin, and the three 2D edge functions of the
  * sheared vertices decide the hit; an edge function that rounds to zero is
- * recomputed in double, so a ray through a shared edge or vertex hits
- * exactly one of the triangles meeting there (no cracks). A leaf's
+ * recomputed in double, so a ray through a shared edge or vertex always
+ * hits one of the triangles meeting there (no cracks). A leaf's
  * triangles are laid out in blocks of four (mesh_tri4), tested together
  * in SSE with wt_test's operations in its order, so that the vector and
  * scalar walks find the very same floats; a hit names its triangle by its
  * slot, 4 * block + lane.
  *
  * The walk is written once (mesh_walk.h) and compiled for each vector
- * unit; mesh_intersect and mesh_occluded take the best the processor has.
+ * unit; mesh_intersect, mesh_occluded and their world-ray forms take the
+ * best the processor has (mesh_isa_active), through a table of entries.
+ * The triangle test's set-up is made at the walk's first leaf: most rays
+ * that miss a model never reach one.
  */
 #include <float.h>
 #include <stdatomic.h>
