@@ -8,9 +8,11 @@
 #include "core/bvh.h"
 #include "core/integrators.h"
 #include "rtsh/image.h"
+#include "rtsh/memory.h"
 #include "rtsh/mesh.h"
 #include "rtsh/render.h"
 #include "rtsh/rtfile.h"
+#include "rtsh/texture.h"
 #include "rtsh/world.h"
 
 #define MODELS "../shared/models"
@@ -921,6 +923,67 @@ static void test_bunny_counts(void **state)
 	mesh_free(m);
 }
 
+/* Models and images too large for the memory limit (memory.h) are refused
+ * with the figures, at the step that would go past it: the file read, the
+ * reader's arrays, the tree, an image's pixels. A 100 x 500 grid of squares
+ * as an OBJ: 100,000 triangles, ~3.4 MB of text. */
+static void test_memory_limit(void **state)
+{
+	(void)state;
+	char path[300];
+	snprintf(path, sizeof path, "%s/grid.obj", tmpdir);
+	FILE *f = fopen(path, "w");
+	assert_non_null(f);
+	for (int j = 0; j <= 500; j++)
+		for (int i = 0; i <= 100; i++)
+			fprintf(f, "v %d %d 0\n", i, j);
+	for (int j = 0; j < 500; j++)
+		for (int i = 0; i < 100; i++) {
+			int a = j * 101 + i + 1;
+			fprintf(f, "f %d %d %d\nf %d %d %d\n", a, a + 1, a + 102, a, a + 102, a + 101);
+		}
+	fclose(f);
+	rt_error err = {0};
+	/* the file alone is more than 1 MiB */
+	mem_set_limit((size_t)1 << 20);
+	expect_error(mesh_load(path, &err), &err, "the model", "expected at most 1.0 MiB (the set limit)");
+	/* the file fits in 6 MiB, the reader's arrays (~2 x 1.2 MB of corners
+	 * and positions, doubled as they grow) do not */
+	mem_set_limit((size_t)6 << 20);
+	expect_error(mesh_load(path, &err), &err, "grid.obj:", "needs about");
+	/* read under 12 MiB, but the tree wants 100,000 x 200 bytes */
+	mem_set_limit((size_t)12 << 20);
+	mesh *m = mesh_load(path, &err);
+	if (!m)
+		fail_msg("%s", err.msg);
+	assert_int_equal(m->ntris, 100000);
+	assert_false(mesh_prepare(m, false, 0, &err));
+	if (!strstr(err.msg, "(100000 triangles) needs about 19 MiB"))
+		fail_msg("message \"%s\"", err.msg);
+	/* and with room, it is made */
+	mem_set_limit((size_t)64 << 20);
+	assert_true(mesh_prepare(m, false, 0, &err));
+	mesh_free(m);
+	/* an image of 2000 x 2000 pixels (a 12 MB PPM) wants ~107 MiB */
+	snprintf(path, sizeof path, "%s/big.ppm", tmpdir);
+	f = fopen(path, "wb");
+	assert_non_null(f);
+	fprintf(f, "P6\n2000 2000\n255\n");
+	for (int i = 0; i < 2000 * 2000 * 3; i++)
+		fputc(i & 0x7f, f);
+	fclose(f);
+	int w, h;
+	float *px = image_load_rgb(path, true, &w, &h, &err);
+	assert_null(px);
+	if (!strstr(err.msg, "big.ppm (2000x2000 pixels) needs about 107 MiB"))
+		fail_msg("message \"%s\"", err.msg);
+	mem_set_limit((size_t)256 << 20);
+	px = image_load_rgb(path, true, &w, &h, &err);
+	assert_non_null(px);
+	free(px);
+	mem_set_limit(0);
+}
+
 /* igea.ply is one closed genus-0 surface of 134,345 vertices (README):
  * by Euler's formula V - E + F = 2 with 3F = 2E, F = 2V - 4. */
 static void test_igea_strips(void **state)
@@ -958,6 +1021,7 @@ int main(void)
 		cmocka_unit_test(test_instances_share_one_mesh),
 		cmocka_unit_test(test_bunny_counts),
 		cmocka_unit_test(test_igea_strips),
+		cmocka_unit_test(test_memory_limit),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
 }

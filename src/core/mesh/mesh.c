@@ -6,6 +6,7 @@
 #include <errno.h>
 #include <float.h>
 #include <pthread.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
@@ -13,6 +14,7 @@
 
 #include "core/bvh.h"
 #include "rtsh/filesrc.h"
+#include "rtsh/memory.h"
 #include "rtsh/texture.h"
 
 /* --- the builder --- */
@@ -35,9 +37,37 @@ static bool grow(void **a, size_t *cap, size_t need, size_t size)
 	return true;
 }
 
+/* grow, for a builder's array: the builder's bytes after the growth are
+ * checked against the memory limit first. */
+static bool bgrow(mesh_builder *b, void **a, size_t *cap, size_t need, size_t size)
+{
+	if (need <= *cap)
+		return true;
+	size_t c = *cap ? *cap : 64;
+	while (c < need && c <= SIZE_MAX / 2 / size)
+		c *= 2;
+	double after = (double)b->bytes + (double)(c - *cap) * (double)size;
+	char what[300];
+	snprintf(what, sizeof what, "the model %s", b->name ? b->name : "");
+	if (!mem_check(after, what, &b->limit)) {
+		b->over = true;
+		return false;
+	}
+	size_t old = *cap;
+	if (!grow(a, cap, need, size))
+		return false;
+	b->bytes += (*cap - old) * size;
+	return true;
+}
+
+const char *mb_failure(const mesh_builder *b)
+{
+	return b->over ? b->limit.msg : "out of memory";
+}
+
 bool mb_vertex(mesh_builder *b, const float p[3])
 {
-	if (!grow((void **)&b->v, &b->cv, b->nv + 1, sizeof *b->v))
+	if (!bgrow(b, (void **)&b->v, &b->cv, b->nv + 1, sizeof *b->v))
 		return false;
 	memcpy(b->v[b->nv++], p, sizeof *b->v);
 	return true;
@@ -45,7 +75,7 @@ bool mb_vertex(mesh_builder *b, const float p[3])
 
 bool mb_uv(mesh_builder *b, const float t[2])
 {
-	if (!grow((void **)&b->vt, &b->cvt, b->nvt + 1, sizeof *b->vt))
+	if (!bgrow(b, (void **)&b->vt, &b->cvt, b->nvt + 1, sizeof *b->vt))
 		return false;
 	memcpy(b->vt[b->nvt++], t, sizeof *b->vt);
 	return true;
@@ -53,7 +83,7 @@ bool mb_uv(mesh_builder *b, const float t[2])
 
 bool mb_normal(mesh_builder *b, const float n[3])
 {
-	if (!grow((void **)&b->vn, &b->cvn, b->nvn + 1, sizeof *b->vn))
+	if (!bgrow(b, (void **)&b->vn, &b->cvn, b->nvn + 1, sizeof *b->vn))
 		return false;
 	memcpy(b->vn[b->nvn++], n, sizeof *b->vn);
 	return true;
@@ -61,8 +91,8 @@ bool mb_normal(mesh_builder *b, const float n[3])
 
 bool mb_triangle(mesh_builder *b, int32_t c[3][3])
 {
-	if (!grow((void **)&b->c, &b->cc, b->nc + 3, sizeof *b->c) ||
-	    !grow((void **)&b->fm, &b->cf, b->nf + 1, sizeof *b->fm))
+	if (!bgrow(b, (void **)&b->c, &b->cc, b->nc + 3, sizeof *b->c) ||
+	    !bgrow(b, (void **)&b->fm, &b->cf, b->nf + 1, sizeof *b->fm))
 		return false;
 	memcpy(b->c[b->nc], c, 3 * sizeof *b->c);
 	b->nc += 3;
@@ -412,6 +442,10 @@ oom:
 
 bool mesh_prepare(mesh *m, bool smooth, double crease_deg, rt_error *err)
 {
+	char what[300];
+	snprintf(what, sizeof what, "the model %s (%u triangles)", m->path ? m->path : "", m->ntris);
+	if (!mem_check((double)m->ntris * MESH_PREPARE_BYTES, what, err))
+		return false;
 	if (!smooth) {
 		free(m->n);
 		m->n = NULL;

@@ -241,7 +241,7 @@ mesh *mesh_read_assimp(const char *path, rt_error *err)
 	free(dir);
 	if (!ok) {
 		if (err && !err->msg[0])
-			rt_error_set(err, "%s: out of memory reading the model", path);
+			rt_error_set(err, "%s: %s", path, b.over ? b.limit.msg : "out of memory reading the model");
 		mb_free(&b);
 		return NULL;
 	}

@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 
 #include "rtsh/filesrc.h"
+#include "rtsh/memory.h"
 
 /* Files larger than this are refused rather than read. */
 #define SLURP_MAX ((size_t)4 << 30)
@@ -41,6 +42,12 @@ char *rt_file_read_disk(const char *path, const char *what, size_t *len, rt_erro
 		return NULL;
 	}
 	size_t n = (size_t)st.st_size;
+	char what_[300];
+	snprintf(what_, sizeof what_, "the %s %s", what, path);
+	if (!mem_check((double)n, what_, err)) {
+		fclose(f);
+		return NULL;
+	}
 	char *buf = malloc(n + 1);
 	if (!buf) {
 		fclose(f);

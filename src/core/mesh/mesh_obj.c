@@ -275,7 +275,7 @@ static bool read_face(obj_reader *r, cursor *c)
 		memcpy(t[1], r->poly[k], sizeof t[1]);
 		memcpy(t[2], r->poly[k + 1], sizeof t[2]);
 		if (!mb_triangle(&r->b, t))
-			return bad(r, "%s: out of memory", "face");
+			return bad(r, "%s", mb_failure(&r->b));
 	}
 	return true;
 }
@@ -326,16 +326,16 @@ mesh *mesh_parse_obj(const char *name, const char *dir, const char *buf, size_t 
 			if (keyword(&c, "v")) {
 				ok = read_floats(&r, &c, 3, 3, v, "vertex coordinate");
 				float f[3] = {(float)v[0], (float)v[1], (float)v[2]};
-				ok = ok && (mb_vertex(&r.b, f) || bad(&r, "%s: out of memory", "vertex"));
+				ok = ok && (mb_vertex(&r.b, f) || bad(&r, "%s", mb_failure(&r.b)));
 			} else if (keyword(&c, "vt")) {
 				v[1] = 0;
 				ok = read_floats(&r, &c, 1, 2, v, "texture coordinate");
 				float f[2] = {(float)v[0], (float)v[1]};
-				ok = ok && (mb_uv(&r.b, f) || bad(&r, "%s: out of memory", "vt"));
+				ok = ok && (mb_uv(&r.b, f) || bad(&r, "%s", mb_failure(&r.b)));
 			} else if (keyword(&c, "vn")) {
 				ok = read_floats(&r, &c, 3, 3, v, "normal component");
 				float f[3] = {(float)v[0], (float)v[1], (float)v[2]};
-				ok = ok && (mb_normal(&r.b, f) || bad(&r, "%s: out of memory", "vn"));
+				ok = ok && (mb_normal(&r.b, f) || bad(&r, "%s", mb_failure(&r.b)));
 			}
 			break;
 		case 'f':

@@ -205,7 +205,7 @@ static bool add_poly(ply_reader *r, const int32_t *idx, size_t n, bool strip, si
 		for (size_t k = 1; k + 1 < n; k++) {
 			int32_t t[3][3] = {{idx[0], -1, -1}, {idx[k], -1, -1}, {idx[k + 1], -1, -1}};
 			if (!mb_triangle(&r->b, t))
-				return fail(r, "out of memory");
+				return fail(r, "%s", mb_failure(&r->b));
 		}
 		return true;
 	}
@@ -225,7 +225,7 @@ static bool add_poly(ply_reader *r, const int32_t *idx, size_t n, bool strip, si
 		bool odd = ((run - 3) & 1) != 0;
 		int32_t t[3][3] = {{a, -1, -1}, {odd ? c : b, -1, -1}, {odd ? b : c, -1, -1}};
 		if (!mb_triangle(&r->b, t))
-			return fail(r, "out of memory");
+			return fail(r, "%s", mb_failure(&r->b));
 	}
 	return true;
 }
@@ -298,7 +298,7 @@ static bool read_elem(ply_reader *r, const elem *e)
 			float fn[3] = {(float)nrm[0], (float)nrm[1], (float)nrm[2]};
 			float ft[2] = {(float)uv[0], (float)uv[1]};
 			if (!mb_vertex(&r->b, fp) || (has_n && !mb_normal(&r->b, fn)) || (has_uv && !mb_uv(&r->b, ft)))
-				return fail(r, "out of memory");
+				return fail(r, "%s", mb_failure(&r->b));
 		}
 	}
 	return true;

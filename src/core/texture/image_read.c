@@ -18,6 +18,7 @@
 #include <stb/stb_image.h>
 
 #include "core/mesh/mesh_io.h"
+#include "rtsh/memory.h"
 #include "rtsh/texture.h"
 
 /* Images larger than this (in pixels) are refused. */
@@ -68,13 +69,22 @@ static void codes_to_float(const unsigned char *in, size_t n, int comp, bool srg
 			out[3 * i + c] = lut[in[i * (size_t)comp + (comp >= 3 ? c : 0)]];
 }
 
+/* Bytes a pixel takes while an image is read and made a texture: the
+ * decoder's (up to 3 floats), ours (3 floats) and the mip chain's (4/3 of
+ * ours). */
+#define IMAGE_BYTES_PER_PIXEL (12.0 + 12.0 + 4.0)
+
 static bool size_ok(const char *path, long w, long h, rt_error *err)
 {
 	if (w <= 0 || h <= 0)
 		return rt_error_set(err, "%s: the image is %ldx%ld pixels; expected a size of at least 1x1", path, w, h);
 	if ((size_t)w * (size_t)h > IMAGE_MAX_PIXELS || w > 1 << 20 || h > 1 << 20)
 		return rt_error_set(err, "%s: the image is %ldx%ld pixels; expected at most 2^28 pixels", path, w, h);
-	return true;
+	/* the decoder's pixels (floats for HDR), ours, and the mip chain's
+	 * third more (texture.c) */
+	char what[300];
+	snprintf(what, sizeof what, "the image %s (%ldx%ld pixels)", path, w, h);
+	return mem_check((double)w * (double)h * IMAGE_BYTES_PER_PIXEL, what, err);
 }
 
 static float *read_stb(const char *path, const unsigned char *buf, size_t len, bool srgb, int *w, int *h,
