@@ -5,10 +5,21 @@
 #include <stdint.h>
 #include <stdlib.h>
 
+#include "rtsh/memory.h"
 #include "rtsh/texture.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+int LLVMFuzzerInitialize(int *argc, char ***argv);
 const char *__lsan_default_suppressions(void);
+
+/* Images too large for 512 MiB are refused up front (memory.h), well
+ * inside libFuzzer's RSS limit. */
+int LLVMFuzzerInitialize(int *argc, char ***argv)
+{
+	(void)argc, (void)argv;
+	mem_set_limit((size_t)512 << 20);
+	return 0;
+}
 
 /* libXpm (3.5.x) loses a few bytes in xpmParseColors when a colour line is
  * malformed, whatever its caller frees afterwards: not ours to fix. */

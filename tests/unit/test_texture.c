@@ -116,6 +116,31 @@ static void test_ppm_pfm_xpm(void **state)
 
 /* A distant checkerboard must not shimmer: a footprint of many texels
  * returns their average. */
+/* Headers that promise more pixels than their file holds are refused, not
+ * padded: a binary PPM under a name stb_image reads (found by fuzz_texture:
+ * 30 bytes promising 426 x 436,637 pixels became a 2 GB image), and a PNG
+ * whose header says 16000 x 16000 with no pixel data after it (more than
+ * 4,096 pixel bytes a file byte, which no format packs). */
+static void test_headers_that_promise_too_much(void **state)
+{
+	(void)state;
+	static const unsigned char ppm[] = "P6\n426\n436637  2\n  F\nF\n1\b0%";
+	rt_error err = {0};
+	int w, h;
+	float *p = image_decode_rgb("x.tga", ppm, sizeof ppm - 1, true, &w, &h, &err);
+	assert_null(p);
+	if (!strstr(err.msg, "ends early"))
+		fail_msg("message \"%s\"", err.msg);
+	/* PNG: signature, an IHDR of 16000 x 16000 8-bit RGB (its CRC), IEND */
+	static const unsigned char png[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R',
+	                                    0, 0, 0x3e, 0x80, 0, 0, 0x3e, 0x80, 8, 2, 0, 0, 0, 0xce, 0x1c, 0x48, 0x89, 0, 0, 0, 0,
+	                                    'I', 'E', 'N', 'D', 0xae, 0x42, 0x60, 0x82};
+	p = image_decode_rgb("x.png", png, sizeof png, true, &w, &h, &err);
+	assert_null(p);
+	if (!strstr(err.msg, "16000x16000 pixels, more than its 45 bytes can hold"))
+		fail_msg("message \"%s\"", err.msg);
+}
+
 static void test_mipmap_average(void **state)
 {
 	(void)state;
@@ -342,6 +367,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_ppm_pfm_xpm),
+		cmocka_unit_test(test_headers_that_promise_too_much),
 		cmocka_unit_test(test_mipmap_average),
 		cmocka_unit_test(test_corner_lands_where_documented),
 		cmocka_unit_test(test_flat_normal_map_changes_nothing),

@@ -87,6 +87,9 @@ static bool size_ok(const char *path, long w, long h, rt_error *err)
 	return mem_check((double)w * (double)h * IMAGE_BYTES_PER_PIXEL, what, err);
 }
 
+/* Pixel bytes a file byte may hold, at most (read_stb). */
+#define IMAGE_MAX_RATIO 4096.0
+
 static float *read_stb(const char *path, const unsigned char *buf, size_t len, bool srgb, int *w, int *h,
                        rt_error *err)
 {
@@ -101,6 +104,15 @@ static float *read_stb(const char *path, const unsigned char *buf, size_t len, b
 	}
 	if (!size_ok(path, x, y, err))
 		return NULL;
+	/* No format stb_image reads packs more than ~1,000 pixel bytes into one
+	 * file byte (deflate's limit is 1032:1; RLE and JPEG less): a header
+	 * that promises far more describes a file cut short, which some of its
+	 * readers (PNM, BMP) would pad rather than refuse. */
+	if ((double)x * (double)y * 3 > IMAGE_MAX_RATIO * (double)len + 65536.0) {
+		rt_error_set(err, "%s: the header says %dx%d pixels, more than its %zu bytes can hold; expected a "
+		             "complete image", path, x, y, len);
+		return NULL;
+	}
 	/* decoded first, our floats after: a header that promises more than the
 	 * file holds fails in the decoder before the big float buffer exists */
 	size_t n;
@@ -439,7 +451,12 @@ done:
 float *image_decode_rgb(const char *path, const unsigned char *buf, size_t len, bool srgb, int *w, int *h,
                         rt_error *err)
 {
-	switch (format_of(path)) {
+	int f = format_of(path);
+	/* stb_image goes by the content: a binary PNM under another name is
+	 * read by our reader, which checks that its pixels are all there */
+	if (f == F_STB && len >= 2 && buf[0] == 'P' && (buf[1] == '5' || buf[1] == '6'))
+		f = F_PPM;
+	switch (f) {
 	case F_STB:
 		return read_stb(path, buf, len, srgb, w, h, err);
 	case F_PPM:
