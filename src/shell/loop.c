@@ -128,12 +128,22 @@ static void show_output(shell *sh, const abuf *out)
 		return;
 	}
 	fflush(stdout);
-	/* The loop takes the terminal's answers out of the pager's keys; the
-	 * picture waits (screen_clear_all) until the layout comes back. */
-	screen_clear_all(scr);
-	evloop_set_interrupt(ev, stop_paging, NULL);
-	pager_show(ev, scr->fd, out->b, out->len, scr->cols, scr->rows);
-	evloop_set_interrupt(ev, stop_reading, NULL);
+	size_t at = 0;
+	for (;;) {
+		/* The loop takes the terminal's answers out of the pager's keys;
+		 * the picture waits (screen_clear_all) until the layout comes
+		 * back. */
+		screen_clear_all(scr);
+		evloop_set_interrupt(ev, stop_paging, NULL);
+		bool left = pager_show(ev, scr->fd, out->b, out->len, scr->cols, scr->rows, &at);
+		evloop_set_interrupt(ev, stop_reading, NULL);
+		if (left || shell_sig_term || shell_sig_int)
+			break;
+		/* Continued after Ctrl-Z, or the window changed size: the pager
+		 * again where it was, for the window as it is now. */
+		shell_sig_cont = shell_sig_winch = 0;
+		screen_layout(scr, (double)sh->set.width / sh->set.height, true);
+	}
 	/* Readline draws the prompt again when the command returns. */
 	relayout_screen(sh);
 }

@@ -99,8 +99,9 @@ static void draw(evloop *l, int fd, const slice *rows, int nrows, int top, int p
 	abuf_free(&a);
 }
 
-void pager_show(evloop *l, int fd_out, const char *text, size_t len, int cols, int rows)
+bool pager_show(evloop *l, int fd_out, const char *text, size_t len, int cols, int rows, size_t *at)
 {
+	bool left = true;
 	int fd_in = evloop_in_fd(l);
 	struct termios saved, raw;
 	bool have_tty = tcgetattr(fd_in, &saved) == 0;
@@ -117,13 +118,20 @@ void pager_show(evloop *l, int fd_out, const char *text, size_t len, int cols, i
 		split(text, len, cols, sl);
 		int page = rows > 1 ? rows - 1 : 1;
 		int top = 0;
+		/* the row that holds offset *at */
+		while (top + 1 < nrows && (size_t)(sl[top + 1].p - text) <= *at)
+			top++;
 		for (;;) {
 			int max_top = nrows > page ? nrows - page : 0;
 			top = top < 0 ? 0 : top > max_top ? max_top : top;
+			if (nrows)
+				*at = (size_t)(sl[top].p - text);
 			draw(l, fd_out, sl, nrows, top, page, cols);
 			char k[16];
-			if (!evloop_key(l, k, sizeof k, PAGER_ESC_WAIT))
+			if (!evloop_key(l, k, sizeof k, PAGER_ESC_WAIT)) {
+				left = evloop_eof(l);
 				break;
+			}
 			if (strcmp(k, " ") == 0 || strcmp(k, "f") == 0 || strcmp(k, "\x1b[6~") == 0) {
 				if (top >= max_top && k[0] == ' ')
 					break;
@@ -152,4 +160,5 @@ void pager_show(evloop *l, int fd_out, const char *text, size_t len, int cols, i
 		termout_text(evloop_out(l), "\x1b[?25h", 6);
 	else
 		write_all(fd_out, "\x1b[?25h", 6);
+	return left;
 }

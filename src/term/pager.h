@@ -8,6 +8,7 @@
 #ifndef RTSH_PAGER_H
 #define RTSH_PAGER_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "term/evloop.h"
@@ -21,9 +22,12 @@ int pager_rows(const char *text, size_t len, int cols);
  * terminal, is put in non-canonical mode for the while): Space / PgDn / f a page on,
  * b / PgUp a page back, Enter / Down / j a line on, Up / k a line back,
  * g / Home the top, G / End the end, q / Esc leave; Space on the last page
- * leaves too. Returns when the user leaves, at the end of the input, or when
- * the loop's interrupt hook says so (a signal); the caller redraws its
- * screen. */
-void pager_show(evloop *l, int fd_out, const char *text, size_t len, int cols, int rows);
+ * leaves too. *at is the offset in text of the first row to show (0: the
+ * top), and on return that of the first row shown. Returns true when the
+ * user leaves or the input ends, false when the loop's interrupt hook
+ * stopped it (a signal): the caller may show it again from *at, as it was
+ * (after a stop and a continue) or wrapped for a new window size. The
+ * caller redraws its screen after. */
+bool pager_show(evloop *l, int fd_out, const char *text, size_t len, int cols, int rows, size_t *at);
 
 #endif

@@ -6,7 +6,8 @@
 # #{keypad_cursor_flag} = "0 1 0 0"). Ctrl-Z (SIGTSTP) gives the terminal
 # back the same way and SIGCONT takes it again (alternate screen, and the
 # keypad in key mode); SIGINT stops a render or leaves key mode without
-# leaving a mode set.
+# leaving a mode set. The pager comes back after Ctrl-Z and fg, and after a
+# resize, on the text it showed.
 set -u
 s=rtsh-signals-$$
 fail() { echo "FAIL: $*"; tmux kill-session -t "$s" 2>/dev/null; tmux kill-session -t "$s-keep" 2>/dev/null; exit 1; }
@@ -110,5 +111,37 @@ for ctx in prompt render view; do
 	wait_flags "0 1 0 0" "quit after $ctx"
 	tmux kill-session -t "$s"
 done
+# The pager (`help`): Ctrl-Z and fg bring it back on the page it showed, and
+# a new window size wraps it again from the same place (not the top).
+start prompt
+tmux send-keys -t "$s" 'help' Enter
+wait_for "q quit" "help did not open the pager"
+sleep 0.5
+top=$(screen | head -n 1 | cut -c1-20)
+tmux send-keys -t "$s" ' '
+sleep 0.5
+first=$(screen | head -n 1 | cut -c1-20)
+[ "$first" != "$top" ] || fail "Space in the pager did not turn the page"
+kill -s TSTP "$pid"
+for i in $(seq 1 50); do
+	case $(ps -o stat= -p "$pid") in T*) break ;; esac
+	sleep 0.1
+done
+case $(ps -o stat= -p "$pid") in T*) ;; *) fail "SIGTSTP in the pager: rtsh did not stop" ;; esac
+kill -s CONT "$pid"
+wait_for "q quit" "SIGCONT in the pager: the pager is not shown again"
+[ "$(screen | head -n 1 | cut -c1-20)" = "$first" ] ||
+	fail "SIGCONT in the pager: it starts at \"$(screen | head -n 1 | cut -c1-20)\", not \"$first\""
+tmux resize-window -t "$s" -x 70 -y 24
+sleep 1
+wait_for "q quit" "a new window size in the pager: the pager is not shown again"
+# wrapped for 70 columns, the row that holds the same text: not the top
+[ "$(screen | head -n 1 | cut -c1-20)" != "$top" ] || fail "a new window size in the pager: back at the top"
+tmux send-keys -t "$s" q
+wait_for "rtsh>" "no prompt after the pager"
+tmux send-keys -t "$s" 'quit' Enter
+for i in $(seq 1 50); do dead && break; sleep 0.1; done
+dead || fail "quit after the pager: rtsh is still running"
+tmux kill-session -t "$s"
 tmux kill-session -t "$s-keep"
 echo "ok"
