@@ -67,22 +67,27 @@ static inline __attribute__((always_inline)) void ray_node_setup(mesh_ray *r, fl
  * of. */
 static inline __attribute__((always_inline)) void ray_leaf_setup(mesh_ray *r)
 {
-	float dx = r->d[0], dy = r->d[1], dz = r->d[2];
-	float ax = fabsf(dx), ay = fabsf(dy), az = fabsf(dz);
+	float ax = fabsf(r->d[0]), ay = fabsf(r->d[1]), az = fabsf(r->d[2]);
+	/* selects as arithmetic and loads: GCC makes branches of ?: here */
 	int kxy = !(ax > ay);
+#if defined(__SSE2__)
+	float axy = _mm_cvtss_f32(_mm_max_ss(_mm_set_ss(ax), _mm_set_ss(ay))); /* ax > ay ? ax : ay */
+#else
 	float axy = ax > ay ? ax : ay;
-	int kz = axy > az ? kxy : 2;
-	int kx = kz == 2 ? 0 : kz + 1, ky = kx == 2 ? 0 : kx + 1;
-	float dkz = kz == 0 ? dx : kz == 1 ? dy : dz;
-	int swap = (kx ^ ky) & -(int)(dkz < 0.0f);
+#endif
+	int zbig = !(axy > az);
+	int kz = kxy + zbig * (2 - kxy);
+	static const int next[3] = {1, 2, 0};
+	int kx = next[kz], ky = next[kx];
+	int swap = (kx ^ ky) & -(int)(r->d[kz] < 0.0f);
 	kx ^= swap;
 	ky ^= swap;
 	r->kx = kx;
 	r->ky = ky;
 	r->kz = kz;
-	r->sz = kz == 0 ? r->inv[0] : kz == 1 ? r->inv[1] : r->inv[2];
-	r->sx = (kx == 0 ? dx : kx == 1 ? dy : dz) * r->sz;
-	r->sy = (ky == 0 ? dx : ky == 1 ? dy : dz) * r->sz;
+	r->sz = r->inv[kz];
+	r->sx = r->d[kx] * r->sz;
+	r->sy = r->d[ky] * r->sz;
 }
 
 void mesh_ray_make(mesh_ray *r, vec3 o, vec3 d)
