@@ -31,6 +31,14 @@ wait_flags() {
 	fail "$2: the pane's flags are \"$(flags)\", expected \"$1\" (alternate cursor keypad keypad-cursor)"
 }
 dead() { case $(screen) in *rtsh-ended*) return 0 ;; esac; return 1; }
+# wait_stopped WHAT: up to 5 s for rtsh ($pid) to be stopped.
+wait_stopped() {
+	for i in $(seq 1 50); do
+		case $(ps -o stat= -p "$pid") in T*) return 0 ;; esac
+		sleep 0.1
+	done
+	fail "$1: rtsh did not stop"
+}
 
 cat >"$TMP/s.rt" <<'EOF'
 A 0.3 255,255,255
@@ -77,11 +85,7 @@ for ctx in prompt render view; do
 	# Ctrl-Z and fg.
 	start $ctx
 	kill -s TSTP "$pid"
-	for i in $(seq 1 50); do
-		case $(ps -o stat= -p "$pid") in T*) break ;; esac
-		sleep 0.1
-	done
-	case $(ps -o stat= -p "$pid") in T*) ;; *) fail "SIGTSTP in $ctx: rtsh did not stop" ;; esac
+	wait_stopped "SIGTSTP in $ctx"
 	wait_flags "0 1 0 0" "SIGTSTP in $ctx"
 	kill -s CONT "$pid"
 	if [ $ctx = view ]; then
@@ -123,11 +127,7 @@ sleep 0.5
 first=$(screen | head -n 1 | cut -c1-20)
 [ "$first" != "$top" ] || fail "Space in the pager did not turn the page"
 kill -s TSTP "$pid"
-for i in $(seq 1 50); do
-	case $(ps -o stat= -p "$pid") in T*) break ;; esac
-	sleep 0.1
-done
-case $(ps -o stat= -p "$pid") in T*) ;; *) fail "SIGTSTP in the pager: rtsh did not stop" ;; esac
+wait_stopped "SIGTSTP in the pager"
 kill -s CONT "$pid"
 wait_for "q quit" "SIGCONT in the pager: the pager is not shown again"
 [ "$(screen | head -n 1 | cut -c1-20)" = "$first" ] ||
