@@ -2,8 +2,10 @@
 #include "rtsh/filesrc.h"
 
 #include <stdatomic.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include <assimp/cfileio.h>
 #include <assimp/cimport.h>
@@ -136,12 +138,84 @@ static void ai_close_file(struct aiFileIO *io, struct aiFile *f)
 	free(f);
 }
 
+static uint32_t le32(const unsigned char *p)
+{
+	return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+/* A binary glTF's header and chunk lengths against the file's size: assimp
+ * takes them on trust and allocates what they say (a 600-byte file asked
+ * it for 4 GB: found by fuzz_model). False (err set) when one says more
+ * than the file holds. */
+static bool glb_fits(const char *path, const unsigned char *b, size_t len, rt_error *err)
+{
+	if (len < 12 || le32(b) != 0x46546C67u) /* "glTF": else assimp says what it is */
+		return true;
+	uint32_t total = le32(b + 8);
+	if (total > len)
+		return rt_error_set(err, "%s: byte 8: the .glb says it is %u bytes long, the file has %zu; expected a "
+		                    "complete .glb", path, total, len);
+	if (le32(b + 4) != 2)
+		return true; /* glTF 1.0's binary form: its header is checked by assimp */
+	for (size_t at = 12; at + 8 <= total;) {
+		uint32_t n = le32(b + at);
+		if (n > total - at - 8)
+			return rt_error_set(err, "%s: byte %zu: a .glb chunk of %u bytes, %zu left in the file; expected a "
+			                    "complete .glb", path, at, n, (size_t)(total - at - 8));
+		at += 8 + (size_t)n;
+	}
+	return true;
+}
+
+static bool has_ext(const char *path, const char *ext)
+{
+	const char *slash = strrchr(path, '/'), *dot = strrchr(slash ? slash : path, '.');
+	return dot && strcasecmp(dot + 1, ext) == 0;
+}
+
+/* Whether the bytes are what the extension says (rtsh reads .gltf, .glb
+ * and .stl through assimp): when they are not, assimp would try every one
+ * of its importers on them, and one of those reads past its buffer on a
+ * 20-byte file (found by fuzz_model). So only its glTF and STL readers
+ * see a file. False (err set) when they are not. */
+static bool looks_like(const char *path, const unsigned char *b, size_t len, rt_error *err)
+{
+	size_t i = len >= 3 && b[0] == 0xef && b[1] == 0xbb && b[2] == 0xbf ? 3 : 0; /* a UTF-8 BOM */
+	while (i < len && (b[i] == ' ' || b[i] == '\t' || b[i] == '\r' || b[i] == '\n'))
+		i++;
+	if (has_ext(path, "glb")) {
+		if (len >= 4 && le32(b) == 0x46546C67u)
+			return true;
+		return rt_error_set(err, "%s: byte 0: not a binary glTF; expected the bytes \"glTF\" at its start", path);
+	}
+	if (has_ext(path, "gltf")) {
+		if (i < len && b[i] == '{')
+			return true;
+		return rt_error_set(err, "%s: byte %zu: not a glTF file; expected its JSON, from \"{\"", path, i);
+	}
+	if (has_ext(path, "stl")) {
+		/* binary: an 80-byte header, a count, 50 bytes a triangle */
+		if (len >= 84 && (uint64_t)len == 84 + 50 * (uint64_t)le32(b + 80))
+			return true;
+		if (len - i >= 5 && strncasecmp((const char *)b + i, "solid", 5) == 0)
+			return true;
+		return rt_error_set(err, "%s: not an STL file; expected \"solid\" (text) or 84 bytes and 50 a triangle "
+		                    "(binary)", path);
+	}
+	return true;
+}
+
 const struct aiScene *rt_file_ai_import(const char *path, unsigned flags, rt_error *err)
 {
 	size_t len;
 	char *bytes = rt_file_read(path, "model", &len, err);
 	if (!bytes)
 		return NULL;
+	if (!looks_like(path, (const unsigned char *)bytes, len, err) ||
+	    (has_ext(path, "glb") && !glb_fits(path, (const unsigned char *)bytes, len, err))) {
+		free(bytes);
+		return NULL;
+	}
 	ai_job job = {path, bytes, len};
 	struct aiFileIO io = {ai_open_file, ai_close_file, (aiUserData)(void *)&job};
 	const struct aiScene *sc = aiImportFileEx(path, flags, &io);
