@@ -96,6 +96,17 @@ void mesh_ray_make(mesh_ray *r, vec3 o, vec3 d)
 	ray_leaf_setup(r);
 }
 
+/* minps and maxps of one lane: b when either is a NaN */
+static inline float lo_of(float a, float b)
+{
+	return a < b ? a : b;
+}
+
+static inline float hi_of(float a, float b)
+{
+	return a > b ? a : b;
+}
+
 /* The watertight test of one triangle, given its corners' coordinates on
  * the ray's axes kx, ky, kz: t in (tmin, *tmax) sets *tmax and the
  * barycentric weights. The SSE leaf test below does the same operations in
@@ -110,12 +121,22 @@ static inline __attribute__((always_inline)) bool wt_test(const mesh_ray *r, flo
 	float bx = pbx - r->o[kx] - r->sx * bz, by = pby - r->o[ky] - r->sy * bz;
 	float cx = pcx - r->o[kx] - r->sx * cz, cy = pcy - r->o[ky] - r->sy * cz;
 	float u = cx * by - cy * bx, v = ax * cy - ay * cx, w = bx * ay - by * ax;
-	if (u == 0.0f || v == 0.0f || w == 0.0f) {
+	/* The lowest and highest edge function (lo_of and hi_of: minps and
+	 * maxps, NaNs and all). An edge function at zero is recomputed in
+	 * double; only the lowest or highest needs to be: a float edge function
+	 * that is not zero has its exact sign (rounding keeps order), so a zero
+	 * between a negative and a positive changes nothing. */
+	float lo = lo_of(lo_of(u, v), w), hi = hi_of(hi_of(u, v), w);
+	if (lo == 0.0f || hi == 0.0f) {
 		u = (float)((double)cx * by - (double)cy * bx);
 		v = (float)((double)ax * cy - (double)ay * cx);
 		w = (float)((double)bx * ay - (double)by * ax);
+		lo = lo_of(lo_of(u, v), w);
+		hi = hi_of(hi_of(u, v), w);
 	}
-	if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f))
+	/* some below zero and some above: a miss (a NaN fails below, on its
+	 * NaN distance) */
+	if (lo < 0.0f && hi > 0.0f)
 		return false;
 	float det = u + v + w;
 	if (det == 0.0f)
@@ -193,8 +214,10 @@ static inline __attribute__((always_inline)) int block_sse(const mesh_tri4 *q, c
 	__m128 v = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
 	__m128 w = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
 	const __m128 zero = _mm_setzero_ps();
-	unsigned zm = (unsigned)_mm_movemask_ps(
-	    _mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(u, zero), _mm_cmpeq_ps(v, zero)), _mm_cmpeq_ps(w, zero)));
+	/* the lowest and highest edge functions, as wt_test: at zero, the
+	 * lane's are recomputed in double */
+	__m128 lo = _mm_min_ps(_mm_min_ps(u, v), w), hi = _mm_max_ps(_mm_max_ps(u, v), w);
+	unsigned zm = (unsigned)_mm_movemask_ps(_mm_or_ps(_mm_cmpeq_ps(lo, zero), _mm_cmpeq_ps(hi, zero)));
 	if (zm) {
 		_Alignas(16) float fu[4], fv[4], fw[4], fax[4], fay[4], fbx[4], fby[4], fcx[4], fcy[4];
 		_mm_store_ps(fu, u);
@@ -215,17 +238,23 @@ static inline __attribute__((always_inline)) int block_sse(const mesh_tri4 *q, c
 		u = _mm_load_ps(fu);
 		v = _mm_load_ps(fv);
 		w = _mm_load_ps(fw);
+		lo = _mm_min_ps(_mm_min_ps(u, v), w);
+		hi = _mm_max_ps(_mm_max_ps(u, v), w);
 	}
-	__m128 neg = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(v, zero)), _mm_cmplt_ps(w, zero));
-	__m128 pos = _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(v, zero)), _mm_cmpgt_ps(w, zero));
-	__m128 det = _mm_add_ps(_mm_add_ps(u, v), w);
-	__m128 ok = _mm_andnot_ps(_mm_and_ps(neg, pos), _mm_cmpneq_ps(det, zero));
-	if (!_mm_movemask_ps(ok))
+	/* (a NaN lane fails below, on its NaN distance) */
+	__m128 neg = _mm_cmplt_ps(lo, zero);
+	__m128 pos = _mm_cmpgt_ps(hi, zero);
+	/* det is zero only where all three are (same-signed floats do not sum
+	 * to zero): there the distance below is 0 * inf, a NaN, and fails as
+	 * wt_test's det test does */
+	__m128 out = _mm_and_ps(neg, pos); /* the lanes that miss */
+	if (_mm_movemask_ps(out) == 15)
 		return -1;
+	__m128 det = _mm_add_ps(_mm_add_ps(u, v), w);
 	__m128 tt = _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(u, az), _mm_mul_ps(v, bz)), _mm_mul_ps(w, cz)), rq->sz);
 	__m128 inv = _mm_div_ps(_mm_set1_ps(1.0f), det);
 	__m128 th = _mm_mul_ps(tt, inv);
-	ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmpgt_ps(th, _mm_set1_ps(tmin)), _mm_cmplt_ps(th, _mm_set1_ps(*best))));
+	__m128 ok = _mm_andnot_ps(out, _mm_and_ps(_mm_cmpgt_ps(th, _mm_set1_ps(tmin)), _mm_cmplt_ps(th, _mm_set1_ps(*best))));
 	unsigned hm = (unsigned)_mm_movemask_ps(ok);
 	if (!hm)
 		return -1;
