@@ -18,8 +18,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	if (m && m->ntris < 100000 && mesh_prepare(m, true, 60, &err)) {
 		/* the tree against every triangle (mesh_check.h), on small meshes */
 		mesh *raw = m->ntris <= 4096 ? mesh_parse_obj("fuzz.obj", "/nonexistent", (const char *)data, size, &err) : NULL;
-		if (raw)
-			mesh_check(raw, m, data, size);
+		char msg[256];
+		if (raw && mesh_check(raw, m, data, size, msg)) {
+			fprintf(stderr, "%s\n", msg);
+			abort();
+		}
 		mesh_free(raw);
 	}
 	mesh_free(m);

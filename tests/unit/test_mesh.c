@@ -14,6 +14,7 @@
 #include "rtsh/rtfile.h"
 #include "rtsh/texture.h"
 #include "rtsh/world.h"
+#include "../fuzz/mesh_check.h"
 
 #define MODELS "../shared/models"
 
@@ -427,6 +428,45 @@ static mesh *sphere_mesh_as(int nu, int nv, bool prepare)
 static mesh *sphere_mesh(int nu, int nv)
 {
 	return sphere_mesh_as(nu, nv, true);
+}
+
+/* The fuzz targets' check of the tree (tests/fuzz/mesh_check.h) must fire
+ * when a tree lacks a triangle a ray crosses, or has one the mesh lacks:
+ * two unit squares, at z = 0 and z = 0.5, against a tree of only the lower
+ * one (property 3), and the other way round (property 1). */
+static void test_fuzz_tree_check_has_teeth(void **state)
+{
+	(void)state;
+	const char *both = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 0.5\nv 1 0 0.5\nv 1 1 0.5\nv 0 1 0.5\n"
+	                   "f 1 2 3 4\nf 5 6 7 8\n";
+	const char *lower = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 0.5\nv 1 0 0.5\nv 1 1 0.5\nv 0 1 0.5\n"
+	                    "f 1 2 3 4\nf 1 2 3\n";
+	uint8_t data[24];
+	for (int i = 0; i < 24; i++)
+		data[i] = (uint8_t)(60 + 5 * i);
+	rt_error err;
+	mesh *raw_both = mesh_parse_obj("both.obj", ".", both, strlen(both), &err);
+	mesh *raw_lower = mesh_parse_obj("lower.obj", ".", lower, strlen(lower), &err);
+	mesh *tree_both = mesh_parse_obj("both.obj", ".", both, strlen(both), &err);
+	mesh *tree_lower = mesh_parse_obj("lower.obj", ".", lower, strlen(lower), &err);
+	assert_non_null(raw_both);
+	assert_non_null(raw_lower);
+	assert_true(tree_both && mesh_prepare(tree_both, true, 60, &err));
+	assert_true(tree_lower && mesh_prepare(tree_lower, true, 60, &err));
+	char msg[256];
+	assert_null(mesh_check(raw_both, tree_both, data, sizeof data, msg));
+	assert_null(mesh_check(raw_lower, tree_lower, data, sizeof data, msg));
+	/* the rays from the upper corners meet the upper square first */
+	const char *why = mesh_check(raw_both, tree_lower, data, sizeof data, msg);
+	assert_non_null(why);
+	assert_non_null(strstr(why, "property 3"));
+	why = mesh_check(raw_lower, tree_both, data, sizeof data, msg);
+	assert_non_null(why);
+	assert_non_null(strstr(why, "property 1"));
+	mesh_free(raw_both);
+	mesh_free(raw_lower);
+	mesh_free(tree_both);
+	mesh_free(tree_lower);
 }
 
 static void test_tree_matches_brute_force(void **state)
@@ -1025,6 +1065,7 @@ int main(void)
 		cmocka_unit_test(test_gltf_and_stl),
 		cmocka_unit_test(test_glb_embedded_texture),
 		cmocka_unit_test(test_tree_matches_brute_force),
+		cmocka_unit_test(test_fuzz_tree_check_has_teeth),
 		cmocka_unit_test(test_watertight),
 		cmocka_unit_test(test_vector_walks_match_scalar),
 		cmocka_unit_test(test_spatial_splits),
