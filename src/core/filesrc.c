@@ -145,24 +145,38 @@ static uint32_t le32(const unsigned char *p)
 
 /* A binary glTF's header and chunk lengths against the file's size: assimp
  * takes them on trust and allocates what they say (a 600-byte file asked
- * it for 4 GB: found by fuzz_model). False (err set) when one says more
- * than the file holds. */
+ * it for 4 GB; a 281-byte one whose header says 0 bytes asked for 1.5 GB
+ * in its JSON chunk: both found by fuzz_model). So the header's length
+ * must cover the 12-byte header and one chunk header and not pass the end
+ * of the file, and every chunk must end inside it. Chunks are stepped over
+ * as assimp does, their lengths rounded up to 4 bytes. glTF 1.0's binary
+ * form has one content block after a 20-byte header: its length is checked
+ * the same way. False (err set) when something says more than the file
+ * holds. */
 static bool glb_fits(const char *path, const unsigned char *b, size_t len, rt_error *err)
 {
 	if (len < 12 || le32(b) != 0x46546C67u) /* "glTF": else assimp says what it is */
 		return true;
 	uint32_t total = le32(b + 8);
-	if (total > len)
+	if (total < 20 || total > len)
 		return rt_error_set(err, "%s: byte 8: the .glb says it is %u bytes long, the file has %zu; expected a "
-		                    "complete .glb", path, total, len);
-	if (le32(b + 4) != 2)
-		return true; /* glTF 1.0's binary form: its header is checked by assimp */
-	for (size_t at = 12; at + 8 <= total;) {
+		                    "complete .glb (20 bytes at least)", path, total, len);
+	if (le32(b + 4) != 2) {
+		uint32_t n = le32(b + 12); /* glTF 1.0: contentLength */
+		if (n > total - 20)
+			return rt_error_set(err, "%s: byte 12: a .glb content of %u bytes, %u left in the file; expected "
+			                    "a complete .glb", path, n, total - 20);
+		return true;
+	}
+	for (size_t at = 12; at < total;) {
+		if (total - at < 8)
+			return rt_error_set(err, "%s: byte %zu: a .glb chunk header cut short (%zu of 8 bytes); expected a "
+			                    "complete .glb", path, at, (size_t)(total - at));
 		uint32_t n = le32(b + at);
 		if (n > total - at - 8)
 			return rt_error_set(err, "%s: byte %zu: a .glb chunk of %u bytes, %zu left in the file; expected a "
 			                    "complete .glb", path, at, n, (size_t)(total - at - 8));
-		at += 8 + (size_t)n;
+		at += 8 + (((size_t)n + 3) & ~(size_t)3);
 	}
 	return true;
 }

@@ -273,6 +273,31 @@ static void test_gltf_and_stl(void **state)
 	static const unsigned char glb2[20] = {'g', 'l', 'T', 'F', 2, 0, 0, 0, 0, 1, 0, 0};
 	expect_error(mesh_load(tmp_write("short.glb", glb2, sizeof glb2), &err), &err, "short.glb: byte 8",
 	             "says it is 256 bytes long, the file has 20");
+	/* a header that says 0 bytes, ahead of a JSON chunk of 1.5 GB in a
+	 * 36-byte file: assimp read the chunk's length alone and allocated it
+	 * (fuzz_model's slow unit, 1.7 GB and 4.6 s); the header's length
+	 * must cover a header and a chunk header, 20 bytes */
+	static const unsigned char glb3[36] = {'g', 'l', 'T', 'F', 2, 0, 0, 0, 0, 0, 0, 0,
+	                                       0x05, 0x01, 0x00, 0x5b, 'J', 'S', 'O', 'N', '{', '}'};
+	expect_error(mesh_load(tmp_write("zero.glb", glb3, sizeof glb3), &err), &err, "zero.glb: byte 8",
+	             "says it is 0 bytes long, the file has 36");
+	/* the same chunk with the header's length right: the chunk is what
+	 * does not fit, 1,526,726,917 bytes with 16 left */
+	static const unsigned char glb4[36] = {'g', 'l', 'T', 'F', 2, 0, 0, 0, 36, 0, 0, 0,
+	                                       0x05, 0x01, 0x00, 0x5b, 'J', 'S', 'O', 'N', '{', '}'};
+	expect_error(mesh_load(tmp_write("huge.glb", glb4, sizeof glb4), &err), &err, "huge.glb: byte 12",
+	             "a .glb chunk of 1526726917 bytes, 16 left");
+	/* an empty JSON chunk (8 bytes) and 4 bytes after it: a second chunk
+	 * header cut short at byte 20 */
+	static const unsigned char glb5[24] = {'g', 'l', 'T', 'F', 2, 0, 0, 0, 24, 0, 0, 0,
+	                                       0, 0, 0, 0, 'J', 'S', 'O', 'N', 1, 0, 0, 0};
+	expect_error(mesh_load(tmp_write("cut.glb", glb5, sizeof glb5), &err), &err, "cut.glb: byte 20",
+	             "chunk header cut short (4 of 8 bytes)");
+	/* glTF 1.0's binary header: a content of 4 GB in a 24-byte file */
+	static const unsigned char glb6[24] = {'g', 'l', 'T', 'F', 1, 0, 0, 0, 24, 0, 0, 0,
+	                                       0xff, 0xff, 0xff, 0xff, 0, 0, 0, 0, '{', '}', ' ', ' '};
+	expect_error(mesh_load(tmp_write("v1.glb", glb6, sizeof glb6), &err), &err, "v1.glb: byte 12",
+	             "a .glb content of 4294967295 bytes, 4 left");
 }
 
 /* --- a .glb with its texture inside --- */
