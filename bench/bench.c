@@ -57,7 +57,7 @@ typedef struct row {
 	int samples, threads, runs;
 	double seconds; /* median; < 0: none */
 	double mrays;   /* < 0: none */
-	char note[120];
+	char note[160];
 } row;
 
 static row rows[MAX_ROWS];
@@ -329,7 +329,7 @@ static double primary_pass(const world *wd, int w, int h, bool brute, long *hits
 		for (int x = 0; x < w; x++) {
 			ray r = cam_ray(&wd->cam, x + 0.5, y + 0.5, w, h);
 			n += brute ? world_intersect_brute(wd, &r, 0.0, INFINITY, &hh)
-			           : world_intersect(wd, &r, 0.0, INFINITY, &hh);
+			           : world_intersect_coherent(wd, &r, 0.0, INFINITY, &hh);
 		}
 	*hits = n;
 	return now() - t0;
@@ -914,7 +914,7 @@ static void bench_mesh(void)
 	world *wd = build(s);
 	double bytes = (double)world_memory(wd) / ntris;
 	double eps = 1e-4 * v3_len(ext);
-	double tp[MAX_RUNS], ts[MAX_RUNS], tpk[MAX_RUNS], tsk[MAX_RUNS], be[MAX_RUNS], byte_e = -1, pe[MAX_RUNS],
+	double tp[MAX_RUNS], ts[MAX_RUNS], tpk[MAX_RUNS], tpu[MAX_RUNS], tsk[MAX_RUNS], be[MAX_RUNS], byte_e = -1, pe[MAX_RUNS],
 	    se[MAX_RUNS];
 	double sink = 0; /* the kernel rows' normals, so that none is left out */
 	int ne = 0;
@@ -943,7 +943,18 @@ static void bench_mesh(void)
 		}
 		ts[i] = cpu_now() - t0;
 		/* the kernel alone, as Embree's rtcIntersect1: distance, triangle,
-		 * barycentric weights and the geometric normal (not unit) */
+		 * barycentric weights and the geometric normal (not unit); camera
+		 * rays with the coherent hint, as the renderer traces them, and
+		 * without it */
+		t0 = cpu_now();
+		for (int y = 0; y < h; y++)
+			for (int x = 0; x < w; x++) {
+				ray r = cam_ray(&wd->cam, x + 0.5, y + 0.5, w, h);
+				trace_hit th;
+				if (world_trace_coherent(wd, &r, 0.0, INFINITY, &th))
+					sink += world_trace_ng(wd, &r, &th).x;
+			}
+		tpk[i] = cpu_now() - t0;
 		t0 = cpu_now();
 		for (int y = 0; y < h; y++)
 			for (int x = 0; x < w; x++) {
@@ -952,7 +963,7 @@ static void bench_mesh(void)
 				if (world_trace(wd, &r, 0.0, INFINITY, &th))
 					sink += world_trace_ng(wd, &r, &th).x;
 			}
-		tpk[i] = cpu_now() - t0;
+		tpu[i] = cpu_now() - t0;
 		t0 = cpu_now();
 		for (long k = 0; k < nsec; k++) {
 			trace_hit th;
@@ -970,9 +981,9 @@ static void bench_mesh(void)
 	}
 	free(sr);
 	double mb = median(tb, runs), mp = median(tp, runs), ms = median(ts, runs);
-	double mpk = median(tpk, runs), msk = median(tsk, runs);
+	double mpk = median(tpk, runs), msk = median(tsk, runs), mpu = median(tpu, runs);
 	double mrp = (double)w * h / mp * 1e-6, mrs = (double)nsec / ms * 1e-6;
-	double mrpk = (double)w * h / mpk * 1e-6, mrsk = (double)nsec / msk * 1e-6;
+	double mrpk = (double)w * h / mpk * 1e-6, mrsk = (double)nsec / msk * 1e-6, mrpu = (double)w * h / mpu * 1e-6;
 	if (sink == 12345.678)
 		puts(""); /* (never: keeps the normals computed) */
 	double eb = ne ? median(be, ne) : -1, ep = ne ? median(pe, ne) : -1, es = ne ? median(se, ne) : -1;
@@ -985,8 +996,9 @@ static void bench_mesh(void)
 	r = add_row("bunny 69k tris", "tri-primary", w, h, 1, 1, runs, mpk, mrpk);
 	if (ne)
 		snprintf(r->note, sizeof r->note,
-		         "CPU time; world_trace + Ng (rtcIntersect1's output); %.0f%% hit; Embree %.2f Mrays/s: rtsh %.2fx",
-		         100.0 * hits / ((double)w * h), ep, mrpk / ep);
+		         "CPU time; world_trace_coherent + Ng; %.0f%% hit; Embree %.2f Mrays/s: "
+		         "rtsh %.2fx (world_trace, no hint: %.2f, %.2fx)",
+		         100.0 * hits / ((double)w * h), ep, mrpk / ep, mrpu, mrpu / ep);
 	r = add_row("bunny 69k tris", "tri-primary-hit", w, h, 1, 1, runs, mp, mrp);
 	if (ne)
 		snprintf(r->note, sizeof r->note,

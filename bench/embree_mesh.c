@@ -47,10 +47,14 @@ static bool monitor(void *ptr, ssize_t n, bool post)
 	return true;
 }
 
-static bool trace(RTCScene sc, vec3 o, vec3 d, float *t, vec3 *ng)
+/* coherent: camera rays in pixel order, given Embree's hint for them as
+ * rtsh's are given its own (world_trace_coherent) */
+static bool trace(RTCScene sc, vec3 o, vec3 d, float *t, vec3 *ng, bool coherent)
 {
 	struct RTCIntersectContext ctx;
 	rtcInitIntersectContext(&ctx);
+	if (coherent)
+		ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
 	struct RTCRayHit rh;
 	rh.ray.org_x = (float)o.x;
 	rh.ray.org_y = (float)o.y;
@@ -124,7 +128,7 @@ int main(int argc, char **argv)
 				ray r = cam_ray(&cv, x + 0.5, y + 0.5, w, h);
 				float t;
 				vec3 ng;
-				hits += trace(sc, r.o, r.d, &t, &ng);
+				hits += trace(sc, r.o, r.d, &t, &ng, true);
 			}
 		double tp = now() - t0;
 		tprim[pass] = tp;
@@ -136,7 +140,7 @@ int main(int argc, char **argv)
 				ray r = cam_ray(&cv, x + 0.5, y + 0.5, w, h);
 				float t;
 				vec3 ng;
-				if (!trace(sc, r.o, r.d, &t, &ng))
+				if (!trace(sc, r.o, r.d, &t, &ng, true))
 					continue;
 				vec3 n = v3_norm(ng);
 				if (v3_dot(n, r.d) > 0)
@@ -148,7 +152,7 @@ int main(int argc, char **argv)
 		for (long i = 0; i < sec_rays; i++) {
 			float t;
 			vec3 ng;
-			trace(sc, sr[i].o, sr[i].d, &t, &ng);
+			trace(sc, sr[i].o, sr[i].d, &t, &ng, false);
 		}
 		double ts = now() - t1;
 		free(sr);

@@ -196,6 +196,13 @@ bool mesh_occluded(const mesh *m, const mesh_ray *r, float tmin, float tmax);
  * so that a ray leaving its surface does not find it again. */
 bool mesh_intersect_world(const mesh *m, const double (*inv)[4], const ray *r, double tmin, double tmax, double *t,
                           uint32_t *slot, float b[3]);
+/* mesh_intersect_world for a ray whose neighbours run in nearly the same
+ * direction (camera rays, taken in pixel order): the same hit to the bit,
+ * by copies of the walk specialised for each octant of directions, faster
+ * when the octant repeats and slower when it does not (bench/README.md).
+ * Embree's "coherent" intersect context is the same kind of hint. */
+bool mesh_intersect_world_coherent(const mesh *m, const double (*inv)[4], const ray *r, double tmin, double tmax,
+                                   double *t, uint32_t *slot, float b[3]);
 bool mesh_occluded_world(const mesh *m, const double (*inv)[4], const ray *r, double tmin, double tmax);
 /* The vector unit the walk uses: AVX2 where the processor has it (one slab
  * test for a node's eight children; with AVX-512's registers where it has

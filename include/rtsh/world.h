@@ -184,6 +184,10 @@ void world_free(world *w);
 
 /* Nearest hit with tmin < t < tmax. */
 bool world_intersect(const world *w, const ray *r, double tmin, double tmax, hit *h);
+/* The same hit, for camera rays traced in pixel order: a model's walk
+ * takes its copies specialised by the direction's octant, which repeats
+ * from one camera ray to the next (mesh_intersect_world_coherent). */
+bool world_intersect_coherent(const world *w, const ray *r, double tmin, double tmax, hit *h);
 /* world_intersect in its two stages. world_trace finds the nearest hit:
  * its distance, primitive and what the primitive's test left (a shape's
  * normal in its own space; on a model, the triangle and its barycentric
@@ -199,6 +203,7 @@ typedef struct trace_hit {
 	vec3 nl;
 } trace_hit;
 bool world_trace(const world *w, const ray *r, double tmin, double tmax, trace_hit *th);
+bool world_trace_coherent(const world *w, const ray *r, double tmin, double tmax, trace_hit *th);
 void world_finish(const world *w, const ray *r, const trace_hit *th, hit *h);
 vec3 world_trace_ng(const world *w, const ray *r, const trace_hit *th);
 /* Any hit with tmin < t < tmax (shadow rays). */

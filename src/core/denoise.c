@@ -35,7 +35,7 @@ static void first_surface(const world *w, ray r, double f[7])
 	double dist = 0.0;
 	for (int k = 0;; k++) {
 		hit h;
-		if (!world_intersect(w, &r, 0.0, INFINITY, &h)) {
+		if (!(k == 0 ? world_intersect_coherent : world_intersect)(w, &r, 0.0, INFINITY, &h)) {
 			/* The sky: its own colour, no normal, no depth. */
 			f[0] += clamp01(tint.x);
 			f[1] += clamp01(tint.y);

@@ -330,7 +330,7 @@ vec3 path_radiance(const world *w, const render_settings *s, ray r, sampler *g)
 	for (int bounce = 0;; bounce++) {
 		g->dim = dim0 + 6u * (uint32_t)bounce;
 		hit h;
-		if (!world_intersect(w, &r, 0.0, INFINITY, &h)) {
+		if (!(bounce == 0 ? world_intersect_coherent : world_intersect)(w, &r, 0.0, INFINITY, &h)) {
 			vec3 bg = world_background(w, r.d, MODE_PATH);
 			if (w->env && env_from_pdf > 0.0) {
 				double pe = envmap_pdf(w->env, r.d);

@@ -15,7 +15,9 @@ bool surf_material(world *w, const object *o, uint32_t i, rt_error *err);
 /* A mesh object's primitive and world bounds. */
 bool surf_make_inst(world *w, const object *o, uint32_t i, prim *p, box *b, rt_error *err);
 /* Instance tests: the nearest hit stores (triangle, b1, b2) in *nl. */
-bool surf_inst_hit(const world *w, const prim *p, const ray *r, double tmin, double tmax, double *t, vec3 *nl);
+/* coherent: the ray is a camera ray (mesh_intersect_world_coherent) */
+bool surf_inst_hit(const world *w, const prim *p, const ray *r, double tmin, double tmax, double *t, vec3 *nl,
+                   bool coherent);
 bool surf_inst_occluded(const world *w, const prim *p, const ray *r, double tmin, double tmax);
 void surf_inst_finish(const world *w, const prim *p, const ray *r, vec3 nl, hit *h);
 /* The geometric normal of that hit in world space, not unit. */

@@ -15,10 +15,11 @@ static double schlick(double cos_i, double eta_ratio)
 	return r0 + (1.0 - r0) * x * x * x * x * x;
 }
 
-static vec3 trace(const world *w, ray r, int depth)
+/* first: r is a camera ray (world_intersect_coherent) */
+static vec3 trace(const world *w, ray r, int depth, bool first)
 {
 	hit h;
-	if (!world_intersect(w, &r, 0.0, INFINITY, &h))
+	if (!(first ? world_intersect_coherent : world_intersect)(w, &r, 0.0, INFINITY, &h))
 		return world_background(w, r.d, MODE_WHITTED);
 	const mat_lin *m = &w->mats[h.mat];
 	vec3 n = h.front ? h.n : v3_neg(h.n);
@@ -56,17 +57,17 @@ static vec3 trace(const world *w, ray r, int depth)
 		double cos_i = fmin(v3_dot(v, n), 1.0);
 		double sin2_t = eta * eta * (1.0 - cos_i * cos_i);
 		vec3 refl_dir = v3_reflect(r.d, n);
-		vec3 refl = trace(w, (ray){p, refl_dir}, depth - 1);
+		vec3 refl = trace(w, (ray){p, refl_dir}, depth - 1, false);
 		if (sin2_t >= 1.0)
 			return v3_add(c, refl); /* total internal reflection */
 		double kr = schlick(cos_i, h.front ? 1.0 / m->ior : m->ior);
 		vec3 tdir = v3_add(v3_scale(r.d, eta), v3_scale(n, eta * cos_i - sqrt(1.0 - sin2_t)));
 		vec3 q = offset_point(w, h.p, v3_neg(n));
-		vec3 trans = trace(w, (ray){q, v3_norm(tdir)}, depth - 1);
+		vec3 trans = trace(w, (ray){q, v3_norm(tdir)}, depth - 1, false);
 		return v3_add(c, v3_add(v3_scale(refl, kr), v3_scale(v3_mul(trans, albedo), 1.0 - kr)));
 	}
 	if (m->reflective > 0.0) {
-		vec3 refl = trace(w, (ray){p, v3_reflect(r.d, n)}, depth - 1);
+		vec3 refl = trace(w, (ray){p, v3_reflect(r.d, n)}, depth - 1, false);
 		if (m->metal > 0.0)
 			refl = v3_mul(refl, v3_lerp(v3(1, 1, 1), albedo, m->metal));
 		c = v3_lerp(c, refl, m->reflective);
@@ -76,5 +77,5 @@ static vec3 trace(const world *w, ray r, int depth)
 
 vec3 whitted_radiance(const world *w, const render_settings *s, ray r)
 {
-	return trace(w, r, s->depth);
+	return trace(w, r, s->depth, true);
 }

@@ -393,7 +393,7 @@ static bool other_hit(const world *w, const prim *p, const ray *r, double tmin, 
 		return tri_intersect(tr->v0, tr->e1, tr->e2, r->o, r->d, tmin, tmax, t);
 	}
 	if (p->tag == PRIM_MESH)
-		return surf_inst_hit(w, p, r, tmin, tmax, t, nl);
+		return surf_inst_hit(w, p, r, tmin, tmax, t, nl, false);
 	const prim_shape *sh = &w->shapes[p->u.index];
 	vec3 o, d;
 	to_object(sh, r, &o, &d);
@@ -415,14 +415,15 @@ static bool other_occluded(const world *w, const prim *p, const ray *r, double t
 	return shape_kinds[sh->kind]->occluded(o, d, sh->tube, tmin, tmax);
 }
 
-/* The nearest hit of one primitive in (tmin, tmax). */
+/* The nearest hit of one primitive in (tmin, tmax); coherent: r is a
+ * camera ray (world_trace_coherent). */
 static inline bool prim_hit(const world *w, const prim *p, const ray *r, double tmin, double tmax, double *t,
-                            vec3 *nl)
+                            vec3 *nl, bool coherent)
 {
 	if (p->tag == PRIM_SPHERE)
 		return sphere_hit(p, r, tmin, tmax, t);
 	if (p->tag == PRIM_MESH)
-		return surf_inst_hit(w, p, r, tmin, tmax, t, nl);
+		return surf_inst_hit(w, p, r, tmin, tmax, t, nl, coherent);
 	return other_hit(w, p, r, tmin, tmax, t, nl);
 }
 
@@ -653,7 +654,7 @@ static inline int push_hits(const bvh_node *n, unsigned m, const float tn[4], wa
 
 /* The nearest hit's primitive, distance and local data (world.h). */
 static inline __attribute__((always_inline)) bool trace(const world *w, const ray *r, double tmin, double tmax,
-                                                        trace_hit *th)
+                                                        trace_hit *th, bool coherent)
 {
 	const prim *best = NULL;
 	const prim_plane *best_plane = NULL;
@@ -669,7 +670,7 @@ static inline __attribute__((always_inline)) bool trace(const world *w, const ra
 	if (w->nprims == 1 && w->prims[0].tag == PRIM_MESH) {
 		/* a lone model (the model viewer's world): the root of its own
 		 * tree is the box test the world's would make first */
-		if (surf_inst_hit(w, &w->prims[0], r, tmin, tmax, &t, &nl)) {
+		if (surf_inst_hit(w, &w->prims[0], r, tmin, tmax, &t, &nl, coherent)) {
 			tmax = t;
 			best = &w->prims[0];
 			best_n = nl;
@@ -688,7 +689,7 @@ static inline __attribute__((always_inline)) bool trace(const world *w, const ra
 				const prim *p = &w->prims[child];
 				uint32_t count = meta & ~BVH_LEAF;
 				for (uint32_t k = 0; k < count; k++)
-					if (prim_hit(w, &p[k], r, tmin, tmax, &t, &nl)) {
+					if (prim_hit(w, &p[k], r, tmin, tmax, &t, &nl, coherent)) {
 						tmax = t;
 						ftmax = to_float_up(tmax);
 						best = &p[k];
@@ -739,7 +740,12 @@ static inline __attribute__((always_inline)) void finish(const world *w, const r
 
 bool world_trace(const world *w, const ray *r, double tmin, double tmax, trace_hit *th)
 {
-	return trace(w, r, tmin, tmax, th);
+	return trace(w, r, tmin, tmax, th, false);
+}
+
+bool world_trace_coherent(const world *w, const ray *r, double tmin, double tmax, trace_hit *th)
+{
+	return trace(w, r, tmin, tmax, th, true);
 }
 
 void world_finish(const world *w, const ray *r, const trace_hit *th, hit *h)
@@ -772,7 +778,16 @@ vec3 world_trace_ng(const world *w, const ray *r, const trace_hit *th)
 bool world_intersect(const world *w, const ray *r, double tmin, double tmax, hit *h)
 {
 	trace_hit th;
-	if (!trace(w, r, tmin, tmax, &th))
+	if (!trace(w, r, tmin, tmax, &th, false))
+		return false;
+	finish(w, r, &th, h);
+	return true;
+}
+
+bool world_intersect_coherent(const world *w, const ray *r, double tmin, double tmax, hit *h)
+{
+	trace_hit th;
+	if (!trace(w, r, tmin, tmax, &th, true))
 		return false;
 	finish(w, r, &th, h);
 	return true;
@@ -841,7 +856,7 @@ bool world_intersect_brute(const world *w, const ray *r, double tmin, double tma
 			best_plane = &w->planes[i];
 		}
 	for (size_t i = 0; i < w->nprims; i++)
-		if (prim_hit(w, &w->prims[i], r, tmin, tmax, &t, &nl)) {
+		if (prim_hit(w, &w->prims[i], r, tmin, tmax, &t, &nl, false)) {
 			tmax = t;
 			best = &w->prims[i];
 			best_n = nl;

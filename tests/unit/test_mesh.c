@@ -686,7 +686,8 @@ static void test_spatial_splits(void **state)
 /* An instance's entry (mesh_intersect_world: the world ray, the world-to-
  * model matrix) finds what the ray taken into the model's coordinates by
  * hand finds: the same triangle at the same distance (the ray's parameter
- * is the same in both spaces: the direction is not made unit). */
+ * is the same in both spaces: the direction is not made unit); and so does
+ * its coherent form, with directions in every octant. */
 static void test_world_ray_entry(void **state)
 {
 	(void)state;
@@ -716,6 +717,23 @@ static void test_world_ray_entry(void **state)
 		bool h2 = mesh_intersect_world(m, (const double(*)[4])M, &wr, 0, INFINITY, &t, &k, b);
 		assert_int_equal(h1, h2);
 		assert_int_equal(mesh_occluded_world(m, (const double(*)[4])M, &wr, 0, INFINITY), h1);
+		/* the coherent entry (the walk's copies by octant where the vector
+		 * unit has them), on every unit: the same hit to the bit */
+		for (int isa = MESH_ISA_SCALAR; isa < MESH_ISA_BEST; isa++) {
+			if (!mesh_isa_force((mesh_isa)isa))
+				continue;
+			double tc = -1;
+			uint32_t kc = UINT32_MAX;
+			float bc[3] = {0};
+			bool hc = mesh_intersect_world_coherent(m, (const double(*)[4])M, &wr, 0, INFINITY, &tc, &kc, bc);
+			assert_int_equal(hc, h1);
+			if (hc) {
+				assert_true(tc == t);
+				assert_int_equal(kc, k);
+				assert_memory_equal(bc, b, sizeof bc);
+			}
+		}
+		assert_true(mesh_isa_force(MESH_ISA_BEST));
 		if (h1) {
 			hits++;
 			assert_true(t == (double)ft);

@@ -13,13 +13,14 @@
 
 static inline __attribute__((always_inline)) WALK_TARGET bool WALK(const mesh *m, mesh_ray *r, bool leaf_ready,
                                                                    float box_tmin, float guard, float *tmax,
-                                                                   uint32_t *tri, float b[3], bool any)
+                                                                   uint32_t *tri, float b[3], bool any,
+                                                                   const size_t rn0, const size_t rn1,
+                                                                   const size_t rn2)
 {
 	const mesh_node *nodes = m->nodes;
-	/* byte offsets in a node of the near rows of each axis (the far rows
-	 * one bit away), and the ray's slab constants in registers of their
-	 * own (GCC keeps arrays of vectors on the stack) */
-	const size_t rn0 = near_row(r, 0), rn1 = near_row(r, 1), rn2 = near_row(r, 2);
+	/* rn0..rn2: byte offsets in a node of the near rows of each axis (the
+	 * far rows one bit away); the ray's slab constants in registers of
+	 * their own (GCC keeps arrays of vectors on the stack) */
 #define rf0 (rn0 ^ MESH_ROW)
 #define rf1 (rn1 ^ MESH_ROW)
 #define rf2 (rn2 ^ MESH_ROW)
