@@ -20,7 +20,8 @@
 #define HOLD_ANSWER 2.0     /* a cut answer (CSI digits, DCS) waits this long for its end */
 #define HOLD_MAX 512        /* bytes of a cut sequence held at most */
 #define SLICE_MIN 1024
-#define SLICE_FIRST 4096    /* before the link is measured */
+#define SLICE_FIRST 4096    /* the first slice, before the link is measured */
+#define SLICE_START_MAX (32u << 10) /* the largest slice before then */
 #define SLICE_MAX (4u << 20)
 #define SLICE_TIMEOUT_MIN 10.0
 #define SAMPLE_SECONDS 0.1 /* the least link time one throughput figure spans */
@@ -46,6 +47,7 @@ struct termout {
 	double last_dsr;   /* when the last slice's answer (DSR or DA1) came (0: none yet) */
 	double acc_bytes, acc_seconds; /* slices answered since the last figure */
 	double link_free;  /* when the link will have sent the slices out, at bps (estimate) */
+	size_t start_budget; /* the slice before the link is measured (0: SLICE_FIRST) */
 
 	/* Input held: an escape sequence cut at the end of a read. */
 	char hold[HOLD_MAX];
@@ -213,6 +215,16 @@ static void learn(termout *o, double now, double t, size_t bytes, bool slice)
 	}
 	if (slice)
 		o->last_dsr = now;
+	/* Not measured yet after a slice: the link took it in less than
+	 * SAMPLE_SECONDS, so the next one is twice as big (a slow start):
+	 * on a fast link, 4 KB slices one round trip apart would use a
+	 * fraction of it and take seconds to span a figure (at 1 MB/s with a
+	 * 20 ms round trip, 175 KB/s for 2.5 s); here it is measured within a
+	 * few round trips, and on a slow link after the first slice. */
+	if (slice && !(o->st.bps > 0)) {
+		size_t b = o->start_budget ? o->start_budget : SLICE_FIRST;
+		o->start_budget = b * 2 < SLICE_START_MAX ? b * 2 : SLICE_START_MAX;
+	}
 }
 
 /* An answer of kind k: the queries before the first of that kind were not
@@ -402,7 +414,7 @@ void termout_input(termout *o, const char *b, size_t n, double now, abuf *keys)
 static size_t slice_budget(const termout *o)
 {
 	if (!(o->st.bps > 0))
-		return SLICE_FIRST;
+		return o->start_budget ? o->start_budget : SLICE_FIRST;
 	double b = o->st.bps * TERMOUT_SLICE_SECONDS;
 	return b < SLICE_MIN ? SLICE_MIN : b > SLICE_MAX ? SLICE_MAX : (size_t)b;
 }
