@@ -19,7 +19,7 @@
 #   - 30 KB/s with sixel (8x16-pixel cells): every key echoes, p95 as above;
 #   - 1 MB/s, 20 ms: idle within 1 s after the render; whole pictures
 #     reach the terminal while it refines (at least 2 a second; measured
-#     8.9-9.7 since the slices grow until the link is measured: 0.0-3.8
+#     8.9-9.7 since the slices grow until the link is measured: 0.4-3.8
 #     before, 4 KB slices one round trip apart for the first 2.5 s of a
 #     2.7 s render).
 # Usage: run.sh RTSH LINKSIM. The figures go to $RTSH_TEST_RESULTS/link.txt.
