@@ -27,9 +27,10 @@ static inline __attribute__((always_inline)) WALK_TARGET bool WALK(const mesh *m
 	float best = *tmax;
 #define ROW(n, off) ((const float *)((const char *)(n)->b + (off)))
 #if WALK_ISA >= 2
-	const __m256 ox = _mm256_set1_ps(r->o[0]), oy = _mm256_set1_ps(r->o[1]), oz = _mm256_set1_ps(r->o[2]);
-	const __m256 ix = _mm256_set1_ps(r->inv[0]), iy = _mm256_set1_ps(r->inv[1]), iz = _mm256_set1_ps(r->inv[2]);
-	const __m256 t0_8 = _mm256_set1_ps(box_tmin), slack8 = _mm256_set1_ps(BVH_SLAB_SLACK);
+	__m256 ox = _mm256_set1_ps(r->o[0]), oy = _mm256_set1_ps(r->o[1]), oz = _mm256_set1_ps(r->o[2]);
+	__m256 ix = _mm256_set1_ps(r->inv[0]), iy = _mm256_set1_ps(r->inv[1]), iz = _mm256_set1_ps(r->inv[2]);
+	__m256 t0_8 = _mm256_set1_ps(box_tmin);
+	const __m256 slack8 = _mm256_set1_ps(BVH_SLAB_SLACK);
 	__m256 best8 = _mm256_set1_ps(best);
 #elif WALK_ISA == 1
 	const __m128 ox = _mm_set1_ps(r->o[0]), oy = _mm_set1_ps(r->o[1]), oz = _mm_set1_ps(r->o[2]);
@@ -147,13 +148,25 @@ static inline __attribute__((always_inline)) WALK_TARGET bool WALK(const mesh *m
 						goto done;
 				}
 			}
-			if (found) {
 #if WALK_ISA >= 2
-				best8 = _mm256_set1_ps(best);
+			/* the node tests' ray made again from memory (one broadcast
+			 * each): dead through the leaf's blocks, whose tests then
+			 * have the registers to themselves, instead of stored and
+			 * loaded around them (the empty asm: the compiler may not
+			 * keep the old values for them) */
+			__asm__("" : "+m"(*r));
+			ox = _mm256_set1_ps(r->o[0]);
+			oy = _mm256_set1_ps(r->o[1]);
+			oz = _mm256_set1_ps(r->o[2]);
+			ix = _mm256_set1_ps(r->inv[0]);
+			iy = _mm256_set1_ps(r->inv[1]);
+			iz = _mm256_set1_ps(r->inv[2]);
+			t0_8 = _mm256_set1_ps(box_tmin);
+			best8 = _mm256_set1_ps(best);
 #elif WALK_ISA == 1
+			if (found)
 				best4 = _mm_set1_ps(best);
 #endif
-			}
 		}
 	pop:
 		if (!any)
