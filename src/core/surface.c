@@ -215,24 +215,6 @@ bool surf_make_inst(world *w, const object *o, uint32_t index, prim *p, box *b, 
 	return true;
 }
 
-bool surf_inst_hit(const world *w, const prim *p, const ray *r, double tmin, double tmax, double *t, vec3 *nl,
-                   bool coherent)
-{
-	const prim_inst *in = &w->insts[p->u.index];
-	uint32_t slot;
-	float b[3];
-	if (!(coherent ? mesh_intersect_world_coherent : mesh_intersect_world)(in->mesh, in->inv, r, tmin, tmax, t, &slot,
-	                                                                       b))
-		return false;
-	*nl = v3((double)slot, b[1], b[2]);
-	return true;
-}
-
-bool surf_inst_occluded(const world *w, const prim *p, const ray *r, double tmin, double tmax)
-{
-	const prim_inst *in = &w->insts[p->u.index];
-	return mesh_occluded_world(in->mesh, in->inv, r, tmin, tmax);
-}
 
 /* --- textures at the hit --- */
 
