@@ -48,6 +48,7 @@ struct termout {
 	double acc_bytes, acc_seconds; /* slices answered since the last figure */
 	double link_free;  /* when the link will have sent the slices out, at bps (estimate) */
 	size_t start_budget; /* the slice before the link is measured (0: SLICE_FIRST) */
+	double last_slice_seconds; /* the link time of the last slice answered */
 
 	/* Input held: an escape sequence cut at the end of a read. */
 	char hold[HOLD_MAX];
@@ -207,6 +208,7 @@ static void learn(termout *o, double now, double t, size_t bytes, bool slice)
 			d = now - o->last_dsr;
 		o->acc_bytes += (double)bytes;
 		o->acc_seconds += d > 0 ? d : 0;
+		o->last_slice_seconds = d > 0 ? d : 0;
 		if (o->acc_seconds >= SAMPLE_SECONDS) {
 			double bps = o->acc_bytes / o->acc_seconds;
 			o->st.bps = o->st.bps > 0 ? 0.6 * o->st.bps + 0.4 * bps : bps;
@@ -220,8 +222,10 @@ static void learn(termout *o, double now, double t, size_t bytes, bool slice)
 	 * on a fast link, 4 KB slices one round trip apart would use a
 	 * fraction of it and take seconds to span a figure (at 1 MB/s with a
 	 * 20 ms round trip, 175 KB/s for 2.5 s); here it is measured within a
-	 * few round trips, and on a slow link after the first slice. */
-	if (slice && !(o->st.bps > 0)) {
+	 * few round trips, and on a slow link after the first slice. Twice
+	 * as big only while that takes at most SAMPLE_SECONDS of link, so a
+	 * key typed meanwhile never waits behind more than that. */
+	if (slice && !(o->st.bps > 0) && 2 * o->last_slice_seconds <= SAMPLE_SECONDS) {
 		size_t b = o->start_budget ? o->start_budget : SLICE_FIRST;
 		o->start_budget = b * 2 < SLICE_START_MAX ? b * 2 : SLICE_START_MAX;
 	}

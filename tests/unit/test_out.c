@@ -323,6 +323,7 @@ typedef struct sim_result {
 	                    * (once the link is measured) */
 	long slices;
 	double measured_in; /* seconds from the first slice to the first figure (-1: never) */
+	double start_slice; /* the most link time of one slice before that figure */
 } sim_result;
 
 static sim_result simulate(double rate, double rtt, double read_every, double seconds, double probe_late)
@@ -384,6 +385,8 @@ static sim_result simulate(double rate, double rtt, double read_every, double se
 			if (measured && q > r.max_queue)
 				r.max_queue = q;
 			answers[qn++] = busy_until + rtt; /* kinds[qn] set above */
+			if (!measured && (double)n / rate > r.start_slice)
+				r.start_slice = (double)n / rate;
 			carried += (double)n;
 			r.slices++;
 		}
@@ -409,16 +412,17 @@ static void test_pipelined_slices(void **state)
 	(void)state;
 	/* 30 KB/s and 100 ms; the same with answers read in bunches; 1 MB/s and
 	 * 20 ms with the start-up answer read 0.3 s late (the round trip is
-	 * then first overestimated 15 times). */
+	 * then first overestimated 15 times); 45 KB/s, where the first slice
+	 * is just short of a figure. */
 	const struct {
 		double rate, rtt, read_every, probe_late;
-	} cases[] = {{30000, 0.1, 0.001, 0}, {30000, 0.1, 0.03, 0}, {1e6, 0.02, 0.001, 0.3}};
-	for (int k = 0; k < 3; k++) {
+	} cases[] = {{30000, 0.1, 0.001, 0}, {30000, 0.1, 0.03, 0}, {1e6, 0.02, 0.001, 0.3}, {45000, 0.1, 0.001, 0}};
+	for (int k = 0; k < 4; k++) {
 		double rate = cases[k].rate;
 		sim_result r = simulate(rate, cases[k].rtt, cases[k].read_every, 6.0, cases[k].probe_late);
 		print_message("%.0f B/s, read every %.3f s: bps %.0f, link used %.2f, queue max %.3f s, %ld slices, "
-		              "measured %.3f s after the first\n",
-		              rate, cases[k].read_every, r.bps, r.util, r.max_queue, r.slices, r.measured_in);
+		              "measured %.3f s after the first, start-up slices at most %.3f s\n",
+		              rate, cases[k].read_every, r.bps, r.util, r.max_queue, r.slices, r.measured_in, r.start_slice);
 		assert_true(r.bps > 0.85 * rate && r.bps < 1.2 * rate);
 		assert_true(r.util > 0.85);
 		/* measured within a few round trips of the first slice, by the
@@ -427,6 +431,12 @@ static void test_pipelined_slices(void **state)
 		 * (0.12 s); the first slice alone spans a figure at 30 KB/s (4 KB
 		 * take 0.137 s), after its round trip (0.1 s) */
 		assert_true(r.measured_in >= 0 && r.measured_in < 0.5);
+		/* and the slices grow only while they take at most 0.1 s of link
+		 * (the figure's span): at 45 KB/s the first 4 KB take 0.091 s, so
+		 * the next is 4 KB again, not 8 (0.18 s ahead of a key); the first
+		 * is 4 KB whatever the link (0.137 s at 30 KB/s) */
+		double first_slice = 4096 / rate;
+		assert_true(r.start_slice <= (first_slice > 0.1 ? first_slice : 0.1) + 16 * 40 / rate);
 		/* the queue, the slice just written, and what one row's run may
 		 * add past the budget (16 cells of about 40 bytes) */
 		assert_true(r.max_queue <= TERMOUT_QUEUE_SECONDS + TERMOUT_SLICE_SECONDS + 16 * 40 / rate + 0.02);
