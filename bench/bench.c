@@ -875,6 +875,21 @@ static void bench_mesh_load(void)
 	unlink(path);
 }
 
+/* The camera rays through the kernel (world_trace + Ng, what Embree's
+ * rtcIntersect1 returns), with the coherent hint or without: CPU time. */
+static double kernel_primary(const world *wd, int w, int h, bool coherent, double *sink)
+{
+	double t0 = cpu_now();
+	for (int y = 0; y < h; y++)
+		for (int x = 0; x < w; x++) {
+			ray r = cam_ray(&wd->cam, x + 0.5, y + 0.5, w, h);
+			trace_hit th;
+			if ((coherent ? world_trace_coherent : world_trace)(wd, &r, 0.0, INFINITY, &th))
+				*sink += world_trace_ng(wd, &r, &th).x;
+		}
+	return cpu_now() - t0;
+}
+
 static void bench_mesh(void)
 {
 	bench_mesh_load();
@@ -946,24 +961,8 @@ static void bench_mesh(void)
 		 * barycentric weights and the geometric normal (not unit); camera
 		 * rays with the coherent hint, as the renderer traces them, and
 		 * without it */
-		t0 = cpu_now();
-		for (int y = 0; y < h; y++)
-			for (int x = 0; x < w; x++) {
-				ray r = cam_ray(&wd->cam, x + 0.5, y + 0.5, w, h);
-				trace_hit th;
-				if (world_trace_coherent(wd, &r, 0.0, INFINITY, &th))
-					sink += world_trace_ng(wd, &r, &th).x;
-			}
-		tpk[i] = cpu_now() - t0;
-		t0 = cpu_now();
-		for (int y = 0; y < h; y++)
-			for (int x = 0; x < w; x++) {
-				ray r = cam_ray(&wd->cam, x + 0.5, y + 0.5, w, h);
-				trace_hit th;
-				if (world_trace(wd, &r, 0.0, INFINITY, &th))
-					sink += world_trace_ng(wd, &r, &th).x;
-			}
-		tpu[i] = cpu_now() - t0;
+		tpk[i] = kernel_primary(wd, w, h, true, &sink);
+		tpu[i] = kernel_primary(wd, w, h, false, &sink);
 		t0 = cpu_now();
 		for (long k = 0; k < nsec; k++) {
 			trace_hit th;

@@ -47,7 +47,7 @@ struct termout {
 	double last_dsr;   /* when the last slice's answer (DSR or DA1) came (0: none yet) */
 	double acc_bytes, acc_seconds; /* slices answered since the last figure */
 	double link_free;  /* when the link will have sent the slices out, at bps (estimate) */
-	size_t start_budget; /* the slice before the link is measured (0: SLICE_FIRST) */
+	size_t start_budget; /* the slice before the link is measured */
 	double last_slice_seconds; /* the link time of the last slice answered */
 
 	/* Input held: an escape sequence cut at the end of a read. */
@@ -71,6 +71,7 @@ termout *termout_new(int fd)
 	if (!o)
 		return NULL;
 	o->fd = fd;
+	o->start_budget = SLICE_FIRST;
 	o->state = TERMOUT_IDLE;
 	o->final = true;
 	abuf_init(&o->buf);
@@ -226,8 +227,8 @@ static void learn(termout *o, double now, double t, size_t bytes, bool slice)
 	 * as big only while that takes at most SAMPLE_SECONDS of link, so a
 	 * key typed meanwhile never waits behind more than that. */
 	if (slice && !(o->st.bps > 0) && 2 * o->last_slice_seconds <= SAMPLE_SECONDS) {
-		size_t b = o->start_budget ? o->start_budget : SLICE_FIRST;
-		o->start_budget = b * 2 < SLICE_START_MAX ? b * 2 : SLICE_START_MAX;
+		size_t b = o->start_budget * 2;
+		o->start_budget = b < SLICE_START_MAX ? b : SLICE_START_MAX;
 	}
 }
 
@@ -418,7 +419,7 @@ void termout_input(termout *o, const char *b, size_t n, double now, abuf *keys)
 static size_t slice_budget(const termout *o)
 {
 	if (!(o->st.bps > 0))
-		return o->start_budget ? o->start_budget : SLICE_FIRST;
+		return o->start_budget;
 	double b = o->st.bps * TERMOUT_SLICE_SECONDS;
 	return b < SLICE_MIN ? SLICE_MIN : b > SLICE_MAX ? SLICE_MAX : (size_t)b;
 }

@@ -410,20 +410,10 @@ _Thread_local unsigned long mesh_stat_nodes, mesh_stat_blocks, mesh_stat_leaves;
 		return walk(m, r, leaf_ready, tmin, guard, tmax, tri, b, any, near_row(r, 0), near_row(r, 1),       \
 		            near_row(r, 2));                                                                         \
 	}
-WALK_BY_RAY(walk_scalar_r, walk_scalar, )
-#if defined(__SSE2__)
-WALK_BY_RAY(walk_sse_r, walk_sse, )
-#endif
-#if defined(HAVE_AVX2_WALK)
-WALK_BY_RAY(walk_avx2_r, walk_avx2, AVX2)
-WALK_BY_RAY(walk_avx512_r, walk_avx512, AVX512)
-WALK_BY_OCTANT(walk_avx2_o, walk_avx2, AVX2)
-WALK_BY_OCTANT(walk_avx512_o, walk_avx512, AVX512)
-#endif
 
 /* A world ray on an instance (M: world to model) for the walk `walk`. */
 #define WALK_WORLD(name, walk, target)                                                                              \
-	static target inline __attribute__((always_inline)) bool name(     const mesh *m, const double (*M)[4],     \
+	static target inline __attribute__((always_inline)) bool name(const mesh *m, const double (*M)[4],          \
 	                                                                     const ray *wr, double tmin, double tmax, \
 	                                                                     double *t, uint32_t *slot, float b[3],   \
 	                                                                     bool any)                                \
@@ -451,12 +441,13 @@ WALK_BY_OCTANT(walk_avx512_o, walk_avx512, AVX512)
  * the model's rounding (m->eps in the model's units, made the ray's at the
  * first leaf); the boxes from the caller's tmin, which is no larger (they
  * are visited a little more, never less). */
-#define WALK_ENTRIES(isa, walk, target)                                                                             \
+#define WALK_ENTRIES(isa, walk0, target)                                                                            \
+	WALK_BY_RAY(isa##_walk, walk0, target)                                                                       \
 	static target __attribute__((noinline)) bool isa##_hit(const mesh *m, const mesh_ray *r, float tmin,           \
 	                                                       float *tmax, uint32_t *tri, float b[3])                \
 	{                                                                                                             \
 		mesh_ray lr = *r;                                                                                     \
-		return walk(m, &lr, true, tmin, 0, tmax, tri, b, false);                                              \
+		return isa##_walk(m, &lr, true, tmin, 0, tmax, tri, b, false);                                              \
 	}                                                                                                             \
 	static target __attribute__((noinline)) bool isa##_any(const mesh *m, const mesh_ray *r, float tmin,           \
 	                                                       float tmax)                                            \
@@ -464,9 +455,9 @@ WALK_BY_OCTANT(walk_avx512_o, walk_avx512, AVX512)
 		uint32_t tri;                                                                                         \
 		float b[3];                                                                                           \
 		mesh_ray lr = *r;                                                                                     \
-		return walk(m, &lr, true, tmin, 0, &tmax, &tri, b, true);                                             \
+		return isa##_walk(m, &lr, true, tmin, 0, &tmax, &tri, b, true);                                             \
 	}                                                                                                             \
-	WALK_WORLD(isa##_world, walk, target)                                                                        \
+	WALK_WORLD(isa##_world, isa##_walk, target)                                                                        \
 	static target __attribute__((noinline)) bool isa##_hit_world(const mesh *m, const double (*M)[4],             \
 	                                                             const ray *wr, double tmin, double tmax,         \
 	                                                             double *t, uint32_t *slot, float b[3])           \
@@ -484,8 +475,9 @@ WALK_BY_OCTANT(walk_avx512_o, walk_avx512, AVX512)
 
 /* The coherent entry (mesh_intersect_world_coherent): the copies of the
  * walk by octant where the vector unit has them. */
-#define WALK_COHERENT(isa, walk, target)                                                                            \
-	WALK_WORLD(isa##_world_o, walk, target)                                                                      \
+#define WALK_COHERENT(isa, walk0, target)                                                                           \
+	WALK_BY_OCTANT(isa##_walk_o, walk0, target)                                                                  \
+	WALK_WORLD(isa##_world_o, isa##_walk_o, target)                                                              \
 	static target __attribute__((noinline)) bool isa##_hit_world_coherent(const mesh *m, const double (*M)[4],    \
 	                                                                      const ray *wr, double tmin,             \
 	                                                                      double tmax, double *t,                 \
@@ -504,15 +496,15 @@ typedef struct walker {
 	                           double *t, uint32_t *slot, float b[3]);
 } walker;
 
-WALK_ENTRIES(scalar, walk_scalar_r, )
+WALK_ENTRIES(scalar, walk_scalar, )
 #if defined(__SSE2__)
-WALK_ENTRIES(sse, walk_sse_r, )
+WALK_ENTRIES(sse, walk_sse, )
 #endif
 #if defined(HAVE_AVX2_WALK)
-WALK_ENTRIES(avx2, walk_avx2_r, AVX2)
-WALK_ENTRIES(avx512, walk_avx512_r, AVX512)
-WALK_COHERENT(avx2, walk_avx2_o, AVX2)
-WALK_COHERENT(avx512, walk_avx512_o, AVX512)
+WALK_ENTRIES(avx2, walk_avx2, AVX2)
+WALK_ENTRIES(avx512, walk_avx512, AVX512)
+WALK_COHERENT(avx2, walk_avx2, AVX2)
+WALK_COHERENT(avx512, walk_avx512, AVX512)
 #endif
 
 static const walker walkers[MESH_ISA_BEST] = {
