@@ -305,6 +305,17 @@ static inline __attribute__((always_inline)) size_t near_row(const mesh_ray *r, 
 	return (size_t)(MESH_LO(a) + neg) * MESH_ROW;
 }
 
+/* Asks for the node or leaf blocks that ref names, to be in the cache when
+ * the walk pops it. */
+static inline __attribute__((always_inline)) void prefetch_ref(const mesh *m, uint32_t ref)
+{
+	const char *a = ref & MESH_LEAF ? (const char *)&m->blk[ref & (MESH_MAX_BLOCKS - 1)] : (const char *)&m->nodes[ref];
+	__builtin_prefetch(a);
+	__builtin_prefetch(a + 64);
+	__builtin_prefetch(a + 128);
+	__builtin_prefetch(a + 192);
+}
+
 /* Pushes the children of n in mask hm (at least two) with their entry
  * distances, nearest on top, and returns the nearest, popped. */
 static inline __attribute__((always_inline)) uint32_t push_sorted(const mesh_node *n, unsigned hm, const float *tn,

@@ -113,6 +113,7 @@ static inline __attribute__((always_inline)) WALK_TARGET bool WALK(const mesh *m
 				continue;
 			}
 			ref = push_sorted(n, hm, tn, stack, &sp);
+			prefetch_ref(m, stack[sp - 1].ref);
 		}
 		{
 			/* a leaf: its blocks */
