@@ -52,7 +52,9 @@ typedef struct mesh_tri4 {
  * boxes b[row][k] as floats rounded outward (rows MESH_LO(axis) and
  * MESH_HI(axis): low x, high x, low y, high y, low z, high z, so that a
  * ray's far row is its near row's neighbour, one bit apart), and a
- * reference each: an inner node's index, or
+ * reference each: an inner node's byte offset in the node array (the walk
+ * adds it to the array's address: no multiply between a child's reference
+ * and its loads), or
  * MESH_LEAF | (blocks - 1) << MESH_LEAF_SHIFT | the leaf's first block.
  * An unused child has an empty box (lo = +inf, hi = -inf). 224 bytes: four
  * cache lines, read by one AVX2 slab test or two SSE ones. */
@@ -67,6 +69,8 @@ typedef struct mesh_node {
 	_Alignas(32) float b[6][MESH_WIDTH];
 	uint32_t child[MESH_WIDTH];
 } mesh_node;
+/* Nodes a tree may have: their byte offsets stay below MESH_LEAF. */
+#define MESH_MAX_NODES (MESH_LEAF / sizeof(mesh_node))
 
 typedef struct mesh {
 	char *path;

@@ -309,7 +309,7 @@ static inline __attribute__((always_inline)) size_t near_row(const mesh_ray *r, 
  * the walk pops it. */
 static inline __attribute__((always_inline)) void prefetch_ref(const mesh *m, uint32_t ref)
 {
-	const char *a = ref & MESH_LEAF ? (const char *)&m->blk[ref & (MESH_MAX_BLOCKS - 1)] : (const char *)&m->nodes[ref];
+	const char *a = ref & MESH_LEAF ? (const char *)&m->blk[ref & (MESH_MAX_BLOCKS - 1)] : (const char *)m->nodes + ref;
 	__builtin_prefetch(a);
 	__builtin_prefetch(a + 64);
 	__builtin_prefetch(a + 128);

@@ -130,6 +130,7 @@ typedef struct emitter_state {
 	mesh *m;
 	const bvh2 *t;
 	uint32_t nodes, blocks;
+	bool too_many; /* more nodes than MESH_MAX_NODES */
 } emitter_state;
 
 static void empty_child(mesh_node *n, int k)
@@ -174,6 +175,8 @@ static uint32_t emit_node(emitter_state *e, uint32_t n2)
 	bvh_slot s[MESH_WIDTH];
 	int cnt = bvh2_gather(e->t, n2, MESH_WIDTH, s);
 	uint32_t ni = e->nodes++;
+	if (ni >= MESH_MAX_NODES)
+		e->too_many = true; /* (its offset would read as a leaf: reported when done) */
 	mesh_node *n = &e->m->nodes[ni];
 	for (int k = cnt; k < MESH_WIDTH; k++)
 		empty_child(n, k);
@@ -187,7 +190,7 @@ static uint32_t emit_node(emitter_state *e, uint32_t n2)
 		uint32_t ref = s[k].meta ? emit_leaf(e, s[k].child, count) : emit_node(e, s[k].child);
 		e->m->nodes[ni].child[k] = ref; /* (no pointer kept across the recursion) */
 	}
-	return ni;
+	return (uint32_t)(ni * sizeof(mesh_node));
 }
 
 /* Blocks a leaf of `count` references takes. */
@@ -234,7 +237,7 @@ bool mesh_build_tree(mesh *m, rt_error *err)
 		bvh2_free(&t);
 		return rt_error_set(err, "%s: out of memory building the triangle tree", m->path);
 	}
-	emitter_state e = {m, &t, 0, 0};
+	emitter_state e = {m, &t, 0, 0, false};
 	if (t.root_meta) {
 		/* one leaf (or none): a root node that holds it alone */
 		mesh_node *n = &m->nodes[e.nodes++];
@@ -251,6 +254,8 @@ bool mesh_build_tree(mesh *m, rt_error *err)
 	m->nblk = e.blocks;
 	m->nrefs = (uint32_t)t.nrefs;
 	bvh2_free(&t);
+	if (e.too_many)
+		return rt_error_set(err, "%s: too many triangles (%u) for one model's tree", m->path, m->ntris);
 	if (m->nnodes < nn) {
 		mesh_node *fit = aligned_alloc(64, (m->nnodes * sizeof *fit + 63) / 64 * 64);
 		if (fit) {

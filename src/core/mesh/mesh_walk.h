@@ -51,7 +51,7 @@ static inline __attribute__((always_inline)) WALK_TARGET bool WALK(const mesh *m
 	uint32_t ref = 0; /* the root node */
 	for (;;) {
 		while (!(ref & MESH_LEAF)) {
-			const mesh_node *n = &nodes[ref];
+			const mesh_node *n = (const mesh_node *)((const char *)nodes + ref);
 			_Alignas(32) float tn[MESH_WIDTH];
 #ifdef MESH_STATS
 			mesh_stat_nodes++;
