@@ -4,9 +4,9 @@
  * precision. A node's eight slab tests run at once in one AVX2 register
  * (built twice: for AVX2, and with AVX-512's 32 registers), or two SSE2
  * ones, or one by one in scalar code; the far distances are
- * widened by 1 + 2 gamma(3) (Ize, "Robust BVH ray traversal", JCGT 2013)
- * and so is the nearest hit where the walk prunes, so no box the ray
- * enters is skipped. The walk goes to the nearest child the ray enters and
+ * widened by 1 + 2 gamma(3) (Ize, "Robust BVH ray traversal", JCGT 2013;
+ * through the reciprocal of the direction, mesh_walk.h) and so is the
+ * nearest hit where the walk prunes, so no box the ray enters is skipped. The walk goes to the nearest child the ray enters and
  * keeps the others on a stack with their entry distances, nearest on top.
  *
  * Triangles are tested watertight (Woop, Benthin & Wald, "Watertight

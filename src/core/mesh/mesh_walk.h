@@ -29,14 +29,26 @@ static inline __attribute__((always_inline)) WALK_TARGET bool WALK(const mesh *m
 #if WALK_ISA >= 2
 	__m256 ox = _mm256_set1_ps(r->o[0]), oy = _mm256_set1_ps(r->o[1]), oz = _mm256_set1_ps(r->o[2]);
 	__m256 ix = _mm256_set1_ps(r->inv[0]), iy = _mm256_set1_ps(r->inv[1]), iz = _mm256_set1_ps(r->inv[2]);
-	__m256 t0_8 = _mm256_set1_ps(box_tmin);
+	/* The far distances widened by BVH_SLAB_SLACK (Ize) through the
+	 * reciprocal, fx = inv * S, not each distance, so that no multiply is
+	 * left between a node's far planes and its test. As safe: inv is
+	 * common to both sides, so a near distance (b - o) * inv is at most
+	 * exact * (1 + eps)^2 and a far one at least exact * S * (1 - eps)^3
+	 * (the difference, inv * S, the product), and S = 1 + 2 gamma(3)
+	 * exceeds (1 + eps)^2 / (1 - eps)^3 = 1 + 5 eps + O(eps^2). The
+	 * nearest hit, where the walk prunes, is widened once per leaf. Every
+	 * unit does the same: the same boxes, the same hits. */
 	const __m256 slack8 = _mm256_set1_ps(BVH_SLAB_SLACK);
-	__m256 best8 = _mm256_set1_ps(best);
+	__m256 fx = _mm256_mul_ps(ix, slack8), fy = _mm256_mul_ps(iy, slack8), fz = _mm256_mul_ps(iz, slack8);
+	__m256 t0_8 = _mm256_set1_ps(box_tmin);
+	__m256 best8 = _mm256_set1_ps(best * BVH_SLAB_SLACK);
 #elif WALK_ISA == 1
 	const __m128 ox = _mm_set1_ps(r->o[0]), oy = _mm_set1_ps(r->o[1]), oz = _mm_set1_ps(r->o[2]);
 	const __m128 ix = _mm_set1_ps(r->inv[0]), iy = _mm_set1_ps(r->inv[1]), iz = _mm_set1_ps(r->inv[2]);
-	const __m128 t0_4 = _mm_set1_ps(box_tmin), slack4 = _mm_set1_ps(BVH_SLAB_SLACK);
-	__m128 best4 = _mm_set1_ps(best);
+	const __m128 slack4 = _mm_set1_ps(BVH_SLAB_SLACK);
+	const __m128 fx = _mm_mul_ps(ix, slack4), fy = _mm_mul_ps(iy, slack4), fz = _mm_mul_ps(iz, slack4);
+	const __m128 t0_4 = _mm_set1_ps(box_tmin);
+	__m128 best4 = _mm_set1_ps(best * BVH_SLAB_SLACK);
 #endif
 	float tmin = box_tmin; /* the triangles' (raised at the first leaf) */
 #if WALK_ISA >= 1
@@ -61,39 +73,39 @@ static inline __attribute__((always_inline)) WALK_TARGET bool WALK(const mesh *m
 			{
 				/* max(x, acc) and min(x, acc) return acc when x is NaN */
 				__m256 t0 = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(ROW(n, rn0)), ox), ix), t0_8);
-				__m256 t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(ROW(n, rf0)), ox), ix), best8);
+				__m256 t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(ROW(n, rf0)), ox), fx), best8);
 				t0 = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(ROW(n, rn1)), oy), iy), t0);
-				t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(ROW(n, rf1)), oy), iy), t1);
+				t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(ROW(n, rf1)), oy), fy), t1);
 				t0 = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(ROW(n, rn2)), oz), iz), t0);
-				t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(ROW(n, rf2)), oz), iz), t1);
+				t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(ROW(n, rf2)), oz), fz), t1);
 				_mm256_store_ps(tn, t0);
-				hm = (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(t0, _mm256_mul_ps(t1, slack8), _CMP_LE_OQ));
+				hm = (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ));
 			}
 #elif WALK_ISA == 1
 			hm = 0;
 			for (int h = 0; h < 2; h++) {
 				__m128 t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(ROW(n, rn0) + 4 * h), ox), ix), t0_4);
-				__m128 t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(ROW(n, rf0) + 4 * h), ox), ix), best4);
+				__m128 t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(ROW(n, rf0) + 4 * h), ox), fx), best4);
 				t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(ROW(n, rn1) + 4 * h), oy), iy), t0);
-				t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(ROW(n, rf1) + 4 * h), oy), iy), t1);
+				t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(ROW(n, rf1) + 4 * h), oy), fy), t1);
 				t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(ROW(n, rn2) + 4 * h), oz), iz), t0);
-				t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(ROW(n, rf2) + 4 * h), oz), iz), t1);
+				t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(ROW(n, rf2) + 4 * h), oz), fz), t1);
 				_mm_store_ps(&tn[4 * h], t0);
-				hm |= (unsigned)_mm_movemask_ps(_mm_cmple_ps(t0, _mm_mul_ps(t1, slack4))) << (4 * h);
+				hm |= (unsigned)_mm_movemask_ps(_mm_cmple_ps(t0, t1)) << (4 * h);
 			}
 #else
 			hm = 0;
 			for (int k = 0; k < MESH_WIDTH; k++) {
-				float t0 = box_tmin, t1 = best;
+				float t0 = box_tmin, t1 = best * BVH_SLAB_SLACK;
 				const size_t rn[3] = {rn0, rn1, rn2}, rf[3] = {rf0, rf1, rf2};
 				for (int a = 0; a < 3; a++) {
 					float tnear = (ROW(n, rn[a])[k] - r->o[a]) * r->inv[a];
-					float tfar = (ROW(n, rf[a])[k] - r->o[a]) * r->inv[a];
+					float tfar = (ROW(n, rf[a])[k] - r->o[a]) * (r->inv[a] * BVH_SLAB_SLACK);
 					t0 = tnear > t0 ? tnear : t0;
 					t1 = tfar < t1 ? tfar : t1;
 				}
 				tn[k] = t0;
-				hm |= (unsigned)(t0 <= t1 * BVH_SLAB_SLACK) << k;
+				hm |= (unsigned)(t0 <= t1) << k;
 			}
 #endif
 			if (!hm)
@@ -162,11 +174,14 @@ static inline __attribute__((always_inline)) WALK_TARGET bool WALK(const mesh *m
 			ix = _mm256_set1_ps(r->inv[0]);
 			iy = _mm256_set1_ps(r->inv[1]);
 			iz = _mm256_set1_ps(r->inv[2]);
+			fx = _mm256_mul_ps(ix, slack8);
+			fy = _mm256_mul_ps(iy, slack8);
+			fz = _mm256_mul_ps(iz, slack8);
 			t0_8 = _mm256_set1_ps(box_tmin);
-			best8 = _mm256_set1_ps(best);
+			best8 = _mm256_set1_ps(best * BVH_SLAB_SLACK);
 #elif WALK_ISA == 1
 			if (found)
-				best4 = _mm_set1_ps(best);
+				best4 = _mm_set1_ps(best * BVH_SLAB_SLACK);
 #endif
 		}
 	pop:
