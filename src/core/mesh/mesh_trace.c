@@ -426,7 +426,8 @@ _Thread_local unsigned long mesh_stat_nodes, mesh_stat_blocks, mesh_stat_leaves;
 /* A world ray on an instance (M: world to model) for the walk `walk`. An
  * instance that is not turned (an upright model: M scales and moves only)
  * skips M's zeros, 24 of its 33 operations: the same floats but for the
- * sign of a zero coordinate, on every unit (camera rays +6%, bench/README.md). */
+ * sign of a zero coordinate, on every unit (camera rays +7%, diffuse +2%:
+ * bench/README.md). */
 #define WALK_WORLD(name, walk, target)                                                                              \
 	static target inline __attribute__((always_inline)) bool name(const mesh *m, const double (*M)[4],          \
 	                                                                     const ray *wr, double tmin, double tmax, \
