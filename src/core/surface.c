@@ -215,7 +215,6 @@ bool surf_make_inst(world *w, const object *o, uint32_t index, prim *p, box *b, 
 	return true;
 }
 
-
 /* --- textures at the hit --- */
 
 static double luminance(vec3 c)

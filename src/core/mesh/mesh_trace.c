@@ -6,8 +6,9 @@
  * ones, or one by one in scalar code; the far distances are
  * widened by 1 + 2 gamma(3) (Ize, "Robust BVH ray traversal", JCGT 2013;
  * through the reciprocal of the direction, mesh_walk.h) and so is the
- * nearest hit where the walk prunes, so no box the ray enters is skipped. The walk goes to the nearest child the ray enters and
- * keeps the others on a stack with their entry distances, nearest on top.
+ * nearest hit where the walk prunes, so no box the ray enters is skipped.
+ * The walk goes to the nearest child the ray enters and keeps the others
+ * on a stack with their entry distances, nearest on top.
  *
  * Triangles are tested watertight (Woop, Benthin & Wald, "Watertight
  * ray/triangle intersection", JCGT 2013): the ray is sheared so it runs

@@ -49,6 +49,8 @@ static inline __attribute__((always_inline)) WALK_TARGET bool WALK(const mesh *m
 	const __m128 fx = _mm_mul_ps(ix, slack4), fy = _mm_mul_ps(iy, slack4), fz = _mm_mul_ps(iz, slack4);
 	const __m128 t0_4 = _mm_set1_ps(box_tmin);
 	__m128 best4 = _mm_set1_ps(best * BVH_SLAB_SLACK);
+#else
+	const float invf[3] = {r->inv[0] * BVH_SLAB_SLACK, r->inv[1] * BVH_SLAB_SLACK, r->inv[2] * BVH_SLAB_SLACK};
 #endif
 	float tmin = box_tmin; /* the triangles' (raised at the first leaf) */
 #if WALK_ISA >= 1
@@ -95,12 +97,13 @@ static inline __attribute__((always_inline)) WALK_TARGET bool WALK(const mesh *m
 			}
 #else
 			hm = 0;
+			const float best_far = best * BVH_SLAB_SLACK;
 			for (int k = 0; k < MESH_WIDTH; k++) {
-				float t0 = box_tmin, t1 = best * BVH_SLAB_SLACK;
+				float t0 = box_tmin, t1 = best_far;
 				const size_t rn[3] = {rn0, rn1, rn2}, rf[3] = {rf0, rf1, rf2};
 				for (int a = 0; a < 3; a++) {
 					float tnear = (ROW(n, rn[a])[k] - r->o[a]) * r->inv[a];
-					float tfar = (ROW(n, rf[a])[k] - r->o[a]) * (r->inv[a] * BVH_SLAB_SLACK);
+					float tfar = (ROW(n, rf[a])[k] - r->o[a]) * invf[a];
 					t0 = tnear > t0 ? tnear : t0;
 					t1 = tfar < t1 ? tfar : t1;
 				}
