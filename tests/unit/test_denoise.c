@@ -347,7 +347,11 @@ static void set_pixel(framebuffer *fb, int i, float r, float g, float b)
 	fb->rgb[i * 3 + 1] = g;
 	fb->rgb[i * 3 + 2] = b;
 	double l = 0.2126 * r + 0.7152 * g + 0.0722 * b;
-	fb->feat[(size_t)i * DENOISE_FEATURES + 7] = (float)(l * l);
+	float *f = fb->feat + (size_t)i * DENOISE_FEATURES;
+	f[7] = f[13] = (float)(l * l);
+	f[10] = r; /* the even samples are the same as all of them */
+	f[11] = g;
+	f[12] = b;
 }
 
 /* Without noise nothing changes: a constant picture, and a picture of two
