@@ -170,6 +170,7 @@ void denoise_features(const world *w, const render_settings *s, int px, int py, 
 /* The regression's windows: radius 4 (9x9 pixels) and 2 (5x5). */
 #define WIN_OUT 4
 #define WIN_IN 2
+#define TAPS ((2 * WIN_OUT + 1) * (2 * WIN_OUT + 1))
 /* Its unknowns: a constant, the slopes along x and y, along the normal's
  * three components and along the depth. */
 #define NU 7
@@ -214,6 +215,7 @@ typedef struct job {
 	float *am;              /* 3 a pixel: the albedo the radiance is divided by */
 	bool *mixed;            /* the pixel's features vary inside it */
 	texel *t;               /* the chains; CH_ALL later holds the result */
+	float *data;            /* 8 a pixel: what the regression fits (regression_rows) */
 	float *fit;             /* 6 a pixel: the candidates CAND_IN and CAND_OUT */
 	float *err;             /* NCAND a pixel: their estimated squared errors */
 	float *out;
@@ -283,6 +285,14 @@ static void setup_rows(job *j, int y0, int y1)
 				t->h[CH_B].c[k] = isfinite(b) ? b / am[k] : 0.0f;
 				t->h[CH_ALL].c[k] = isfinite(c) ? c / am[k] : 0.0f;
 			}
+			/* all the samples' colour and each half's brightness */
+			float *d = j->data + i * 8;
+			d[0] = t->h[CH_ALL].c[0];
+			d[1] = t->h[CH_ALL].c[1];
+			d[2] = t->h[CH_ALL].c[2];
+			d[3] = lum(t->h[CH_A].c);
+			d[4] = lum(t->h[CH_B].c);
+			d[5] = d[6] = d[7] = 0.0f;
 		}
 }
 
@@ -340,11 +350,16 @@ static void variance_rows(job *j, int y0, int y1)
 		}
 }
 
-/* Cholesky solve of the n x n system a x = b, 3 right-hand sides (a
+/* Right-hand sides of the regressions: red, green, blue of all the
+ * samples, and the brightness of each half. */
+#define NRHS 5
+
+/* Cholesky solve of the n x n system a x = b with m right-hand sides (a
  * positive definite and overwritten; only its lower triangle is read).
  * False when it is not. */
-static bool solve(int n, float a[][MIX_NU], float b[][3], float x[][3])
+static bool solve(int n, float a[][MIX_NU], int m, float b[][NRHS], float x[][NRHS])
 {
+	float inv[MIX_NU]; /* 1 / the factor's diagonal */
 	for (int c = 0; c < n; c++) {
 		float d = a[c][c];
 		for (int k = 0; k < c; k++)
@@ -353,26 +368,27 @@ static bool solve(int n, float a[][MIX_NU], float b[][3], float x[][3])
 			return false;
 		d = sqrtf(d);
 		a[c][c] = d;
+		inv[c] = 1.0f / d;
 		for (int r = c + 1; r < n; r++) {
 			float v = a[r][c];
 			for (int k = 0; k < c; k++)
 				v -= a[r][k] * a[c][k];
-			a[r][c] = v / d;
+			a[r][c] = v * inv[c];
 		}
 	}
-	for (int ch = 0; ch < 3; ch++) {
+	for (int ch = 0; ch < m; ch++) {
 		float z[MIX_NU];
 		for (int r = 0; r < n; r++) {
 			float v = b[r][ch];
 			for (int k = 0; k < r; k++)
 				v -= a[r][k] * z[k];
-			z[r] = v / a[r][r];
+			z[r] = v * inv[r];
 		}
 		for (int r = n - 1; r >= 0; r--) {
 			float v = z[r];
 			for (int k = r + 1; k < n; k++)
 				v -= a[k][r] * x[k][ch];
-			x[r][ch] = v / a[r][r];
+			x[r][ch] = v * inv[r];
 		}
 	}
 	return true;
@@ -392,68 +408,108 @@ static float cross_error(const chan *r, float na, float nb, float la, float lb)
 	       0.25f * (la - lb) * (la - lb);
 }
 
+/* Four floats in one SIMD register (a GCC and Clang extension), for the
+ * regression's sums. */
+typedef float v4 __attribute__((vector_size(16)));
+
+static inline v4 v4_splat(float x)
+{
+	return (v4){x, x, x, x};
+}
+
+static inline v4 v4_load(const float *p)
+{
+	v4 v;
+	memcpy(&v, p, sizeof v);
+	return v;
+}
+
+/* A row of sums (8 regressors, 8 data) into a and b. */
+static inline void store_row(const v4 s[4], float *a, float *b)
+{
+	memcpy(a, &s[0], sizeof s[0]);
+	memcpy(a + 4, &s[1], sizeof s[1]);
+	memcpy(b, &s[2], sizeof s[2]);
+	memcpy(b + 4, &s[3], sizeof s[3]);
+}
+
 /* Weighted first-order regression (NFOR, Bitterli et al. 2016, without its
- * colour weights) of each half's radiance over albedo on the screen
- * position, the normal and the depth, over the inner and the outer window
- * around each pixel of rows [y0, y1), evaluated at the pixel. The taps are
- * weighted by how alike their features are (albedo, normal, depth off the
- * pixel's plane) and by nothing else: no weight depends on the noise, so
- * each half's fit depends on its own samples only, and cross_error
- * estimates the candidates' errors honestly. A fit weights the halves by
- * their samples: the regression of all the samples, by linearity. */
+ * colour weights) of the radiance over albedo on the screen position, the
+ * normal and the depth, over the inner and the outer window around each
+ * pixel of rows [y0, y1), evaluated at the pixel. The taps are weighted by
+ * how alike their features are (albedo, normal, depth off the pixel's
+ * plane) and by nothing else: no weight depends on the noise, so the fit
+ * of each half's brightness depends on that half's samples only, and
+ * cross_error estimates the candidates' errors honestly. The fit of all the
+ * samples is the halves' fits weighted by their samples (the fit is linear
+ * in the data). */
 static void regression_rows(job *j, int y0, int y1)
 {
 	int w = j->fb->w, h = j->fb->h;
 	float na = j->n[CH_A], nb = j->n[CH_B], n = j->n[CH_ALL];
-	float wa = na / n, wb = nb / n;
 	for (int y = y0; y < y1; y++)
 		for (int x = 0; x < w; x++) {
 			size_t i = (size_t)y * w + x;
 			const guide *gp = &j->g[i];
 			float inv_z = 1.0f / (SIGMA_Z * gp->z + 1e-6f);
-			/* lower triangles and right-hand sides (half a rgb, half b
-			 * rgb) of the inner window and of the outer ring */
-			float a[2][NU][NU], b[2][NU][6];
-			memset(a, 0, sizeof a);
-			memset(b, 0, sizeof b);
-			for (int dy = -WIN_OUT; dy <= WIN_OUT; dy++) {
-				int qy = y + dy;
-				if (qy < 0 || qy >= h)
-					continue;
-				for (int dx = -WIN_OUT; dx <= WIN_OUT; dx++) {
-					int qx = x + dx;
-					if (qx < 0 || qx >= w)
+			/* The taps with a weight: the inner window's first, then the
+			 * rest of the outer one; each with its weight, regressors and
+			 * data (rows of 8 floats, SIMD-friendly). */
+			float tw[TAPS], tv[TAPS][8], td[TAPS][8];
+			int nt = 0, n_in = 0;
+			for (int ring = 0; ring < 2; ring++) {
+				for (int dy = -WIN_OUT; dy <= WIN_OUT; dy++) {
+					int qy = y + dy;
+					if (qy < 0 || qy >= h)
 						continue;
-					size_t q = (size_t)qy * w + qx;
-					const guide *gq = &j->g[q];
-					float e = 0;
-					for (int k = 0; k < 6; k++)
-						e += (gp->f[k] - gq->f[k]) * (gp->f[k] - gq->f[k]);
-					e += fabsf(gq->z - (gp->z + gp->gx * (float)dx + gp->gy * (float)dy)) * inv_z;
-					float wt = exp_fast(e);
-					if (wt <= 0)
-						continue;
-					int win = abs(dx) <= WIN_IN && abs(dy) <= WIN_IN ? 0 : 1;
-					float v[NU] = {1.0f,
-					               (float)dx * (1.0f / WIN_OUT),
-					               (float)dy * (1.0f / WIN_OUT),
-					               gq->f[3] - gp->f[3],
-					               gq->f[4] - gp->f[4],
-					               gq->f[5] - gp->f[5],
-					               (gq->z - gp->z) * inv_z};
-					const float *ca = j->t[q].h[CH_A].c, *cb = j->t[q].h[CH_B].c;
-					for (int r = 0; r < NU; r++) {
-						float wv = wt * v[r];
-						for (int c = 0; c <= r; c++)
-							a[win][r][c] += wv * v[c];
-						b[win][r][0] += wv * ca[0];
-						b[win][r][1] += wv * ca[1];
-						b[win][r][2] += wv * ca[2];
-						b[win][r][3] += wv * cb[0];
-						b[win][r][4] += wv * cb[1];
-						b[win][r][5] += wv * cb[2];
+					for (int dx = -WIN_OUT; dx <= WIN_OUT; dx++) {
+						int qx = x + dx;
+						bool inner = abs(dx) <= WIN_IN && abs(dy) <= WIN_IN;
+						if (qx < 0 || qx >= w || inner == (ring == 1))
+							continue;
+						size_t q = (size_t)qy * w + qx;
+						const guide *gq = &j->g[q];
+						float e = 0;
+						for (int k = 0; k < 6; k++)
+							e += (gp->f[k] - gq->f[k]) * (gp->f[k] - gq->f[k]);
+						e += fabsf(gq->z - (gp->z + gp->gx * (float)dx + gp->gy * (float)dy)) * inv_z;
+						float wt = exp_fast(e);
+						if (wt <= 0)
+							continue;
+						tw[nt] = wt;
+						float *v = tv[nt];
+						v[0] = 1.0f;
+						v[1] = (float)dx * (1.0f / WIN_OUT);
+						v[2] = (float)dy * (1.0f / WIN_OUT);
+						v[3] = gq->f[3] - gp->f[3];
+						v[4] = gq->f[4] - gp->f[4];
+						v[5] = gq->f[5] - gp->f[5];
+						v[6] = (gq->z - gp->z) * inv_z;
+						v[7] = 0.0f;
+						memcpy(td[nt], j->data + q * 8, sizeof td[nt]);
+						nt++;
 					}
 				}
+				if (ring == 0)
+					n_in = nt;
+			}
+			/* The normal equations of the inner window (0) and the outer
+			 * one (1): row by row, so that a row's sums stay in registers. */
+			float a[2][NU][8], b[2][NU][8];
+			for (int r = 0; r < NU; r++) {
+				v4 s[4] = {{0}};
+				for (int t = 0; t < nt; t++) {
+					if (t == n_in)
+						store_row(s, a[0][r], b[0][r]);
+					v4 wv = v4_splat(tw[t] * tv[t][r]);
+					s[0] += wv * v4_load(tv[t]);
+					s[1] += wv * v4_load(tv[t] + 4);
+					s[2] += wv * v4_load(td[t]);
+					s[3] += wv * v4_load(td[t] + 4);
+				}
+				if (nt == n_in)
+					store_row(s, a[0][r], b[0][r]);
+				store_row(s, a[1][r], b[1][r]);
 			}
 			const chan *r0 = j->t[i].h;
 			float am = lum(j->am + i * 3), am2 = am * am;
@@ -467,48 +523,29 @@ static void regression_rows(job *j, int y0, int y1)
 				err[CAND_RAW] = r0[CH_ALL].v / n * am2;
 			}
 			for (int c = 0; c < 2; c++) {
-				if (c == 1) /* the outer window: the inner one and the ring */
-					for (int r = 0; r < NU; r++) {
-						for (int k = 0; k <= r; k++)
-							a[1][r][k] += a[0][r][k];
-						for (int k = 0; k < 6; k++)
-							b[1][r][k] += b[0][r][k];
-					}
-				float half[2][3];
-				bool ok = true;
-				for (int hb = 0; hb < (j->halves ? 2 : 1) && ok; hb++) {
-					float m[NU][MIX_NU], rhs[NU][3], beta[NU][3];
-					for (int r = 0; r < NU; r++) {
-						for (int k = 0; k <= r; k++)
-							m[r][k] = a[c][r][k];
-						for (int k = 0; k < 3; k++)
-							rhs[r][k] = b[c][r][hb * 3 + k];
-					}
-					float ridge = m[0][0] * RIDGE;
-					for (int r = 1; r < NU; r++)
-						m[r][r] += ridge;
-					ok = solve(NU, m, rhs, beta);
-					for (int k = 0; k < 3; k++)
-						half[hb][k] = beta[0][k];
+				float m[NU][MIX_NU], rhs[NU][NRHS], beta[NU][NRHS];
+				for (int r = 0; r < NU; r++) {
+					for (int k = 0; k <= r; k++)
+						m[r][k] = a[c][r][k];
+					for (int k = 0; k < NRHS; k++)
+						rhs[r][k] = b[c][r][k];
 				}
+				float ridge = m[0][0] * RIDGE;
+				for (int r = 1; r < NU; r++)
+					m[r][r] += ridge;
 				float *o = fit + c * 3;
-				if (!ok) {
+				if (!solve(NU, m, j->halves ? NRHS : 3, rhs, beta)) {
 					for (int k = 0; k < 3; k++)
 						o[k] = r0[CH_ALL].c[k];
 					err[CAND_IN + c] = err[CAND_RAW];
 					continue;
 				}
-				if (!j->halves) {
-					/* one sample: the halves are the whole, and no error
-					 * can be estimated: the outer window is taken */
-					for (int k = 0; k < 3; k++)
-						o[k] = half[0][k];
-					err[CAND_IN + c] = c == 1 ? -INFINITY : INFINITY;
-					continue;
-				}
 				for (int k = 0; k < 3; k++)
-					o[k] = wa * half[0][k] + wb * half[1][k];
-				err[CAND_IN + c] = cross_error(r0, na, nb, lum(half[0]), lum(half[1])) * am2;
+					o[k] = beta[0][k];
+				/* With one sample there are no halves and no error can be
+				 * estimated: the outer window is taken. */
+				err[CAND_IN + c] = j->halves ? cross_error(r0, na, nb, beta[0][3], beta[0][4]) * am2
+				                             : c == 1 ? -INFINITY : INFINITY;
 			}
 		}
 }
@@ -560,7 +597,7 @@ static bool mix_pixel(const job *j, int x, int y, float o[3])
 	int w = j->fb->w, h = j->fb->h;
 	size_t i = (size_t)y * w + x;
 	const guide *gp = &j->g[i];
-	float a[MIX_NU][MIX_NU] = {{0}}, b[MIX_NU][3] = {{0}}, beta[MIX_NU][3];
+	float a[MIX_NU][MIX_NU] = {{0}}, b[MIX_NU][NRHS] = {{0}}, beta[MIX_NU][NRHS];
 	float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {0, 0, 0};
 	float inv_z = 1.0f / (gp->z + 1e-6f);
 	for (int dy = -MIX_R; dy <= MIX_R; dy++)
@@ -590,7 +627,7 @@ static bool mix_pixel(const job *j, int x, int y, float o[3])
 	float ridge = a[0][0] * 1e-3f; /* slopes held back a little */
 	for (int r = 1; r < MIX_NU; r++)
 		a[r][r] += ridge;
-	if (!solve(MIX_NU, a, b, beta))
+	if (!solve(MIX_NU, a, 3, b, beta))
 		return false;
 	/* Within the window's range; and a move the pixel's noise cannot
 	 * explain (more than MIX_K standard deviations of its brightness) is
@@ -685,11 +722,12 @@ bool denoise_image(const framebuffer *fb, float *out, int threads)
 	j.am = malloc(n * 3 * sizeof *j.am);
 	j.mixed = malloc(n * sizeof *j.mixed);
 	j.t = malloc(n * sizeof *j.t);
+	j.data = malloc(n * 8 * sizeof *j.data);
 	j.fit = malloc(n * 6 * sizeof *j.fit);
 	j.err = malloc(n * NCAND * sizeof *j.err);
 	pthread_t *tid = malloc((size_t)threads * sizeof *tid);
 	worker_arg *args = malloc((size_t)threads * sizeof *args);
-	bool ok = j.g && j.am && j.mixed && j.t && j.fit && j.err && tid && args;
+	bool ok = j.g && j.am && j.mixed && j.t && j.data && j.fit && j.err && tid && args;
 	if (ok) {
 		pthread_mutex_init(&j.lock, NULL);
 		pthread_cond_init(&j.go_cond, NULL);
@@ -722,6 +760,7 @@ bool denoise_image(const framebuffer *fb, float *out, int threads)
 	free(j.am);
 	free(j.mixed);
 	free(j.t);
+	free(j.data);
 	free(j.fit);
 	free(j.err);
 	free(tid);
