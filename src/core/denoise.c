@@ -167,10 +167,9 @@ void denoise_features(const world *w, const render_settings *s, int px, int py, 
 #define SIGMA_A2 0.01f
 #define SIGMA_N2 0.08f
 #define SIGMA_Z 0.02f
-/* The regression's windows: radius 4 (9x9 pixels) and 2 (5x5). */
-#define WIN_OUT 4
-#define WIN_IN 2
-#define TAPS ((2 * WIN_OUT + 1) * (2 * WIN_OUT + 1))
+/* The regression's window: radius 4 (9x9 pixels). */
+#define WIN 4
+#define TAPS ((2 * WIN + 1) * (2 * WIN + 1))
 /* Its unknowns: a constant, the slopes along x and y, along the normal's
  * three components and along the depth. */
 #define NU 7
@@ -205,9 +204,8 @@ typedef struct texel {
 	chan h[NCH];
 } texel;
 
-/* The candidates for a pixel: itself, and the regression over the inner
- * and over the outer window. */
-enum { CAND_RAW, CAND_IN, CAND_OUT, NCAND };
+/* The candidates for a pixel: itself, and the regression. */
+enum { CAND_RAW, CAND_FIT, NCAND };
 
 typedef struct job {
 	const framebuffer *fb;
@@ -216,7 +214,7 @@ typedef struct job {
 	bool *mixed;            /* the pixel's features vary inside it */
 	texel *t;               /* the chains; CH_ALL later holds the result */
 	float *data;            /* 8 a pixel: what the regression fits (regression_rows) */
-	float *fit;             /* 6 a pixel: the candidates CAND_IN and CAND_OUT */
+	float *fit;             /* 3 a pixel: the regression's value */
 	float *err;             /* NCAND a pixel: their estimated squared errors */
 	float *out;
 	float n[NCH];           /* samples in each chain */
@@ -424,129 +422,99 @@ static inline v4 v4_load(const float *p)
 	return v;
 }
 
-/* A row of sums (8 regressors, 8 data) into a and b. */
-static inline void store_row(const v4 s[4], float *a, float *b)
-{
-	memcpy(a, &s[0], sizeof s[0]);
-	memcpy(a + 4, &s[1], sizeof s[1]);
-	memcpy(b, &s[2], sizeof s[2]);
-	memcpy(b + 4, &s[3], sizeof s[3]);
-}
-
 /* Weighted first-order regression (NFOR, Bitterli et al. 2016, without its
  * colour weights) of the radiance over albedo on the screen position, the
- * normal and the depth, over the inner and the outer window around each
- * pixel of rows [y0, y1), evaluated at the pixel. The taps are weighted by
- * how alike their features are (albedo, normal, depth off the pixel's
- * plane) and by nothing else: no weight depends on the noise, so the fit
- * of each half's brightness depends on that half's samples only, and
- * cross_error estimates the candidates' errors honestly. The fit of all the
- * samples is the halves' fits weighted by their samples (the fit is linear
- * in the data). */
+ * normal and the depth, over the window around each pixel of rows
+ * [y0, y1), evaluated at the pixel. The taps are weighted by how alike
+ * their features are (albedo, normal, depth off the pixel's plane) and by
+ * nothing else: no weight depends on the noise, so the fit of each half's
+ * brightness depends on that half's samples only, and cross_error
+ * estimates the fit's error honestly. */
 static void regression_rows(job *j, int y0, int y1)
 {
 	int w = j->fb->w, h = j->fb->h;
-	float na = j->n[CH_A], nb = j->n[CH_B], n = j->n[CH_ALL];
+	float na = j->n[CH_A], nb = j->n[CH_B];
 	for (int y = y0; y < y1; y++)
 		for (int x = 0; x < w; x++) {
 			size_t i = (size_t)y * w + x;
 			const guide *gp = &j->g[i];
 			float inv_z = 1.0f / (SIGMA_Z * gp->z + 1e-6f);
-			/* The taps with a weight: the inner window's first, then the
-			 * rest of the outer one; each with its weight, regressors and
+			/* The taps with a weight: each one's weight, regressors and
 			 * data (rows of 8 floats, SIMD-friendly). */
 			float tw[TAPS], tv[TAPS][8], td[TAPS][8];
-			int nt = 0, n_in = 0;
-			for (int ring = 0; ring < 2; ring++) {
-				for (int dy = -WIN_OUT; dy <= WIN_OUT; dy++) {
-					int qy = y + dy;
-					if (qy < 0 || qy >= h)
+			int nt = 0;
+			for (int dy = -WIN; dy <= WIN; dy++) {
+				int qy = y + dy;
+				if (qy < 0 || qy >= h)
+					continue;
+				for (int dx = -WIN; dx <= WIN; dx++) {
+					int qx = x + dx;
+					if (qx < 0 || qx >= w)
 						continue;
-					for (int dx = -WIN_OUT; dx <= WIN_OUT; dx++) {
-						int qx = x + dx;
-						bool inner = abs(dx) <= WIN_IN && abs(dy) <= WIN_IN;
-						if (qx < 0 || qx >= w || inner == (ring == 1))
-							continue;
-						size_t q = (size_t)qy * w + qx;
-						const guide *gq = &j->g[q];
-						float e = 0;
-						for (int k = 0; k < 6; k++)
-							e += (gp->f[k] - gq->f[k]) * (gp->f[k] - gq->f[k]);
-						e += fabsf(gq->z - (gp->z + gp->gx * (float)dx + gp->gy * (float)dy)) * inv_z;
-						float wt = exp_fast(e);
-						if (wt <= 0)
-							continue;
-						tw[nt] = wt;
-						float *v = tv[nt];
-						v[0] = 1.0f;
-						v[1] = (float)dx * (1.0f / WIN_OUT);
-						v[2] = (float)dy * (1.0f / WIN_OUT);
-						v[3] = gq->f[3] - gp->f[3];
-						v[4] = gq->f[4] - gp->f[4];
-						v[5] = gq->f[5] - gp->f[5];
-						v[6] = (gq->z - gp->z) * inv_z;
-						v[7] = 0.0f;
-						memcpy(td[nt], j->data + q * 8, sizeof td[nt]);
-						nt++;
-					}
+					size_t q = (size_t)qy * w + qx;
+					const guide *gq = &j->g[q];
+					float e = 0;
+					for (int k = 0; k < 6; k++)
+						e += (gp->f[k] - gq->f[k]) * (gp->f[k] - gq->f[k]);
+					e += fabsf(gq->z - (gp->z + gp->gx * (float)dx + gp->gy * (float)dy)) * inv_z;
+					float wt = exp_fast(e);
+					if (wt <= 0)
+						continue;
+					tw[nt] = wt;
+					float *v = tv[nt];
+					v[0] = 1.0f;
+					v[1] = (float)dx * (1.0f / WIN);
+					v[2] = (float)dy * (1.0f / WIN);
+					v[3] = gq->f[3] - gp->f[3];
+					v[4] = gq->f[4] - gp->f[4];
+					v[5] = gq->f[5] - gp->f[5];
+					v[6] = (gq->z - gp->z) * inv_z;
+					v[7] = 0.0f;
+					memcpy(td[nt], j->data + q * 8, sizeof td[nt]);
+					nt++;
 				}
-				if (ring == 0)
-					n_in = nt;
 			}
-			/* The normal equations of the inner window (0) and the outer
-			 * one (1): row by row, so that a row's sums stay in registers. */
-			float a[2][NU][8], b[2][NU][8];
+			/* The normal equations, row by row, so that a row's sums stay
+			 * in registers; the lower triangle is what solve reads. */
+			float m[NU][MIX_NU], rhs[NU][NRHS], beta[NU][NRHS];
 			for (int r = 0; r < NU; r++) {
 				v4 s[4] = {{0}};
 				for (int t = 0; t < nt; t++) {
-					if (t == n_in)
-						store_row(s, a[0][r], b[0][r]);
 					v4 wv = v4_splat(tw[t] * tv[t][r]);
 					s[0] += wv * v4_load(tv[t]);
 					s[1] += wv * v4_load(tv[t] + 4);
 					s[2] += wv * v4_load(td[t]);
 					s[3] += wv * v4_load(td[t] + 4);
 				}
-				if (nt == n_in)
-					store_row(s, a[0][r], b[0][r]);
-				store_row(s, a[1][r], b[1][r]);
+				float row[16];
+				memcpy(row, s, sizeof row);
+				memcpy(m[r], row, sizeof m[r]);
+				memcpy(rhs[r], row + 8, sizeof rhs[r]);
 			}
+			float ridge = m[0][0] * RIDGE;
+			for (int r = 1; r < NU; r++)
+				m[r][r] += ridge;
 			const chan *r0 = j->t[i].h;
 			float am = lum(j->am + i * 3), am2 = am * am;
-			float *fit = j->fit + i * 6, *err = j->err + i * NCAND;
-			if (j->halves) {
-				/* the raw pixel estimated the same way, so that all the
-				 * candidates' estimates share their noise */
-				float la = lum(r0[CH_A].c), lb = lum(r0[CH_B].c);
-				err[CAND_RAW] = cross_error(r0, na, nb, la, lb) * am2;
-			} else {
-				err[CAND_RAW] = r0[CH_ALL].v / n * am2;
+			float *fit = j->fit + i * 3, *err = j->err + i * NCAND;
+			if (!solve(NU, m, j->halves ? NRHS : 3, rhs, beta)) {
+				memcpy(fit, r0[CH_ALL].c, sizeof r0[CH_ALL].c);
+				err[CAND_RAW] = 0.0f; /* the raw pixel */
+				err[CAND_FIT] = INFINITY;
+				continue;
 			}
-			for (int c = 0; c < 2; c++) {
-				float m[NU][MIX_NU], rhs[NU][NRHS], beta[NU][NRHS];
-				for (int r = 0; r < NU; r++) {
-					for (int k = 0; k <= r; k++)
-						m[r][k] = a[c][r][k];
-					for (int k = 0; k < NRHS; k++)
-						rhs[r][k] = b[c][r][k];
-				}
-				float ridge = m[0][0] * RIDGE;
-				for (int r = 1; r < NU; r++)
-					m[r][r] += ridge;
-				float *o = fit + c * 3;
-				if (!solve(NU, m, j->halves ? NRHS : 3, rhs, beta)) {
-					for (int k = 0; k < 3; k++)
-						o[k] = r0[CH_ALL].c[k];
-					err[CAND_IN + c] = err[CAND_RAW];
-					continue;
-				}
-				for (int k = 0; k < 3; k++)
-					o[k] = beta[0][k];
-				/* With one sample there are no halves and no error can be
-				 * estimated: the outer window is taken. */
-				err[CAND_IN + c] = j->halves ? cross_error(r0, na, nb, beta[0][3], beta[0][4]) * am2
-				                             : c == 1 ? -INFINITY : INFINITY;
+			for (int k = 0; k < 3; k++)
+				fit[k] = beta[0][k];
+			if (!j->halves) {
+				/* One sample: no halves, no error estimate; the fit. */
+				err[CAND_RAW] = INFINITY;
+				err[CAND_FIT] = 0.0f;
+				continue;
 			}
+			/* The raw pixel estimated the same way as the fit, so that
+			 * the two estimates share their noise. */
+			err[CAND_RAW] = cross_error(r0, na, nb, lum(r0[CH_A].c), lum(r0[CH_B].c)) * am2;
+			err[CAND_FIT] = cross_error(r0, na, nb, beta[0][3], beta[0][4]) * am2;
 		}
 }
 
@@ -578,7 +546,7 @@ static void pick_rows(job *j, int y0, int y1)
 				if (s[c] < s[best])
 					best = c;
 			chan *o = &j->t[i].h[CH_ALL];
-			const float *am = j->am + i * 3, *c = best == CAND_RAW ? o->c : j->fit + i * 6 + (best - 1) * 3;
+			const float *am = j->am + i * 3, *c = best == CAND_RAW ? o->c : j->fit + i * 3;
 			float l = lum(am);
 			for (int k = 0; k < 3; k++) {
 				float v = c[k] * am[k];
@@ -723,7 +691,7 @@ bool denoise_image(const framebuffer *fb, float *out, int threads)
 	j.mixed = malloc(n * sizeof *j.mixed);
 	j.t = malloc(n * sizeof *j.t);
 	j.data = malloc(n * 8 * sizeof *j.data);
-	j.fit = malloc(n * 6 * sizeof *j.fit);
+	j.fit = malloc(n * 3 * sizeof *j.fit);
 	j.err = malloc(n * NCAND * sizeof *j.err);
 	pthread_t *tid = malloc((size_t)threads * sizeof *tid);
 	worker_arg *args = malloc((size_t)threads * sizeof *args);
