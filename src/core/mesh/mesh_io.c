@@ -24,15 +24,19 @@ char *file_slurp(const char *path, const char *what, size_t *len, rt_error *err)
 
 char *rt_file_read_disk(const char *path, const char *what, size_t *len, rt_error *err)
 {
-	FILE *f = fopen(path, "rb");
+	const char *kind;
+	FILE *f = rt_file_open_regular(path, &kind);
 	if (!f) {
-		rt_error_set(err, "%s: cannot read the %s: %s", path, what, strerror(errno));
+		if (kind)
+			rt_error_set(err, "%s: cannot read the %s: it is %s; expected a regular file", path, what, kind);
+		else
+			rt_error_set(err, "%s: cannot read the %s: %s", path, what, strerror(errno));
 		return NULL;
 	}
 	struct stat st;
-	if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
+	if (fstat(fileno(f), &st) != 0) {
 		fclose(f);
-		rt_error_set(err, "%s: cannot read the %s: not a regular file", path, what);
+		rt_error_set(err, "%s: cannot read the %s: %s", path, what, strerror(errno));
 		return NULL;
 	}
 	if ((unsigned long long)st.st_size > SLURP_MAX) {
