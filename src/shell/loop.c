@@ -159,6 +159,31 @@ static double frame_gap(const shell *sh)
 	return g < FRAME_INTERVAL ? FRAME_INTERVAL : g > FRAME_GAP_MAX ? FRAME_GAP_MAX : g;
 }
 
+/* Runs one line of what readline gave (a pasted block has several); its
+ * output goes to `out` when the picture is on screen. With `inline_errors`
+ * (a paste of several lines) an error goes to `out` too, after the
+ * output of the lines before it, so that each message stays next to its
+ * line. */
+static bool run_one(shell *sh, const char *line, abuf *out, bool inline_errors)
+{
+	history_add_line(&hist, line);
+	if (sh->scr && sh->scr->active)
+		sh->capture = out;
+	bool ok = shell_run_line(sh, line);
+	sh->capture = NULL;
+	if (!ok && inline_errors) {
+		if (sh->scr && sh->scr->active) {
+			if (!sh->err_reported && sh->err[0])
+				abuf_printf(out, "%s\n", sh->err);
+			sh->err_reported = false;
+			sh->err[0] = '\0';
+		} else {
+			shell_report(sh);
+		}
+	}
+	return ok;
+}
+
 static void on_line(char *line)
 {
 	shell *sh = active;
@@ -167,8 +192,8 @@ static void on_line(char *line)
 		sh->quit = true;
 		return;
 	}
-	history_add_line(&hist, line);
 	shell_sig_int = 0;
+	atomic_store(&sh->cancel, false);
 	/* readline gave the terminal its own modes back while the command
 	 * runs: echo off all the same, so that an answer of the terminal (to
 	 * a picture slice in flight) is not echoed onto the screen. On again
@@ -182,16 +207,38 @@ static void on_line(char *line)
 		tcsetattr(STDIN_FILENO, TCSADRAIN, &q);
 	}
 	/* With a picture on screen, the output is held back: if it is longer
-	 * than the command area, the pager shows it over the whole screen. */
+	 * than the command area, the pager shows it over the whole screen.
+	 * A bracketed paste of several lines comes as one line with newlines
+	 * in it: each line is a command of its own, run in turn as bash does
+	 * (its own history entry and error); Ctrl-C stops the rest. */
 	abuf out;
 	abuf_init(&out);
-	if (sh->scr && sh->scr->active)
-		sh->capture = &out;
-	bool ok = shell_run_line(sh, line);
-	sh->capture = NULL;
+	bool several = strpbrk(line, "\n\r") != NULL;
+	long left = 0;
+	bool ok = true;
+	for (char *p = line; p && !sh->quit;) {
+		char *end = p + strcspn(p, "\n\r");
+		char *next = *end ? end + 1 : NULL;
+		*end = '\0';
+		if (shell_sig_int || (several && atomic_load(&sh->cancel))) {
+			left += p[strspn(p, " \t")] != '\0';
+		} else if (!several) {
+			ok = run_one(sh, p, &out, false);
+		} else if (p[strspn(p, " \t")]) {
+			run_one(sh, p, &out, true);
+			fflush(stdout);
+		}
+		p = next;
+	}
 	free(line);
-	if (out.len && !out.failed)
-		show_output(sh, &out);
+	if (left)
+		abuf_printf(&out, "Ctrl-C: %ld pasted line%s not run\n", left, left == 1 ? "" : "s");
+	if (out.len && !out.failed) {
+		if (sh->scr && sh->scr->active)
+			show_output(sh, &out);
+		else
+			fwrite(out.b, 1, out.len, stdout);
+	}
 	abuf_free(&out);
 	if (!ok)
 		shell_report(sh);
