@@ -377,6 +377,7 @@ bool cmd_clear(shell *sh, int argc, char **argv, const char *rest)
 		/* Clear the scroll region only, and start again at its bottom. */
 		fflush(stdout);
 		screen_clear_commands(sh->scr);
+		screen_log_clear(sh->scr);
 	}
 	return true;
 }

@@ -117,6 +117,23 @@ static void draw_picture(shell *sh)
 
 static void relayout_screen(shell *sh);
 
+/* Text shown in the command area, remembered for a new layout. */
+static void area_log(shell *sh, const char *text, size_t n)
+{
+	if (sh->scr && sh->scr->active)
+		screen_log(sh->scr, text, n);
+}
+
+/* Prints sh->err (shell_report), remembered for a new layout. */
+static void report(shell *sh)
+{
+	if (!sh->err_reported && sh->err[0]) {
+		area_log(sh, sh->err, strlen(sh->err));
+		area_log(sh, "\n", 1);
+	}
+	shell_report(sh);
+}
+
 /* Prints a command's output in the command area, or pages it when it would
  * scroll out of sight there. */
 static void show_output(shell *sh, const abuf *out)
@@ -125,6 +142,7 @@ static void show_output(shell *sh, const abuf *out)
 	int area = scr->rows - scr->region_top; /* the command area, prompt included */
 	if (pager_rows(out->b, out->len, scr->cols) < area) {
 		fwrite(out->b, 1, out->len, stdout);
+		screen_log(scr, out->b, out->len);
 		return;
 	}
 	fflush(stdout);
@@ -168,9 +186,9 @@ static bool run_one(shell *sh, const char *line, abuf *out, bool inline_errors)
 {
 	history_add_line(&hist, line);
 	if (sh->scr && sh->scr->active)
-		sh->capture = out;
+		sh->capture = sh->notes = out; /* warnings too, in their place */
 	bool ok = shell_run_line(sh, line);
-	sh->capture = NULL;
+	sh->capture = sh->notes = NULL;
 	if (!ok && inline_errors) {
 		if (sh->scr && sh->scr->active) {
 			if (!sh->err_reported && sh->err[0])
@@ -178,7 +196,7 @@ static bool run_one(shell *sh, const char *line, abuf *out, bool inline_errors)
 			sh->err_reported = false;
 			sh->err[0] = '\0';
 		} else {
-			shell_report(sh);
+			report(sh);
 		}
 	}
 	return ok;
@@ -192,6 +210,9 @@ static void on_line(char *line)
 		sh->quit = true;
 		return;
 	}
+	area_log(sh, PROMPT, strlen(PROMPT));
+	area_log(sh, line, strlen(line));
+	area_log(sh, "\n", 1);
 	shell_sig_int = 0;
 	atomic_store(&sh->cancel, false);
 	/* readline gave the terminal its own modes back while the command
@@ -241,7 +262,7 @@ static void on_line(char *line)
 	}
 	abuf_free(&out);
 	if (!ok)
-		shell_report(sh);
+		report(sh);
 	fflush(stdout);
 	if (quiet)
 		tcsetattr(STDIN_FILENO, TCSADRAIN, &modes);
@@ -272,6 +293,9 @@ static void interrupt(shell *sh)
 		shell_notice(sh, "Ctrl-C: the rest of the picture was not sent");
 	}
 	rl_callback_sigcleanup();
+	area_log(sh, PROMPT, strlen(PROMPT));
+	area_log(sh, rl_line_buffer, strlen(rl_line_buffer));
+	area_log(sh, "^C\n", 3);
 	rl_replace_line("", 0);
 	fputs("^C", rl_outstream);
 	rl_crlf();
