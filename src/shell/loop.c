@@ -207,6 +207,16 @@ static void on_line(char *line)
 	shell *sh = active;
 	if (!line) { /* Ctrl-D or end of input */
 		fputs("\n", stdout);
+		if (!evloop_eof(ev) && shell_quit_asks(sh)) {
+			/* Ctrl-D again leaves. */
+			static const char q[] = "the scene has edits not saved (save FILE.rt keeps them); Ctrl-D again, "
+			                        "or quit!, leaves without them\n";
+			fputs(q, stdout);
+			area_log(sh, PROMPT "\n", strlen(PROMPT) + 1);
+			area_log(sh, q, sizeof q - 1);
+			fflush(stdout);
+			return;
+		}
 		sh->quit = true;
 		return;
 	}

@@ -4,6 +4,9 @@
 # the prompt are on screen again afterwards, also a command's output that
 # came just before a render stopped by Ctrl-Z.
 set -u
+# A tmux server of its own: other tests' servers come and go.
+sock=rtsh-e2e-$$
+tmux() { command tmux -L "$sock" "$@"; }
 s=rtsh-keep-$$
 fail() { echo "FAIL: $*"; tmux kill-session -t "$s" 2>/dev/null; exit 1; }
 screen() { tmux capture-pane -t "$s" -p; }

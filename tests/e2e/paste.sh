@@ -4,6 +4,9 @@
 # line is its own command (its own history entry, its own error), and the
 # prompt comes back at the bottom of the command area.
 set -u
+# A tmux server of its own: other tests' servers come and go.
+sock=rtsh-e2e-$$
+tmux() { command tmux -L "$sock" "$@"; }
 s=rtsh-paste-$$
 fail() { echo "FAIL: $*"; tmux kill-session -t "$s" 2>/dev/null; exit 1; }
 screen() { tmux capture-pane -t "$s" -p; }
