@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "core/mesh/mesh_io.h"
+#include "rtsh/filesrc.h"
 #include "rtsh/mesh.h"
 
 typedef struct cursor {
@@ -118,7 +119,7 @@ static char *map_file(cursor *c, const char *dir, float *bm)
 static bool read_mtl(mesh_builder *b, const char *path, const char *dir)
 {
 	size_t len;
-	char *buf = file_slurp(path, "material library", &len, NULL);
+	char *buf = rt_file_read(path, "material library", &len, NULL);
 	if (!buf)
 		return true; /* a missing library leaves the defaults */
 	mesh_mat *cur = NULL;
@@ -384,7 +385,7 @@ mesh *mesh_parse_obj(const char *name, const char *dir, const char *buf, size_t 
 mesh *mesh_read_obj(const char *path, rt_error *err)
 {
 	size_t len;
-	char *buf = file_slurp(path, "model", &len, err);
+	char *buf = rt_file_read(path, "model", &len, err);
 	if (!buf)
 		return NULL;
 	char *dir = path_dir(path);

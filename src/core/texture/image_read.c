@@ -17,7 +17,8 @@
 #include <X11/xpm.h>
 #include <stb/stb_image.h>
 
-#include "core/mesh/mesh_io.h"
+#include "base/readhelp.h"
+#include "rtsh/filesrc.h"
 #include "rtsh/memory.h"
 #include "rtsh/texture.h"
 
@@ -477,7 +478,7 @@ float *image_load_rgb(const char *path, bool srgb, int *w, int *h, rt_error *err
 	if (format_of(path) == F_NONE)
 		return image_decode_rgb(path, NULL, 0, srgb, w, h, err);
 	size_t len;
-	char *buf = file_slurp(path, "image", &len, err);
+	char *buf = rt_file_read(path, "image", &len, err);
 	if (!buf)
 		return NULL;
 	float *out = image_decode_rgb(path, (const unsigned char *)buf, len, srgb, w, h, err);
