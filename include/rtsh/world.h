@@ -18,6 +18,7 @@
 #include "rtsh/error.h"
 #include "rtsh/math.h"
 #include "rtsh/scene.h"
+#include "rtsh/srgb.h" /* srgb255_to_linear: scene colours */
 
 /* A material in linear light, as the integrators use it. */
 typedef struct mat_lin {
@@ -217,8 +218,5 @@ cam_view cam_view_make(const camera *c);
 /* The primary ray through the image point (fx, fy) in pixels of a w x h
  * image, (0,0) the top-left corner, (w,h) the bottom-right. */
 ray cam_ray(const cam_view *c, double fx, double fy, int w, int h);
-
-/* sRGB (0..255) to linear [0,1], per channel. */
-vec3 srgb255_to_linear(vec3 c);
 
 #endif
