@@ -219,4 +219,12 @@ cam_view cam_view_make(const camera *c);
  * image, (0,0) the top-left corner, (w,h) the bottom-right. */
 ray cam_ray(const cam_view *c, double fx, double fy, int w, int h);
 
+/* For the benchmark (bench/bench.c) and rtsh-mpi's counts: the rays
+ * world_intersect and world_occluded traced in the calling thread since the
+ * last reset (a thread-local count, so no cache line is shared between
+ * threads), and the bytes a world holds beyond its struct. */
+void world_rays_reset(void);
+uint64_t world_rays_traced(void);
+size_t world_memory(const world *w);
+
 #endif

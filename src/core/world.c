@@ -10,7 +10,7 @@
 #include <emmintrin.h>
 #endif
 
-#include "bvh.h"
+#include "core/bvh/bvh.h"
 #include "emitters.h"
 #include "envmap.h"
 #include "surface.h"
