@@ -16,6 +16,7 @@
 #include "core/mesh/mesh_io.h"
 #include "rtsh/filesrc.h"
 #include "rtsh/mesh.h"
+#include "rtsh/srgb.h"
 
 typedef struct cursor {
 	const char *s, *end;
@@ -71,8 +72,7 @@ static mesh_mat mat_default(void)
 static double srgb_to_lin(double v)
 {
 	/* MTL colours are written as display values */
-	v = v < 0 ? 0 : v > 1 ? 1 : v;
-	return v <= 0.04045 ? v / 12.92 : pow((v + 0.055) / 1.055, 2.4);
+	return srgb_to_linear(v < 0 ? 0 : v > 1 ? 1 : v);
 }
 
 /* A map statement's file: the last word, after options such as -bm 0.5. */
