@@ -1,82 +1,17 @@
-/* rtsh — where the core reads the files a scene references (filesrc.h). */
-#include "rtsh/filesrc.h"
+/* rtsh — assimp opens a model's files (the model, a .gltf's buffers)
+ * through the scene's file source (rt_file_read, rtsh/filesrc.h). */
+#include "core/mesh/mesh_io.h"
 
-#include <errno.h>
-#include <fcntl.h>
-#include <stdatomic.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <unistd.h>
 
 #include <assimp/cfileio.h>
 #include <assimp/cimport.h>
 #include <assimp/scene.h>
 
-static _Atomic(const rt_file_source *) source;
-
-void rt_file_source_set(const rt_file_source *src)
-{
-	atomic_store(&source, src);
-}
-
-char *rt_file_read(const char *path, const char *what, size_t *len, rt_error *err)
-{
-	const rt_file_source *s = atomic_load(&source);
-	if (s && s->read)
-		return s->read(s->ctx, path, what, len, err);
-	return rt_file_read_disk(path, what, len, err);
-}
-
-int rt_file_stat(const char *path, struct stat *st)
-{
-	const rt_file_source *s = atomic_load(&source);
-	if (s && s->stat)
-		return s->stat(s->ctx, path, st);
-	return stat(path, st);
-}
-
-const char *rt_file_kind(mode_t mode)
-{
-	return S_ISREG(mode)    ? NULL
-	       : S_ISDIR(mode)  ? "a directory"
-	       : S_ISFIFO(mode) ? "a FIFO (named pipe)"
-	       : S_ISCHR(mode)  ? "a character device"
-	       : S_ISBLK(mode)  ? "a block device"
-	       : S_ISSOCK(mode) ? "a socket"
-	                        : "not a regular file";
-}
-
-FILE *rt_file_open_regular(const char *path, const char **kind)
-{
-	*kind = NULL;
-	struct stat st;
-	if (stat(path, &st) != 0)
-		return NULL;
-	if ((*kind = rt_file_kind(st.st_mode)))
-		return NULL;
-	int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-	if (fd < 0)
-		return NULL;
-	int flags = fcntl(fd, F_GETFL);
-	if (fstat(fd, &st) != 0 || (*kind = rt_file_kind(st.st_mode)) || flags < 0 ||
-	    fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) != 0) {
-		int e = errno;
-		close(fd);
-		errno = e;
-		return NULL;
-	}
-	FILE *f = fdopen(fd, "rb");
-	if (!f) {
-		int e = errno;
-		close(fd);
-		errno = e;
-	}
-	return f;
-}
-
-/* --- assimp's files through rt_file_read --- */
+#include "rtsh/filesrc.h"
 
 /* One import: the model's bytes, read once before assimp starts. */
 typedef struct ai_job {
