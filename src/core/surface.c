@@ -141,11 +141,16 @@ bool surf_material(world *w, const object *o, uint32_t i, rt_error *err)
 		if (mm->map_kd) {
 			if (!hold_texture(w, mm->map_kd, true, &t.tex, err))
 				return false;
-			t.tint = false;
+			t.tint = mm->gltf; /* glTF: texture x baseColorFactor */
 		} else if (mm->tex_kd) { /* embedded in the model: the mesh holds it */
 			t.tex = mm->tex_kd;
-			t.tint = false;
+			t.tint = mm->gltf;
 		}
+		if (mm->gltf && (mm->map_kd || mm->tex_kd)) /* KHR_texture_transform, then the object's */
+			for (int a = 0; a < 2; a++) {
+				t.uvo[a] += mm->uvo[a] * t.uvs[a];
+				t.uvs[a] *= mm->uvs[a];
+			}
 		if (mm->map_norm && !hold_texture(w, mm->map_norm, false, &t.nmap, err))
 			return false;
 		if (!mm->map_norm && mm->tex_norm)
