@@ -18,6 +18,7 @@
 #include "rtsh/error.h"
 #include "rtsh/math.h"
 #include "rtsh/scene.h"
+#include "rtsh/srgb.h" /* srgb255_to_linear: scene colours */
 
 /* A material in linear light, as the integrators use it. */
 typedef struct mat_lin {
@@ -218,7 +219,12 @@ cam_view cam_view_make(const camera *c);
  * image, (0,0) the top-left corner, (w,h) the bottom-right. */
 ray cam_ray(const cam_view *c, double fx, double fy, int w, int h);
 
-/* sRGB (0..255) to linear [0,1], per channel. */
-vec3 srgb255_to_linear(vec3 c);
+/* For the benchmark (bench/bench.c) and rtsh-mpi's counts: the rays
+ * world_intersect and world_occluded traced in the calling thread since the
+ * last reset (a thread-local count, so no cache line is shared between
+ * threads), and the bytes a world holds beyond its struct. */
+void world_rays_reset(void);
+uint64_t world_rays_traced(void);
+size_t world_memory(const world *w);
 
 #endif

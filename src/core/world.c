@@ -10,42 +10,11 @@
 #include <emmintrin.h>
 #endif
 
-#include "bvh.h"
+#include "core/bvh/bvh.h"
 #include "emitters.h"
 #include "envmap.h"
 #include "surface.h"
 #include "rtsh/shape.h"
-
-/* sRGB code (0..255, not necessarily whole) to linear, IEC 61966-2-1. */
-static double srgb_decode(double code)
-{
-	double v = code / 255.0;
-	return v <= 0.04045 ? v / 12.92 : pow((v + 0.055) / 1.055, 2.4);
-}
-
-/* The 256 whole codes, computed once: a million-object world_build would
- * otherwise spend 0.1 s in pow(). The values are the same bits. */
-static double srgb_table[256];
-static pthread_once_t srgb_once = PTHREAD_ONCE_INIT;
-
-static void srgb_table_init(void)
-{
-	for (int i = 0; i < 256; i++)
-		srgb_table[i] = srgb_decode(i);
-}
-
-static double srgb_channel(double code)
-{
-	if (code >= 0.0 && code <= 255.0 && code == (double)(int)code)
-		return srgb_table[(int)code];
-	return srgb_decode(code);
-}
-
-vec3 srgb255_to_linear(vec3 c)
-{
-	pthread_once(&srgb_once, srgb_table_init);
-	return v3(srgb_channel(c.x), srgb_channel(c.y), srgb_channel(c.z));
-}
 
 cam_view cam_view_make(const camera *c)
 {
