@@ -35,6 +35,7 @@
 #include <cjson/cJSON.h>
 
 #include "core/mesh/mesh_io.h"
+#include "rtsh/filesrc.h"
 #include "rtsh/gltf.h"
 #include "rtsh/memory.h"
 #include "rtsh/mesh.h"
@@ -433,7 +434,7 @@ static bool buffer(gl *g, size_t i, const unsigned char **p, size_t *len)
 			if (!path)
 				return fail(g, where, "out of memory");
 			size_t n = 0;
-			char *data = file_slurp(path, "glTF buffer", &n, g->err);
+			char *data = rt_file_read(path, "glTF buffer", &n, g->err);
 			free(path);
 			if (!data)
 				return false;
@@ -1278,7 +1279,7 @@ mesh *mesh_parse_gltf(const char *name, const char *dir, const char *buf, size_t
 mesh *mesh_read_gltf(const char *path, rt_error *err)
 {
 	size_t len;
-	char *buf = file_slurp(path, "model", &len, err);
+	char *buf = rt_file_read(path, "model", &len, err);
 	if (!buf)
 		return NULL;
 	char *dir = path_dir(path);
@@ -1434,7 +1435,7 @@ bool gltf_read_info(const char *path, gltf_info *out, rt_error *err)
 {
 	size_t len;
 	memset(out, 0, sizeof *out);
-	char *buf = file_slurp(path, "model", &len, err);
+	char *buf = rt_file_read(path, "model", &len, err);
 	if (!buf)
 		return false;
 	bool ok = gltf_parse_info(path, buf, len, out, err);
