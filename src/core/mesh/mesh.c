@@ -78,14 +78,25 @@ bool mb_triangle(mesh_builder *b, int32_t c[3][3])
 	return true;
 }
 
+bool mb_texture(mesh_builder *b, texture *t)
+{
+	if (!mem_grow((void **)&b->texs, &b->ctexs, b->ntexs + 1, sizeof *b->texs)) {
+		texture_free(t);
+		return false;
+	}
+	b->texs[b->ntexs++] = t;
+	return true;
+}
+
+/* The embedded textures are the mesh's (texs), not the material's. */
 static void mat_free(mesh_mat *m)
 {
 	free(m->name);
 	free(m->map_kd);
 	free(m->map_bump);
 	free(m->map_norm);
-	texture_free(m->tex_kd);
-	texture_free(m->tex_norm);
+	free(m->map_mr);
+	free(m->map_emit);
 }
 
 void mb_free(mesh_builder *b)
@@ -98,6 +109,9 @@ void mb_free(mesh_builder *b)
 	for (size_t i = 0; i < b->nmats; i++)
 		mat_free(&b->mats[i]);
 	free(b->mats);
+	for (size_t i = 0; i < b->ntexs; i++)
+		texture_free(b->texs[i]);
+	free(b->texs);
 	memset(b, 0, sizeof *b);
 }
 
@@ -220,6 +234,10 @@ mesh *mb_finish(mesh_builder *b, rt_error *err)
 	m->mats = b->mats;
 	b->mats = NULL;
 	b->nmats = 0;
+	m->ntexs = (uint32_t)b->ntexs;
+	m->texs = b->texs;
+	b->texs = NULL;
+	b->ntexs = 0;
 	if (m->nmats > 1) {
 		m->tmat = b->fm;
 		b->fm = NULL;
@@ -265,6 +283,9 @@ void mesh_free(mesh *m)
 	for (uint32_t i = 0; i < m->nmats; i++)
 		mat_free(&m->mats[i]);
 	free(m->mats);
+	for (uint32_t i = 0; i < m->ntexs; i++)
+		texture_free(m->texs[i]);
+	free(m->texs);
 	free(m->nodes);
 	free(m->blk);
 	free(m->btri);
@@ -294,8 +315,8 @@ size_t mesh_memory(const mesh *m)
 		n += (size_t)m->ntris * sizeof *m->tmat;
 	n += (size_t)m->nnodes * sizeof *m->nodes;
 	n += (size_t)m->nblk * (sizeof *m->blk + sizeof *m->btri);
-	for (uint32_t i = 0; i < m->nmats; i++)
-		n += tex_bytes(m->mats[i].tex_kd) + tex_bytes(m->mats[i].tex_norm);
+	for (uint32_t i = 0; i < m->ntexs; i++)
+		n += tex_bytes(m->texs[i]);
 	return n;
 }
 

@@ -26,8 +26,8 @@ static const struct model_format {
 	const char *ext;
 	mesh *(*read)(const char *path, rt_error *err);
 } formats[] = {
-	{"obj", mesh_read_obj},     {"ply", mesh_read_ply},    {"gltf", mesh_read_assimp},
-	{"glb", mesh_read_assimp},  {"stl", mesh_read_assimp},
+	{"obj", mesh_read_obj},   {"ply", mesh_read_ply},    {"gltf", mesh_read_gltf},
+	{"glb", mesh_read_gltf},  {"stl", mesh_read_assimp},
 };
 enum { NFORMATS = sizeof formats / sizeof formats[0] };
 
