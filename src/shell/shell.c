@@ -229,6 +229,8 @@ void shell_refresh(shell *sh)
 	}
 	/* A new pixels setting takes effect here; what the terminal answered
 	 * later, in the loop's after_probe. */
+	if (sh->set.symbols != sh->scr->symbols)
+		screen_set_symbols(sh->scr, sh->set.symbols);
 	if (sh->set.pixels == sh->scr->pixels || !screen_set_pixels(sh->scr, sh->set.pixels))
 		screen_layout(sh->scr, aspect_of(&sh->set), false);
 	if (sh->scr->img_w <= 0 || sh->scr->img_h <= 0) {
