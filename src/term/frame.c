@@ -28,12 +28,6 @@ frame *frame_new(int cols, int rows, frame_palette pal)
 	return frame_new_symbols(cols, rows, pal, SYMBOLS_HALF);
 }
 
-double frame_flat_default(symbols_kind sym)
-{
-	(void)sym;
-	return 0;
-}
-
 frame *frame_new_symbols(int cols, int rows, frame_palette pal, symbols_kind sym)
 {
 	if (cols < 1 || rows < 1 || sym < SYMBOLS_HALF || sym >= SYMBOLS_AUTO)
@@ -50,7 +44,7 @@ frame *frame_new_symbols(int cols, int rows, frame_palette pal, symbols_kind sym
 	f->sync = true;
 	f->sym = sym;
 	f->nsub = symbols_table[sym].w * symbols_table[sym].h;
-	f->flat = frame_flat_default(sym);
+	f->lambda = sym == SYMBOLS_HALF ? 0 : FRAME_SYMBOLS_LAMBDA;
 	for (unsigned m = 0; m < 1u << f->nsub; m++)
 		f->glyph_len[m] = (uint8_t)symbols_utf8(sym, m, f->glyph[m]);
 	f->cur = calloc(n, sizeof *f->cur);
@@ -251,6 +245,157 @@ static void fit_cell(frame *f, int cx, int cy)
 		*c = (frame_cell){qa, qb, mask};
 }
 
+static int param_len(frame_palette pal, uint32_t v, bool bg);
+
+/* The squared error (sRGB levels, summed over the cell's samples) of
+ * showing subpixels sub[n] as a where mask has them, b elsewhere. */
+static double cell_error(const float sub[][3], int n, uint32_t mask, uint32_t a, uint32_t b)
+{
+	double e = 0;
+	for (int i = 0; i < n; i++) {
+		uint32_t v = mask >> i & 1 ? a : b;
+		for (int c = 0; c < 3; c++) {
+			double d = sub[i][c] - (double)(v >> (16 - 8 * c) & 255);
+			e += d * d;
+		}
+	}
+	return e * (SYMBOLS_SAMPLE_W * SYMBOLS_SAMPLE_H) / n;
+}
+
+/* Bytes of the colours of a cell (a, and b when two) that the SGR state
+ * (fg, bg) does not hold, and of its glyph: about what the update sends. */
+static int cell_bytes(const frame *f, uint32_t a, uint32_t b, bool two, uint32_t fg, uint32_t bg)
+{
+	int n = 4, k = 0;
+	if (a != fg && a != bg)
+		n += param_len(f->pal, a, false), k++;
+	if (two && b != fg && b != bg && b != a)
+		n += param_len(f->pal, b, true), k++;
+	return n + (k ? 2 + k : 0);
+}
+
+static int colour_dist2(uint32_t a, uint32_t b)
+{
+	int d = 0;
+	for (int sh = 0; sh < 24; sh += 8) {
+		int e = (int)(a >> sh & 255) - (int)(b >> sh & 255);
+		d += e * e;
+	}
+	return d;
+}
+
+static uint32_t rgb_of(const float c[3])
+{
+	uint32_t v = 0;
+	for (int ch = 0; ch < 3; ch++) {
+		long r = lroundf(c[ch]);
+		v = v << 8 | (uint32_t)(r < 0 ? 0 : r > 255 ? 255 : r);
+	}
+	return v;
+}
+
+/* Rate and distortion along row cy of a truecolor symbol frame: a cell may
+ * keep a colour of the cell before it (its SGR state), or take one colour,
+ * when that costs less than f->lambda squared error (sRGB levels over its
+ * samples) a byte saved. The row is walked left to right, as an update
+ * sends it. */
+static void rd_row(frame *f, int cy)
+{
+	enum { SW = SYMBOLS_SAMPLE_W, SH = SYMBOLS_SAMPLE_H };
+	size_t cw = (size_t)f->cols * SW;
+	uint32_t fg = UINT32_MAX, bg = UINT32_MAX; /* not known */
+	int n = f->nsub;
+	for (int cx = 0; cx < f->cols; cx++) {
+		frame_cell *c = &f->cur[(size_t)cy * f->cols + cx];
+		size_t at = (size_t)cy * SH * cw + (size_t)cx * SW;
+		bool whole = true;
+		for (int y = 0; y < SH && whole; y++)
+			for (int x = 0; x < SW; x++)
+				whole &= f->def[at + y * cw + x] != 0;
+		if (!whole || c->top == FRAME_DEFAULT || c->bot == FRAME_DEFAULT) {
+			fg = c->top;
+			bg = c->bot;
+			continue;
+		}
+		float sub[8][3];
+		symbols_subpixels(f->sym, f->px + at * 3, cw * 3, sub);
+		/* the fit, and its cost */
+		frame_cell best = *c;
+		bool two = c->mask != 0;
+		double best_j = cell_error((const float(*)[3])sub, n, c->mask, c->top, c->bot) +
+		                f->lambda * cell_bytes(f, c->top, c->bot, two, fg, bg);
+		frame_cell cand[7];
+		int nc = 0;
+		float mean[3] = {0, 0, 0};
+		for (int i = 0; i < n; i++)
+			for (int ch = 0; ch < 3; ch++)
+				mean[ch] += sub[i][ch] / (float)n;
+		uint32_t m = rgb_of(mean);
+		cand[nc++] = (frame_cell){m, m, 0};
+		/* one colour of the state for the whole cell */
+		if (fg != UINT32_MAX && fg != FRAME_DEFAULT)
+			cand[nc++] = (frame_cell){fg, fg, 0};
+		if (bg != UINT32_MAX && bg != FRAME_DEFAULT && bg != fg)
+			cand[nc++] = (frame_cell){bg, bg, 0};
+		if (fg != UINT32_MAX && bg != UINT32_MAX && fg != FRAME_DEFAULT && bg != FRAME_DEFAULT) {
+			/* both colours of the state: each subpixel the nearer */
+			uint32_t mask = 0;
+			for (int i = 0; i < n; i++)
+				if (cell_error((const float(*)[3])sub + i, 1, 1, fg, fg) <
+				    cell_error((const float(*)[3])sub + i, 1, 1, bg, bg))
+					mask |= 1u << i;
+			cand[nc++] = fg == bg ? (frame_cell){fg, fg, 0} : (frame_cell){fg, bg, mask};
+		}
+		/* one colour of the state for the fit's nearer colour, the other
+		 * the mean of the subpixels left to it */
+		for (int k = 0; k < 2 && two; k++) {
+			uint32_t x = k ? bg : fg;
+			if (x == UINT32_MAX || x == FRAME_DEFAULT)
+				continue;
+			uint32_t mask = 0;
+			float rest[3] = {0, 0, 0};
+			int nr = 0;
+			/* x stands for the fit's colour nearer to it */
+			uint32_t other = colour_dist2(x, c->top) < colour_dist2(x, c->bot) ? c->bot : c->top;
+			for (int i = 0; i < n; i++) {
+				if (cell_error((const float(*)[3])sub + i, 1, 1, x, x) <=
+				    cell_error((const float(*)[3])sub + i, 1, 1, other, other)) {
+					mask |= 1u << i;
+				} else {
+					for (int ch = 0; ch < 3; ch++)
+						rest[ch] += sub[i][ch];
+					nr++;
+				}
+			}
+			if (nr == 0) {
+				cand[nc++] = (frame_cell){x, x, 0};
+				continue;
+			}
+			for (int ch = 0; ch < 3; ch++)
+				rest[ch] /= (float)nr;
+			uint32_t r = rgb_of(rest);
+			cand[nc++] = mask && r != x ? (frame_cell){x, r, mask} : (frame_cell){r, r, 0};
+		}
+		for (int k = 0; k < nc; k++) {
+			bool t = cand[k].mask != 0;
+			double j = cell_error((const float(*)[3])sub, n, cand[k].mask, cand[k].top, cand[k].bot) +
+			           f->lambda * cell_bytes(f, cand[k].top, cand[k].bot, t, fg, bg);
+			if (j < best_j) {
+				best_j = j;
+				best = cand[k];
+			}
+		}
+		*c = best;
+		if (best.mask == 0) {
+			if (best.top != fg && best.top != bg)
+				bg = best.top;
+		} else {
+			fg = best.top;
+			bg = best.bot;
+		}
+	}
+}
+
 /* frame_put_image for the symbol sets: the samples, then every cell they
  * touch fitted again. */
 static void put_symbols(frame *f, const uint8_t *rgb, int w, int h, int ox, int oy)
@@ -265,9 +410,12 @@ static void put_symbols(frame *f, const uint8_t *rgb, int w, int h, int ox, int 
 		       (size_t)(x1 - x0) * 3);
 		memset(f->def + (size_t)y * cw + x0, 1, (size_t)(x1 - x0));
 	}
-	for (int cy = y0 / SYMBOLS_SAMPLE_H; cy <= (y1 - 1) / SYMBOLS_SAMPLE_H; cy++)
+	for (int cy = y0 / SYMBOLS_SAMPLE_H; cy <= (y1 - 1) / SYMBOLS_SAMPLE_H; cy++) {
 		for (int cx = x0 / SYMBOLS_SAMPLE_W; cx <= (x1 - 1) / SYMBOLS_SAMPLE_W; cx++)
 			fit_cell(f, cx, cy);
+		if (f->lambda > 0 && f->pal == PALETTE_TRUECOLOR)
+			rd_row(f, cy);
+	}
 }
 
 void frame_put_image(frame *f, const uint8_t *rgb, int w, int h, int ox, int oy)

@@ -158,12 +158,14 @@ static void assert_screen_is_symbols(const emu *e, const frame *f)
 		}
 }
 
-static void round_trip(symbols_kind sym, frame_palette pal)
+static void round_trip(symbols_kind sym, frame_palette pal, bool rd)
 {
 	const int cols = 23, rows = 7;
 	test_rng r = {(uint64_t)sym * 31 + (uint64_t)pal};
 	frame *f = frame_new_symbols(cols, rows, pal, sym);
 	assert_non_null(f);
+	if (!rd)
+		f->lambda = 0; /* the best fit, cell by cell */
 	f->x0 = 2;
 	f->y0 = 1;
 	emu e;
@@ -194,7 +196,7 @@ static void round_trip(symbols_kind sym, frame_palette pal)
 			uint8_t a[3], b[3];
 			symbols_fit((const float(*)[3])sub, f->nsub, f->flat, &mask, a, b);
 			frame_cell c = f->cur[cy * cols + cx];
-			if (pal == PALETTE_TRUECOLOR && mask) {
+			if (pal == PALETTE_TRUECOLOR && mask && !rd) {
 				assert_true(c.mask == mask);
 				assert_int_equal(c.top, (uint32_t)a[0] << 16 | (uint32_t)a[1] << 8 | a[2]);
 			}
@@ -208,10 +210,49 @@ static void test_round_trips(void **state)
 {
 	(void)state;
 	for (int s = SYMBOLS_QUADRANT; s <= SYMBOLS_OCTANT; s++) {
-		round_trip((symbols_kind)s, PALETTE_TRUECOLOR);
-		round_trip((symbols_kind)s, PALETTE_256);
-		round_trip((symbols_kind)s, PALETTE_16);
+		round_trip((symbols_kind)s, PALETTE_TRUECOLOR, false);
+		round_trip((symbols_kind)s, PALETTE_TRUECOLOR, true);
+		round_trip((symbols_kind)s, PALETTE_256, true);
+		round_trip((symbols_kind)s, PALETTE_16, true);
 	}
+}
+
+/* A grey ramp of one level a cell, flat cells: the rate-distortion pass
+ * keeps the colour before while its error, 24 d^2 (8 samples, 3 channels,
+ * d levels off), and the glyph's 4 bytes cost less than the new colour's
+ * 20 (\e[48;2;v;v;vm and the glyph), each byte worth lambda = 5: 24 d^2 + 20
+ * < 100 for d = 1, not 2. So every other cell sends its colour: a cell
+ * costs (17 + 1) / 2 bytes instead of 17 ("\e[48;2;41;41;41m "), and none is
+ * off by more than 1 level. */
+static void test_rate_distortion_ramp(void **state)
+{
+	(void)state;
+	const int cols = 60, rows = 2;
+	uint8_t img[2 * 60 * 4 * 2 * 3];
+	for (int y = 0; y < rows * 4; y++)
+		for (int x = 0; x < cols * 2; x++)
+			memset(img + ((size_t)y * cols * 2 + x) * 3, 40 + x / 2, 3);
+	size_t bytes[2];
+	for (int rd = 0; rd < 2; rd++) {
+		frame *f = frame_new_symbols(cols, rows, PALETTE_TRUECOLOR, SYMBOLS_SEXTANT);
+		assert_non_null(f);
+		if (!rd)
+			f->lambda = 0;
+		else
+			assert_near(f->lambda, 5, 0);
+		frame_put_image(f, img, cols * 2, rows * 4, 0, 0);
+		for (int i = 0; i < cols * rows; i++) {
+			frame_cell c = f->cur[i];
+			int want = 40 + i % cols;
+			for (int k = 0; k < 2; k++) {
+				int v = (int)((k ? c.bot : c.top) & 255);
+				assert_true(abs(v - want) <= (rd ? 1 : 0));
+			}
+		}
+		bytes[rd] = frame_update(f)->len;
+		frame_free(f);
+	}
+	assert_true(bytes[1] * 10 < bytes[0] * 6);
 }
 
 static void test_choose(void **state)
@@ -236,6 +277,7 @@ int main(void)
 		cmocka_unit_test(test_subpixel_areas),
 		cmocka_unit_test(test_fit_by_hand),
 		cmocka_unit_test(test_round_trips),
+		cmocka_unit_test(test_rate_distortion_ramp),
 		cmocka_unit_test(test_choose),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
