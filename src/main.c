@@ -13,6 +13,7 @@
 #include "rtsh/world.h"
 #include "shell/args.h"
 #include "shell/preview.h"
+#include "shell/turntable.h"
 
 static int usage_error(const char *fmt, const char *arg)
 {
@@ -128,6 +129,8 @@ int main(int argc, char **argv)
 		return rc;
 	if (o.preview)
 		return preview_main(&o);
+	if (o.output && o.turntable)
+		return turntable_batch(&o);
 	if (o.output)
 		return batch_render(&o);
 	return shell_main(&o);
