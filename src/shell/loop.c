@@ -18,6 +18,7 @@
 #include <readline/history.h>
 #include <readline/readline.h>
 
+#include "shell/keymode.h"
 #include "shell/complete.h"
 #include "shell/history.h"
 #include "term/pager.h"
@@ -337,6 +338,10 @@ int shell_interactive(shell *sh, bool use_screen, const int wake[2])
 		termout_ask_pixels(scr.out, sh->set.pixels != PIXELS_OFF);
 		termout_probe(scr.out, asked_color, now());
 	}
+
+	/* rtsh --turntable: key mode spinning from the start. */
+	if (sh->opt->turntable && sh->scr)
+		keymode_turntable(sh, KEYMODE_SPIN_SECONDS);
 
 	int status = 0;
 	while (!sh->quit) {
