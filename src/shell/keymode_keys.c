@@ -54,9 +54,9 @@ const km_keyrow keymode_keys[] = {
 	 {{'u', KM_UNDO, 0}, {'U', KM_REDO, 0}}},
 	{"? F1", "hide / show the help bar", "?", "hide this", 14, {{'?', KM_HELP, 0}, {KEYS_F(1), KM_HELP, 0}}},
 	{"Ctrl-L F5", "repaint", NULL, NULL, 0, {{12, KM_REDRAW, 0}, {KEYS_F(5), KM_REDRAW, 0}}},
-	{"0", "reset the view: the camera as key mode began", "0", "reset", 15, {{'0', KM_HOME, 0}}},
+	{"0", "reset the view: the camera as key mode began", NULL, NULL, 0, {{'0', KM_HOME, 0}}},
 	{"f (model viewer)", "frame the selection (the whole model when the camera is selected);\n"
-	                     "in the model viewer the arrows orbit (Shift+arrows fly) and F moves down",
+	                     "in the model viewer the arrows orbit (Shift+arrows fly), F moves down",
 	 NULL, NULL, 0, {{0, KM_NONE, 0}}},
 	{"Esc q", "back to the shell; every change stays (undo, save x.rt)", "Esc", "back", 1,
 	 {{KEYS_ESC, KM_QUIT, 0}, {'q', KM_QUIT, 0}, {'Q', KM_QUIT, 0}}},
