@@ -39,7 +39,7 @@ CFLAGS  += -fsanitize=$(SAN) -fno-omit-frame-pointer -fno-sanitize-recover=all
 LDFLAGS += -fsanitize=$(SAN)
 endif
 
-CORE_SRC  := $(sort $(wildcard src/core/*.c src/core/*/*.c src/scene/*.c))
+CORE_SRC  := $(sort $(wildcard src/base/*.c src/model/*.c src/core/*.c src/core/*/*.c src/scene/*.c))
 FRONT_SRC := $(sort $(wildcard src/term/*.c src/shell/*.c))
 CORE_OBJ  := $(CORE_SRC:%.c=$(BUILD)/%.o)
 FRONT_OBJ := $(FRONT_SRC:%.c=$(BUILD)/%.o)

@@ -33,7 +33,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "core/bvh.h"
+#include "core/bvh/bvh.h"
 #include "rtsh/denoise.h"
 #include "mesh_rays.h"
 #include "rtsh/mesh.h"

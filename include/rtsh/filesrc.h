@@ -8,9 +8,9 @@
  * loader's per-load hook (rt_load_opts.read, rt_read_file); these files are
  * read later, while the world is built, where no load options exist.
  *
- * Every reader in src/core reads such a file through rt_file_read (the
- * model readers' file_slurp), checks it through rt_file_stat (the caches),
- * and assimp opens its files through rt_file_ai_import.
+ * Every reader in src/core reads such a file through rt_file_read, checks
+ * it through rt_file_stat (the caches), and assimp opens its files through
+ * rt_file_ai_import (src/core/mesh/ai_files.c). Base layer (src/base).
  */
 #ifndef RTSH_FILESRC_H
 #define RTSH_FILESRC_H
@@ -37,13 +37,7 @@ char *rt_file_read(const char *path, const char *what, size_t *len, rt_error *er
 /* stat(2) through the source, or on disk. */
 int rt_file_stat(const char *path, struct stat *st);
 /* Reads from disk: "PATH: cannot read the WHAT: reason" on failure (files
- * larger than 4 GiB are refused). Defined with the model readers. */
+ * larger than 4 GiB are refused). */
 char *rt_file_read_disk(const char *path, const char *what, size_t *len, rt_error *err);
-
-/* assimp's aiImportFile, with every file assimp opens (the model, and a
- * .gltf's buffers) read through rt_file_read. NULL with err set ("PATH:
- * cannot read the model: reason") on failure; free with aiReleaseImport. */
-struct aiScene;
-const struct aiScene *rt_file_ai_import(const char *path, unsigned flags, rt_error *err);
 
 #endif

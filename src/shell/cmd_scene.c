@@ -77,10 +77,12 @@ bool cmd_save(shell *sh, int argc, char **argv, const char *rest)
 	rt_error err;
 	bool ok = true;
 	if (has_ext(path, ".rt")) {
-		if (!save_rt(sh, path, &err))
+		if (!save_rt(sh, path, &err)) {
 			ok = save_failed(sh, &err);
-		else
+		} else {
+			sh->saved_gen = editor_generation(sh->ed);
 			shell_info(sh, "saved the scene to %s\n", path);
+		}
 	} else if (has_ext(path, ".ans")) {
 		frame *f = shell_picture_frame(sh, PALETTE_TRUECOLOR, picture_columns());
 		if (!f) {

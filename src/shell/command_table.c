@@ -66,7 +66,9 @@ const command command_table[] = {
 	{"help", "?", "help [COMMAND]", 0, 1, {"@command"}, "the commands, or one command's usage",
 	 cmd_help},
 	{"clear", NULL, "clear", 0, 0, {NULL}, "clear the command area", cmd_clear},
-	{"quit", "exit", "quit", 0, 0, {NULL}, "leave rtsh (Ctrl-D too); the terminal is restored",
+	{"quit", "exit", "quit\nquit!", 0, 0, {NULL},
+	 "leave rtsh (Ctrl-D too); the terminal is restored. With edits not saved as .rt, asks once (quit or\n"
+	 "Ctrl-D again leaves); quit! does not ask, nor do -q and command files",
 	 cmd_quit},
 };
 const size_t command_count = sizeof command_table / sizeof command_table[0];

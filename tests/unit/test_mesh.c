@@ -5,7 +5,7 @@
 
 #include <unistd.h>
 
-#include "core/bvh.h"
+#include "core/bvh/bvh.h"
 #include "core/integrators.h"
 #include "rtsh/image.h"
 #include "rtsh/memory.h"

@@ -12,7 +12,7 @@
 #include <strings.h>
 #include <sys/stat.h>
 
-#include "core/bvh.h"
+#include "core/bvh/bvh.h"
 #include "rtsh/filesrc.h"
 #include "rtsh/memory.h"
 #include "rtsh/texture.h"

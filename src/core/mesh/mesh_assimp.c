@@ -24,8 +24,8 @@
 
 #include "core/mesh/mesh_io.h"
 #include "rtsh/filesrc.h"
-#include "rtsh/image.h"
 #include "rtsh/mesh.h"
+#include "rtsh/srgb.h"
 #include "rtsh/texture.h"
 
 static double lin(double v)
