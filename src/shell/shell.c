@@ -446,12 +446,24 @@ frame *shell_picture_frame(shell *sh, frame_palette pal, int cols)
 
 /* --- scenes --- */
 
+bool shell_quit_asks(shell *sh)
+{
+	uint64_t gen = editor_generation(sh->ed);
+	if (!sh->interactive || sh->depth > 0 || sh->opt->quiet || gen == sh->saved_gen ||
+	    sh->quit_asked_gen == gen + 1)
+		return false;
+	sh->quit_asked_gen = gen + 1;
+	return true;
+}
+
 bool shell_replace_scene(shell *sh, scene *s, const char *label)
 {
 	rt_error err;
 	shell_edit_begin(sh);
 	bool ok = editor_replace(sh->ed, s, label, &err);
 	shell_edit_end(sh);
+	if (ok)
+		sh->saved_gen = editor_generation(sh->ed);
 	return ok ? true : shell_fail(sh, "%s", err.msg);
 }
 
@@ -517,6 +529,7 @@ bool shell_init(shell *sh, const rtsh_options *o, int wake_fd)
 		return false;
 	}
 	sh->label = o->scene ? strdup(o->scene) : NULL;
+	sh->saved_gen = editor_generation(sh->ed);
 	sh->set = fresh_settings(sh, false);
 	name_from_label(sh);
 	return true;

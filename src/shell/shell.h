@@ -80,6 +80,9 @@ typedef struct shell {
 	char notice[256];      /* said once in the status line (until notice_until) */
 	double notice_until;
 	bool err_reported;     /* err was printed already (by a nested source) */
+	uint64_t saved_gen;    /* the editor's generation when the scene was loaded or saved as .rt */
+	uint64_t quit_asked_gen; /* quit asked about unsaved edits at this generation (+1; 0: not asked) */
+	bool force;            /* the command word ended in "!" (quit!) */
 	int depth;             /* source nesting */
 	unsigned hand_set;     /* bit i: settings_table[i] was changed by `set` (answer.c) */
 	void (*status_hook)(struct shell *sh); /* redraws the status line (interactive) */
@@ -124,6 +127,11 @@ const framebuffer *shell_full_image(shell *sh, bool force);
 /* The picture as a frame of cells for `save X.ans` and `show`: the current
  * preview when there is one, else rendered at `cols` columns. */
 frame *shell_picture_frame(shell *sh, frame_palette pal, int cols);
+
+/* True when an interactive quit should ask first: edits not saved as .rt,
+ * not asked already about these edits, not -q, not from a command file.
+ * Marks the question asked (the caller says it). */
+bool shell_quit_asks(shell *sh);
 
 /* Replaces the scene (load, next, prev, generate). */
 bool shell_replace_scene(shell *sh, scene *s, const char *label);

@@ -31,6 +31,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "term/abuf.h"
 #include "term/encoder.h"
 #include "term/frame.h"
 #include "term/out.h"
@@ -55,7 +56,17 @@ typedef struct screen {
 	termout *out;      /* every byte of the screen goes out through it */
 	bool active;
 	char status[512];  /* the status line's text */
+	abuf log;          /* the command area's recent text (screen_log), drawn
+	                    * again after a resize or Ctrl-Z and fg */
 } screen;
+
+/* Remembers text shown in the command area (the prompt and the command,
+ * its output, its error), so that a new layout (a resize, Ctrl-Z and fg,
+ * the pager's or key mode's end) shows the area's last lines again. Only
+ * the last few kilobytes are kept. */
+void screen_log(screen *s, const char *text, size_t n);
+/* Forgets the command area's text (clear). */
+void screen_log_clear(screen *s);
 
 /* Enters the alternate screen of fd and lays it out for an image of the
  * given aspect. False when fd is not a terminal. */
@@ -108,6 +119,14 @@ void screen_resume(screen *s);
  * screen_keypad turned it on, every mode reset, main screen); nothing when
  * no screen is entered. */
 void screen_restore_async(void);
+/* Remembers text shown in the command area (the prompt and the command,
+ * its output, its error), so that a new layout (a resize, Ctrl-Z and fg,
+ * the pager's or key mode's end) shows the area's last lines again. Only
+ * the last few kilobytes are kept. */
+void screen_log(screen *s, const char *text, size_t n);
+/* Forgets the command area's text (clear). */
+void screen_log_clear(screen *s);
+
 /* Enters the alternate screen again, with the keypad mode it had. */
 void screen_reenter_async(void);
 /* Sends terminfo's keypad transmit string on_seq (on) or off_seq (off) to
