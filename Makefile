@@ -29,7 +29,7 @@ WARN    := -Wall -Wextra -Wpedantic -Werror -Wshadow -Wstrict-prototypes -Wmissi
 CPPFLAGS += -Iinclude -Isrc -I$(BUILD) -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -DRTSH_VERSION=\"$(VERSION)\"
 CFLAGS  ?= $(OPT) -g
 CFLAGS  += $(CSTD) $(WARN) -fno-math-errno -pthread -MMD -MP
-LDLIBS_CORE := -lpng -lassimp -lXpm -lstb -lm -pthread
+LDLIBS_CORE := -lpng -lassimp -lcjson -lXpm -lstb -lm -pthread
 # libsixel carries its own copy of stb_image: libstb (in LDLIBS_CORE) must come first
 # so that the scene loader's stbi_* calls reach libstb, not libsixel's.
 LDLIBS_FRONT := -lreadline -lncursesw $(LDLIBS_CORE) -lsixel -lz
@@ -39,7 +39,7 @@ CFLAGS  += -fsanitize=$(SAN) -fno-omit-frame-pointer -fno-sanitize-recover=all
 LDFLAGS += -fsanitize=$(SAN)
 endif
 
-CORE_SRC  := $(sort $(wildcard src/core/*.c src/core/*/*.c src/scene/*.c))
+CORE_SRC  := $(sort $(wildcard src/base/*.c src/model/*.c src/core/*.c src/core/*/*.c src/scene/*.c))
 FRONT_SRC := $(sort $(wildcard src/term/*.c src/shell/*.c))
 CORE_OBJ  := $(CORE_SRC:%.c=$(BUILD)/%.o)
 FRONT_OBJ := $(FRONT_SRC:%.c=$(BUILD)/%.o)

@@ -14,6 +14,7 @@
 
 #include "rtsh/error.h"
 #include "rtsh/render.h"
+#include "rtsh/srgb.h" /* linear_to_srgb8: the 8-bit formats */
 
 typedef enum image_format {
 	IMAGE_UNKNOWN,
@@ -43,11 +44,6 @@ const image_type *image_type_of(const char *path);
 void image_extensions(char *buf, size_t size, bool readable);
 /* Reads any readable format, by extension. */
 framebuffer *image_read(const char *path, rt_error *err);
-
-/* Linear [0,1] to 8-bit sRGB, rounded, clamped; exact inverse of srgb8_to_linear
- * on the 256 codes. */
-uint8_t linear_to_srgb8(double v);
-double srgb8_to_linear(double code);
 
 /* Writes the framebuffer. `exposure` (stops: radiance x 2^exposure) applies
  * to the 8-bit formats; a PFM keeps the linear radiance as rendered. */

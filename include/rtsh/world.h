@@ -18,17 +18,46 @@
 #include "rtsh/error.h"
 #include "rtsh/math.h"
 #include "rtsh/scene.h"
+#include "rtsh/srgb.h" /* srgb255_to_linear: scene colours */
+
+/* The material families (material.c): each gives its BSDF, pdf, sampling,
+ * albedo and Whitted shading; the integrators never look further. Zero is
+ * the seeds' Phong family, so a zeroed mat_lin is a Phong material. */
+enum { MAT_PHONG = 0, MAT_PBR = 1, MAT_FAMILY_COUNT };
 
 /* A material in linear light, as the integrators use it. */
 typedef struct mat_lin {
-	vec3 albedo;       /* linear colour */
-	double diffuse, specular, shininess, reflective;
-	double fuzz, metal, ior;
+	vec3 albedo;       /* linear colour (PBR: the base colour) */
+	double ior;        /* Phong: 0 opaque, else glass; PBR: the dielectric's index (1.5 when absent) */
 	vec3 emission;     /* emitted radiance (linear) */
 	double checker;    /* squares per unit; 0 = none */
 	int32_t light;     /* index into world.emitters; -1 when not sampled */
+	uint8_t family;    /* MAT_PHONG or MAT_PBR */
+	bool thin;         /* PBR: thin-walled transmission */
 	const struct mat_tex *tx; /* textures, or NULL (most materials): 8 bytes here */
+	union {
+		struct { /* the seeds' Phong family (rtsh(5)) */
+			double diffuse, specular, shininess, reflective;
+			double fuzz, metal;
+		};
+		struct mat_pbr_lin { /* the PBR family (glTF 2.0 metallic-roughness, scene.h) */
+			float roughness;  /* perceptual, [0,1]; GGX alpha = roughness^2 */
+			float metallic, transmission; /* [0,1] */
+			float clearcoat, clearcoat_roughness; /* [0,1] */
+			float specular_factor;   /* [0,1] KHR_materials_specular specularFactor */
+			float specular_color[3]; /* linear, its specularColorFactor */
+			float sigma_a[3]; /* volume absorption per scene unit, -ln(att colour) / att distance; 0 none */
+		} pbr;
+	};
 } mat_lin;
+
+/* The linear material of a scene material (emission = emit x emit_color or
+ * colour; a PBR material's absent roughness is 1, its absent ior 1.5). A
+ * reader of another format (glTF) fills a `material` and calls this. */
+mat_lin mat_lin_make(const material *m);
+/* Linear [0,1] (and above) to sRGB codes 0..255, not rounded: the inverse of
+ * srgb255_to_linear, for readers whose colours are linear (glTF factors). */
+vec3 linear_to_srgb255(vec3 c);
 
 /* The textures of a material (texture.h; NULL = none), held by the world. */
 typedef struct mat_tex {
@@ -218,7 +247,12 @@ cam_view cam_view_make(const camera *c);
  * image, (0,0) the top-left corner, (w,h) the bottom-right. */
 ray cam_ray(const cam_view *c, double fx, double fy, int w, int h);
 
-/* sRGB (0..255) to linear [0,1], per channel. */
-vec3 srgb255_to_linear(vec3 c);
+/* For the benchmark (bench/bench.c) and rtsh-mpi's counts: the rays
+ * world_intersect and world_occluded traced in the calling thread since the
+ * last reset (a thread-local count, so no cache line is shared between
+ * threads), and the bytes a world holds beyond its struct. */
+void world_rays_reset(void);
+uint64_t world_rays_traced(void);
+size_t world_memory(const world *w);
 
 #endif

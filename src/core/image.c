@@ -12,6 +12,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "rtsh/filesrc.h"
+
 /* The extension of path ("" when none). */
 static const char *extension(const char *path)
 {
@@ -24,52 +26,6 @@ image_format image_format_of(const char *path)
 {
 	const image_type *t = image_type_of(path);
 	return t ? t->format : IMAGE_UNKNOWN;
-}
-
-/* The 8-bit code of a linear value is the sRGB encoding (IEC 61966-2-1)
- * rounded to nearest: code k covers the linear values from
- * threshold[k] = decode((k - 0.5) / 255) up to threshold[k + 1]. A table of
- * buckets over [0,1) gives the code at the start of each bucket, and at most
- * a step or two up the thresholds finds the code: no pow() per pixel, which
- * matters for every terminal frame. */
-#define SRGB_BUCKETS 4096
-
-static double srgb_threshold[257];
-static uint8_t srgb_bucket[SRGB_BUCKETS];
-static pthread_once_t srgb_once = PTHREAD_ONCE_INIT;
-
-static void srgb_tables(void)
-{
-	srgb_threshold[0] = -INFINITY;
-	for (int k = 1; k < 256; k++)
-		srgb_threshold[k] = srgb8_to_linear(k - 0.5);
-	srgb_threshold[256] = INFINITY;
-	int code = 0;
-	for (int b = 0; b < SRGB_BUCKETS; b++) {
-		double v = (double)b / SRGB_BUCKETS;
-		while (v >= srgb_threshold[code + 1])
-			code++;
-		srgb_bucket[b] = (uint8_t)code;
-	}
-}
-
-uint8_t linear_to_srgb8(double v)
-{
-	if (!(v > 0.0))
-		return 0;
-	if (v >= 1.0)
-		return 255;
-	pthread_once(&srgb_once, srgb_tables);
-	int code = srgb_bucket[(int)(v * SRGB_BUCKETS)];
-	while (v >= srgb_threshold[code + 1])
-		code++;
-	return (uint8_t)code;
-}
-
-double srgb8_to_linear(double code)
-{
-	double c = code / 255.0;
-	return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4);
 }
 
 typedef struct image_ctx {
@@ -262,9 +218,13 @@ static bool data_fits(FILE *f, double need)
 
 framebuffer *image_read_pfm(const char *path, rt_error *err)
 {
-	FILE *f = fopen(path, "rb");
+	const char *kind;
+	FILE *f = rt_file_open_regular(path, &kind);
 	if (!f) {
-		rt_error_at(err, path, 0, 0, "cannot open (%s)", strerror(errno));
+		if (kind)
+			rt_error_at(err, path, 0, 0, "is %s; expected a regular file", kind);
+		else
+			rt_error_at(err, path, 0, 0, "cannot open (%s)", strerror(errno));
 		return NULL;
 	}
 	int w, h;
@@ -298,9 +258,13 @@ framebuffer *image_read_pfm(const char *path, rt_error *err)
 
 framebuffer *image_read_ppm(const char *path, rt_error *err)
 {
-	FILE *f = fopen(path, "rb");
+	const char *kind;
+	FILE *f = rt_file_open_regular(path, &kind);
 	if (!f) {
-		rt_error_at(err, path, 0, 0, "cannot open (%s)", strerror(errno));
+		if (kind)
+			rt_error_at(err, path, 0, 0, "is %s; expected a regular file", kind);
+		else
+			rt_error_at(err, path, 0, 0, "cannot open (%s)", strerror(errno));
 		return NULL;
 	}
 	int w, h;

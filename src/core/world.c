@@ -10,42 +10,11 @@
 #include <emmintrin.h>
 #endif
 
-#include "bvh.h"
+#include "core/bvh/bvh.h"
 #include "emitters.h"
 #include "envmap.h"
 #include "surface.h"
 #include "rtsh/shape.h"
-
-/* sRGB code (0..255, not necessarily whole) to linear, IEC 61966-2-1. */
-static double srgb_decode(double code)
-{
-	double v = code / 255.0;
-	return v <= 0.04045 ? v / 12.92 : pow((v + 0.055) / 1.055, 2.4);
-}
-
-/* The 256 whole codes, computed once: a million-object world_build would
- * otherwise spend 0.1 s in pow(). The values are the same bits. */
-static double srgb_table[256];
-static pthread_once_t srgb_once = PTHREAD_ONCE_INIT;
-
-static void srgb_table_init(void)
-{
-	for (int i = 0; i < 256; i++)
-		srgb_table[i] = srgb_decode(i);
-}
-
-static double srgb_channel(double code)
-{
-	if (code >= 0.0 && code <= 255.0 && code == (double)(int)code)
-		return srgb_table[(int)code];
-	return srgb_decode(code);
-}
-
-vec3 srgb255_to_linear(vec3 c)
-{
-	pthread_once(&srgb_once, srgb_table_init);
-	return v3(srgb_channel(c.x), srgb_channel(c.y), srgb_channel(c.z));
-}
 
 cam_view cam_view_make(const camera *c)
 {
@@ -68,9 +37,21 @@ ray cam_ray(const cam_view *c, double fx, double fy, int w, int h)
 	return (ray){c->pos, v3_norm(d)};
 }
 
-static mat_lin material_linear(const material *m)
+static double srgb_encode(double v)
 {
-	mat_lin l;
+	if (!(v > 0.0))
+		return 0.0;
+	return 255.0 * (v <= 0.0031308 ? v * 12.92 : 1.055 * pow(v, 1.0 / 2.4) - 0.055);
+}
+
+vec3 linear_to_srgb255(vec3 c)
+{
+	return v3(srgb_encode(c.x), srgb_encode(c.y), srgb_encode(c.z));
+}
+
+mat_lin mat_lin_make(const material *m)
+{
+	mat_lin l = {0};
 	l.albedo = srgb255_to_linear(m->color);
 	l.diffuse = m->diffuse;
 	l.specular = m->specular;
@@ -79,10 +60,34 @@ static mat_lin material_linear(const material *m)
 	l.fuzz = m->fuzz;
 	l.metal = m->metal;
 	l.ior = m->ior;
-	l.emission = v3_scale(l.albedo, m->emission);
+	const material_pbr *p = m->pbr;
+	bool own_emit = p && p->emit_color.x >= 0.0 && p->emit_color.y >= 0.0 && p->emit_color.z >= 0.0;
+	l.emission = v3_scale(own_emit ? srgb255_to_linear(p->emit_color) : l.albedo, m->emission);
 	l.checker = m->checker;
 	l.light = -1; /* set by emitters_build */
 	l.tx = NULL;  /* set by surf_material */
+	if (!p)
+		return l;
+	l.family = MAT_PBR;
+	l.ior = m->ior >= 1.0 ? m->ior : 1.5;
+	l.pbr.roughness = (float)(p->roughness >= 0.0 ? p->roughness : 1.0);
+	l.pbr.metallic = (float)p->metallic;
+	l.pbr.transmission = (float)p->transmission;
+	l.thin = p->thin != 0;
+	l.pbr.clearcoat = (float)p->clearcoat;
+	l.pbr.clearcoat_roughness = (float)p->clearcoat_roughness;
+	l.pbr.specular_factor = (float)p->specular_factor;
+	vec3 sc = srgb255_to_linear(p->specular_color);
+	l.pbr.specular_color[0] = (float)sc.x;
+	l.pbr.specular_color[1] = (float)sc.y;
+	l.pbr.specular_color[2] = (float)sc.z;
+	if (p->att_dist > 0.0) {
+		vec3 a = srgb255_to_linear(p->att_color);
+		/* Beer-Lambert: white light keeps a of itself after att_dist */
+		double c[3] = {a.x, a.y, a.z};
+		for (int i = 0; i < 3; i++)
+			l.pbr.sigma_a[i] = (float)(c[i] > 0 ? -log(c[i]) / p->att_dist : 1e30);
+	}
 	return l;
 }
 
@@ -259,7 +264,7 @@ world *world_build(const scene *s, rt_error *err)
 	double extent = v3_max_abs(c.pos);
 	for (size_t i = 0; i < s->nobjs; i++) {
 		const object *o = &s->objs[i];
-		w->mats[i] = material_linear(&o->mat);
+		w->mats[i] = mat_lin_make(&o->mat);
 		bool plane = (obj_kind_flags(o->kind) & KIND_UNBOUNDED) != 0;
 		if (!surf_material(w, o, (uint32_t)i, err) ||
 		    (plane ? !make_plane(w, o, (uint32_t)i, &w->planes[w->nplanes], err)

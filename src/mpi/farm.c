@@ -10,7 +10,6 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "core/bvh.h"
 
 enum { FARM_ASK = 1, FARM_TILES = 2, FARM_RESULT = 3 };
 

@@ -702,10 +702,10 @@ bool editor_object_set_key(editor *ed, size_t i, const char *assignment, rt_erro
 		if (strlen(rt_keys[j].name) == nlen && strncmp(rt_keys[j].name, assignment, nlen) == 0)
 			k = &rt_keys[j];
 	if (!k || !eq || !rt_key_applies(k, o.kind)) {
-		char list[256] = "";
+		char list[1024] = "";
 		size_t used = 0;
 		for (size_t j = 0; j < rt_nkeys; j++)
-			if (rt_key_applies(&rt_keys[j], o.kind))
+			if (used < sizeof list && rt_key_applies(&rt_keys[j], o.kind))
 				used += (size_t)snprintf(list + used, sizeof list - used, "%s%s=",
 				                         used ? " " : "", rt_keys[j].name);
 		return rt_error_set(err, "\"%s\" is %s; expected KEY=VALUE with one of %s", assignment,
@@ -713,14 +713,15 @@ bool editor_object_set_key(editor *ed, size_t i, const char *assignment, rt_erro
 		                    list);
 	}
 	if (k->type != RT_KEY_NUM)
-		return rt_error_set(err, "\"%s\": %s= takes a file or U,V; expected it on the object's line "
+		return rt_error_set(err, "\"%s\": %s= takes a file, U,V or R,G,B; expected it on the object's line "
 		                         "(add, or edit the .rt file)",
 		                    assignment, k->name);
 	double v;
 	if (num_scan_str(eq + 1, RT_NUM_MAX, &v) != NUM_OK || v < k->min || v > k->max ||
 	    (k->is_int && v != floor(v)) || (k->extra && !k->extra(v)))
 		return rt_error_set(err, "\"%s\" is out of range; expected %s", assignment, k->expect);
-	rt_key_set(k, &o, v);
+	if (!rt_key_set(k, &o, v))
+		return rt_error_set(err, "\"%s\": out of memory", assignment);
 	return editor_set_object(ed, i, &o, err);
 }
 

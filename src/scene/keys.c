@@ -4,12 +4,15 @@
  * scene.h's material, and a paragraph in rtsh(5)). */
 #include <math.h>
 #include <stddef.h>
+#include <string.h>
 
 #include "rtsh/rtfile.h"
 #include "scene/rtfile_priv.h"
 
 static bool ior_rule(double v) { return v == 0.0 || v >= 1.0; }
 static bool positive(double v) { return v > 0.0; }
+
+#define PBR(f) (RT_KEY_PBR | offsetof(material_pbr, f))
 
 /* name, field, int, on triangles, kinds, in the short form, min, max, default, rule,
  * expected, help */
@@ -44,6 +47,31 @@ const rt_key rt_keys[] = {
 	 "uvscale=U,V, two numbers in [-1e6,1e6], not 0", "texture repeats along U,V", RT_KEY_PAIR, false},
 	{"uvoffset", offsetof(object, mat.uvoffset), false, true, 0, false, -1e6, 1e6, 0, NULL,
 	 "uvoffset=U,V, two numbers in [-1e6,1e6]", "texture shift along U,V", RT_KEY_PAIR, false},
+	/* the physically based family (scene.h, rtsh(5) "Materials") */
+	{"roughness", PBR(roughness), false, true, 0, false, 0, 1, -1, NULL,
+	 "roughness in [0,1]", "PBR: microfacet roughness, GGX alpha = roughness^2", RT_KEY_NUM, false},
+	{"metallic", PBR(metallic), false, true, 0, false, 0, 1, 0, NULL, "metallic in [0,1]",
+	 "PBR: conductor (1) with F0 = colour, or dielectric (0)", RT_KEY_NUM, false},
+	{"transmission", PBR(transmission), false, true, 0, false, 0, 1, 0, NULL,
+	 "transmission in [0,1]", "PBR: share of the dielectric that refracts (glass)", RT_KEY_NUM, false},
+	{"thin", PBR(thin), true, true, 0, false, 0, 1, 0, NULL, "thin 0 (a volume) or 1",
+	 "PBR: thin-walled transmission (1), no bending", RT_KEY_NUM, false},
+	{"att_color", PBR(att_color), false, true, 0, false, 0, 255, 255, NULL,
+	 "att_color=R,G,B, each in [0,255]", "PBR: colour after att_dist inside the volume", RT_KEY_RGB, false},
+	{"att_dist", PBR(att_dist), false, true, 0, false, 0, 1e6, 0, NULL,
+	 "att_dist in [0,1e6] (0 infinite)", "PBR: distance for att_color (0 infinite)", RT_KEY_NUM, false},
+	{"clearcoat", PBR(clearcoat), false, true, 0, false, 0, 1, 0, NULL,
+	 "clearcoat in [0,1]", "PBR: weight of a clear varnish coat", RT_KEY_NUM, false},
+	{"clearcoat_roughness", PBR(clearcoat_roughness), false, true, 0, false, 0, 1, 0, NULL,
+	 "clearcoat_roughness in [0,1]", "PBR: roughness of the coat", RT_KEY_NUM, false},
+	{"specular_factor", PBR(specular_factor), false, true, 0, false, 0, 1, 1, NULL,
+	 "specular_factor in [0,1]", "PBR: strength of the dielectric's reflection", RT_KEY_NUM, false},
+	{"specular_color", PBR(specular_color), false, true, 0, false, 0, 255, 255, NULL,
+	 "specular_color=R,G,B, each in [0,255]", "PBR: tint of the dielectric's reflection", RT_KEY_RGB,
+	 false},
+	{"emit_color", PBR(emit_color), false, true, 0, false, 0, 255, -1, NULL,
+	 "emit_color=R,G,B, each in [0,255]", "emission colour (else the colour), times emit", RT_KEY_RGB,
+	 false},
 	{"smooth", offsetof(object, smooth), true, false, 0, false, 0, 1, 1, NULL,
 	 "smooth 0 (flat faces) or 1 (smooth normals)", "mesh: smooth normals (1) or flat faces (0)",
 	 RT_KEY_NUM, true},
@@ -70,19 +98,62 @@ bool rt_key_applies(const rt_key *k, obj_kind kind)
 	return !k->needs || (f & k->needs);
 }
 
+/* Where key k's value is in o: in the object, or in o's PBR block (the
+ * absent one when o has none). */
+static const char *key_src(const rt_key *k, const object *o, material_pbr *tmp)
+{
+	if (!(k->offset & RT_KEY_PBR))
+		return (const char *)o + k->offset;
+	*tmp = o->mat.pbr ? *o->mat.pbr : material_pbr_absent();
+	return (const char *)tmp + (k->offset & ~RT_KEY_PBR);
+}
+
 double rt_key_get(const rt_key *k, const object *o)
 {
-	const char *base = (const char *)o + k->offset;
+	material_pbr tmp;
+	const char *base = key_src(k, o, &tmp);
 	if (k->is_int)
 		return *(const int *)(const void *)base;
 	return *(const double *)(const void *)base;
 }
 
-void rt_key_set(const rt_key *k, object *o, double v)
+void rt_key_get_n(const rt_key *k, const object *o, double *v, int n)
 {
-	char *base = (char *)o + k->offset;
+	material_pbr tmp;
+	memcpy(v, key_src(k, o, &tmp), (size_t)n * sizeof *v);
+}
+
+/* Writes n doubles (or one int) into o's field of key k. */
+static bool key_store(const rt_key *k, object *o, const double *v, int n)
+{
+	if (!(k->offset & RT_KEY_PBR)) {
+		char *base = (char *)o + k->offset;
+		if (k->is_int)
+			*(int *)(void *)base = (int)v[0];
+		else
+			memcpy(base, v, (size_t)n * sizeof *v);
+		return true;
+	}
+	material_pbr p = o->mat.pbr ? *o->mat.pbr : material_pbr_absent();
+	char *base = (char *)&p + (k->offset & ~RT_KEY_PBR);
 	if (k->is_int)
-		*(int *)(void *)base = (int)v;
+		*(int *)(void *)base = (int)v[0];
 	else
-		*(double *)(void *)base = v;
+		memcpy(base, v, (size_t)n * sizeof *v);
+	bool oom = false;
+	const material_pbr *q = material_pbr_intern(&p, &oom);
+	if (oom)
+		return false;
+	o->mat.pbr = q;
+	return true;
+}
+
+bool rt_key_set(const rt_key *k, object *o, double v)
+{
+	return key_store(k, o, &v, 1);
+}
+
+bool rt_key_set_n(const rt_key *k, object *o, const double *v, int n)
+{
+	return key_store(k, o, v, n);
 }

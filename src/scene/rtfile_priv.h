@@ -28,13 +28,19 @@ typedef struct rt_key {
 	bool (*extra)(double v); /* a further rule within [min,max], or NULL */
 	const char *expect; /* what a valid value is, for messages */
 	const char *help;   /* one line for `help` */
-	int type;           /* RT_KEY_NUM (0), RT_KEY_FILE or RT_KEY_PAIR */
+	int type;           /* RT_KEY_NUM (0), RT_KEY_FILE, RT_KEY_PAIR or RT_KEY_RGB */
 	bool mesh_only;     /* only on mesh objects */
 } rt_key;
 
 /* RT_KEY_FILE: a file name (const char * field, rt_intern'ed, resolved
- * against the .rt file's folder); RT_KEY_PAIR: U,V into double[2]. */
-enum { RT_KEY_NUM, RT_KEY_FILE, RT_KEY_PAIR };
+ * against the .rt file's folder); RT_KEY_PAIR: U,V into double[2];
+ * RT_KEY_RGB: R,G,B into a vec3 (min, max per channel; absent when all
+ * three equal def). */
+enum { RT_KEY_NUM, RT_KEY_FILE, RT_KEY_PAIR, RT_KEY_RGB };
+/* An offset with this bit is one into the material's shared PBR block
+ * (scene.h, material_pbr), which rt_key_get / rt_key_set copy, change and
+ * intern: read and write such keys only through them. */
+#define RT_KEY_PBR ((size_t)1 << 24)
 /* The folder model and texture names are written relative to (rt_save sets
  * it for the duration of a write; "" = as stored). */
 extern _Thread_local const char *rt_write_dir;
@@ -48,7 +54,11 @@ bool rt_key_applies(const rt_key *k, obj_kind kind);
 /* The key's value in o, as a double. */
 double rt_key_get(const rt_key *k, const object *o);
 /* Stores v (already checked) in o. */
-void rt_key_set(const rt_key *k, object *o, double v);
+bool rt_key_set(const rt_key *k, object *o, double v);
+/* The n numbers (2 for RT_KEY_PAIR, 3 for RT_KEY_RGB) of a key; setting
+ * is false only when out of memory (a new PBR block). */
+void rt_key_get_n(const rt_key *k, const object *o, double *v, int n);
+bool rt_key_set_n(const rt_key *k, object *o, const double *v, int n);
 
 /* Numbers are read and written in the "C" locale whatever the program's
  * locale is: rt_numloc_enter switches the calling thread, leave restores. */

@@ -17,6 +17,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "rtsh/filesrc.h"
 #include "rtsh/mesh.h"
 #include "rtsh/num.h"
 #include "rtsh/render.h"
@@ -696,10 +697,10 @@ static bool parse_keys(parser *p, const elem_def *e, object *o)
 		       !(strlen(rt_keys[k].name) == nlen && memcmp(rt_keys[k].name, t->s, nlen) == 0))
 			k++;
 		if (k == rt_nkeys || (!rt_keys[k].mesh_only && !rt_key_applies(&rt_keys[k], o->kind))) {
-			char list[256] = "";
+			char list[1024] = "";
 			size_t used = 0;
 			for (size_t j = 0; j < rt_nkeys; j++)
-				if (rt_key_applies(&rt_keys[j], o->kind))
+				if (used < sizeof list && rt_key_applies(&rt_keys[j], o->kind))
 					used += (size_t)snprintf(list + used, sizeof list - used, "%s%s=",
 					                         used ? " " : "", rt_keys[j].name);
 			char what[64];
@@ -718,6 +719,18 @@ static bool parse_keys(parser *p, const elem_def *e, object *o)
 		if (key->type == RT_KEY_FILE) {
 			if (!get_file(p, t, val, t->len - nlen - 1, key, (const char **)(void *)((char *)o + key->offset)))
 				return false;
+			continue;
+		}
+		if (key->type == RT_KEY_RGB) {
+			tok pt = *t;
+			pt.s = val;
+			pt.len = t->len - nlen - 1;
+			double c[3];
+			range r = {key->min, key->max, false, false, key->expect};
+			if (!get_tuple(p, &pt, e->name, key->name, 3, "R,G,B", &r, c))
+				return false;
+			if (!rt_key_set_n(key, o, c, 3))
+				return fail_tok(p, t, e->name, "key", "could not be kept: out of memory", key->expect);
 			continue;
 		}
 		if (key->type == RT_KEY_PAIR) {
@@ -742,7 +755,8 @@ static bool parse_keys(parser *p, const elem_def *e, object *o)
 		if (v < key->min || v > key->max || (key->is_int && v != floor(v)) ||
 		    (key->extra && !key->extra(v)))
 			return fail_tok(p, t, e->name, "key", "is out of range", key->expect);
-		rt_key_set(key, o, v);
+		if (!rt_key_set(key, o, v))
+			return fail_tok(p, t, e->name, "key", "could not be kept: out of memory", key->expect);
 	}
 	return true;
 }
@@ -1206,20 +1220,25 @@ scene *rt_load_string(const char *text, size_t len, const char *name, const rt_l
 static char *read_file(void *ctx, const char *path, size_t *len, rt_error *err)
 {
 	(void)ctx;
-	FILE *f = fopen(path, "rb");
-	if (!f) {
-		rt_error_at(err, path, 0, 0, "cannot open: %s; expected a readable .rt file",
-		            strerror(errno));
+	struct stat st;
+	if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
+		rt_error_at(err, path, 0, 0, "is a directory; expected a .rt file");
 		return NULL;
 	}
-	struct stat st;
+	/* A FIFO or a device is refused before it is opened (issue 31): opening
+	 * a FIFO waits for a writer, a device may never end. */
+	const char *kind;
+	FILE *f = rt_file_open_regular(path, &kind);
+	if (!f) {
+		if (kind)
+			rt_error_at(err, path, 0, 0, "is %s; expected a regular .rt file", kind);
+		else
+			rt_error_at(err, path, 0, 0, "cannot open: %s; expected a readable .rt file",
+			            strerror(errno));
+		return NULL;
+	}
 	size_t cap = 1 << 16;
 	if (fstat(fileno(f), &st) == 0) {
-		if (S_ISDIR(st.st_mode)) {
-			fclose(f);
-			rt_error_at(err, path, 0, 0, "is a directory; expected a .rt file");
-			return NULL;
-		}
 		if (S_ISREG(st.st_mode) && (unsigned long long)st.st_size > RT_FILE_MAX) {
 			fclose(f);
 			rt_error_at(err, path, 0, 0,

@@ -153,6 +153,21 @@ static void fmt_keys(sbuf *b, const object *o, bool short_form)
 			sb_file(b, f);
 			continue;
 		}
+		if (k->type == RT_KEY_RGB) {
+			double c[3];
+			rt_key_get_n(k, o, c, 3);
+			if (c[0] == k->def && c[1] == k->def && c[2] == k->def)
+				continue;
+			sb_put(b, " ");
+			sb_put(b, k->name);
+			sb_put(b, "=");
+			sb_num(b, c[0]);
+			sb_put(b, ",");
+			sb_num(b, c[1]);
+			sb_put(b, ",");
+			sb_num(b, c[2]);
+			continue;
+		}
 		if (k->type == RT_KEY_PAIR) {
 			const double *uv = (const double *)(const void *)((const char *)o + k->offset);
 			if (uv[0] == k->def && uv[1] == k->def)

@@ -57,13 +57,18 @@ const command command_table[] = {
 	{"view", NULL, "view", 0, 0, {NULL},
 	 "full-screen key mode: arrow keys move the camera or a selected object on a fast preview; Esc returns",
 	 cmd_view},
+	{"turntable", NULL, "turntable [SECONDS]", 0, 1, {NULL},
+	 "key mode with the camera spinning about the scene's centre, a turn in SECONDS (8); any key stops it",
+	 cmd_turntable},
 	{"show", NULL, "show [COLUMNS]", 0, 1, {NULL},
 	 "print the picture on standard output (half blocks; plain characters without colour)", cmd_show},
 	{"source", ".", "source FILE", 1, 1, {"@file"}, "run a command file", cmd_source},
 	{"help", "?", "help [COMMAND]", 0, 1, {"@command"}, "the commands, or one command's usage",
 	 cmd_help},
 	{"clear", NULL, "clear", 0, 0, {NULL}, "clear the command area", cmd_clear},
-	{"quit", "exit", "quit", 0, 0, {NULL}, "leave rtsh (Ctrl-D too); the terminal is restored",
+	{"quit", "exit", "quit\nquit!", 0, 0, {NULL},
+	 "leave rtsh (Ctrl-D too); the terminal is restored. With edits not saved as .rt, asks once (quit or\n"
+	 "Ctrl-D again leaves); quit! does not ask, nor do -q and command files",
 	 cmd_quit},
 };
 const size_t command_count = sizeof command_table / sizeof command_table[0];

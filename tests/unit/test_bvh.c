@@ -7,7 +7,7 @@
  * in one point, huge coordinates, rays in the planes of the boxes). */
 #include "testutil.h"
 
-#include "core/bvh.h"
+#include "core/bvh/bvh.h"
 #include "rtsh/generate.h"
 #include "rtsh/world.h"
 

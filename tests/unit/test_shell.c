@@ -177,7 +177,8 @@ static void test_completion(void **state)
 	/* the keys after set come from the reader's table (rtfile.h) */
 	assert_candidates(complete_at_end(sh, "object 1 set ", &files),
 	                  "twist= fuzz= metal= ior= emit= checker= tube= texture= normalmap= bump= bumpscale= "
-	                  "uvscale= uvoffset= smooth= crease=");
+	                  "uvscale= uvoffset= roughness= metallic= transmission= thin= att_color= att_dist= clearcoat= "
+	                  "clearcoat_roughness= specular_factor= specular_color= emit_color= smooth= crease=");
 	assert_candidates(complete_at_end(sh, "object 1 move ", &files), "");
 	assert_candidates(complete_at_end(sh, "obj 2 r", &files), "rotate");
 	assert_candidates(complete_at_end(sh, "light ", &files), "1 2 3");

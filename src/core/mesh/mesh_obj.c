@@ -14,7 +14,9 @@
 #include <string.h>
 
 #include "core/mesh/mesh_io.h"
+#include "rtsh/filesrc.h"
 #include "rtsh/mesh.h"
+#include "rtsh/srgb.h"
 
 typedef struct cursor {
 	const char *s, *end;
@@ -70,8 +72,7 @@ static mesh_mat mat_default(void)
 static double srgb_to_lin(double v)
 {
 	/* MTL colours are written as display values */
-	v = v < 0 ? 0 : v > 1 ? 1 : v;
-	return v <= 0.04045 ? v / 12.92 : pow((v + 0.055) / 1.055, 2.4);
+	return srgb_to_linear(v < 0 ? 0 : v > 1 ? 1 : v);
 }
 
 /* A map statement's file: the last word, after options such as -bm 0.5. */
@@ -118,7 +119,7 @@ static char *map_file(cursor *c, const char *dir, float *bm)
 static bool read_mtl(mesh_builder *b, const char *path, const char *dir)
 {
 	size_t len;
-	char *buf = file_slurp(path, "material library", &len, NULL);
+	char *buf = rt_file_read(path, "material library", &len, NULL);
 	if (!buf)
 		return true; /* a missing library leaves the defaults */
 	mesh_mat *cur = NULL;
@@ -384,7 +385,7 @@ mesh *mesh_parse_obj(const char *name, const char *dir, const char *buf, size_t 
 mesh *mesh_read_obj(const char *path, rt_error *err)
 {
 	size_t len;
-	char *buf = file_slurp(path, "model", &len, err);
+	char *buf = rt_file_read(path, "model", &len, err);
 	if (!buf)
 		return NULL;
 	char *dir = path_dir(path);

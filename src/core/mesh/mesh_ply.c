@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "core/mesh/mesh_io.h"
+#include "rtsh/filesrc.h"
 #include "rtsh/mesh.h"
 
 enum { T_NONE, T_I8, T_U8, T_I16, T_U16, T_I32, T_U32, T_F32, T_F64 };
@@ -459,7 +460,7 @@ fail:
 mesh *mesh_read_ply(const char *path, rt_error *err)
 {
 	size_t len;
-	char *buf = file_slurp(path, "model", &len, err);
+	char *buf = rt_file_read(path, "model", &len, err);
 	if (!buf)
 		return NULL;
 	mesh *m = mesh_parse_ply(path, buf, len, err);

@@ -40,7 +40,7 @@
 #define HAVE_AVX2_WALK 1
 #endif
 
-#include "core/bvh.h"
+#include "core/bvh/bvh.h"
 #include "rtsh/mesh.h"
 
 /* The ray o + t d, in floats, made ready for the walk's box tests: written

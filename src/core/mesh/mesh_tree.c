@@ -13,7 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "core/bvh.h"
+#include "core/bvh/bvh.h"
 #include "rtsh/mesh.h"
 
 /* SAH cost of a node visit in block tests: 8-wide nodes cost about two

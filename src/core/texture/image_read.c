@@ -17,8 +17,10 @@
 #include <X11/xpm.h>
 #include <stb/stb_image.h>
 
-#include "core/mesh/mesh_io.h"
+#include "base/readhelp.h"
+#include "rtsh/filesrc.h"
 #include "rtsh/memory.h"
+#include "rtsh/srgb.h"
 #include "rtsh/texture.h"
 
 /* Images larger than this (in pixels) are refused. */
@@ -53,17 +55,12 @@ bool image_format_known(const char *path)
 	return format_of(path) != F_NONE;
 }
 
-static float srgb_decode(double v)
-{
-	return (float)(v <= 0.04045 ? v / 12.92 : pow((v + 0.055) / 1.055, 2.4));
-}
-
 /* 8-bit codes to floats, through a table */
 static void codes_to_float(const unsigned char *in, size_t n, int comp, bool srgb, float *out)
 {
 	float lut[256];
 	for (int i = 0; i < 256; i++)
-		lut[i] = srgb ? srgb_decode(i / 255.0) : (float)(i / 255.0);
+		lut[i] = srgb ? (float)srgb8_to_linear(i) : (float)(i / 255.0);
 	for (size_t i = 0; i < n; i++)
 		for (int c = 0; c < 3; c++)
 			out[3 * i + c] = lut[in[i * (size_t)comp + (comp >= 3 ? c : 0)]];
@@ -234,7 +231,7 @@ static float *read_ppm(const char *path, const unsigned char *buf, size_t len, b
 				return NULL;
 			}
 			double f = (double)(v < 0 ? 0 : v > maxv ? maxv : v) / (double)maxv;
-			float lf = srgb ? srgb_decode(f) : (float)f;
+			float lf = srgb ? (float)srgb_to_linear(f) : (float)f;
 			if (comp == 1)
 				out[3 * i] = out[3 * i + 1] = out[3 * i + 2] = lf;
 			else
@@ -356,7 +353,7 @@ static bool xpm_color(const char *s, float rgb[3], bool srgb)
 			c[k] = names[i].c[k];
 	}
 	for (int k = 0; k < 3; k++)
-		rgb[k] = srgb ? srgb_decode(c[k] / 255.0) : (float)(c[k] / 255.0);
+		rgb[k] = srgb ? (float)srgb_to_linear(c[k] / 255.0) : (float)(c[k] / 255.0);
 	return true;
 }
 
@@ -477,7 +474,7 @@ float *image_load_rgb(const char *path, bool srgb, int *w, int *h, rt_error *err
 	if (format_of(path) == F_NONE)
 		return image_decode_rgb(path, NULL, 0, srgb, w, h, err);
 	size_t len;
-	char *buf = file_slurp(path, "image", &len, err);
+	char *buf = rt_file_read(path, "image", &len, err);
 	if (!buf)
 		return NULL;
 	float *out = image_decode_rgb(path, (const unsigned char *)buf, len, srgb, w, h, err);

@@ -25,7 +25,10 @@
 #endif
 
 #include "rtsh/error.h"
-#include "rtsh/world.h"
+#include "rtsh/math.h"
+
+/* The 4-wide tree (world.h names it; world.c walks it). */
+typedef struct bvh bvh;
 
 /* Deepest binary tree the builder makes; the 4-wide tree is no deeper, and
  * a walk holds at most 3 entries per level on its stack. */
@@ -178,13 +181,5 @@ double bvh_fbox_half_area(const bvh_fbox *b);
  * set) when out of memory or n is too large. */
 bvh *bvh_build(const box *bounds, const float *costs, size_t n, uint32_t *order, rt_error *err);
 void bvh_free(bvh *t);
-
-/* For the benchmark (bench/bench.c): the rays world_intersect and
- * world_occluded traced in the calling thread since the last reset (a
- * thread-local count, so no cache line is shared between threads), and the
- * bytes a world holds beyond its struct. */
-void world_rays_reset(void);
-uint64_t world_rays_traced(void);
-size_t world_memory(const world *w);
 
 #endif

@@ -52,6 +52,17 @@ material material_default(vec3 color)
 	};
 }
 
+material_pbr material_pbr_absent(void)
+{
+	return (material_pbr){
+		.roughness = -1.0,
+		.att_color = {255.0, 255.0, 255.0},
+		.specular_factor = 1.0,
+		.specular_color = {255.0, 255.0, 255.0},
+		.emit_color = {-1.0, -1.0, -1.0},
+	};
+}
+
 scene *scene_new(void)
 {
 	scene *s = calloc(1, sizeof(scene));
@@ -120,7 +131,8 @@ static bool material_equal(const material *a, const material *b)
 	       a->checker == b->checker && a->texture == b->texture && a->normalmap == b->normalmap &&
 	       a->bump == b->bump && a->bumpscale == b->bumpscale && a->uvscale[0] == b->uvscale[0] &&
 	       a->uvscale[1] == b->uvscale[1] && a->uvoffset[0] == b->uvoffset[0] &&
-	       a->uvoffset[1] == b->uvoffset[1];
+	       a->uvoffset[1] == b->uvoffset[1] &&
+	       a->pbr == b->pbr;
 }
 
 bool object_equal(const object *a, const object *b)

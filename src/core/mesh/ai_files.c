@@ -1,7 +1,7 @@
-/* rtsh — where the core reads the files a scene references (filesrc.h). */
-#include "rtsh/filesrc.h"
+/* rtsh — assimp opens a model's files (the model, a .gltf's buffers)
+ * through the scene's file source (rt_file_read, rtsh/filesrc.h). */
+#include "core/mesh/mesh_io.h"
 
-#include <stdatomic.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -11,30 +11,7 @@
 #include <assimp/cimport.h>
 #include <assimp/scene.h>
 
-static _Atomic(const rt_file_source *) source;
-
-void rt_file_source_set(const rt_file_source *src)
-{
-	atomic_store(&source, src);
-}
-
-char *rt_file_read(const char *path, const char *what, size_t *len, rt_error *err)
-{
-	const rt_file_source *s = atomic_load(&source);
-	if (s && s->read)
-		return s->read(s->ctx, path, what, len, err);
-	return rt_file_read_disk(path, what, len, err);
-}
-
-int rt_file_stat(const char *path, struct stat *st)
-{
-	const rt_file_source *s = atomic_load(&source);
-	if (s && s->stat)
-		return s->stat(s->ctx, path, st);
-	return stat(path, st);
-}
-
-/* --- assimp's files through rt_file_read --- */
+#include "rtsh/filesrc.h"
 
 /* One import: the model's bytes, read once before assimp starts. */
 typedef struct ai_job {

@@ -1,5 +1,5 @@
-/* rtsh — file and number helpers of the model and image readers. */
-#include "core/mesh/mesh_io.h"
+/* rtsh — path and number helpers of the model and image readers (readhelp.h). */
+#include "base/readhelp.h"
 
 #include <errno.h>
 #include <math.h>
@@ -9,63 +9,6 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "rtsh/filesrc.h"
-#include "rtsh/memory.h"
-
-/* Files larger than this are refused rather than read. */
-#define SLURP_MAX ((size_t)4 << 30)
-
-/* Through the process's file source (rtsh/filesrc.h): rtsh-mpi serves the
- * bytes rank 0 read. */
-char *file_slurp(const char *path, const char *what, size_t *len, rt_error *err)
-{
-	return rt_file_read(path, what, len, err);
-}
-
-char *rt_file_read_disk(const char *path, const char *what, size_t *len, rt_error *err)
-{
-	FILE *f = fopen(path, "rb");
-	if (!f) {
-		rt_error_set(err, "%s: cannot read the %s: %s", path, what, strerror(errno));
-		return NULL;
-	}
-	struct stat st;
-	if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
-		fclose(f);
-		rt_error_set(err, "%s: cannot read the %s: not a regular file", path, what);
-		return NULL;
-	}
-	if ((unsigned long long)st.st_size > SLURP_MAX) {
-		fclose(f);
-		rt_error_set(err, "%s: the %s is %lld bytes; expected at most %zu", path, what,
-		             (long long)st.st_size, SLURP_MAX);
-		return NULL;
-	}
-	size_t n = (size_t)st.st_size;
-	char what_[300];
-	snprintf(what_, sizeof what_, "the %s %s", what, path);
-	if (!mem_check((double)n, what_, err)) {
-		fclose(f);
-		return NULL;
-	}
-	char *buf = malloc(n + 1);
-	if (!buf) {
-		fclose(f);
-		rt_error_set(err, "%s: out of memory reading the %s (%zu bytes)", path, what, n);
-		return NULL;
-	}
-	size_t got = fread(buf, 1, n, f);
-	bool bad = ferror(f);
-	fclose(f);
-	if (bad || got != n) {
-		free(buf);
-		rt_error_set(err, "%s: cannot read the %s: %s", path, what, bad ? strerror(errno) : "short read");
-		return NULL;
-	}
-	buf[n] = '\0';
-	*len = n;
-	return buf;
-}
 
 char *path_join(const char *dir, const char *rel)
 {

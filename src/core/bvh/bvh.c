@@ -27,7 +27,7 @@
  * The binary tree is then made wide: bvh2_gather lists a wide node's
  * children (world.c's trees are 4 wide, a mesh's 8, mesh_tree.c).
  */
-#include "bvh.h"
+#include "core/bvh/bvh.h"
 
 #include <stdlib.h>
 #include <string.h>

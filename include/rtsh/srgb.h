@@ -1,0 +1,22 @@
+/* rtsh — sRGB (IEC 61966-2-1), the one place it is decoded and encoded
+ * (base layer, src/base/srgb.c). Scene colours, MTL colours, 8-bit
+ * textures and PPM files are sRGB; the renderer works in linear light. */
+#ifndef RTSH_SRGB_H
+#define RTSH_SRGB_H
+
+#include <stdint.h>
+
+#include "rtsh/math.h"
+
+/* A display value in [0,1] to linear light (not clamped). */
+double srgb_to_linear(double v);
+/* An sRGB code 0..255, not necessarily whole, to linear: srgb_to_linear(code
+ * / 255); whole codes come from a table of the same bits. */
+double srgb8_to_linear(double code);
+/* The three channels of an sRGB colour 0..255 to linear. */
+vec3 srgb255_to_linear(vec3 c);
+/* Linear [0,1] to 8-bit sRGB, rounded, clamped; exact inverse of srgb8_to_linear
+ * on the 256 codes. */
+uint8_t linear_to_srgb8(double v);
+
+#endif
