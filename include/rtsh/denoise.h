@@ -10,24 +10,29 @@
  * taken (first hits only), so that the features of an edge pixel are as
  * well antialiased as that many samples would make its colour.
  *
- * denoise_image filters the noisy radiance with the edge-avoiding a-trous
- * wavelet transform (Dammertz, Sewtz, Hanika & Lensch, "Edge-avoiding
- * A-Trous wavelet transform for fast global illumination filtering", HPG
- * 2010): five passes of a 3x3 B-spline kernel whose taps lie 1, 2, 4, 8
- * and 16 pixels apart, each tap weighted down by how much its normal,
- * albedo, depth and brightness differ from the centre's. As in SVGF (Schied
- * et al., "Spatiotemporal variance-guided filtering", HPG 2017) the
- * radiance is divided by the albedo first (textures are not blurred, only
- * the lighting), depth is compared along its own gradient (slanted planes
- * are one surface), and brightness differences are measured against a
- * per-pixel estimate of the noise that each pass carries along, so that
- * converged pixels are left alone and shadow edges stay. From the second
- * pass on, each pass fits a plane to its weighted taps (first-order
- * regression) rather than taking their mean, so that where an edge cuts
- * the taps off on one side a gradient of the lighting is not flattened.
- * Last, a pixel that is part one surface, part another is regressed on the
- * features of its 3x3 window: it gets the mix of its neighbours' filtered
- * colours that its features say.
+ * A lamp's albedo feature is its emission, far from any surface's, so that
+ * no filter mixes a lamp with what lies next to it. The job also keeps the
+ * mean radiance and squared brightness of the even-numbered samples: with
+ * those of all of them they split the samples into two independent halves.
+ *
+ * denoise_image is a feature regression after NFOR (Bitterli et al.,
+ * "Nonlinearly Weighted First-order Regression for Denoising Monte Carlo
+ * Renderings", EGSR 2016), with its colour weights left out. The radiance is divided by
+ * the albedo (textures are not blurred, only the lighting); around each
+ * pixel a first-order model of the lighting in screen position, normal and
+ * depth is fitted by least squares over 9x9 pixels, each weighted by how
+ * alike its albedo, normal and depth (off the pixel's plane) are to the
+ * pixel's, and evaluated at the pixel. No weight depends on the noise, so
+ * the fit of each half depends on that half's samples alone, and the other
+ * half's raw pixel estimates the fit's squared error without bias (NFOR's
+ * cross-buffer estimate: half a's fit against half b's pixel is off by a's
+ * error plus b's noise, whose variance the samples give). Per pixel the fit
+ * or the raw pixel is kept, whichever the estimate, averaged over 9x9
+ * pixels, says is closer: shadows and highlights the features do not see
+ * stay sharp. Last, a pixel that is part one surface, part another is
+ * regressed on the features of its 3x3 window: it gets the mix of its
+ * neighbours that its features say. With one sample there are no halves:
+ * the fit is taken.
  *
  * The result depends only on the image and its features, never on the
  * number of threads.
