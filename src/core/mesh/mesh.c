@@ -100,14 +100,25 @@ bool mb_triangle(mesh_builder *b, int32_t c[3][3])
 	return true;
 }
 
+bool mb_texture(mesh_builder *b, texture *t)
+{
+	if (!grow((void **)&b->texs, &b->ctexs, b->ntexs + 1, sizeof *b->texs)) {
+		texture_free(t);
+		return false;
+	}
+	b->texs[b->ntexs++] = t;
+	return true;
+}
+
+/* The embedded textures are the mesh's (texs), not the material's. */
 static void mat_free(mesh_mat *m)
 {
 	free(m->name);
 	free(m->map_kd);
 	free(m->map_bump);
 	free(m->map_norm);
-	texture_free(m->tex_kd);
-	texture_free(m->tex_norm);
+	free(m->map_mr);
+	free(m->map_emit);
 }
 
 void mb_free(mesh_builder *b)
@@ -120,6 +131,9 @@ void mb_free(mesh_builder *b)
 	for (size_t i = 0; i < b->nmats; i++)
 		mat_free(&b->mats[i]);
 	free(b->mats);
+	for (size_t i = 0; i < b->ntexs; i++)
+		texture_free(b->texs[i]);
+	free(b->texs);
 	memset(b, 0, sizeof *b);
 }
 
@@ -242,6 +256,10 @@ mesh *mb_finish(mesh_builder *b, rt_error *err)
 	m->mats = b->mats;
 	b->mats = NULL;
 	b->nmats = 0;
+	m->ntexs = (uint32_t)b->ntexs;
+	m->texs = b->texs;
+	b->texs = NULL;
+	b->ntexs = 0;
 	if (m->nmats > 1) {
 		m->tmat = b->fm;
 		b->fm = NULL;
@@ -287,6 +305,9 @@ void mesh_free(mesh *m)
 	for (uint32_t i = 0; i < m->nmats; i++)
 		mat_free(&m->mats[i]);
 	free(m->mats);
+	for (uint32_t i = 0; i < m->ntexs; i++)
+		texture_free(m->texs[i]);
+	free(m->texs);
 	free(m->nodes);
 	free(m->blk);
 	free(m->btri);
@@ -316,8 +337,8 @@ size_t mesh_memory(const mesh *m)
 		n += (size_t)m->ntris * sizeof *m->tmat;
 	n += (size_t)m->nnodes * sizeof *m->nodes;
 	n += (size_t)m->nblk * (sizeof *m->blk + sizeof *m->btri);
-	for (uint32_t i = 0; i < m->nmats; i++)
-		n += tex_bytes(m->mats[i].tex_kd) + tex_bytes(m->mats[i].tex_norm);
+	for (uint32_t i = 0; i < m->ntexs; i++)
+		n += tex_bytes(m->texs[i]);
 	return n;
 }
 
@@ -592,7 +613,9 @@ mesh *mesh_load(const char *path, rt_error *err)
 		m = mesh_read_obj(path, err);
 	else if (strcasecmp(e, "ply") == 0)
 		m = mesh_read_ply(path, err);
-	else if (strcasecmp(e, "gltf") == 0 || strcasecmp(e, "glb") == 0 || strcasecmp(e, "stl") == 0)
+	else if (strcasecmp(e, "gltf") == 0 || strcasecmp(e, "glb") == 0)
+		m = mesh_read_gltf(path, err);
+	else if (strcasecmp(e, "stl") == 0)
 		m = mesh_read_assimp(path, err);
 	else {
 		rt_error_set(err, "%s: unknown model format \".%s\"; expected .obj, .ply, .gltf, .glb or .stl",
