@@ -82,7 +82,9 @@ struct keymode {
 	double step;
 
 	km_sel sel;
-	bool run_open;         /* an undo group is open for the edits since the last pause */
+	bool run_open;         /* an undo group is open: typed keys since the last pause, a drag, a turn */
+	int run_key;           /* what opened it: a key, KEYS_MOUSE (a drag), KEYS_NONE (the turntable) */
+	km_sel run_sel;
 	double last_edit;      /* when the last edit key came */
 
 	km_cur cur;
@@ -747,10 +749,13 @@ void keymode_key(keymode *km, int key)
 	if (keymode_is_edit(a.op)) {
 		/* Edit keys without a pause in typing between them (whichever
 		 * keys, whichever selection) undo as one step. */
-		if (!(km->run_open && km->last_key - km->last_edit < KEYMODE_STEP_PAUSE)) {
+		if (!(km->run_open && km->run_key != KEYS_MOUSE && km->run_key != KEYS_NONE &&
+		      km->last_key - km->last_edit < KEYMODE_STEP_PAUSE)) {
 			km_close_run(km);
 			editor_group_begin(sh->ed);
 			km->run_open = true;
+			km->run_key = key;
+			km->run_sel = km->sel;
 		}
 		km->last_edit = km->last_key;
 		uint64_t gen = editor_generation(sh->ed);
