@@ -25,6 +25,7 @@
 #include "mpi/farm.h"
 #include "mpi/fileset.h"
 #include "mpi/wire.h"
+#include "rtsh/denoise.h"
 #include "rtsh/image.h"
 #include "rtsh/render.h"
 #include "rtsh/rtfile.h"
@@ -209,6 +210,13 @@ static void setup(int argc, char **argv, job_config *c, fileset *files, world **
 	}
 	free((*fb)->sum); /* one pass: no running sums, as render_image */
 	(*fb)->sum = NULL;
+	if (farm_denoises(&c->set) && !denoise_prepare(*fb)) {
+		fprintf(stderr, "%s: out of memory for the denoiser's features of a %dx%d image\n", o.scene,
+		        c->set.width, c->set.height);
+		fb_free(*fb);
+		*fb = NULL;
+		goto out;
+	}
 	c->progress = !o.quiet && watched();
 	*output = o.output;
 	c->status = -1;
@@ -537,7 +545,11 @@ int main(int argc, char **argv)
 	int status = 0;
 	if (rank == 0) {
 		double rendered = MPI_Wtime() - t0;
-		if (!image_write(output, fb, c.set.exposure, &err)) {
+		fb->spp = c.set.samples;
+		if (fb->feat && !denoise_image(fb, fb->rgb, render_threads(&c.set))) {
+			fprintf(stderr, "%s: out of memory denoising a %dx%d image\n", output, fb->w, fb->h);
+			status = 1;
+		} else if (!image_write(output, fb, c.set.exposure, &err)) {
 			char msg[MSG_MAX];
 			rt_error_format(&err, msg, sizeof msg);
 			fprintf(stderr, "%s\n", msg);
