@@ -16,7 +16,7 @@
 
 scene *rt_load_model(const char *path, const rt_load_opts *opts, rt_error *err)
 {
-	mesh *m = mesh_cache_get(path, true, 60, err);
+	mesh *m = mesh_cache_get(path, true, 60, opts ? opts->cancel : NULL, err);
 	if (!m)
 		return NULL;
 	vec3 ext = v3_sub(m->bounds.hi, m->bounds.lo);
