@@ -147,8 +147,7 @@ bool shell_run_line(shell *sh, const char *line);
  * returns false. */
 bool shell_run_text(shell *sh, const char *text, const char *name, bool count_commands);
 /* The longest command line, in bytes without its newline, that a command
- * file, source, standard input or the prompt may hold (rtsh(1)); -c text is
- * bounded by the system's limit on one argument instead. */
+ * file, -c, source, standard input or the prompt may hold (rtsh(1)). */
 #define SHELL_LINE_MAX 65536
 #define SHELL_LINE_MAX_TEXT "65536"
 /* Runs a command file ("-" or "/dev/stdin" = standard input; any other
