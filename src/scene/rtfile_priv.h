@@ -68,4 +68,7 @@ typedef struct rt_numloc {
 void rt_numloc_enter(rt_numloc *l);
 void rt_numloc_leave(rt_numloc *l);
 
+/* True when name ends in ".rt" (strict mode asks for it). */
+bool rt_name_is_rt(const char *name);
+
 #endif
