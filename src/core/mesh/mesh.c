@@ -1,43 +1,21 @@
 /* rtsh — meshes: the builder the readers share, welding, normals, the tree
- * and the cache (mesh.h). */
+ * (mesh.h); mesh_load.c reads them by format and caches them. */
 #include "rtsh/mesh.h"
 
 #include <ctype.h>
 #include <errno.h>
 #include <float.h>
-#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
-#include <sys/stat.h>
 
 #include "core/bvh/bvh.h"
-#include "rtsh/filesrc.h"
 #include "rtsh/memory.h"
 #include "rtsh/texture.h"
 
 /* --- the builder --- */
 
-static bool grow(void **a, size_t *cap, size_t need, size_t size)
-{
-	if (need <= *cap)
-		return true;
-	size_t c = *cap ? *cap : 64;
-	while (c < need) {
-		if (c > SIZE_MAX / 2 / size)
-			return false;
-		c *= 2;
-	}
-	void *p = realloc(*a, c * size);
-	if (!p)
-		return false;
-	*a = p;
-	*cap = c;
-	return true;
-}
-
-/* grow, for a builder's array: the builder's bytes after the growth are
+/* mem_grow, for a builder's array: the builder's bytes after the growth are
  * checked against the memory limit first. */
 static bool bgrow(mesh_builder *b, void **a, size_t *cap, size_t need, size_t size)
 {
@@ -54,7 +32,7 @@ static bool bgrow(mesh_builder *b, void **a, size_t *cap, size_t need, size_t si
 		return false;
 	}
 	size_t old = *cap;
-	if (!grow(a, cap, need, size))
+	if (!mem_grow(a, cap, need, size))
 		return false;
 	b->bytes += (*cap - old) * size;
 	return true;
@@ -102,7 +80,7 @@ bool mb_triangle(mesh_builder *b, int32_t c[3][3])
 
 bool mb_texture(mesh_builder *b, texture *t)
 {
-	if (!grow((void **)&b->texs, &b->ctexs, b->ntexs + 1, sizeof *b->texs)) {
+	if (!mem_grow((void **)&b->texs, &b->ctexs, b->ntexs + 1, sizeof *b->texs)) {
 		texture_free(t);
 		return false;
 	}
@@ -584,137 +562,4 @@ void mesh_surface(const mesh *m, uint32_t slot, const float b[3], mesh_surf *s)
 			s->dpdv = v3_scale(v3_sub(v3_scale(e2, du1), v3_scale(e1, du2)), 1.0 / det);
 		}
 	}
-}
-
-/* --- loading by extension, and the cache --- */
-
-static const char *ext_of(const char *path)
-{
-	const char *slash = strrchr(path, '/');
-	const char *dot = strrchr(slash ? slash : path, '.');
-	return dot ? dot + 1 : "";
-}
-
-bool mesh_format_known(const char *path)
-{
-	static const char *const known[] = {"obj", "ply", "gltf", "glb", "stl"};
-	const char *e = ext_of(path);
-	for (size_t i = 0; i < sizeof known / sizeof known[0]; i++)
-		if (strcasecmp(e, known[i]) == 0)
-			return true;
-	return false;
-}
-
-mesh *mesh_load(const char *path, rt_error *err)
-{
-	const char *e = ext_of(path);
-	mesh *m;
-	if (strcasecmp(e, "obj") == 0)
-		m = mesh_read_obj(path, err);
-	else if (strcasecmp(e, "ply") == 0)
-		m = mesh_read_ply(path, err);
-	else if (strcasecmp(e, "gltf") == 0 || strcasecmp(e, "glb") == 0)
-		m = mesh_read_gltf(path, err);
-	else if (strcasecmp(e, "stl") == 0)
-		m = mesh_read_assimp(path, err);
-	else {
-		rt_error_set(err, "%s: unknown model format \".%s\"; expected .obj, .ply, .gltf, .glb or .stl",
-		             path, e);
-		return NULL;
-	}
-	if (m && !m->path) {
-		m->path = strdup(path);
-		if (!m->path) {
-			mesh_free(m);
-			rt_error_set(err, "%s: out of memory", path);
-			return NULL;
-		}
-	}
-	return m;
-}
-
-typedef struct cache_entry {
-	mesh *m;
-	char *path;
-	bool smooth;
-	double crease;
-	off_t size;
-	struct timespec mtime;
-} cache_entry;
-
-static pthread_mutex_t cache_lock = PTHREAD_MUTEX_INITIALIZER;
-static cache_entry *cache;
-static size_t ncache, ccache;
-
-mesh *mesh_cache_get(const char *path, bool smooth, double crease_deg, rt_error *err)
-{
-	struct stat st;
-	if (rt_file_stat(path, &st) != 0) {
-		rt_error_set(err, "%s: cannot read the model: %s", path, strerror(errno));
-		return NULL;
-	}
-	if (!smooth)
-		crease_deg = 0;
-	pthread_mutex_lock(&cache_lock);
-	for (size_t i = 0; i < ncache; i++) {
-		cache_entry *c = &cache[i];
-		if (strcmp(c->path, path) == 0 && c->smooth == smooth && c->crease == crease_deg &&
-		    c->size == st.st_size && c->mtime.tv_sec == st.st_mtim.tv_sec &&
-		    c->mtime.tv_nsec == st.st_mtim.tv_nsec) {
-			c->m->refs++;
-			pthread_mutex_unlock(&cache_lock);
-			return c->m;
-		}
-	}
-	pthread_mutex_unlock(&cache_lock);
-	mesh *m = mesh_load(path, err);
-	if (!m)
-		return NULL;
-	if (!mesh_prepare(m, smooth, crease_deg, err)) {
-		mesh_free(m);
-		return NULL;
-	}
-	pthread_mutex_lock(&cache_lock);
-	char *p = strdup(path);
-	if (!p || !grow((void **)&cache, &ccache, ncache + 1, sizeof *cache)) {
-		pthread_mutex_unlock(&cache_lock);
-		free(p);
-		mesh_free(m);
-		rt_error_set(err, "%s: out of memory", path);
-		return NULL;
-	}
-	m->refs = 1;
-	cache[ncache++] = (cache_entry){m, p, smooth, crease_deg, st.st_size, st.st_mtim};
-	pthread_mutex_unlock(&cache_lock);
-	return m;
-}
-
-/* Meshes nobody uses stay cached (a world is rebuilt on every edit, and the
- * next one usually wants the same models) unless the cache holds more than
- * this many unused ones, when the unused are dropped. */
-#define CACHE_KEEP 8
-
-void mesh_cache_put(mesh *m)
-{
-	if (!m)
-		return;
-	pthread_mutex_lock(&cache_lock);
-	if (m->refs > 0)
-		m->refs--;
-	size_t unused = 0;
-	for (size_t i = 0; i < ncache; i++)
-		unused += cache[i].m->refs == 0;
-	if (unused > CACHE_KEEP) {
-		size_t j = 0;
-		for (size_t i = 0; i < ncache; i++) {
-			if (cache[i].m->refs == 0) {
-				mesh_free(cache[i].m);
-				free(cache[i].path);
-			} else {
-				cache[j++] = cache[i];
-			}
-		}
-		ncache = j;
-	}
-	pthread_mutex_unlock(&cache_lock);
 }
