@@ -82,9 +82,10 @@ struct keymode {
 	double step;
 
 	km_sel sel;
-	bool run_open;         /* an undo group for a run of one key is open */
-	int run_key;
+	bool run_open;         /* an undo group is open: typed keys since the last pause, a drag, a turn */
+	int run_key;           /* what opened it: a key, KEYS_MOUSE (a drag), KEYS_NONE (the turntable) */
 	km_sel run_sel;
+	double last_edit;      /* when the last edit key came */
 
 	km_cur cur;
 	bool want_fast, want_refine; /* a render to start */
@@ -746,14 +747,17 @@ void keymode_key(keymode *km, int key)
 		return;
 	km->last_key = now();
 	if (keymode_is_edit(a.op)) {
-		if (!(km->run_open && km->run_key == key && km->run_sel.kind == km->sel.kind &&
-		      km->run_sel.index == km->sel.index)) {
+		/* Edit keys without a pause in typing between them (whichever
+		 * keys, whichever selection) undo as one step. */
+		if (!(km->run_open && km->run_key != KEYS_MOUSE && km->run_key != KEYS_NONE &&
+		      km->last_key - km->last_edit < KEYMODE_STEP_PAUSE)) {
 			km_close_run(km);
 			editor_group_begin(sh->ed);
 			km->run_open = true;
 			km->run_key = key;
 			km->run_sel = km->sel;
 		}
+		km->last_edit = km->last_key;
 		uint64_t gen = editor_generation(sh->ed);
 		rt_error err;
 		if (!keymode_apply(sh->ed, &a, &err))

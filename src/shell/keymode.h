@@ -59,6 +59,8 @@
  * after the last key before the picture is refined. */
 #define KEYMODE_FRAME_BUDGET 0.025
 #define KEYMODE_IDLE 0.15
+/* Edits with no pause this long (seconds) between them undo as one step. */
+#define KEYMODE_STEP_PAUSE 1.0
 /* Seconds: the length the refine's passes aim at (after a first of one
  * sample). */
 #define KEYMODE_PASS_SECONDS 0.2
