@@ -19,6 +19,8 @@ char *rt_model_text(const char *path, size_t *len, rt_error *err)
 	mesh *m = mesh_cache_get(path, true, 60, err);
 	if (!m)
 		return NULL;
+	if (m->warning) /* a missing material library, say */
+		rt_warn(opts ? opts->warn : NULL, NULL, 0, 0, "%s", m->warning);
 	vec3 ext = v3_sub(m->bounds.hi, m->bounds.lo);
 	mesh_cache_put(m);
 	double longest = v3_max_comp(ext);
