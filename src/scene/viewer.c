@@ -14,7 +14,7 @@
 #include "rtsh/mesh.h"
 #include "rtsh/rtfile.h"
 
-char *rt_model_text(const char *path, size_t *len, rt_error *err)
+char *rt_model_text(const char *path, const rt_load_opts *opts, size_t *len, rt_error *err)
 {
 	mesh *m = mesh_cache_get(path, true, 60, err);
 	if (!m)
@@ -66,7 +66,7 @@ char *rt_model_text(const char *path, size_t *len, rt_error *err)
 scene *rt_load_model(const char *path, const rt_load_opts *opts, rt_error *err)
 {
 	size_t n;
-	char *text = rt_model_text(path, &n, err);
+	char *text = rt_model_text(path, opts, &n, err);
 	if (!text)
 		return NULL;
 	scene *s = rt_load_string(text, n, path, opts, err);

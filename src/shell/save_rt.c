@@ -71,7 +71,7 @@ bool save_rt(shell *sh, const char *path, rt_error *err)
 	/* The model viewer's scene was made from the model: its text is made
 	 * again (the comment, the lines in their order). */
 	rt_error merr;
-	char *src = mesh_format_known(label) ? rt_model_text(label, &len, &merr) : read_source(label, &len);
+	char *src = mesh_format_known(label) ? rt_model_text(label, NULL, &len, &merr) : read_source(label, &len);
 	rt_keep_source = label; /* its folder resolves model and texture names */
 	bool ok = rt_save_keeping(&s, src, len, path, err);
 	rt_keep_source = NULL;
