@@ -1133,12 +1133,12 @@ static scene *rand_scene(test_rng *r)
 	}
 	int ncams = 1 + (int)trange(r, 0, 3);
 	for (int i = 0; i < ncams; i++) {
-		camera c = {rand_vec(r, -50, 50), rand_dir(r), trange(r, 1, 179)};
+		camera c = {rand_vec(r, -50, 50), rand_dir(r), trange(r, 1, 179), false, 0};
 		assert_true(scene_add_camera(s, &c, &err));
 	}
 	int nlights = (int)trange(r, 0, 4);
 	for (int i = 0; i < nlights; i++) {
-		light l = {rand_vec(r, -50, 50), trand(r), rand_color(r)};
+		light l = {.pos = rand_vec(r, -50, 50), .ratio = trand(r), .color = rand_color(r)};
 		assert_true(scene_add_light(s, &l, &err));
 	}
 	if (trand(r) < 0.3) {
