@@ -135,6 +135,9 @@ mesh *mesh_parse_ply(const char *name, const char *buf, size_t len, rt_error *er
 mesh *mesh_parse_gltf(const char *name, const char *dir, const char *buf, size_t len, rt_error *err);
 /* True when the extension is one mesh_load reads. */
 bool mesh_format_known(const char *path);
+/* The extensions mesh_load reads as a message lists them (".obj, .ply, ...
+ * or .stl"), into buf (truncated to size). */
+void mesh_format_list(char *buf, size_t size);
 
 /* Bytes a triangle takes at the peak of mesh_prepare, with the mesh it
  * holds (measured: 136-142 on a 1M-triangle torus, flat or smooth; the

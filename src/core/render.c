@@ -29,6 +29,7 @@ render_settings render_settings_default(void)
 		.seed = 1,
 		.exposure = 0.0,
 		.denoise = DENOISE_AUTO,
+		.symbols = 4, /* auto */
 	};
 }
 

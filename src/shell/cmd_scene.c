@@ -446,3 +446,13 @@ bool cmd_view(shell *sh, int argc, char **argv, const char *rest)
 	(void)argc, (void)argv, (void)rest;
 	return keymode_run(sh);
 }
+
+/* Key mode with the turntable on (keymode.c). */
+bool cmd_turntable(shell *sh, int argc, char **argv, const char *rest)
+{
+	(void)rest;
+	double seconds = KEYMODE_SPIN_SECONDS;
+	if (argc == 1 && !arg_number(sh, "turntable", argv[0], 0.5, 3600, &seconds))
+		return false;
+	return keymode_turntable(sh, seconds);
+}

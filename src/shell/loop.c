@@ -18,6 +18,7 @@
 #include <readline/history.h>
 #include <readline/readline.h>
 
+#include "shell/keymode.h"
 #include "shell/complete.h"
 #include "shell/history.h"
 #include "term/pager.h"
@@ -346,7 +347,8 @@ static void after_probe(shell *sh)
 	if (probe_seen || termout_get_state(o) == TERMOUT_PROBING)
 		return;
 	probe_seen = true;
-	if (sh->set.pixels != PIXELS_OFF && screen_set_pixels(sh->scr, sh->set.pixels)) {
+	bool sym = sh->set.symbols == SYMBOLS_AUTO && screen_set_symbols(sh->scr, sh->set.symbols);
+	if ((sh->set.pixels != PIXELS_OFF && screen_set_pixels(sh->scr, sh->set.pixels)) || sym) {
 		/* The answers told the cell size or, for auto, the protocol: the
 		 * screen was laid out again for it. */
 		shell_refresh(sh);
@@ -416,8 +418,13 @@ int shell_interactive(shell *sh, bool use_screen, const int wake[2])
 	/* After readline turned echo off, so the answers are not echoed. */
 	if (sh->scr && !getenv("RTSH_NO_PACING")) {
 		termout_ask_pixels(scr.out, sh->set.pixels != PIXELS_OFF);
+		termout_ask_version(scr.out, sh->set.symbols == SYMBOLS_AUTO);
 		termout_probe(scr.out, asked_color, now());
 	}
+
+	/* rtsh --turntable: key mode spinning from the start. */
+	if (sh->opt->turntable && sh->scr)
+		keymode_turntable(sh, KEYMODE_SPIN_SECONDS);
 
 	int status = 0;
 	while (!sh->quit) {

@@ -229,6 +229,8 @@ void shell_refresh(shell *sh)
 	}
 	/* A new pixels setting takes effect here; what the terminal answered
 	 * later, in the loop's after_probe. */
+	if (sh->set.symbols != sh->scr->symbols)
+		screen_set_symbols(sh->scr, sh->set.symbols);
 	if (sh->set.pixels == sh->scr->pixels || !screen_set_pixels(sh->scr, sh->set.pixels))
 		screen_layout(sh->scr, aspect_of(&sh->set), false);
 	if (sh->scr->img_w <= 0 || sh->scr->img_h <= 0) {
@@ -393,12 +395,22 @@ frame *shell_picture_frame(shell *sh, frame_palette pal, int cols)
 	const float *rgb;
 	int w, h;
 	framebuffer *fb = NULL;
-	if (sh->scr && sh->img.w > 0 && sh->img.rgb) {
+	/* The symbol set asked for, else the screen's (a file: half blocks). */
+	symbols_kind k = sh->set.symbols >= SYMBOLS_HALF && sh->set.symbols < SYMBOLS_AUTO
+	                     ? (symbols_kind)sh->set.symbols
+	                 : sh->scr && sh->scr->active ? sh->scr->sym
+	                                              : SYMBOLS_HALF;
+	if (pal == PALETTE_NONE)
+		k = SYMBOLS_HALF;
+	int sx = k == SYMBOLS_HALF ? 1 : SYMBOLS_SAMPLE_W, sy = k == SYMBOLS_HALF ? 2 : SYMBOLS_SAMPLE_H;
+	if (sh->scr && sh->img.w > 0 && sh->img.rgb && !sh->scr->pix_ops && sh->scr->sym == k) {
 		rgb = sh->img.rgb;
 		w = sh->img.w;
 		h = sh->img.h;
 	} else {
 		screen_fit(cols, 1000, aspect_of(&sh->set), pal == PALETTE_NONE, &w, &h);
+		w = w * sx;
+		h = h * sy / 2;
 		rsvc_hold(sh->rs);
 		rt_error err;
 		rt_error_clear(&err);
@@ -418,7 +430,7 @@ frame *shell_picture_frame(shell *sh, frame_palette pal, int cols)
 		}
 		rgb = fb->rgb;
 	}
-	frame *f = frame_new(w, (h + 1) / 2, pal);
+	frame *f = frame_new_symbols((w + sx - 1) / sx, (h + sy - 1) / sy, pal, k);
 	uint8_t *px = malloc((size_t)w * h * 3);
 	if (!f || !px) {
 		frame_free(f);

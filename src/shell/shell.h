@@ -146,7 +146,13 @@ bool shell_run_line(shell *sh, const char *line);
  * instead of lines. Reports the first error as "NAME:LINE: message" and
  * returns false. */
 bool shell_run_text(shell *sh, const char *text, const char *name, bool count_commands);
-/* Runs a command file ("-" = standard input). */
+/* The longest command line, in bytes without its newline, that a command
+ * file, -c, source, standard input or the prompt may hold (rtsh(1)). */
+#define SHELL_LINE_MAX 65536
+#define SHELL_LINE_MAX_TEXT "65536"
+/* Runs a command file ("-" or "/dev/stdin" = standard input; any other
+ * file that is not a regular one is refused unopened). A NUL byte or a line
+ * longer than SHELL_LINE_MAX ends it with "FILE:LINE: message". */
 bool shell_run_file(shell *sh, const char *path);
 /* Prints sh->err for an interactive command (not yet reported). */
 void shell_report(shell *sh);

@@ -152,6 +152,13 @@ static void compute_layout(screen *s)
 	s->img_y = (2 * s->pic_rows - s->img_h) / 2;
 	if (s->pal == PALETTE_NONE)
 		s->img_y &= ~1;
+	else if (s->sym != SYMBOLS_HALF) {
+		/* 2x4 samples a cell: the half blocks' canvas, twice as fine */
+		s->img_w *= 2;
+		s->img_h *= 2;
+		s->img_x *= 2;
+		s->img_y *= 2;
+	}
 }
 
 static void put(screen *s, const abuf *a)
@@ -190,7 +197,7 @@ static void open_encoder(screen *s)
 		if (s->pix_ops == &encoder_kitty)
 			kitty_shown = 1;
 		if (!s->enc)
-			s->enc = encoder_halfblock.open(&g);
+			s->enc = encoder_symbols(s->pix_ops ? SYMBOLS_HALF : s->sym)->open(&g);
 	}
 	if (s->out)
 		termout_set_picture(s->out, s->enc);
@@ -326,6 +333,7 @@ bool screen_layout(screen *s, double aspect, bool force)
 		s->enc->ops->clear(s->enc);
 	} else if (changed || force || !s->enc) {
 		if (!s->enc || s->enc->geom.cols != s->cols || s->enc->geom.rows != s->pic_rows ||
+		    (!s->pix_ops && s->enc->ops != encoder_symbols(s->sym)) ||
 		    s->enc->geom.pal != s->pal || s->enc->geom.cell_w != s->cell_w ||
 		    s->enc->geom.cell_h != s->cell_h)
 			open_encoder(s);
@@ -451,6 +459,26 @@ bool screen_set_pixels(screen *s, int mode)
 	if (s->active) {
 		if (kitty_shown)
 			screen_clear_all(s);
+		encoder_close(s->enc);
+		s->enc = NULL;
+		screen_layout(s, s->aspect, true);
+	}
+	return true;
+}
+
+bool screen_set_symbols(screen *s, int kind)
+{
+	s->symbols = kind;
+	symbols_kind k = kind >= SYMBOLS_HALF && kind <= SYMBOLS_AUTO ? (symbols_kind)kind : SYMBOLS_AUTO;
+	if (k == SYMBOLS_AUTO) {
+		const pixels_caps *c = s->out ? termout_pixels(s->out) : NULL;
+		k = symbols_choose(getenv("TERM_PROGRAM"), c && c->version[0] ? c->version : NULL,
+		                   getenv("VTE_VERSION"), getenv("TMUX") && *getenv("TMUX"));
+	}
+	if (k == s->sym)
+		return false;
+	s->sym = k;
+	if (s->active && !s->pix_ops) {
 		encoder_close(s->enc);
 		s->enc = NULL;
 		screen_layout(s, s->aspect, true);

@@ -2,7 +2,8 @@
  * scroll region of a few lines at the bottom for the prompt and the output
  * of commands.
  *
- *   row 0 .. pic_rows-1        the picture (half blocks, frame.h)
+ *   row 0 .. pic_rows-1        the picture (half blocks or another symbol
+ *                              set, frame.h; or real pixels, pixels.h)
  *   row status_row             the status line (reverse video)
  *   rows region_top .. rows-1  the scroll region (DECSTBM); the cursor lives
  *                              here, so readline and printf work as usual
@@ -44,8 +45,11 @@ typedef struct screen {
 	frame_palette pal;
 	double aspect;     /* width / height of the image */
 	int img_w, img_h;  /* the preview's size in pixels (0 when no picture) */
-	int img_x, img_y;  /* its place on the cols x 2*pic_rows pixel canvas */
+	int img_x, img_y;  /* its place on the encoder's canvas (half blocks:
+	                    * cols x 2*pic_rows pixels) */
 	encoder *enc;      /* the picture area's encoder */
+	int symbols;       /* symbols_kind asked for (screen_set_symbols) */
+	symbols_kind sym;  /* the symbol set in use (not SYMBOLS_AUTO) */
 	int pixels;        /* pixels_mode asked for (screen_set_pixels) */
 	const encoder_ops *pix_ops; /* the pixel encoder in use; NULL: half blocks */
 	int cell_w, cell_h; /* a cell in pixels (0: not known) */
@@ -89,6 +93,11 @@ void screen_set_palette(screen *s, frame_palette pal);
  * nothing, or the cell size in pixels is not known). Lays the screen out
  * again when the encoder changes; true then. */
 bool screen_set_pixels(screen *s, int mode);
+/* The cells' glyphs when not in real pixels (term/symbols.h): half,
+ * quadrant, sextant, octant or auto (symbols_choose on TERM_PROGRAM,
+ * VTE_VERSION and the XTVERSION answer of the start-up probe). Lays the
+ * screen out again when the set in use changes; true then. */
+bool screen_set_symbols(screen *s, int kind);
 /* Deletes the picture's kitty images now, if it showed any (they float
  * over text): before something else draws on the screen (key mode). */
 void screen_drop_images(screen *s);
