@@ -116,6 +116,7 @@ typedef struct mesh {
 	                      splits put one triangle in several leaves */
 	float eps;         /* self-hit guard in object units */
 	size_t refs;       /* users in the cache (mesh_cache_get) */
+	char *warning;     /* the reader's first warning ("FILE:LINE: ..."), NULL: none (owned) */
 } mesh;
 
 /* --- loading --- */
@@ -174,6 +175,7 @@ typedef struct mesh_builder {
 	uint16_t cur_mat;
 	size_t bytes;      /* what the arrays above hold */
 	bool over;         /* a growth was refused by the memory limit */
+	char *warning;     /* the first warning, handed to the mesh (owned) */
 	rt_error limit;    /* ... and how (memory.h) */
 } mesh_builder;
 

@@ -164,6 +164,8 @@ scene *rt_load_model(const char *path, const rt_load_opts *opts, rt_error *err)
 	mesh *m = mesh_cache_get(path, true, 60, err);
 	if (!m)
 		return NULL;
+	if (m->warning) /* a missing material library, say */
+		rt_warn(opts ? opts->warn : NULL, NULL, 0, 0, "%s", m->warning);
 	vec3 ext = v3_sub(m->bounds.hi, m->bounds.lo);
 	mesh_cache_put(m);
 	double longest = v3_max_comp(ext);

@@ -646,7 +646,13 @@ static void km_spin_step(keymode *km, double t)
 static void km_pick(keymode *km, int x, int y)
 {
 	const world *w = km_world(km);
-	double px = (x - 1) + 0.5 - km->kv.img_x, py = 2.0 * (y - 1) + 1.0 - km->kv.img_y;
+	/* canvas pixels a cell: 1x2 for half blocks, 2x4 for the other
+	 * symbol sets, the cell's size in real pixels */
+	int cw = km->kv.cols, ch = 2 * km->kv.pic_rows;
+	if (km->kv.enc)
+		km->kv.enc->ops->canvas(&km->kv.enc->geom, &cw, &ch);
+	double sx = km->kv.cols > 0 ? (double)cw / km->kv.cols : 1, sy = km->kv.pic_rows > 0 ? (double)ch / km->kv.pic_rows : 2;
+	double px = ((x - 1) + 0.5) * sx - km->kv.img_x, py = ((y - 1) + 0.5) * sy - km->kv.img_y;
 	if (!w || px < 0 || py < 0 || px >= km->kv.img_w || py >= km->kv.img_h)
 		return;
 	const scene *s = editor_scene(km->sh->ed);
@@ -1107,6 +1113,13 @@ bool keymode_turntable(shell *sh, double seconds)
 	size_t undo0 = editor_undo_count(sh->ed);
 	keymode *km = keymode_new(sh, out, scr->pal, cols, rows);
 	bool ok = km != NULL;
+	if (km) {
+		/* The shell's picture: real pixels or its symbol set. */
+		const pixels_caps *pc = termout_pixels(out);
+		const encoder_ops *ops = scr->pix_ops ? scr->pix_ops : encoder_symbols(scr->sym);
+		keyview_set_encoder(&km->kv, ops, scr->cell_w, scr->cell_h, pc ? pc->sixel_w : 0, pc ? pc->sixel_h : 0);
+		km_layout(km);
+	}
 	if (km)
 		keymode_spin(km, seconds);
 	while (km && !keymode_done(km)) {
@@ -1164,6 +1177,7 @@ bool keymode_turntable(shell *sh, double seconds)
 	tcsetattr(in, TCSANOW, &saved);
 	sh->scr = scr;
 	sh->status_hook = hook;
+	screen_drop_images(scr); /* key mode's kitty images, if any */
 	termout_set_picture(out, scr->enc);
 	screen_layout(scr, (double)sh->set.width / sh->set.height, true);
 	rl_set_screen_size(scr->rows - scr->region_top, scr->cols);

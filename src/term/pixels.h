@@ -21,8 +21,9 @@
  *   \e_G...;<base64>\e\\      kitty graphics: transmit, place, delete, query
  *   \eP...q...\e\\            sixel (libsixel's DCS)
  *   \e]1337;File=...:<b64>\a  iTerm2 inline image
- *   \e7 \e[R;CH ... \e8       each strip of the picture placed at its cell
- *                             (enc_pixels.c), the cursor saved and restored
+ *   \e7 \e[?25l \e[R;CH ...  each strip of the picture placed at its cell
+ *   \e8 \e[?25h              (enc_pixels.c), the cursor saved, hidden while
+ *                             the image comes, restored and shown again
  *   \e[c  \e[16t  \e[?2;1;0S  questions: DA1 (sixel is attribute 4),
  *                             the cell size in pixels, XTSMGRAPHICS (the
  *                             largest sixel image)

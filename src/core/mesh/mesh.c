@@ -112,6 +112,7 @@ void mb_free(mesh_builder *b)
 	for (size_t i = 0; i < b->ntexs; i++)
 		texture_free(b->texs[i]);
 	free(b->texs);
+	free(b->warning);
 	memset(b, 0, sizeof *b);
 }
 
@@ -238,6 +239,8 @@ mesh *mb_finish(mesh_builder *b, rt_error *err)
 	m->texs = b->texs;
 	b->texs = NULL;
 	b->ntexs = 0;
+	m->warning = b->warning;
+	b->warning = NULL;
 	if (m->nmats > 1) {
 		m->tmat = b->fm;
 		b->fm = NULL;
@@ -286,6 +289,7 @@ void mesh_free(mesh *m)
 	for (uint32_t i = 0; i < m->ntexs; i++)
 		texture_free(m->texs[i]);
 	free(m->texs);
+	free(m->warning);
 	free(m->nodes);
 	free(m->blk);
 	free(m->btri);
