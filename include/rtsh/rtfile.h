@@ -48,6 +48,10 @@ scene *rt_load_file(const char *path, const rt_load_opts *opts, rt_error *err);
  * the model on a ground plane, framed by the camera, with a light and a
  * sky (viewer.c). rt_load_file calls it for those extensions. */
 scene *rt_load_model(const char *path, const rt_load_opts *opts, rt_error *err);
+/* The text of that scene (.rt lines naming the model by its file name,
+ * relative to its folder), in a new buffer of *len bytes and a NUL; NULL
+ * (err set) when the model cannot be read. `save x.rt` keeps it. */
+char *rt_model_text(const char *path, const rt_load_opts *opts, size_t *len, rt_error *err);
 /* Loads a scene from memory (text need not be NUL-terminated); `name` is the
  * file name used in messages. */
 scene *rt_load_string(const char *text, size_t len, const char *name, const rt_load_opts *opts,

@@ -1281,7 +1281,7 @@ static void parser_done(parser *p)
 	free(p->text);
 }
 
-static bool has_rt_extension(const char *name)
+bool rt_name_is_rt(const char *name)
 {
 	size_t n = strlen(name);
 	return n >= 3 && strcmp(name + n - 3, ".rt") == 0;
@@ -1298,7 +1298,7 @@ scene *rt_load_string(const char *text, size_t len, const char *name, const rt_l
 	parser p;
 	parser_init(&p, s, name, opts, err);
 	bool ok;
-	if (p.strict && !has_rt_extension(p.name)) {
+	if (p.strict && !rt_name_is_rt(p.name)) {
 		ok = fail(&p, 0, "the file name does not end in .rt; expected a .rt file (strict mode)");
 	} else {
 		rt_numloc loc;
@@ -1392,24 +1392,6 @@ char *rt_read_file(const char *path, const rt_load_opts *opts, size_t *len, rt_e
 	if (opts && opts->read)
 		return opts->read(opts->read_ctx, path, len, err);
 	return read_file(NULL, path, len, err);
-}
-
-scene *rt_load_file(const char *path, const rt_load_opts *opts, rt_error *err)
-{
-	if (mesh_format_known(path) && !(opts && opts->strict))
-		return rt_load_model(path, opts, err);
-	if (opts && opts->strict && !has_rt_extension(path)) {
-		rt_error_at(err, path, 0, 0,
-		            "the file name does not end in .rt; expected a .rt file (strict mode)");
-		return NULL;
-	}
-	size_t len = 0;
-	char *text = rt_read_file(path, opts, &len, err);
-	if (!text)
-		return NULL;
-	scene *s = rt_load_string(text, len, path, opts, err);
-	free(text);
-	return s;
 }
 
 bool rt_parse_line(scene *s, const char *line, const char *name, int lineno,
