@@ -49,7 +49,7 @@ static bool put(char *text, size_t size, size_t *n, const char *fmt, ...)
  * framed as the model viewer frames a model; one with neither lights nor
  * emissive materials gets the viewer's stage lighting, and its status line
  * says so; otherwise it is lit by what it holds, on black, in path mode. */
-static scene *load_gltf(const char *path, const rt_load_opts *opts, rt_error *err)
+static char *gltf_text(const char *path, const rt_load_opts *opts, size_t *len, bool *stage_lit, rt_error *err)
 {
 	mesh *m = mesh_cache_get(path, true, 60, err);
 	if (!m)
@@ -67,9 +67,9 @@ static scene *load_gltf(const char *path, const rt_load_opts *opts, rt_error *er
 	const char *base = slash ? slash + 1 : path;
 	bool quote = strpbrk(base, " \t,#\"") != NULL;
 	bool stage = gi.nlights == 0 && !gi.emissive;
+	*stage_lit = stage;
 	size_t size = 4096 + 256 * (gi.ncams + gi.nlights), n = 0;
 	char *text = malloc(size);
-	scene *s = NULL;
 	if (!text) {
 		rt_error_set(err, "%s: out of memory", path);
 		goto done;
@@ -142,25 +142,25 @@ static scene *load_gltf(const char *path, const rt_load_opts *opts, rt_error *er
 	}
 	if (!ok) {
 		rt_error_set(err, "%s: the file name is too long", path);
+		free(text);
+		text = NULL;
 		goto done;
 	}
-	s = rt_load_string(text, n, path, opts, err);
-	if (s && stage) {
-		s->note = rt_intern("stage lighting", strlen("stage lighting"));
+	*len = n;
+	if (stage)
 		rt_warn(opts ? opts->warn : NULL, path, 0, 0,
 		        "no lights and no emissive materials: lit by the model viewer's stage lighting");
-	}
 done:
-	free(text);
 	gltf_info_free(&gi);
-	return s;
+	return text;
 }
 
 
 char *rt_model_text(const char *path, const rt_load_opts *opts, size_t *len, rt_error *err)
 {
+	bool stage;
 	if (has_ext(path, "gltf") || has_ext(path, "glb"))
-		return load_gltf(path, opts, err);
+		return gltf_text(path, opts, len, &stage, err);
 	mesh *m = mesh_cache_get(path, true, 60, err);
 	if (!m)
 		return NULL;
@@ -211,10 +211,13 @@ char *rt_model_text(const char *path, const rt_load_opts *opts, size_t *len, rt_
 scene *rt_load_model(const char *path, const rt_load_opts *opts, rt_error *err)
 {
 	size_t n;
-	char *text = rt_model_text(path, opts, &n, err);
+	bool gltf = has_ext(path, "gltf") || has_ext(path, "glb"), stage = false;
+	char *text = gltf ? gltf_text(path, opts, &n, &stage, err) : rt_model_text(path, opts, &n, err);
 	if (!text)
 		return NULL;
 	scene *s = rt_load_string(text, n, path, opts, err);
 	free(text);
+	if (s && stage) /* the status line says so */
+		s->note = rt_intern("stage lighting", strlen("stage lighting"));
 	return s;
 }
