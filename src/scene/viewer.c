@@ -51,7 +51,7 @@ static bool put(char *text, size_t size, size_t *n, const char *fmt, ...)
  * says so; otherwise it is lit by what it holds, on black, in path mode. */
 static char *gltf_text(const char *path, const rt_load_opts *opts, size_t *len, bool *stage_lit, rt_error *err)
 {
-	mesh *m = mesh_cache_get(path, true, 60, err);
+	mesh *m = mesh_cache_get(path, true, 60, opts ? opts->cancel : NULL, err);
 	if (!m)
 		return NULL;
 	box bb = m->bounds;
@@ -161,7 +161,7 @@ char *rt_model_text(const char *path, const rt_load_opts *opts, size_t *len, rt_
 	bool stage;
 	if (has_ext(path, "gltf") || has_ext(path, "glb"))
 		return gltf_text(path, opts, len, &stage, err);
-	mesh *m = mesh_cache_get(path, true, 60, err);
+	mesh *m = mesh_cache_get(path, true, 60, opts ? opts->cancel : NULL, err);
 	if (!m)
 		return NULL;
 	if (m->warning) /* a missing material library, say */
