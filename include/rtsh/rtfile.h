@@ -12,6 +12,7 @@
 #ifndef RTSH_RTFILE_H
 #define RTSH_RTFILE_H
 
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -31,6 +32,10 @@ typedef struct rt_load_opts {
 	 * them from memory on the other ranks. */
 	rt_read_fn read;
 	void *read_ctx;
+	/* Optional: when set (Ctrl-C in the shell), the load stops soon after,
+	 * with the error "stopped", at the next line or in a model's normals or
+	 * tree (a model's or an image's decoder runs to its end first). */
+	const atomic_bool *cancel;
 } rt_load_opts;
 
 /* Reads a file the way the loader does: through opts->read when set, else

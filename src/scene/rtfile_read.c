@@ -60,6 +60,7 @@ typedef struct parser {
 	bool strict;
 	bool single;      /* rt_parse_line: once-only elements replace */
 	const rt_warnings *warn;
+	const atomic_bool *cancel; /* rt_load_opts.cancel */
 	rt_error *err;
 	int line;
 	/* The line of the first A, C, L, R (or set resolution), sky and set
@@ -658,7 +659,7 @@ static bool get_file(parser *p, const tok *t, const char *name, size_t n, const 
 	bool ok = true;
 	bool image = key || strcmp(p->toks[0].s, "sky") == 0;
 	if (image) {
-		texture *tx = texture_cache_get(full, key && strcmp(key->name, "texture") == 0, &ferr);
+		texture *tx = texture_cache_get(full, key && strcmp(key->name, "texture") == 0, p->cancel, &ferr);
 		ok = tx != NULL;
 		texture_cache_put(tx);
 	} else if (!mesh_format_known(full)) {
@@ -965,7 +966,7 @@ static bool parse_mesh(parser *p, const elem_def *e)
 	 * is reported with this line */
 	rt_error merr;
 	rt_error_clear(&merr);
-	mesh *m = mesh_cache_get(o.file, o.smooth != 0, o.crease, &merr);
+	mesh *m = mesh_cache_get(o.file, o.smooth != 0, o.crease, p->cancel, &merr);
 	if (!m) {
 		char msg[RT_ERROR_MSG_MAX];
 		rt_error_format(&merr, msg, sizeof msg);
@@ -1117,6 +1118,8 @@ static bool parse_text(parser *p, const char *text, size_t len)
 		size_t j = i;
 		while (j < len && text[j] != '\n' && text[j] != '\r')
 			j++;
+		if ((p->line & 4095) == 0 && p->cancel && atomic_load(p->cancel))
+			return fail(p, 0, "stopped");
 		if (!parse_line(p, text + i, j - i))
 			return false;
 		if (j + 1 < len && text[j] == '\r' && text[j + 1] == '\n')
@@ -1163,6 +1166,7 @@ static void parser_init(parser *p, scene *s, const char *name, const rt_load_opt
 	p->name = name ? name : "";
 	p->strict = opts && opts->strict;
 	p->warn = opts ? opts->warn : NULL;
+	p->cancel = opts ? opts->cancel : NULL;
 	p->err = err;
 	/* model and texture names are relative to the .rt file's folder */
 	const char *slash = strrchr(p->name, '/');

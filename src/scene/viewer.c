@@ -16,7 +16,7 @@
 
 char *rt_model_text(const char *path, const rt_load_opts *opts, size_t *len, rt_error *err)
 {
-	mesh *m = mesh_cache_get(path, true, 60, err);
+	mesh *m = mesh_cache_get(path, true, 60, opts ? opts->cancel : NULL, err);
 	if (!m)
 		return NULL;
 	if (m->warning) /* a missing material library, say */
