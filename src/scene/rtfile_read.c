@@ -200,8 +200,20 @@ static bool lex_line(parser *p, const char *s, size_t len)
 			continue;
 		}
 		for (;;) {
-			while (i < len && !is_blank(s[i]) && !comment_at(s, i, len))
+			while (i < len && !is_blank(s[i]) && !comment_at(s, i, len)) {
+				if (s[i] == '"' && out > t.s && out[-1] == '=') {
+					/* KEY="a file name": blanks, '#' and ',' are its own */
+					const char *q = memchr(s + i + 1, '"', len - i - 1);
+					if (!q)
+						return fail(p, (int)i + 1, "a quote that is not closed; expected KEY=\"NAME\"");
+					size_t n = (size_t)(q - (s + i + 1));
+					memcpy(out, s + i + 1, n);
+					out += n;
+					i = (size_t)(q - s) + 1;
+					continue;
+				}
 				*out++ = s[i++];
+			}
 			t.endcol = (int)i + 1;
 			size_t j = i;
 			while (j < len && is_blank(s[j]))

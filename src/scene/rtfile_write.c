@@ -128,7 +128,7 @@ void rt_write_file_name(const char *file, char *out, size_t size)
 	if (n && strncmp(file, dir, n) == 0 && file[n] == '/')
 		name = file + n + 1;
 	else if (n && file[0] != '/' && realpath(file, abs))
-		name = abs;
+		name = strncmp(abs, dir, n) == 0 && abs[n] == '/' ? abs + n + 1 : abs; /* below it after all */
 	bool quote = strpbrk(name, " \t,#\"") != NULL || strstr(name, "//") != NULL || !name[0];
 	snprintf(out, size, "%s%s%s", quote ? "\"" : "", name, quote ? "\"" : "");
 }

@@ -923,6 +923,12 @@ int keymode_tick(keymode *km)
 	return drawn;
 }
 
+void keymode_late_keys(keymode *km, abuf *to)
+{
+	abuf_add(to, km->late.b, km->late.len);
+	abuf_reset(&km->late);
+}
+
 double keymode_timeout(const keymode *km)
 {
 	double t = now(), best = -1;
@@ -1148,8 +1154,7 @@ bool keymode_turntable(shell *sh, double seconds)
 		int b;
 		while ((b = evloop_getc(ev)) >= 0)
 			abuf_char(&pend, (char)b);
-		abuf_add(&pend, km->late.b, km->late.len);
-		abuf_reset(&km->late);
+		keymode_late_keys(km, &pend);
 		if (pend.len && !pend.failed)
 			keys_feed(k, pend.b, pend.len); /* a full pipe: keys typed far ahead are dropped */
 		abuf_reset(&pend);
