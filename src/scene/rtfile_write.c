@@ -262,6 +262,28 @@ static void fmt_light(sbuf *b, const light *l)
 	sb_vec(b, l->pos);
 	sb_field(b, l->ratio);
 	sb_vec(b, l->color);
+	if (l->kind == LIGHT_MINIRT)
+		return;
+	sb_put(b, l->kind == LIGHT_SUN ? " lux=" : " cd=");
+	sb_num(b, l->intensity);
+	if (l->kind != LIGHT_POINT) {
+		sb_put(b, " dir=");
+		sb_num(b, l->dir.x);
+		sb_put(b, ",");
+		sb_num(b, l->dir.y);
+		sb_put(b, ",");
+		sb_num(b, l->dir.z);
+	}
+	if (l->kind == LIGHT_SPOT) {
+		sb_put(b, " cone=");
+		sb_num(b, l->inner);
+		sb_put(b, ",");
+		sb_num(b, l->outer);
+	}
+	if (l->kind != LIGHT_SUN && l->range > 0) {
+		sb_put(b, " range=");
+		sb_num(b, l->range);
+	}
 }
 
 static void fmt_camera(sbuf *b, const camera *c, const char *id)
@@ -270,6 +292,12 @@ static void fmt_camera(sbuf *b, const camera *c, const char *id)
 	sb_vec(b, c->pos);
 	sb_vec(b, c->dir);
 	sb_field(b, c->fov);
+	if (c->vertical)
+		sb_put(b, " vertical=1");
+	if (c->ortho > 0) {
+		sb_put(b, " ortho=");
+		sb_num(b, c->ortho);
+	}
 }
 
 void rt_format_object(const object *o, char *buf, size_t size)

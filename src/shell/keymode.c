@@ -336,8 +336,11 @@ static void km_mark(keymode *km, uint8_t *img)
 		km->light_behind = !(z > 0);
 		if (km->light_behind)
 			return; /* the status line says so */
-		double u = v3_dot(p, c->right) / (z * c->tan_half);
-		double v = v3_dot(p, c->up) / (z * c->tan_half * ((double)h / w));
+		double tx = cam_tan_x(c, w, h);
+		if (!(tx > 0))
+			return; /* an orthographic view: no marker */
+		double u = v3_dot(p, c->right) / (z * tx);
+		double v = v3_dot(p, c->up) / (z * tx * ((double)h / w));
 		double fx = (u + 1) * 0.5 * w, fy = (1 - v) * 0.5 * h;
 		static const uint8_t white[3] = {255, 255, 255}, dark[3] = {40, 30, 0};
 		if (!(fx >= 0 && fy >= 0 && fx < w && fy < h)) {
