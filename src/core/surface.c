@@ -40,7 +40,7 @@ static bool hold_texture(world *w, const char *path, bool srgb, const struct tex
 	if (!t)
 		return rt_error_set(err, "out of memory loading textures");
 	w->texs = t;
-	texture *tx = texture_cache_get(path, srgb, err);
+	texture *tx = texture_cache_get(path, srgb, w->cancel, err);
 	if (!tx)
 		return false;
 	w->texs[w->ntexs++] = tx;
@@ -71,7 +71,7 @@ bool surf_begin(world *w, const scene *s, rt_error *err)
 		const object *o = &s->objs[i];
 		if (!(obj_kind_flags(o->kind) & KIND_MODEL))
 			continue;
-		mesh *m = mesh_cache_get(o->file ? o->file : "", o->smooth != 0, o->crease, err);
+		mesh *m = mesh_cache_get(o->file ? o->file : "", o->smooth != 0, o->crease, w->cancel, err);
 		if (!m) {
 			char msg[RT_ERROR_MSG_MAX];
 			rt_error_format(err, msg, sizeof msg);
@@ -354,6 +354,13 @@ void surf_inst_finish(const world *w, const prim *p, const ray *r, vec3 nl, hit 
 	h->has_uv = false;
 	if (m->uv && wants_uv(w, h))
 		apply_uv(w, h, s.u, s.v, mat3x4_vector(in->fwd, s.dpdu), mat3x4_vector(in->fwd, s.dpdv));
+	/* smooth meshes: rays leave from the smooth surface (mesh_surf.shift),
+	 * unless they may pass through it (glass), where the point moved out
+	 * would put the far side's rays in front of the face */
+	const mat_lin *ml = &w->mats[h->mat];
+	bool through = ml->family == MAT_PBR ? ml->pbr.transmission > 0 || ml->thin : ml->ior != 0;
+	if (m->n && !through)
+		h->p = v3_add(h->p, mat3x4_vector(in->fwd, s.shift));
 }
 
 /* The linear part of the inverse of a 3x4 matrix's linear part. */

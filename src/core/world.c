@@ -169,11 +169,17 @@ static bool reorder(world *w, const uint32_t *order)
 
 world *world_build(const scene *s, rt_error *err)
 {
+	return world_build_cancel(s, NULL, err);
+}
+
+world *world_build_cancel(const scene *s, const atomic_bool *cancel, rt_error *err)
+{
 	world *w = calloc(1, sizeof *w);
 	if (!w) {
 		rt_error_set(err, "out of memory preparing the scene");
 		return NULL;
 	}
+	w->cancel = cancel;
 	atomic_init(&w->refs, 1);
 	camera c = scene_camera(s);
 	w->cam = cam_view_make(&c);
@@ -217,8 +223,20 @@ world *world_build(const scene *s, rt_error *err)
 	}
 	w->nlights = s->nlights;
 	for (size_t i = 0; i < s->nlights; i++) {
-		w->lights[i].pos = s->lights[i].pos;
-		w->lights[i].radiance = v3_scale(srgb255_to_linear(s->lights[i].color), s->lights[i].ratio);
+		const light *sl = &s->lights[i];
+		light_lin *l = &w->lights[i];
+		l->pos = sl->pos;
+		l->radiance = v3_scale(srgb255_to_linear(sl->color), sl->ratio);
+		l->kind = sl->kind;
+		if (sl->kind != LIGHT_MINIRT) {
+			/* I candela at d give I / d^2 lux: pi L = I (see light_at) */
+			l->radiance = v3_scale(l->radiance, sl->intensity / RT_PI);
+			l->dir = v3_len(sl->dir) > 0 ? v3_norm(sl->dir) : v3(0, -1, 0);
+			l->range = sl->range;
+			double ci = cos(deg_to_rad(sl->inner)), co = cos(deg_to_rad(sl->outer));
+			l->cos_outer = co;
+			l->cone_scale = 1.0 / fmax(1e-3, ci - co);
+		}
 	}
 	w->nmats = s->nobjs;
 	if (!surf_begin(w, s, err)) {
@@ -231,6 +249,13 @@ world *world_build(const scene *s, rt_error *err)
 	double extent = v3_max_abs(c.pos);
 	for (size_t i = 0; i < s->nobjs; i++) {
 		const object *o = &s->objs[i];
+		if ((i & 0xffff) == 0 && cancel && atomic_load(cancel)) {
+			free(bounds);
+			free(order);
+			world_free(w);
+			rt_error_set(err, "stopped");
+			return NULL;
+		}
 		w->mats[i] = mat_lin_make(&o->mat);
 		bool plane = (obj_kind_flags(o->kind) & KIND_UNBOUNDED) != 0;
 		if (!surf_material(w, o, (uint32_t)i, err) ||
@@ -270,7 +295,7 @@ world *world_build(const scene *s, rt_error *err)
 		costs[i] = w->prims[i].tag == PRIM_SPHERE     ? 1.0f
 		           : w->prims[i].tag == PRIM_TRIANGLE ? 2.0f
 		                                              : shape_kinds[s->objs[w->prims[i].object].kind]->cost;
-	w->tree = bvh_build(bounds, costs, w->nprims, order, err);
+	w->tree = bvh_build(bounds, costs, w->nprims, order, cancel, err);
 	free(costs);
 	free(bounds);
 	bool ok = w->tree && reorder(w, order);
@@ -281,6 +306,7 @@ world *world_build(const scene *s, rt_error *err)
 		world_free(w);
 		return NULL;
 	}
+	w->cancel = NULL;
 	return w;
 }
 

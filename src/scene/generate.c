@@ -227,12 +227,12 @@ static bool gen_setting(scene *s, uint64_t seed, rt_error *err)
 	gen_rng r = gen_stream(seed, 1);
 	s->has_ambient = true;
 	s->amb = (ambient){0.15, v3(180, 200, 255)};
-	camera cam = {v3(0, 7, -17), v3(0, -4, 17), 60};
+	camera cam = {v3(0, 7, -17), v3(0, -4, 17), 60, false, 0};
 	if (!scene_add_camera(s, &cam, err))
 		return false;
 	int64_t nl = gen_int(&r, 2, 4);
 	for (int64_t i = 0; i < nl; i++) {
-		light l;
+		light l = {0};
 		l.pos = v3((double)gen_int(&r, -90, 90) / 10.0, (double)gen_int(&r, 70, 130) / 10.0,
 		           (double)gen_int(&r, -120, 60) / 10.0);
 		l.ratio = (double)(gen_int(&r, 50, 90) * 2 / nl) / 100.0;
@@ -278,7 +278,14 @@ scene *scene_generate(size_t n, uint64_t seed, const gen_opts *opts, rt_error *e
 	}
 	gen_rng r = gen_stream(seed, spheres ? 3 : 2);
 	int64_t d = typical_size(n, spheres);
-	for (size_t i = 0; i < n; i++)
+	const atomic_bool *cancel = opts ? opts->cancel : NULL;
+	for (size_t i = 0; i < n; i++) {
+		if ((i & 0xffff) == 0 && cancel && atomic_load(cancel)) {
+			scene_free(s);
+			rt_error_set(err, "stopped");
+			return NULL;
+		}
 		s->objs[s->nobjs++] = spheres ? gen_sphere(&r, d, true) : gen_shape(&r, d);
+	}
 	return s;
 }

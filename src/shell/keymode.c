@@ -168,7 +168,7 @@ static const world *km_world(keymode *km)
 	world_release(km->w);
 	rt_error err;
 	rt_error_clear(&err);
-	km->w = rsvc_world(km->rs, editor_scene(km->sh->ed), gen, &err);
+	km->w = rsvc_world(km->rs, editor_scene(km->sh->ed), gen, NULL, &err);
 	km->wgen = gen;
 	if (!km->w)
 		km_message(km, "the scene cannot be shown: %s", err.msg);
@@ -336,8 +336,11 @@ static void km_mark(keymode *km, uint8_t *img)
 		km->light_behind = !(z > 0);
 		if (km->light_behind)
 			return; /* the status line says so */
-		double u = v3_dot(p, c->right) / (z * c->tan_half);
-		double v = v3_dot(p, c->up) / (z * c->tan_half * ((double)h / w));
+		double tx = cam_tan_x(c, w, h);
+		if (!(tx > 0))
+			return; /* an orthographic view: no marker */
+		double u = v3_dot(p, c->right) / (z * tx);
+		double v = v3_dot(p, c->up) / (z * tx * ((double)h / w));
 		double fx = (u + 1) * 0.5 * w, fy = (1 - v) * 0.5 * h;
 		static const uint8_t white[3] = {255, 255, 255}, dark[3] = {40, 30, 0};
 		if (!(fx >= 0 && fy >= 0 && fx < w && fy < h)) {
@@ -638,17 +641,24 @@ static void km_spin_step(keymode *km, double t)
 	km_set_camera(km, &c);
 }
 
+/* The encoder's canvas pixels a cell: 1x2 for half blocks, 2x4 for the
+ * other symbol sets, the cell's size in real pixels. */
+static void km_cell_pixels(const keymode *km, double *sx, double *sy)
+{
+	int cw = km->kv.cols, ch = 2 * km->kv.pic_rows;
+	if (km->kv.enc)
+		km->kv.enc->ops->canvas(&km->kv.enc->geom, &cw, &ch);
+	*sx = km->kv.cols > 0 ? (double)cw / km->kv.cols : 1;
+	*sy = km->kv.pic_rows > 0 ? (double)ch / km->kv.pic_rows : 2;
+}
+
 /* The object under the cell (x, y) (1-based): a ray through its middle,
  * as the renderer casts them. */
 static void km_pick(keymode *km, int x, int y)
 {
 	const world *w = km_world(km);
-	/* canvas pixels a cell: 1x2 for half blocks, 2x4 for the other
-	 * symbol sets, the cell's size in real pixels */
-	int cw = km->kv.cols, ch = 2 * km->kv.pic_rows;
-	if (km->kv.enc)
-		km->kv.enc->ops->canvas(&km->kv.enc->geom, &cw, &ch);
-	double sx = km->kv.cols > 0 ? (double)cw / km->kv.cols : 1, sy = km->kv.pic_rows > 0 ? (double)ch / km->kv.pic_rows : 2;
+	double sx, sy;
+	km_cell_pixels(km, &sx, &sy);
 	double px = ((x - 1) + 0.5) * sx - km->kv.img_x, py = ((y - 1) + 0.5) * sy - km->kv.img_y;
 	if (!w || px < 0 || py < 0 || px >= km->kv.img_w || py >= km->kv.img_h)
 		return;
@@ -680,9 +690,10 @@ static void km_apply_drag(keymode *km)
 		/* The scene follows the cursor: at the pivot's distance, a pixel
 		 * of the picture is 2 d tan(fov/2) / width. */
 		cam_view v = cam_view_make(&c);
-		double d = v3_len(v3_sub(c.pos, km->pivot));
+		double d = v3_len(v3_sub(c.pos, km->pivot)), sx, sy;
+		km_cell_pixels(km, &sx, &sy);
 		double u = km->kv.img_w > 0 ? 2.0 * d * v.tan_half / km->kv.img_w : 0;
-		vec3 mv = v3_add(v3_scale(v.right, -dx * u), v3_scale(v.up, 2.0 * dy * u));
+		vec3 mv = v3_add(v3_scale(v.right, -dx * sx * u), v3_scale(v.up, dy * sy * u));
 		c.pos = v3_add(c.pos, mv);
 		km->pivot = v3_add(km->pivot, mv);
 	} else {
@@ -923,6 +934,12 @@ int keymode_tick(keymode *km)
 	return drawn;
 }
 
+void keymode_late_keys(keymode *km, abuf *to)
+{
+	abuf_add(to, km->late.b, km->late.len);
+	abuf_reset(&km->late);
+}
+
 double keymode_timeout(const keymode *km)
 {
 	double t = now(), best = -1;
@@ -1148,8 +1165,7 @@ bool keymode_turntable(shell *sh, double seconds)
 		int b;
 		while ((b = evloop_getc(ev)) >= 0)
 			abuf_char(&pend, (char)b);
-		abuf_add(&pend, km->late.b, km->late.len);
-		abuf_reset(&km->late);
+		keymode_late_keys(km, &pend);
 		if (pend.len && !pend.failed)
 			keys_feed(k, pend.b, pend.len); /* a full pipe: keys typed far ahead are dropped */
 		abuf_reset(&pend);

@@ -30,6 +30,9 @@ typedef struct encoder_geom {
 	int max_w, max_h;    /* the largest image the terminal takes in pixels
 	                      * (sixel: XTSMGRAPHICS); 0 when not known */
 	frame_palette pal;   /* the colours the terminal takes */
+	bool exact;          /* cell encoders: every cell the best fit of its own
+	                      * pixels, no colour kept from a neighbour to save
+	                      * bytes (frame.lambda 0) */
 } encoder_geom;
 
 typedef struct encoder encoder;

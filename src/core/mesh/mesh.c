@@ -360,7 +360,7 @@ static size_t normal_slot(const uint32_t *slot, size_t cap, const mesh *m, const
  * corners of equal vertex and normal find each other through a hash table,
  * not by comparing every pair. */
 #define CREASE_DEG_MAX 256
-static bool smooth_normals(mesh *m, double crease_deg, rt_error *err)
+static bool smooth_normals(mesh *m, double crease_deg, const atomic_bool *cancel, rt_error *err)
 {
 	uint32_t nv = m->nverts, nt = m->ntris;
 	size_t cap = 16;
@@ -407,6 +407,16 @@ static bool smooth_normals(mesh *m, double crease_deg, rt_error *err)
 	uint32_t next = nv;
 	for (uint32_t v = 0; v < nv; v++) {
 		uint32_t s = start[v], e = start[v + 1], deg = e - s;
+		if ((v & 0xffff) == 0 && cancel && atomic_load_explicit(cancel, memory_order_relaxed)) {
+			free(fn);
+			free(start);
+			free(list);
+			free(newid);
+			free(ang);
+			free(slot);
+			free(nn);
+			return rt_error_set(err, "stopped");
+		}
 		vec3 all = v3(0, 0, 0); /* the sum of every face, when the crease is ignored */
 		if (deg > CREASE_DEG_MAX)
 			for (uint32_t j = s; j < e; j++)
@@ -487,6 +497,11 @@ oom:
 
 bool mesh_prepare(mesh *m, bool smooth, double crease_deg, rt_error *err)
 {
+	return mesh_prepare_cancel(m, smooth, crease_deg, NULL, err);
+}
+
+bool mesh_prepare_cancel(mesh *m, bool smooth, double crease_deg, const atomic_bool *cancel, rt_error *err)
+{
 	char what[300];
 	snprintf(what, sizeof what, "the model %s (%u triangles)", m->path ? m->path : "", m->ntris);
 	if (!mem_check((double)m->ntris * MESH_PREPARE_BYTES, what, err))
@@ -494,10 +509,10 @@ bool mesh_prepare(mesh *m, bool smooth, double crease_deg, rt_error *err)
 	if (!smooth) {
 		free(m->n);
 		m->n = NULL;
-	} else if (!m->n && !smooth_normals(m, crease_deg, err)) {
+	} else if (!m->n && !smooth_normals(m, crease_deg, cancel, err)) {
 		return false;
 	}
-	if (!mesh_build_tree(m, err))
+	if (!mesh_build_tree(m, cancel, err))
 		return false;
 	/* triangles, then vertices, in the order the blocks first use them, so
 	 * that shading a leaf's triangles finds their data close together */
@@ -583,7 +598,7 @@ void mesh_surface(const mesh *m, uint32_t slot, const float b[3], mesh_surf *s)
 	s->ng = v3_cross(e1, e2);
 	s->ns = s->ng;
 	s->u = s->v = 0;
-	s->dpdu = s->dpdv = v3(0, 0, 0);
+	s->dpdu = s->dpdv = s->shift = v3(0, 0, 0);
 	uint32_t t = mesh_slot_tri(m, slot);
 	s->mat = m->nmats == 0 ? -1 : m->tmat ? m->tmat[t] : 0;
 	if (!m->tri)
@@ -596,6 +611,22 @@ void mesh_surface(const mesh *m, uint32_t slot, const float b[3], mesh_surf *s)
 		/* a normal on the far side of the face would shade it black */
 		if (v3_dot(n, n) > 0)
 			s->ns = v3_dot(n, s->ng) >= 0 ? n : v3_neg(n);
+		/* the shadow terminator (mesh_surf.shift): p' = p + sum_k b_k
+		 * max(0, -(p - p_k).n_k) n_k, each corner's normal on the side of
+		 * the face the interpolated one is on */
+		vec3 p = v3(0, 0, 0);
+		for (int k = 0; k < 3; k++)
+			p = v3_madd(p, pc[k], b[k]);
+		for (int k = 0; k < 3; k++) {
+			vec3 nk = v3(m->n[i[k]][0], m->n[i[k]][1], m->n[i[k]][2]);
+			double l = v3_len(nk);
+			if (!(l > 0))
+				continue;
+			nk = v3_scale(nk, (v3_dot(nk, s->ns) >= 0 ? 1.0 : -1.0) / l);
+			double d = v3_dot(v3_sub(p, pc[k]), nk);
+			if (d < 0)
+				s->shift = v3_madd(s->shift, nk, -d * b[k]);
+		}
 	}
 	if (m->uv) {
 		const float *a = m->uv[i[0]], *bb = m->uv[i[1]], *c = m->uv[i[2]];
