@@ -187,7 +187,7 @@ static double power_w(double a, double b)
 	return a * a / (a * a + b * b);
 }
 
-vec3 envmap_light(const world *w, const bsdf *b, vec3 p, sampler *g)
+vec3 envmap_light(const world *w, const bsdf *b, vec3 p, vec3 pdn, sampler *g)
 {
 	const envmap *e = w->env;
 	double u1, u2, pdf;
@@ -196,8 +196,12 @@ vec3 envmap_light(const world *w, const bsdf *b, vec3 p, sampler *g)
 	if (!(pdf > 0))
 		return v3(0, 0, 0);
 	double cos_i = v3_dot(b->n, wi);
-	if (cos_i <= 0)
-		return v3(0, 0, 0);
+	if (cos_i <= 0) {
+		if (!b->through) /* below: through a rough transmission only */
+			return v3(0, 0, 0);
+		cos_i = -cos_i;
+		p = pdn;
+	}
 	vec3 f = bsdf_eval(b, wi);
 	if (f.x <= 0 && f.y <= 0 && f.z <= 0)
 		return v3(0, 0, 0);

@@ -21,9 +21,10 @@ double envmap_pdf(const envmap *e, vec3 d);
 /* A direction picked in proportion to luminance x solid angle from two
  * numbers in [0,1); its density in *pdf (0: none). */
 vec3 envmap_sample(const envmap *e, double u1, double u2, double *pdf);
-/* Next-event estimation toward the sky from p (path mode), weighted by the
+/* Next-event estimation toward the sky from p (pdn: the point below the
+ * surface, for a rough transmission; path mode), weighted by the
  * power heuristic against the bsdf's own sampling. */
-vec3 envmap_light(const world *w, const struct bsdf *b, vec3 p, struct sampler *g);
+vec3 envmap_light(const world *w, const struct bsdf *b, vec3 p, vec3 pdn, struct sampler *g);
 size_t envmap_memory(const envmap *e);
 
 #endif
