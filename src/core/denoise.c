@@ -42,7 +42,7 @@ static void first_surface(const world *w, ray r, double f[7])
 			f[2] += clamp01(tint.z);
 			return;
 		}
-		const mat_lin *m = &w->mats[h.object];
+		const mat_lin *m = &w->mats[h.mat]; /* a model's own material, too */
 		bsdf b;
 		bsdf_make(&b, m, &h, v3_neg(r.d));
 		dist += h.t;
