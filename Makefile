@@ -29,7 +29,7 @@ WARN    := -Wall -Wextra -Wpedantic -Werror -Wshadow -Wstrict-prototypes -Wmissi
 CPPFLAGS += -Iinclude -Isrc -I$(BUILD) -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -DRTSH_VERSION=\"$(VERSION)\"
 CFLAGS  ?= $(OPT) -g
 CFLAGS  += $(CSTD) $(WARN) -fno-math-errno -pthread -MMD -MP
-LDLIBS_CORE := -lpng -lassimp -lXpm -lstb -lm -pthread
+LDLIBS_CORE := -lpng -lassimp -lcjson -lXpm -lstb -lm -pthread
 # libsixel carries its own copy of stb_image: libstb (in LDLIBS_CORE) must come first
 # so that the scene loader's stbi_* calls reach libstb, not libsixel's.
 LDLIBS_FRONT := -lreadline -lncursesw $(LDLIBS_CORE) -lsixel -lz

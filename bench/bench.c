@@ -46,9 +46,12 @@
 #include "term/frame.h"
 #include "term/keys.h"
 #include "term/pixels.h"
+#include "term/symbols.h"
+
+#include "symbols_quality.h"
 
 #define MAX_RUNS 101
-#define MAX_ROWS 64
+#define MAX_ROWS 128
 
 typedef struct row {
 	char scene[48];
@@ -717,6 +720,160 @@ static void bench_pixels(void)
 	scene_free(s);
 }
 
+/* --- symbols (issue 27, src/term/symbols.c) -----------------------------
+ * The picture as the terminal shows it, per symbol set, against a render at
+ * 2x4 samples a cell (the octants' grid): rtsh's cell encoder fed that
+ * render (half blocks: its 2x2 means, what a half block covers), and chafa
+ * fed the same render as a PPM, both decoded by symbols_quality.h; PSNR,
+ * SSIM and the bytes of one full frame in 24-bit colour. */
+
+/* chafa's output for the reference image in ppm (cols x crows cells), or
+ * NULL when chafa is not there; *len its bytes. */
+static char *run_chafa(const char *ppm, int cols, int nrow, const char *syms, size_t *len, double *seconds)
+{
+	char cmd[512];
+	snprintf(cmd, sizeof cmd,
+	         "chafa --size %dx%d --stretch --symbols %s -c full --dither none -w 9 -O 9 -f symbols "
+	         "--polite on '%s' 2>/dev/null",
+	         cols, nrow, syms, ppm);
+	double t0 = now();
+	FILE *p = popen(cmd, "r");
+	if (!p)
+		return NULL;
+	size_t cap = 1 << 16, n = 0;
+	char *b = malloc(cap);
+	for (size_t k; b && (k = fread(b + n, 1, cap - n, p)) > 0;) {
+		n += k;
+		if (n == cap) {
+			char *nb = realloc(b, cap *= 2);
+			if (!nb) {
+				free(b);
+				b = NULL;
+			}
+			b = nb;
+		}
+	}
+	int st = pclose(p);
+	*seconds = now() - t0;
+	if (st != 0 || n == 0) {
+		free(b);
+		return NULL;
+	}
+	*len = n;
+	return b;
+}
+
+static void bench_symbols(void)
+{
+	static const struct {
+		const char *path, *name;
+		int spp;
+	} scenes[] = {
+		{"scenes/showcase.rt", "showcase.rt", 4},
+		{"scenes/cornell.rt", "cornell.rt", 64},
+		{"scenes/spot.rt", "spot.rt", 16},
+	};
+	const int cols = 160, crows = 45;
+	const int W = cols * SQ_W, H = crows * SQ_H;
+	uint8_t *ref = malloc((size_t)W * H * 3), *shown = malloc((size_t)W * H * 3),
+	        *half = malloc((size_t)cols * crows * 2 * 3);
+	framebuffer *fb = fb_new(W, H);
+	if (!ref || !shown || !half || !fb)
+		fail("memory", NULL);
+	char ppm[64];
+	snprintf(ppm, sizeof ppm, "/tmp/rtsh-bench-sym-%ld.ppm", (long)getpid());
+	for (size_t si = 0; si < sizeof scenes / sizeof scenes[0]; si++) {
+		scene *s = load(scenes[si].path);
+		world *wd = build(s);
+		render_settings set = settings(W, H, 2);
+		render_settings_apply_hints(&set, &s->hints);
+		set.width = W;
+		set.height = H;
+		set.threads = 2;
+		set.samples = scenes[si].spp;
+		render_once(wd, &set, fb);
+		frame_srgb_from_linear(fb->rgb, (size_t)W * H, set.exposure, ref);
+		world_free(wd);
+		scene_free(s);
+		/* the half blocks' input: each half block's 2x2 samples */
+		for (int y = 0; y < crows * 2; y++)
+			for (int x = 0; x < cols; x++)
+				for (int c = 0; c < 3; c++) {
+					int v = 0;
+					for (int k = 0; k < 4; k++)
+						v += ref[((size_t)(2 * y + k / 2) * W + 2 * x + k % 2) * 3 + c];
+					half[((size_t)y * cols + x) * 3 + c] = (uint8_t)((v + 2) / 4);
+				}
+		size_t half_bytes = 0;
+		double half_psnr = 0;
+		for (int k = SYMBOLS_HALF; k <= SYMBOLS_OCTANT; k++) {
+			double t[MAX_RUNS];
+			size_t bytes = 0;
+			int nr = quick ? 1 : 5;
+			for (int i = 0; i < nr; i++) {
+				frame *f = frame_new_symbols(cols, crows, PALETTE_TRUECOLOR, (symbols_kind)k);
+				if (!f)
+					fail("memory", NULL);
+				double t0 = now();
+				if (k == SYMBOLS_HALF)
+					frame_put_image(f, half, cols, crows * 2, 0, 0);
+				else
+					frame_put_image(f, ref, W, H, 0, 0);
+				const abuf *out = frame_update(f);
+				t[i] = now() - t0;
+				bytes = out->len;
+				if (i == 0 && sq_decode(out->b, out->len, cols, crows, shown) != 0)
+					fail("symbols: the decoder met a glyph it does not know", NULL);
+				frame_free(f);
+			}
+			double psnr = sq_psnr(ref, shown, (size_t)W * H), ssim = sq_ssim(ref, shown, W, H);
+			if (k == SYMBOLS_HALF) {
+				half_bytes = bytes;
+				half_psnr = psnr;
+			}
+			char mode[24];
+			snprintf(mode, sizeof mode, "sym-%s", symbols_name((symbols_kind)k));
+			row *r = add_row(scenes[si].name, mode, cols, crows, set.samples, 1, nr, median(t, nr), -1);
+			snprintf(r->note, sizeof r->note,
+			         "PSNR %.2f dB (%+.2f vs half), SSIM %.4f, %zu bytes (%.2fx half); put+update time",
+			         psnr, psnr - half_psnr, ssim, bytes, (double)bytes / (double)half_bytes);
+		}
+		/* chafa on the same render */
+		FILE *f = fopen(ppm, "wb");
+		if (!f)
+			fail(ppm, NULL);
+		fprintf(f, "P6\n%d %d\n255\n", W, H);
+		fwrite(ref, 1, (size_t)W * H * 3, f);
+		if (fclose(f) != 0)
+			fail(ppm, NULL);
+		static const char *const sets[] = {"half", "quad", "sextant", "block", "block+quad+sextant"};
+		for (size_t k = 0; k < sizeof sets / sizeof sets[0]; k++) {
+			size_t len = 0;
+			double secs = 0;
+			char *out = run_chafa(ppm, cols, crows, sets[k], &len, &secs);
+			if (!out) {
+				fprintf(stderr, "bench: chafa is not installed: its symbols crows are left out\n");
+				break;
+			}
+			int unknown = sq_decode(out, len, cols, crows, shown);
+			double psnr = sq_psnr(ref, shown, (size_t)W * H), ssim = sq_ssim(ref, shown, W, H);
+			char mode[24];
+			snprintf(mode, sizeof mode, "chafa-%.17s", sets[k]);
+			row *r = add_row(scenes[si].name, mode, cols, crows, set.samples, 1, 1, secs, -1);
+			snprintf(r->note, sizeof r->note,
+			         "PSNR %.2f dB (%+.2f vs rtsh half), SSIM %.4f, %zu bytes (%.2fx rtsh half)%s", psnr,
+			         psnr - half_psnr, ssim, len, (double)len / (double)half_bytes,
+			         unknown ? ", glyphs not known to the decoder" : "");
+			free(out);
+		}
+	}
+	unlink(ppm);
+	fb_free(fb);
+	free(half);
+	free(shown);
+	free(ref);
+}
+
 /* --- key mode (issue 6, src/shell/keymode.c) ---------------------------
  * The time from a key to the first updated frame: a key-mode session on
  * showcase.rt of 160x48 cells drawing into /dev/null. Each run waits until
@@ -1052,7 +1209,7 @@ static void print_table(FILE *f, bool tsv)
 
 static void usage(void)
 {
-	fputs("usage: bench [--quick] [--runs N] [--out FILE.tsv] [--only grid|primary|spheres|load|path|preview|denoise|pixels|keymode|mesh]\n",
+	fputs("usage: bench [--quick] [--runs N] [--out FILE.tsv] [--only grid|primary|spheres|load|path|preview|denoise|pixels|keymode|mesh|symbols]\n",
 	      stderr);
 	exit(2);
 }
@@ -1117,6 +1274,8 @@ int main(int argc, char **argv)
 		bench_pixels();
 	if (!only || strcmp(only, "keymode") == 0)
 		bench_keymode();
+	if (!only || strcmp(only, "symbols") == 0)
+		bench_symbols();
 	if (!only || strcmp(only, "mesh") == 0)
 		bench_mesh();
 	la = fopen("/proc/loadavg", "r");

@@ -12,6 +12,8 @@
 #include "rtsh/settings.h"
 #include "rtsh/world.h"
 #include "shell/args.h"
+#include "shell/preview.h"
+#include "shell/turntable.h"
 
 static int usage_error(const char *fmt, const char *arg)
 {
@@ -125,6 +127,10 @@ int main(int argc, char **argv)
 	int rc = args_parse(argc, argv, ARGS_RTSH, "rtsh", &o);
 	if (rc >= 0)
 		return rc;
+	if (o.preview)
+		return preview_main(&o);
+	if (o.output && o.turntable)
+		return turntable_batch(&o);
 	if (o.output)
 		return batch_render(&o);
 	return shell_main(&o);

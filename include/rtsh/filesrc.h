@@ -16,6 +16,7 @@
 #define RTSH_FILESRC_H
 
 #include <stddef.h>
+#include <stdio.h>
 #include <sys/stat.h>
 
 #include "rtsh/error.h"
@@ -39,5 +40,17 @@ int rt_file_stat(const char *path, struct stat *st);
 /* Reads from disk: "PATH: cannot read the WHAT: reason" on failure (files
  * larger than 4 GiB are refused). */
 char *rt_file_read_disk(const char *path, const char *what, size_t *len, rt_error *err);
+
+/* Opens a file on disk for reading ("rb") when it is a regular file. It is
+ * stat(2)ed first, so a FIFO, a device, a socket or a directory (or a link
+ * to one) is refused without being opened: opening a FIFO waits for a
+ * writer, and /dev/zero never ends. Then it is opened without blocking and
+ * checked again (fstat), in case the name changed in between. NULL on
+ * failure, with *kind the file's kind (rt_file_kind) when that is why, else
+ * *kind NULL and errno set. */
+FILE *rt_file_open_regular(const char *path, const char **kind);
+/* The kind of a file that is not a regular one: "a FIFO (named pipe)",
+ * "a directory", "a character device"...; NULL for a regular file. */
+const char *rt_file_kind(mode_t mode);
 
 #endif

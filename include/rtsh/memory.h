@@ -43,4 +43,9 @@ void mem_set_limit(size_t bytes);
  * false. */
 bool mem_check(double bytes, const char *what, rt_error *err);
 
+/* Makes room for `need` elements of `size` bytes in the array *a of
+ * capacity *cap, doubling from 64; false (nothing changed) on overflow or
+ * when out of memory. */
+bool mem_grow(void **a, size_t *cap, size_t need, size_t size);
+
 #endif

@@ -35,9 +35,30 @@ typedef struct mesh_mat {
 	char *map_norm;   /* tangent-space normal map */
 	float bump_scale; /* -bm, 1 by default */
 	/* images embedded in the model file (a .glb's), decoded when it is
-	 * read and owned by the mesh; the map_ path is NULL then */
+	 * read and held by the mesh (mesh.texs); the map_ path is NULL then */
 	struct texture *tex_kd, *tex_norm;
+	/* glTF 2.0 (mesh_gltf.c; zero from the other readers). kd is the base
+	 * colour factor and ke the emissive factor x KHR_materials_emissive_strength. */
+	bool gltf;        /* the texture is multiplied by kd (glTF), not kd's replacement (MTL) */
+	float alpha;      /* baseColorFactor's alpha */
+	uint8_t alpha_mode; /* MESH_ALPHA_* */
+	float alpha_cutoff; /* MASK: texels of alpha below it are holes (0.5) */
+	float normal_scale; /* normalTexture.scale (1) */
+	float transmission; /* KHR_materials_transmission (0) */
+	float ior;          /* KHR_materials_ior (1.5) */
+	float thickness;    /* KHR_materials_volume: 0 thin-walled */
+	float att_dist;     /* ... attenuationDistance, 0: infinite */
+	float att_color[3]; /* ... attenuationColor (linear, 1,1,1) */
+	float clearcoat, clearcoat_roughness; /* KHR_materials_clearcoat (0, 0) */
+	float specular;     /* KHR_materials_specular specularFactor (1) */
+	float specular_color[3]; /* ... specularColorFactor (1,1,1) */
+	char *map_mr, *map_emit;             /* metallic-roughness, emissive textures */
+	struct texture *tex_mr, *tex_emit;   /* ... embedded */
+	float uvs[2], uvo[2]; /* KHR_texture_transform of the base colour texture, in
+	                       * rtsh's uv (v up): uv x uvs + uvo; (1,1), (0,0) */
 } mesh_mat;
+
+enum { MESH_ALPHA_OPAQUE, MESH_ALPHA_MASK, MESH_ALPHA_BLEND };
 
 /* Four triangles of a leaf laid out for the leaf test (mesh_trace.c):
  * v[3 * corner + axis][lane] is a vertex coordinate, the same float as the
@@ -83,6 +104,8 @@ typedef struct mesh {
 	uint16_t *tmat;    /* material per triangle, NULL when nmats <= 1 */
 	mesh_mat *mats;
 	uint32_t nmats;
+	struct texture **texs; /* the embedded images the materials point to (owned) */
+	uint32_t ntexs;
 	box bounds;        /* of the positions */
 	mesh_node *nodes;  /* the tree (mesh_prepare): node 0 is the root */
 	uint32_t nnodes;
@@ -104,11 +127,17 @@ mesh *mesh_load(const char *path, rt_error *err);
 mesh *mesh_read_obj(const char *path, rt_error *err);
 mesh *mesh_read_ply(const char *path, rt_error *err);
 mesh *mesh_read_assimp(const char *path, rt_error *err);
+mesh *mesh_read_gltf(const char *path, rt_error *err);
 /* The same readers on a buffer, `name` used in messages (fuzzing, tests). */
 mesh *mesh_parse_obj(const char *name, const char *dir, const char *buf, size_t len, rt_error *err);
 mesh *mesh_parse_ply(const char *name, const char *buf, size_t len, rt_error *err);
+/* dir NULL: a buffer or image outside the bytes is not read (an error). */
+mesh *mesh_parse_gltf(const char *name, const char *dir, const char *buf, size_t len, rt_error *err);
 /* True when the extension is one mesh_load reads. */
 bool mesh_format_known(const char *path);
+/* The extensions mesh_load reads as a message lists them (".obj, .ply, ...
+ * or .stl"), into buf (truncated to size). */
+void mesh_format_list(char *buf, size_t size);
 
 /* Bytes a triangle takes at the peak of mesh_prepare, with the mesh it
  * holds (measured: 136-142 on a 1M-triangle torus, flat or smooth; the
@@ -141,6 +170,7 @@ typedef struct mesh_builder {
 	int32_t (*c)[3]; size_t nc, cc;
 	uint16_t *fm;  size_t nf, cf;    /* material per triangle */
 	mesh_mat *mats; size_t nmats, cmats;
+	struct texture **texs; size_t ntexs, ctexs; /* embedded images (mb_texture) */
 	uint16_t cur_mat;
 	size_t bytes;      /* what the arrays above hold */
 	bool over;         /* a growth was refused by the memory limit */
@@ -159,6 +189,9 @@ bool mb_uv(mesh_builder *b, const float t[2]);
 bool mb_normal(mesh_builder *b, const float n[3]);
 /* A triangle of three corners, each (position, uv, normal), -1 absent. */
 bool mb_triangle(mesh_builder *b, int32_t c[3][3]);
+/* Gives the builder (then the mesh) an embedded image to hold; false when
+ * out of memory (t is freed then). */
+bool mb_texture(mesh_builder *b, struct texture *t);
 /* Welds the corners into vertices; NULL (err set) on failure. Frees b's
  * arrays in every case. */
 mesh *mb_finish(mesh_builder *b, rt_error *err);

@@ -32,4 +32,11 @@ num_status num_scan_long(const char *s, long min, long max, long *out);
 /* A whole number >= 0 filling s (DIGITS, no sign). */
 num_status num_scan_u64(const char *s, unsigned long long *out);
 
+/* a + b added in the decimals the two are written with (their shortest
+ * round-trip forms): 0.101 + 0.001 is 0.102 exactly, not
+ * 0.10200000000000001, so that many small edits do not drift. When the
+ * decimals exceed what a double holds at the sum's magnitude (a move
+ * computed in camera axes, 1/3), the plain sum. */
+double num_add_decimal(double a, double b);
+
 #endif

@@ -44,6 +44,8 @@ typedef struct render_settings {
 	int denoise;       /* denoise_mode */
 	int pixels;        /* the shell's picture: off (half blocks), kitty, sixel,
 	                    * iterm, auto (term/pixels.h, pixels_mode) */
+	int symbols;       /* the cells' glyphs when not in real pixels: half,
+	                    * quadrant, sextant, octant, auto (term/symbols.h) */
 } render_settings;
 
 render_settings render_settings_default(void);

@@ -19,6 +19,7 @@ typedef enum setting_type {
 	SETTING_MODE,       /* whitted|path */
 	SETTING_DENOISE,    /* auto|on|off (denoise_mode) */
 	SETTING_PIXELS,     /* off|kitty|sixel|iterm|auto (pixels_mode) */
+	SETTING_SYMBOLS,    /* half|quadrant|sextant|octant|auto (symbols_kind) */
 } setting_type;
 
 typedef struct setting_def {

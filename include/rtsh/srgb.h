@@ -15,6 +15,9 @@ double srgb_to_linear(double v);
 double srgb8_to_linear(double code);
 /* The three channels of an sRGB colour 0..255 to linear. */
 vec3 srgb255_to_linear(vec3 c);
+/* Linear [0,1] (and above) to sRGB codes 0..255, not rounded: the inverse of
+ * srgb255_to_linear, for readers whose colours are linear (glTF factors). */
+vec3 linear_to_srgb255(vec3 c);
 /* Linear [0,1] to 8-bit sRGB, rounded, clamped; exact inverse of srgb8_to_linear
  * on the 256 codes. */
 uint8_t linear_to_srgb8(double v);

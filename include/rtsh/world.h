@@ -56,9 +56,6 @@ typedef struct mat_lin {
  * colour; a PBR material's absent roughness is 1, its absent ior 1.5). A
  * reader of another format (glTF) fills a `material` and calls this. */
 mat_lin mat_lin_make(const material *m);
-/* Linear [0,1] (and above) to sRGB codes 0..255, not rounded: the inverse of
- * srgb255_to_linear, for readers whose colours are linear (glTF factors). */
-vec3 linear_to_srgb255(vec3 c);
 
 /* The textures of a material (texture.h; NULL = none), held by the world. */
 typedef struct mat_tex {

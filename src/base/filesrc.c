@@ -2,12 +2,14 @@
 #include "rtsh/filesrc.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <stdatomic.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "rtsh/memory.h"
 
@@ -34,20 +36,63 @@ int rt_file_stat(const char *path, struct stat *st)
 	return stat(path, st);
 }
 
+const char *rt_file_kind(mode_t mode)
+{
+	return S_ISREG(mode)    ? NULL
+	       : S_ISDIR(mode)  ? "a directory"
+	       : S_ISFIFO(mode) ? "a FIFO (named pipe)"
+	       : S_ISCHR(mode)  ? "a character device"
+	       : S_ISBLK(mode)  ? "a block device"
+	       : S_ISSOCK(mode) ? "a socket"
+	                        : "not a regular file";
+}
+
+FILE *rt_file_open_regular(const char *path, const char **kind)
+{
+	*kind = NULL;
+	struct stat st;
+	if (stat(path, &st) != 0)
+		return NULL;
+	if ((*kind = rt_file_kind(st.st_mode)))
+		return NULL;
+	int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+	if (fd < 0)
+		return NULL;
+	int flags = fcntl(fd, F_GETFL);
+	if (fstat(fd, &st) != 0 || (*kind = rt_file_kind(st.st_mode)) || flags < 0 ||
+	    fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) != 0) {
+		int e = errno;
+		close(fd);
+		errno = e;
+		return NULL;
+	}
+	FILE *f = fdopen(fd, "rb");
+	if (!f) {
+		int e = errno;
+		close(fd);
+		errno = e;
+	}
+	return f;
+}
+
 /* Files larger than this are refused rather than read. */
 #define SLURP_MAX ((size_t)4 << 30)
 
 char *rt_file_read_disk(const char *path, const char *what, size_t *len, rt_error *err)
 {
-	FILE *f = fopen(path, "rb");
+	const char *kind;
+	FILE *f = rt_file_open_regular(path, &kind);
 	if (!f) {
-		rt_error_set(err, "%s: cannot read the %s: %s", path, what, strerror(errno));
+		if (kind)
+			rt_error_set(err, "%s: cannot read the %s: it is %s; expected a regular file", path, what, kind);
+		else
+			rt_error_set(err, "%s: cannot read the %s: %s", path, what, strerror(errno));
 		return NULL;
 	}
 	struct stat st;
-	if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
+	if (fstat(fileno(f), &st) != 0) {
 		fclose(f);
-		rt_error_set(err, "%s: cannot read the %s: not a regular file", path, what);
+		rt_error_set(err, "%s: cannot read the %s: %s", path, what, strerror(errno));
 		return NULL;
 	}
 	if ((unsigned long long)st.st_size > SLURP_MAX) {

@@ -1,8 +1,10 @@
-/* rtsh — memory estimates (memory.h). */
+/* rtsh — memory estimates, and growing arrays (memory.h). */
 #include "rtsh/memory.h"
 
 #include <stdatomic.h>
+#include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -92,4 +94,22 @@ bool mem_check(double bytes, const char *what, rt_error *err)
 	                    "%s needs about %s of memory on top of the %s held by %ld scene%s (the current one and "
 	                    "those kept for undo); expected at most %s in all (%s)",
 	                    what, need, kept, scenes, scenes == 1 ? "" : "s", have, why);
+}
+
+bool mem_grow(void **a, size_t *cap, size_t need, size_t size)
+{
+	if (need <= *cap)
+		return true;
+	size_t c = *cap ? *cap : 64;
+	while (c < need) {
+		if (c > SIZE_MAX / 2 / size)
+			return false;
+		c *= 2;
+	}
+	void *p = realloc(*a, c * size);
+	if (!p)
+		return false;
+	*a = p;
+	*cap = c;
+	return true;
 }

@@ -6,6 +6,7 @@
 #include <locale.h>
 #include <math.h>
 #include <pthread.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -122,4 +123,48 @@ num_status num_scan_u64(const char *s, unsigned long long *out)
 		return NUM_BIG;
 	*out = v;
 	return NUM_OK;
+}
+
+/* Decimals after the point in x's shortest round-trip form; 99 when it
+ * needs 17 digits or is not finite. */
+static int shortest_decimals(double x)
+{
+	if (!isfinite(x))
+		return 99;
+	if (x == 0)
+		return 0;
+	char t[40];
+	for (int p = 1; p <= 16; p++) {
+		snprintf(t, sizeof t, "%.*e", p - 1, x);
+		if (strtod(t, NULL) == x) {
+			int e = atoi(strchr(t, 'e') + 1);
+			int d = p - 1 - e;
+			return d < 0 ? 0 : d;
+		}
+	}
+	return 99;
+}
+
+double num_add_decimal(double a, double b)
+{
+	double s = a + b;
+	pthread_once(&c_once, c_locale_init);
+	locale_t old = c_locale ? uselocale(c_locale) : (locale_t)0;
+	int k = shortest_decimals(a), kb = shortest_decimals(b);
+	if (kb > k)
+		k = kb;
+	/* a and b are within half an ulp of decimals of k places, so their
+	 * sum is within an ulp or two of a decimal of k places: rounding finds
+	 * it while an ulp of s is far below half a unit in the k-th place. */
+	double r = s;
+	if (k <= 15 && isfinite(s) && fabs(s) * pow(10.0, k) < 1e14) {
+		char t[64];
+		snprintf(t, sizeof t, "%.*f", k, s);
+		r = strtod(t, NULL);
+		if (r == 0)
+			r = 0.0; /* not -0 */
+	}
+	if (old)
+		uselocale(old);
+	return r;
 }

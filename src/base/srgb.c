@@ -35,6 +35,18 @@ vec3 srgb255_to_linear(vec3 c)
 	return v3(srgb8_to_linear(c.x), srgb8_to_linear(c.y), srgb8_to_linear(c.z));
 }
 
+static double srgb_encode(double v)
+{
+	if (!(v > 0.0))
+		return 0.0;
+	return 255.0 * (v <= 0.0031308 ? v * 12.92 : 1.055 * pow(v, 1.0 / 2.4) - 0.055);
+}
+
+vec3 linear_to_srgb255(vec3 c)
+{
+	return v3(srgb_encode(c.x), srgb_encode(c.y), srgb_encode(c.z));
+}
+
 /* The 8-bit code of a linear value is the sRGB encoding (IEC 61966-2-1)
  * rounded to nearest: code k covers the linear values from
  * threshold[k] = decode((k - 0.5) / 255) up to threshold[k + 1]. A table of

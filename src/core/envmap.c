@@ -12,8 +12,7 @@
  */
 #include "envmap.h"
 
-#include "integrators.h"
-
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -180,34 +179,4 @@ vec3 envmap_sample(const envmap *e, double u1, double u2, double *pdf)
 	double p_uv = e->texw[(size_t)y * e->w + x] * (double)e->w * (double)e->h;
 	*pdf = st > 0 ? p_uv / (2 * PI * PI * st) : 0;
 	return d;
-}
-
-static double power_w(double a, double b)
-{
-	return a * a / (a * a + b * b);
-}
-
-vec3 envmap_light(const world *w, const bsdf *b, vec3 p, vec3 pdn, sampler *g)
-{
-	const envmap *e = w->env;
-	double u1, u2, pdf;
-	samp_2d(g, &u1, &u2);
-	vec3 wi = envmap_sample(e, u1, u2, &pdf);
-	if (!(pdf > 0))
-		return v3(0, 0, 0);
-	double cos_i = v3_dot(b->n, wi);
-	if (cos_i <= 0) {
-		if (!b->through) /* below: through a rough transmission only */
-			return v3(0, 0, 0);
-		cos_i = -cos_i;
-		p = pdn;
-	}
-	vec3 f = bsdf_eval(b, wi);
-	if (f.x <= 0 && f.y <= 0 && f.z <= 0)
-		return v3(0, 0, 0);
-	ray sr = {p, wi};
-	if (world_occluded(w, &sr, 0.0, INFINITY))
-		return v3(0, 0, 0);
-	double wt = power_w(pdf, bsdf_pdf(b, wi));
-	return v3_mul(f, v3_scale(envmap_eval(e, wi), cos_i * wt / pdf));
 }

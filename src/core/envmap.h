@@ -5,9 +5,6 @@
 
 #include "rtsh/world.h"
 
-struct bsdf;
-struct sampler;
-
 typedef struct envmap envmap;
 
 /* A sky from image `path` (linear), radiance x strength, turned by
@@ -21,10 +18,6 @@ double envmap_pdf(const envmap *e, vec3 d);
 /* A direction picked in proportion to luminance x solid angle from two
  * numbers in [0,1); its density in *pdf (0: none). */
 vec3 envmap_sample(const envmap *e, double u1, double u2, double *pdf);
-/* Next-event estimation toward the sky from p (pdn: the point below the
- * surface, for a rough transmission; path mode), weighted by the
- * power heuristic against the bsdf's own sampling. */
-vec3 envmap_light(const world *w, const struct bsdf *b, vec3 p, vec3 pdn, struct sampler *g);
 size_t envmap_memory(const envmap *e);
 
 #endif

@@ -12,6 +12,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "rtsh/filesrc.h"
+
 /* The extension of path ("" when none). */
 static const char *extension(const char *path)
 {
@@ -216,9 +218,13 @@ static bool data_fits(FILE *f, double need)
 
 framebuffer *image_read_pfm(const char *path, rt_error *err)
 {
-	FILE *f = fopen(path, "rb");
+	const char *kind;
+	FILE *f = rt_file_open_regular(path, &kind);
 	if (!f) {
-		rt_error_at(err, path, 0, 0, "cannot open (%s)", strerror(errno));
+		if (kind)
+			rt_error_at(err, path, 0, 0, "is %s; expected a regular file", kind);
+		else
+			rt_error_at(err, path, 0, 0, "cannot open (%s)", strerror(errno));
 		return NULL;
 	}
 	int w, h;
@@ -252,9 +258,13 @@ framebuffer *image_read_pfm(const char *path, rt_error *err)
 
 framebuffer *image_read_ppm(const char *path, rt_error *err)
 {
-	FILE *f = fopen(path, "rb");
+	const char *kind;
+	FILE *f = rt_file_open_regular(path, &kind);
 	if (!f) {
-		rt_error_at(err, path, 0, 0, "cannot open (%s)", strerror(errno));
+		if (kind)
+			rt_error_at(err, path, 0, 0, "is %s; expected a regular file", kind);
+		else
+			rt_error_at(err, path, 0, 0, "cannot open (%s)", strerror(errno));
 		return NULL;
 	}
 	int w, h;

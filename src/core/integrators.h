@@ -5,6 +5,11 @@
 #include "rtsh/render.h"
 #include "sampler.h"
 
+/* The camera ray of sample `sample` of pixel (px, py) of an fw x fh image,
+ * and in *sp the sampler the integrator goes on with (camera.c). */
+ray camera_sample_ray(const world *w, const render_settings *s, int px, int py, int fw, int fh, int sample,
+                      sampler *sp);
+
 /* Radiance arriving along r (unit direction) by ambient + Phong + hard
  * shadows + mirror reflection / refraction up to s->depth (whitted.c). */
 vec3 whitted_radiance(const world *w, const render_settings *s, ray r);

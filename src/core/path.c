@@ -121,6 +121,35 @@ static vec3 emitter_light(const world *w, const bsdf *b, vec3 p, vec3 pdn, uint3
 	return v3_mul(f, v3_scale(w->mats[e->object].emission, cos_i * weight / pdf_l));
 }
 
+/* Next-event estimation toward the sky from p (pdn below the surface, for a
+ * rough transmission): a direction picked by the sky's luminance
+ * (envmap_sample), weighted by the power heuristic against the bsdf's own
+ * sampling. */
+static vec3 sky_light(const world *w, const bsdf *b, vec3 p, vec3 pdn, sampler *g)
+{
+	const envmap *e = w->env;
+	double u1, u2, pdf;
+	samp_2d(g, &u1, &u2);
+	vec3 wi = envmap_sample(e, u1, u2, &pdf);
+	if (!(pdf > 0))
+		return v3(0, 0, 0);
+	double cos_i = v3_dot(b->n, wi);
+	if (cos_i <= 0) {
+		if (!b->through) /* below: through a rough transmission only */
+			return v3(0, 0, 0);
+		cos_i = -cos_i;
+		p = pdn;
+	}
+	vec3 f = bsdf_eval(b, wi);
+	if (f.x <= 0 && f.y <= 0 && f.z <= 0)
+		return v3(0, 0, 0);
+	ray sr = {p, wi};
+	if (world_occluded(w, &sr, 0.0, INFINITY))
+		return v3(0, 0, 0);
+	double wt = power_weight(pdf, bsdf_pdf(b, wi));
+	return v3_mul(f, v3_scale(envmap_eval(e, wi), cos_i * wt / pdf));
+}
+
 vec3 path_radiance(const world *w, const render_settings *s, ray r, sampler *g)
 {
 	/* Each bounce has its own dimensions whatever happens at it: the light
@@ -174,9 +203,9 @@ vec3 path_radiance(const world *w, const render_settings *s, ray r, sampler *g)
 			radiance = v3_add(radiance, v3_mul(thr, emitter_light(w, &b, p, pdn, h.object, g)));
 		if (b.smooth && w->env) {
 			/* the sky's two numbers: hashed dimensions of their own, far
-			 * from the bounces' (envmap.c) */
+			 * from the bounces' */
 			g->dim = (1u << 20) + 2u * (uint32_t)bounce;
-			radiance = v3_add(radiance, v3_mul(thr, envmap_light(w, &b, p, pdn, g)));
+			radiance = v3_add(radiance, v3_mul(thr, sky_light(w, &b, p, pdn, g)));
 		}
 
 		g->dim = dim0 + 6u * (uint32_t)bounce + 2u;

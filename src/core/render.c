@@ -29,6 +29,7 @@ render_settings render_settings_default(void)
 		.seed = 1,
 		.exposure = 0.0,
 		.denoise = DENOISE_AUTO,
+		.symbols = 4, /* auto */
 	};
 }
 
@@ -115,38 +116,10 @@ framebuffer *fb_reuse(framebuffer **fb, int w, int h)
 	return *fb;
 }
 
-/* The camera ray of one sample, and the sampler positioned after the two
- * dimensions that place it in its pixel. */
-static ray sample_ray(const world *w, const render_settings *s, int px, int py, int fw, int fh,
-                      int sample, sampler *sp)
-{
-	uint64_t pixel = (uint64_t)py * (uint64_t)fw + (uint64_t)px;
-	double u = 0.5, v = 0.5;
-	/* Dimensions 0 and 1 place the sample in its pixel (one Whitted sample
-	 * sits at the centre and needs no numbers); the path's numbers follow.
-	 * Every pixel has its own scrambles, the same for all its samples, so
-	 * that its first 2^k positions are stratified (sampler.h). */
-	*sp = (sampler){0, 0, 0, 0};
-	if (s->samples > 1 || s->mode == MODE_PATH) {
-		*sp = sampler_for(s->seed, pixel, (uint32_t)sample);
-		if (s->samples > 1)
-			samp_2d(sp, &u, &v);
-		sp->dim = 2;
-	}
-	return cam_ray(&w->cam, px + u, py + v, fw, fh);
-}
-
-ray render_sample_ray(const world *w, const render_settings *s, int px, int py, int fw, int fh,
-                      int sample)
-{
-	sampler sp;
-	return sample_ray(w, s, px, py, fw, fh, sample, &sp);
-}
-
 vec3 render_sample(const world *w, const render_settings *s, int px, int py, int fw, int fh, int sample)
 {
 	sampler sp;
-	ray r = sample_ray(w, s, px, py, fw, fh, sample, &sp);
+	ray r = camera_sample_ray(w, s, px, py, fw, fh, sample, &sp);
 	vec3 c = s->mode == MODE_PATH ? path_radiance(w, s, r, &sp) : whitted_radiance(w, s, r);
 	/* A NaN or infinity from a degenerate case must not poison the pixel. */
 	if (!v3_finite(c))

@@ -16,6 +16,8 @@
 static const char *const denoise_names[] = {"auto", "on", "off"};
 /* The names of term/pixels.h's pixels_mode values, in order. */
 static const char *const pixels_names[] = {"off", "kitty", "sixel", "iterm", "auto"};
+/* The names of term/symbols.h's symbols_kind values, in order. */
+static const char *const symbols_names[] = {"half", "quadrant", "sextant", "octant", "auto"};
 
 const setting_def settings_table[] = {
 #define AT(field) offsetof(render_settings, field)
@@ -30,6 +32,8 @@ const setting_def settings_table[] = {
 	 "path mode: denoise auto (previews only), on (saved images too) or off"},
 	{"pixels", SETTING_PIXELS, 0, 4, AT(pixels),
 	 "the picture in real pixels: off (half blocks), kitty, sixel, iterm, or auto (ask the terminal)"},
+	{"symbols", SETTING_SYMBOLS, 0, 4, AT(symbols),
+	 "the cells' glyphs: half, quadrant, sextant, octant, or auto (what the terminal is known to draw)"},
 #undef AT
 };
 const size_t settings_count = sizeof settings_table / sizeof settings_table[0];
@@ -144,6 +148,15 @@ bool settings_set(render_settings *s, const setting_def *def, const char *value,
 			}
 		return rt_error_set(err, "pixels \"%s\" is not valid; expected off, kitty, sixel, iterm or auto",
 		                    value);
+	case SETTING_SYMBOLS:
+		for (int i = 0; i < 5; i++)
+			if (strcmp(value, symbols_names[i]) == 0) {
+				s->symbols = i;
+				return true;
+			}
+		return rt_error_set(err,
+		                    "symbols \"%s\" is not valid; expected half, quadrant, sextant, octant or auto",
+		                    value);
 	}
 	return rt_error_set(err, "internal: setting %s has no type", def->name);
 }
@@ -171,6 +184,9 @@ void settings_format(const render_settings *s, const setting_def *def, char *buf
 		return;
 	case SETTING_PIXELS:
 		snprintf(buf, size, "%s", pixels_names[s->pixels >= 0 && s->pixels < 5 ? s->pixels : 0]);
+		return;
+	case SETTING_SYMBOLS:
+		snprintf(buf, size, "%s", symbols_names[s->symbols >= 0 && s->symbols < 5 ? s->symbols : 4]);
 		return;
 	}
 }

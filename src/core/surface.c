@@ -107,6 +107,28 @@ bool surf_begin(world *w, const scene *s, rt_error *err)
 	return true;
 }
 
+/* A glTF material (mesh_gltf.c) in the PBR family: its factors are
+ * linear already. Thin-walled without KHR_materials_volume (thickness 0);
+ * the volume's attenuation in the file's units. */
+static void gltf_material(const mesh_mat *mm, mat_lin *l)
+{
+	l->family = MAT_PBR;
+	l->ior = mm->ior >= 1.0f ? mm->ior : 1.5;
+	l->thin = mm->thickness <= 0.0f;
+	l->pbr.roughness = mm->roughness;
+	l->pbr.metallic = mm->metallic;
+	l->pbr.transmission = mm->transmission;
+	l->pbr.clearcoat = mm->clearcoat;
+	l->pbr.clearcoat_roughness = mm->clearcoat_roughness;
+	l->pbr.specular_factor = mm->specular;
+	for (int k = 0; k < 3; k++) {
+		l->pbr.specular_color[k] = mm->specular_color[k];
+		float a = mm->att_color[k];
+		l->pbr.sigma_a[k] = mm->att_dist > 0.0f ? (a > 0.0f ? -logf(a) / mm->att_dist : 1e30f) : 0.0f;
+	}
+	l->emission = v3(0, 0, 0);
+}
+
 bool surf_material(world *w, const object *o, uint32_t i, rt_error *err)
 {
 	mat_lin *m = &w->mats[i];
@@ -132,6 +154,8 @@ bool surf_material(world *w, const object *o, uint32_t i, rt_error *err)
 	for (uint32_t k = 0; k < me->nmats; k++) {
 		const mesh_mat *mm = &me->mats[k];
 		mat_lin l = w->mats[i];
+		if (mm->gltf)
+			gltf_material(mm, &l);
 		l.albedo = v3(mm->kd[0], mm->kd[1], mm->kd[2]);
 		vec3 ke = v3(mm->ke[0], mm->ke[1], mm->ke[2]);
 		if (v3_max_comp(ke) > 0)
@@ -141,11 +165,16 @@ bool surf_material(world *w, const object *o, uint32_t i, rt_error *err)
 		if (mm->map_kd) {
 			if (!hold_texture(w, mm->map_kd, true, &t.tex, err))
 				return false;
-			t.tint = false;
+			t.tint = mm->gltf; /* glTF: texture x baseColorFactor */
 		} else if (mm->tex_kd) { /* embedded in the model: the mesh holds it */
 			t.tex = mm->tex_kd;
-			t.tint = false;
+			t.tint = mm->gltf;
 		}
+		if (mm->gltf && (mm->map_kd || mm->tex_kd)) /* KHR_texture_transform, then the object's */
+			for (int a = 0; a < 2; a++) {
+				t.uvo[a] += mm->uvo[a] * t.uvs[a];
+				t.uvs[a] *= mm->uvs[a];
+			}
 		if (mm->map_norm && !hold_texture(w, mm->map_norm, false, &t.nmap, err))
 			return false;
 		if (!mm->map_norm && mm->tex_norm)

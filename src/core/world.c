@@ -16,39 +16,6 @@
 #include "surface.h"
 #include "rtsh/shape.h"
 
-cam_view cam_view_make(const camera *c)
-{
-	cam_view v;
-	v.pos = c->pos;
-	v.fwd = v3_norm(c->dir);
-	vec3 up_ref = fabs(v.fwd.y) > 0.999999 ? v3(0, 0, 1) : v3(0, 1, 0);
-	v.right = v3_norm(v3_cross(up_ref, v.fwd));
-	v.up = v3_cross(v.fwd, v.right);
-	double fov = clampd(c->fov, 0.01, 179.99);
-	v.tan_half = tan(deg_to_rad(fov) * 0.5);
-	return v;
-}
-
-ray cam_ray(const cam_view *c, double fx, double fy, int w, int h)
-{
-	double u = (2.0 * fx / w - 1.0) * c->tan_half;
-	double v = (1.0 - 2.0 * fy / h) * c->tan_half * ((double)h / w);
-	vec3 d = v3_add(c->fwd, v3_add(v3_scale(c->right, u), v3_scale(c->up, v)));
-	return (ray){c->pos, v3_norm(d)};
-}
-
-static double srgb_encode(double v)
-{
-	if (!(v > 0.0))
-		return 0.0;
-	return 255.0 * (v <= 0.0031308 ? v * 12.92 : 1.055 * pow(v, 1.0 / 2.4) - 0.055);
-}
-
-vec3 linear_to_srgb255(vec3 c)
-{
-	return v3(srgb_encode(c.x), srgb_encode(c.y), srgb_encode(c.z));
-}
-
 mat_lin mat_lin_make(const material *m)
 {
 	mat_lin l = {0};

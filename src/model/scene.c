@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "rtsh/memory.h"
+#include "rtsh/num.h"
 
 static const struct {
 	const char *id, *name;
@@ -364,14 +365,21 @@ bool object_validate(const object *o, rt_error *err)
 	return true;
 }
 
+/* p + d in the decimals they are written with (num_add_decimal): many
+ * small moves do not drift. */
+static vec3 add_decimal(vec3 p, vec3 d)
+{
+	return v3(num_add_decimal(p.x, d.x), num_add_decimal(p.y, d.y), num_add_decimal(p.z, d.z));
+}
+
 void object_move(object *o, vec3 d)
 {
 	if ((obj_kind_flags(o->kind) & KIND_VERTICES)) {
 		for (int i = 0; i < 3; i++)
-			o->tri[i] = v3_add(o->tri[i], d);
+			o->tri[i] = add_decimal(o->tri[i], d);
 		return;
 	}
-	o->pos = v3_add(o->pos, d);
+	o->pos = add_decimal(o->pos, d);
 }
 
 /* Reads (dir, twist) back from a rotation matrix r = orient(dir, twist). */

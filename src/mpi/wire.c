@@ -13,7 +13,7 @@ struct settings_fields {
 	render_mode mode;
 	uint64_t seed;
 	double exposure;
-	int denoise, pixels;
+	int denoise, pixels, symbols;
 };
 _Static_assert(sizeof(render_settings) == sizeof(struct settings_fields),
                "render_settings changed: send the new field in src/mpi/wire.c");
@@ -83,8 +83,8 @@ static double get_f64(reader *r)
 	return v;
 }
 
-/* version 1's fields after the header: 7 + 6 + 2 i32, 2 u64, 1 f64 */
-#define BODY_V1 (15 * 4 + 2 * 8 + 8)
+/* version 2's fields after the header: 7 + 6 + 3 i32, 2 u64, 1 f64 */
+#define BODY_V1 (16 * 4 + 2 * 8 + 8)
 #define HEADER (8 + 4 + 4)
 _Static_assert(HEADER + BODY_V1 <= WIRE_CONFIG_SIZE, "the configuration fits its buffer");
 
@@ -113,6 +113,7 @@ void wire_put_config(const job_config *c, unsigned char buf[WIRE_CONFIG_SIZE])
 	put_f64(&w, s->exposure);
 	put_i32(&w, s->denoise);
 	put_i32(&w, s->pixels);
+	put_i32(&w, s->symbols);
 	put_u64(&w, c->files);
 }
 
@@ -161,6 +162,7 @@ bool wire_get_config(job_config *c, const unsigned char buf[WIRE_CONFIG_SIZE], c
 	s->exposure = get_f64(&r);
 	s->denoise = get_i32(&r);
 	s->pixels = get_i32(&r);
+	s->symbols = get_i32(&r);
 	k.files = get_u64(&r);
 	bool ok = in_range("status", k.status, -1, 255, why, whylen) &&
 	          in_range("tile", k.tile, 0, 1024, why, whylen) &&
@@ -170,7 +172,8 @@ bool wire_get_config(job_config *c, const unsigned char buf[WIRE_CONFIG_SIZE], c
 	          in_range("denoise", s->denoise, DENOISE_AUTO, DENOISE_OFF, why, whylen) &&
 	          in_range("threads", s->threads, 0, INT32_MAX, why, whylen) &&
 	          in_range("depth", s->depth, 0, INT32_MAX, why, whylen) &&
-	          in_range("pixels", s->pixels, 0, INT32_MAX, why, whylen);
+	          in_range("pixels", s->pixels, 0, INT32_MAX, why, whylen) &&
+	          in_range("symbols", s->symbols, 0, INT32_MAX, why, whylen);
 	if (ok && k.status < 0) /* a job to render: an image of a size fb_new takes */
 		ok = in_range("width", s->width, 1, RENDER_MAX_DIM, why, whylen) &&
 		     in_range("height", s->height, 1, RENDER_MAX_DIM, why, whylen) &&

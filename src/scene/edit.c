@@ -747,7 +747,8 @@ bool editor_light_move(editor *ed, size_t i, vec3 d, rt_error *err)
 	light l;
 	if (!get_light(ed, i, &l, err))
 		return false;
-	l.pos = v3_add(l.pos, d);
+	/* In the decimals written (num_add_decimal): no drift. */
+	l.pos = v3(num_add_decimal(l.pos.x, d.x), num_add_decimal(l.pos.y, d.y), num_add_decimal(l.pos.z, d.z));
 	return editor_set_light(ed, i, &l, err);
 }
 

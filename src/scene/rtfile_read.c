@@ -17,6 +17,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "rtsh/filesrc.h"
 #include "rtsh/mesh.h"
 #include "rtsh/num.h"
 #include "rtsh/render.h"
@@ -1219,20 +1220,25 @@ scene *rt_load_string(const char *text, size_t len, const char *name, const rt_l
 static char *read_file(void *ctx, const char *path, size_t *len, rt_error *err)
 {
 	(void)ctx;
-	FILE *f = fopen(path, "rb");
-	if (!f) {
-		rt_error_at(err, path, 0, 0, "cannot open: %s; expected a readable .rt file",
-		            strerror(errno));
+	struct stat st;
+	if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
+		rt_error_at(err, path, 0, 0, "is a directory; expected a .rt file");
 		return NULL;
 	}
-	struct stat st;
+	/* A FIFO or a device is refused before it is opened (issue 31): opening
+	 * a FIFO waits for a writer, a device may never end. */
+	const char *kind;
+	FILE *f = rt_file_open_regular(path, &kind);
+	if (!f) {
+		if (kind)
+			rt_error_at(err, path, 0, 0, "is %s; expected a regular .rt file", kind);
+		else
+			rt_error_at(err, path, 0, 0, "cannot open: %s; expected a readable .rt file",
+			            strerror(errno));
+		return NULL;
+	}
 	size_t cap = 1 << 16;
 	if (fstat(fileno(f), &st) == 0) {
-		if (S_ISDIR(st.st_mode)) {
-			fclose(f);
-			rt_error_at(err, path, 0, 0, "is a directory; expected a .rt file");
-			return NULL;
-		}
 		if (S_ISREG(st.st_mode) && (unsigned long long)st.st_size > RT_FILE_MAX) {
 			fclose(f);
 			rt_error_at(err, path, 0, 0,

@@ -153,7 +153,7 @@ void answer_undo(shell *sh, const char *verb, const char *note)
 	if (note)
 		shell_info(sh, "%s: %s\n", verb, note);
 	else
-		shell_info(sh, "%s: one edit made in key mode (view)\n", verb);
+		shell_info(sh, "%s: edits made in key mode (view)\n", verb);
 }
 
 static const char *plural(size_t n)

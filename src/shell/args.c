@@ -10,6 +10,8 @@
 enum {
 	OPT_STRICT = 0x100,
 	OPT_COLOR,
+	OPT_PREVIEW,
+	OPT_TURNTABLE,
 	OPT_SETTING = 0x200, /* OPT_SETTING + i: settings_table[i] */
 };
 
@@ -35,6 +37,10 @@ static const struct {
 	{{"quiet", no_argument, NULL, 'q'}, false, NULL, "no progress output"},
 	{{"strict", no_argument, NULL, OPT_STRICT}, false, NULL, "validate scenes by the 42 subject's rules"},
 	{{"color", required_argument, NULL, OPT_COLOR}, false, "WHEN", "auto|truecolor|256|16|none: colour output (default auto)"},
+	{{"preview", required_argument, NULL, OPT_PREVIEW}, true, "COLSxROWS",
+	 "print a still picture of the scene or model, COLS x ROWS cells, and exit (file managers)"},
+	{{"turntable", optional_argument, NULL, OPT_TURNTABLE}, true, "[FRAMES]",
+	 "a full turn of the camera about the scene: in the terminal, or FRAMES frames with -o (.gif, frame%03d.png)"},
 	{{"help", no_argument, NULL, 'h'}, false, NULL, "this help"},
 	{{"version", no_argument, NULL, 'V'}, false, NULL, "the version"},
 };
@@ -141,6 +147,26 @@ static int parse_color(const char *prog, const char *v, color_mode *out)
 	return usage_error(prog, "option --color: \"%s\" is not valid; expected auto, truecolor, 256, 16 or none", v);
 }
 
+/* "COLSxROWS", each 1..OPTIONS_MAX_CELLS. */
+static bool parse_cells(const char *s, int *cols, int *rows)
+{
+	if (s[0] < '0' || s[0] > '9')
+		return false;
+	char *end;
+	long c = strtol(s, &end, 10);
+	if (*end != 'x' && *end != 'X')
+		return false;
+	const char *r0 = end + 1;
+	if (r0[0] < '0' || r0[0] > '9')
+		return false;
+	long r = strtol(r0, &end, 10);
+	if (*end || c < 1 || c > OPTIONS_MAX_CELLS || r < 1 || r > OPTIONS_MAX_CELLS)
+		return false;
+	*cols = (int)c;
+	*rows = (int)r;
+	return true;
+}
+
 /* The option as the user wrote it, for a message: "-x", or "--name" (the
  * argument after '=' left off). */
 static void option_text(char *const *argv, int at, int short_opt, char *buf, size_t size)
@@ -223,6 +249,29 @@ int args_parse(int argc, char **argv, args_kind kind, const char *prog, rtsh_opt
 			if (rc == 0)
 				rc = -1;
 			break;
+		case OPT_PREVIEW:
+			o->preview = optarg;
+			if (!parse_cells(optarg, &o->preview_cols, &o->preview_rows))
+				rc = usage_error(prog, "option --preview: \"%s\" is not a size; expected COLSxROWS, each 1..%d",
+				                 optarg, OPTIONS_MAX_CELLS);
+			break;
+		case OPT_TURNTABLE: {
+			/* --turntable FRAMES as well as --turntable=FRAMES */
+			const char *v = optarg;
+			if (!v && optind < argc && argv[optind][0] >= '0' && argv[optind][0] <= '9')
+				v = argv[optind++];
+			o->turntable = true;
+			if (v) {
+				char *end;
+				long f = strtol(v, &end, 10);
+				if (end == v || *end || f < 1 || f > OPTIONS_MAX_FRAMES)
+					rc = usage_error(prog, "option --turntable: \"%s\" is not a frame count; expected 1..%d", v,
+					                 OPTIONS_MAX_FRAMES);
+				else
+					o->turntable_frames = (int)f;
+			}
+			break;
+		}
 		case ':':
 			option_text(argv, optind - 1, optopt, name, sizeof name);
 			rc = usage_error(prog, "option %s needs a value", name);
@@ -268,6 +317,12 @@ int args_parse(int argc, char **argv, args_kind kind, const char *prog, rtsh_opt
 		return usage_error(prog, "-o cannot be combined with -c or -f; use the shell's save command");
 	if (o->commands && o->file)
 		return usage_error(prog, "give -c or -f, not both");
+	if (o->preview && (o->output || o->commands || o->file || o->turntable))
+		return usage_error(prog, "--preview prints the picture; it cannot be combined with -o, -c, -f or --turntable");
+	if (o->turntable_frames && !o->output)
+		return usage_error(prog, "--turntable FRAMES needs -o OUT (.gif, or a numbered name such as frame%%03d.png)");
+	if (o->turntable && !o->turntable_frames && o->output)
+		return usage_error(prog, "--turntable with -o needs a frame count: --turntable FRAMES -o OUT");
 	if (o->interactive && !o->commands && !o->file)
 		return usage_error(prog, "-i needs -c or -f");
 	return -1;

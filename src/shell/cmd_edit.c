@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "rtsh/edit.h"
+#include "rtsh/num.h"
 #include "rtsh/rtfile.h"
 #include "shell/answer.h"
 #include "shell/commands.h"
@@ -315,14 +316,33 @@ static bool undo_redo(shell *sh, bool redo)
 	return ok ? true : shell_fail(sh, "%s: %s", redo ? "redo" : "undo", err.msg);
 }
 
+/* undo [N] / redo [N]: N steps (1 without N); all of them or, when fewer
+ * are there, none. */
+static bool undo_redo_n(shell *sh, bool redo, int argc, char **argv)
+{
+	const char *what = redo ? "redo" : "undo";
+	long n = 1;
+	if (argc == 1 && num_scan_long(argv[0], 1, EDITOR_MAX_UNDO, &n) != NUM_OK)
+		return shell_fail(sh, "%s: \"%s\" is not a number of steps; expected 1..%d", what, argv[0],
+		                  EDITOR_MAX_UNDO);
+	size_t have = redo ? editor_redo_count(sh->ed) : editor_undo_count(sh->ed);
+	if (have > 0 && (size_t)n > have)
+		return shell_fail(sh, "%s: %ld steps asked, %zu to %s; expected %s 1..%zu", what, n, have, what,
+		                  what, have);
+	for (long i = 0; i < n; i++)
+		if (!undo_redo(sh, redo))
+			return false;
+	return true;
+}
+
 bool cmd_undo(shell *sh, int argc, char **argv, const char *rest)
 {
-	(void)argc, (void)argv, (void)rest;
-	return undo_redo(sh, false);
+	(void)rest;
+	return undo_redo_n(sh, false, argc, argv);
 }
 
 bool cmd_redo(shell *sh, int argc, char **argv, const char *rest)
 {
-	(void)argc, (void)argv, (void)rest;
-	return undo_redo(sh, true);
+	(void)rest;
+	return undo_redo_n(sh, true, argc, argv);
 }

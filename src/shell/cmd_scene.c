@@ -77,10 +77,12 @@ bool cmd_save(shell *sh, int argc, char **argv, const char *rest)
 	rt_error err;
 	bool ok = true;
 	if (has_ext(path, ".rt")) {
-		if (!save_rt(sh, path, &err))
+		if (!save_rt(sh, path, &err)) {
 			ok = save_failed(sh, &err);
-		else
+		} else {
+			sh->saved_gen = editor_generation(sh->ed);
 			shell_info(sh, "saved the scene to %s\n", path);
+		}
 	} else if (has_ext(path, ".ans")) {
 		frame *f = shell_picture_frame(sh, PALETTE_TRUECOLOR, picture_columns());
 		if (!f) {
@@ -443,4 +445,14 @@ bool cmd_view(shell *sh, int argc, char **argv, const char *rest)
 {
 	(void)argc, (void)argv, (void)rest;
 	return keymode_run(sh);
+}
+
+/* Key mode with the turntable on (keymode.c). */
+bool cmd_turntable(shell *sh, int argc, char **argv, const char *rest)
+{
+	(void)rest;
+	double seconds = KEYMODE_SPIN_SECONDS;
+	if (argc == 1 && !arg_number(sh, "turntable", argv[0], 0.5, 3600, &seconds))
+		return false;
+	return keymode_turntable(sh, seconds);
 }

@@ -287,11 +287,20 @@ bool command_run(shell *sh, const char *text)
 		free(buf);
 		return true;
 	}
+	/* A command word ending in "!" forces it (quit!: no question). */
+	size_t wl = strlen(argv[0]);
+	bool force = wl > 1 && argv[0][wl - 1] == '!';
+	if (force)
+		argv[0][wl - 1] = '\0';
 	const command *c = command_find(argv[0], msg, sizeof msg);
-	if (!c) {
+	if (!c || (force && c->run != cmd_quit)) {
+		if (c)
+			snprintf(msg, sizeof msg, "%s: \"%s!\" is not a command; only quit! takes a \"!\"", c->name,
+			         argv[0]);
 		free(buf);
 		return shell_fail(sh, "%s", msg);
 	}
+	sh->force = force;
 	int nargs = argc - 1;
 	if (nargs < c->min_args || (c->max_args != CMD_ANY && nargs > c->max_args) || argc > CMD_MAX_ARGS) {
 		char u[512];
@@ -366,6 +375,11 @@ bool cmd_help(shell *sh, int argc, char **argv, const char *rest)
 bool cmd_quit(shell *sh, int argc, char **argv, const char *rest)
 {
 	(void)argc, (void)argv, (void)rest;
+	if (!sh->force && shell_quit_asks(sh)) {
+		shell_out(sh, "quit: the scene has edits not saved (save FILE.rt keeps them); quit again, or quit!, "
+		              "leaves without them\n");
+		return true;
+	}
 	sh->quit = true;
 	return true;
 }
@@ -377,6 +391,7 @@ bool cmd_clear(shell *sh, int argc, char **argv, const char *rest)
 		/* Clear the scroll region only, and start again at its bottom. */
 		fflush(stdout);
 		screen_clear_commands(sh->scr);
+		screen_log_clear(sh->scr);
 	}
 	return true;
 }

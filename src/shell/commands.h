@@ -92,6 +92,7 @@ bool cmd_generate(shell *sh, int argc, char **argv, const char *rest);
 bool cmd_next(shell *sh, int argc, char **argv, const char *rest);
 bool cmd_prev(shell *sh, int argc, char **argv, const char *rest);
 bool cmd_view(shell *sh, int argc, char **argv, const char *rest);
+bool cmd_turntable(shell *sh, int argc, char **argv, const char *rest);
 bool cmd_show(shell *sh, int argc, char **argv, const char *rest);
 bool cmd_source(shell *sh, int argc, char **argv, const char *rest);
 bool cmd_help(shell *sh, int argc, char **argv, const char *rest);

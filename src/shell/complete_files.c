@@ -9,10 +9,7 @@
 #include <sys/stat.h>
 
 #include "rtsh/image.h"
-
-/* What `load` reads; a model format joins here when load reads it. */
-/* what `load` opens: scenes, and models for the model viewer (rtsh(1)) */
-static const char *const scene_exts[] = {".rt", ".obj", ".ply", ".gltf", ".glb", ".stl", NULL};
+#include "rtsh/mesh.h"
 
 /* What `save` writes besides the image formats of image.h. */
 static const char *const text_exts[] = {".ans", ".rt", NULL};
@@ -78,7 +75,7 @@ void complete_files(const char *text, file_use use, void (*add)(void *ctx, const
 			snprintf(full, sizeof full, "%s/%s", dir, n);
 			struct stat st;
 			bool is_dir = stat(full, &st) == 0 && S_ISDIR(st.st_mode);
-			if (!is_dir && !(use == FILES_SCENE ? in(scene_exts, n) : output_name_ok(n)))
+			if (!is_dir && !(use == FILES_SCENE ? (ends_with(n, ".rt") || mesh_format_known(n)) : output_name_ok(n)))
 				continue;
 			snprintf(cand, sizeof cand, "%.*s%s%s", (int)dlen, text, n, is_dir ? "/" : "");
 			add(ctx, cand);

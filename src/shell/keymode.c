@@ -29,6 +29,8 @@
 
 #include <readline/readline.h>
 
+#include "rtsh/mesh.h"
+#include "rtsh/orbit.h"
 #include "rtsh/settings.h"
 #include "rtsh/shape.h"
 #include "rtsh/world.h"
@@ -80,9 +82,10 @@ struct keymode {
 	double step;
 
 	km_sel sel;
-	bool run_open;         /* an undo group for a run of one key is open */
-	int run_key;
+	bool run_open;         /* an undo group is open: typed keys since the last pause, a drag, a turn */
+	int run_key;           /* what opened it: a key, KEYS_MOUSE (a drag), KEYS_NONE (the turntable) */
 	km_sel run_sel;
+	double last_edit;      /* when the last edit key came */
 
 	km_cur cur;
 	bool want_fast, want_refine; /* a render to start */
@@ -104,6 +107,19 @@ struct keymode {
 	int mask_w, mask_h;
 	bool sel_visible;
 	bool light_behind;     /* the selected light is behind the camera */
+
+	bool model;            /* the model viewer's scene: arrows orbit */
+	camera home;           /* `0` brings it back */
+	/* The mouse: a button held since (press_x, press_y); the camera
+	 * follows (mouse_x, mouse_y) from (done_x, done_y) at the next tick. */
+	bool drag, pan, moved;
+	int press_x, press_y, done_x, done_y, mouse_x, mouse_y;
+	vec3 pivot;
+	/* The turntable: a turn in spin seconds (0: not spinning) from
+	 * spin_cam at spin_t0. */
+	double spin, spin_t0;
+	camera spin_cam;
+	vec3 spin_pivot;
 
 	char msg[256];
 	double msg_until;
@@ -469,6 +485,14 @@ static void km_close_run(keymode *km)
 	}
 }
 
+/* The scene's home view and whether it is the model viewer's. */
+static void km_home(keymode *km)
+{
+	const char *label = editor_label(km->sh->ed);
+	km->model = label && mesh_format_known(label);
+	km->home = scene_camera(editor_scene(km->sh->ed));
+}
+
 /* After an edit that may have replaced the scene (undo, redo, PgUp/PgDn):
  * the step, the selection and the layout follow the new scene. */
 static void km_after_replace(keymode *km, const char *label_before)
@@ -481,6 +505,7 @@ static void km_after_replace(keymode *km, const char *label_before)
 		km->step = keymode_step(editor_scene(sh->ed));
 		km->cost = 0;
 		km->sel = (km_sel){KM_SEL_CAMERA, 0};
+		km_home(km);
 	}
 	if (!keymode_sel_valid(editor_scene(sh->ed), km->sel))
 		km->sel = (km_sel){KM_SEL_CAMERA, 0};
@@ -557,25 +582,188 @@ static void km_settings(keymode *km, const km_action *a)
 	km->want_fast = false;
 }
 
+/* One edit of the active camera (an undo step of its own unless a run or
+ * a drag is open). */
+static void km_set_camera(keymode *km, const camera *c)
+{
+	shell *sh = km->sh;
+	uint64_t gen = editor_generation(sh->ed);
+	rt_error err;
+	if (!editor_set_camera(sh->ed, editor_scene(sh->ed)->cam, c, &err))
+		km_message(km, "%s", err.msg);
+	if (editor_generation(sh->ed) != gen) {
+		km->edits++;
+		km->want_fast = true;
+		km->last_key = now();
+	}
+}
+
+static void km_stop_spin(keymode *km)
+{
+	if (km->spin > 0) {
+		km->spin = 0;
+		km_close_run(km);
+		km_message(km, "turntable stopped; u undoes the turn");
+	}
+}
+
+void keymode_spin(keymode *km, double seconds)
+{
+	if (!(seconds > 0))
+		return;
+	km_close_run(km);
+	const scene *s = editor_scene(km->sh->ed);
+	km->spin = seconds;
+	km->spin_t0 = now();
+	km->spin_cam = scene_camera(s);
+	km->spin_pivot = orbit_scene_centre(s);
+	editor_group_begin(km->sh->ed);
+	km->run_open = true;
+	km->run_key = KEYS_NONE;
+	km->run_sel = km->sel;
+	km->want_fast = true;
+	km_message(km, "turntable: a turn in %g s; any key stops it", seconds);
+}
+
+/* The turntable's next view, once the last one is drawn (frames are paced
+ * as the keys' are: one in flight, a newer picture overtaking an older
+ * one on a slow link). */
+static void km_spin_step(keymode *km, double t)
+{
+	if (!(km->spin > 0) || km->want_fast || km->held || (rsvc_busy(km->rs) && !km->cur.refine))
+		return;
+	double turns = (t - km->spin_t0) / km->spin;
+	double deg = 360.0 * (turns - floor(turns));
+	camera c = orbit_camera(km->spin_cam, km->spin_pivot, deg, 0.0);
+	km_set_camera(km, &c);
+}
+
+/* The object under the cell (x, y) (1-based): a ray through its middle,
+ * as the renderer casts them. */
+static void km_pick(keymode *km, int x, int y)
+{
+	const world *w = km_world(km);
+	/* canvas pixels a cell: 1x2 for half blocks, 2x4 for the other
+	 * symbol sets, the cell's size in real pixels */
+	int cw = km->kv.cols, ch = 2 * km->kv.pic_rows;
+	if (km->kv.enc)
+		km->kv.enc->ops->canvas(&km->kv.enc->geom, &cw, &ch);
+	double sx = km->kv.cols > 0 ? (double)cw / km->kv.cols : 1, sy = km->kv.pic_rows > 0 ? (double)ch / km->kv.pic_rows : 2;
+	double px = ((x - 1) + 0.5) * sx - km->kv.img_x, py = ((y - 1) + 0.5) * sy - km->kv.img_y;
+	if (!w || px < 0 || py < 0 || px >= km->kv.img_w || py >= km->kv.img_h)
+		return;
+	const scene *s = editor_scene(km->sh->ed);
+	ray r = cam_ray(&w->cam, px, py, km->kv.img_w, km->kv.img_h);
+	hit h;
+	km_close_run(km);
+	if (world_intersect(w, &r, 0.0, INFINITY, &h) && h.object < s->nobjs) {
+		km->sel = (km_sel){KM_SEL_OBJECT, h.object};
+		km_message(km, "selected object %zu %s", (size_t)h.object + 1, obj_kind_name(s->objs[h.object].kind));
+	} else {
+		km->sel = (km_sel){KM_SEL_CAMERA, 0};
+		km_message(km, "nothing there: the camera is selected");
+	}
+	km->dirty = true;
+}
+
+/* The drag so far: the camera from (done_x, done_y) to (mouse_x, mouse_y). */
+static void km_apply_drag(keymode *km)
+{
+	int dx = km->mouse_x - km->done_x, dy = km->mouse_y - km->done_y;
+	if (!km->drag || (dx == 0 && dy == 0))
+		return;
+	km->done_x = km->mouse_x;
+	km->done_y = km->mouse_y;
+	const scene *s = editor_scene(km->sh->ed);
+	camera c = scene_camera(s);
+	if (km->pan) {
+		/* The scene follows the cursor: at the pivot's distance, a pixel
+		 * of the picture is 2 d tan(fov/2) / width. */
+		cam_view v = cam_view_make(&c);
+		double d = v3_len(v3_sub(c.pos, km->pivot));
+		double u = km->kv.img_w > 0 ? 2.0 * d * v.tan_half / km->kv.img_w : 0;
+		vec3 mv = v3_add(v3_scale(v.right, -dx * u), v3_scale(v.up, 2.0 * dy * u));
+		c.pos = v3_add(c.pos, mv);
+		km->pivot = v3_add(km->pivot, mv);
+	} else {
+		c = orbit_camera(c, km->pivot, -dx * KEYMODE_DRAG_DEG, 2.0 * dy * KEYMODE_DRAG_DEG);
+	}
+	km_set_camera(km, &c);
+}
+
+void keymode_mouse(keymode *km, const keys_mouse *m)
+{
+	if (km->quit)
+		return;
+	km_stop_spin(km);
+	const scene *s = editor_scene(km->sh->ed);
+	if (m->button == KEYS_WHEEL_UP || m->button == KEYS_WHEEL_DOWN) {
+		km_apply_drag(km);
+		if (!km->drag)
+			km_close_run(km);
+		camera c = orbit_dolly(scene_camera(s), keymode_pivot(s, km->sel),
+		                       m->button == KEYS_WHEEL_UP ? KEYMODE_DOLLY : 1.0 - 1.0 / (1.0 - KEYMODE_DOLLY));
+		km_set_camera(km, &c);
+		return;
+	}
+	if (m->motion) {
+		if (km->drag) {
+			km->mouse_x = m->x;
+			km->mouse_y = m->y;
+			km->moved |= m->x != km->press_x || m->y != km->press_y;
+		}
+		return;
+	}
+	if (!m->release && (m->button == KEYS_BUTTON_LEFT || m->button == KEYS_BUTTON_MIDDLE)) {
+		km_close_run(km);
+		km->drag = true;
+		km->pan = m->shift || m->button == KEYS_BUTTON_MIDDLE;
+		km->moved = false;
+		km->press_x = km->done_x = km->mouse_x = m->x;
+		km->press_y = km->done_y = km->mouse_y = m->y;
+		km->pivot = keymode_pivot(s, km->sel);
+		/* The whole drag is one undo step. */
+		editor_group_begin(km->sh->ed);
+		km->run_open = true;
+		km->run_key = KEYS_MOUSE;
+		km->run_sel = km->sel;
+		return;
+	}
+	if (m->release && km->drag) {
+		km->mouse_x = m->x;
+		km->mouse_y = m->y;
+		km->moved |= m->x != km->press_x || m->y != km->press_y;
+		km_apply_drag(km);
+		km->drag = false;
+		km_close_run(km);
+		if (!km->moved && !km->pan)
+			km_pick(km, m->x, m->y);
+	}
+}
+
 void keymode_key(keymode *km, int key)
 {
 	if (km->quit)
 		return;
+	km_stop_spin(km);
 	shell *sh = km->sh;
 	const scene *s = editor_scene(sh->ed);
-	km_action a = keymode_map(key, s, km->sel, km->step);
+	km_action a = km->model ? keymode_map_model(key, s, km->sel, km->step) : keymode_map(key, s, km->sel, km->step);
 	if (a.op == KM_NONE)
 		return;
 	km->last_key = now();
 	if (keymode_is_edit(a.op)) {
-		if (!(km->run_open && km->run_key == key && km->run_sel.kind == km->sel.kind &&
-		      km->run_sel.index == km->sel.index)) {
+		/* Edit keys without a pause in typing between them (whichever
+		 * keys, whichever selection) undo as one step. */
+		if (!(km->run_open && km->run_key != KEYS_MOUSE && km->run_key != KEYS_NONE &&
+		      km->last_key - km->last_edit < KEYMODE_STEP_PAUSE)) {
 			km_close_run(km);
 			editor_group_begin(sh->ed);
 			km->run_open = true;
 			km->run_key = key;
 			km->run_sel = km->sel;
 		}
+		km->last_edit = km->last_key;
 		uint64_t gen = editor_generation(sh->ed);
 		rt_error err;
 		if (!keymode_apply(sh->ed, &a, &err))
@@ -646,6 +834,19 @@ void keymode_key(keymode *km, int key)
 	case KM_QUIT:
 		km->quit = true;
 		break;
+	case KM_FRAME: {
+		box b = km->sel.kind == KM_SEL_OBJECT && km->sel.index < s->nobjs ? object_bounds(&s->objs[km->sel.index])
+		                                                                  : orbit_scene_bounds(s);
+		if (km->sel.kind == KM_SEL_LIGHT && km->sel.index < s->nlights)
+			b = (box){v3_sub(s->lights[km->sel.index].pos, v3_splat(km->step * 4)),
+			          v3_add(s->lights[km->sel.index].pos, v3_splat(km->step * 4))};
+		camera c = orbit_frame(scene_camera(s), b, km_aspect(km));
+		km_set_camera(km, &c);
+		break;
+	}
+	case KM_HOME:
+		km_set_camera(km, &km->home);
+		break;
 	default:
 		break;
 	}
@@ -671,6 +872,8 @@ static bool km_take(keymode *km)
 int keymode_tick(keymode *km)
 {
 	double t = now();
+	km_apply_drag(km);
+	km_spin_step(km, t);
 	if (km->want_fast) {
 		km->want_fast = false;
 		km->want_refine = false;
@@ -740,6 +943,9 @@ double keymode_timeout(const keymode *km)
 		if (best < 0 || d < best)
 			best = d;
 	}
+	/* The turntable's next view. */
+	if (km->spin > 0 && (best < 0 || best > 0.02))
+		best = 0.02;
 	/* Let the fps figure go when keys stop. */
 	if (km->fast_frames > 1 && t - km->fast_times[(km->fast_frames - 1) % 16] < 0.6) {
 		double d = km->fast_times[(km->fast_frames - 1) % 16] + 0.6 - t;
@@ -797,6 +1003,7 @@ keymode *keymode_new(shell *sh, termout *out, frame_palette pal, int cols, int r
 	rsvc_hold(km->rs);
 	km->step = keymode_step(editor_scene(sh->ed));
 	km->sel = (km_sel){KM_SEL_CAMERA, 0};
+	km_home(km);
 	km_layout(km);
 	km->want_refine = true;
 	km->refined = true;
@@ -852,6 +1059,11 @@ static void raw_modes(int fd, const struct termios *saved)
 
 bool keymode_run(shell *sh)
 {
+	return keymode_turntable(sh, 0);
+}
+
+bool keymode_turntable(shell *sh, double seconds)
+{
 	screen *scr = sh->scr;
 	evloop *ev = sh->ev;
 	if (!sh->interactive || !scr || !scr->active || !scr->out || !ev || evloop_out(ev) != scr->out ||
@@ -887,12 +1099,26 @@ bool keymode_run(shell *sh)
 	sh->status_hook = NULL;
 	sh->scr = NULL;
 	raw_modes(in, &saved);
-	screen_keypad(fd, keys_keypad_on(k), keys_keypad_off(k), true);
+	/* The keypad transmit mode and the mouse (SGR reports of presses,
+	 * releases and drags), off again on every way out (screen.h). */
+	char on[96], off[96];
+	snprintf(on, sizeof on, "%s%s", keys_keypad_on(k), KEYS_MOUSE_ON);
+	snprintf(off, sizeof off, "%s%s", KEYS_MOUSE_OFF, keys_keypad_off(k));
+	screen_keypad(fd, on, off, true);
 	int cols, rows;
 	term_size(fd, &cols, &rows);
 	size_t undo0 = editor_undo_count(sh->ed);
 	keymode *km = keymode_new(sh, out, scr->pal, cols, rows);
 	bool ok = km != NULL;
+	if (km) {
+		/* The shell's picture: real pixels or its symbol set. */
+		const pixels_caps *pc = termout_pixels(out);
+		const encoder_ops *ops = scr->pix_ops ? scr->pix_ops : encoder_symbols(scr->sym);
+		keyview_set_encoder(&km->kv, ops, scr->cell_w, scr->cell_h, pc ? pc->sixel_w : 0, pc ? pc->sixel_h : 0);
+		km_layout(km);
+	}
+	if (km)
+		keymode_spin(km, seconds);
 	while (km && !keymode_done(km)) {
 		keymode_tick(km);
 		/* Keys, wake-ups (a frame, a signal), the scheduler's slices and
@@ -929,8 +1155,12 @@ bool keymode_run(shell *sh)
 		abuf_reset(&pend);
 		int c;
 		while (!keymode_done(km) && (c = keys_next(k)) != KEYS_NONE)
-			if (c != KEYS_RESIZE)
+			if (c == KEYS_MOUSE) {
+				keys_mouse m = keys_mouse_event(k);
+				keymode_mouse(km, &m);
+			} else if (c != KEYS_RESIZE) {
 				keymode_key(km, c);
+			}
 		if (evloop_eof(ev))
 			break; /* the terminal is gone */
 	}
@@ -944,6 +1174,7 @@ bool keymode_run(shell *sh)
 	tcsetattr(in, TCSANOW, &saved);
 	sh->scr = scr;
 	sh->status_hook = hook;
+	screen_drop_images(scr); /* key mode's kitty images, if any */
 	termout_set_picture(out, scr->enc);
 	screen_layout(scr, (double)sh->set.width / sh->set.height, true);
 	rl_set_screen_size(scr->rows - scr->region_top, scr->cols);

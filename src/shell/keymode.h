@@ -31,6 +31,7 @@
 #include "rtsh/edit.h"
 #include "rtsh/scene.h"
 #include "shell/shell.h"
+#include "term/keys.h"
 #include "term/keyview.h"
 #include "term/out.h"
 
@@ -44,10 +45,22 @@
 /* Light brightness per key; camera field of view per key (degrees). */
 #define KEYMODE_BRIGHTNESS 0.05
 #define KEYMODE_FOV_DEG 5.0
+/* The model viewer's arrow keys orbit the camera by this many degrees; a
+ * mouse drag by KEYMODE_DRAG_DEG a pixel of the picture (a column is one
+ * pixel across, a row two down: a Right arrow is a drag of two columns to
+ * the right, an Up arrow a drag of one row up). The wheel moves the camera
+ * a tenth of the way to what it turns about. */
+#define KEYMODE_ORBIT_DEG 5.0
+#define KEYMODE_DRAG_DEG 2.5
+#define KEYMODE_DOLLY 0.1
+/* Seconds a turn of `turntable` takes when not told. */
+#define KEYMODE_SPIN_SECONDS 8.0
 /* Seconds: the longest a frame may take while keys arrive; the quiet time
  * after the last key before the picture is refined. */
 #define KEYMODE_FRAME_BUDGET 0.025
 #define KEYMODE_IDLE 0.15
+/* Edits with no pause this long (seconds) between them undo as one step. */
+#define KEYMODE_STEP_PAUSE 1.0
 /* Seconds: the length the refine's passes aim at (after a first of one
  * sample). */
 #define KEYMODE_PASS_SECONDS 0.2
@@ -83,6 +96,9 @@ typedef enum km_op {
 	KM_REDRAW,     /* repaint the whole screen */
 	KM_HELP,       /* show or hide the help bar */
 	KM_QUIT,       /* back to the shell */
+	KM_ORBIT,      /* orbit the camera about d: a = yaw, b = pitch degrees (orbit_camera) */
+	KM_FRAME,      /* frame the selection (the whole scene when the camera is selected) */
+	KM_HOME,       /* the camera as key mode began */
 } km_op;
 
 /* The key table (keymode_keys.c): each row is the keys of one line of
@@ -136,6 +152,14 @@ bool keymode_sel_valid(const scene *s, km_sel sel);
  * where it looks; for objects and lights, forward is that direction made
  * horizontal; right is the camera's right; R/F go along world +Y. */
 km_action keymode_map(int key, const scene *s, km_sel sel, double step);
+/* The model viewer's keys (the scene is a model's, rtsh/rtfile.h): the
+ * arrows orbit the camera about keymode_pivot (Right: the model turns to
+ * the right, Up: its front tilts up), Shift+arrows fly as the arrows do
+ * elsewhere, f frames the selection; every other key as keymode_map. */
+km_action keymode_map_model(int key, const scene *s, km_sel sel, double step);
+/* What the camera orbits about: the selected object's centre (its box's),
+ * the selected light, or the scene's centre (orbit_scene_centre). */
+vec3 keymode_pivot(const scene *s, km_sel sel);
 /* True for the actions that edit the scene (those keymode_apply makes). */
 bool keymode_is_edit(km_op op);
 /* Makes the scene edit of a (KM_MOVE, KM_TURN, KM_ROTATE, KM_SCALE) as
@@ -163,6 +187,16 @@ void keymode_free(keymode *km);
 /* Handles one key (edits go to the editor at once; renders start in
  * keymode_tick). */
 void keymode_key(keymode *km, int key);
+/* Handles one mouse event (term/keys.h): a drag with the left button
+ * orbits the camera about keymode_pivot, with Shift or the middle button
+ * pans it, the wheel moves it nearer or farther, a click (press and
+ * release in one cell) selects the object under the cursor. Motions are
+ * coalesced: the camera follows the newest position at the next
+ * keymode_tick. A drag is one undo step. */
+void keymode_mouse(keymode *km, const keys_mouse *m);
+/* Spins the camera about the scene's centre, a turn in `seconds` (the
+ * turntable); any key or click stops it (the turn is one undo step). */
+void keymode_spin(keymode *km, double seconds);
 /* Starts, cancels and refines renders as needed and draws a finished
  * frame; returns the number of frames written (0 or 1). */
 int keymode_tick(keymode *km);
@@ -185,5 +219,7 @@ long keymode_frames(const keymode *km);
  * SIGHUP), then gives the shell's screen back as it was. False (error
  * recorded) when there is no full-screen terminal. */
 bool keymode_run(shell *sh);
+/* The same, the camera spinning (keymode_spin) from the start. */
+bool keymode_turntable(shell *sh, double seconds);
 
 #endif

@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "rtsh/orbit.h"
 #include "rtsh/shape.h"
 #include "term/abuf.h"
 #include "term/keys.h"
@@ -53,6 +54,10 @@ const km_keyrow keymode_keys[] = {
 	 {{'u', KM_UNDO, 0}, {'U', KM_REDO, 0}}},
 	{"? F1", "hide / show the help bar", "?", "hide this", 14, {{'?', KM_HELP, 0}, {KEYS_F(1), KM_HELP, 0}}},
 	{"Ctrl-L F5", "repaint", NULL, NULL, 0, {{12, KM_REDRAW, 0}, {KEYS_F(5), KM_REDRAW, 0}}},
+	{"0", "reset the view: the camera as key mode began", NULL, NULL, 0, {{'0', KM_HOME, 0}}},
+	{"f (model viewer)", "frame the selection (the whole model when the camera is selected);\n"
+	                     "in the model viewer the arrows orbit (Shift+arrows fly), F moves down",
+	 NULL, NULL, 0, {{0, KM_NONE, 0}}},
 	{"Esc q", "back to the shell; every change stays (undo, save x.rt)", "Esc", "back", 1,
 	 {{KEYS_ESC, KM_QUIT, 0}, {'q', KM_QUIT, 0}, {'Q', KM_QUIT, 0}}},
 };
@@ -244,9 +249,57 @@ km_action keymode_map(int key, const scene *s, km_sel sel, double step)
 	}
 }
 
+vec3 keymode_pivot(const scene *s, km_sel sel)
+{
+	if (sel.kind == KM_SEL_OBJECT && sel.index < s->nobjs && s->objs[sel.index].kind != OBJ_PLANE) {
+		box b = object_bounds(&s->objs[sel.index]);
+		if (!box_is_empty(b) && v3_finite(b.lo) && v3_finite(b.hi))
+			return box_center(b);
+	}
+	if (sel.kind == KM_SEL_LIGHT && sel.index < s->nlights)
+		return s->lights[sel.index].pos;
+	return orbit_scene_centre(s);
+}
+
+km_action keymode_map_model(int key, const scene *s, km_sel sel, double step)
+{
+	double yaw = 0, pitch = 0;
+	switch (key) {
+	case KEYS_LEFT:
+		yaw = KEYMODE_ORBIT_DEG;
+		break;
+	case KEYS_RIGHT:
+		yaw = -KEYMODE_ORBIT_DEG;
+		break;
+	case KEYS_UP:
+		pitch = -KEYMODE_ORBIT_DEG;
+		break;
+	case KEYS_DOWN:
+		pitch = KEYMODE_ORBIT_DEG;
+		break;
+	case KEYS_SHIFT_UP:
+		return keymode_map(KEYS_UP, s, sel, step);
+	case KEYS_SHIFT_DOWN:
+		return keymode_map(KEYS_DOWN, s, sel, step);
+	case KEYS_SHIFT_LEFT:
+		return keymode_map(KEYS_LEFT, s, sel, step);
+	case KEYS_SHIFT_RIGHT:
+		return keymode_map(KEYS_RIGHT, s, sel, step);
+	case 'f':
+		return act(KM_FRAME, sel);
+	default:
+		return keymode_map(key, s, sel, step);
+	}
+	km_action a = act(KM_ORBIT, sel);
+	a.a = yaw;
+	a.b = pitch;
+	a.d = keymode_pivot(s, sel);
+	return a;
+}
+
 bool keymode_is_edit(km_op op)
 {
-	return op == KM_MOVE || op == KM_TURN || op == KM_ROTATE || op == KM_SCALE;
+	return op == KM_MOVE || op == KM_TURN || op == KM_ROTATE || op == KM_SCALE || op == KM_ORBIT;
 }
 
 bool keymode_apply(editor *ed, const km_action *a, rt_error *err)
@@ -264,6 +317,10 @@ bool keymode_apply(editor *ed, const km_action *a, rt_error *err)
 		return editor_camera_pos(ed, v3_add(scene_camera(s).pos, a->d), err);
 	case KM_TURN:
 		return editor_camera_turn(ed, a->a, a->b, err);
+	case KM_ORBIT: {
+		camera c = orbit_camera(scene_camera(s), a->d, a->a, a->b);
+		return editor_set_camera(ed, s->cam, &c, err);
+	}
 	case KM_ROTATE:
 		if (a->sel.kind != KM_SEL_OBJECT)
 			return rt_error_set(err, "only objects rotate; press Tab to select one");

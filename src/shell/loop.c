@@ -18,6 +18,7 @@
 #include <readline/history.h>
 #include <readline/readline.h>
 
+#include "shell/keymode.h"
 #include "shell/complete.h"
 #include "shell/history.h"
 #include "term/pager.h"
@@ -117,6 +118,23 @@ static void draw_picture(shell *sh)
 
 static void relayout_screen(shell *sh);
 
+/* Text shown in the command area, remembered for a new layout. */
+static void area_log(shell *sh, const char *text, size_t n)
+{
+	if (sh->scr && sh->scr->active)
+		screen_log(sh->scr, text, n);
+}
+
+/* Prints sh->err (shell_report), remembered for a new layout. */
+static void report(shell *sh)
+{
+	if (!sh->err_reported && sh->err[0]) {
+		area_log(sh, sh->err, strlen(sh->err));
+		area_log(sh, "\n", 1);
+	}
+	shell_report(sh);
+}
+
 /* Prints a command's output in the command area, or pages it when it would
  * scroll out of sight there. */
 static void show_output(shell *sh, const abuf *out)
@@ -125,6 +143,7 @@ static void show_output(shell *sh, const abuf *out)
 	int area = scr->rows - scr->region_top; /* the command area, prompt included */
 	if (pager_rows(out->b, out->len, scr->cols) < area) {
 		fwrite(out->b, 1, out->len, stdout);
+		screen_log(scr, out->b, out->len);
 		return;
 	}
 	fflush(stdout);
@@ -159,16 +178,54 @@ static double frame_gap(const shell *sh)
 	return g < FRAME_INTERVAL ? FRAME_INTERVAL : g > FRAME_GAP_MAX ? FRAME_GAP_MAX : g;
 }
 
+/* Runs one line of what readline gave (a pasted block has several); its
+ * output goes to `out` when the picture is on screen. With `inline_errors`
+ * (a paste of several lines) an error goes to `out` too, after the
+ * output of the lines before it, so that each message stays next to its
+ * line. */
+static bool run_one(shell *sh, const char *line, abuf *out, bool inline_errors)
+{
+	history_add_line(&hist, line);
+	if (sh->scr && sh->scr->active)
+		sh->capture = sh->notes = out; /* warnings too, in their place */
+	bool ok = shell_run_line(sh, line);
+	sh->capture = sh->notes = NULL;
+	if (!ok && inline_errors) {
+		if (sh->scr && sh->scr->active) {
+			if (!sh->err_reported && sh->err[0])
+				abuf_printf(out, "%s\n", sh->err);
+			sh->err_reported = false;
+			sh->err[0] = '\0';
+		} else {
+			report(sh);
+		}
+	}
+	return ok;
+}
+
 static void on_line(char *line)
 {
 	shell *sh = active;
 	if (!line) { /* Ctrl-D or end of input */
 		fputs("\n", stdout);
+		if (!evloop_eof(ev) && shell_quit_asks(sh)) {
+			/* Ctrl-D again leaves. */
+			static const char q[] = "the scene has edits not saved (save FILE.rt keeps them); Ctrl-D again, "
+			                        "or quit!, leaves without them\n";
+			fputs(q, stdout);
+			area_log(sh, PROMPT "\n", strlen(PROMPT) + 1);
+			area_log(sh, q, sizeof q - 1);
+			fflush(stdout);
+			return;
+		}
 		sh->quit = true;
 		return;
 	}
-	history_add_line(&hist, line);
+	area_log(sh, PROMPT, strlen(PROMPT));
+	area_log(sh, line, strlen(line));
+	area_log(sh, "\n", 1);
 	shell_sig_int = 0;
+	atomic_store(&sh->cancel, false);
 	/* readline gave the terminal its own modes back while the command
 	 * runs: echo off all the same, so that an answer of the terminal (to
 	 * a picture slice in flight) is not echoed onto the screen. On again
@@ -182,19 +239,41 @@ static void on_line(char *line)
 		tcsetattr(STDIN_FILENO, TCSADRAIN, &q);
 	}
 	/* With a picture on screen, the output is held back: if it is longer
-	 * than the command area, the pager shows it over the whole screen. */
+	 * than the command area, the pager shows it over the whole screen.
+	 * A bracketed paste of several lines comes as one line with newlines
+	 * in it: each line is a command of its own, run in turn as bash does
+	 * (its own history entry and error); Ctrl-C stops the rest. */
 	abuf out;
 	abuf_init(&out);
-	if (sh->scr && sh->scr->active)
-		sh->capture = &out;
-	bool ok = shell_run_line(sh, line);
-	sh->capture = NULL;
+	bool several = strpbrk(line, "\n\r") != NULL;
+	long left = 0;
+	bool ok = true;
+	for (char *p = line; p && !sh->quit;) {
+		char *end = p + strcspn(p, "\n\r");
+		char *next = *end ? end + 1 : NULL;
+		*end = '\0';
+		if (shell_sig_int || (several && atomic_load(&sh->cancel))) {
+			left += p[strspn(p, " \t")] != '\0';
+		} else if (!several) {
+			ok = run_one(sh, p, &out, false);
+		} else if (p[strspn(p, " \t")]) {
+			run_one(sh, p, &out, true);
+			fflush(stdout);
+		}
+		p = next;
+	}
 	free(line);
-	if (out.len && !out.failed)
-		show_output(sh, &out);
+	if (left)
+		abuf_printf(&out, "Ctrl-C: %ld pasted line%s not run\n", left, left == 1 ? "" : "s");
+	if (out.len && !out.failed) {
+		if (sh->scr && sh->scr->active)
+			show_output(sh, &out);
+		else
+			fwrite(out.b, 1, out.len, stdout);
+	}
 	abuf_free(&out);
 	if (!ok)
-		shell_report(sh);
+		report(sh);
 	fflush(stdout);
 	if (quiet)
 		tcsetattr(STDIN_FILENO, TCSADRAIN, &modes);
@@ -225,6 +304,9 @@ static void interrupt(shell *sh)
 		shell_notice(sh, "Ctrl-C: the rest of the picture was not sent");
 	}
 	rl_callback_sigcleanup();
+	area_log(sh, PROMPT, strlen(PROMPT));
+	area_log(sh, rl_line_buffer, strlen(rl_line_buffer));
+	area_log(sh, "^C\n", 3);
 	rl_replace_line("", 0);
 	fputs("^C", rl_outstream);
 	rl_crlf();
@@ -265,7 +347,8 @@ static void after_probe(shell *sh)
 	if (probe_seen || termout_get_state(o) == TERMOUT_PROBING)
 		return;
 	probe_seen = true;
-	if (sh->set.pixels != PIXELS_OFF && screen_set_pixels(sh->scr, sh->set.pixels)) {
+	bool sym = sh->set.symbols == SYMBOLS_AUTO && screen_set_symbols(sh->scr, sh->set.symbols);
+	if ((sh->set.pixels != PIXELS_OFF && screen_set_pixels(sh->scr, sh->set.pixels)) || sym) {
 		/* The answers told the cell size or, for auto, the protocol: the
 		 * screen was laid out again for it. */
 		shell_refresh(sh);
@@ -335,8 +418,13 @@ int shell_interactive(shell *sh, bool use_screen, const int wake[2])
 	/* After readline turned echo off, so the answers are not echoed. */
 	if (sh->scr && !getenv("RTSH_NO_PACING")) {
 		termout_ask_pixels(scr.out, sh->set.pixels != PIXELS_OFF);
+		termout_ask_version(scr.out, sh->set.symbols == SYMBOLS_AUTO);
 		termout_probe(scr.out, asked_color, now());
 	}
+
+	/* rtsh --turntable: key mode spinning from the start. */
+	if (sh->opt->turntable && sh->scr)
+		keymode_turntable(sh, KEYMODE_SPIN_SECONDS);
 
 	int status = 0;
 	while (!sh->quit) {

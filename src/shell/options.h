@@ -16,6 +16,9 @@ typedef struct option_setting {
 } option_setting;
 
 #define OPTIONS_MAX_SETTINGS 16
+/* --preview: the largest side in cells; --turntable: the most frames. */
+#define OPTIONS_MAX_CELLS 1000
+#define OPTIONS_MAX_FRAMES 3600
 
 typedef struct rtsh_options {
 	const char *scene;     /* SCENE.rt or NULL (the built-in showcase) */
@@ -26,6 +29,10 @@ typedef struct rtsh_options {
 	bool quiet;            /* -q */
 	bool strict;           /* --strict */
 	color_mode color;      /* --color */
+	const char *preview;   /* --preview COLSxROWS (shell/preview.h) */
+	int preview_cols, preview_rows;
+	bool turntable;        /* --turntable [FRAMES] */
+	int turntable_frames;  /* FRAMES, 0 when not given */
 	option_setting settings[OPTIONS_MAX_SETTINGS];
 	int nsettings;
 } rtsh_options;

@@ -6,6 +6,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "rtsh/filesrc.h"
 #include "rtsh/rtkeep.h"
 #include "rtsh/rtfile.h"
 #include "shell/builtin_scene.h"
@@ -34,7 +35,8 @@ scene_hints save_rt_hints(const scene_hints *h, const render_settings *set)
 /* The file's text, or NULL when it cannot be read (or is too big). */
 static char *read_source(const char *path, size_t *len)
 {
-	FILE *f = fopen(path, "rb");
+	const char *kind;
+	FILE *f = rt_file_open_regular(path, &kind); /* a FIFO would wait for a writer */
 	if (!f)
 		return NULL;
 	struct stat st;

@@ -12,6 +12,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rtsh/filesrc.h"
+#include "rtsh/memory.h"
 #include "shell/commands.h"
 #include "shell/shell.h"
 
@@ -73,6 +75,16 @@ static bool blank(const char *s)
 static bool run_line(shell *sh, const char *text, const char *name, long lineno, long *count,
                      bool count_commands)
 {
+	if (strlen(text) > SHELL_LINE_MAX) {
+		sh->err[0] = '\0';
+		shell_fail(sh, "the line is longer than " SHELL_LINE_MAX_TEXT " bytes; expected at most " SHELL_LINE_MAX_TEXT);
+		if (name) {
+			fflush(stdout);
+			fprintf(stderr, "%s:%ld: %s\n", name, lineno, sh->err);
+			sh->err_reported = true;
+		}
+		return false;
+	}
 	char *line = strdup(text);
 	if (!line)
 		return shell_fail(sh, "out of memory");
@@ -145,30 +157,75 @@ bool shell_run_text(shell *sh, const char *text, const char *name, bool count_co
 	return ok;
 }
 
+/* How reading one line ended. */
+typedef enum line_end { LINE_OK, LINE_EOF, LINE_NUL, LINE_LONG, LINE_ERROR } line_end;
+
+/* Reads one line of f into buf (SHELL_LINE_MAX + 2 bytes) without its
+ * newline, NUL-terminated. Stops at the first NUL byte (LINE_NUL) and at the
+ * first byte past SHELL_LINE_MAX (LINE_LONG), so endless input (/dev/zero, a
+ * line that never ends) costs one line's buffer and no more. */
+static line_end read_line(FILE *f, char *buf)
+{
+	size_t n = 0;
+	int c;
+	while ((c = getc(f)) != EOF && c != '\n') {
+		if (c == '\0')
+			return LINE_NUL;
+		if (n == SHELL_LINE_MAX)
+			return LINE_LONG;
+		buf[n++] = (char)c;
+	}
+	buf[n] = '\0';
+	if (c == EOF && ferror(f))
+		return LINE_ERROR;
+	return c == EOF && n == 0 ? LINE_EOF : LINE_OK;
+}
+
 bool shell_run_file(shell *sh, const char *path)
 {
-	bool is_stdin = strcmp(path, "-") == 0;
-	FILE *f = is_stdin ? stdin : fopen(path, "r");
+	bool is_stdin = strcmp(path, "-") == 0 || strcmp(path, "/dev/stdin") == 0;
+	const char *kind = NULL;
+	errno = 0;
+	/* Only standard input may be a pipe or a device: a FIFO given by name is
+	 * refused before it is opened, which would wait for a writer (issue 31). */
+	FILE *f = is_stdin ? stdin : rt_file_open_regular(path, &kind);
+	if (!f && kind)
+		return shell_fail(sh, "%s: is %s; expected a command file (a regular file, or - for standard input)",
+		                  path, kind);
 	if (!f)
 		return shell_fail(sh, "cannot open %s: %s", path, strerror(errno));
-	const char *name = is_stdin ? "stdin" : path;
-	char *line = NULL;
-	size_t cap = 0;
+	const char *name = strcmp(path, "-") == 0 ? "stdin" : path;
+	rt_error merr;
+	bool fits = mem_check(SHELL_LINE_MAX + 2, "a command line", &merr);
+	char *line = fits ? malloc(SHELL_LINE_MAX + 2) : NULL;
+	if (!line) {
+		if (!is_stdin)
+			fclose(f);
+		return shell_fail(sh, "%s", fits ? "out of memory reading a command line" : merr.msg);
+	}
 	long lineno = 0, count = 0;
 	bool ok = true;
-	ssize_t n;
-	while (ok && !sh->quit && (n = getline(&line, &cap, f)) >= 0) {
+	while (ok && !sh->quit) {
+		line_end e = read_line(f, line);
+		if (e == LINE_EOF)
+			break;
 		lineno++;
-		if (memchr(line, '\0', (size_t)n)) {
-			fprintf(stderr, "%s:%ld: the line holds a NUL byte; expected text\n", name, lineno);
+		const char *bad = e == LINE_NUL    ? "the line holds a NUL byte; expected text"
+		                  : e == LINE_LONG ? "the line is longer than " SHELL_LINE_MAX_TEXT
+		                                     " bytes; expected at most " SHELL_LINE_MAX_TEXT
+		                  : e == LINE_ERROR ? strerror(errno)
+		                                    : NULL;
+		if (bad) {
+			fflush(stdout);
+			if (e == LINE_ERROR)
+				fprintf(stderr, "%s:%ld: cannot read: %s\n", name, lineno, bad);
+			else
+				fprintf(stderr, "%s:%ld: %s\n", name, lineno, bad);
 			sh->err_reported = true;
-			ok = shell_fail(sh, "the line holds a NUL byte; expected text");
+			ok = shell_fail(sh, "%s", bad);
 			break;
 		}
 		ok = run_line(sh, line, name, lineno, &count, false);
-	}
-	if (ok && ferror(f)) {
-		ok = shell_fail(sh, "cannot read %s: %s", name, strerror(errno));
 	}
 	free(line);
 	if (!is_stdin)

@@ -229,6 +229,8 @@ void shell_refresh(shell *sh)
 	}
 	/* A new pixels setting takes effect here; what the terminal answered
 	 * later, in the loop's after_probe. */
+	if (sh->set.symbols != sh->scr->symbols)
+		screen_set_symbols(sh->scr, sh->set.symbols);
 	if (sh->set.pixels == sh->scr->pixels || !screen_set_pixels(sh->scr, sh->set.pixels))
 		screen_layout(sh->scr, aspect_of(&sh->set), false);
 	if (sh->scr->img_w <= 0 || sh->scr->img_h <= 0) {
@@ -391,12 +393,22 @@ frame *shell_picture_frame(shell *sh, frame_palette pal, int cols)
 	const float *rgb;
 	int w, h;
 	framebuffer *fb = NULL;
-	if (sh->scr && sh->img.w > 0 && sh->img.rgb) {
+	/* The symbol set asked for, else the screen's (a file: half blocks). */
+	symbols_kind k = sh->set.symbols >= SYMBOLS_HALF && sh->set.symbols < SYMBOLS_AUTO
+	                     ? (symbols_kind)sh->set.symbols
+	                 : sh->scr && sh->scr->active ? sh->scr->sym
+	                                              : SYMBOLS_HALF;
+	if (pal == PALETTE_NONE)
+		k = SYMBOLS_HALF;
+	int sx = k == SYMBOLS_HALF ? 1 : SYMBOLS_SAMPLE_W, sy = k == SYMBOLS_HALF ? 2 : SYMBOLS_SAMPLE_H;
+	if (sh->scr && sh->img.w > 0 && sh->img.rgb && !sh->scr->pix_ops && sh->scr->sym == k) {
 		rgb = sh->img.rgb;
 		w = sh->img.w;
 		h = sh->img.h;
 	} else {
 		screen_fit(cols, 1000, aspect_of(&sh->set), pal == PALETTE_NONE, &w, &h);
+		w = w * sx;
+		h = h * sy / 2;
 		rsvc_hold(sh->rs);
 		rt_error err;
 		rt_error_clear(&err);
@@ -416,7 +428,7 @@ frame *shell_picture_frame(shell *sh, frame_palette pal, int cols)
 		}
 		rgb = fb->rgb;
 	}
-	frame *f = frame_new(w, (h + 1) / 2, pal);
+	frame *f = frame_new_symbols((w + sx - 1) / sx, (h + sy - 1) / sy, pal, k);
 	uint8_t *px = malloc((size_t)w * h * 3);
 	if (!f || !px) {
 		frame_free(f);
@@ -434,12 +446,24 @@ frame *shell_picture_frame(shell *sh, frame_palette pal, int cols)
 
 /* --- scenes --- */
 
+bool shell_quit_asks(shell *sh)
+{
+	uint64_t gen = editor_generation(sh->ed);
+	if (!sh->interactive || sh->depth > 0 || sh->opt->quiet || gen == sh->saved_gen ||
+	    sh->quit_asked_gen == gen + 1)
+		return false;
+	sh->quit_asked_gen = gen + 1;
+	return true;
+}
+
 bool shell_replace_scene(shell *sh, scene *s, const char *label)
 {
 	rt_error err;
 	shell_edit_begin(sh);
 	bool ok = editor_replace(sh->ed, s, label, &err);
 	shell_edit_end(sh);
+	if (ok)
+		sh->saved_gen = editor_generation(sh->ed);
 	return ok ? true : shell_fail(sh, "%s", err.msg);
 }
 
@@ -505,6 +529,7 @@ bool shell_init(shell *sh, const rtsh_options *o, int wake_fd)
 		return false;
 	}
 	sh->label = o->scene ? strdup(o->scene) : NULL;
+	sh->saved_gen = editor_generation(sh->ed);
 	sh->set = fresh_settings(sh, false);
 	name_from_label(sh);
 	return true;

@@ -80,6 +80,9 @@ typedef struct shell {
 	char notice[256];      /* said once in the status line (until notice_until) */
 	double notice_until;
 	bool err_reported;     /* err was printed already (by a nested source) */
+	uint64_t saved_gen;    /* the editor's generation when the scene was loaded or saved as .rt */
+	uint64_t quit_asked_gen; /* quit asked about unsaved edits at this generation (+1; 0: not asked) */
+	bool force;            /* the command word ended in "!" (quit!) */
 	int depth;             /* source nesting */
 	unsigned hand_set;     /* bit i: settings_table[i] was changed by `set` (answer.c) */
 	void (*status_hook)(struct shell *sh); /* redraws the status line (interactive) */
@@ -125,6 +128,11 @@ const framebuffer *shell_full_image(shell *sh, bool force);
  * preview when there is one, else rendered at `cols` columns. */
 frame *shell_picture_frame(shell *sh, frame_palette pal, int cols);
 
+/* True when an interactive quit should ask first: edits not saved as .rt,
+ * not asked already about these edits, not -q, not from a command file.
+ * Marks the question asked (the caller says it). */
+bool shell_quit_asks(shell *sh);
+
 /* Replaces the scene (load, next, prev, generate). */
 bool shell_replace_scene(shell *sh, scene *s, const char *label);
 /* Loads a scene file (the current scene stays on failure). */
@@ -138,7 +146,13 @@ bool shell_run_line(shell *sh, const char *line);
  * instead of lines. Reports the first error as "NAME:LINE: message" and
  * returns false. */
 bool shell_run_text(shell *sh, const char *text, const char *name, bool count_commands);
-/* Runs a command file ("-" = standard input). */
+/* The longest command line, in bytes without its newline, that a command
+ * file, -c, source, standard input or the prompt may hold (rtsh(1)). */
+#define SHELL_LINE_MAX 65536
+#define SHELL_LINE_MAX_TEXT "65536"
+/* Runs a command file ("-" or "/dev/stdin" = standard input; any other
+ * file that is not a regular one is refused unopened). A NUL byte or a line
+ * longer than SHELL_LINE_MAX ends it with "FILE:LINE: message". */
 bool shell_run_file(shell *sh, const char *path);
 /* Prints sh->err for an interactive command (not yet reported). */
 void shell_report(shell *sh);

@@ -1,6 +1,8 @@
-/* rtsh — the half-block encoder (encoder.h): two pixels a cell, drawn by
- * the frame module (frame.h), which keeps the cells the terminal shows and
- * sends the changed ones, a few rows per part. */
+/* rtsh — the cell encoders (encoder.h): half blocks, two pixels a cell,
+ * and the other symbol sets (term/symbols.h: quadrants, sextants,
+ * octants), drawn by the frame module (frame.h), which keeps the cells the
+ * terminal shows and sends the changed ones, a few rows per part. A symbol
+ * set's canvas holds 2x4 samples a cell. */
 #include <stdlib.h>
 
 #include "term/encoder.h"
@@ -16,14 +18,22 @@ static void hb_canvas(const encoder_geom *g, int *w, int *h)
 	*h = 2 * g->rows;
 }
 
-static encoder *hb_open(const encoder_geom *g)
+static void sym_canvas(const encoder_geom *g, int *w, int *h)
+{
+	*w = g->cols * SYMBOLS_SAMPLE_W;
+	*h = g->rows * SYMBOLS_SAMPLE_H;
+	if (g->pal == PALETTE_NONE)
+		hb_canvas(g, w, h); /* no colour: one character a cell, as half blocks */
+}
+
+static encoder *cells_open(const encoder_geom *g, const encoder_ops *ops, symbols_kind sym)
 {
 	halfblock *e = calloc(1, sizeof *e);
 	if (!e)
 		return NULL;
-	e->base.ops = &encoder_halfblock;
+	e->base.ops = ops;
 	e->base.geom = *g;
-	e->fr = frame_new(g->cols, g->rows, g->pal);
+	e->fr = frame_new_symbols(g->cols, g->rows, g->pal, sym);
 	if (!e->fr) {
 		free(e);
 		return NULL;
@@ -76,16 +86,34 @@ static void hb_set_lossy(encoder *e, int tol)
 	((halfblock *)e)->fr->tol = tol;
 }
 
-const encoder_ops encoder_halfblock = {
-	.name = "halfblock",
-	.canvas = hb_canvas,
-	.open = hb_open,
-	.close = hb_close,
-	.put = hb_put,
-	.clear = hb_clear,
-	.invalidate = hb_invalidate,
-	.update = hb_update,
-	.dirty = hb_dirty,
-	.keep_shown = hb_keep_shown,
-	.set_lossy = hb_set_lossy,
-};
+static encoder *hb_open(const encoder_geom *g)
+{
+	return cells_open(g, &encoder_halfblock, SYMBOLS_HALF);
+}
+
+static encoder *quadrant_open(const encoder_geom *g)
+{
+	return cells_open(g, &encoder_quadrant, SYMBOLS_QUADRANT);
+}
+
+static encoder *sextant_open(const encoder_geom *g)
+{
+	return cells_open(g, &encoder_sextant, SYMBOLS_SEXTANT);
+}
+
+static encoder *octant_open(const encoder_geom *g)
+{
+	return cells_open(g, &encoder_octant, SYMBOLS_OCTANT);
+}
+
+#define CELL_OPS(NAME, CANVAS, OPEN)                                                              \
+	{                                                                                         \
+		.name = NAME, .canvas = CANVAS, .open = OPEN, .close = hb_close, .put = hb_put,     \
+		.clear = hb_clear, .invalidate = hb_invalidate, .update = hb_update,              \
+		.dirty = hb_dirty, .keep_shown = hb_keep_shown, .set_lossy = hb_set_lossy,        \
+	}
+
+const encoder_ops encoder_halfblock = CELL_OPS("halfblock", hb_canvas, hb_open);
+const encoder_ops encoder_quadrant = CELL_OPS("quadrant", sym_canvas, quadrant_open);
+const encoder_ops encoder_sextant = CELL_OPS("sextant", sym_canvas, sextant_open);
+const encoder_ops encoder_octant = CELL_OPS("octant", sym_canvas, octant_open);

@@ -180,7 +180,12 @@ static void pix_invalidate(encoder *b)
 	memset(e->stale, 0, (size_t)e->nstrips * sizeof *e->stale);
 }
 
-/* Appends tile k, placed at its cell with the cursor saved and restored. */
+/* Appends tile k, placed at its cell with the cursor saved and restored,
+ * and hidden meanwhile: a terminal that draws its cursor while the image's
+ * bytes are still coming (xterm, between two reads) puts it on the tile's
+ * first cell, and when the cursor leaves, paints that cell again as text,
+ * over the image: a cell-sized hole in the terminal's background colour
+ * (issue 31, defect 8). */
 static bool send_strip(pix_enc *e, int k, abuf *out)
 {
 	const encoder_geom *g = &e->base.geom;
@@ -188,7 +193,7 @@ static bool send_strip(pix_enc *e, int k, abuf *out)
 	tile_rect(e, k, &x, &y, &w, &h);
 	int rows = h / g->cell_h, cols = w / g->cell_w;
 	size_t len0 = out->len;
-	abuf_printf(out, "\x1b" "7\x1b[%d;%dH", g->y0 + y / g->cell_h + 1, g->x0 + x / g->cell_w + 1);
+	abuf_printf(out, "\x1b" "7\x1b[?25l\x1b[%d;%dH", g->y0 + y / g->cell_h + 1, g->x0 + x / g->cell_w + 1);
 	const uint8_t *p = e->rgb + ((size_t)y * e->w + x) * 3;
 	if (w < e->w) { /* a tile narrower than the canvas: its rows together */
 		for (int row = 0; row < h; row++)
@@ -203,7 +208,7 @@ static bool send_strip(pix_enc *e, int k, abuf *out)
 	} else {
 		ok = pixels_encode(e->mode, out, p, w, h, cols, rows);
 	}
-	abuf_str(out, "\x1b" "8");
+	abuf_str(out, g->cursor_off ? "\x1b" "8" : "\x1b" "8\x1b[?25h");
 	if (!ok || out->failed) {
 		out->len = len0;
 		return false;

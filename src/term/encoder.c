@@ -5,6 +5,9 @@
 
 const encoder_ops *const encoder_table[] = {
 	&encoder_halfblock,
+	&encoder_quadrant,
+	&encoder_sextant,
+	&encoder_octant,
 	&encoder_kitty,
 	&encoder_sixel,
 	&encoder_iterm,
@@ -17,4 +20,18 @@ const encoder_ops *encoder_find(const char *name)
 		if (strcmp(encoder_table[i]->name, name) == 0)
 			return encoder_table[i];
 	return NULL;
+}
+
+const encoder_ops *encoder_symbols(symbols_kind k)
+{
+	switch (k) {
+	case SYMBOLS_QUADRANT:
+		return &encoder_quadrant;
+	case SYMBOLS_SEXTANT:
+		return &encoder_sextant;
+	case SYMBOLS_OCTANT:
+		return &encoder_octant;
+	default:
+		return &encoder_halfblock;
+	}
 }

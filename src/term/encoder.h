@@ -67,8 +67,11 @@ struct encoder {
 	encoder_geom geom;
 };
 
-/* The half-block encoder (term/frame.h underneath). */
-extern const encoder_ops encoder_halfblock;
+/* The half-block encoder (term/frame.h underneath), and the other symbol
+ * sets' (term/symbols.h): a canvas of 2x4 samples a cell. */
+extern const encoder_ops encoder_halfblock, encoder_quadrant, encoder_sextant, encoder_octant;
+/* The cell encoder of a symbol set (not SYMBOLS_AUTO). */
+const encoder_ops *encoder_symbols(symbols_kind k);
 /* Real pixels (term/pixels.h; enc_pixels.c): the canvas is the area at the
  * terminal's pixel size (geom.cell_w, cell_h must be known). */
 extern const encoder_ops encoder_kitty, encoder_sixel, encoder_iterm;

@@ -25,8 +25,15 @@
 
 frame *frame_new(int cols, int rows, frame_palette pal)
 {
-	if (cols < 1 || rows < 1)
+	return frame_new_symbols(cols, rows, pal, SYMBOLS_HALF);
+}
+
+frame *frame_new_symbols(int cols, int rows, frame_palette pal, symbols_kind sym)
+{
+	if (cols < 1 || rows < 1 || sym < SYMBOLS_HALF || sym >= SYMBOLS_AUTO)
 		return NULL;
+	if (pal == PALETTE_NONE)
+		sym = SYMBOLS_HALF;
 	frame *f = calloc(1, sizeof *f);
 	if (!f)
 		return NULL;
@@ -35,10 +42,19 @@ frame *frame_new(int cols, int rows, frame_palette pal)
 	f->rows = rows;
 	f->pal = pal;
 	f->sync = true;
+	f->sym = sym;
+	f->nsub = symbols_table[sym].w * symbols_table[sym].h;
+	f->lambda = sym == SYMBOLS_HALF ? 0 : FRAME_SYMBOLS_LAMBDA;
+	for (unsigned m = 0; m < 1u << f->nsub; m++)
+		f->glyph_len[m] = (uint8_t)symbols_utf8(sym, m, f->glyph[m]);
 	f->cur = calloc(n, sizeof *f->cur);
 	f->shown = calloc(n, sizeof *f->shown);
+	if (sym != SYMBOLS_HALF) {
+		f->px = calloc(n * SYMBOLS_SAMPLE_W * SYMBOLS_SAMPLE_H, 3);
+		f->def = calloc(n * SYMBOLS_SAMPLE_W * SYMBOLS_SAMPLE_H, 1);
+	}
 	abuf_init(&f->out);
-	if (!f->cur || !f->shown) {
+	if (!f->cur || !f->shown || (sym != SYMBOLS_HALF && (!f->px || !f->def))) {
 		frame_free(f);
 		return NULL;
 	}
@@ -52,6 +68,8 @@ void frame_free(frame *f)
 		return;
 	free(f->cur);
 	free(f->shown);
+	free(f->px);
+	free(f->def);
 	abuf_free(&f->out);
 	free(f);
 }
@@ -63,11 +81,13 @@ void frame_invalidate(frame *f)
 
 void frame_clear(frame *f)
 {
-	frame_cell blank = {FRAME_DEFAULT, FRAME_DEFAULT};
+	frame_cell blank = {FRAME_DEFAULT, FRAME_DEFAULT, f->sym == SYMBOLS_HALF};
 	if (f->pal == PALETTE_NONE)
-		blank = (frame_cell){' ', ' '};
+		blank = (frame_cell){' ', ' ', 1};
 	for (size_t i = 0; i < (size_t)f->cols * (size_t)f->rows; i++)
 		f->cur[i] = blank;
+	if (f->def)
+		memset(f->def, 0, (size_t)f->cols * f->rows * SYMBOLS_SAMPLE_W * SYMBOLS_SAMPLE_H);
 }
 
 /* --- palettes --- */
@@ -167,9 +187,244 @@ void frame_srgb_from_linear(const float *rgb, size_t npix, double exposure, uint
 		out[i] = linear_to_srgb8(rgb[i] * k);
 }
 
+/* Fits cell (cx, cy) of a symbol frame to its canvas samples. */
+static void fit_cell(frame *f, int cx, int cy)
+{
+	enum { SW = SYMBOLS_SAMPLE_W, SH = SYMBOLS_SAMPLE_H };
+	size_t cw = (size_t)f->cols * SW;
+	size_t at = (size_t)cy * SH * cw + (size_t)cx * SW;
+	const uint8_t *px = f->px + at * 3, *def = f->def + at;
+	int ndef = 0;
+	for (int y = 0; y < SH; y++)
+		for (int x = 0; x < SW; x++)
+			ndef += def[y * cw + x] != 0;
+	frame_cell *c = &f->cur[(size_t)cy * f->cols + cx];
+	if (ndef == 0) {
+		*c = (frame_cell){FRAME_DEFAULT, FRAME_DEFAULT, 0};
+		return;
+	}
+	float sub[8][3];
+	uint8_t a[3], b[3];
+	unsigned mask;
+	if (ndef < SW * SH) {
+		/* The edge of a letterboxed picture: the subpixels mostly covered
+		 * show the mean of its samples there, the rest the default
+		 * background (which only a background colour can show). */
+		const symbol_set *set = &symbols_table[f->sym];
+		uint8_t cov[SH][SW][3];
+		for (int y = 0; y < SH; y++)
+			for (int x = 0; x < SW; x++)
+				memset(cov[y][x], def[y * cw + x] ? 255 : 0, 3);
+		symbols_subpixels(f->sym, &cov[0][0][0], SW * 3, sub);
+		mask = 0;
+		for (int i = 0; i < set->w * set->h; i++)
+			if (sub[i][0] > 127.5f)
+				mask |= 1u << i;
+		double acc[3] = {0, 0, 0};
+		for (int y = 0; y < SH; y++)
+			for (int x = 0; x < SW; x++)
+				if (def[y * cw + x])
+					for (int ch = 0; ch < 3; ch++)
+						acc[ch] += px[(y * cw + x) * 3 + ch];
+		for (int ch = 0; ch < 3; ch++)
+			a[ch] = (uint8_t)(acc[ch] / ndef + 0.5);
+		*c = (frame_cell){palette_quantize(f->pal, a[0], a[1], a[2]), FRAME_DEFAULT, mask};
+		if (mask == 0)
+			*c = (frame_cell){FRAME_DEFAULT, FRAME_DEFAULT, 0};
+		else if (mask == (1u << f->nsub) - 1)
+			*c = (frame_cell){c->top, c->top, 0};
+		return;
+	}
+	symbols_subpixels(f->sym, px, cw * 3, sub);
+	symbols_fit((const float(*)[3])sub, f->nsub, f->flat, &mask, a, b);
+	uint32_t qa = palette_quantize(f->pal, a[0], a[1], a[2]);
+	uint32_t qb = palette_quantize(f->pal, b[0], b[1], b[2]);
+	if (mask == 0 || qa == qb)
+		*c = (frame_cell){qa, qa, 0};
+	else
+		*c = (frame_cell){qa, qb, mask};
+}
+
+static int param_len(frame_palette pal, uint32_t v, bool bg);
+
+/* The squared error (sRGB levels, summed over the cell's samples) of
+ * showing subpixels sub[n] as a where mask has them, b elsewhere. */
+static double cell_error(const float sub[][3], int n, uint32_t mask, uint32_t a, uint32_t b)
+{
+	double e = 0;
+	for (int i = 0; i < n; i++) {
+		uint32_t v = mask >> i & 1 ? a : b;
+		for (int c = 0; c < 3; c++) {
+			double d = sub[i][c] - (double)(v >> (16 - 8 * c) & 255);
+			e += d * d;
+		}
+	}
+	return e * (SYMBOLS_SAMPLE_W * SYMBOLS_SAMPLE_H) / n;
+}
+
+/* Bytes of the colours of a cell (a, and b when two) that the SGR state
+ * (fg, bg) does not hold, and of its glyph: about what the update sends. */
+static int cell_bytes(const frame *f, uint32_t a, uint32_t b, bool two, uint32_t fg, uint32_t bg)
+{
+	int n = 4, k = 0;
+	if (a != fg && a != bg)
+		n += param_len(f->pal, a, false), k++;
+	if (two && b != fg && b != bg && b != a)
+		n += param_len(f->pal, b, true), k++;
+	return n + (k ? 2 + k : 0);
+}
+
+static int colour_dist2(uint32_t a, uint32_t b)
+{
+	int d = 0;
+	for (int sh = 0; sh < 24; sh += 8) {
+		int e = (int)(a >> sh & 255) - (int)(b >> sh & 255);
+		d += e * e;
+	}
+	return d;
+}
+
+static uint32_t rgb_of(const float c[3])
+{
+	uint32_t v = 0;
+	for (int ch = 0; ch < 3; ch++) {
+		long r = lroundf(c[ch]);
+		v = v << 8 | (uint32_t)(r < 0 ? 0 : r > 255 ? 255 : r);
+	}
+	return v;
+}
+
+/* Rate and distortion along row cy of a truecolor symbol frame: a cell may
+ * keep a colour of the cell before it (its SGR state), or take one colour,
+ * when that costs less than f->lambda squared error (sRGB levels over its
+ * samples) a byte saved. The row is walked left to right, as an update
+ * sends it. */
+static void rd_row(frame *f, int cy)
+{
+	enum { SW = SYMBOLS_SAMPLE_W, SH = SYMBOLS_SAMPLE_H };
+	size_t cw = (size_t)f->cols * SW;
+	uint32_t fg = UINT32_MAX, bg = UINT32_MAX; /* not known */
+	int n = f->nsub;
+	for (int cx = 0; cx < f->cols; cx++) {
+		frame_cell *c = &f->cur[(size_t)cy * f->cols + cx];
+		size_t at = (size_t)cy * SH * cw + (size_t)cx * SW;
+		bool whole = true;
+		for (int y = 0; y < SH && whole; y++)
+			for (int x = 0; x < SW; x++)
+				whole &= f->def[at + y * cw + x] != 0;
+		if (!whole || c->top == FRAME_DEFAULT || c->bot == FRAME_DEFAULT) {
+			fg = c->top;
+			bg = c->bot;
+			continue;
+		}
+		float sub[8][3];
+		symbols_subpixels(f->sym, f->px + at * 3, cw * 3, sub);
+		/* the fit, and its cost */
+		frame_cell best = *c;
+		bool two = c->mask != 0;
+		double best_j = cell_error((const float(*)[3])sub, n, c->mask, c->top, c->bot) +
+		                f->lambda * cell_bytes(f, c->top, c->bot, two, fg, bg);
+		frame_cell cand[7];
+		int nc = 0;
+		float mean[3] = {0, 0, 0};
+		for (int i = 0; i < n; i++)
+			for (int ch = 0; ch < 3; ch++)
+				mean[ch] += sub[i][ch] / (float)n;
+		uint32_t m = rgb_of(mean);
+		cand[nc++] = (frame_cell){m, m, 0};
+		/* one colour of the state for the whole cell */
+		if (fg != UINT32_MAX && fg != FRAME_DEFAULT)
+			cand[nc++] = (frame_cell){fg, fg, 0};
+		if (bg != UINT32_MAX && bg != FRAME_DEFAULT && bg != fg)
+			cand[nc++] = (frame_cell){bg, bg, 0};
+		if (fg != UINT32_MAX && bg != UINT32_MAX && fg != FRAME_DEFAULT && bg != FRAME_DEFAULT) {
+			/* both colours of the state: each subpixel the nearer */
+			uint32_t mask = 0;
+			for (int i = 0; i < n; i++)
+				if (cell_error((const float(*)[3])sub + i, 1, 1, fg, fg) <
+				    cell_error((const float(*)[3])sub + i, 1, 1, bg, bg))
+					mask |= 1u << i;
+			cand[nc++] = fg == bg ? (frame_cell){fg, fg, 0} : (frame_cell){fg, bg, mask};
+		}
+		/* one colour of the state for the fit's nearer colour, the other
+		 * the mean of the subpixels left to it */
+		for (int k = 0; k < 2 && two; k++) {
+			uint32_t x = k ? bg : fg;
+			if (x == UINT32_MAX || x == FRAME_DEFAULT)
+				continue;
+			uint32_t mask = 0;
+			float rest[3] = {0, 0, 0};
+			int nr = 0;
+			/* x stands for the fit's colour nearer to it */
+			uint32_t other = colour_dist2(x, c->top) < colour_dist2(x, c->bot) ? c->bot : c->top;
+			for (int i = 0; i < n; i++) {
+				if (cell_error((const float(*)[3])sub + i, 1, 1, x, x) <=
+				    cell_error((const float(*)[3])sub + i, 1, 1, other, other)) {
+					mask |= 1u << i;
+				} else {
+					for (int ch = 0; ch < 3; ch++)
+						rest[ch] += sub[i][ch];
+					nr++;
+				}
+			}
+			if (nr == 0) {
+				cand[nc++] = (frame_cell){x, x, 0};
+				continue;
+			}
+			for (int ch = 0; ch < 3; ch++)
+				rest[ch] /= (float)nr;
+			uint32_t r = rgb_of(rest);
+			cand[nc++] = mask && r != x ? (frame_cell){x, r, mask} : (frame_cell){r, r, 0};
+		}
+		for (int k = 0; k < nc; k++) {
+			bool t = cand[k].mask != 0;
+			double j = cell_error((const float(*)[3])sub, n, cand[k].mask, cand[k].top, cand[k].bot) +
+			           f->lambda * cell_bytes(f, cand[k].top, cand[k].bot, t, fg, bg);
+			if (j < best_j) {
+				best_j = j;
+				best = cand[k];
+			}
+		}
+		*c = best;
+		if (best.mask == 0) {
+			if (best.top != fg && best.top != bg)
+				bg = best.top;
+		} else {
+			fg = best.top;
+			bg = best.bot;
+		}
+	}
+}
+
+/* frame_put_image for the symbol sets: the samples, then every cell they
+ * touch fitted again. */
+static void put_symbols(frame *f, const uint8_t *rgb, int w, int h, int ox, int oy)
+{
+	int cw = f->cols * SYMBOLS_SAMPLE_W, ch = f->rows * SYMBOLS_SAMPLE_H;
+	int x0 = ox < 0 ? 0 : ox, y0 = oy < 0 ? 0 : oy;
+	int x1 = ox + w < cw ? ox + w : cw, y1 = oy + h < ch ? oy + h : ch;
+	if (x1 <= x0 || y1 <= y0)
+		return;
+	for (int y = y0; y < y1; y++) {
+		memcpy(f->px + ((size_t)y * cw + x0) * 3, rgb + ((size_t)(y - oy) * w + (x0 - ox)) * 3,
+		       (size_t)(x1 - x0) * 3);
+		memset(f->def + (size_t)y * cw + x0, 1, (size_t)(x1 - x0));
+	}
+	for (int cy = y0 / SYMBOLS_SAMPLE_H; cy <= (y1 - 1) / SYMBOLS_SAMPLE_H; cy++) {
+		for (int cx = x0 / SYMBOLS_SAMPLE_W; cx <= (x1 - 1) / SYMBOLS_SAMPLE_W; cx++)
+			fit_cell(f, cx, cy);
+		if (f->lambda > 0 && f->pal == PALETTE_TRUECOLOR)
+			rd_row(f, cy);
+	}
+}
+
 void frame_put_image(frame *f, const uint8_t *rgb, int w, int h, int ox, int oy)
 {
 	int ph = 2 * f->rows;
+	if (f->sym != SYMBOLS_HALF) {
+		put_symbols(f, rgb, w, h, ox, oy);
+		return;
+	}
 	if (f->pal == PALETTE_NONE) {
 		/* One character per cell: only whole cells of the image count. */
 		for (int cy = 0; cy < f->rows; cy++) {
@@ -181,7 +436,7 @@ void frame_put_image(frame *f, const uint8_t *rgb, int w, int h, int ox, int oy)
 				if (x < 0 || x >= w)
 					continue;
 				char c = frame_ascii(rgb + ((size_t)y0 * w + x) * 3, rgb + ((size_t)y1 * w + x) * 3);
-				f->cur[(size_t)cy * f->cols + cx] = (frame_cell){(uint8_t)c, (uint8_t)c};
+				f->cur[(size_t)cy * f->cols + cx] = (frame_cell){(uint8_t)c, (uint8_t)c, 1};
 			}
 		}
 		return;
@@ -257,54 +512,54 @@ static void put_param(abuf *a, frame_palette pal, uint32_t v, bool bg)
 	}
 }
 
-/* The ways to draw a cell. */
-enum glyph { G_SPACE, G_FULL, G_UPPER, G_LOWER };
-static const char *const glyph_utf8[] = {" ", "\xe2\x96\x88", "\xe2\x96\x80", "\xe2\x96\x84"};
-static const int glyph_len[] = {1, 3, 3, 3};
-
 typedef struct sgr {
 	uint32_t fg, bg;
 } sgr;
 
+/* A way to draw a cell: the glyph of `mask` (0: a space; the full mask:
+ * U+2588) in colours fg on bg. */
 typedef struct way {
-	enum glyph g;
+	uint32_t mask;
 	uint32_t fg, bg; /* UNKNOWN: this way keeps the current one */
 } way;
 
-/* The one or two ways to draw cell c; returns how many. */
-static int ways_of(frame_cell c, way w[2])
+/* The one or two ways to draw cell c in frame f; returns how many. */
+static int ways_of(const frame *f, frame_cell c, way w[2])
 {
-	if (c.top == c.bot) {
+	uint32_t full = (1u << f->nsub) - 1;
+	if (c.top == c.bot || c.mask == 0 || c.mask == full) {
+		uint32_t v = c.mask == 0 ? c.bot : c.top;
 		int n = 0;
-		w[n++] = (way){G_SPACE, UNKNOWN, c.top};
-		if (c.top != FRAME_DEFAULT)
-			w[n++] = (way){G_FULL, c.top, UNKNOWN};
+		w[n++] = (way){0, UNKNOWN, v};
+		if (v != FRAME_DEFAULT)
+			w[n++] = (way){full, v, UNKNOWN};
 		return n;
 	}
 	int n = 0;
 	if (c.top != FRAME_DEFAULT)
-		w[n++] = (way){G_UPPER, c.top, c.bot};
+		w[n++] = (way){c.mask, c.top, c.bot};
 	if (c.bot != FRAME_DEFAULT)
-		w[n++] = (way){G_LOWER, c.bot, c.top};
+		w[n++] = (way){full ^ c.mask, c.bot, c.top};
 	return n;
 }
 
 /* Bytes to go from state s to way w, and the state after. */
-static int way_cost(frame_palette pal, sgr s, way w, sgr *after)
+static int way_cost(const frame *f, sgr s, way w, sgr *after)
 {
 	bool set_fg = w.fg != UNKNOWN && w.fg != s.fg;
 	bool set_bg = w.bg != UNKNOWN && w.bg != s.bg;
-	int n = glyph_len[w.g];
+	int n = f->glyph_len[w.mask];
 	if (set_fg || set_bg)
-		n += 3 + (set_fg ? param_len(pal, w.fg, false) : 0) + (set_bg ? param_len(pal, w.bg, true) : 0) +
+		n += 3 + (set_fg ? param_len(f->pal, w.fg, false) : 0) + (set_bg ? param_len(f->pal, w.bg, true) : 0) +
 		     (set_fg && set_bg);
 	after->fg = w.fg != UNKNOWN ? w.fg : s.fg;
 	after->bg = w.bg != UNKNOWN ? w.bg : s.bg;
 	return n;
 }
 
-static void emit_way(abuf *a, frame_palette pal, sgr *s, way w)
+static void emit_way(abuf *a, const frame *f, sgr *s, way w)
 {
+	frame_palette pal = f->pal;
 	bool set_fg = w.fg != UNKNOWN && w.fg != s->fg;
 	bool set_bg = w.bg != UNKNOWN && w.bg != s->bg;
 	if (set_fg || set_bg) {
@@ -317,8 +572,8 @@ static void emit_way(abuf *a, frame_palette pal, sgr *s, way w)
 			put_param(a, pal, w.bg, true);
 		abuf_char(a, 'm');
 	}
-	way_cost(pal, *s, w, s);
-	abuf_str(a, glyph_utf8[w.g]);
+	way_cost(f, *s, w, s);
+	abuf_add(a, f->glyph[w.mask], f->glyph_len[w.mask]);
 }
 
 typedef struct node {
@@ -329,9 +584,9 @@ typedef struct node {
 
 /* Draws cells [a, b) of a row, from SGR state *s, with the fewest bytes the
  * Viterbi pass finds. */
-static void emit_run(frame_palette pal, abuf *out, const frame_cell *row, int a, int b, sgr *s)
+static void emit_run(const frame *f, abuf *out, const frame_cell *row, int a, int b, sgr *s)
 {
-	if (pal == PALETTE_NONE) {
+	if (f->pal == PALETTE_NONE) {
 		for (int x = a; x < b; x++)
 			abuf_char(out, (char)row[x].top);
 		return;
@@ -345,14 +600,14 @@ static void emit_run(frame_palette pal, abuf *out, const frame_cell *row, int a,
 	}
 	way w[2];
 	for (int i = 0; i < n; i++) {
-		int k = ways_of(row[a + i], w);
+		int k = ways_of(f, row[a + i], w);
 		for (int o = 0; o < 2; o++) {
 			node *nd = &nodes[2 * i + o];
 			nd->cost = -1;
 			if (o >= k)
 				continue;
 			if (i == 0) {
-				nd->cost = way_cost(pal, *s, w[o], &nd->st);
+				nd->cost = way_cost(f, *s, w[o], &nd->st);
 				nd->back = -1;
 				continue;
 			}
@@ -361,7 +616,7 @@ static void emit_run(frame_palette pal, abuf *out, const frame_cell *row, int a,
 				if (pv->cost < 0)
 					continue;
 				sgr st;
-				int c = pv->cost + way_cost(pal, pv->st, w[o], &st);
+				int c = pv->cost + way_cost(f, pv->st, w[o], &st);
 				if (nd->cost < 0 || c < nd->cost) {
 					nd->cost = c;
 					nd->st = st;
@@ -384,8 +639,8 @@ static void emit_run(frame_palette pal, abuf *out, const frame_cell *row, int a,
 		o = nodes[2 * i + o].back;
 	}
 	for (int i = 0; i < n; i++) {
-		ways_of(row[a + i], w);
-		emit_way(out, pal, s, w[(int)choice[i]]);
+		ways_of(f, row[a + i], w);
+		emit_way(out, f, s, w[(int)choice[i]]);
 	}
 	free(choice);
 	if (nodes != stack_nodes)
@@ -394,7 +649,7 @@ static void emit_run(frame_palette pal, abuf *out, const frame_cell *row, int a,
 
 static bool cell_eq(frame_cell a, frame_cell b)
 {
-	return a.top == b.top && a.bot == b.bot;
+	return a.top == b.top && a.bot == b.bot && a.mask == b.mask;
 }
 
 static void cursor_to(abuf *a, int row, int col)
@@ -409,7 +664,7 @@ static void cursor_to(abuf *a, int row, int col)
 }
 
 /* A value no real cell takes: "the terminal's cell is not known". */
-static const frame_cell unknown_cell = {0xfffffffeu, 0xfffffffeu};
+static const frame_cell unknown_cell = {0xfffffffeu, 0xfffffffeu, 0};
 
 static void forget_shown(frame *f)
 {
@@ -437,19 +692,24 @@ static void update_begin(const frame *f, update_state *u, abuf *out)
 }
 
 /* True when the terminal's cell b may stay for a: equal, or in truecolor
- * within f->tol in every channel of both pixels. */
+ * within f->tol in every channel of every subpixel. */
 static bool cell_close(const frame *f, frame_cell a, frame_cell b)
 {
 	if (cell_eq(a, b))
 		return true;
-	if (f->tol <= 0 || f->pal != PALETTE_TRUECOLOR || a.top == FRAME_DEFAULT || a.bot == FRAME_DEFAULT ||
-	    b.top == FRAME_DEFAULT || b.bot == FRAME_DEFAULT || b.top == unknown_cell.top)
+	if (f->tol <= 0 || f->pal != PALETTE_TRUECOLOR || b.top == unknown_cell.top)
 		return false;
-	for (int sh = 0; sh < 24; sh += 8) {
-		int d1 = (int)((a.top >> sh) & 0xff) - (int)((b.top >> sh) & 0xff);
-		int d2 = (int)((a.bot >> sh) & 0xff) - (int)((b.bot >> sh) & 0xff);
-		if (d1 > f->tol || d1 < -f->tol || d2 > f->tol || d2 < -f->tol)
+	for (int i = 0; i < f->nsub; i++) {
+		uint32_t ca = a.mask >> i & 1 ? a.top : a.bot, cb = b.mask >> i & 1 ? b.top : b.bot;
+		if (ca == cb)
+			continue;
+		if (ca == FRAME_DEFAULT || cb == FRAME_DEFAULT)
 			return false;
+		for (int sh = 0; sh < 24; sh += 8) {
+			int d = (int)((ca >> sh) & 0xff) - (int)((cb >> sh) & 0xff);
+			if (d > f->tol || d < -f->tol)
+				return false;
+		}
 	}
 	return true;
 }
@@ -489,7 +749,7 @@ static bool update_row(frame *f, update_state *u, int y, size_t budget)
 		} else if (u->row != y || u->col != x) {
 			cursor_to(out, f->y0 + y, f->x0 + x);
 		}
-		emit_run(f->pal, out, row, x, end, &u->s);
+		emit_run(f, out, row, x, end, &u->s);
 		memcpy(old + x, row + x, sizeof *row * (size_t)(end - x));
 		u->row = y;
 		u->col = end;
@@ -571,7 +831,7 @@ void frame_text(const frame *f, abuf *out)
 {
 	for (int y = 0; y < f->rows; y++) {
 		sgr s = {UNKNOWN, FRAME_DEFAULT}; /* after a reset */
-		emit_run(f->pal, out, f->cur + (size_t)y * f->cols, 0, f->cols, &s);
+		emit_run(f, out, f->cur + (size_t)y * f->cols, 0, f->cols, &s);
 		abuf_str(out, f->pal == PALETTE_NONE ? "\n" : "\x1b[m\n");
 	}
 }

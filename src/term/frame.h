@@ -1,10 +1,15 @@
-/* rtsh — the half-block frame encoder.
+/* rtsh — the cell frame encoder: half blocks and the other symbol sets.
  *
  * A frame is a grid of character cells; each cell shows two stacked pixels
  * with U+2580 UPPER HALF BLOCK (foreground = upper pixel, background = lower
  * pixel), or whichever of space, U+2584 LOWER HALF BLOCK and U+2588 FULL
- * BLOCK costs fewer bytes for the same two colours. The encoder keeps the
- * cells the terminal shows and sends only the cells that changed.
+ * BLOCK costs fewer bytes for the same two colours. A frame of another
+ * symbol set (term/symbols.h: quadrants, sextants, octants) shows a grid of
+ * subpixels a cell instead, each cell in two colours: its canvas holds 2x4
+ * samples a cell, and each cell takes the glyph and colours of least error
+ * (symbols_fit), or the complement glyph with the colours swapped when
+ * that costs fewer bytes. The encoder keeps the cells the terminal shows
+ * and sends only the cells that changed.
  *
  * Every escape sequence this module sends (ESC = \e, CSI = \e[):
  *   \e[?2026h  \e[?2026l   begin / end synchronized update (DEC mode 2026)
@@ -26,6 +31,7 @@
 #include <stdint.h>
 
 #include "term/abuf.h"
+#include "term/symbols.h"
 
 typedef enum frame_palette {
 	PALETTE_TRUECOLOR, /* cells hold 0xRRGGBB */
@@ -38,9 +44,13 @@ typedef enum frame_palette {
 #define FRAME_DEFAULT 0xff000000u
 
 /* Two stacked pixels, quantised for the frame's palette. In PALETTE_NONE a
- * cell is one character: top == bot == its code. */
+ * cell is one character: top == bot == its code. In a frame of another
+ * symbol set, top is the colour of the subpixels in mask (symbols.h) and
+ * bot the colour of the others; a cell of one colour has mask 0 and
+ * top == bot (half blocks: mask is always 1, the upper pixel). */
 typedef struct frame_cell {
 	uint32_t top, bot;
+	uint32_t mask;
 } frame_cell;
 
 typedef struct frame {
@@ -55,12 +65,30 @@ typedef struct frame {
 	int next_row;      /* where the next frame_update_part starts */
 	int tol;           /* truecolor: a shown cell within tol (sRGB levels, each
 	                      channel) of the current one is left as it is; 0: exact */
+	symbols_kind sym;  /* the symbol set (SYMBOLS_HALF: two pixels a cell) */
+	int nsub;          /* subpixels a cell */
+	double flat;       /* symbols: a split that gains at most this much squared
+	                      error over one colour is not worth its bytes (symbols_fit) */
+	double lambda;     /* symbols, truecolor: squared error (sRGB levels over a
+	                      cell's samples) worth a byte (rd_row); 0: the best fit */
+	uint8_t *px;       /* symbols: the canvas, cols*2 x rows*4 samples, sRGB */
+	uint8_t *def;      /* symbols: 1 where the canvas holds a picture's sample,
+	                      0 where it shows the default background */
+	char glyph[256][4]; /* the UTF-8 of each mask's glyph ... */
+	uint8_t glyph_len[256]; /* ... and its length */
 	abuf out;
 } frame;
 
 /* A new frame of cols x rows cells, all default background; NULL when out
  * of memory or a size is < 1. */
 frame *frame_new(int cols, int rows, frame_palette pal);
+/* The same with symbol set sym (not SYMBOLS_AUTO; PALETTE_NONE takes half
+ * blocks, one character a cell). */
+frame *frame_new_symbols(int cols, int rows, frame_palette pal, symbols_kind sym);
+/* frame.lambda of the symbol sets: measured on three scenes (bench
+ * symbols rows, bench/README.md), 5 keeps the PSNR within 0.25 dB of the
+ * best fit's and sends 0.45-0.8x its bytes. */
+#define FRAME_SYMBOLS_LAMBDA 5.0
 void frame_free(frame *f);
 /* Forgets what the terminal shows (after the screen was cleared). */
 void frame_invalidate(frame *f);
@@ -68,8 +96,8 @@ void frame_invalidate(frame *f);
 /* Sets every cell to the default background. */
 void frame_clear(frame *f);
 /* Puts an image of w x h sRGB pixels (3 bytes each, rows top to bottom) at
- * pixel (ox, oy) of the frame's cols x 2*rows pixel canvas; pixels outside
- * the image keep their value. */
+ * pixel (ox, oy) of the frame's cols x 2*rows pixel canvas (other symbol
+ * sets: cols*2 x rows*4); pixels outside the image keep their value. */
 void frame_put_image(frame *f, const uint8_t *rgb, int w, int h, int ox, int oy);
 
 /* The update that turns what the terminal shows into the current cells, as

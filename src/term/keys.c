@@ -19,6 +19,7 @@ struct keys {
 	char smkx[64], rmkx[64];
 	/* Codes ncurses gives to terminfo's extended shift+arrow keys. */
 	int shift_up, shift_down;
+	keys_mouse mouse;     /* the last KEYS_MOUSE */
 };
 
 /* Signals ncurses may take over in newterm: the shell's handlers stay. */
@@ -85,6 +86,68 @@ keys *keys_open(int in_fd, int esc_ms)
 	return k;
 }
 
+size_t keys_parse_mouse(const char *s, size_t n, keys_mouse *m)
+{
+	long v[3] = {0, 0, 0};
+	size_t i = 0;
+	for (int f = 0; f < 3; f++) {
+		size_t start = i;
+		while (i < n && s[i] >= '0' && s[i] <= '9' && i - start < 6)
+			v[f] = v[f] * 10 + (s[i++] - '0');
+		if (i == start || i >= n)
+			return 0;
+		if (f < 2 && s[i++] != ';')
+			return 0;
+	}
+	if (s[i] != 'M' && s[i] != 'm')
+		return 0;
+	long b = v[0];
+	memset(m, 0, sizeof *m);
+	m->release = s[i] == 'm';
+	m->x = (int)v[1];
+	m->y = (int)v[2];
+	m->shift = b & 4;
+	m->meta = b & 8;
+	m->ctrl = b & 16;
+	m->motion = (b & 32) != 0;
+	long low = b & 3;
+	if (b & 128)
+		m->button = KEYS_BUTTON_OTHER;
+	else if (b & 64)
+		m->button = low == 0 ? KEYS_WHEEL_UP : low == 1 ? KEYS_WHEEL_DOWN : KEYS_BUTTON_OTHER;
+	else
+		m->button = (keys_button)low; /* 3: no button */
+	return i + 1;
+}
+
+/* The rest of an SGR mouse report, after its "\e[<" (ncurses took those
+ * as the terminfo's kmous, or left them to late_answer): true with
+ * k->mouse set; else every byte read is put back. */
+static bool mouse_rest(keys *k)
+{
+	char seq[24];
+	int got[24], n = 0, d;
+	while (n < 23 && (d = wgetch(k->pad)) != ERR) {
+		got[n] = d;
+		seq[n++] = d < 128 ? (char)d : '?';
+		if (d >= 0x40 && d <= 0x7e)
+			break;
+	}
+	keys_mouse m;
+	if (n > 0 && keys_parse_mouse(seq, (size_t)n, &m) == (size_t)n) {
+		k->mouse = m;
+		return true;
+	}
+	while (n > 0)
+		ungetch(got[--n]);
+	return false;
+}
+
+keys_mouse keys_mouse_event(const keys *k)
+{
+	return k->mouse;
+}
+
 /* After an Esc that ncurses could not make a key of: true (and the bytes
  * gone) when it starts a terminal's answer to a status query that came
  * late (CSI digits n, CSI ? digits c: no key looks like that); else the
@@ -111,8 +174,26 @@ int keys_next(keys *k)
 	int c = wgetch(k->pad);
 	if (c == ERR)
 		return KEYS_NONE;
-	if (c == 27 && late_answer(k))
-		return KEYS_OTHER;
+	if (c == 27) {
+		/* An SGR mouse report where terminfo names another (tmux's
+		 * kmous is \e[M): \e [ < ... */
+		int b1 = wgetch(k->pad);
+		if (b1 == '[') {
+			int b2 = wgetch(k->pad);
+			if (b2 == '<' && mouse_rest(k))
+				return KEYS_MOUSE;
+			if (b2 != ERR)
+				ungetch(b2);
+		}
+		if (b1 != ERR)
+			ungetch(b1);
+		if (late_answer(k))
+			return KEYS_OTHER;
+	}
+	if (c == KEY_MOUSE) {
+		/* terminfo's kmous is \e[< (xterm's): the report follows. */
+		return mouse_rest(k) ? KEYS_MOUSE : KEYS_OTHER;
+	}
 	if (c < KEY_MIN)
 		return c;
 	if (c >= KEY_F(1) && c <= KEY_F(63))

@@ -36,11 +36,42 @@ enum {
 	KEYS_BACKTAB,        /* Shift+Tab */
 	KEYS_RESIZE,
 	KEYS_OTHER,          /* a function key key mode has no use for */
+	KEYS_MOUSE,          /* a mouse event: keys_mouse_event says which */
 	KEYS_F1 = 0x110100,  /* KEYS_F1 + n - 1 is Fn */
 };
 #define KEYS_F(n) (KEYS_F1 + (n) - 1)
 
 typedef struct keys keys;
+
+/* A mouse event of xterm's SGR encoding (mode 1006), \e[<B;X;YM for a
+ * press or a motion and \e[<B;X;Ym for a release. */
+typedef enum keys_button {
+	KEYS_BUTTON_LEFT,
+	KEYS_BUTTON_MIDDLE,
+	KEYS_BUTTON_RIGHT,
+	KEYS_BUTTON_NONE,       /* a motion with no button held */
+	KEYS_WHEEL_UP,
+	KEYS_WHEEL_DOWN,
+	KEYS_BUTTON_OTHER,      /* wheel left/right, buttons 8 to 11 */
+} keys_button;
+
+typedef struct keys_mouse {
+	keys_button button;
+	int x, y;               /* the cell, 1-based, as the terminal counts */
+	bool release;           /* the button went up ('m') */
+	bool motion;            /* moved with the button held (mode 1002) */
+	bool shift, meta, ctrl;
+} keys_mouse;
+
+/* Reads one SGR mouse report from the n bytes at s, which follow its
+ * "\e[<" (the digits, semicolons and the final M or m); returns the bytes
+ * it took, 0 when s does not start one (or it is cut short). */
+size_t keys_parse_mouse(const char *s, size_t n, keys_mouse *m);
+/* The escape sequences that turn the mouse on (button presses, releases
+ * and motion while a button is held, 1002; in the SGR encoding, 1006) and
+ * off again. */
+#define KEYS_MOUSE_ON "\x1b[?1002h\x1b[?1006h"
+#define KEYS_MOUSE_OFF "\x1b[?1006l\x1b[?1002l"
 
 /* Reads keys from the terminal on in_fd with an Esc delay of esc_ms
  * milliseconds. The process's signal handlers are kept as they were. NULL
@@ -56,6 +87,8 @@ bool keys_feed(keys *k, const char *b, size_t n);
 /* The next key waiting, or KEYS_NONE; never blocks longer than the Esc
  * delay (to tell Esc from the start of a sequence). */
 int keys_next(keys *k);
+/* The mouse event keys_next last returned as KEYS_MOUSE. */
+keys_mouse keys_mouse_event(const keys *k);
 /* terminfo's keypad transmit on / off strings (smkx, rmkx), "" when none:
  * send the first while reading keys and the second after. */
 const char *keys_keypad_on(const keys *k);

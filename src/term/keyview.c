@@ -1,6 +1,7 @@
 /* rtsh — the key view (keyview.h). */
 #include "term/keyview.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -38,18 +39,52 @@ void keyview_layout(keyview *v, int cols, int rows, bool help, double aspect)
 		v->pic_rows = 0;
 	} else {
 		bool whole = v->pal == PALETTE_NONE;
-		screen_fit(cols, v->pic_rows, aspect, whole, &v->img_w, &v->img_h);
-		v->img_x = (cols - v->img_w) / 2;
-		v->img_y = (2 * v->pic_rows - v->img_h) / 2;
-		if (whole)
-			v->img_y &= ~1;
-		encoder_geom g = {.cols = cols, .rows = v->pic_rows, .pal = v->pal, .cursor_off = true};
-		v->enc = encoder_halfblock.open(&g);
+		encoder_geom g = {.cols = cols, .rows = v->pic_rows, .pal = v->pal, .cursor_off = true,
+		                  .cell_w = v->cell_w, .cell_h = v->cell_h, .max_w = v->max_w, .max_h = v->max_h};
+		const encoder_ops *ops = v->ops && !whole ? v->ops : &encoder_halfblock;
+		v->enc = ops->open(&g);
+		if (!v->enc && ops != &encoder_halfblock) {
+			ops = &encoder_halfblock;
+			v->enc = ops->open(&g);
+		}
+		if (ops == &encoder_halfblock) {
+			screen_fit(cols, v->pic_rows, aspect, whole, &v->img_w, &v->img_h);
+			v->img_x = (cols - v->img_w) / 2;
+			v->img_y = (2 * v->pic_rows - v->img_h) / 2;
+			if (whole)
+				v->img_y &= ~1;
+		} else {
+			/* Square pixels on the encoder's canvas (2x4 samples a cell,
+			 * or the terminal's pixels), the aspect fitted inside. */
+			int cw, ch;
+			ops->canvas(&g, &cw, &ch);
+			if (!(aspect > 0) || !isfinite(aspect))
+				aspect = 16.0 / 9.0;
+			v->img_w = cw;
+			v->img_h = (int)lround(cw / aspect);
+			if (v->img_h > ch) {
+				v->img_h = ch;
+				v->img_w = (int)lround(ch * aspect);
+			}
+			v->img_w = v->img_w < 1 ? 1 : v->img_w > cw ? cw : v->img_w;
+			v->img_h = v->img_h < 1 ? 1 : v->img_h;
+			v->img_x = (cw - v->img_w) / 2;
+			v->img_y = (ch - v->img_h) / 2;
+		}
 		if (!v->enc)
 			v->img_w = v->img_h = 0;
 		termout_set_picture(v->out, v->enc);
 	}
 	keyview_repaint(v);
+}
+
+void keyview_set_encoder(keyview *v, const encoder_ops *ops, int cell_w, int cell_h, int max_w, int max_h)
+{
+	v->ops = ops;
+	v->cell_w = cell_w;
+	v->cell_h = cell_h;
+	v->max_w = max_w;
+	v->max_h = max_h;
 }
 
 void keyview_repaint(keyview *v)
@@ -123,6 +158,8 @@ void keyview_draw(keyview *v, const char *status)
 	abuf_str(a, "\x1b[?2026h");
 	if (v->repaint) {
 		abuf_str(a, "\x1b[r\x1b[m\x1b[2J\x1b[?25l");
+		if (v->ops == &encoder_kitty)
+			abuf_str(a, "\x1b_Ga=d,d=A,q=2\x1b\\"); /* kitty's images float over the text */
 		if (v->enc)
 			v->enc->ops->invalidate(v->enc);
 		v->status_shown[0] = '\0';

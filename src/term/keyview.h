@@ -15,6 +15,8 @@
  *   \e[1m  \e[22m         bold on / off (the help bar's keys)
  *   \e[K                  clear to the end of the line
  *   \e[?25l \e[?25h       hide / show the cursor
+ *   \e_Ga=d,d=A,q=2\e\\     kitty: delete the images (at a repaint, when the
+ *                         picture is in kitty images)
  */
 #ifndef RTSH_KEYVIEW_H
 #define RTSH_KEYVIEW_H
@@ -43,8 +45,12 @@ typedef struct keyview {
 	bool help;                 /* the help bar is shown */
 	int pic_rows;              /* the picture's rows; the status line and help bar follow */
 	int img_w, img_h;          /* the picture in pixels (0: no room for one) ... */
-	int img_x, img_y;          /* ... and its place on the cols x 2*pic_rows canvas */
-	encoder *enc;              /* the picture's (half blocks) */
+	int img_x, img_y;          /* ... and its place on the encoder's canvas */
+	const encoder_ops *ops;    /* the picture's encoder (keyview_set_encoder);
+	                            * NULL: half blocks */
+	int cell_w, cell_h;        /* a cell in pixels, for real pixels (0: not known) */
+	int max_w, max_h;          /* the largest sixel image (0: not known) */
+	encoder *enc;              /* the picture's */
 	bool repaint;              /* clear the screen at the next draw */
 	char status_shown[1024];
 	abuf a;
@@ -56,6 +62,10 @@ void keyview_init(keyview *v, termout *out, frame_palette pal, const keyview_ite
 /* Stops sending the picture and frees the view (the scheduler keeps no
  * picture: the caller gives it its own back). */
 void keyview_free(keyview *v);
+/* The encoder of the picture: half blocks (NULL), another symbol set, or
+ * real pixels (cell_w x cell_h pixels a cell; max_w, max_h the largest
+ * sixel image, 0 when not known), from the next keyview_layout on. */
+void keyview_set_encoder(keyview *v, const encoder_ops *ops, int cell_w, int cell_h, int max_w, int max_h);
 /* Lays out a terminal of cols x rows cells for a picture of the aspect
  * (width / height), with or without the help bar; the next draw clears
  * the screen. */

@@ -57,6 +57,7 @@ struct termout {
 
 	int truecolor;
 	bool ask_pixels;   /* the pixel questions go with the probe */
+	bool ask_version;  /* XTVERSION goes with it (it is one of the pixel questions) */
 	pixels_caps pix;   /* their answers */
 	bool final;         /* the picture is not a refinement pass */
 	bool fresh;         /* a new picture was put and has not gone whole yet */
@@ -161,6 +162,11 @@ void termout_ask_pixels(termout *o, bool on)
 	o->ask_pixels = on;
 }
 
+void termout_ask_version(termout *o, bool on)
+{
+	o->ask_version = on;
+}
+
 const pixels_caps *termout_pixels(const termout *o)
 {
 	return &o->pix;
@@ -177,6 +183,8 @@ void termout_probe(termout *o, bool ask_color, double now)
 	}
 	if (o->ask_pixels)
 		pixels_questions(a); /* answered before DA1, or never */
+	else if (o->ask_version)
+		abuf_str(a, "\x1b[>q");
 	abuf_str(a, DA1_QUERY);
 	push_query(o, Q_DA1, now, 0);
 	o->probe_sent = now;
@@ -346,14 +354,16 @@ static size_t parse(termout *o, const char *p, size_t n, double now, abuf *keys)
 			i = j;
 			continue;
 		}
-		if (o->ask_pixels) {
+		if (o->ask_pixels || o->ask_version) {
 			size_t k = pixels_answer(&o->pix, p + i, n - i);
 			if (k) {
 				i += k;
 				continue;
 			}
-			/* the kitty answer (an APC) cut short: hold it */
-			if (n - i >= 2 && p[i + 1] == '_' && o->qlen > 0 && n - i < HOLD_MAX) {
+			/* the kitty answer (an APC) or XTVERSION's (a DCS) cut short:
+			 * hold it */
+			if (n - i >= 2 && (p[i + 1] == '_' || (p[i + 1] == 'P' && (n - i < 3 || p[i + 2] == '>'))) &&
+			    o->qlen > 0 && n - i < HOLD_MAX) {
 				bool end = false;
 				for (size_t j = i + 2; j + 1 < n && !end; j++)
 					end = p[j] == '\x1b' && p[j + 1] == '\\';

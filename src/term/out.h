@@ -106,6 +106,9 @@ void termout_picture_final(termout *o, bool final);
  * (term/pixels.h: the kitty graphics query, XTSMGRAPHICS, the cell size);
  * the answers are kept for termout_pixels. */
 void termout_ask_pixels(termout *o, bool on);
+/* Also asks XTVERSION (the terminal's name, for `symbols auto`; asked
+ * anyway with the pixel questions), kept in termout_pixels()->version. */
+void termout_ask_version(termout *o, bool on);
 /* What the terminal said about pixels (all false/0 until it answered). */
 const pixels_caps *termout_pixels(const termout *o);
 /* Sends the start-up questions (the truecolor ones when ask_color) and

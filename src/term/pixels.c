@@ -132,6 +132,7 @@ void pixels_questions(abuf *out)
 	abuf_printf(out, "\x1b_Gi=%d,s=1,v=1,a=q,t=d,f=24;AAAA\x1b\\", QUERY_ID);
 	abuf_str(out, "\x1b[?2;1;0S"); /* XTSMGRAPHICS: read the largest sixel geometry */
 	abuf_str(out, "\x1b[16t");     /* the cell size in pixels */
+	abuf_str(out, "\x1b[>q");      /* XTVERSION */
 }
 
 void pixels_queries(abuf *out)
@@ -178,6 +179,21 @@ static size_t one_answer(pixels_caps *c, const char *s, size_t n, bool take_da1)
 				for (size_t j = 3; j + (size_t)k + 2 <= i; j++)
 					if (memcmp(s + j, id, (size_t)k) == 0 && memcmp(s + j + k, "OK", 2) == 0)
 						c->kitty = true;
+				return i + 2;
+			}
+		return 0;
+	}
+	if (n >= 3 && s[1] == 'P' && s[2] == '>') {
+		/* XTVERSION: \eP>|<name and version>\e\\ */
+		for (size_t i = 3; i + 1 < n; i++)
+			if (s[i] == 0x1b && s[i + 1] == '\\') {
+				if (s[3] == '|') {
+					size_t k = 0;
+					for (size_t j = 4; j < i && k + 1 < sizeof c->version; j++)
+						if (s[j] >= 0x20 && s[j] < 0x7f)
+							c->version[k++] = s[j];
+					c->version[k] = '\0';
+				}
 				return i + 2;
 			}
 		return 0;

@@ -21,11 +21,14 @@
  *   \e_G...;<base64>\e\\      kitty graphics: transmit, place, delete, query
  *   \eP...q...\e\\            sixel (libsixel's DCS)
  *   \e]1337;File=...:<b64>\a  iTerm2 inline image
- *   \e7 \e[R;CH ... \e8       each strip of the picture placed at its cell
- *                             (enc_pixels.c), the cursor saved and restored
+ *   \e7 \e[?25l \e[R;CH ...  each strip of the picture placed at its cell
+ *   \e8 \e[?25h              (enc_pixels.c), the cursor saved, hidden while
+ *                             the image comes, restored and shown again
  *   \e[c  \e[16t  \e[?2;1;0S  questions: DA1 (sixel is attribute 4),
  *                             the cell size in pixels, XTSMGRAPHICS (the
  *                             largest sixel image)
+ *   \e[>q                     XTVERSION: the terminal's name and version
+ *                             (answered \eP>|text\e\\)
  */
 #ifndef RTSH_PIXELS_H
 #define RTSH_PIXELS_H
@@ -93,17 +96,19 @@ typedef struct pixels_caps {
 	bool tmux;            /* inside tmux (TMUX is set) */
 	int sixel_w, sixel_h; /* XTSMGRAPHICS: the largest sixel image; 0 unknown */
 	int cell_w, cell_h;   /* a cell in pixels (CSI 16 t or TIOCGWINSZ); 0 unknown */
+	char version[64];     /* XTVERSION's answer ("XTerm(379)", "foot(1.16.2)",
+	                       * "tmux 3.3a"); "" unknown */
 } pixels_caps;
 
 /* The questions, in the order to send them: the kitty query, XTSMGRAPHICS,
- * CSI 16 t, then DA1, which every terminal answers and which therefore
+ * CSI 16 t, XTVERSION, then DA1, which every terminal answers and which therefore
  * comes last (when its answer is in, the others were answered or never
  * will be). */
 void pixels_queries(abuf *out);
 /* The same questions without DA1, for a caller that sends DA1 itself. */
 void pixels_questions(abuf *out);
 /* The length of the answer to one of the questions at the start of s
- * (kitty's, XTSMGRAPHICS, CSI 16 t), recorded in c; 0 when s starts none
+ * (kitty's, XTSMGRAPHICS, CSI 16 t, XTVERSION), recorded in c; 0 when s starts none
  * (a DA1 answer is recorded, sixel, but not taken: 0). */
 size_t pixels_answer(pixels_caps *c, const char *s, size_t n);
 /* Reads the answers in n bytes from the terminal into c, returning how

@@ -152,6 +152,13 @@ static void compute_layout(screen *s)
 	s->img_y = (2 * s->pic_rows - s->img_h) / 2;
 	if (s->pal == PALETTE_NONE)
 		s->img_y &= ~1;
+	else if (s->sym != SYMBOLS_HALF) {
+		/* 2x4 samples a cell: the half blocks' canvas, twice as fine */
+		s->img_w *= 2;
+		s->img_h *= 2;
+		s->img_x *= 2;
+		s->img_y *= 2;
+	}
 }
 
 static void put(screen *s, const abuf *a)
@@ -190,7 +197,7 @@ static void open_encoder(screen *s)
 		if (s->pix_ops == &encoder_kitty)
 			kitty_shown = 1;
 		if (!s->enc)
-			s->enc = encoder_halfblock.open(&g);
+			s->enc = encoder_symbols(s->pix_ops ? SYMBOLS_HALF : s->sym)->open(&g);
 	}
 	if (s->out)
 		termout_set_picture(s->out, s->enc);
@@ -238,8 +245,61 @@ void screen_fit_text(abuf *a, const char *text, int cols)
 		abuf_char(a, ' ');
 }
 
+/* The command area's text kept for a new layout: at most LOG_KEEP bytes,
+ * trimmed at a line's start. */
+#define LOG_KEEP 8192
+
+void screen_log(screen *s, const char *text, size_t n)
+{
+	abuf_add(&s->log, text, n);
+	if (s->log.failed) {
+		abuf_free(&s->log);
+		abuf_init(&s->log);
+		return;
+	}
+	if (s->log.len <= LOG_KEEP)
+		return;
+	size_t cut = s->log.len - LOG_KEEP;
+	const char *nl = memchr(s->log.b + cut, '\n', s->log.len - cut);
+	cut = nl ? (size_t)(nl + 1 - s->log.b) : s->log.len;
+	memmove(s->log.b, s->log.b + cut, s->log.len - cut);
+	s->log.len -= cut;
+}
+
+void screen_log_clear(screen *s)
+{
+	abuf_reset(&s->log);
+}
+
+/* The last lines of the command area's text, each ended by "\r\n" from
+ * the region's bottom row: the region scrolls them up into place and the
+ * cursor ends on the bottom row, where the prompt goes. A line wider than
+ * the screen wraps and pushes the oldest ones out. */
+static void replay_log(screen *s, abuf *a)
+{
+	int room = s->rows - s->region_top - 1;
+	if (room <= 0 || s->log.len == 0)
+		return;
+	const char *b = s->log.b;
+	size_t end = s->log.len;
+	if (b[end - 1] == '\n')
+		end--; /* the last line's end */
+	size_t start = end;
+	for (int lines = 0; start > 0; start--) {
+		if (b[start - 1] == '\n' && ++lines == room)
+			break;
+	}
+	for (size_t i = start; i < end; i++) {
+		if (b[i] == '\n')
+			abuf_str(a, "\r\n");
+		else if (b[i] != '\r')
+			abuf_char(a, b[i]);
+	}
+	abuf_str(a, "\r\n");
+}
+
 /* Clears the screen, sets the scroll region, draws the status line and puts
- * the cursor on the last row. */
+ * the cursor on the last row, under the command area's last lines. */
 static void redraw_chrome(screen *s)
 {
 	abuf a;
@@ -249,6 +309,8 @@ static void redraw_chrome(screen *s)
 		abuf_printf(&a, "\x1b[%d;%dr", s->region_top + 1, s->rows);
 	abuf_printf(&a, "\x1b[%dH", s->rows);
 	draw_status(s, &a);
+	if (s->region_top < s->rows)
+		replay_log(s, &a);
 	put(s, &a);
 	abuf_free(&a);
 	if (s->enc)
@@ -271,6 +333,7 @@ bool screen_layout(screen *s, double aspect, bool force)
 		s->enc->ops->clear(s->enc);
 	} else if (changed || force || !s->enc) {
 		if (!s->enc || s->enc->geom.cols != s->cols || s->enc->geom.rows != s->pic_rows ||
+		    (!s->pix_ops && s->enc->ops != encoder_symbols(s->sym)) ||
 		    s->enc->geom.pal != s->pal || s->enc->geom.cell_w != s->cell_w ||
 		    s->enc->geom.cell_h != s->cell_h)
 			open_encoder(s);
@@ -316,6 +379,7 @@ void screen_leave(screen *s)
 	s->enc = NULL;
 	termout_free(s->out);
 	s->out = NULL;
+	abuf_free(&s->log);
 }
 
 void screen_drop_images(screen *s)
@@ -395,6 +459,26 @@ bool screen_set_pixels(screen *s, int mode)
 	if (s->active) {
 		if (kitty_shown)
 			screen_clear_all(s);
+		encoder_close(s->enc);
+		s->enc = NULL;
+		screen_layout(s, s->aspect, true);
+	}
+	return true;
+}
+
+bool screen_set_symbols(screen *s, int kind)
+{
+	s->symbols = kind;
+	symbols_kind k = kind >= SYMBOLS_HALF && kind <= SYMBOLS_AUTO ? (symbols_kind)kind : SYMBOLS_AUTO;
+	if (k == SYMBOLS_AUTO) {
+		const pixels_caps *c = s->out ? termout_pixels(s->out) : NULL;
+		k = symbols_choose(getenv("TERM_PROGRAM"), c && c->version[0] ? c->version : NULL,
+		                   getenv("VTE_VERSION"), getenv("TMUX") && *getenv("TMUX"));
+	}
+	if (k == s->sym)
+		return false;
+	s->sym = k;
+	if (s->active && !s->pix_ops) {
 		encoder_close(s->enc);
 		s->enc = NULL;
 		screen_layout(s, s->aspect, true);

@@ -2,7 +2,8 @@
  * scroll region of a few lines at the bottom for the prompt and the output
  * of commands.
  *
- *   row 0 .. pic_rows-1        the picture (half blocks, frame.h)
+ *   row 0 .. pic_rows-1        the picture (half blocks or another symbol
+ *                              set, frame.h; or real pixels, pixels.h)
  *   row status_row             the status line (reverse video)
  *   rows region_top .. rows-1  the scroll region (DECSTBM); the cursor lives
  *                              here, so readline and printf work as usual
@@ -30,6 +31,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "term/abuf.h"
 #include "term/encoder.h"
 #include "term/frame.h"
 #include "term/out.h"
@@ -43,15 +45,28 @@ typedef struct screen {
 	frame_palette pal;
 	double aspect;     /* width / height of the image */
 	int img_w, img_h;  /* the preview's size in pixels (0 when no picture) */
-	int img_x, img_y;  /* its place on the cols x 2*pic_rows pixel canvas */
+	int img_x, img_y;  /* its place on the encoder's canvas (half blocks:
+	                    * cols x 2*pic_rows pixels) */
 	encoder *enc;      /* the picture area's encoder */
+	int symbols;       /* symbols_kind asked for (screen_set_symbols) */
+	symbols_kind sym;  /* the symbol set in use (not SYMBOLS_AUTO) */
 	int pixels;        /* pixels_mode asked for (screen_set_pixels) */
 	const encoder_ops *pix_ops; /* the pixel encoder in use; NULL: half blocks */
 	int cell_w, cell_h; /* a cell in pixels (0: not known) */
 	termout *out;      /* every byte of the screen goes out through it */
 	bool active;
 	char status[512];  /* the status line's text */
+	abuf log;          /* the command area's recent text (screen_log), drawn
+	                    * again after a resize or Ctrl-Z and fg */
 } screen;
+
+/* Remembers text shown in the command area (the prompt and the command,
+ * its output, its error), so that a new layout (a resize, Ctrl-Z and fg,
+ * the pager's or key mode's end) shows the area's last lines again. Only
+ * the last few kilobytes are kept. */
+void screen_log(screen *s, const char *text, size_t n);
+/* Forgets the command area's text (clear). */
+void screen_log_clear(screen *s);
 
 /* Enters the alternate screen of fd and lays it out for an image of the
  * given aspect. False when fd is not a terminal. */
@@ -78,6 +93,11 @@ void screen_set_palette(screen *s, frame_palette pal);
  * nothing, or the cell size in pixels is not known). Lays the screen out
  * again when the encoder changes; true then. */
 bool screen_set_pixels(screen *s, int mode);
+/* The cells' glyphs when not in real pixels (term/symbols.h): half,
+ * quadrant, sextant, octant or auto (symbols_choose on TERM_PROGRAM,
+ * VTE_VERSION and the XTVERSION answer of the start-up probe). Lays the
+ * screen out again when the set in use changes; true then. */
+bool screen_set_symbols(screen *s, int kind);
 /* Deletes the picture's kitty images now, if it showed any (they float
  * over text): before something else draws on the screen (key mode). */
 void screen_drop_images(screen *s);
@@ -99,6 +119,14 @@ void screen_resume(screen *s);
  * screen_keypad turned it on, every mode reset, main screen); nothing when
  * no screen is entered. */
 void screen_restore_async(void);
+/* Remembers text shown in the command area (the prompt and the command,
+ * its output, its error), so that a new layout (a resize, Ctrl-Z and fg,
+ * the pager's or key mode's end) shows the area's last lines again. Only
+ * the last few kilobytes are kept. */
+void screen_log(screen *s, const char *text, size_t n);
+/* Forgets the command area's text (clear). */
+void screen_log_clear(screen *s);
+
 /* Enters the alternate screen again, with the keypad mode it had. */
 void screen_reenter_async(void);
 /* Sends terminfo's keypad transmit string on_seq (on) or off_seq (off) to

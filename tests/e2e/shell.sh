@@ -68,6 +68,10 @@ for i in $(seq 1 50); do
 done
 [ -n "$back" ] || fail "the picture did not come back after the pager"
 tmux capture-pane -t "$s" -p | tail -n 2 | grep -q '^rtsh> *$' || fail "no prompt after the pager"
+# The scene was edited and not saved: quit asks once, a second quit leaves.
+tmux send-keys -t "$s" 'quit' Enter
+sleep 0.5
+tmux capture-pane -t "$s" -p | grep -q 'edits not saved' || fail "quit after an edit did not ask"
 tmux send-keys -t "$s" 'quit' Enter
 for i in $(seq 1 50); do
 	sleep 0.1

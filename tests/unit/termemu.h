@@ -166,6 +166,14 @@ static inline void emu_feed(emu *e, const char *s, size_t n)
 			i++;
 			continue;
 		}
+		/* A 4-byte UTF-8 sequence (sextants, octants). */
+		if ((c & 0xf8) == 0xf0 && i + 3 < n) {
+			uint32_t cp = (uint32_t)(c & 0x07) << 18 | (uint32_t)(s[i + 1] & 0x3f) << 12 |
+			              (uint32_t)(s[i + 2] & 0x3f) << 6 | (uint32_t)(s[i + 3] & 0x3f);
+			emu_put(e, cp);
+			i += 4;
+			continue;
+		}
 		/* A 3-byte UTF-8 sequence (the block characters). */
 		if ((c & 0xf0) != 0xe0 || i + 2 >= n)
 			fail_msg("unexpected byte 0x%02x", c);

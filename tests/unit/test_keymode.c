@@ -413,23 +413,35 @@ static void test_session(void **state)
 	assert_null(strstr(ss.text, "\x1b[?1049")); /* never leaves the alternate screen */
 	editor *ed = ss.sh.ed;
 	size_t undo0 = editor_undo_count(ed);
-	/* Tab selects object 1; three Rights are one run: one undo step. */
+	/* Tab selects object 1; keys without a pause between them are one
+	 * undo step, whichever keys they are (issue 31, friction 4). */
 	keymode_key(ss.km, '\t');
 	for (int i = 0; i < 3; i++)
 		keymode_key(ss.km, KEYS_RIGHT);
 	assert_vec_near(editor_scene(ed)->objs[0].pos, v3(1.5, 0, 0), 1e-12);
 	assert_true(run_for(&ss, 0.1) >= 1);
 	assert_non_null(strstr(ss.text, "object 1 sphere"));
-	keymode_key(ss.km, KEYS_UP); /* another key: a new run */
+	keymode_key(ss.km, KEYS_UP); /* another key, no pause: the same step */
 	keymode_key(ss.km, KEYS_RIGHT);
 	assert_int_equal(keymode_edits(ss.km), 5);
-	keymode_key(ss.km, 'u'); /* takes back the last run (one Right) */
-	assert_vec_near(editor_scene(ed)->objs[0].pos, v3(1.5, 0, 0.5), 1e-12);
-	keymode_key(ss.km, 'u'); /* and the Up */
+	assert_vec_near(editor_scene(ed)->objs[0].pos, v3(2.0, 0, 0.5), 1e-12);
+	/* A pause in typing ends the step; the keys after it are the next. */
+	run_for(&ss, KEYMODE_STEP_PAUSE + 0.1);
+	keymode_key(ss.km, KEYS_LEFT);
+	keymode_key(ss.km, KEYS_DOWN);
 	assert_vec_near(editor_scene(ed)->objs[0].pos, v3(1.5, 0, 0), 1e-12);
+	keymode_key(ss.km, 'u'); /* takes back the keys after the pause */
+	assert_vec_near(editor_scene(ed)->objs[0].pos, v3(2.0, 0, 0.5), 1e-12);
+	keymode_key(ss.km, 'u'); /* and the five before it */
+	assert_vec_near(editor_scene(ed)->objs[0].pos, v3(0, 0, 0), 1e-12);
 	keymode_key(ss.km, 'U'); /* redo */
-	assert_vec_near(editor_scene(ed)->objs[0].pos, v3(1.5, 0, 0.5), 1e-12);
-	assert_int_equal(editor_undo_count(ed), undo0 + 2);
+	assert_vec_near(editor_scene(ed)->objs[0].pos, v3(2.0, 0, 0.5), 1e-12);
+	assert_int_equal(editor_undo_count(ed), undo0 + 1);
+	/* 300 presses of different keys in one burst: one step. */
+	size_t undo1 = editor_undo_count(ed);
+	for (int i = 0; i < 300; i++)
+		keymode_key(ss.km, i % 3 == 0 ? KEYS_RIGHT : i % 3 == 1 ? KEYS_UP : ']');
+	assert_int_equal(editor_undo_count(ed), undo1 + 1);
 	/* Settings keys change the shell's settings. */
 	int samples = ss.sh.set.samples;
 	keymode_key(ss.km, '.');

@@ -1,6 +1,7 @@
 /* rtsh — tests of the math value types: matrices, inverses, transforms. */
 #include "testutil.h"
 
+#include "rtsh/num.h"
 #include "rtsh/scene.h"
 
 static void assert_identity(mat4 m, double tol)
@@ -199,10 +200,34 @@ static void test_object_xform_sizes(void **state)
 	assert_non_null(strstr(err.msg, "not invertible"));
 }
 
+/* Sums in the decimals written (issue 31, friction 7): the exact decimal
+ * sums, worked by hand, against the plain double sums that drift. */
+static void test_add_decimal(void **state)
+{
+	(void)state;
+	double x = 0.1, plain = 0.1;
+	for (int i = 0; i < 500; i++) {
+		x = num_add_decimal(x, 0.001);
+		plain += 0.001;
+	}
+	assert_true(x == 0.6);
+	assert_true(plain != 0.6); /* what the test guards against */
+	x = 0;
+	for (int i = 0; i < 2000; i++)
+		x = num_add_decimal(x, -0.001);
+	assert_true(x == -2.0);
+	assert_true(num_add_decimal(0.1, 0.2) == 0.3);
+	assert_true(num_add_decimal(1e20, 0.5) == 1e20 + 0.5);      /* beyond a double's decimals: the sum */
+	assert_true(num_add_decimal(1.0 / 3.0, 0.1) == 1.0 / 3.0 + 0.1); /* 17 digits: the sum */
+	assert_true(num_add_decimal(0.123456789012, 1) == 1.123456789012);
+	assert_false(signbit(num_add_decimal(-0.001, 0.001))); /* 0, not -0 */
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_inverse_product_is_identity),
+		cmocka_unit_test(test_add_decimal),
 		cmocka_unit_test(test_singular_matrices_are_refused),
 		cmocka_unit_test(test_points_vectors_normals),
 		cmocka_unit_test(test_transform_composition),

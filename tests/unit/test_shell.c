@@ -122,7 +122,9 @@ static void test_arguments_and_messages(void **state)
 	assert_string_equal(sh->err, "delete: too few arguments; usage: delete object N | delete light N | "
 	                             "delete camera N");
 	assert_false(command_run(sh, "undo now"));
-	assert_string_equal(sh->err, "undo: too many arguments; usage: undo");
+	assert_string_equal(sh->err, "undo: \"now\" is not a number of steps; expected 1..1000");
+	assert_false(command_run(sh, "undo 1 2"));
+	assert_string_equal(sh->err, "undo: too many arguments; usage: undo [N]");
 	assert_false(command_run(sh, "undo"));
 	assert_string_equal(sh->err, "undo: nothing to undo");
 	assert_false(command_run(sh, "set samples lots"));

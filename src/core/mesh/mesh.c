@@ -1,43 +1,21 @@
 /* rtsh — meshes: the builder the readers share, welding, normals, the tree
- * and the cache (mesh.h). */
+ * (mesh.h); mesh_load.c reads them by format and caches them. */
 #include "rtsh/mesh.h"
 
 #include <ctype.h>
 #include <errno.h>
 #include <float.h>
-#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
-#include <sys/stat.h>
 
 #include "core/bvh/bvh.h"
-#include "rtsh/filesrc.h"
 #include "rtsh/memory.h"
 #include "rtsh/texture.h"
 
 /* --- the builder --- */
 
-static bool grow(void **a, size_t *cap, size_t need, size_t size)
-{
-	if (need <= *cap)
-		return true;
-	size_t c = *cap ? *cap : 64;
-	while (c < need) {
-		if (c > SIZE_MAX / 2 / size)
-			return false;
-		c *= 2;
-	}
-	void *p = realloc(*a, c * size);
-	if (!p)
-		return false;
-	*a = p;
-	*cap = c;
-	return true;
-}
-
-/* grow, for a builder's array: the builder's bytes after the growth are
+/* mem_grow, for a builder's array: the builder's bytes after the growth are
  * checked against the memory limit first. */
 static bool bgrow(mesh_builder *b, void **a, size_t *cap, size_t need, size_t size)
 {
@@ -54,7 +32,7 @@ static bool bgrow(mesh_builder *b, void **a, size_t *cap, size_t need, size_t si
 		return false;
 	}
 	size_t old = *cap;
-	if (!grow(a, cap, need, size))
+	if (!mem_grow(a, cap, need, size))
 		return false;
 	b->bytes += (*cap - old) * size;
 	return true;
@@ -100,14 +78,25 @@ bool mb_triangle(mesh_builder *b, int32_t c[3][3])
 	return true;
 }
 
+bool mb_texture(mesh_builder *b, texture *t)
+{
+	if (!mem_grow((void **)&b->texs, &b->ctexs, b->ntexs + 1, sizeof *b->texs)) {
+		texture_free(t);
+		return false;
+	}
+	b->texs[b->ntexs++] = t;
+	return true;
+}
+
+/* The embedded textures are the mesh's (texs), not the material's. */
 static void mat_free(mesh_mat *m)
 {
 	free(m->name);
 	free(m->map_kd);
 	free(m->map_bump);
 	free(m->map_norm);
-	texture_free(m->tex_kd);
-	texture_free(m->tex_norm);
+	free(m->map_mr);
+	free(m->map_emit);
 }
 
 void mb_free(mesh_builder *b)
@@ -120,6 +109,9 @@ void mb_free(mesh_builder *b)
 	for (size_t i = 0; i < b->nmats; i++)
 		mat_free(&b->mats[i]);
 	free(b->mats);
+	for (size_t i = 0; i < b->ntexs; i++)
+		texture_free(b->texs[i]);
+	free(b->texs);
 	memset(b, 0, sizeof *b);
 }
 
@@ -242,6 +234,10 @@ mesh *mb_finish(mesh_builder *b, rt_error *err)
 	m->mats = b->mats;
 	b->mats = NULL;
 	b->nmats = 0;
+	m->ntexs = (uint32_t)b->ntexs;
+	m->texs = b->texs;
+	b->texs = NULL;
+	b->ntexs = 0;
 	if (m->nmats > 1) {
 		m->tmat = b->fm;
 		b->fm = NULL;
@@ -287,6 +283,9 @@ void mesh_free(mesh *m)
 	for (uint32_t i = 0; i < m->nmats; i++)
 		mat_free(&m->mats[i]);
 	free(m->mats);
+	for (uint32_t i = 0; i < m->ntexs; i++)
+		texture_free(m->texs[i]);
+	free(m->texs);
 	free(m->nodes);
 	free(m->blk);
 	free(m->btri);
@@ -316,8 +315,8 @@ size_t mesh_memory(const mesh *m)
 		n += (size_t)m->ntris * sizeof *m->tmat;
 	n += (size_t)m->nnodes * sizeof *m->nodes;
 	n += (size_t)m->nblk * (sizeof *m->blk + sizeof *m->btri);
-	for (uint32_t i = 0; i < m->nmats; i++)
-		n += tex_bytes(m->mats[i].tex_kd) + tex_bytes(m->mats[i].tex_norm);
+	for (uint32_t i = 0; i < m->ntexs; i++)
+		n += tex_bytes(m->texs[i]);
 	return n;
 }
 
@@ -328,28 +327,65 @@ static vec3 vtx(const mesh *m, uint32_t i)
 	return v3(m->p[i][0], m->p[i][1], m->p[i][2]);
 }
 
+/* The slot of (vertex v, normal n) in the open-addressed table slot[cap]
+ * of corner numbers: the corner there has this vertex and normal, or the
+ * slot is free (UINT32_MAX). */
+static size_t normal_slot(const uint32_t *slot, size_t cap, const mesh *m, const float (*nn)[3], uint32_t v,
+                          const float n[3])
+{
+	uint32_t bits[3];
+	memcpy(bits, n, sizeof bits);
+	int32_t key[3] = {(int32_t)(v ^ bits[2] * 0x9E3779B1u), (int32_t)bits[0], (int32_t)bits[1]};
+	size_t h = (size_t)hash3(key) & (cap - 1);
+	while (slot[h] != UINT32_MAX &&
+	       !(m->tri[slot[h] / 3][slot[h] % 3] == v && memcmp(nn[slot[h]], n, sizeof *nn) == 0))
+		h = (h + 1) & (cap - 1);
+	return h;
+}
+
 /* Smooth normals weighted by corner angle (Thürmer & Wüthrich, "Computing
  * vertex normals from polygonal facets", 1998), a face contributing to a
  * corner only when it meets the corner's face at no more than the crease
  * angle; corners of one position with different normals become different
- * vertices. */
+ * vertices.
+ *
+ * Linear in the corners (issue 31): each corner's angle is computed once; a
+ * vertex of more than CREASE_DEG_MAX faces ignores the crease, so its sum
+ * is one sum for all its corners; a vertex of fewer compares each corner's
+ * face with the others, at most CREASE_DEG_MAX comparisons a corner; and
+ * corners of equal vertex and normal find each other through a hash table,
+ * not by comparing every pair. */
+#define CREASE_DEG_MAX 256
 static bool smooth_normals(mesh *m, double crease_deg, rt_error *err)
 {
 	uint32_t nv = m->nverts, nt = m->ntris;
+	size_t cap = 16;
+	while (cap < 6 * (size_t)nt)
+		cap *= 2;
 	vec3 *fn = malloc((size_t)nt * sizeof *fn);
 	uint32_t *start = calloc((size_t)nv + 1, sizeof *start);
 	uint32_t *list = malloc((size_t)nt * 3 * sizeof *list);
 	uint32_t *newid = malloc((size_t)nt * 3 * sizeof *newid);
+	double *ang = malloc((size_t)nt * 3 * sizeof *ang);
+	uint32_t *slot = malloc(cap * sizeof *slot);
 	float(*nn)[3] = malloc((size_t)nt * 3 * sizeof *nn);
-	if (!fn || !start || !list || !newid || !nn)
+	if (!fn || !start || !list || !newid || !ang || !slot || !nn)
 		goto oom;
+	memset(slot, 0xff, cap * sizeof *slot);
 	for (uint32_t t = 0; t < nt; t++) {
 		vec3 a = vtx(m, m->tri[t][0]), b = vtx(m, m->tri[t][1]), c = vtx(m, m->tri[t][2]);
 		vec3 n = v3_cross(v3_sub(b, a), v3_sub(c, a));
 		double l = v3_len(n);
 		fn[t] = l > 0 ? v3_scale(n, 1.0 / l) : v3(0, 0, 0);
-		for (int k = 0; k < 3; k++)
+		for (int k = 0; k < 3; k++) {
 			start[m->tri[t][k] + 1]++;
+			/* the corner's angle */
+			vec3 p = vtx(m, m->tri[t][k]);
+			vec3 e1 = v3_sub(vtx(m, m->tri[t][(k + 1) % 3]), p);
+			vec3 e2 = v3_sub(vtx(m, m->tri[t][(k + 2) % 3]), p);
+			double la = v3_len(e1), lb = v3_len(e2);
+			ang[3 * t + k] = la > 0 && lb > 0 ? acos(clampd(v3_dot(e1, e2) / (la * lb), -1, 1)) : 0;
+		}
 	}
 	for (uint32_t v = 0; v < nv; v++)
 		start[v + 1] += start[v];
@@ -367,35 +403,38 @@ static bool smooth_normals(mesh *m, double crease_deg, rt_error *err)
 	uint32_t next = nv;
 	for (uint32_t v = 0; v < nv; v++) {
 		uint32_t s = start[v], e = start[v + 1], deg = e - s;
+		vec3 all = v3(0, 0, 0); /* the sum of every face, when the crease is ignored */
+		if (deg > CREASE_DEG_MAX)
+			for (uint32_t j = s; j < e; j++)
+				all = v3_madd(all, fn[list[j] / 3], ang[list[j]]);
 		for (uint32_t i = s; i < e; i++) {
 			uint32_t ci = list[i], ti = ci / 3;
-			vec3 sum = v3(0, 0, 0);
-			for (uint32_t j = s; j < e; j++) {
-				uint32_t cj = list[j], tj = cj / 3, kj = cj % 3;
-				if (deg <= 256 && v3_dot(fn[ti], fn[tj]) < cosc)
-					continue;
-				vec3 p = vtx(m, m->tri[tj][kj]);
-				vec3 a = v3_sub(vtx(m, m->tri[tj][(kj + 1) % 3]), p);
-				vec3 b = v3_sub(vtx(m, m->tri[tj][(kj + 2) % 3]), p);
-				double la = v3_len(a), lb = v3_len(b);
-				double ang = la > 0 && lb > 0 ? acos(clampd(v3_dot(a, b) / (la * lb), -1, 1)) : 0;
-				sum = v3_madd(sum, fn[tj], ang);
-			}
+			vec3 sum = all;
+			if (deg <= CREASE_DEG_MAX)
+				for (uint32_t j = s; j < e; j++) {
+					uint32_t cj = list[j], tj = cj / 3;
+					if (v3_dot(fn[ti], fn[tj]) >= cosc)
+						sum = v3_madd(sum, fn[tj], ang[cj]);
+				}
 			double l = v3_len(sum);
 			vec3 n = l > 0 ? v3_scale(sum, 1.0 / l) : fn[ti];
 			nn[ci][0] = (float)n.x;
 			nn[ci][1] = (float)n.y;
 			nn[ci][2] = (float)n.z;
 			/* the same vertex as an earlier corner with this normal */
-			uint32_t id = UINT32_MAX;
-			for (uint32_t j = s; j < i && id == UINT32_MAX; j++)
-				if (memcmp(nn[list[j]], nn[ci], sizeof *nn) == 0)
-					id = newid[list[j]];
-			if (id == UINT32_MAX)
-				id = i == s ? v : next++;
-			newid[ci] = id;
+			size_t h = normal_slot(slot, cap, m, (const float(*)[3])nn, v, nn[ci]);
+			if (slot[h] != UINT32_MAX) {
+				newid[ci] = newid[slot[h]];
+			} else {
+				slot[h] = ci;
+				newid[ci] = i == s ? v : next++;
+			}
 		}
 	}
+	free(slot);
+	slot = NULL;
+	free(ang);
+	ang = NULL;
 	float(*p)[3] = malloc((size_t)next * sizeof *p);
 	float(*n)[3] = malloc((size_t)next * sizeof *n);
 	float(*uv)[2] = m->uv ? malloc((size_t)next * sizeof *uv) : NULL;
@@ -436,6 +475,8 @@ oom:
 	free(start);
 	free(list);
 	free(newid);
+	free(ang);
+	free(slot);
 	free(nn);
 	return rt_error_set(err, "%s: out of memory computing normals", m->path ? m->path : "mesh");
 }
@@ -563,135 +604,4 @@ void mesh_surface(const mesh *m, uint32_t slot, const float b[3], mesh_surf *s)
 			s->dpdv = v3_scale(v3_sub(v3_scale(e2, du1), v3_scale(e1, du2)), 1.0 / det);
 		}
 	}
-}
-
-/* --- loading by extension, and the cache --- */
-
-static const char *ext_of(const char *path)
-{
-	const char *slash = strrchr(path, '/');
-	const char *dot = strrchr(slash ? slash : path, '.');
-	return dot ? dot + 1 : "";
-}
-
-bool mesh_format_known(const char *path)
-{
-	static const char *const known[] = {"obj", "ply", "gltf", "glb", "stl"};
-	const char *e = ext_of(path);
-	for (size_t i = 0; i < sizeof known / sizeof known[0]; i++)
-		if (strcasecmp(e, known[i]) == 0)
-			return true;
-	return false;
-}
-
-mesh *mesh_load(const char *path, rt_error *err)
-{
-	const char *e = ext_of(path);
-	mesh *m;
-	if (strcasecmp(e, "obj") == 0)
-		m = mesh_read_obj(path, err);
-	else if (strcasecmp(e, "ply") == 0)
-		m = mesh_read_ply(path, err);
-	else if (strcasecmp(e, "gltf") == 0 || strcasecmp(e, "glb") == 0 || strcasecmp(e, "stl") == 0)
-		m = mesh_read_assimp(path, err);
-	else {
-		rt_error_set(err, "%s: unknown model format \".%s\"; expected .obj, .ply, .gltf, .glb or .stl",
-		             path, e);
-		return NULL;
-	}
-	if (m && !m->path) {
-		m->path = strdup(path);
-		if (!m->path) {
-			mesh_free(m);
-			rt_error_set(err, "%s: out of memory", path);
-			return NULL;
-		}
-	}
-	return m;
-}
-
-typedef struct cache_entry {
-	mesh *m;
-	char *path;
-	bool smooth;
-	double crease;
-	off_t size;
-	struct timespec mtime;
-} cache_entry;
-
-static pthread_mutex_t cache_lock = PTHREAD_MUTEX_INITIALIZER;
-static cache_entry *cache;
-static size_t ncache, ccache;
-
-mesh *mesh_cache_get(const char *path, bool smooth, double crease_deg, rt_error *err)
-{
-	struct stat st;
-	if (rt_file_stat(path, &st) != 0) {
-		rt_error_set(err, "%s: cannot read the model: %s", path, strerror(errno));
-		return NULL;
-	}
-	if (!smooth)
-		crease_deg = 0;
-	pthread_mutex_lock(&cache_lock);
-	for (size_t i = 0; i < ncache; i++) {
-		cache_entry *c = &cache[i];
-		if (strcmp(c->path, path) == 0 && c->smooth == smooth && c->crease == crease_deg &&
-		    c->size == st.st_size && c->mtime.tv_sec == st.st_mtim.tv_sec &&
-		    c->mtime.tv_nsec == st.st_mtim.tv_nsec) {
-			c->m->refs++;
-			pthread_mutex_unlock(&cache_lock);
-			return c->m;
-		}
-	}
-	pthread_mutex_unlock(&cache_lock);
-	mesh *m = mesh_load(path, err);
-	if (!m)
-		return NULL;
-	if (!mesh_prepare(m, smooth, crease_deg, err)) {
-		mesh_free(m);
-		return NULL;
-	}
-	pthread_mutex_lock(&cache_lock);
-	char *p = strdup(path);
-	if (!p || !grow((void **)&cache, &ccache, ncache + 1, sizeof *cache)) {
-		pthread_mutex_unlock(&cache_lock);
-		free(p);
-		mesh_free(m);
-		rt_error_set(err, "%s: out of memory", path);
-		return NULL;
-	}
-	m->refs = 1;
-	cache[ncache++] = (cache_entry){m, p, smooth, crease_deg, st.st_size, st.st_mtim};
-	pthread_mutex_unlock(&cache_lock);
-	return m;
-}
-
-/* Meshes nobody uses stay cached (a world is rebuilt on every edit, and the
- * next one usually wants the same models) unless the cache holds more than
- * this many unused ones, when the unused are dropped. */
-#define CACHE_KEEP 8
-
-void mesh_cache_put(mesh *m)
-{
-	if (!m)
-		return;
-	pthread_mutex_lock(&cache_lock);
-	if (m->refs > 0)
-		m->refs--;
-	size_t unused = 0;
-	for (size_t i = 0; i < ncache; i++)
-		unused += cache[i].m->refs == 0;
-	if (unused > CACHE_KEEP) {
-		size_t j = 0;
-		for (size_t i = 0; i < ncache; i++) {
-			if (cache[i].m->refs == 0) {
-				mesh_free(cache[i].m);
-				free(cache[i].path);
-			} else {
-				cache[j++] = cache[i];
-			}
-		}
-		ncache = j;
-	}
-	pthread_mutex_unlock(&cache_lock);
 }

@@ -119,9 +119,9 @@ static texture *embedded_texture(const struct aiTexture *tx, unsigned index, con
 /* A material's texture of `type`: a file beside the model (*file) or an
  * image embedded in it (*tex). False (err set) when an embedded image
  * cannot be read. */
-static bool material_texture(const struct aiScene *sc, const struct aiMaterial *m, enum aiTextureType type,
-                             const char *path, const char *dir, bool srgb, char **file, texture **tex,
-                             rt_error *err)
+static bool material_texture(mesh_builder *b, const struct aiScene *sc, const struct aiMaterial *m,
+                             enum aiTextureType type, const char *path, const char *dir, bool srgb, char **file,
+                             texture **tex, rt_error *err)
 {
 	struct aiString s;
 	*file = NULL;
@@ -132,6 +132,10 @@ static bool material_texture(const struct aiScene *sc, const struct aiMaterial *
 	const struct aiTexture *tx = embedded_image(sc, s.data, &index);
 	if (tx) {
 		*tex = embedded_texture(tx, index, path, srgb, err);
+		if (*tex && !mb_texture(b, *tex)) {
+			*tex = NULL;
+			rt_error_set(err, "%s: out of memory", path);
+		}
 		return *tex != NULL;
 	}
 	if (s.data[0] == '*') /* names an image the file does not hold */
@@ -178,12 +182,12 @@ mesh *mesh_read_assimp(const char *path, rt_error *err)
 				m->metallic = (float)v;
 			if (aiGetMaterialFloatArray(am, AI_MATKEY_ROUGHNESS_FACTOR, &v, NULL) == AI_SUCCESS)
 				m->roughness = (float)v;
-			ok = material_texture(sc, am, aiTextureType_BASE_COLOR, path, dir, true, &m->map_kd, &m->tex_kd, err);
+			ok = material_texture(&b, sc, am, aiTextureType_BASE_COLOR, path, dir, true, &m->map_kd, &m->tex_kd, err);
 			if (ok && !m->map_kd && !m->tex_kd)
-				ok = material_texture(sc, am, aiTextureType_DIFFUSE, path, dir, true, &m->map_kd, &m->tex_kd,
+				ok = material_texture(&b, sc, am, aiTextureType_DIFFUSE, path, dir, true, &m->map_kd, &m->tex_kd,
 				                      err);
 			ok = ok &&
-			     material_texture(sc, am, aiTextureType_NORMALS, path, dir, false, &m->map_norm, &m->tex_norm, err);
+			     material_texture(&b, sc, am, aiTextureType_NORMALS, path, dir, false, &m->map_norm, &m->tex_norm, err);
 		}
 	}
 	bool has_uv = true, has_n = true;

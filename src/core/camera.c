@@ -1,0 +1,54 @@
+/* rtsh — the camera's rays: the view a camera gives (world.h) and the ray
+ * of each sample of each pixel (render.h, integrators.h). */
+#include <math.h>
+
+#include "integrators.h"
+
+cam_view cam_view_make(const camera *c)
+{
+	cam_view v;
+	v.pos = c->pos;
+	v.fwd = v3_norm(c->dir);
+	vec3 up_ref = fabs(v.fwd.y) > 0.999999 ? v3(0, 0, 1) : v3(0, 1, 0);
+	v.right = v3_norm(v3_cross(up_ref, v.fwd));
+	v.up = v3_cross(v.fwd, v.right);
+	double fov = clampd(c->fov, 0.01, 179.99);
+	v.tan_half = tan(deg_to_rad(fov) * 0.5);
+	return v;
+}
+
+ray cam_ray(const cam_view *c, double fx, double fy, int w, int h)
+{
+	double u = (2.0 * fx / w - 1.0) * c->tan_half;
+	double v = (1.0 - 2.0 * fy / h) * c->tan_half * ((double)h / w);
+	vec3 d = v3_add(c->fwd, v3_add(v3_scale(c->right, u), v3_scale(c->up, v)));
+	return (ray){c->pos, v3_norm(d)};
+}
+
+/* The sampler is left positioned after the two dimensions that place the
+ * sample in its pixel. */
+ray camera_sample_ray(const world *w, const render_settings *s, int px, int py, int fw, int fh, int sample,
+                      sampler *sp)
+{
+	uint64_t pixel = (uint64_t)py * (uint64_t)fw + (uint64_t)px;
+	double u = 0.5, v = 0.5;
+	/* Dimensions 0 and 1 place the sample in its pixel (one Whitted sample
+	 * sits at the centre and needs no numbers); the path's numbers follow.
+	 * Every pixel has its own scrambles, the same for all its samples, so
+	 * that its first 2^k positions are stratified (sampler.h). */
+	*sp = (sampler){0, 0, 0, 0};
+	if (s->samples > 1 || s->mode == MODE_PATH) {
+		*sp = sampler_for(s->seed, pixel, (uint32_t)sample);
+		if (s->samples > 1)
+			samp_2d(sp, &u, &v);
+		sp->dim = 2;
+	}
+	return cam_ray(&w->cam, px + u, py + v, fw, fh);
+}
+
+ray render_sample_ray(const world *w, const render_settings *s, int px, int py, int fw, int fh,
+                      int sample)
+{
+	sampler sp;
+	return camera_sample_ray(w, s, px, py, fw, fh, sample, &sp);
+}

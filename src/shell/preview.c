@@ -1,0 +1,199 @@
+/* rtsh — previews for file managers (preview.h). */
+#include "shell/preview.h"
+
+#include <errno.h>
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/ioctl.h>
+#include <sys/stat.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include "rtsh/mesh.h"
+#include "rtsh/orbit.h"
+#include "rtsh/render.h"
+#include "rtsh/rtfile.h"
+#include "rtsh/settings.h"
+#include "rtsh/world.h"
+#include "shell/args.h"
+#include "term/abuf.h"
+#include "term/caps.h"
+#include "term/frame.h"
+#include "term/pixels.h"
+
+#define STR(x) #x
+#define XSTR(x) STR(x)
+
+/* The watchdog: a loader or a render that takes too long ends the process
+ * (write and _exit are async-signal-safe); a file manager never waits on a
+ * hung previewer. */
+static void watchdog(int sig)
+{
+	(void)sig;
+	static const char msg[] = "rtsh: --preview: gave up after " XSTR(PREVIEW_TIMEOUT) " seconds\n";
+	ssize_t w = write(STDERR_FILENO, msg, sizeof msg - 1);
+	(void)w;
+	_exit(1);
+}
+
+static int fail(const char *file, const char *what)
+{
+	fprintf(stderr, "rtsh: %s: %s\n", file, what);
+	return 1;
+}
+
+/* --pixels auto on a terminal: ask it (raw mode for the answers), at most
+ * a second. */
+static pixels_mode ask_terminal(int *cell_w, int *cell_h)
+{
+	pixels_caps c = {0};
+	struct termios saved;
+	if (isatty(STDIN_FILENO) && tcgetattr(STDIN_FILENO, &saved) == 0) {
+		struct termios t = saved;
+		t.c_lflag &= ~(tcflag_t)(ICANON | ECHO);
+		t.c_cc[VMIN] = 0;
+		t.c_cc[VTIME] = 0;
+		tcsetattr(STDIN_FILENO, TCSANOW, &t);
+		abuf keys;
+		abuf_init(&keys);
+		pixels_probe(STDIN_FILENO, STDOUT_FILENO, 1.0, &c, &keys);
+		abuf_free(&keys);
+		tcsetattr(STDIN_FILENO, TCSANOW, &saved);
+	}
+	pixels_caps_env(&c, getenv("TERM_PROGRAM"), getenv("LC_TERMINAL"), getenv("TMUX"));
+	if (c.cell_w > 0 && c.cell_h > 0) {
+		*cell_w = c.cell_w;
+		*cell_h = c.cell_h;
+	}
+	return pixels_choose(&c);
+}
+
+/* The size of a cell in pixels: the terminal's, when standard output is
+ * one that says; else 10 x 20. */
+static void cell_size(int *w, int *h)
+{
+	struct winsize ws;
+	*w = 10;
+	*h = 20;
+	if (isatty(STDOUT_FILENO) && ioctl(STDOUT_FILENO, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 0 &&
+	    ws.ws_row > 0 && ws.ws_xpixel >= ws.ws_col && ws.ws_ypixel >= ws.ws_row) {
+		*w = ws.ws_xpixel / ws.ws_col;
+		*h = ws.ws_ypixel / ws.ws_row;
+	}
+}
+
+/* The palette: --color when given; else, on a terminal, what it says;
+ * into a pipe (the file managers), 24-bit colour unless NO_COLOR. */
+static frame_palette preview_palette(color_mode m)
+{
+	if (m != COLOR_AUTO || isatty(STDOUT_FILENO))
+		return caps_palette(m, STDOUT_FILENO);
+	const char *nc = getenv("NO_COLOR");
+	return nc && *nc ? PALETTE_NONE : PALETTE_TRUECOLOR;
+}
+
+int preview_main(const rtsh_options *o)
+{
+	const char *file = o->scene;
+	if (!file) {
+		fprintf(stderr, "rtsh: --preview needs a file\nTry 'rtsh --help' for more information.\n");
+		return 2;
+	}
+	signal(SIGALRM, watchdog);
+	alarm(PREVIEW_TIMEOUT);
+	/* Only regular files: a FIFO would block the open, a device or a
+	 * folder means nothing. */
+	struct stat st;
+	if (stat(file, &st) != 0)
+		return fail(file, strerror(errno));
+	if (!S_ISREG(st.st_mode))
+		return fail(file, "not a regular file; expected a scene (.rt) or a model file");
+	rt_error err;
+	rt_load_opts lo = {.strict = false, .warn = NULL};
+	scene *s = rt_load_file(file, &lo, &err);
+	if (!s) {
+		char msg[RT_ERROR_MSG_MAX + RT_ERROR_FILE_MAX + 32];
+		rt_error_format(&err, msg, sizeof msg);
+		fprintf(stderr, "%s\n", msg);
+		return 1;
+	}
+	render_settings set = render_settings_default();
+	render_settings_apply_hints(&set, &s->hints);
+	/* Fast: Whitted at most 4 samples; path at most 8, denoised. */
+	if (set.mode == MODE_PATH) {
+		set.samples = set.samples < 8 ? set.samples : 8;
+		set.denoise = DENOISE_ON;
+		set.depth = set.depth < 6 ? set.depth : 6;
+	} else {
+		set.samples = set.samples < 4 ? set.samples : 4;
+	}
+	options_apply_settings(o, &set);
+	int cols = o->preview_cols, rows = o->preview_rows;
+	pixels_mode pm = (pixels_mode)set.pixels;
+	int cw, ch;
+	cell_size(&cw, &ch);
+	if (pm == PIXELS_AUTO)
+		pm = isatty(STDOUT_FILENO) ? ask_terminal(&cw, &ch) : PIXELS_OFF;
+	int w = cols, h = 2 * rows;
+	if (pm != PIXELS_OFF) {
+		w = cols * cw;
+		h = rows * ch;
+	}
+	/* A model fills the pane (the viewer frames it for 16:9); a scene
+	 * keeps its view, at least as high as in a 16:9 picture: a wide pane
+	 * widens the field of view rather than cutting the top off. */
+	if (s->ncams > 0 && mesh_format_known(file)) {
+		camera *c = &s->cams[s->cam];
+		*c = orbit_frame(*c, orbit_scene_bounds(s), (double)w / h);
+	} else if (s->ncams > 0) {
+		camera *c = &s->cams[s->cam];
+		double th = tan(deg_to_rad(c->fov) * 0.5), aspect = (double)w / h;
+		double need = th * 9.0 / 16.0 * aspect;
+		if (need > th)
+			c->fov = fmin(2.0 * rad_to_deg(atan(need)), 150.0);
+	}
+	set.width = w;
+	set.height = h;
+	world *wd = world_build(s, &err);
+	scene_free(s);
+	if (!wd)
+		return fail(file, err.msg);
+	framebuffer *fb = render_image(wd, &set, NULL, NULL, NULL, &err);
+	world_free(wd);
+	if (!fb)
+		return fail(file, err.msg);
+	uint8_t *rgb = malloc((size_t)w * h * 3);
+	if (!rgb) {
+		fb_free(fb);
+		return fail(file, "out of memory");
+	}
+	frame_srgb_from_linear(fb->rgb, (size_t)w * h, set.exposure, rgb);
+	fb_free(fb);
+	abuf a;
+	abuf_init(&a);
+	if (pm != PIXELS_OFF) {
+		if (!pixels_encode(pm, &a, rgb, w, h, cols, rows))
+			a.failed = true;
+	} else {
+		frame *f = frame_new(cols, rows, preview_palette(o->color));
+		if (!f) {
+			a.failed = true;
+		} else {
+			frame_put_image(f, rgb, w, h, 0, 0);
+			frame_text(f, &a);
+			frame_free(f);
+		}
+	}
+	free(rgb);
+	int rc = 0;
+	if (a.failed)
+		rc = fail(file, "out of memory");
+	else if (!write_all(STDOUT_FILENO, a.b, a.len))
+		rc = fail("standard output", strerror(errno));
+	abuf_free(&a);
+	alarm(0);
+	return rc;
+}

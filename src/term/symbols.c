@@ -1,0 +1,262 @@
+/* rtsh — symbol sets (symbols.h). */
+#include "term/symbols.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+const symbol_set symbols_table[SYMBOLS_AUTO] = {
+	[SYMBOLS_HALF] = {"half", 1, 2, 11},
+	[SYMBOLS_QUADRANT] = {"quadrant", 2, 2, 11},
+	[SYMBOLS_SEXTANT] = {"sextant", 2, 3, 130},
+	[SYMBOLS_OCTANT] = {"octant", 2, 4, 160},
+};
+
+static const char *const kind_names[] = {"half", "quadrant", "sextant", "octant", "auto"};
+
+const char *symbols_name(symbols_kind k)
+{
+	return k >= SYMBOLS_HALF && k <= SYMBOLS_AUTO ? kind_names[k] : "half";
+}
+
+bool symbols_parse(const char *s, symbols_kind *k)
+{
+	for (int i = SYMBOLS_HALF; i <= SYMBOLS_AUTO; i++)
+		if (strcmp(s, kind_names[i]) == 0) {
+			*k = (symbols_kind)i;
+			return true;
+		}
+	return false;
+}
+
+/* Quadrants, mask bit 0 top left, 1 top right, 2 bottom left, 3 bottom
+ * right (Unicode's block elements, U+2580..U+259F). */
+static const uint16_t quadrant_cp[16] = {
+	0x20,   0x2598, 0x259d, 0x2580, 0x2596, 0x258c, 0x259e, 0x259b,
+	0x2597, 0x259a, 0x2590, 0x259c, 0x2584, 0x2599, 0x259f, 0x2588,
+};
+
+/* The octant patterns that other characters hold, besides the sixteen
+ * quadrants (a quadrant is two octants stacked): Unicode 16's U+1CD00
+ * block skips them, so an octant's code point is its rank among the
+ * patterns not skipped. */
+static const struct {
+	uint8_t mask;
+	uint32_t cp;
+} octant_other[] = {
+	{0x01, 0x1cea8}, /* LEFT HALF UPPER ONE QUARTER BLOCK */
+	{0x02, 0x1ceab}, /* RIGHT HALF UPPER ONE QUARTER BLOCK */
+	{0x03, 0x1fb82}, /* UPPER ONE QUARTER BLOCK */
+	{0x14, 0x1fbe6}, /* MIDDLE LEFT ONE QUARTER BLOCK */
+	{0x28, 0x1fbe7}, /* MIDDLE RIGHT ONE QUARTER BLOCK */
+	{0x3f, 0x1fb85}, /* UPPER THREE QUARTERS BLOCK */
+	{0x40, 0x1cea3}, /* LEFT HALF LOWER ONE QUARTER BLOCK */
+	{0x80, 0x1cea0}, /* RIGHT HALF LOWER ONE QUARTER BLOCK */
+	{0xc0, 0x2582},  /* LOWER ONE QUARTER BLOCK */
+	{0xfc, 0x2586},  /* LOWER THREE QUARTERS BLOCK */
+};
+#define N_OCTANT_OTHER (sizeof octant_other / sizeof octant_other[0])
+
+/* The quadrant an octant mask is, or -1: each pair of octant rows equal. */
+static int octant_as_quadrant(unsigned m)
+{
+	unsigned r0 = m & 3, r1 = m >> 2 & 3, r2 = m >> 4 & 3, r3 = m >> 6 & 3;
+	if (r0 != r1 || r2 != r3)
+		return -1;
+	return (int)(r0 | r2 << 2);
+}
+
+static bool octant_skipped(unsigned m)
+{
+	if (octant_as_quadrant(m) >= 0)
+		return true;
+	for (size_t i = 0; i < N_OCTANT_OTHER; i++)
+		if (octant_other[i].mask == m)
+			return true;
+	return false;
+}
+
+uint32_t symbols_codepoint(symbols_kind k, unsigned mask)
+{
+	switch (k) {
+	case SYMBOLS_HALF:
+		mask &= 3;
+		return mask == 0 ? 0x20 : mask == 1 ? 0x2580 : mask == 2 ? 0x2584 : 0x2588;
+	case SYMBOLS_QUADRANT:
+		return quadrant_cp[mask & 15];
+	case SYMBOLS_SEXTANT:
+		mask &= 63;
+		/* U+1FB00.. run through masks 1..62 but the two columns. */
+		if (mask == 0 || mask == 63)
+			return mask ? 0x2588 : 0x20;
+		if (mask == 21)
+			return 0x258c;
+		if (mask == 42)
+			return 0x2590;
+		return 0x1fb00 + mask - 1 - (mask > 21) - (mask > 42);
+	case SYMBOLS_OCTANT: {
+		mask &= 255;
+		int q = octant_as_quadrant(mask);
+		if (q >= 0)
+			return quadrant_cp[q];
+		for (size_t i = 0; i < N_OCTANT_OTHER; i++)
+			if (octant_other[i].mask == mask)
+				return octant_other[i].cp;
+		unsigned rank = 0;
+		for (unsigned m = 0; m < mask; m++)
+			rank += !octant_skipped(m);
+		return 0x1cd00 + rank;
+	}
+	case SYMBOLS_AUTO:
+		break;
+	}
+	return 0x20;
+}
+
+int symbols_utf8(symbols_kind k, unsigned mask, char out[4])
+{
+	uint32_t c = symbols_codepoint(k, mask);
+	if (c < 0x80) {
+		out[0] = (char)c;
+		return 1;
+	}
+	if (c < 0x10000) {
+		out[0] = (char)(0xe0 | c >> 12);
+		out[1] = (char)(0x80 | (c >> 6 & 0x3f));
+		out[2] = (char)(0x80 | (c & 0x3f));
+		return 3;
+	}
+	out[0] = (char)(0xf0 | c >> 18);
+	out[1] = (char)(0x80 | (c >> 12 & 0x3f));
+	out[2] = (char)(0x80 | (c >> 6 & 0x3f));
+	out[3] = (char)(0x80 | (c & 0x3f));
+	return 4;
+}
+
+int symbols_mask_of(symbols_kind k, uint32_t cp)
+{
+	if (k < SYMBOLS_HALF || k >= SYMBOLS_AUTO)
+		return -1;
+	unsigned n = 1u << (symbols_table[k].w * symbols_table[k].h);
+	if (k == SYMBOLS_OCTANT && cp >= 0x1cd00 && cp <= 0x1cde5) {
+		unsigned rank = 0;
+		for (unsigned m = 0; m < n; m++)
+			if (!octant_skipped(m) && rank++ == cp - 0x1cd00)
+				return (int)m;
+	}
+	for (unsigned m = 0; m < n; m++)
+		if (symbols_codepoint(k, m) == cp)
+			return (int)m;
+	return -1;
+}
+
+void symbols_subpixels(symbols_kind k, const uint8_t *s, size_t stride, float sub[8][3])
+{
+	const symbol_set *set = &symbols_table[k];
+	/* Subpixel row j covers sample rows [j*H/h, (j+1)*H/h): each sample
+	 * row weighs the length it shares with that span. */
+	for (int j = 0; j < set->h; j++) {
+		double lo = (double)j * SYMBOLS_SAMPLE_H / set->h, hi = (double)(j + 1) * SYMBOLS_SAMPLE_H / set->h;
+		for (int c = 0; c < set->w; c++) {
+			double acc[3] = {0, 0, 0};
+			for (int r = 0; r < SYMBOLS_SAMPLE_H; r++) {
+				double a = r > lo ? r : lo, b = r + 1 < hi ? r + 1 : hi;
+				if (b <= a)
+					continue;
+				/* the samples under this subpixel's columns */
+				for (int x = c * SYMBOLS_SAMPLE_W / set->w; x < (c + 1) * SYMBOLS_SAMPLE_W / set->w; x++) {
+					const uint8_t *p = s + (size_t)r * stride + (size_t)x * 3;
+					for (int ch = 0; ch < 3; ch++)
+						acc[ch] += (b - a) * p[ch];
+				}
+			}
+			double area = (hi - lo) * ((double)SYMBOLS_SAMPLE_W / set->w);
+			for (int ch = 0; ch < 3; ch++)
+				sub[j * set->w + c][ch] = (float)(acc[ch] / area);
+		}
+	}
+}
+
+static uint8_t to_byte(double v)
+{
+	long r = lround(v);
+	return (uint8_t)(r < 0 ? 0 : r > 255 ? 255 : r);
+}
+
+double symbols_fit(const float sub[][3], int n, double flat, unsigned *mask, uint8_t a[3], uint8_t b[3])
+{
+	/* The squared error of a split is sum |p|^2 - |S_a|^2/n_a - |S_b|^2/n_b
+	 * (each side at its mean), so the best split has the largest
+	 * |S_a|^2/n_a + |S_b|^2/n_b. Walk the splits in Gray-code order, one
+	 * subpixel moving sides each step; subpixel n-1 stays in b (a split
+	 * and its complement are the same). */
+	double tot[3] = {0, 0, 0}, sq = 0;
+	for (int i = 0; i < n; i++)
+		for (int c = 0; c < 3; c++) {
+			tot[c] += sub[i][c];
+			sq += (double)sub[i][c] * sub[i][c];
+		}
+	double flat_score = (tot[0] * tot[0] + tot[1] * tot[1] + tot[2] * tot[2]) / n;
+	double sa[3] = {0, 0, 0};
+	int na = 0;
+	unsigned m = 0, best_m = 0;
+	double best = flat_score;
+	unsigned steps = 1u << (n - 1);
+	for (unsigned g = 1; g < steps; g++) {
+		int bit = __builtin_ctz(g); /* the subpixel that moves */
+		double sign = (m >> bit & 1) ? -1 : 1;
+		m ^= 1u << bit;
+		na += (int)sign;
+		for (int c = 0; c < 3; c++)
+			sa[c] += sign * sub[bit][c];
+		if (na == 0)
+			continue;
+		double sb0 = tot[0] - sa[0], sb1 = tot[1] - sa[1], sb2 = tot[2] - sa[2];
+		double score = (sa[0] * sa[0] + sa[1] * sa[1] + sa[2] * sa[2]) / na +
+		               (sb0 * sb0 + sb1 * sb1 + sb2 * sb2) / (n - na);
+		if (score > best) {
+			best = score;
+			best_m = m;
+		}
+	}
+	if (best_m == 0 || best - flat_score <= flat) {
+		for (int c = 0; c < 3; c++)
+			a[c] = b[c] = to_byte(tot[c] / n);
+		*mask = 0;
+		return sq - flat_score;
+	}
+	double ma[3] = {0, 0, 0}, mb[3] = {0, 0, 0};
+	int ka = 0;
+	for (int i = 0; i < n; i++) {
+		bool in = best_m >> i & 1;
+		ka += in;
+		for (int c = 0; c < 3; c++)
+			(in ? ma : mb)[c] += sub[i][c];
+	}
+	for (int c = 0; c < 3; c++) {
+		a[c] = to_byte(ma[c] / ka);
+		b[c] = to_byte(mb[c] / (n - ka));
+	}
+	*mask = best_m;
+	return sq - best;
+}
+
+symbols_kind symbols_choose(const char *term_program, const char *xtversion, const char *vte_version, bool tmux)
+{
+	(void)tmux; /* inside tmux, TERM_PROGRAM and XTVERSION name tmux itself */
+	/* Terminals that draw the block elements and "Symbols for Legacy
+	 * Computing" themselves, not from a font that may lack them: kitty,
+	 * WezTerm, foot, Ghostty and VTE (GNOME Terminal and its kin, 0.64
+	 * on). Octants (Unicode 16, 2024) are left to `set symbols octant`:
+	 * which releases draw them is not known here. */
+	static const char *const programs[] = {"WezTerm", "ghostty", "kitty"};
+	for (size_t i = 0; term_program && i < sizeof programs / sizeof programs[0]; i++)
+		if (strcmp(term_program, programs[i]) == 0)
+			return SYMBOLS_SEXTANT;
+	if (xtversion && (strncmp(xtversion, "kitty(", 6) == 0 || strncmp(xtversion, "foot(", 5) == 0 ||
+	                  strncmp(xtversion, "WezTerm ", 8) == 0 || strncmp(xtversion, "ghostty ", 8) == 0))
+		return SYMBOLS_SEXTANT;
+	if (vte_version && atol(vte_version) >= 6400)
+		return SYMBOLS_SEXTANT;
+	return SYMBOLS_HALF;
+}

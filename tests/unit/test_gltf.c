@@ -1,0 +1,365 @@
+/* rtsh — the glTF 2.0 reader (mesh_gltf.c, gltf.h): files the tests write
+ * themselves, every expected value worked out by hand. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "rtsh/gltf.h"
+#include "rtsh/memory.h"
+#include "rtsh/mesh.h"
+#include "testutil.h"
+
+/* --- writing glTF --- */
+
+static void b64(const unsigned char *in, size_t n, char *out)
+{
+	static const char a[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+	size_t k = 0;
+	for (size_t i = 0; i < n; i += 3) {
+		uint32_t v = (uint32_t)in[i] << 16 | (i + 1 < n ? (uint32_t)in[i + 1] << 8 : 0) | (i + 2 < n ? in[i + 2] : 0);
+		out[k++] = a[v >> 18 & 63];
+		out[k++] = a[v >> 12 & 63];
+		out[k++] = i + 1 < n ? a[v >> 6 & 63] : '=';
+		out[k++] = i + 2 < n ? a[v & 63] : '=';
+	}
+	out[k] = '\0';
+}
+
+/* One triangle (1,0,0) (0,1,0) (0,0,1)... given as 3 positions and the
+ * indices 0 1 2 (uint16, padded to 8 bytes): the buffer as a data: URI, and
+ * a bufferView/accessor pair for each. `rest` holds the file's other
+ * top-level members (nodes, scenes, ...), ending with a comma. */
+static char *tri_gltf(const float p[3][3], const char *rest)
+{
+	unsigned char bin[44];
+	memcpy(bin, p, 36);
+	const uint16_t idx[4] = {0, 1, 2, 0};
+	memcpy(bin + 36, idx, 8);
+	char data[80];
+	b64(bin, sizeof bin, data);
+	char *s = malloc(4096);
+	assert_non_null(s);
+	snprintf(s, 4096,
+	         "{\"asset\":{\"version\":\"2.0\"},%s"
+	         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
+	         "\"buffers\":[{\"byteLength\":44,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
+	         "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":6}],"
+	         "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+	         "{\"bufferView\":1,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}",
+	         rest, data);
+	return s;
+}
+
+static const float unit_tri[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+
+static bool has_vertex(const mesh *m, vec3 v, double tol)
+{
+	for (uint32_t i = 0; i < m->nverts; i++)
+		if (fabs(m->p[i][0] - v.x) <= tol && fabs(m->p[i][1] - v.y) <= tol && fabs(m->p[i][2] - v.z) <= tol)
+			return true;
+	return false;
+}
+
+/* --- the node hierarchy --- */
+
+/* A parent at T(1,2,3) R(90 degrees about Z) S(2) over a child whose
+ * matrix moves it by (1,0,0). By hand, a vertex (x,y,z) of the child's mesh
+ * goes to (x+1, y, z), then scaled (2x+2, 2y, 2z), turned about Z (x, y) ->
+ * (-y, x): (-2y, 2x+2, 2z), then moved: (1-2y, 2x+4, 2z+3); the reader
+ * mirrors X (scene frame): (2y-1, 2x+4, 2z+3). So (1,0,0) -> (-1,6,3),
+ * (0,1,0) -> (1,4,3), (0,0,1) -> (-1,4,5). */
+static void test_trs_composition(void **state)
+{
+	(void)state;
+	double h = sqrt(0.5);
+	char rest[512];
+	snprintf(rest, sizeof rest,
+	         "\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"translation\":[1,2,3],"
+	         "\"rotation\":[0,0,%.17g,%.17g],\"scale\":[2,2,2],\"children\":[1]},"
+	         "{\"mesh\":0,\"matrix\":[1,0,0,0, 0,1,0,0, 0,0,1,0, 1,0,0,1]}],",
+	         h, h);
+	char *text = tri_gltf(unit_tri, rest);
+	rt_error err = {0};
+	mesh *m = mesh_parse_gltf("trs.gltf", NULL, text, strlen(text), &err);
+	if (!m)
+		fail_msg("%s", err.msg);
+	assert_int_equal(m->ntris, 1);
+	assert_true(has_vertex(m, v3(-1, 6, 3), 1e-5));
+	assert_true(has_vertex(m, v3(1, 4, 3), 1e-5));
+	assert_true(has_vertex(m, v3(-1, 4, 5), 1e-5));
+	mesh_free(m);
+	free(text);
+}
+
+/* A mirroring node (scale -1 on X) keeps the faces' outward side: the
+ * triangle (1,0,0) (0,1,0) (0,0,1) faces (1,1,1) in the file; mirrored by
+ * the node it faces (-1,1,1), and mirrored again into the scene frame
+ * (1,1,1). The geometric normal of the prepared mesh says which side. */
+static void test_mirroring_node_keeps_winding(void **state)
+{
+	(void)state;
+	char *text = tri_gltf(unit_tri, "\"nodes\":[{\"mesh\":0,\"scale\":[-1,1,1]}],");
+	rt_error err = {0};
+	mesh *m = mesh_parse_gltf("mirror.gltf", NULL, text, strlen(text), &err);
+	if (!m)
+		fail_msg("%s", err.msg);
+	assert_true(mesh_prepare(m, false, 0, &err));
+	mesh_surf sf;
+	const float b[3] = {1.0f / 3, 1.0f / 3, 1.0f / 3};
+	mesh_surface(m, 0, b, &sf);
+	vec3 n = v3_norm(sf.ng);
+	assert_vec_near(n, v3_norm(v3(1, 1, 1)), 1e-6);
+	mesh_free(m);
+	free(text);
+	/* without the node's mirror: (1,1,1) in the file, (-1,1,1) in the scene */
+	text = tri_gltf(unit_tri, "\"nodes\":[{\"mesh\":0}],");
+	m = mesh_parse_gltf("plain.gltf", NULL, text, strlen(text), &err);
+	assert_non_null(m);
+	assert_true(mesh_prepare(m, false, 0, &err));
+	mesh_surface(m, 0, b, &sf);
+	assert_vec_near(v3_norm(sf.ng), v3_norm(v3(-1, 1, 1)), 1e-6);
+	mesh_free(m);
+	free(text);
+}
+
+/* --- materials --- */
+
+static void test_material_extensions(void **state)
+{
+	(void)state;
+	char *text = tri_gltf(unit_tri,
+	                      "\"nodes\":[{\"mesh\":0}],\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":"
+	                      "[0.5,0.25,1,0.75],\"metallicFactor\":0.3,\"roughnessFactor\":0.2},"
+	                      "\"emissiveFactor\":[1,0.5,0],\"alphaMode\":\"MASK\",\"alphaCutoff\":0.4,"
+	                      "\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":4},"
+	                      "\"KHR_materials_transmission\":{\"transmissionFactor\":0.9},"
+	                      "\"KHR_materials_ior\":{\"ior\":1.33},\"KHR_materials_volume\":{\"thicknessFactor\":0.1,"
+	                      "\"attenuationDistance\":2,\"attenuationColor\":[1,0.5,0.25]},"
+	                      "\"KHR_materials_clearcoat\":{\"clearcoatFactor\":1,\"clearcoatRoughnessFactor\":0.1},"
+	                      "\"KHR_materials_specular\":{\"specularFactor\":0.5,\"specularColorFactor\":[1,1,0.5]}}}],");
+	/* the primitive names material 0 */
+	char *at = strstr(text, "\"indices\":1}");
+	assert_non_null(at);
+	char fixed[4096];
+	snprintf(fixed, sizeof fixed, "%.*s\"indices\":1,\"material\":0}%s", (int)(at - text), text,
+	         at + strlen("\"indices\":1}"));
+	rt_error err = {0};
+	mesh *m = mesh_parse_gltf("mat.gltf", NULL, fixed, strlen(fixed), &err);
+	if (!m)
+		fail_msg("%s", err.msg);
+	assert_int_equal(m->nmats, 1);
+	const mesh_mat *mm = &m->mats[0];
+	assert_near(mm->kd[0], 0.5, 0);
+	assert_near(mm->kd[1], 0.25, 0);
+	assert_near(mm->alpha, 0.75, 0);
+	assert_near(mm->metallic, 0.3, 1e-7);
+	assert_near(mm->roughness, 0.2, 1e-7);
+	/* emissive x strength: (1, 0.5, 0) x 4 */
+	assert_near(mm->ke[0], 4, 0);
+	assert_near(mm->ke[1], 2, 0);
+	assert_near(mm->ke[2], 0, 0);
+	assert_int_equal(mm->alpha_mode, MESH_ALPHA_MASK);
+	assert_near(mm->alpha_cutoff, 0.4, 1e-7);
+	assert_near(mm->transmission, 0.9, 1e-7);
+	assert_near(mm->ior, 1.33, 1e-6);
+	assert_near(mm->thickness, 0.1, 1e-7);
+	assert_near(mm->att_dist, 2, 0);
+	assert_near(mm->att_color[2], 0.25, 0);
+	assert_near(mm->clearcoat, 1, 0);
+	assert_near(mm->clearcoat_roughness, 0.1, 1e-7);
+	assert_near(mm->specular, 0.5, 0);
+	assert_near(mm->specular_color[2], 0.5, 0);
+	mesh_free(m);
+	free(text);
+}
+
+/* --- cameras and lights --- */
+
+/* A camera at (2,1,5) turned 90 degrees about +Y: glTF cameras look down
+ * their -Z, which the turn takes to -X; mirrored into the scene frame: the
+ * position (-2,1,5), looking along +X, up +Y. yfov 0.5 rad, aspect 2. An
+ * orthographic camera with xmag 3, ymag 1.5. A point light of 100 cd, a
+ * spot of 50 cd (cones 0.2 and 0.4 rad) under a node scaled 2 (its range 5
+ * becomes 10) and a directional light of 3 lux shining down -Y. */
+static void test_cameras_and_lights(void **state)
+{
+	(void)state;
+	double h = sqrt(0.5);
+	char rest[2048];
+	snprintf(rest, sizeof rest,
+	         "\"nodes\":[{\"camera\":0,\"translation\":[2,1,5],\"rotation\":[0,%.17g,0,%.17g]},"
+	         "{\"camera\":1},{\"mesh\":0},"
+	         "{\"translation\":[0,4,0],\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}},"
+	         "{\"scale\":[2,2,2],\"extensions\":{\"KHR_lights_punctual\":{\"light\":1}}},"
+	         "{\"rotation\":[%.17g,0,0,%.17g],\"extensions\":{\"KHR_lights_punctual\":{\"light\":2}}}],"
+	         "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.5,\"aspectRatio\":2,\"znear\":0.1}},"
+	         "{\"type\":\"orthographic\",\"orthographic\":{\"xmag\":3,\"ymag\":1.5,\"znear\":0,\"zfar\":10}}],"
+	         "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[{\"type\":\"point\",\"intensity\":100,"
+	         "\"color\":[1,0.5,0.25]},{\"type\":\"spot\",\"intensity\":50,\"range\":5,\"spot\":"
+	         "{\"innerConeAngle\":0.2,\"outerConeAngle\":0.4}},{\"type\":\"directional\",\"intensity\":3}]}},",
+	         h, h, -h, h);
+	char *text = tri_gltf(unit_tri, rest);
+	gltf_info gi;
+	rt_error err = {0};
+	if (!gltf_parse_info("cl.gltf", text, strlen(text), &gi, &err))
+		fail_msg("%s", err.msg);
+	assert_int_equal(gi.ncams, 2);
+	assert_vec_near(gi.cams[0].pos, v3(-2, 1, 5), 1e-12);
+	assert_vec_near(gi.cams[0].fwd, v3(1, 0, 0), 1e-12);
+	assert_vec_near(gi.cams[0].up, v3(0, 1, 0), 1e-12);
+	assert_false(gi.cams[0].ortho);
+	assert_near(gi.cams[0].yfov, 0.5, 0);
+	assert_near(gi.cams[0].aspect, 2, 0);
+	assert_true(gi.cams[1].ortho);
+	assert_near(gi.cams[1].xmag, 3, 0);
+	assert_near(gi.cams[1].ymag, 1.5, 0);
+	assert_vec_near(gi.cams[1].fwd, v3(0, 0, -1), 0);
+	assert_int_equal(gi.nlights, 3);
+	assert_int_equal(gi.lights[0].type, GLTF_POINT);
+	assert_vec_near(gi.lights[0].pos, v3(0, 4, 0), 0);
+	assert_near(gi.lights[0].intensity, 100, 0);
+	assert_near(gi.lights[0].color[1], 0.5, 0);
+	assert_int_equal(gi.lights[1].type, GLTF_SPOT);
+	assert_near(gi.lights[1].range, 10, 1e-12);
+	assert_near(gi.lights[1].inner, 0.2, 0);
+	assert_near(gi.lights[1].outer, 0.4, 0);
+	/* -90 degrees about X takes -Z to -Y */
+	assert_int_equal(gi.lights[2].type, GLTF_DIRECTIONAL);
+	assert_vec_near(gi.lights[2].dir, v3(0, -1, 0), 1e-12);
+	assert_false(gi.emissive);
+	gltf_info_free(&gi);
+	free(text);
+}
+
+/* --- bad files: the JSON path or byte, and what was expected --- */
+
+static void expect_fail(const char *text, const char *want1, const char *want2)
+{
+	rt_error err = {0};
+	mesh *m = mesh_parse_gltf("bad.gltf", NULL, text, strlen(text), &err);
+	if (m)
+		fail_msg("read \"%s\"; expected the error \"%s\"", text, want1);
+	if (!strstr(err.msg, want1) || !strstr(err.msg, want2))
+		fail_msg("message \"%s\" lacks \"%s\" / \"%s\"", err.msg, want1, want2);
+}
+
+static void test_bad_files(void **state)
+{
+	(void)state;
+	expect_fail("{\"asset\":{\"version\":\"1.0\"}}", "bad.gltf: asset.version", "expected a glTF 2.0 file");
+	expect_fail("[1,2]", "bad.gltf: byte 0", "not a glTF file");
+	expect_fail("{\"asset\":{\"version\":\"2.0\"},\"extensionsRequired\":[\"KHR_draco_mesh_compression\"]}",
+	            "extensionsRequired[0]: \"KHR_draco_mesh_compression\" is not read by rtsh", "expected only");
+	/* the POSITION accessor names a view that is too short */
+	char *t = tri_gltf(unit_tri, "\"nodes\":[{\"mesh\":0}],");
+	char *at = strstr(t, "\"byteLength\":36}");
+	assert_non_null(at);
+	memcpy(at, "\"byteLength\":35}", 16);
+	expect_fail(t, "bad.gltf: accessors[0]:", "bufferViews[0] has 35; expected the accessor inside its view");
+	free(t);
+	t = tri_gltf(unit_tri, "\"nodes\":[{\"mesh\":0}],");
+	/* the indices read as two uint32 (0x00010000, 0x00000002) */
+	at = strstr(t, "\"componentType\":5123");
+	assert_non_null(at);
+	memcpy(at, "\"componentType\":5125", 20);
+	at = strstr(t, "\"byteLength\":6}");
+	memcpy(at, "\"byteLength\":8}", 15);
+	at = strstr(t, "\"count\":3,\"type\":\"SCALAR\"");
+	at[8] = '2';
+	/* 2 indices make no triangle: no triangles in the scene */
+	expect_fail(t, "bad.gltf: no triangles in the scene", "expected a node with a mesh");
+	free(t);
+	/* a missing POSITION, named by its path */
+	expect_fail("{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0}],\"meshes\":[{\"primitives\":"
+	            "[{\"attributes\":{\"NORMAL\":0}}]}],\"accessors\":[{\"componentType\":5126,\"count\":3,"
+	            "\"type\":\"VEC3\"}]}",
+	            "bad.gltf: meshes[0].primitives[0].attributes.POSITION: no \"POSITION\"", "expected an index");
+	/* a node placed twice, and a cycle: a tree is expected */
+	t = tri_gltf(unit_tri, "\"nodes\":[{\"children\":[1,1]},{\"mesh\":0}],");
+	expect_fail(t, "bad.gltf: nodes[0]: children[1]: node 1 is already in the hierarchy", "expected a tree");
+	free(t);
+	t = tri_gltf(unit_tri, "\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"children\":[1]},{\"mesh\":0,\"children\":[0]}],");
+	expect_fail(t, "bad.gltf: nodes[1]: children[0]: node 0 is already in the hierarchy", "expected a tree");
+	free(t);
+	/* a buffer that says more than its data holds */
+	t = tri_gltf(unit_tri, "\"nodes\":[{\"mesh\":0}],");
+	at = strstr(t, "\"byteLength\":44");
+	memcpy(at, "\"byteLength\":48", 15);
+	expect_fail(t, "bad.gltf: buffers[0]: byteLength 48, the data has 44 bytes", "expected at most 44");
+	free(t);
+	/* an index out of range */
+	const float p[3][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+	t = tri_gltf(p, "\"nodes\":[{\"mesh\":0}],");
+	/* the index data is "AAABAAIAAAA=": 0 1 2 0; make the second index 7 */
+	at = strstr(t, "AAABAAIAAAA=");
+	assert_non_null(at);
+	memcpy(at, "AAAHAAIAAAA=", 12);
+	expect_fail(t, "bad.gltf: meshes[0].primitives[0].indices: index 1 of 3 is 7",
+	            "expected below 3, the POSITION count");
+	free(t);
+	/* a .glb cut short */
+	static const unsigned char glb[24] = {'g', 'l', 'T', 'F', 2, 0, 0, 0, 24, 0, 0, 0,
+	                                      0xf8, 0xff, 0xff, 0xff, 'J', 'S', 'O', 'N', '{', '}', ' ', ' '};
+	rt_error err;
+	assert_null(mesh_parse_gltf("cut.glb", NULL, (const char *)glb, sizeof glb, &err));
+	assert_non_null(strstr(err.msg, "cut.glb: byte 12: a .glb chunk of 4294967288 bytes, 4 left"));
+}
+
+/* A small file whose nodes place one mesh many times makes more triangles
+ * than its bytes: the triangles the nodes place are checked against the
+ * memory limit before any is built. 1,000 nodes naming a one-triangle mesh
+ * need about 1,000 x 200 + 3,000 x 64 = 392,000 bytes by the reader's
+ * estimate, over a limit of 300,000 (the JSON itself, about 3,100 values of
+ * 64 bytes, fits). */
+static void test_hostile_instancing(void **state)
+{
+	(void)state;
+	size_t cap = 1000 * 16 + 256;
+	char *nodes = malloc(cap);
+	assert_non_null(nodes);
+	size_t k = (size_t)snprintf(nodes, cap, "\"nodes\":[");
+	for (int i = 0; i < 1000; i++)
+		k += (size_t)snprintf(nodes + k, cap - k, "%s{\"mesh\":0}", i ? "," : "");
+	snprintf(nodes + k, cap - k, "],");
+	char *t = tri_gltf(unit_tri, "");
+	/* tri_gltf's buffer is 4096 bytes: build the file by hand around it */
+	size_t n = strlen(t) + strlen(nodes) + 1;
+	char *text = malloc(n);
+	assert_non_null(text);
+	const char *after = t + strlen("{\"asset\":{\"version\":\"2.0\"},");
+	snprintf(text, n, "{\"asset\":{\"version\":\"2.0\"},%s%s", nodes, after);
+	mem_set_limit(300000);
+	rt_error err = {0};
+	mesh *m = mesh_parse_gltf("many.gltf", NULL, text, strlen(text), &err);
+	mem_set_limit(0);
+	assert_null(m);
+	assert_non_null(strstr(err.msg, "many.gltf (1000 triangles) needs about"));
+	m = mesh_parse_gltf("many.gltf", NULL, text, strlen(text), &err);
+	if (!m)
+		fail_msg("%s", err.msg);
+	assert_int_equal(m->ntris, 1000);
+	mesh_free(m);
+	free(text);
+	free(t);
+	free(nodes);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	    cmocka_unit_test(test_trs_composition),
+	    cmocka_unit_test(test_mirroring_node_keeps_winding),
+	    cmocka_unit_test(test_material_extensions),
+	    cmocka_unit_test(test_cameras_and_lights),
+	    cmocka_unit_test(test_bad_files),
+	    cmocka_unit_test(test_hostile_instancing),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
