@@ -490,10 +490,144 @@ static void bench_preview(void)
 	scene_free(s);
 }
 
+/* --- the denoiser (issue 27) ------------------------------------------------ */
+
+/* The scenes and sizes of issue 27: the preview's sizes from 128x96 to
+ * 640x360, and 1280x720 for `save`. */
+static const char *const dn_scenes[] = {"cornell", "sky-spheres", "metal-fuzz", "final", "spot"};
+static const int dn_sizes[][2] = {{128, 96}, {160, 96}, {200, 120}, {320, 180},
+                                  {480, 270}, {640, 360}, {1280, 720}};
+/* Samples of the references: 1024 up to 320x180, 512 at 480x270 and
+ * 640x360, 256 at 1280x720 (a reference already rendered with more is
+ * used instead). A reference's own noise adds the same to every column's
+ * squared error, so it can only bring the ratios towards 1. */
+static int dn_ref_samples(int w, int h)
+{
+	long px = (long)w * h;
+	return px <= 320 * 180 ? 1024 : px <= 640 * 360 ? 512 : 256;
+}
+
+/* Pixels left out: those whose centre ray meets a lamp (an emitting
+ * object, not the sky) and their 8 neighbours, where any picture's error is
+ * the lamp's edge (radiance 8 or more next to radiance below 1). */
+static unsigned char *lamp_mask(const world *w, int fw, int fh, long *count)
+{
+	unsigned char *em = calloc((size_t)fw * fh, 1), *out = calloc((size_t)fw * fh, 1);
+	if (!em || !out)
+		die("memory", NULL);
+	for (int y = 0; y < fh; y++)
+		for (int x = 0; x < fw; x++) {
+			ray r = cam_ray(&w->cam, x + 0.5, y + 0.5, fw, fh);
+			hit h;
+			if (world_intersect(w, &r, 0.0, INFINITY, &h)) {
+				vec3 e = w->mats[h.object].emission;
+				em[y * fw + x] = e.x > 0 || e.y > 0 || e.z > 0;
+			}
+		}
+	*count = 0;
+	for (int y = 0; y < fh; y++)
+		for (int x = 0; x < fw; x++) {
+			for (int dy = -1; dy <= 1; dy++)
+				for (int dx = -1; dx <= 1; dx++) {
+					int X = x + dx, Y = y + dy;
+					if (X >= 0 && Y >= 0 && X < fw && Y < fh && em[Y * fw + X])
+						out[y * fw + x] = 1;
+				}
+			*count += out[y * fw + x];
+		}
+	free(em);
+	return out;
+}
+
+/* The RMS error of the linear radiance over the pixels off the mask. */
+static double rms_masked(const framebuffer *a, const framebuffer *ref, const unsigned char *mask)
+{
+	double s = 0;
+	long n = 0;
+	for (long i = 0; i < (long)a->w * a->h; i++) {
+		if (mask[i])
+			continue;
+		for (int c = 0; c < 3; c++) {
+			double d = (double)a->rgb[i * 3 + c] - ref->rgb[i * 3 + c];
+			s += d * d;
+		}
+		n += 3;
+	}
+	return sqrt(s / (n ? n : 1));
+}
+
+/* 8 samples denoised, 64 and 8 raw, against a reference of another seed
+ * (the same seed would share its first samples with the pictures). */
+static void bench_denoise(const char *only_scene, int only_w, int only_h)
+{
+	printf("\nthe denoiser (issue 27): RMS error of the linear radiance against a reference of another "
+	       "seed (ref: its samples), lamp pixels and their neighbours left out; all threads\n");
+	printf("%-12s %9s %5s %10s %10s %10s %8s %8s\n", "scene", "size", "ref", "8 dn", "64 raw", "8 raw",
+	       "dn/64", "dn/8");
+	int nbad = 0, nrows = 0;
+	for (size_t si = 0; si < sizeof dn_scenes / sizeof *dn_scenes; si++) {
+		if (only_scene && strcmp(only_scene, dn_scenes[si]) != 0)
+			continue;
+		char path[256];
+		snprintf(path, sizeof path, "scenes/%s.rt", dn_scenes[si]);
+		scene *s = load(path);
+		int depth = s->hints.depth >= 0 ? s->hints.depth : 5;
+		rt_error err;
+		world *w = world_build(s, &err);
+		if (!w)
+			die("world_build", &err);
+		for (size_t ri = 0; ri < sizeof dn_sizes / sizeof *dn_sizes; ri++) {
+			int W = dn_sizes[ri][0], H = dn_sizes[ri][1];
+			if (only_w > 0 && (W != only_w || H != only_h))
+				continue;
+			int nref = dn_ref_samples(W, H);
+			char rpath[300];
+			for (int more = 1024; more > nref; more /= 2) {
+				snprintf(rpath, sizeof rpath, QDIR "/dn-%s-%dx%d-%d.pfm", dn_scenes[si], W, H, more);
+				if (exists(rpath)) {
+					nref = more;
+					break;
+				}
+			}
+			snprintf(rpath, sizeof rpath, QDIR "/dn-%s-%dx%d-%d.pfm", dn_scenes[si], W, H, nref);
+			framebuffer *ref = reference(w, path_settings(W, H, nref, depth, 0, 4242), rpath);
+			long nlamp;
+			unsigned char *mask = lamp_mask(w, W, H, &nlamp);
+			double e[3];
+			static const int spp[3] = {8, 64, 8};
+			for (int k = 0; k < 3; k++) {
+				render_settings set = path_settings(W, H, spp[k], depth, 0, 1);
+				set.denoise = k == 0 ? DENOISE_ON : DENOISE_OFF;
+				double cpu;
+				framebuffer *fb = render_timed(w, &set, &cpu);
+				e[k] = rms_masked(fb, ref, mask);
+				fb_free(fb);
+			}
+			char size[32];
+			snprintf(size, sizeof size, "%dx%d", W, H);
+			bool win = e[0] < e[1];
+			nbad += !win;
+			nrows++;
+			printf("%-12s %9s %5d %10.5f %10.5f %10.5f %8.3f %8.3f%s\n", dn_scenes[si], size, nref, e[0],
+			       e[1], e[2], e[0] / e[1], e[0] / e[2], win ? "" : "  (loses to 64 raw)");
+			fflush(stdout);
+			if (tsv)
+				fprintf(tsv, "%s.rt\tdenoise-rms\t%s\t%d\t%.6f\t%.6f\t%.6f\t%ld\n", dn_scenes[si], size,
+				        nref, e[0], e[1], e[2], nlamp);
+			free(mask);
+			fb_free(ref);
+		}
+		world_free(w);
+		scene_free(s);
+	}
+	printf("8 spp denoised below 64 raw in %d of %d rows\n", nrows - nbad, nrows);
+}
+
 int main(int argc, char **argv)
 {
 	const char *only = NULL, *out = NULL, *one = NULL;
 	bool cycles = true;
+	int only_w = 0, only_h = 0;
 	for (int i = 1; i < argc; i++) {
 		if (strcmp(argv[i], "--only") == 0 && i + 1 < argc)
 			only = argv[++i];
@@ -503,9 +637,12 @@ int main(int argc, char **argv)
 			cycles = false;
 		else if (strcmp(argv[i], "--scene") == 0 && i + 1 < argc)
 			one = argv[++i];
+		else if (strcmp(argv[i], "--size") == 0 && i + 1 < argc &&
+		         sscanf(argv[i + 1], "%dx%d", &only_w, &only_h) == 2)
+			i++;
 		else {
-			fputs("usage: quality [--only cycles|preview] [--scene cornell|glass-sky|pbr] [--out FILE.tsv] "
-			      "[--no-cycles]\n",
+			fputs("usage: quality [--only cycles|preview|denoise] [--scene NAME] [--size WxH] "
+			      "[--out FILE.tsv] [--no-cycles]\n",
 			      stderr);
 			return 2;
 		}
@@ -524,6 +661,8 @@ int main(int argc, char **argv)
 	}
 	if (!only || strcmp(only, "preview") == 0)
 		bench_preview();
+	if (!only || strcmp(only, "denoise") == 0)
+		bench_denoise(one, only_w, only_h);
 	if (tsv && fclose(tsv) != 0)
 		die(out, NULL);
 	return 0;

@@ -83,10 +83,13 @@ static int batch_render(const rtsh_options *o)
 		return 1;
 	}
 	render_settings set = render_settings_default();
-	if (render_settings_apply_hints(&set, &s->hints) && !o->quiet)
+	bool clamped = render_settings_apply_hints(&set, &s->hints);
+	int cw = set.width, ch = set.height;
+	options_apply_settings(o, &set);
+	/* Said only when the clamped size is the one rendered (not -r's). */
+	if (clamped && set.width == cw && set.height == ch && !o->quiet)
 		fprintf(stderr, "%s: resolution %dx%d is too large; rendering %dx%d (use -r to choose)\n",
 		        o->scene, s->hints.width, s->hints.height, set.width, set.height);
-	options_apply_settings(o, &set);
 	world *w = world_build(s, &err);
 	scene_free(s);
 	if (!w) {

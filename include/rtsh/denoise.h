@@ -10,24 +10,29 @@
  * taken (first hits only), so that the features of an edge pixel are as
  * well antialiased as that many samples would make its colour.
  *
- * denoise_image filters the noisy radiance with the edge-avoiding a-trous
- * wavelet transform (Dammertz, Sewtz, Hanika & Lensch, "Edge-avoiding
- * A-Trous wavelet transform for fast global illumination filtering", HPG
- * 2010): five passes of a 3x3 B-spline kernel whose taps lie 1, 2, 4, 8
- * and 16 pixels apart, each tap weighted down by how much its normal,
- * albedo, depth and brightness differ from the centre's. As in SVGF (Schied
- * et al., "Spatiotemporal variance-guided filtering", HPG 2017) the
- * radiance is divided by the albedo first (textures are not blurred, only
- * the lighting), depth is compared along its own gradient (slanted planes
- * are one surface), and brightness differences are measured against a
- * per-pixel estimate of the noise that each pass carries along, so that
- * converged pixels are left alone and shadow edges stay. From the second
- * pass on, each pass fits a plane to its weighted taps (first-order
- * regression) rather than taking their mean, so that where an edge cuts
- * the taps off on one side a gradient of the lighting is not flattened.
- * Last, a pixel that is part one surface, part another is regressed on the
- * features of its 3x3 window: it gets the mix of its neighbours' filtered
- * colours that its features say.
+ * A lamp's albedo feature is its emission, far from any surface's, so that
+ * no filter mixes a lamp with what lies next to it. The job also keeps the
+ * mean radiance and squared brightness of the even-numbered samples: with
+ * those of all of them they split the samples into two independent halves.
+ *
+ * denoise_image is a feature regression after NFOR (Bitterli et al.,
+ * "Nonlinearly Weighted First-order Regression for Denoising Monte Carlo
+ * Renderings", EGSR 2016), with its colour weights left out. The radiance is divided by
+ * the albedo (textures are not blurred, only the lighting); around each
+ * pixel a first-order model of the lighting in screen position, normal and
+ * depth is fitted by least squares over 9x9 pixels, each weighted by how
+ * alike its albedo, normal and depth (off the pixel's plane) are to the
+ * pixel's, and evaluated at the pixel. No weight depends on the noise, so
+ * the fit of each half depends on that half's samples alone, and the other
+ * half's raw pixel estimates the fit's squared error without bias (NFOR's
+ * cross-buffer estimate: half a's fit against half b's pixel is off by a's
+ * error plus b's noise, whose variance the samples give). Per pixel the fit
+ * or the raw pixel is kept, whichever the estimate, averaged over 9x9
+ * pixels, says is closer: shadows and highlights the features do not see
+ * stay sharp. Last, a pixel that is part one surface, part another is
+ * regressed on the features of its 3x3 window: it gets the mix of its
+ * neighbours that its features say. With one sample there are no halves:
+ * the fit is taken.
  *
  * The result depends only on the image and its features, never on the
  * number of threads.
@@ -45,12 +50,16 @@
  *   3-5  normal x y z (the side facing the camera),
  *   6    depth (distance along the camera ray; 0 for the sky),
  *   7    the mean over all the samples of their squared brightness
- *        (denoise_sq), from which the noise of the pixel is estimated,
+ *        (denoise_radiance), from which the noise of the pixel is estimated,
  *   8    the mean squared length of the albedo, 9 of the depth (how much
- *        the features vary inside the pixel).
- * All but 7 are means over the first DENOISE_FEATURE_SAMPLES samples' camera
- * rays, or over DENOISE_EDGE_SAMPLES positions where those disagree. */
-#define DENOISE_FEATURES 10
+ *        the features vary inside the pixel),
+ *   10-12 the mean radiance of the pixel's even-numbered samples, 13 the
+ *        mean of their squared brightness: with the means over all of them
+ *        (framebuffer.rgb, 7) they split the samples into two independent
+ *        halves, each filtered with weights that the other one gives.
+ * 0-6, 8 and 9 are means over the first DENOISE_FEATURE_SAMPLES samples'
+ * camera rays, or over DENOISE_EDGE_SAMPLES positions where those disagree. */
+#define DENOISE_FEATURES 14
 /* The features are the mean of at most this many samples per pixel... */
 #define DENOISE_FEATURE_SAMPLES 8
 /* ...or of this many camera positions (first hits only, no paths) at a
@@ -65,11 +74,23 @@
  * render jobs into it record features; false when out of memory. */
 bool denoise_prepare(framebuffer *fb);
 
-/* The squared brightness (Rec. 709 luminance) of one sample's radiance. */
-static inline double denoise_sq(vec3 c)
+/* Doubles of a pixel's radiance sums over a run of its samples
+ * (denoise_radiance): the squared brightness, the even samples' radiance
+ * and squared brightness. */
+#define DENOISE_RACC 5
+
+/* Adds sample k's radiance c to ra (DENOISE_RACC doubles): its squared
+ * brightness (Rec. 709 luminance), and when k is even c and that again. */
+static inline void denoise_radiance(vec3 c, int k, double *ra)
 {
 	double l = 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
-	return l * l;
+	ra[0] += l * l;
+	if (!(k & 1)) {
+		ra[1] += c.x;
+		ra[2] += c.y;
+		ra[3] += c.z;
+		ra[4] += l * l;
+	}
 }
 
 /* Adds to acc (DENOISE_ACC doubles, laid out like the features) what the
@@ -78,12 +99,12 @@ void denoise_sample(const world *w, ray r, double *acc);
 
 /* Updates the features f of pixel (px, py) of an fw x fh image (those of
  * samples [0, begin)) with samples [begin, end): acc holds denoise_sample's
- * sums over those of them below DENOISE_FEATURE_SAMPLES, sq the sum of
- * denoise_sq over all of them. Render jobs call it per pixel; when the
+ * sums over those of them below DENOISE_FEATURE_SAMPLES, ra the sums of
+ * denoise_radiance over all of them. Render jobs call it per pixel; when the
  * pixel reaches DENOISE_FEATURE_SAMPLES and its features vary, the edge
  * positions are added (render_sample_ray with s). */
 void denoise_features(const world *w, const render_settings *s, int px, int py, int fw, int fh,
-                      int begin, int end, double sq, const double *acc, float *f);
+                      int begin, int end, const double *ra, const double *acc, float *f);
 
 /* Writes the denoised radiance of fb (which has features and samples) to
  * out, w*h*3 linear floats; out may be fb->rgb. threads: the workers to use

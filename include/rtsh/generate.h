@@ -2,6 +2,7 @@
 #ifndef RTSH_GENERATE_H
 #define RTSH_GENERATE_H
 
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -11,6 +12,7 @@
 
 typedef struct gen_opts {
 	bool spheres_only; /* only spheres, all inside one fixed region (benchmarks) */
+	const atomic_bool *cancel; /* when set, generating stops: NULL, err "stopped" */
 } gen_opts;
 
 /* A new scene of n random objects (n >= 1) with 2-4 coloured lights, an

@@ -21,6 +21,7 @@ typedef enum image_format {
 	IMAGE_PPM,
 	IMAGE_PFM,
 	IMAGE_PNG,
+	IMAGE_JPEG,
 } image_format;
 
 /* By the path's extension (case-insensitive). */

@@ -16,6 +16,7 @@
 #ifndef RTSH_MESH_H
 #define RTSH_MESH_H
 
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -116,6 +117,7 @@ typedef struct mesh {
 	                      splits put one triangle in several leaves */
 	float eps;         /* self-hit guard in object units */
 	size_t refs;       /* users in the cache (mesh_cache_get) */
+	char *warning;     /* the reader's first warning ("FILE:LINE: ..."), NULL: none (owned) */
 } mesh;
 
 /* --- loading --- */
@@ -149,6 +151,9 @@ void mesh_format_list(char *buf, size_t size);
  * than crease_deg degrees. False (err set) when out of memory, or when its
  * estimate (MESH_PREPARE_BYTES a triangle) exceeds the memory limit. */
 bool mesh_prepare(mesh *m, bool smooth, double crease_deg, rt_error *err);
+/* mesh_prepare that stops, false with err "stopped", soon after *cancel is
+ * set (NULL: never): Ctrl-C in the shell. */
+bool mesh_prepare_cancel(mesh *m, bool smooth, double crease_deg, const atomic_bool *cancel, rt_error *err);
 void mesh_free(mesh *m);
 /* Bytes held by a prepared mesh (benchmark: bytes per triangle). */
 size_t mesh_memory(const mesh *m);
@@ -156,7 +161,7 @@ size_t mesh_memory(const mesh *m);
 /* A prepared mesh shared by every user of the same file, normals options
  * and file version (size and mtime): loaded once. mesh_cache_put releases
  * one reference. Thread-safe. */
-mesh *mesh_cache_get(const char *path, bool smooth, double crease_deg, rt_error *err);
+mesh *mesh_cache_get(const char *path, bool smooth, double crease_deg, const atomic_bool *cancel, rt_error *err);
 void mesh_cache_put(mesh *m);
 
 /* --- the builder the readers share --- */
@@ -174,6 +179,7 @@ typedef struct mesh_builder {
 	uint16_t cur_mat;
 	size_t bytes;      /* what the arrays above hold */
 	bool over;         /* a growth was refused by the memory limit */
+	char *warning;     /* the first warning, handed to the mesh (owned) */
 	rt_error limit;    /* ... and how (memory.h) */
 } mesh_builder;
 
@@ -255,8 +261,9 @@ bool mesh_isa_force(mesh_isa isa);
 bool mesh_intersect_scalar(const mesh *m, const mesh_ray *r, float tmin, float *tmax, uint32_t *tri, float b[3]);
 bool mesh_occluded_scalar(const mesh *m, const mesh_ray *r, float tmin, float tmax);
 /* Builds the tree and its blocks from p and tri (mesh_prepare calls it).
- * False (err set) when out of memory or the mesh is too large. */
-bool mesh_build_tree(mesh *m, rt_error *err);
+ * False (err set) when out of memory or the mesh is too large, or
+ * "stopped" when *cancel (NULL: never) was set. */
+bool mesh_build_tree(mesh *m, const atomic_bool *cancel, rt_error *err);
 /* The same without the tree, on a mesh not prepared (positions and
  * triangles as read; *tri an index in tri): the tests' reference. */
 bool mesh_intersect_brute(const mesh *m, const mesh_ray *r, float tmin, float *tmax, uint32_t *tri, float b[3]);

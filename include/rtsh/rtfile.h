@@ -12,6 +12,7 @@
 #ifndef RTSH_RTFILE_H
 #define RTSH_RTFILE_H
 
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -31,6 +32,10 @@ typedef struct rt_load_opts {
 	 * them from memory on the other ranks. */
 	rt_read_fn read;
 	void *read_ctx;
+	/* Optional: when set (Ctrl-C in the shell), the load stops soon after,
+	 * with the error "stopped", at the next line or in a model's normals or
+	 * tree (a model's or an image's decoder runs to its end first). */
+	const atomic_bool *cancel;
 } rt_load_opts;
 
 /* Reads a file the way the loader does: through opts->read when set, else
@@ -48,6 +53,10 @@ scene *rt_load_file(const char *path, const rt_load_opts *opts, rt_error *err);
  * the model on a ground plane, framed by the camera, with a light and a
  * sky (viewer.c). rt_load_file calls it for those extensions. */
 scene *rt_load_model(const char *path, const rt_load_opts *opts, rt_error *err);
+/* The text of that scene (.rt lines naming the model by its file name,
+ * relative to its folder), in a new buffer of *len bytes and a NUL; NULL
+ * (err set) when the model cannot be read. `save x.rt` keeps it. */
+char *rt_model_text(const char *path, const rt_load_opts *opts, size_t *len, rt_error *err);
 /* Loads a scene from memory (text need not be NUL-terminated); `name` is the
  * file name used in messages. */
 scene *rt_load_string(const char *text, size_t len, const char *name, const rt_load_opts *opts,

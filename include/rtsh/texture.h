@@ -14,6 +14,7 @@
 #ifndef RTSH_TEXTURE_H
 #define RTSH_TEXTURE_H
 
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stddef.h>
 
@@ -53,7 +54,7 @@ texture *texture_load(const char *path, bool srgb, rt_error *err);
 void texture_free(texture *t);
 
 /* Loaded once per (path, srgb, file version); thread-safe. */
-texture *texture_cache_get(const char *path, bool srgb, rt_error *err);
+texture *texture_cache_get(const char *path, bool srgb, const atomic_bool *cancel, rt_error *err);
 void texture_cache_put(texture *t);
 
 /* The filtered colour at (u, v); `width` is the footprint in u units (0:

@@ -179,6 +179,7 @@ typedef struct world {
 	box bounds;      /* of the bounded primitives */
 	double eps;      /* self-intersection offset scale for this scene */
 	atomic_long refs; /* references (world_retain / world_release) */
+	const atomic_bool *cancel; /* while world_build runs: its flag (NULL: none) */
 } world;
 
 /* A ray-surface hit in world space. */
@@ -199,6 +200,10 @@ typedef struct hit {
  * memory or an object cannot be placed. The scene is not referenced after.
  * The caller holds the one reference. */
 world *world_build(const scene *s, rt_error *err);
+/* world_build that stops, NULL with err "stopped", soon after *cancel is set
+ * (NULL: never): between objects, in a model's normals and tree, in the
+ * BVH (Ctrl-C in the shell). */
+world *world_build_cancel(const scene *s, const atomic_bool *cancel, rt_error *err);
 /* Worlds are reference-counted, so that no thread renders from a world
  * another may free: whoever keeps a world beyond a call (a render thread, a
  * cache, key mode) holds a reference. world_retain takes one more and

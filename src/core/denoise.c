@@ -1,4 +1,4 @@
-/* rtsh — the first-hit features and the edge-avoiding a-trous denoiser
+/* rtsh — the first-hit features and the feature-regression denoiser
  * (denoise.h). */
 #include "rtsh/denoise.h"
 
@@ -49,11 +49,18 @@ static void first_surface(const world *w, ray r, double f[7])
 		vec3 a, tt = v3(0, 0, 0), dir = v3(0, 0, 0);
 		int follow = bsdf_features(&b, &a, &tt, &dir);
 		if (follow == 0 || k == 3 || m->emission.x + m->emission.y + m->emission.z > 0.0) {
-			a = v3_add(a, m->emission); /* a lamp is white */
-			a = v3_mul(a, tint);
-			f[0] += clamp01(a.x);
-			f[1] += clamp01(a.y);
-			f[2] += clamp01(a.z);
+			vec3 e = m->emission;
+			if (e.x + e.y + e.z > 0.0) {
+				/* A lamp's "albedo" is its emission, unclamped: far from any
+				 * surface's, so that no filter mixes the two. */
+				a = v3_mul(v3_add(v3_scale(a, 0.0), e), tint);
+			} else {
+				a = v3_mul(a, tint);
+				a = v3(clamp01(a.x), clamp01(a.y), clamp01(a.z));
+			}
+			f[0] += a.x;
+			f[1] += a.y;
+			f[2] += a.z;
 			f[3] += b.n.x;
 			f[4] += b.n.y;
 			f[5] += b.n.z;
@@ -100,14 +107,21 @@ static bool features_vary(const float *f)
 }
 
 void denoise_features(const world *w, const render_settings *s, int px, int py, int fw, int fh,
-                      int begin, int end, double sq, const double *acc, float *f)
+                      int begin, int end, const double *ra, const double *acc, float *f)
 {
-	f[7] = (float)(((double)f[7] * begin + sq) / end);
+	f[7] = (float)(((double)f[7] * begin + ra[0]) / end);
+	/* the even samples: (begin + 1) / 2 of them before, (end + 1) / 2 after */
+	int e0 = (begin + 1) / 2, e1 = (end + 1) / 2;
+	if (e1 > e0)
+		for (int k = 0; k < 3; k++)
+			f[10 + k] = (float)(((double)f[10 + k] * e0 + ra[1 + k]) / e1);
+	if (e1 > e0)
+		f[13] = (float)(((double)f[13] * e0 + ra[4]) / e1);
 	int n0 = begin < DENOISE_FEATURE_SAMPLES ? begin : DENOISE_FEATURE_SAMPLES;
 	int n1 = end < DENOISE_FEATURE_SAMPLES ? end : DENOISE_FEATURE_SAMPLES;
 	if (n1 <= n0)
 		return;
-	for (int k = 0; k < DENOISE_FEATURES; k++)
+	for (int k = 0; k < DENOISE_ACC; k++)
 		if (k != 7)
 			f[k] = (float)(((double)f[k] * n0 + acc[k]) / n1);
 	if (n1 < DENOISE_FEATURE_SAMPLES || !features_vary(f))
@@ -124,57 +138,75 @@ void denoise_features(const world *w, const render_settings *s, int px, int py, 
 		sum[8] += one[0] * one[0] + one[1] * one[1] + one[2] * one[2];
 		sum[9] += one[6] * one[6];
 	}
-	for (int k = 0; k < DENOISE_FEATURES; k++)
+	for (int k = 0; k < DENOISE_ACC; k++)
 		if (k != 7)
 			f[k] = (float)(sum[k] / DENOISE_EDGE_SAMPLES);
 }
 
 /* --- the filter ------------------------------------------------------------ */
 
-/* The constants were tuned at 160x90, 8 samples, against 4096-sample
- * references of scenes/cornell.rt (tests/unit/test_denoise.c),
- * sky-spheres.rt, final.rt and metal-fuzz.rt, three seeds each. */
-#define LEVELS 5
-/* Edge-stopping strengths: brightness in standard deviations of its noise
- * (SVGF's sigma_l) on the first pass, narrowed on each later pass (Dammertz
- * et al. halve it); normals and albedo as squared distances; depth as the
- * distance off the plane that the pixel's depth and gradient predict, in
- * shares of its depth. */
-#define SIGMA_L 8.0f
-#define SIGMA_L_DECAY 0.6f
-#define SIGMA_N2 0.08f
+/* The constants were chosen at 128x96 and 200x120, 8 samples, against
+ * 1024-sample references of scenes/cornell.rt, sky-spheres.rt,
+ * metal-fuzz.rt and final.rt (bench/quality.c, `--only denoise`).
+ *
+ * Feature distances: albedo and normals as squared distances over these,
+ * depth as the distance off the plane that the pixel's depth and gradient
+ * predict, in shares of its depth. */
 #define SIGMA_A2 0.01f
+#define SIGMA_N2 0.08f
 #define SIGMA_Z 0.02f
-/* Fireflies: a pixel brighter than its same-surface 3x3 neighbours' mean by
- * more than this many of their standard deviations is brought down to it. */
-#define FIREFLY_K 4.0f
+/* The regression's window: radius 4 (9x9 pixels). */
+#define WIN 4
+#define TAPS ((2 * WIN + 1) * (2 * WIN + 1))
+/* Its unknowns: a constant, the slopes along x and y, along the normal's
+ * three components and along the depth. */
+#define NU 7
+/* The slopes are held back by a ridge of this share of the weights. */
+#define RIDGE 1e-3f
+/* The candidates' errors are averaged over (2 PICK_R + 1)^2 pixels. */
+#define PICK_R 4
+/* A mixed pixel's regression may move it by at most this many standard
+ * deviations of its noise. */
+#define MIX_K 3.0f
+#define MIX_R 1     /* the mixed pixels' window: (2 MIX_R + 1)^2 pixels */
+#define MIX_NU 8    /* its unknowns: a constant and 7 feature slopes */
 
-/* What every tap reads (32 bytes: two to a cache line)... */
+/* What every regression tap reads of a pixel. */
 typedef struct guide {
 	float f[6];   /* albedo / sqrt(SIGMA_A2), normal / sqrt(SIGMA_N2) */
 	float z;      /* depth */
-	float unused;
+	float gx, gy; /* the depth's gradient per pixel */
 } guide;
 
-/* ...and what only the pixel itself does. */
-typedef struct pixel_info {
-	float gx, gy; /* the depth's gradient per pixel */
-	float am[3];  /* the albedo the radiance was divided by */
-	bool mixed;   /* its features vary inside the pixel (features_vary) */
-} pixel_info;
-
-/* Radiance over albedo, and its estimated noise variance. */
-typedef struct texel {
+/* A pixel's value in one chain: radiance over albedo, and the variance of
+ * one sample's brightness (over albedo squared). */
+typedef struct chan {
 	float c[3];
-	float var;
+	float v;
+} chan;
+
+/* The chains: the even-numbered samples (half a), the odd ones (half b),
+ * and all of them. */
+enum { CH_A, CH_B, CH_ALL, NCH };
+typedef struct texel {
+	chan h[NCH];
 } texel;
+
+/* The candidates for a pixel: itself, and the regression. */
+enum { CAND_RAW, CAND_FIT, NCAND };
 
 typedef struct job {
 	const framebuffer *fb;
 	guide *g;
-	pixel_info *px;
-	texel *buf[2];
+	float *am;              /* 3 a pixel: the albedo the radiance is divided by */
+	bool *mixed;            /* the pixel's features vary inside it */
+	texel *t;               /* the chains; CH_ALL later holds the result */
+	float *data;            /* 8 a pixel: what the regression fits (regression_rows) */
+	float *fit;             /* 3 a pixel: the regression's value */
+	float *err;             /* NCAND a pixel: their estimated squared errors */
 	float *out;
+	float n[NCH];           /* samples in each chain */
+	bool halves;            /* at least two samples: two independent halves */
 	int threads;            /* workers sharing the rows, this thread included */
 	pthread_barrier_t bar;  /* between the passes */
 	pthread_mutex_t lock;
@@ -208,7 +240,7 @@ static float depth_slope(const float *z, int x, int w, int stride)
 	return isfinite(g) ? g : 0.0f;
 }
 
-/* Features, demodulated radiance and its variance for rows [y0, y1). */
+/* Features and the chains (radiance over albedo) for rows [y0, y1). */
 static void setup_rows(job *j, int y0, int y1)
 {
 	const framebuffer *fb = j->fb;
@@ -218,277 +250,103 @@ static void setup_rows(job *j, int y0, int y1)
 			size_t i = (size_t)y * w + x;
 			const float *f = fb->feat + i * DENOISE_FEATURES;
 			guide *g = &j->g[i];
-			pixel_info *p = &j->px[i];
+			float *am = j->am + i * 3;
 			for (int k = 0; k < 3; k++) {
 				g->f[k] = f[k] * (1.0f / sqrtf(SIGMA_A2));
 				g->f[3 + k] = f[3 + k] * (1.0f / sqrtf(SIGMA_N2));
-				p->am[k] = (float)albedo_divisor(f[k]);
+				am[k] = (float)albedo_divisor(f[k]);
 			}
 			g->z = f[6];
-			g->unused = 0;
-			p->mixed = features_vary(f);
-			p->gx = depth_slope(f + 6, x, w, DENOISE_FEATURES);
-			p->gy = depth_slope(f + 6, y, h, DENOISE_FEATURES * w);
-			texel *t = &j->buf[0][i];
+			g->gx = depth_slope(f + 6, x, w, DENOISE_FEATURES);
+			g->gy = depth_slope(f + 6, y, h, DENOISE_FEATURES * w);
+			j->mixed[i] = features_vary(f);
+			texel *t = &j->t[i];
 			for (int k = 0; k < 3; k++) {
-				float c = fb->rgb[i * 3 + k];
-				t->c[k] = isfinite(c) ? c / p->am[k] : 0.0f;
+				float c = fb->rgb[i * 3 + k], a = c, b = c;
+				if (j->halves) {
+					a = f[10 + k];
+					b = (c * j->n[CH_ALL] - a * j->n[CH_A]) / j->n[CH_B];
+				}
+				t->h[CH_A].c[k] = isfinite(a) ? a / am[k] : 0.0f;
+				t->h[CH_B].c[k] = isfinite(b) ? b / am[k] : 0.0f;
+				t->h[CH_ALL].c[k] = isfinite(c) ? c / am[k] : 0.0f;
 			}
+			/* all the samples' colour and each half's brightness */
+			float *d = j->data + i * 8;
+			d[0] = t->h[CH_ALL].c[0];
+			d[1] = t->h[CH_ALL].c[1];
+			d[2] = t->h[CH_ALL].c[2];
+			d[3] = lum(t->h[CH_A].c);
+			d[4] = lum(t->h[CH_B].c);
+			d[5] = d[6] = d[7] = 0.0f;
 		}
 }
 
-/* The brightness of the 3x3 neighbours of (x, y) in src that lie on the
- * same surface: those whose features k0..5 are within a squared distance
- * of 4 of the pixel's own (k0 = 3: the normals alone; 0: all of them).
- * Sums the brightness and its square into s1 and s2 and counts them in n;
- * the pixel itself counts when with_self. */
-static void neighbours(const job *j, const texel *src, int x, int y, int k0, bool with_self,
-                       float *s1, float *s2, float *n)
-{
-	int w = j->fb->w, h = j->fb->h;
-	const guide *gp = &j->g[(size_t)y * w + x];
-	*s1 = *s2 = *n = 0;
-	for (int dy = -1; dy <= 1; dy++) {
-		int qy = y + dy;
-		if (qy < 0 || qy >= h)
-			continue;
-		for (int dx = -1; dx <= 1; dx++) {
-			int qx = x + dx;
-			if (qx < 0 || qx >= w || (!with_self && dx == 0 && dy == 0))
-				continue;
-			size_t q = (size_t)qy * w + qx;
-			const guide *gq = &j->g[q];
-			float d = 0; /* the features' squared distance, scaled */
-			for (int k = k0; k < 6; k++)
-				d += (gp->f[k] - gq->f[k]) * (gp->f[k] - gq->f[k]);
-			if (d > 4.0f)
-				continue;
-			float l = lum(src[q].c);
-			*s1 += l;
-			*s2 += l * l;
-			*n += 1;
-		}
-	}
-}
-
-/* The noise variance of each pixel's brightness: from its own samples
- * (the mean of their squares), or with a single sample the variance over
- * its 3x3 neighbours on the same surface (a spatial estimate, as SVGF's
- * when a pixel has no history). */
+/* The noise variance of one sample's brightness in each chain: from the
+ * chain's own samples (with two or more in each half; else the pixel's,
+ * pooled), or with a single sample the variance over the pixel's 3x3
+ * neighbours on the same surface (a spatial estimate, as SVGF's when a
+ * pixel has no history). */
 static void variance_rows(job *j, int y0, int y1)
 {
-	const framebuffer *fb = j->fb;
-	int w = fb->w;
-	texel *t = j->buf[1];
-	for (int y = y0; y < y1; y++)
-		for (int x = 0; x < w; x++) {
-			size_t i = (size_t)y * w + x;
-			if (fb->spp >= 2) {
-				/* The variance of the pixel's mean, from its own samples,
-				 * over the albedo squared like its radiance. */
-				float m1 = lum(fb->rgb + i * 3), m2 = fb->feat[i * DENOISE_FEATURES + 7];
-				float am = lum(j->px[i].am);
-				float v = (m2 - m1 * m1) / (float)(fb->spp - 1) / (am * am);
-				t[i].var = v > 0 ? v : 0;
-				continue;
-			}
-			float s1, s2, n;
-			neighbours(j, t, x, y, 3, true, &s1, &s2, &n);
-			float mean = s1 / n, var = s2 / n - mean * mean;
-			/* n samples estimate it with n - 1 degrees of freedom */
-			t[i].var = n > 1 ? (var > 0 ? var : 0) * n / (n - 1) : 0.0f;
-		}
-}
-
-/* Fireflies brought down (FIREFLY_K), src to dst. */
-static void clamp_rows(job *j, const texel *src, texel *dst, int y0, int y1)
-{
-	int w = j->fb->w;
-	for (int y = y0; y < y1; y++)
-		for (int x = 0; x < w; x++) {
-			size_t i = (size_t)y * w + x;
-			float s1, s2, n;
-			neighbours(j, src, x, y, 0, false, &s1, &s2, &n);
-			dst[i] = src[i];
-			if (n < 3)
-				continue;
-			float mean = s1 / n, var = s2 / n - mean * mean;
-			float limit = mean + FIREFLY_K * sqrtf(var > 0 ? var : 0);
-			float l = lum(src[i].c);
-			if (l > limit && l > 0) {
-				float k = limit / l;
-				dst[i].c[0] *= k;
-				dst[i].c[1] *= k;
-				dst[i].c[2] *= k;
-			}
-		}
-}
-
-/* The 3x3 B-spline kernel (1 2 1)/4 in each direction. Dammertz et al. and
- * SVGF use the 5x5 one (1 4 6 4 1)/16; on cornell.rt at 160x90 the 3x3 one
- * with 5 passes (taps up to 31 pixels away) gave the same error within 1%
- * in 40% of the time. */
-#define KR 1
-/* The first-order fit's slopes are held back by a ridge of this share of
- * the weights (a plane through few taps would otherwise swing widely). */
-#define LWR_RIDGE 0.15f
-/* The first pass (taps next to each other) keeps the weighted mean: a
- * plane through adjacent noisy pixels follows their noise. */
-#define LWR_STEP 2
-static const float kernel2[2 * KR + 1][2 * KR + 1] = {
-	{1.0f / 16, 1.0f / 8, 1.0f / 16}, {1.0f / 8, 1.0f / 4, 1.0f / 8}, {1.0f / 16, 1.0f / 8, 1.0f / 16}};
-
-/* One a-trous pass with taps `step` pixels apart, rows [y0, y1) from src to
- * dst. */
-static void atrous_rows(job *j, const texel *src, texel *dst, int step, int y0, int y1)
-{
-	float sigma_l = SIGMA_L;
-	for (int s = 1; s < step; s *= 2)
-		sigma_l *= SIGMA_L_DECAY;
 	const framebuffer *fb = j->fb;
 	int w = fb->w, h = fb->h;
 	for (int y = y0; y < y1; y++)
 		for (int x = 0; x < w; x++) {
 			size_t i = (size_t)y * w + x;
-			const guide *gp = &j->g[i];
-			const texel *tp = &src[i];
-			/* the variance, smoothed by a 3x3 Gaussian (SVGF) */
-			float gv = 0, gw = 0;
-			if (x > 0 && x < w - 1 && y > 0 && y < h - 1) {
-				const texel *a = tp - w, *c = tp + w;
-				gv = 0.0625f * (a[-1].var + a[1].var + c[-1].var + c[1].var) +
-				     0.125f * (a[0].var + c[0].var + tp[-1].var + tp[1].var) + 0.25f * tp->var;
-				gw = 1.0f;
-			} else {
-				for (int dy = -1; dy <= 1; dy++)
-					for (int dx = -1; dx <= 1; dx++) {
-						int qx = x + dx, qy = y + dy;
-						if (qx < 0 || qx >= w || qy < 0 || qy >= h)
-							continue;
-						float k = (dx ? 0.25f : 0.5f) * (dy ? 0.25f : 0.5f);
-						gv += k * src[(size_t)qy * w + qx].var;
-						gw += k;
-					}
-			}
-			if (gv <= 0.0f) {
-				/* no noise around: nothing to filter */
-				dst[i] = *tp;
+			const float *f = fb->feat + i * DENOISE_FEATURES;
+			float am = lum(j->am + i * 3), am2 = am * am;
+			chan *hc = j->t[i].h;
+			if (fb->spp >= 2) {
+				float n = j->n[CH_ALL], m1 = lum(hc[CH_ALL].c) * am;
+				float v = (f[7] - m1 * m1) * n / (n - 1) / am2;
+				hc[CH_ALL].v = hc[CH_A].v = hc[CH_B].v = v > 0 ? v : 0;
+				if (fb->spp >= 4) {
+					float na = j->n[CH_A], nb = j->n[CH_B];
+					float ma = lum(hc[CH_A].c) * am, mb = lum(hc[CH_B].c) * am;
+					float qa = f[13], qb = (f[7] * n - f[13] * na) / nb;
+					float va = (qa - ma * ma) * na / (na - 1) / am2;
+					float vb = (qb - mb * mb) * nb / (nb - 1) / am2;
+					hc[CH_A].v = va > 0 ? va : 0;
+					hc[CH_B].v = vb > 0 ? vb : 0;
+				}
 				continue;
 			}
-			float lp = lum(tp->c);
-			float inv_l = 1.0f / (sigma_l * sqrtf(gv / gw) + 1e-6f);
-			/* Depth: how far the tap lies off the plane through this pixel
-			 * along its depth gradient, against a share of the depth. */
-			float inv_z = 1.0f / (SIGMA_Z * gp->z + 1e-6f);
-			float gxs = j->px[i].gx * (float)step, gys = j->px[i].gy * (float)step;
-			int lo = -KR, hi = KR;
-			while (x + lo * step < 0)
-				lo++;
-			while (x + hi * step >= w)
-				hi--;
-			/* the taps: weight, offset (in steps) and texel; and the
-			 * weights' moments for the first-order fit */
-			float tw[9];
-			int tx[9], ty[9];
-			const texel *tt[9];
-			tw[0] = kernel2[KR][KR];
-			tx[0] = ty[0] = 0;
-			tt[0] = tp;
-			int nt = 1;
-			float s0 = tw[0], sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
-			for (int dy = -KR; dy <= KR; dy++) {
-				int qy = y + dy * step;
-				if (qy < 0 || qy >= h)
-					continue;
-				const guide *gr = &j->g[(size_t)qy * w + x];
-				const texel *tr = &src[(size_t)qy * w + x];
-				float zrow = gp->z + gys * (float)dy;
-				for (int dx = lo; dx <= hi; dx++) {
-					if (dx == 0 && dy == 0)
+			const guide *gp = &j->g[i];
+			float s1 = 0, s2 = 0, n = 0;
+			for (int dy = -1; dy <= 1; dy++)
+				for (int dx = -1; dx <= 1; dx++) {
+					int qx = x + dx, qy = y + dy;
+					if (qx < 0 || qx >= w || qy < 0 || qy >= h)
 						continue;
-					const guide *gq = gr + dx * step;
-					const texel *tq = tr + dx * step;
-					float e = 0;
-					for (int k = 0; k < 6; k++)
-						e += (gp->f[k] - gq->f[k]) * (gp->f[k] - gq->f[k]);
-					e += fabsf(gq->z - (zrow + gxs * (float)dx)) * inv_z;
-					e += fabsf(lp - lum(tq->c)) * inv_l;
-					float wt = kernel2[dy + KR][dx + KR] * exp_fast(e);
-					tw[nt] = wt;
-					tx[nt] = dx;
-					ty[nt] = dy;
-					tt[nt] = tq;
-					nt++;
-					/* offsets are -1, 0 or 1: their squares are 0 or 1 */
-					s0 += wt;
-					sx += (float)dx * wt;
-					sy += (float)dy * wt;
-					sxx += dx ? wt : 0.0f;
-					syy += dy ? wt : 0.0f;
-					sxy += (float)(dx * dy) * wt;
+					size_t q = (size_t)qy * w + qx;
+					float d = 0; /* the normals' squared distance, scaled */
+					for (int k = 3; k < 6; k++)
+						d += (gp->f[k] - j->g[q].f[k]) * (gp->f[k] - j->g[q].f[k]);
+					if (d > 4.0f)
+						continue;
+					float l = lum(j->t[q].h[CH_ALL].c);
+					s1 += l;
+					s2 += l * l;
+					n += 1;
 				}
-			}
-			/* Zero order: the weighted mean. First order (a plane through
-			 * the taps, least squares, its value at the centre): the same
-			 * where the weights are symmetric, unbiased on a slope where an
-			 * edge cuts them off on one side. */
-			float ca = 1.0f / s0, cb = 0, cc = 0;
-			if (step >= LWR_STEP) {
-				float ridge = LWR_RIDGE * s0;
-				sxx += ridge;
-				syy += ridge;
-				float c00 = sxx * syy - sxy * sxy, c01 = sxy * sy - sx * syy, c02 = sx * sxy - sxx * sy;
-				float det = s0 * c00 + sx * c01 + sy * c02;
-				if (det > 1e-6f * s0 * s0 * s0) {
-					ca = c00 / det;
-					cb = c01 / det;
-					cc = c02 / det;
-				}
-			}
-			/* the result: sum l_t c_t with l_t = w_t (ca + cb x_t + cc y_t),
-			 * its variance sum l_t^2 var_t */
-			float sum[3] = {0, 0, 0}, vsum = 0;
-			for (int t = 0; t < nt; t++) {
-				float l = tw[t] * (ca + cb * (float)tx[t] + cc * (float)ty[t]);
-				sum[0] += l * tt[t]->c[0];
-				sum[1] += l * tt[t]->c[1];
-				sum[2] += l * tt[t]->c[2];
-				vsum += l * l * tt[t]->var;
-			}
-			texel *o = &dst[i];
-			o->c[0] = sum[0] > 0 ? sum[0] : 0;
-			o->c[1] = sum[1] > 0 ? sum[1] : 0;
-			o->c[2] = sum[2] > 0 ? sum[2] : 0;
-			o->var = vsum;
+			float mean = s1 / n, var = s2 / n - mean * mean;
+			/* n samples estimate it with n - 1 degrees of freedom */
+			hc[CH_ALL].v = hc[CH_A].v = hc[CH_B].v = n > 1 ? (var > 0 ? var : 0) * n / (n - 1) : 0.0f;
 		}
 }
 
-/* The filtered lighting times the albedo again, into dst (radiance and
- * the variance of its brightness). */
-static void finish_rows(job *j, const texel *src, texel *dst, int y0, int y1)
-{
-	int w = j->fb->w;
-	for (int y = y0; y < y1; y++)
-		for (int x = 0; x < w; x++) {
-			size_t i = (size_t)y * w + x;
-			for (int k = 0; k < 3; k++)
-				dst[i].c[k] = src[i].c[k] * j->px[i].am[k];
-			float am = lum(j->px[i].am);
-			dst[i].var = src[i].var * am * am;
-		}
-}
+/* Right-hand sides of the regressions: red, green, blue of all the
+ * samples, and the brightness of each half. */
+#define NRHS 5
 
-/* The regression may move a pixel by at most this many standard
- * deviations of its remaining noise. */
-#define REG_K 1.0f
-#define RR 1        /* the regression's window: (2 RR + 1)^2 pixels */
-#define NR 8        /* its unknowns: a constant and 7 feature slopes */
-
-/* Cholesky solve of the NR x NR system a x = b (a positive definite; a is
- * overwritten). False when it is not. */
-static bool solve(float a[NR][NR], float b[NR][3], float x[NR][3])
+/* Cholesky solve of the n x n system a x = b with m right-hand sides (a
+ * positive definite and overwritten; only its lower triangle is read).
+ * False when it is not. */
+static bool solve(int n, float a[][MIX_NU], int m, float b[][NRHS], float x[][NRHS])
 {
-	for (int c = 0; c < NR; c++) {
+	float inv[MIX_NU]; /* 1 / the factor's diagonal */
+	for (int c = 0; c < n; c++) {
 		float d = a[c][c];
 		for (int k = 0; k < c; k++)
 			d -= a[c][k] * a[c][k];
@@ -496,124 +354,283 @@ static bool solve(float a[NR][NR], float b[NR][3], float x[NR][3])
 			return false;
 		d = sqrtf(d);
 		a[c][c] = d;
-		for (int r = c + 1; r < NR; r++) {
+		inv[c] = 1.0f / d;
+		for (int r = c + 1; r < n; r++) {
 			float v = a[r][c];
 			for (int k = 0; k < c; k++)
 				v -= a[r][k] * a[c][k];
-			a[r][c] = v / d;
+			a[r][c] = v * inv[c];
 		}
 	}
-	for (int ch = 0; ch < 3; ch++) {
-		float z[NR];
-		for (int r = 0; r < NR; r++) {
+	for (int ch = 0; ch < m; ch++) {
+		float z[MIX_NU];
+		for (int r = 0; r < n; r++) {
 			float v = b[r][ch];
 			for (int k = 0; k < r; k++)
 				v -= a[r][k] * z[k];
-			z[r] = v / a[r][r];
+			z[r] = v * inv[r];
 		}
-		for (int r = NR - 1; r >= 0; r--) {
+		for (int r = n - 1; r >= 0; r--) {
 			float v = z[r];
-			for (int k = r + 1; k < NR; k++)
+			for (int k = r + 1; k < n; k++)
 				v -= a[k][r] * x[k][ch];
-			x[r][ch] = v / a[r][r];
+			x[r][ch] = v * inv[r];
 		}
 	}
 	return true;
 }
 
+/* The error of a candidate whose halves came out at brightness la and lb,
+ * from the halves (NFOR's cross-buffer estimate): half a's value against
+ * half b's raw one is off by a's error and by b's noise, whose variance is
+ * known, and so with b against a; less that noise, and less half the
+ * halves' own noise (their difference squared over 4), since the whole has
+ * half their variance. Unbiased for any candidate whose half a depends on
+ * half a's samples only, and b on b's. */
+static float cross_error(const chan *r, float na, float nb, float la, float lb)
+{
+	float da = la - lum(r[CH_B].c), db = lb - lum(r[CH_A].c);
+	return 0.5f * (da * da + db * db) - 0.5f * (r[CH_B].v / nb + r[CH_A].v / na) -
+	       0.25f * (la - lb) * (la - lb);
+}
+
+/* Four floats in one SIMD register (a GCC and Clang extension), for the
+ * regression's sums. */
+typedef float v4 __attribute__((vector_size(16)));
+
+static inline v4 v4_splat(float x)
+{
+	return (v4){x, x, x, x};
+}
+
+static inline v4 v4_load(const float *p)
+{
+	v4 v;
+	memcpy(&v, p, sizeof v);
+	return v;
+}
+
+/* Weighted first-order regression (NFOR, Bitterli et al. 2016, without its
+ * colour weights) of the radiance over albedo on the screen position, the
+ * normal and the depth, over the window around each pixel of rows
+ * [y0, y1), evaluated at the pixel. The taps are weighted by how alike
+ * their features are (albedo, normal, depth off the pixel's plane) and by
+ * nothing else: no weight depends on the noise, so the fit of each half's
+ * brightness depends on that half's samples only, and cross_error
+ * estimates the fit's error honestly. */
+static void regression_rows(job *j, int y0, int y1)
+{
+	int w = j->fb->w, h = j->fb->h;
+	float na = j->n[CH_A], nb = j->n[CH_B];
+	for (int y = y0; y < y1; y++)
+		for (int x = 0; x < w; x++) {
+			size_t i = (size_t)y * w + x;
+			const guide *gp = &j->g[i];
+			float inv_z = 1.0f / (SIGMA_Z * gp->z + 1e-6f);
+			/* The taps with a weight: each one's weight, regressors and
+			 * data (rows of 8 floats, SIMD-friendly). */
+			float tw[TAPS], tv[TAPS][8], td[TAPS][8];
+			int nt = 0;
+			for (int dy = -WIN; dy <= WIN; dy++) {
+				int qy = y + dy;
+				if (qy < 0 || qy >= h)
+					continue;
+				for (int dx = -WIN; dx <= WIN; dx++) {
+					int qx = x + dx;
+					if (qx < 0 || qx >= w)
+						continue;
+					size_t q = (size_t)qy * w + qx;
+					const guide *gq = &j->g[q];
+					float e = 0;
+					for (int k = 0; k < 6; k++)
+						e += (gp->f[k] - gq->f[k]) * (gp->f[k] - gq->f[k]);
+					e += fabsf(gq->z - (gp->z + gp->gx * (float)dx + gp->gy * (float)dy)) * inv_z;
+					float wt = exp_fast(e);
+					if (wt <= 0)
+						continue;
+					tw[nt] = wt;
+					float *v = tv[nt];
+					v[0] = 1.0f;
+					v[1] = (float)dx * (1.0f / WIN);
+					v[2] = (float)dy * (1.0f / WIN);
+					v[3] = gq->f[3] - gp->f[3];
+					v[4] = gq->f[4] - gp->f[4];
+					v[5] = gq->f[5] - gp->f[5];
+					v[6] = (gq->z - gp->z) * inv_z;
+					v[7] = 0.0f;
+					memcpy(td[nt], j->data + q * 8, sizeof td[nt]);
+					nt++;
+				}
+			}
+			/* The normal equations, row by row, so that a row's sums stay
+			 * in registers; the lower triangle is what solve reads. */
+			float m[NU][MIX_NU], rhs[NU][NRHS], beta[NU][NRHS];
+			for (int r = 0; r < NU; r++) {
+				v4 s[4] = {{0}};
+				for (int t = 0; t < nt; t++) {
+					v4 wv = v4_splat(tw[t] * tv[t][r]);
+					s[0] += wv * v4_load(tv[t]);
+					s[1] += wv * v4_load(tv[t] + 4);
+					s[2] += wv * v4_load(td[t]);
+					s[3] += wv * v4_load(td[t] + 4);
+				}
+				float row[16];
+				memcpy(row, s, sizeof row);
+				memcpy(m[r], row, sizeof m[r]);
+				memcpy(rhs[r], row + 8, sizeof rhs[r]);
+			}
+			float ridge = m[0][0] * RIDGE;
+			for (int r = 1; r < NU; r++)
+				m[r][r] += ridge;
+			const chan *r0 = j->t[i].h;
+			float am = lum(j->am + i * 3), am2 = am * am;
+			float *fit = j->fit + i * 3, *err = j->err + i * NCAND;
+			if (!solve(NU, m, j->halves ? NRHS : 3, rhs, beta)) {
+				memcpy(fit, r0[CH_ALL].c, sizeof r0[CH_ALL].c);
+				err[CAND_RAW] = 0.0f; /* the raw pixel */
+				err[CAND_FIT] = INFINITY;
+				continue;
+			}
+			for (int k = 0; k < 3; k++)
+				fit[k] = beta[0][k];
+			if (!j->halves) {
+				/* One sample: no halves, no error estimate; the fit. */
+				err[CAND_RAW] = INFINITY;
+				err[CAND_FIT] = 0.0f;
+				continue;
+			}
+			/* The raw pixel estimated the same way as the fit, so that
+			 * the two estimates share their noise. */
+			err[CAND_RAW] = cross_error(r0, na, nb, lum(r0[CH_A].c), lum(r0[CH_B].c)) * am2;
+			err[CAND_FIT] = cross_error(r0, na, nb, beta[0][3], beta[0][4]) * am2;
+		}
+}
+
+/* Chooses per pixel the candidate whose estimated error, averaged over
+ * (2 PICK_R + 1)^2 pixels, is the least (NFOR filters its errors before
+ * choosing too: one pixel's estimate is as noisy as the pixel), times
+ * the albedo again, into the all-samples chain (radiance, and the noise
+ * variance of the mean's brightness). */
+static void pick_rows(job *j, int y0, int y1)
+{
+	int w = j->fb->w, h = j->fb->h;
+	for (int y = y0; y < y1; y++)
+		for (int x = 0; x < w; x++) {
+			size_t i = (size_t)y * w + x;
+			float s[NCAND] = {0};
+			for (int qy = y - PICK_R; qy <= y + PICK_R; qy++) {
+				if (qy < 0 || qy >= h)
+					continue;
+				for (int qx = x - PICK_R; qx <= x + PICK_R; qx++) {
+					if (qx < 0 || qx >= w)
+						continue;
+					const float *e = j->err + ((size_t)qy * w + qx) * NCAND;
+					for (int c = 0; c < NCAND; c++)
+						s[c] += e[c];
+				}
+			}
+			int best = CAND_RAW;
+			for (int c = 1; c < NCAND; c++)
+				if (s[c] < s[best])
+					best = c;
+			chan *o = &j->t[i].h[CH_ALL];
+			const float *am = j->am + i * 3, *c = best == CAND_RAW ? o->c : j->fit + i * 3;
+			float l = lum(am);
+			for (int k = 0; k < 3; k++) {
+				float v = c[k] * am[k];
+				o->c[k] = v > 0 ? v : 0;
+			}
+			o->v = o->v / j->n[CH_ALL] * l * l;
+		}
+}
+
 /* A pixel whose features vary inside it (part one surface, part another):
- * a first-order regression of the filtered radiance on the features over
- * its 3x3 window, each pixel weighted by the inverse of its remaining
- * noise, evaluated at the pixel's own features, so that it gets the mix
- * its features say. False when the system is singular. */
-static bool regress_pixel(const job *j, const texel *src, int x, int y, float o[3])
+ * a first-order regression of the chosen radiance on the features over
+ * its 3x3 window, evaluated at the pixel's own features, so that it gets
+ * the mix its features say. False when the system is singular. */
+static bool mix_pixel(const job *j, int x, int y, float o[3])
 {
 	int w = j->fb->w, h = j->fb->h;
 	size_t i = (size_t)y * w + x;
 	const guide *gp = &j->g[i];
-	float a[NR][NR] = {{0}}, b[NR][3] = {{0}}, beta[NR][3];
+	float a[MIX_NU][MIX_NU] = {{0}}, b[MIX_NU][NRHS] = {{0}}, beta[MIX_NU][NRHS];
 	float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {0, 0, 0};
 	float inv_z = 1.0f / (gp->z + 1e-6f);
-	for (int dy = -RR; dy <= RR; dy++)
-		for (int dx = -RR; dx <= RR; dx++) {
+	for (int dy = -MIX_R; dy <= MIX_R; dy++)
+		for (int dx = -MIX_R; dx <= MIX_R; dx++) {
 			int qx = x + dx, qy = y + dy;
 			if (qx < 0 || qx >= w || qy < 0 || qy >= h)
 				continue;
 			size_t q = (size_t)qy * w + qx;
 			const guide *gq = &j->g[q];
-			float v[NR];
+			const float *c = j->t[q].h[CH_ALL].c;
+			float v[MIX_NU];
 			v[0] = 1;
 			for (int k = 0; k < 6; k++)
 				v[1 + k] = gq->f[k] - gp->f[k];
 			v[7] = (gq->z - gp->z) * inv_z * 10.0f;
-			float wt = 1.0f / (src[q].var + 1e-6f);
 			for (int ch = 0; ch < 3; ch++) {
-				float c = src[q].c[ch];
-				lo[ch] = c < lo[ch] ? c : lo[ch];
-				hi[ch] = c > hi[ch] ? c : hi[ch];
+				lo[ch] = c[ch] < lo[ch] ? c[ch] : lo[ch];
+				hi[ch] = c[ch] > hi[ch] ? c[ch] : hi[ch];
 			}
-			for (int r = 0; r < NR; r++) {
-				for (int c = 0; c <= r; c++)
-					a[r][c] += wt * v[r] * v[c];
+			for (int r = 0; r < MIX_NU; r++) {
+				for (int k = 0; k <= r; k++)
+					a[r][k] += v[r] * v[k];
 				for (int ch = 0; ch < 3; ch++)
-					b[r][ch] += wt * v[r] * src[q].c[ch];
+					b[r][ch] += v[r] * c[ch];
 			}
 		}
 	float ridge = a[0][0] * 1e-3f; /* slopes held back a little */
-	for (int r = 1; r < NR; r++)
+	for (int r = 1; r < MIX_NU; r++)
 		a[r][r] += ridge;
-	if (!solve(a, b, beta))
+	if (!solve(MIX_NU, a, 3, b, beta))
 		return false;
-	/* Within the window's range; and a move the pixel's remaining noise
-	 * cannot explain (more than REG_K standard deviations of its
-	 * brightness) is cut down to that. */
+	/* Within the window's range; and a move the pixel's noise cannot
+	 * explain (more than MIX_K standard deviations of its brightness) is
+	 * cut down to that. */
+	const chan *p = &j->t[i].h[CH_ALL];
 	float r[3];
 	for (int k = 0; k < 3; k++)
 		r[k] = beta[0][k] < lo[k] ? lo[k] : beta[0][k] > hi[k] ? hi[k] : beta[0][k];
-	float d = fabsf(lum(r) - lum(src[i].c));
-	float lim = REG_K * sqrtf(src[i].var), t = d > lim ? lim / d : 1.0f;
+	float d = fabsf(lum(r) - lum(p->c));
+	float lim = MIX_K * sqrtf(p->v), t = d > lim ? lim / d : 1.0f;
 	for (int k = 0; k < 3; k++)
-		o[k] = src[i].c[k] + t * (r[k] - src[i].c[k]);
+		o[k] = p->c[k] + t * (r[k] - p->c[k]);
 	return true;
 }
 
 /* The final radiance into out: mixed pixels regressed, the others as
- * filtered. */
-static void regress_rows(job *j, const texel *src, int y0, int y1)
+ * chosen. */
+static void mix_rows(job *j, int y0, int y1)
 {
 	int w = j->fb->w;
 	for (int y = y0; y < y1; y++)
 		for (int x = 0; x < w; x++) {
 			size_t i = (size_t)y * w + x;
 			float *o = j->out + i * 3;
-			if (!j->px[i].mixed || !regress_pixel(j, src, x, y, o))
+			if (!j->mixed[i] || !mix_pixel(j, x, y, o))
 				for (int k = 0; k < 3; k++)
-					o[k] = src[i].c[k];
+					o[k] = j->t[i].h[CH_ALL].c[k];
 		}
+}
+
+static void barrier(job *j)
+{
+	if (j->threads > 1)
+		pthread_barrier_wait(&j->bar);
 }
 
 static void run_rows(job *j, int y0, int y1)
 {
 	setup_rows(j, y0, y1);
-	if (j->threads > 1)
-		pthread_barrier_wait(&j->bar);
-	clamp_rows(j, j->buf[0], j->buf[1], y0, y1);
-	if (j->threads > 1)
-		pthread_barrier_wait(&j->bar);
+	barrier(j);
 	variance_rows(j, y0, y1);
-	for (int l = 0; l < LEVELS; l++) {
-		if (j->threads > 1)
-			pthread_barrier_wait(&j->bar);
-		atrous_rows(j, j->buf[(l + 1) & 1], j->buf[l & 1], 1 << l, y0, y1);
-	}
-	const texel *last = j->buf[(LEVELS + 1) & 1];
-	texel *spare = j->buf[LEVELS & 1];
-	if (j->threads > 1)
-		pthread_barrier_wait(&j->bar); /* spare was the last pass's source */
-	finish_rows(j, last, spare, y0, y1);
-	if (j->threads > 1)
-		pthread_barrier_wait(&j->bar); /* out may be fb->rgb, read by setup */
-	regress_rows(j, spare, y0, y1);
+	barrier(j);
+	regression_rows(j, y0, y1);
+	barrier(j);
+	pick_rows(j, y0, y1);
+	barrier(j); /* out may be fb->rgb, read by setup */
+	mix_rows(j, y0, y1);
 }
 
 typedef struct worker_arg {
@@ -653,13 +670,20 @@ bool denoise_image(const framebuffer *fb, float *out, int threads)
 	if (threads > h)
 		threads = h;
 	job j = {.fb = fb, .out = out};
+	j.halves = fb->spp >= 2;
+	j.n[CH_A] = j.halves ? (float)((fb->spp + 1) / 2) : 1.0f;
+	j.n[CH_B] = j.halves ? (float)(fb->spp / 2) : 1.0f;
+	j.n[CH_ALL] = fb->spp > 1 ? (float)fb->spp : 1.0f;
 	j.g = malloc(n * sizeof *j.g);
-	j.px = malloc(n * sizeof *j.px);
-	j.buf[0] = malloc(n * sizeof *j.buf[0]);
-	j.buf[1] = malloc(n * sizeof *j.buf[1]);
+	j.am = malloc(n * 3 * sizeof *j.am);
+	j.mixed = malloc(n * sizeof *j.mixed);
+	j.t = malloc(n * sizeof *j.t);
+	j.data = malloc(n * 8 * sizeof *j.data);
+	j.fit = malloc(n * 3 * sizeof *j.fit);
+	j.err = malloc(n * NCAND * sizeof *j.err);
 	pthread_t *tid = malloc((size_t)threads * sizeof *tid);
 	worker_arg *args = malloc((size_t)threads * sizeof *args);
-	bool ok = j.g && j.px && j.buf[0] && j.buf[1] && tid && args;
+	bool ok = j.g && j.am && j.mixed && j.t && j.data && j.fit && j.err && tid && args;
 	if (ok) {
 		pthread_mutex_init(&j.lock, NULL);
 		pthread_cond_init(&j.go_cond, NULL);
@@ -689,9 +713,12 @@ bool denoise_image(const framebuffer *fb, float *out, int threads)
 		pthread_cond_destroy(&j.go_cond);
 	}
 	free(j.g);
-	free(j.px);
-	free(j.buf[0]);
-	free(j.buf[1]);
+	free(j.am);
+	free(j.mixed);
+	free(j.t);
+	free(j.data);
+	free(j.fit);
+	free(j.err);
 	free(tid);
 	free(args);
 	return ok;

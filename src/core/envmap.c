@@ -37,7 +37,7 @@ envmap *envmap_new(const char *path, double strength, double rotation_deg, rt_er
 		rt_error_set(err, "out of memory loading the sky");
 		return NULL;
 	}
-	e->tex = texture_cache_get(path, false, err);
+	e->tex = texture_cache_get(path, false, NULL, err);
 	if (!e->tex) {
 		free(e);
 		return NULL;

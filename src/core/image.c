@@ -5,6 +5,7 @@
 #include <fcntl.h>
 #include <math.h>
 #include <png.h>
+#include <stb/stb_image_write.h>
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
@@ -116,12 +117,36 @@ static bool write_png(FILE *f, void *vctx, rt_error *err)
 	return ok || rt_error_at(err, c->path, 0, 0, "PNG encoding failed");
 }
 
+/* stb_image_write's output goes to the file; a failed write is kept. */
+static void jpeg_out(void *ctx, void *data, int size)
+{
+	FILE *f = ctx;
+	if (size > 0)
+		fwrite(data, 1, (size_t)size, f);
+}
+
+static bool write_jpeg(FILE *f, void *vctx, rt_error *err)
+{
+	image_ctx *c = vctx;
+	uint8_t *px = encode_rows(c);
+	if (!px)
+		return rt_error_at(err, c->path, 0, 0, "out of memory");
+	/* Quality 92: no blocks a person sees on a rendered picture. */
+	int ok = stbi_write_jpg_to_func(jpeg_out, f, c->fb->w, c->fb->h, 3, px, 92);
+	free(px);
+	if (!ok)
+		return rt_error_at(err, c->path, 0, 0, "JPEG encoding failed");
+	return !ferror(f) || rt_error_at(err, c->path, 0, 0, "write failed");
+}
+
 /* The formats, by extension: a new one is a line here (and its encoder
  * above, its decoder below). */
 static const image_type types[] = {
 	{".ppm", "PPM", IMAGE_PPM, write_ppm, image_read_ppm, "8-bit sRGB, binary netpbm (P6)"},
 	{".pfm", "PFM", IMAGE_PFM, write_pfm, image_read_pfm, "linear 32-bit float, as rendered"},
 	{".png", "PNG", IMAGE_PNG, write_png, NULL, "8-bit sRGB, libpng"},
+	{".jpg", "JPEG", IMAGE_JPEG, write_jpeg, NULL, "8-bit sRGB, baseline, quality 92 (stb_image_write)"},
+	{".jpeg", "JPEG", IMAGE_JPEG, write_jpeg, NULL, "8-bit sRGB, as .jpg"},
 };
 #define NTYPES (sizeof types / sizeof types[0])
 

@@ -149,20 +149,20 @@ typedef struct shared {
 static void pixel_add(const world *w, const render_settings *s, int x, int y, int fw, int fh,
                       int s0, int s1, double acc[3], float *feat)
 {
-	double fa[DENOISE_ACC] = {0}, sq = 0.0;
+	double fa[DENOISE_ACC] = {0}, ra[DENOISE_RACC] = {0};
 	for (int k = s0; k < s1; k++) {
 		vec3 c = render_sample(w, s, x, y, fw, fh, k);
 		acc[0] += c.x;
 		acc[1] += c.y;
 		acc[2] += c.z;
 		if (feat) {
-			sq += denoise_sq(c);
+			denoise_radiance(c, k, ra);
 			if (k < DENOISE_FEATURE_SAMPLES) /* what this sample's ray first sees */
 				denoise_sample(w, render_sample_ray(w, s, x, y, fw, fh, k), fa);
 		}
 	}
 	if (feat)
-		denoise_features(w, s, x, y, fw, fh, s0, s1, sq, fa, feat);
+		denoise_features(w, s, x, y, fw, fh, s0, s1, ra, fa, feat);
 }
 
 static void render_tile(shared *sh, long t)

@@ -40,7 +40,7 @@ static bool hold_texture(world *w, const char *path, bool srgb, const struct tex
 	if (!t)
 		return rt_error_set(err, "out of memory loading textures");
 	w->texs = t;
-	texture *tx = texture_cache_get(path, srgb, err);
+	texture *tx = texture_cache_get(path, srgb, w->cancel, err);
 	if (!tx)
 		return false;
 	w->texs[w->ntexs++] = tx;
@@ -71,7 +71,7 @@ bool surf_begin(world *w, const scene *s, rt_error *err)
 		const object *o = &s->objs[i];
 		if (!(obj_kind_flags(o->kind) & KIND_MODEL))
 			continue;
-		mesh *m = mesh_cache_get(o->file ? o->file : "", o->smooth != 0, o->crease, err);
+		mesh *m = mesh_cache_get(o->file ? o->file : "", o->smooth != 0, o->crease, w->cancel, err);
 		if (!m) {
 			char msg[RT_ERROR_MSG_MAX];
 			rt_error_format(err, msg, sizeof msg);

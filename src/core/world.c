@@ -170,11 +170,17 @@ static bool reorder(world *w, const uint32_t *order)
 
 world *world_build(const scene *s, rt_error *err)
 {
+	return world_build_cancel(s, NULL, err);
+}
+
+world *world_build_cancel(const scene *s, const atomic_bool *cancel, rt_error *err)
+{
 	world *w = calloc(1, sizeof *w);
 	if (!w) {
 		rt_error_set(err, "out of memory preparing the scene");
 		return NULL;
 	}
+	w->cancel = cancel;
 	atomic_init(&w->refs, 1);
 	camera c = scene_camera(s);
 	w->cam = cam_view_make(&c);
@@ -232,6 +238,13 @@ world *world_build(const scene *s, rt_error *err)
 	double extent = v3_max_abs(c.pos);
 	for (size_t i = 0; i < s->nobjs; i++) {
 		const object *o = &s->objs[i];
+		if ((i & 0xffff) == 0 && cancel && atomic_load(cancel)) {
+			free(bounds);
+			free(order);
+			world_free(w);
+			rt_error_set(err, "stopped");
+			return NULL;
+		}
 		w->mats[i] = mat_lin_make(&o->mat);
 		bool plane = (obj_kind_flags(o->kind) & KIND_UNBOUNDED) != 0;
 		if (!surf_material(w, o, (uint32_t)i, err) ||
@@ -271,7 +284,7 @@ world *world_build(const scene *s, rt_error *err)
 		costs[i] = w->prims[i].tag == PRIM_SPHERE     ? 1.0f
 		           : w->prims[i].tag == PRIM_TRIANGLE ? 2.0f
 		                                              : shape_kinds[s->objs[w->prims[i].object].kind]->cost;
-	w->tree = bvh_build(bounds, costs, w->nprims, order, err);
+	w->tree = bvh_build(bounds, costs, w->nprims, order, cancel, err);
 	free(costs);
 	free(bounds);
 	bool ok = w->tree && reorder(w, order);
@@ -282,6 +295,7 @@ world *world_build(const scene *s, rt_error *err)
 		world_free(w);
 		return NULL;
 	}
+	w->cancel = NULL;
 	return w;
 }
 

@@ -179,10 +179,13 @@ static void setup(int argc, char **argv, job_config *c, fileset *files, world **
 		goto out;
 	}
 	c->set = render_settings_default();
-	if (render_settings_apply_hints(&c->set, &s->hints) && !o.quiet)
+	bool clamped = render_settings_apply_hints(&c->set, &s->hints);
+	int cw = c->set.width, ch = c->set.height;
+	options_apply_settings(&o, &c->set);
+	/* Said only when the clamped size is the one rendered (not -r's). */
+	if (clamped && c->set.width == cw && c->set.height == ch && !o.quiet)
 		fprintf(stderr, "%s: resolution %dx%d is too large; rendering %dx%d (use -r to choose)\n",
 		        o.scene, s->hints.width, s->hints.height, c->set.width, c->set.height);
-	options_apply_settings(&o, &c->set);
 	*w = world_build(s, &err);
 	scene_free(s);
 	rt_file_source_set(NULL);

@@ -278,7 +278,14 @@ scene *scene_generate(size_t n, uint64_t seed, const gen_opts *opts, rt_error *e
 	}
 	gen_rng r = gen_stream(seed, spheres ? 3 : 2);
 	int64_t d = typical_size(n, spheres);
-	for (size_t i = 0; i < n; i++)
+	const atomic_bool *cancel = opts ? opts->cancel : NULL;
+	for (size_t i = 0; i < n; i++) {
+		if ((i & 0xffff) == 0 && cancel && atomic_load(cancel)) {
+			scene_free(s);
+			rt_error_set(err, "stopped");
+			return NULL;
+		}
 		s->objs[s->nobjs++] = spheres ? gen_sphere(&r, d, true) : gen_shape(&r, d);
+	}
 	return s;
 }

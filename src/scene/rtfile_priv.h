@@ -44,6 +44,10 @@ enum { RT_KEY_NUM, RT_KEY_FILE, RT_KEY_PAIR, RT_KEY_RGB };
 /* The folder model and texture names are written relative to (rt_save sets
  * it for the duration of a write; "" = as stored). */
 extern _Thread_local const char *rt_write_dir;
+/* A model or texture file name as a file written to rt_write_dir says it
+ * (relative to it when below it, else as stored, made absolute when a
+ * relative name would not be found from there; quoted when needed). */
+void rt_write_file_name(const char *file, char *out, size_t size);
 
 extern const rt_key rt_keys[];
 extern const size_t rt_nkeys;
@@ -67,5 +71,8 @@ typedef struct rt_numloc {
 } rt_numloc;
 void rt_numloc_enter(rt_numloc *l);
 void rt_numloc_leave(rt_numloc *l);
+
+/* True when name ends in ".rt" (strict mode asks for it). */
+bool rt_name_is_rt(const char *name);
 
 #endif

@@ -60,6 +60,7 @@ typedef struct parser {
 	bool strict;
 	bool single;      /* rt_parse_line: once-only elements replace */
 	const rt_warnings *warn;
+	const atomic_bool *cancel; /* rt_load_opts.cancel */
 	rt_error *err;
 	int line;
 	/* The line of the first A, C, L, R (or set resolution), sky and set
@@ -658,7 +659,7 @@ static bool get_file(parser *p, const tok *t, const char *name, size_t n, const 
 	bool ok = true;
 	bool image = key || strcmp(p->toks[0].s, "sky") == 0;
 	if (image) {
-		texture *tx = texture_cache_get(full, key && strcmp(key->name, "texture") == 0, &ferr);
+		texture *tx = texture_cache_get(full, key && strcmp(key->name, "texture") == 0, p->cancel, &ferr);
 		ok = tx != NULL;
 		texture_cache_put(tx);
 	} else if (!mesh_format_known(full)) {
@@ -965,7 +966,7 @@ static bool parse_mesh(parser *p, const elem_def *e)
 	 * is reported with this line */
 	rt_error merr;
 	rt_error_clear(&merr);
-	mesh *m = mesh_cache_get(o.file, o.smooth != 0, o.crease, &merr);
+	mesh *m = mesh_cache_get(o.file, o.smooth != 0, o.crease, p->cancel, &merr);
 	if (!m) {
 		char msg[RT_ERROR_MSG_MAX];
 		rt_error_format(&merr, msg, sizeof msg);
@@ -1117,6 +1118,8 @@ static bool parse_text(parser *p, const char *text, size_t len)
 		size_t j = i;
 		while (j < len && text[j] != '\n' && text[j] != '\r')
 			j++;
+		if ((p->line & 4095) == 0 && p->cancel && atomic_load(p->cancel))
+			return fail(p, 0, "stopped");
 		if (!parse_line(p, text + i, j - i))
 			return false;
 		if (j + 1 < len && text[j] == '\r' && text[j + 1] == '\n')
@@ -1163,6 +1166,7 @@ static void parser_init(parser *p, scene *s, const char *name, const rt_load_opt
 	p->name = name ? name : "";
 	p->strict = opts && opts->strict;
 	p->warn = opts ? opts->warn : NULL;
+	p->cancel = opts ? opts->cancel : NULL;
 	p->err = err;
 	/* model and texture names are relative to the .rt file's folder */
 	const char *slash = strrchr(p->name, '/');
@@ -1183,7 +1187,7 @@ static void parser_done(parser *p)
 	free(p->text);
 }
 
-static bool has_rt_extension(const char *name)
+bool rt_name_is_rt(const char *name)
 {
 	size_t n = strlen(name);
 	return n >= 3 && strcmp(name + n - 3, ".rt") == 0;
@@ -1200,7 +1204,7 @@ scene *rt_load_string(const char *text, size_t len, const char *name, const rt_l
 	parser p;
 	parser_init(&p, s, name, opts, err);
 	bool ok;
-	if (p.strict && !has_rt_extension(p.name)) {
+	if (p.strict && !rt_name_is_rt(p.name)) {
 		ok = fail(&p, 0, "the file name does not end in .rt; expected a .rt file (strict mode)");
 	} else {
 		rt_numloc loc;
@@ -1294,24 +1298,6 @@ char *rt_read_file(const char *path, const rt_load_opts *opts, size_t *len, rt_e
 	if (opts && opts->read)
 		return opts->read(opts->read_ctx, path, len, err);
 	return read_file(NULL, path, len, err);
-}
-
-scene *rt_load_file(const char *path, const rt_load_opts *opts, rt_error *err)
-{
-	if (mesh_format_known(path) && !(opts && opts->strict))
-		return rt_load_model(path, opts, err);
-	if (opts && opts->strict && !has_rt_extension(path)) {
-		rt_error_at(err, path, 0, 0,
-		            "the file name does not end in .rt; expected a .rt file (strict mode)");
-		return NULL;
-	}
-	size_t len = 0;
-	char *text = rt_read_file(path, opts, &len, err);
-	if (!text)
-		return NULL;
-	scene *s = rt_load_string(text, len, path, opts, err);
-	free(text);
-	return s;
 }
 
 bool rt_parse_line(scene *s, const char *line, const char *name, int lineno,

@@ -119,7 +119,7 @@ _Thread_local const char *rt_write_dir = "";
 /* A model or texture name as the file being written should say it:
  * relative to its folder when it lies below it, else as stored (and made
  * absolute when a relative name would not be found from the new folder). */
-static void sb_file(sbuf *b, const char *file)
+void rt_write_file_name(const char *file, char *out, size_t size)
 {
 	char abs[4096];
 	const char *dir = rt_write_dir ? rt_write_dir : "";
@@ -130,11 +130,14 @@ static void sb_file(sbuf *b, const char *file)
 	else if (n && file[0] != '/' && realpath(file, abs))
 		name = abs;
 	bool quote = strpbrk(name, " \t,#\"") != NULL || strstr(name, "//") != NULL || !name[0];
-	if (quote)
-		sb_put(b, "\"");
+	snprintf(out, size, "%s%s%s", quote ? "\"" : "", name, quote ? "\"" : "");
+}
+
+static void sb_file(sbuf *b, const char *file)
+{
+	char name[4200];
+	rt_write_file_name(file, name, sizeof name);
 	sb_put(b, name);
-	if (quote)
-		sb_put(b, "\"");
 }
 
 static void fmt_keys(sbuf *b, const object *o, bool short_form)

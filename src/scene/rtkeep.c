@@ -716,6 +716,128 @@ static void rewrite(writer *w, const src_line *sl, const lline *l, const obuf *b
 	ob_add(&w->o, s + sl->len, sl->end - sl->at - sl->len);
 }
 
+/* --- file names in a file written elsewhere --- */
+
+/* True when a and b name the same file (the same spelling, or the same
+ * real path). */
+static bool same_file(const char *a, const char *b)
+{
+	if (a == b || (a && b && strcmp(a, b) == 0))
+		return true;
+	if (!a || !b)
+		return false;
+	char ra[4096], rb[4096];
+	return realpath(a, ra) && realpath(b, rb) && strcmp(ra, rb) == 0;
+}
+
+/* Makes t's file names ref's where they name the same files (the model,
+ * the RT_KEY_FILE keys), so that object_equal compares the files, not how
+ * they are spelt. */
+static void files_agree(object *t, const object *ref)
+{
+	if (t->file != ref->file && same_file(t->file, ref->file))
+		t->file = ref->file;
+	for (size_t i = 0; i < rt_nkeys; i++) {
+		if (rt_keys[i].type != RT_KEY_FILE || (rt_keys[i].offset & RT_KEY_PBR))
+			continue;
+		const char **a = (const char **)(void *)((char *)t + rt_keys[i].offset);
+		const char *b = *(const char *const *)(const void *)((const char *)ref + rt_keys[i].offset);
+		if (*a != b && same_file(*a, b))
+			*a = b;
+	}
+}
+
+/* The name a line is read with in the folder written to. */
+static void dest_name(char *name, size_t size)
+{
+	snprintf(name, size, "%s%ssaved.rt", rt_write_dir ? rt_write_dir : "",
+	         rt_write_dir && rt_write_dir[0] ? "/" : "");
+}
+
+/* True when the source line sl, read from the folder written to, gives
+ * the object want (or, sky, the scene's sky with its file). */
+static bool line_reads_as(const writer *w, const src_line *sl, const object *want, bool is_sky)
+{
+	char name[4200];
+	dest_name(name, sizeof name);
+	char *line = malloc(sl->len + 1);
+	scene *t = scene_new();
+	bool same = false;
+	rt_error err;
+	if (line && t) {
+		memcpy(line, w->src + sl->at, sl->len);
+		line[sl->len] = '\0';
+		if (rt_parse_line(t, line, name, 1, NULL, &err)) {
+			if (is_sky) {
+				same = t->has_sky && same_file(t->sky.file, w->s->sky.file);
+			} else if (t->nobjs == 1) {
+				object o = t->objs[0];
+				files_agree(&o, want);
+				same = object_equal(&o, want);
+			}
+		}
+	}
+	free(line);
+	scene_free(t);
+	return same;
+}
+
+/* An unchanged element's line in a file written to another folder: its
+ * file names (a model's, key=FILE, the sky's) are rewritten where they
+ * would no longer name the same file from there, and nothing else; false
+ * when the line has more tokens than the lexer keeps (then the caller
+ * writes the element afresh). */
+static bool retarget_files(writer *w, const src_line *sl, const object *o, const char *sky_file)
+{
+	const char *text = w->src + sl->at;
+	lline l;
+	lex(text, sl->len, &l);
+	if (l.n > LTOK_MAX)
+		return false;
+	obuf body = {0};
+	size_t pos = l.lead;
+	for (size_t k = 0; k < l.n; k++) {
+		const ltok *t = &l.t[k];
+		ob_add(&body, text + pos, t->at - pos);
+		pos = t->at + t->len;
+		char name[4200];
+		const char *eq = k > 0 ? memchr(text + t->at, '=', t->len) : NULL;
+		if (k == 1 && sky_file) {
+			rt_write_file_name(sky_file, name, sizeof name);
+			ob_str(&body, name);
+			continue;
+		}
+		if (k == 1 && o && (obj_kind_flags(o->kind) & KIND_MODEL) && o->file && !eq) {
+			rt_write_file_name(o->file, name, sizeof name);
+			ob_str(&body, name);
+			continue;
+		}
+		if (eq && o) {
+			size_t klen = (size_t)(eq - (text + t->at));
+			const rt_key *key = NULL;
+			for (size_t i = 0; i < rt_nkeys && !key; i++)
+				if (rt_keys[i].type == RT_KEY_FILE && !(rt_keys[i].offset & RT_KEY_PBR) &&
+				    strlen(rt_keys[i].name) == klen && memcmp(rt_keys[i].name, text + t->at, klen) == 0)
+					key = &rt_keys[i];
+			const char *f = key ? *(const char *const *)(const void *)((const char *)o + key->offset) : NULL;
+			if (f) {
+				rt_write_file_name(f, name, sizeof name);
+				ob_add(&body, text + t->at, klen + 1);
+				ob_str(&body, name);
+				continue;
+			}
+		}
+		ob_add(&body, text + t->at, t->len);
+	}
+	if (body.failed) {
+		free(body.b);
+		return false;
+	}
+	rewrite(w, sl, &l, &body);
+	free(body.b);
+	return true;
+}
+
 static void copy_line(writer *w, const src_line *sl)
 {
 	ob_add(&w->o, w->src + sl->at, sl->end - sl->at);
@@ -739,7 +861,12 @@ static void write_line(writer *w, const src_line *sl)
 		if (j == NONE)
 			return;
 		if (object_equal(&b->s->objs[sl->idx], &s->objs[j])) {
-			copy_line(w, sl);
+			/* Written to another folder, its file names may need to
+			 * change; nothing else does. */
+			bool files = s->objs[j].file || s->objs[j].mat.texture || s->objs[j].mat.normalmap ||
+			             s->objs[j].mat.bump;
+			if (!files || line_reads_as(w, sl, &s->objs[j], false) || !retarget_files(w, sl, &s->objs[j], NULL))
+				copy_line(w, sl);
 			return;
 		}
 		lex(text, sl->len, &l);
@@ -778,7 +905,9 @@ static void write_line(writer *w, const src_line *sl)
 		if (!once_present(s, (once_kind)sl->idx))
 			return;
 		if (once_same(b->s, s, (once_kind)sl->idx)) {
-			copy_line(w, sl);
+			if (sl->idx != ONCE_SKY || !s->sky.file || line_reads_as(w, sl, NULL, true) ||
+			    !retarget_files(w, sl, NULL, s->sky.file))
+				copy_line(w, sl);
 			return;
 		}
 		lex(text, sl->len, &l);
@@ -890,6 +1019,11 @@ static bool loads_to(const char *text, size_t len, const scene *s)
 	scene *t = rt_load_string(text, len, name, NULL, &err);
 	if (!t)
 		return false;
+	/* the same files, however the names are spelt from there */
+	for (size_t i = 0; i < t->nobjs && t->nobjs == s->nobjs; i++)
+		files_agree(&t->objs[i], &s->objs[i]);
+	if (t->has_sky && s->has_sky && t->sky.file != s->sky.file && same_file(t->sky.file, s->sky.file))
+		t->sky.file = s->sky.file;
 	scene c = *s;
 	c.cam = 0;
 	bool same = scene_equal(t, &c);

@@ -14,11 +14,13 @@
 #include "rtsh/mesh.h"
 #include "rtsh/rtfile.h"
 
-scene *rt_load_model(const char *path, const rt_load_opts *opts, rt_error *err)
+char *rt_model_text(const char *path, const rt_load_opts *opts, size_t *len, rt_error *err)
 {
-	mesh *m = mesh_cache_get(path, true, 60, err);
+	mesh *m = mesh_cache_get(path, true, 60, opts ? opts->cancel : NULL, err);
 	if (!m)
 		return NULL;
+	if (m->warning) /* a missing material library, say */
+		rt_warn(opts ? opts->warn : NULL, NULL, 0, 0, "%s", m->warning);
 	vec3 ext = v3_sub(m->bounds.hi, m->bounds.lo);
 	mesh_cache_put(m);
 	double longest = v3_max_comp(ext);
@@ -36,8 +38,12 @@ scene *rt_load_model(const char *path, const rt_load_opts *opts, rt_error *err)
 	const char *slash = strrchr(path, '/');
 	const char *base = slash ? slash + 1 : path;
 	bool quote = strpbrk(base, " \t,#\"") != NULL;
-	char text[8192];
-	int n = snprintf(text, sizeof text,
+	char *text = malloc(8192);
+	if (!text) {
+		rt_error_set(err, "out of memory");
+		return NULL;
+	}
+	int n = snprintf(text, 8192,
 	                 "# the model viewer's scene for %s\n"
 	                 "A 0.25 255,255,255\n"
 	                 "C %.6g,%.6g,%.6g %.6g,%.6g,%.6g %g\n"
@@ -48,9 +54,22 @@ scene *rt_load_model(const char *path, const rt_load_opts *opts, rt_error *err)
 	                 "set samples 4\n",
 	                 base, cam.x, cam.y, cam.z, dir.x, dir.y, dir.z, fov, lamp.x, lamp.y, lamp.z,
 	                 quote ? "\"" : "", base, quote ? "\"" : "", e.y / 2);
-	if (n < 0 || (size_t)n >= sizeof text) {
+	if (n < 0 || n >= 8192) {
+		free(text);
 		rt_error_set(err, "%s: the file name is too long", path);
 		return NULL;
 	}
-	return rt_load_string(text, (size_t)n, path, opts, err);
+	*len = (size_t)n;
+	return text;
+}
+
+scene *rt_load_model(const char *path, const rt_load_opts *opts, rt_error *err)
+{
+	size_t n;
+	char *text = rt_model_text(path, opts, &n, err);
+	if (!text)
+		return NULL;
+	scene *s = rt_load_string(text, n, path, opts, err);
+	free(text);
+	return s;
 }

@@ -112,7 +112,17 @@ bool cmd_camera(shell *sh, int argc, char **argv, const char *rest)
 		buf[comma - v] = '\0';
 		if (!parse_number(buf, &yp[0]) || !parse_number(buf + (comma - v) + 1, &yp[1]))
 			return shell_fail(sh, "%s: \"%s\" is not a turn; expected YAW,PITCH in degrees", what, v);
-		EDIT(sh, what, editor_camera_turn(sh->ed, yp[0], yp[1], &err_));
+		uint64_t gen = editor_generation(sh->ed);
+		rt_error err;
+		shell_edit_begin(sh);
+		bool ok = editor_camera_turn(sh->ed, yp[0], yp[1], &err);
+		shell_edit_end(sh);
+		if (!ok)
+			return shell_fail(sh, "%s: %s", what, err.msg);
+		if (editor_generation(sh->ed) == gen && yp[1] != 0) /* nothing turned: say why */
+			shell_info(sh, "%s: already %g degrees %s, the most it tilts; a %s pitch turns it back\n", what,
+			           EDIT_PITCH_LIMIT, yp[1] > 0 ? "up" : "down", yp[1] > 0 ? "negative" : "positive");
+		return true;
 	}
 	}
 }

@@ -216,7 +216,7 @@ static void list_objects(shell *sh, const scene *s)
 		const object *o = &s->objs[i];
 		rt_format_object(o, line, sizeof line);
 		/* a mesh: its triangle count (the model is cached, so this is cheap) */
-		mesh *m = o->kind == OBJ_MESH && o->file ? mesh_cache_get(o->file, o->smooth != 0, o->crease, NULL) : NULL;
+		mesh *m = o->kind == OBJ_MESH && o->file ? mesh_cache_get(o->file, o->smooth != 0, o->crease, NULL, NULL) : NULL;
 		if (m)
 			shell_out(sh, "object %zu: %s  # %u triangles\n", i + 1, line, m->ntris);
 		else
@@ -277,7 +277,12 @@ bool cmd_generate(shell *sh, int argc, char **argv, const char *rest)
 		seed = ((uint64_t)t.tv_sec * 1000003u ^ (uint64_t)t.tv_nsec) % 1000000;
 	}
 	rt_error err;
-	scene *s = scene_generate((size_t)n, seed, NULL, &err);
+	atomic_store(&sh->cancel, false);
+	scene *s = scene_generate((size_t)n, seed, &(gen_opts){.cancel = &sh->cancel}, &err);
+	if (!s && atomic_load(&sh->cancel)) {
+		shell_sig_int = 0; /* the Ctrl-C is used up */
+		return shell_fail(sh, "generate: stopped; the scene is as it was");
+	}
 	if (!s)
 		return shell_fail(sh, "generate: %s", err.msg);
 	char label[96];

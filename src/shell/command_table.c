@@ -13,7 +13,7 @@ const command command_table[] = {
 	 "replace the scene by a .rt file, or by a model (.obj .ply .gltf .glb .stl) on a framed stage; on any "
 	 "error the current scene stays",
 	 cmd_load},
-	{"save", NULL, "save FILE.ppm|FILE.pfm|FILE.png|FILE.ans|FILE.rt", 1, 1, {"@output"},
+	{"save", NULL, "save FILE.ppm|FILE.pfm|FILE.png|FILE.jpg|FILE.ans|FILE.rt", 1, 1, {"@output"},
 	 "write the image (full resolution, rendered first if needed), the picture as ANSI text, or the scene",
 	 cmd_save},
 	{"render", NULL, "render", 0, 0, {NULL},

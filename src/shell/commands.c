@@ -365,7 +365,16 @@ bool cmd_help(shell *sh, int argc, char **argv, const char *rest)
 	              "usage):\n");
 	for (size_t i = 0; i < command_count; i++) {
 		const command *c = &command_table[i];
-		shell_out(sh, "  %-9s %s\n", c->name, c->help);
+		/* A help of several lines: the others under the first. */
+		const char *p = c->help;
+		size_t k = strcspn(p, "\n");
+		shell_out(sh, "  %-9s %.*s\n", c->name, (int)k, p);
+		for (p += k; *p == '\n';) {
+			p++;
+			k = strcspn(p, "\n");
+			shell_out(sh, "            %.*s\n", (int)k, p);
+			p += k;
+		}
 	}
 	shell_out(sh, "vectors X,Y,Z and colours R,G,B (0-255) as in .rt files; objects and lights "
 	              "are numbered from 1 (see list)\n");

@@ -69,6 +69,9 @@ static void add_commands(list *l, const char *text)
 		add(l, command_table[i].name, text);
 }
 
+/* The candidates are file names (load, save): readline quotes them. */
+static bool listed_files;
+
 /* One '|'-separated alternative of a spec. */
 static void add_alternative(list *l, const shell *sh, const char *alt, size_t len, char **words, int nwords,
                             const char *text, bool *files)
@@ -80,8 +83,10 @@ static void add_alternative(list *l, const shell *sh, const char *alt, size_t le
 		*files = true;
 	} else if (strcmp(a, "@scene") == 0) {
 		complete_files(text, FILES_SCENE, add_file, l);
+		listed_files = true;
 	} else if (strcmp(a, "@output") == 0) {
 		complete_files(text, FILES_OUTPUT, add_file, l);
+		listed_files = true;
 	} else if (strcmp(a, "@command") == 0) {
 		add_commands(l, text);
 	} else if (strcmp(a, "@setting") == 0) {
@@ -182,7 +187,13 @@ static char **attempt(const char *text, int start, int end)
 {
 	(void)end;
 	bool files = false;
+	listed_files = false;
+	/* Inside an open quote the word starts at the quote. */
+	if (rl_completion_quote_character && start > 0)
+		start--;
 	pending = complete_words(completing, rl_line_buffer, start, text, &files);
+	/* File names are quoted as the shell reads them ('my scenes/'). */
+	rl_filename_completion_desired = rl_filename_quoting_desired = listed_files;
 	if (files && !pending) {
 		rl_attempted_completion_over = 0; /* readline completes file names */
 		return NULL;
@@ -207,4 +218,11 @@ void complete_install(shell *sh)
 	completing = sh;
 	rl_attempted_completion_function = attempt;
 	rl_completer_word_break_characters = " \t;";
+	/* A name with a blank or a quote is quoted, and completion goes on
+	 * inside an open quote. */
+	rl_completer_quote_characters = "'\"";
+	rl_filename_quote_characters = " \t;'\"\\#";
+	/* An ambiguous Tab lists the candidates at once (save out<Tab>: out.png,
+	 * out.rt, ...); an inputrc may say otherwise. */
+	rl_variable_bind("show-all-if-ambiguous", "on");
 }

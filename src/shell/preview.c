@@ -12,6 +12,7 @@
 #include <termios.h>
 #include <unistd.h>
 
+#include "rtsh/filesrc.h"
 #include "rtsh/mesh.h"
 #include "rtsh/orbit.h"
 #include "rtsh/render.h"
@@ -109,8 +110,12 @@ int preview_main(const rtsh_options *o)
 	struct stat st;
 	if (stat(file, &st) != 0)
 		return fail(file, strerror(errno));
-	if (!S_ISREG(st.st_mode))
-		return fail(file, "not a regular file; expected a scene (.rt) or a model file");
+	const char *kind = rt_file_kind(st.st_mode);
+	if (kind) {
+		char msg[160];
+		snprintf(msg, sizeof msg, "not a regular file but %s; expected a scene (.rt) or a model file", kind);
+		return fail(file, msg);
+	}
 	rt_error err;
 	rt_load_opts lo = {.strict = false, .warn = NULL};
 	scene *s = rt_load_file(file, &lo, &err);

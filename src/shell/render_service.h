@@ -100,8 +100,9 @@ void rsvc_free(rsvc *sv);
 void rsvc_hold(rsvc *sv);
 /* A reference to the world of scene s at generation gen (the caller
  * releases it), built now if the one kept is older; NULL (err set) when it
- * cannot be built. */
-const world *rsvc_world(rsvc *sv, const scene *s, uint64_t gen, rt_error *err);
+ * cannot be built, or "stopped" when *cancel (NULL: never) was set during
+ * the build (the next call builds it again). */
+const world *rsvc_world(rsvc *sv, const scene *s, uint64_t gen, const atomic_bool *cancel, rt_error *err);
 /* Ends a hold and renders req in the background (starting the thread on
  * first use); an image taken later answers it when its seq is the number
  * returned (0: the thread could not start). A request equal to the last one completed renders nothing and

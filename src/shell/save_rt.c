@@ -7,6 +7,7 @@
 #include <sys/stat.h>
 
 #include "rtsh/filesrc.h"
+#include "rtsh/mesh.h"
 #include "rtsh/rtkeep.h"
 #include "rtsh/rtfile.h"
 #include "shell/builtin_scene.h"
@@ -67,7 +68,10 @@ bool save_rt(shell *sh, const char *path, rt_error *err)
 	if (strncmp(label, "generate:", 9) == 0)
 		return rt_save(&s, path, err);
 	size_t len = 0;
-	char *src = read_source(label, &len);
+	/* The model viewer's scene was made from the model: its text is made
+	 * again (the comment, the lines in their order). */
+	rt_error merr;
+	char *src = mesh_format_known(label) ? rt_model_text(label, NULL, &len, &merr) : read_source(label, &len);
 	rt_keep_source = label; /* its folder resolves model and texture names */
 	bool ok = rt_save_keeping(&s, src, len, path, err);
 	rt_keep_source = NULL;

@@ -75,16 +75,6 @@ static bool blank(const char *s)
 static bool run_line(shell *sh, const char *text, const char *name, long lineno, long *count,
                      bool count_commands)
 {
-	if (strlen(text) > SHELL_LINE_MAX) {
-		sh->err[0] = '\0';
-		shell_fail(sh, "the line is longer than " SHELL_LINE_MAX_TEXT " bytes; expected at most " SHELL_LINE_MAX_TEXT);
-		if (name) {
-			fflush(stdout);
-			fprintf(stderr, "%s:%ld: %s\n", name, lineno, sh->err);
-			sh->err_reported = true;
-		}
-		return false;
-	}
 	char *line = strdup(text);
 	if (!line)
 		return shell_fail(sh, "out of memory");
@@ -96,7 +86,15 @@ static bool run_line(shell *sh, const char *text, const char *name, long lineno,
 		*end = '\0';
 		if (!blank(p)) {
 			(*count)++;
-			if (shell_sig_int && name) {
+			/* One command at most SHELL_LINE_MAX bytes, wherever it came
+			 * from (a file's lines are cut at that length as they are
+			 * read; -c text is bounded by the kernel's argument limit
+			 * and may hold many commands). */
+			if ((size_t)(end - p) > SHELL_LINE_MAX) {
+				sh->err[0] = '\0';
+				ok = shell_fail(sh, "the command is longer than " SHELL_LINE_MAX_TEXT
+				                    " bytes; expected at most " SHELL_LINE_MAX_TEXT);
+			} else if (shell_sig_int && name) {
 				ok = shell_fail(sh, "interrupted");
 			} else {
 				sh->err[0] = '\0';

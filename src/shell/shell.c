@@ -356,10 +356,16 @@ const framebuffer *shell_full_image(shell *sh, bool force)
 	rsvc_hold(sh->rs);
 	rt_error err;
 	rt_error_clear(&err);
-	const world *w = rsvc_world(sh->rs, editor_scene(sh->ed), gen, &err);
+	atomic_store(&sh->cancel, false);
+	const world *w = rsvc_world(sh->rs, editor_scene(sh->ed), gen, &sh->cancel, &err);
 	if (!w) {
 		shell_refresh(sh);
-		shell_fail(sh, "render: %s", err.msg);
+		if (atomic_load(&sh->cancel)) {
+			shell_sig_int = 0; /* the Ctrl-C is used up */
+			shell_fail(sh, "render: stopped while preparing the scene");
+		} else {
+			shell_fail(sh, "render: %s", err.msg);
+		}
 		return NULL;
 	}
 	atomic_store(&sh->cancel, false);
@@ -412,7 +418,8 @@ frame *shell_picture_frame(shell *sh, frame_palette pal, int cols)
 		rsvc_hold(sh->rs);
 		rt_error err;
 		rt_error_clear(&err);
-		const world *wd = rsvc_world(sh->rs, editor_scene(sh->ed), editor_generation(sh->ed), &err);
+		atomic_store(&sh->cancel, false);
+		const world *wd = rsvc_world(sh->rs, editor_scene(sh->ed), editor_generation(sh->ed), &sh->cancel, &err);
 		render_settings s = sh->set;
 		s.width = w;
 		s.height = h;
@@ -473,7 +480,16 @@ bool shell_load(shell *sh, const char *path)
 	if (!p)
 		return shell_fail(sh, "out of memory");
 	rt_error err;
-	scene *s = rt_load_file(p, &sh->load_opts, &err);
+	/* Ctrl-C stops the load (rtsh(1)); the scene stays as it was */
+	atomic_store(&sh->cancel, false);
+	rt_load_opts lo = sh->load_opts;
+	lo.cancel = &sh->cancel;
+	scene *s = rt_load_file(p, &lo, &err);
+	if (!s && atomic_load(&sh->cancel)) {
+		shell_sig_int = 0; /* the Ctrl-C is used up */
+		free(p);
+		return shell_fail(sh, "load: stopped; the scene is as it was");
+	}
 	if (!s) {
 		char msg[RT_ERROR_MSG_MAX + RT_ERROR_FILE_MAX + 32];
 		rt_error_format(&err, msg, sizeof msg);

@@ -291,3 +291,19 @@ static encoder *iterm_open(const encoder_geom *g)
 const encoder_ops encoder_kitty = PIXEL_OPS("kitty", kitty_open);
 const encoder_ops encoder_sixel = PIXEL_OPS("sixel", sixel_open);
 const encoder_ops encoder_iterm = PIXEL_OPS("iterm", iterm_open);
+
+/* One picture in the given protocol, for callers that hold no encoder
+ * (the batch preview). */
+bool pixels_encode(pixels_mode m, abuf *out, const uint8_t *rgb, int w, int h, int cols, int rows)
+{
+	switch (m) {
+	case PIXELS_KITTY:
+		return pixels_kitty(out, rgb, w, h, cols, rows, PIXELS_KITTY_ID);
+	case PIXELS_SIXEL:
+		return pixels_sixel(out, rgb, w, h);
+	case PIXELS_ITERM:
+		return pixels_iterm(out, rgb, w, h, cols, rows);
+	default:
+		return false;
+	}
+}

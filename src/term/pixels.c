@@ -31,20 +31,6 @@ bool pixels_mode_parse(const char *s, pixels_mode *m)
 	return false;
 }
 
-bool pixels_encode(pixels_mode m, abuf *out, const uint8_t *rgb, int w, int h, int cols, int rows)
-{
-	switch (m) {
-	case PIXELS_KITTY:
-		return pixels_kitty(out, rgb, w, h, cols, rows, PIXELS_KITTY_ID);
-	case PIXELS_SIXEL:
-		return pixels_sixel(out, rgb, w, h);
-	case PIXELS_ITERM:
-		return pixels_iterm(out, rgb, w, h, cols, rows);
-	default:
-		return false;
-	}
-}
-
 /* --- base64 (RFC 4648, section 4) ---------------------------------------- */
 
 void pixels_base64(abuf *out, const uint8_t *b, size_t n)

@@ -78,7 +78,7 @@ bool pixels_sixel(abuf *out, const uint8_t *rgb, int w, int h);
  * False on failure (out unchanged). */
 bool pixels_iterm(abuf *out, const uint8_t *rgb, int w, int h, int cols, int rows);
 
-/* The picture in the given protocol (not PIXELS_OFF/AUTO). */
+/* The picture in the given protocol (not PIXELS_OFF/AUTO; enc_pixels.c). */
 bool pixels_encode(pixels_mode m, abuf *out, const uint8_t *rgb, int w, int h, int cols, int rows);
 
 /* Standard base64 (RFC 4648, with padding) of n bytes. */

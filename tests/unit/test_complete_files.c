@@ -74,13 +74,13 @@ static void test_by_type(void **state)
 	check(text, FILES_OUTPUT, want);
 	/* save NAME: NAME with each extension it writes. */
 	snprintf(text, sizeof text, "%s/out", dir);
-	snprintf(want, sizeof want, "%s/out.ans %s/out.pfm %s/out.png %s/out.ppm %s/out.rt", dir, dir, dir, dir,
-	         dir);
+	snprintf(want, sizeof want, "%s/out.ans %s/out.jpeg %s/out.jpg %s/out.pfm %s/out.png %s/out.ppm %s/out.rt",
+	         dir, dir, dir, dir, dir, dir, dir);
 	check(text, FILES_OUTPUT, want);
 	/* A prefix of a file and a folder. */
 	snprintf(text, sizeof text, "%s/s", dir);
-	snprintf(want, sizeof want, "%s/s.ans %s/s.pfm %s/s.png %s/s.ppm %s/s.rt %s/sub/", dir, dir, dir, dir,
-	         dir, dir);
+	snprintf(want, sizeof want, "%s/s.ans %s/s.jpeg %s/s.jpg %s/s.pfm %s/s.png %s/s.ppm %s/s.rt %s/sub/", dir,
+	         dir, dir, dir, dir, dir, dir, dir);
 	check(text, FILES_OUTPUT, want);
 	for (size_t i = 0; i < 6; i++) {
 		char p[600];

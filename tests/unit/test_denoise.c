@@ -6,6 +6,10 @@
  *   - an edge between two flat regions keeps its width (10%-90% rise);
  *   - a picture without noise (piecewise constant, features agreeing) comes
  *     out unchanged; a constant one too, however noisy its neighbours;
+ *   - a flat noisy surface of known noise: the error falls as the mean over
+ *     the regression's 9x9 window says (9x);
+ *   - an edge in the features: no tap crosses it, each side keeps its own
+ *     radiance;
  *   - the features seen through a mirror are the reflected wall's, at the
  *     distance of the whole path;
  *   - the result is identical for any thread count; whitted mode is never
@@ -347,7 +351,11 @@ static void set_pixel(framebuffer *fb, int i, float r, float g, float b)
 	fb->rgb[i * 3 + 1] = g;
 	fb->rgb[i * 3 + 2] = b;
 	double l = 0.2126 * r + 0.7152 * g + 0.0722 * b;
-	fb->feat[(size_t)i * DENOISE_FEATURES + 7] = (float)(l * l);
+	float *f = fb->feat + (size_t)i * DENOISE_FEATURES;
+	f[7] = f[13] = (float)(l * l);
+	f[10] = r; /* the even samples are the same as all of them */
+	f[11] = g;
+	f[12] = b;
 }
 
 /* Without noise nothing changes: a constant picture, and a picture of two
@@ -380,7 +388,119 @@ static void test_no_noise_no_change(void **state)
 	fb_free(fb);
 }
 
-/* The same picture for 1, 2, 3 and 7 threads, byte for byte. */
+/* Fills pixel i of fb with spp grey samples (the same in r, g and b) drawn
+ * from mean + sigma * a uniform variable of variance 1, as a render job
+ * records them: the mean of all, of the even ones, and of their squares. */
+static void noisy_pixel(framebuffer *fb, int i, double mean, double sigma, test_rng *r)
+{
+	double all = 0, even = 0, sq = 0, sq_even = 0;
+	for (int k = 0; k < fb->spp; k++) {
+		double v = mean + sigma * sqrt(12.0) * (trand(r) - 0.5);
+		all += v;
+		sq += v * v;
+		if (!(k & 1)) {
+			even += v;
+			sq_even += v * v;
+		}
+	}
+	int ne = (fb->spp + 1) / 2;
+	float *f = fb->feat + (size_t)i * DENOISE_FEATURES;
+	for (int c = 0; c < 3; c++) {
+		fb->rgb[i * 3 + c] = (float)(all / fb->spp);
+		f[10 + c] = (float)(even / ne);
+	}
+	f[7] = (float)(sq / fb->spp);
+	f[13] = (float)(sq_even / ne);
+}
+
+/* A flat grey surface, 8 samples of known noise a pixel: away from the
+ * border, the regression fits a plane to the 81 pixels of its 9x9 window
+ * (the features are all alike, so every weight is one), and the value of
+ * a least-squares plane at the centre of a symmetric window is the mean of
+ * the window. Its error is therefore the noise of the pixel mean,
+ * sigma / sqrt(8), over sqrt(81): 9x smaller than the raw pixels'. */
+static void test_flat_noise(void **state)
+{
+	(void)state;
+	const int W = 64, H = 48, SPP = 8;
+	const double MEAN = 0.4, SIGMA = 0.2;
+	framebuffer *fb = flat_fb(W, H, SPP);
+	test_rng r = {27};
+	for (int i = 0; i < W * H; i++)
+		noisy_pixel(fb, i, MEAN, SIGMA, &r);
+	float *out = malloc(sizeof(float) * W * H * 3);
+	assert_non_null(out);
+	assert_true(denoise_image(fb, out, 2));
+	double se_raw = 0, se_dn = 0;
+	int n = 0;
+	for (int y = 4; y < H - 4; y++)
+		for (int x = 4; x < W - 4; x++) {
+			int i = y * W + x;
+			se_raw += (fb->rgb[i * 3] - MEAN) * (fb->rgb[i * 3] - MEAN);
+			se_dn += (out[i * 3] - MEAN) * (out[i * 3] - MEAN);
+			n++;
+		}
+	double raw = sqrt(se_raw / n), dn = sqrt(se_dn / n);
+	double expect_raw = SIGMA / sqrt(SPP), expect_dn = expect_raw / 9.0;
+	print_message("flat grey, sigma %.2f a sample, 8 samples: RMS error raw %.5f (expected %.5f), "
+	              "denoised %.5f (expected %.5f)\n",
+	              SIGMA, raw, expect_raw, dn, expect_dn);
+	assert_true(fabs(raw / expect_raw - 1.0) < 0.1); /* the synthetic noise is as stated */
+	/* Windows overlap, so the interior's 2240 pixels hold far fewer
+	 * independent errors: 25% either way. */
+	assert_true(dn < 1.25 * expect_dn);
+	assert_true(dn > 0.75 * expect_dn);
+	free(out);
+	fb_free(fb);
+}
+
+/* An edge in the features (albedo 0.8 left of x = 32, 0.2 right of it,
+ * the same lighting 0.5 everywhere): no tap crosses it (the albedo
+ * distance makes its weight zero), so the columns next to it keep their
+ * own side's radiance, 0.4 and 0.1, within the filtered noise; a blur
+ * across it would pull them towards 0.25. Each side's error is also
+ * checked against the flat case's: the edge's pixels see half a window. */
+static void test_feature_edge(void **state)
+{
+	(void)state;
+	const int W = 64, H = 48, SPP = 8;
+	const double SIGMA = 0.1;
+	framebuffer *fb = flat_fb(W, H, SPP);
+	test_rng r = {12};
+	for (int y = 0; y < H; y++)
+		for (int x = 0; x < W; x++) {
+			int i = y * W + x;
+			float a = x < W / 2 ? 0.8f : 0.2f;
+			float *f = fb->feat + (size_t)i * DENOISE_FEATURES;
+			f[0] = f[1] = f[2] = a;
+			noisy_pixel(fb, i, 0.5 * a, SIGMA * a, &r);
+		}
+	float *out = malloc(sizeof(float) * W * H * 3);
+	assert_non_null(out);
+	assert_true(denoise_image(fb, out, 2));
+	for (int side = 0; side < 2; side++) {
+		int x = side ? W / 2 : W / 2 - 1;
+		double truth = side ? 0.1 : 0.4, s = 0, se = 0;
+		for (int y = 4; y < H - 4; y++) {
+			double v = out[(y * W + x) * 3];
+			s += v;
+			se += (v - truth) * (v - truth);
+		}
+		int n = H - 8;
+		double mean = s / n, rms = sqrt(se / n);
+		/* the raw pixel's noise: SIGMA * albedo / sqrt(8) */
+		double noise = SIGMA * (side ? 0.2 : 0.8) / sqrt(SPP);
+		print_message("column %d next to the edge: mean %.4f (true %.2f), RMS error %.4f (raw noise %.4f)\n",
+		              x, mean, truth, rms, noise);
+		assert_true(fabs(mean - truth) < 0.5 * noise);
+		assert_true(rms < 0.5 * noise);
+	}
+	free(out);
+	fb_free(fb);
+}
+
+/* The same picture for 1, 2, 3 and 7 threads, byte for byte, with 1, 3
+ * and 8 samples. */
 static void test_threads(void **state)
 {
 	(void)state;
@@ -389,25 +509,29 @@ static void test_threads(void **state)
 	                     "sp 1.5,0.5,-1 0,1,0 1,1,1 255,255,255 0 0 1 1\n");
 	world *w = world_build(s, NULL);
 	assert_non_null(w);
-	render_settings set = path_settings(53, 31, 4, 4, 3);
-	framebuffer *fb = fb_new(53, 31);
-	assert_non_null(fb);
-	assert_true(denoise_prepare(fb));
-	render_job job = {.w = w, .set = set, .fb = fb, .sample_begin = 0, .sample_end = 4};
-	assert_int_equal(render_run(&job, NULL), RENDER_DONE);
-	size_t n = (size_t)fb->w * fb->h * 3;
-	float *one = malloc(n * sizeof *one), *many = malloc(n * sizeof *many);
-	assert_non_null(one);
-	assert_non_null(many);
-	assert_true(denoise_image(fb, one, 1));
-	const int threads[] = {2, 3, 7};
-	for (int k = 0; k < 3; k++) {
-		assert_true(denoise_image(fb, many, threads[k]));
-		assert_memory_equal(one, many, n * sizeof *one);
+	/* 1 sample (no halves), 3 (halves of one and two samples) and 8 */
+	const int spps[] = {1, 3, 8};
+	for (int s_i = 0; s_i < 3; s_i++) {
+		render_settings set = path_settings(53, 31, spps[s_i], 4, 3);
+		framebuffer *fb = fb_new(53, 31);
+		assert_non_null(fb);
+		assert_true(denoise_prepare(fb));
+		render_job job = {.w = w, .set = set, .fb = fb, .sample_begin = 0, .sample_end = spps[s_i]};
+		assert_int_equal(render_run(&job, NULL), RENDER_DONE);
+		size_t n = (size_t)fb->w * fb->h * 3;
+		float *one = malloc(n * sizeof *one), *many = malloc(n * sizeof *many);
+		assert_non_null(one);
+		assert_non_null(many);
+		assert_true(denoise_image(fb, one, 1));
+		const int threads[] = {2, 3, 7};
+		for (int k = 0; k < 3; k++) {
+			assert_true(denoise_image(fb, many, threads[k]));
+			assert_memory_equal(one, many, n * sizeof *one);
+		}
+		free(one);
+		free(many);
+		fb_free(fb);
 	}
-	free(one);
-	free(many);
-	fb_free(fb);
 	world_free(w);
 	scene_free(s);
 }
@@ -528,6 +652,8 @@ int main(void)
 		cmocka_unit_test(test_cornell_rmse),
 		cmocka_unit_test(test_edges),
 		cmocka_unit_test(test_no_noise_no_change),
+		cmocka_unit_test(test_flat_noise),
+		cmocka_unit_test(test_feature_edge),
 		cmocka_unit_test(test_threads),
 		cmocka_unit_test(test_features_through_mirror),
 		cmocka_unit_test(test_features_in_passes),

@@ -95,7 +95,7 @@ static void test_obj_mtl_texture_from_source(void **state)
 	assert_near(m->mats[0].kd[0], 0.0, 0);
 	assert_string_equal(m->mats[0].map_kd, DIR "/m/tex/c.ppm");
 	/* the texture the world would load: sRGB 255 is 1, 0 is 0 */
-	texture *t = texture_cache_get(m->mats[0].map_kd, true, &err);
+	texture *t = texture_cache_get(m->mats[0].map_kd, true, NULL, &err);
 	if (!t)
 		fail_msg("%s", err.msg);
 	assert_int_equal(files[2].reads, 1);

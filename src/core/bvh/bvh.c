@@ -66,6 +66,7 @@ typedef struct builder {
 	unsigned block; /* primitives tested together (1: each its own cost) */
 	unsigned leaf_max;
 	double root_area; /* for the spatial splits' overlap test */
+	bool stopped;     /* o->cancel was set: the rest became leaves */
 } builder;
 
 /* The SAH cost of testing primitives of summed cost `sum` in a leaf: the
@@ -523,6 +524,11 @@ static void build(builder *b, size_t begin, size_t end, size_t cap_end, const fb
 	if (depth > b->depth)
 		b->depth = depth;
 	bool leaf = n <= 1 || (depth >= BALANCED_DEPTH && n <= b->leaf_max);
+	/* large nodes look at the cancel flag: at most about 4096 references
+	 * are binned between two looks */
+	if (!leaf && n >= 4096 && b->o->cancel && atomic_load_explicit(b->o->cancel, memory_order_relaxed))
+		b->stopped = true;
+	leaf = leaf || b->stopped;
 	if (!leaf && n <= b->leaf_max) {
 		/* A split costs at least a node visit: a node that costs no more
 		 * to test whole is a leaf without binning (most small nodes). */
@@ -671,6 +677,14 @@ bool bvh2_build(const box *bounds, size_t n, const bvh_build_opts *o, bvh2 *t, r
 	}
 	b.root_area = fbox_half_area(&bb);
 	build(&b, 0, n, cap, &bb, &cb, 0, &t->root, &t->root_meta);
+	if (b.stopped) {
+		free(b.refs);
+		free(b.tmp);
+		free(b.tmp_ids);
+		free(b.nodes);
+		free(b.ids);
+		return rt_error_set(err, "stopped");
+	}
 	free(b.refs);
 	free(b.tmp);
 	free(b.tmp_ids);
@@ -738,14 +752,15 @@ static uint32_t collapse(const bvh2 *t, uint32_t n2, bvh_node *out, size_t *used
 	return ni;
 }
 
-bvh *bvh_build(const box *bounds, const float *costs, size_t n, uint32_t *order, rt_error *err)
+bvh *bvh_build(const box *bounds, const float *costs, size_t n, uint32_t *order, const atomic_bool *cancel,
+               rt_error *err)
 {
 	bvh *t = calloc(1, sizeof *t);
 	if (!t) {
 		rt_error_set(err, "out of memory building the BVH");
 		return NULL;
 	}
-	bvh_build_opts o = {.costs = costs, .block = 1, .trav = COST_TRAVERSE};
+	bvh_build_opts o = {.costs = costs, .block = 1, .trav = COST_TRAVERSE, .cancel = cancel};
 	bvh2 b;
 	if (!bvh2_build(bounds, n, &o, &b, err)) {
 		free(t);

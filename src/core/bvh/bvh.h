@@ -17,6 +17,7 @@
 #ifndef RTSH_BVH_H
 #define RTSH_BVH_H
 
+#include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -150,11 +151,13 @@ typedef struct bvh_build_opts {
 	void (*chop)(const void *ctx, uint32_t id, int axis, const float *pos, int n, bvh_fbox *box);
 	const void *ctx;
 	double split_budget; /* references allowed beyond n, a fraction of n */
+	const atomic_bool *cancel; /* when set, the build stops (NULL: never) */
 } bvh_build_opts;
 
 /* Builds the binary tree over n primitives of world bounds bounds[0..n)
  * (binned SAH, and spatial splits when o->chop is set). False (err set)
- * when out of memory or n is too large. */
+ * when out of memory or n is too large, or "stopped" when o->cancel was
+ * set during the build. */
 bool bvh2_build(const box *bounds, size_t n, const bvh_build_opts *o, bvh2 *t, rt_error *err);
 void bvh2_free(bvh2 *t);
 
@@ -179,7 +182,8 @@ double bvh_fbox_half_area(const bvh_fbox *b);
  * volume hierarchies", 2007). order[i] receives the primitive that goes to
  * place i of tree order (leaves index primitives in that order). NULL (err
  * set) when out of memory or n is too large. */
-bvh *bvh_build(const box *bounds, const float *costs, size_t n, uint32_t *order, rt_error *err);
+bvh *bvh_build(const box *bounds, const float *costs, size_t n, uint32_t *order, const atomic_bool *cancel,
+               rt_error *err);
 void bvh_free(bvh *t);
 
 #endif

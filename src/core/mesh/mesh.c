@@ -112,6 +112,7 @@ void mb_free(mesh_builder *b)
 	for (size_t i = 0; i < b->ntexs; i++)
 		texture_free(b->texs[i]);
 	free(b->texs);
+	free(b->warning);
 	memset(b, 0, sizeof *b);
 }
 
@@ -238,6 +239,8 @@ mesh *mb_finish(mesh_builder *b, rt_error *err)
 	m->texs = b->texs;
 	b->texs = NULL;
 	b->ntexs = 0;
+	m->warning = b->warning;
+	b->warning = NULL;
 	if (m->nmats > 1) {
 		m->tmat = b->fm;
 		b->fm = NULL;
@@ -286,6 +289,7 @@ void mesh_free(mesh *m)
 	for (uint32_t i = 0; i < m->ntexs; i++)
 		texture_free(m->texs[i]);
 	free(m->texs);
+	free(m->warning);
 	free(m->nodes);
 	free(m->blk);
 	free(m->btri);
@@ -356,7 +360,7 @@ static size_t normal_slot(const uint32_t *slot, size_t cap, const mesh *m, const
  * corners of equal vertex and normal find each other through a hash table,
  * not by comparing every pair. */
 #define CREASE_DEG_MAX 256
-static bool smooth_normals(mesh *m, double crease_deg, rt_error *err)
+static bool smooth_normals(mesh *m, double crease_deg, const atomic_bool *cancel, rt_error *err)
 {
 	uint32_t nv = m->nverts, nt = m->ntris;
 	size_t cap = 16;
@@ -403,6 +407,16 @@ static bool smooth_normals(mesh *m, double crease_deg, rt_error *err)
 	uint32_t next = nv;
 	for (uint32_t v = 0; v < nv; v++) {
 		uint32_t s = start[v], e = start[v + 1], deg = e - s;
+		if ((v & 0xffff) == 0 && cancel && atomic_load_explicit(cancel, memory_order_relaxed)) {
+			free(fn);
+			free(start);
+			free(list);
+			free(newid);
+			free(ang);
+			free(slot);
+			free(nn);
+			return rt_error_set(err, "stopped");
+		}
 		vec3 all = v3(0, 0, 0); /* the sum of every face, when the crease is ignored */
 		if (deg > CREASE_DEG_MAX)
 			for (uint32_t j = s; j < e; j++)
@@ -483,6 +497,11 @@ oom:
 
 bool mesh_prepare(mesh *m, bool smooth, double crease_deg, rt_error *err)
 {
+	return mesh_prepare_cancel(m, smooth, crease_deg, NULL, err);
+}
+
+bool mesh_prepare_cancel(mesh *m, bool smooth, double crease_deg, const atomic_bool *cancel, rt_error *err)
+{
 	char what[300];
 	snprintf(what, sizeof what, "the model %s (%u triangles)", m->path ? m->path : "", m->ntris);
 	if (!mem_check((double)m->ntris * MESH_PREPARE_BYTES, what, err))
@@ -490,10 +509,10 @@ bool mesh_prepare(mesh *m, bool smooth, double crease_deg, rt_error *err)
 	if (!smooth) {
 		free(m->n);
 		m->n = NULL;
-	} else if (!m->n && !smooth_normals(m, crease_deg, err)) {
+	} else if (!m->n && !smooth_normals(m, crease_deg, cancel, err)) {
 		return false;
 	}
-	if (!mesh_build_tree(m, err))
+	if (!mesh_build_tree(m, cancel, err))
 		return false;
 	/* triangles, then vertices, in the order the blocks first use them, so
 	 * that shading a leaf's triangles finds their data close together */

@@ -92,7 +92,7 @@ static pthread_mutex_t cache_lock = PTHREAD_MUTEX_INITIALIZER;
 static cache_entry *cache;
 static size_t ncache, ccache;
 
-mesh *mesh_cache_get(const char *path, bool smooth, double crease_deg, rt_error *err)
+mesh *mesh_cache_get(const char *path, bool smooth, double crease_deg, const atomic_bool *cancel, rt_error *err)
 {
 	struct stat st;
 	if (rt_file_stat(path, &st) != 0) {
@@ -116,7 +116,13 @@ mesh *mesh_cache_get(const char *path, bool smooth, double crease_deg, rt_error 
 	mesh *m = mesh_load(path, err);
 	if (!m)
 		return NULL;
-	if (!mesh_prepare(m, smooth, crease_deg, err)) {
+	/* the reader itself runs to its end; a stopped model is not cached */
+	if (cancel && atomic_load(cancel)) {
+		mesh_free(m);
+		rt_error_set(err, "stopped");
+		return NULL;
+	}
+	if (!mesh_prepare_cancel(m, smooth, crease_deg, cancel, err)) {
 		mesh_free(m);
 		return NULL;
 	}

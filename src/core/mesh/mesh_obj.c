@@ -116,12 +116,23 @@ static char *map_file(cursor *c, const char *dir, float *bm)
 	return p;
 }
 
-static bool read_mtl(mesh_builder *b, const char *path, const char *dir)
+static bool read_mtl(mesh_builder *b, const char *path, const char *dir, const char *obj_name, int line)
 {
 	size_t len;
-	char *buf = rt_file_read(path, "material library", &len, NULL);
-	if (!buf)
-		return true; /* a missing library leaves the defaults */
+	rt_error ferr;
+	rt_error_clear(&ferr);
+	char *buf = rt_file_read(path, "material library", &len, &ferr);
+	if (!buf) {
+		/* A missing library leaves the defaults, and says so (once). */
+		if (!b->warning) {
+			char why[RT_ERROR_MSG_MAX + RT_ERROR_FILE_MAX + 32], msg[sizeof why + 256];
+			rt_error_format(&ferr, why, sizeof why);
+			snprintf(msg, sizeof msg, "%s:%d: mtllib: %s; the model's materials are the defaults", obj_name, line,
+			         why);
+			b->warning = strdup(msg);
+		}
+		return true;
+	}
 	mesh_mat *cur = NULL;
 	bool ok = true;
 	const char *s = buf, *end = buf + len;
@@ -357,7 +368,7 @@ mesh *mesh_parse_obj(const char *name, const char *dir, const char *buf, size_t 
 				char *rel = dup_n(n, nn);
 				char *path = rel ? path_join(dir, rel) : NULL;
 				char *mdir = path ? path_dir(path) : NULL;
-				ok = mdir && read_mtl(&r.b, path, mdir);
+				ok = mdir && read_mtl(&r.b, path, mdir, r.name, r.line);
 				if (!ok)
 					bad(&r, "%s: out of memory", "mtllib");
 				free(rel);

@@ -199,7 +199,7 @@ static uint32_t blocks_of(uint32_t meta)
 	return meta ? ((meta & ~BVH_LEAF) + 3) / 4 : 0;
 }
 
-bool mesh_build_tree(mesh *m, rt_error *err)
+bool mesh_build_tree(mesh *m, const atomic_bool *cancel, rt_error *err)
 {
 	box *bounds = malloc((size_t)(m->ntris ? m->ntris : 1) * sizeof *bounds);
 	if (!bounds)
@@ -213,7 +213,7 @@ bool mesh_build_tree(mesh *m, rt_error *err)
 		bounds[t] = b;
 	}
 	bvh_build_opts o = {.block = 4, .trav = MESH_TRAVERSE, .leaf_max = MESH_LEAF_MAX, .chop = tri_chop, .ctx = m,
-	                    .split_budget = MESH_SPLIT_BUDGET};
+	                    .split_budget = MESH_SPLIT_BUDGET, .cancel = cancel};
 	bvh2 t;
 	rt_error e2 = {0};
 	bool ok = bvh2_build(bounds, m->ntris, &o, &t, &e2);

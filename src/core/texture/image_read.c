@@ -463,8 +463,12 @@ float *image_decode_rgb(const char *path, const unsigned char *buf, size_t len, 
 	case F_XPM:
 		return read_xpm(path, buf, len, srgb, w, h, err);
 	default:
-		rt_error_set(err, "%s: unknown image format \".%s\"; expected .png .jpg .jpeg .bmp .tga .hdr .ppm "
-		             ".pgm .pfm or .xpm", path, ext_of(path));
+		if (!*ext_of(path))
+			rt_error_set(err, "%s: the name has no extension; expected .png .jpg .jpeg .bmp .tga .hdr .ppm "
+			             ".pgm .pfm or .xpm", path);
+		else
+			rt_error_set(err, "%s: unknown image format \".%s\"; expected .png .jpg .jpeg .bmp .tga .hdr "
+			             ".ppm .pgm .pfm or .xpm", path, ext_of(path));
 		return NULL;
 	}
 }

@@ -145,7 +145,7 @@ static entry *cache;
 static size_t ncache, ccache;
 #define CACHE_KEEP 16
 
-texture *texture_cache_get(const char *path, bool srgb, rt_error *err)
+texture *texture_cache_get(const char *path, bool srgb, const atomic_bool *cancel, rt_error *err)
 {
 	struct stat st;
 	if (rt_file_stat(path, &st) != 0) {
@@ -166,6 +166,12 @@ texture *texture_cache_get(const char *path, bool srgb, rt_error *err)
 	texture *t = texture_load(path, srgb, err);
 	if (!t)
 		return NULL;
+	/* the decoder runs to its end; a stopped image is not cached */
+	if (cancel && atomic_load(cancel)) {
+		texture_free(t);
+		rt_error_set(err, "stopped");
+		return NULL;
+	}
 	if (!t->path) {
 		texture_free(t);
 		rt_error_set(err, "%s: out of memory", path);

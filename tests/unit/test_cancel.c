@@ -1,0 +1,166 @@
+/* rtsh — long work stops when its cancel flag is set (issue 31, defect 3:
+ * Ctrl-C in the shell): loading a scene with a large model, generating,
+ * building a world. The flag is set before the call, or from another thread
+ * while the work runs; the call then fails with "stopped", keeps nothing in
+ * the caches, and the same call without the flag succeeds after. */
+#include "testutil.h"
+
+#include <pthread.h>
+#include <stdatomic.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "rtsh/generate.h"
+#include "rtsh/mesh.h"
+#include "rtsh/rtfile.h"
+#include "rtsh/world.h"
+
+static char tmpdir[64];
+static char rt_path[128], obj_path[128];
+
+/* A model whose normals and tree take long: one polygon of 400000 corners
+ * on a circle (a fan whose first corner every triangle shares), and a
+ * scene that places it. */
+static int setup(void **state)
+{
+	(void)state;
+	snprintf(tmpdir, sizeof tmpdir, "/tmp/rtsh-cancel-XXXXXX");
+	if (!mkdtemp(tmpdir))
+		return -1;
+	snprintf(obj_path, sizeof obj_path, "%s/fan.obj", tmpdir);
+	snprintf(rt_path, sizeof rt_path, "%s/fan.rt", tmpdir);
+	FILE *f = fopen(obj_path, "w");
+	if (!f)
+		return -1;
+	const int n = 400000;
+	for (int i = 0; i < n; i++)
+		fprintf(f, "v %.9f %.9f %.9f\n", cos(2 * M_PI * i / n), sin(2 * M_PI * i / n), 0.1 * sin(40.0 * i / n));
+	fputc('f', f);
+	for (int i = 1; i <= n; i++)
+		fprintf(f, " %d", i);
+	fputc('\n', f);
+	fclose(f);
+	f = fopen(rt_path, "w");
+	if (!f)
+		return -1;
+	fprintf(f, "C 0,0,-5 0,0,1 60\nL 2,2,-5 1 255,255,255\nmesh fan.obj 0,0,0 0,1,0 2 200,200,200\n");
+	fclose(f);
+	return 0;
+}
+
+static int teardown(void **state)
+{
+	(void)state;
+	char cmd[128];
+	snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
+	return system(cmd) == 0 ? 0 : -1;
+}
+
+/* Sets *flag after `ms` milliseconds, from its own thread. */
+typedef struct later {
+	atomic_bool *flag;
+	int ms;
+} later;
+
+static void *set_later(void *arg)
+{
+	later *l = arg;
+	struct timespec ts = {l->ms / 1000, (long)(l->ms % 1000) * 1000000L};
+	nanosleep(&ts, NULL);
+	atomic_store(l->flag, true);
+	return NULL;
+}
+
+static void test_load_stops(void **state)
+{
+	(void)state;
+	atomic_bool cancel;
+	rt_error err;
+	/* already set: nothing is loaded */
+	atomic_init(&cancel, true);
+	rt_load_opts lo = {.cancel = &cancel};
+	assert_null(rt_load_file(rt_path, &lo, &err));
+	assert_non_null(strstr(err.msg, "stopped"));
+	/* set from another thread while the model's normals and tree are made
+	 * (the reader alone takes a fraction of that) */
+	atomic_store(&cancel, false);
+	later l = {&cancel, 30};
+	pthread_t th;
+	assert_int_equal(pthread_create(&th, NULL, set_later, &l), 0);
+	scene *s = rt_load_file(rt_path, &lo, &err);
+	pthread_join(th, NULL);
+	if (s) {
+		/* the machine finished the whole load in 30 ms: nothing to check */
+		print_message("the load ended before the flag was set\n");
+		scene_free(s);
+	} else {
+		assert_non_null(strstr(err.msg, "stopped"));
+	}
+	/* nothing half made stays in the cache: the same load without the flag
+	 * gives the whole model */
+	atomic_store(&cancel, false);
+	s = rt_load_file(rt_path, &lo, &err);
+	assert_non_null(s);
+	assert_int_equal(s->nobjs, 1);
+	mesh *m = mesh_cache_get(obj_path, true, s->objs[0].crease, NULL, &err);
+	assert_non_null(m);
+	/* the fan of a polygon of n corners: n - 2 triangles, less the few whose
+	 * corners round to one line in float */
+	assert_true(m->ntris <= 400000 - 2 && m->ntris > 399000);
+	mesh_cache_put(m);
+	scene_free(s);
+}
+
+static void test_generate_stops(void **state)
+{
+	(void)state;
+	atomic_bool cancel;
+	atomic_init(&cancel, true);
+	rt_error err;
+	assert_null(scene_generate(1000000, 7, &(gen_opts){.cancel = &cancel}, &err));
+	assert_string_equal(err.msg, "stopped");
+	atomic_store(&cancel, false);
+	scene *s = scene_generate(1000, 7, &(gen_opts){.cancel = &cancel}, &err);
+	assert_non_null(s);
+	scene_free(s);
+}
+
+static void test_world_build_stops(void **state)
+{
+	(void)state;
+	rt_error err;
+	scene *s = scene_generate(300000, 3, NULL, &err);
+	assert_non_null(s);
+	atomic_bool cancel;
+	atomic_init(&cancel, true);
+	assert_null(world_build_cancel(s, &cancel, &err));
+	assert_string_equal(err.msg, "stopped");
+	/* from another thread, during the build */
+	atomic_store(&cancel, false);
+	later l = {&cancel, 20};
+	pthread_t th;
+	assert_int_equal(pthread_create(&th, NULL, set_later, &l), 0);
+	world *w = world_build_cancel(s, &cancel, &err);
+	pthread_join(th, NULL);
+	if (w) {
+		print_message("the build ended before the flag was set\n");
+		world_release(w);
+	} else {
+		assert_string_equal(err.msg, "stopped");
+	}
+	w = world_build_cancel(s, NULL, &err);
+	assert_non_null(w);
+	assert_int_equal(w->nprims + w->nplanes, s->nobjs);
+	world_release(w);
+	scene_free(s);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+	    cmocka_unit_test(test_load_stops),
+	    cmocka_unit_test(test_generate_stops),
+	    cmocka_unit_test(test_world_build_stops),
+	};
+	return cmocka_run_group_tests(tests, setup, teardown);
+}
