@@ -141,16 +141,33 @@ typedef struct object {
 	double crease;    /* crease= degrees beyond which an edge stays sharp (60) */
 } object;
 
+/* The kinds of light: the miniRT light (no fall-off, `ratio` x colour),
+ * and the physical lights of glTF's KHR_lights_punctual (rtsh(5),
+ * "Lights"): a point or a spot of `intensity` candela, with
+ * inverse-square fall-off, or a sun of `intensity` lux shining along dir;
+ * their brightness is ratio x intensity x colour (linear). */
+enum { LIGHT_MINIRT, LIGHT_POINT, LIGHT_SPOT, LIGHT_SUN };
+
 typedef struct light {
 	vec3 pos;
 	double ratio; /* brightness [0,1] */
 	vec3 color;   /* sRGB 0..255 */
+	/* physical lights (L ... cd= or lux=): kind != LIGHT_MINIRT */
+	int kind;
+	double intensity; /* cd= candela (point, spot) or lux= (sun), >= 0 */
+	vec3 dir;         /* dir= where a spot or the sun shines; never zero for them */
+	double inner, outer; /* cone=INNER,OUTER: a spot's cone half-angles, degrees */
+	double range;     /* range= distance where a point or spot ends (glTF's
+	                   * window), 0 = none */
 } light;
 
 typedef struct camera {
 	vec3 pos;
 	vec3 dir;   /* as written; never zero */
-	double fov; /* horizontal, degrees, (0,180) */
+	double fov; /* horizontal, degrees, (0,180); vertical when `vertical` */
+	bool vertical; /* vertical=1: fov is the vertical angle (glTF's yfov) */
+	double ortho;  /* ortho=H > 0: an orthographic view H high above and below
+	                * the centre (glTF's ymag); 0: perspective */
 } camera;
 
 typedef struct ambient {
@@ -189,6 +206,10 @@ typedef struct scene {
 	bool has_sky;
 	sky sky;
 	scene_hints hints;
+	/* What the status line says about the scene beside its name (the glTF
+	 * loader: "stage lighting" for a file with no light of its own);
+	 * rt_intern'ed, NULL = nothing. Not saved. */
+	const char *note;
 } scene;
 
 scene *scene_new(void);

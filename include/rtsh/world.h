@@ -67,8 +67,48 @@ typedef struct mat_tex {
 
 typedef struct light_lin {
 	vec3 pos;
-	vec3 radiance; /* ratio x linear colour */
+	vec3 radiance; /* ratio x linear colour; physical lights: ratio x intensity x colour / pi */
+	int kind;      /* LIGHT_* (scene.h) */
+	vec3 dir;      /* spot, sun: unit, where it shines */
+	double cos_outer, cone_scale; /* spot: glTF's smooth cone (KHR_lights_punctual) */
+	double range;  /* point, spot: 0 none */
 } light_lin;
+
+/* What light l sends to the point p: the direction *wi to it and its
+ * distance *dist (INFINITY for a sun), and the radiance L for which the
+ * irradiance at normal incidence is pi L (the miniRT convention: a white
+ * Lambertian surface facing a miniRT light sends back ratio x colour). A
+ * physical light's irradiance follows the inverse-square law: I / d^2
+ * for I candela (times the spot's cone and the range window), E for a sun
+ * of E lux. Zero when p gets nothing (behind a spot's cone, at the light). */
+static inline vec3 light_at(const light_lin *l, vec3 p, vec3 *wi, double *dist)
+{
+	if (l->kind == LIGHT_SUN) {
+		*wi = v3_neg(l->dir);
+		*dist = INFINITY;
+		return l->radiance;
+	}
+	vec3 to = v3_sub(l->pos, p);
+	double d2 = v3_dot(to, to), d = sqrt(d2);
+	*dist = d;
+	*wi = v3(0, 1, 0);
+	if (!(d > 0.0))
+		return v3(0, 0, 0);
+	*wi = v3_scale(to, 1.0 / d);
+	if (l->kind == LIGHT_MINIRT)
+		return l->radiance;
+	double f = 1.0 / d2;
+	if (l->range > 0) { /* glTF's recommended window: (1 - (d / range)^4) clamped, squared */
+		double q = d / l->range, w = 1.0 - q * q * q * q;
+		f *= w > 0 ? w * w : 0;
+	}
+	if (l->kind == LIGHT_SPOT) {
+		double a = (v3_dot(l->dir, v3_neg(*wi)) - l->cos_outer) * l->cone_scale;
+		a = a < 0 ? 0 : a > 1 ? 1 : a;
+		f *= a * a;
+	}
+	return v3_scale(l->radiance, f);
+}
 
 /* An emissive surface the path tracer samples directly (emitters.h). */
 typedef struct emitter emitter;
@@ -77,8 +117,18 @@ typedef struct emitter emitter;
  * ray direction is fwd + u*half_w*right + v*half_h*up with u, v in [-1,1]. */
 typedef struct cam_view {
 	vec3 pos, fwd, right, up;
-	double tan_half; /* tan(fov / 2), horizontal */
+	double tan_half; /* tan(fov / 2), horizontal (vertical when `vertical`) */
+	bool vertical;   /* camera.vertical: the fov is the vertical angle */
+	double ortho;    /* > 0: orthographic, this half height (camera.ortho) */
 } cam_view;
+
+/* tan(horizontal fov / 2) of c on a w x h image; 0 for an orthographic view. */
+static inline double cam_tan_x(const cam_view *c, int w, int h)
+{
+	if (c->ortho > 0)
+		return 0;
+	return c->vertical ? c->tan_half * w / h : c->tan_half;
+}
 
 /* Float or double (measured for issue 5; figures in bench/README.md): rays,
  * primitives and hits are double, as math.h explains. The BVH (bvh.h) keeps

@@ -191,23 +191,22 @@ static vec3 phong_whitted(const world *w, const mat_lin *m, const hit *hp, ray r
 
 	vec3 c = v3_add(v3_mul(w->ambient, albedo), m->emission);
 	for (size_t i = 0; i < w->nlights; i++) {
-		const light_lin *l = &w->lights[i];
-		vec3 to = v3_sub(l->pos, p);
-		double dist = v3_len(to);
-		if (!(dist > 0.0))
+		vec3 ld;
+		double dist;
+		vec3 lr = light_at(&w->lights[i], p, &ld, &dist); /* physical lights fall off */
+		if (!(lr.x > 0.0 || lr.y > 0.0 || lr.z > 0.0))
 			continue;
-		vec3 ld = v3_scale(to, 1.0 / dist);
 		double ndl = v3_dot(n, ld);
 		if (ndl <= 0.0)
 			continue;
 		ray sr = {p, ld};
 		if (world_occluded(w, &sr, 0.0, dist))
 			continue;
-		c = v3_add(c, v3_mul(l->radiance, v3_scale(albedo, m->diffuse * ndl)));
+		c = v3_add(c, v3_mul(lr, v3_scale(albedo, m->diffuse * ndl)));
 		if (m->specular > 0.0) {
 			double rv = v3_dot(v3_reflect(v3_neg(ld), n), v);
 			if (rv > 0.0)
-				c = v3_add(c, v3_scale(l->radiance, m->specular * pow(rv, m->shininess)));
+				c = v3_add(c, v3_scale(lr, m->specular * pow(rv, m->shininess)));
 		}
 	}
 	if (depth <= 0)

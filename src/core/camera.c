@@ -14,13 +14,23 @@ cam_view cam_view_make(const camera *c)
 	v.up = v3_cross(v.fwd, v.right);
 	double fov = clampd(c->fov, 0.01, 179.99);
 	v.tan_half = tan(deg_to_rad(fov) * 0.5);
+	v.vertical = c->vertical;
+	v.ortho = c->ortho > 0 ? c->ortho : 0;
 	return v;
 }
 
 ray cam_ray(const cam_view *c, double fx, double fy, int w, int h)
 {
-	double u = (2.0 * fx / w - 1.0) * c->tan_half;
-	double v = (1.0 - 2.0 * fy / h) * c->tan_half * ((double)h / w);
+	double x = 2.0 * fx / w - 1.0, y = 1.0 - 2.0 * fy / h;
+	if (c->ortho > 0) { /* parallel rays from the image's rectangle */
+		vec3 o = v3_add(c->pos, v3_add(v3_scale(c->right, x * c->ortho * w / h), v3_scale(c->up, y * c->ortho)));
+		return (ray){o, c->fwd};
+	}
+	double u = x * c->tan_half, v = y * c->tan_half;
+	if (c->vertical)
+		u *= (double)w / h;
+	else
+		v *= (double)h / w;
 	vec3 d = v3_add(c->fwd, v3_add(v3_scale(c->right, u), v3_scale(c->up, v)));
 	return (ray){c->pos, v3_norm(d)};
 }

@@ -37,25 +37,20 @@ static vec3 direct_light(const world *w, const bsdf *b, vec3 p, vec3 pdn)
 	vec3 sum = v3(0, 0, 0);
 	for (size_t i = 0; i < w->nlights; i++) {
 		const light_lin *l = &w->lights[i];
-		vec3 o = p;
-		vec3 to = v3_sub(l->pos, o);
-		double dist = v3_len(to);
-		if (!(dist > 0.0))
+		vec3 o = p, wi;
+		double dist;
+		vec3 lr = light_at(l, o, &wi, &dist); /* physical lights fall off */
+		if (!(lr.x > 0.0 || lr.y > 0.0 || lr.z > 0.0))
 			continue;
-		vec3 wi = v3_scale(to, 1.0 / dist);
 		double c = v3_dot(b->n, wi);
 		if (c <= 0.0) {
 			/* a light below the surface, seen through a rough transmission */
 			if (!b->through)
 				continue;
 			o = pdn;
-			to = v3_sub(l->pos, o);
-			dist = v3_len(to);
-			if (!(dist > 0.0))
-				continue;
-			wi = v3_scale(to, 1.0 / dist);
+			lr = light_at(l, o, &wi, &dist);
 			c = -v3_dot(b->n, wi);
-			if (c <= 0.0)
+			if (!(lr.x > 0.0 || lr.y > 0.0 || lr.z > 0.0) || c <= 0.0)
 				continue;
 		}
 		vec3 f = bsdf_eval(b, wi);
@@ -65,7 +60,7 @@ static vec3 direct_light(const world *w, const bsdf *b, vec3 p, vec3 pdn)
 		if (world_occluded(w, &sr, 0.0, dist))
 			continue;
 		/* f x irradiance, the irradiance being pi L cos (see above) */
-		sum = v3_add(sum, v3_mul(f, v3_scale(l->radiance, RT_PI * c)));
+		sum = v3_add(sum, v3_mul(f, v3_scale(lr, RT_PI * c)));
 	}
 	return sum;
 }

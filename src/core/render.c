@@ -173,7 +173,7 @@ static void render_tile(shared *sh, long t)
 	int x1 = x0 + RENDER_TILE < fb->w ? x0 + RENDER_TILE : fb->w;
 	int y1 = y0 + RENDER_TILE < fb->h ? y0 + RENDER_TILE : fb->h;
 	double inv = 1.0 / job->sample_end;
-	texture_set_pixel_angle(2.0 * job->w->cam.tan_half / fb->w); /* texture footprints */
+	texture_set_pixel_angle(2.0 * cam_tan_x(&job->w->cam, fb->w, fb->h) / fb->w); /* texture footprints */
 	for (int y = y0; y < y1; y++)
 		for (int x = x0; x < x1; x++) {
 			size_t i = ((size_t)y * (size_t)fb->w + (size_t)x) * 3;
@@ -203,7 +203,7 @@ void render_rect(const world *w, const render_settings *s, int x0, int y0, int x
                  float *out)
 {
 	double inv = 1.0 / s->samples;
-	texture_set_pixel_angle(2.0 * w->cam.tan_half / s->width); /* as render_tile */
+	texture_set_pixel_angle(2.0 * cam_tan_x(&w->cam, s->width, s->height) / s->width); /* as render_tile */
 	for (int y = y0; y < y1; y++)
 		for (int x = x0; x < x1; x++) {
 			double acc[3] = {0.0, 0.0, 0.0};

@@ -44,12 +44,11 @@ vec3 whitted_lights(const world *w, const bsdf *b, vec3 p)
 {
 	vec3 c = v3(0, 0, 0);
 	for (size_t i = 0; i < w->nlights; i++) {
-		const light_lin *l = &w->lights[i];
-		vec3 to = v3_sub(l->pos, p);
-		double dist = v3_len(to);
-		if (!(dist > 0.0))
+		vec3 ld;
+		double dist;
+		vec3 lr = light_at(&w->lights[i], p, &ld, &dist); /* physical lights fall off */
+		if (!(lr.x > 0.0 || lr.y > 0.0 || lr.z > 0.0))
 			continue;
-		vec3 ld = v3_scale(to, 1.0 / dist);
 		double ndl = v3_dot(b->n, ld);
 		if (ndl <= 0.0)
 			continue;
@@ -59,7 +58,7 @@ vec3 whitted_lights(const world *w, const bsdf *b, vec3 p)
 		ray sr = {p, ld};
 		if (world_occluded(w, &sr, 0.0, dist))
 			continue;
-		c = v3_add(c, v3_mul(f, v3_scale(l->radiance, RT_PI * ndl)));
+		c = v3_add(c, v3_mul(f, v3_scale(lr, RT_PI * ndl)));
 	}
 	return c;
 }

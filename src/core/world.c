@@ -224,8 +224,20 @@ world *world_build_cancel(const scene *s, const atomic_bool *cancel, rt_error *e
 	}
 	w->nlights = s->nlights;
 	for (size_t i = 0; i < s->nlights; i++) {
-		w->lights[i].pos = s->lights[i].pos;
-		w->lights[i].radiance = v3_scale(srgb255_to_linear(s->lights[i].color), s->lights[i].ratio);
+		const light *sl = &s->lights[i];
+		light_lin *l = &w->lights[i];
+		l->pos = sl->pos;
+		l->radiance = v3_scale(srgb255_to_linear(sl->color), sl->ratio);
+		l->kind = sl->kind;
+		if (sl->kind != LIGHT_MINIRT) {
+			/* I candela at d give I / d^2 lux: pi L = I (see light_at) */
+			l->radiance = v3_scale(l->radiance, sl->intensity / RT_PI);
+			l->dir = v3_len(sl->dir) > 0 ? v3_norm(sl->dir) : v3(0, -1, 0);
+			l->range = sl->range;
+			double ci = cos(deg_to_rad(sl->inner)), co = cos(deg_to_rad(sl->outer));
+			l->cos_outer = co;
+			l->cone_scale = 1.0 / fmax(1e-3, ci - co);
+		}
 	}
 	w->nmats = s->nobjs;
 	if (!surf_begin(w, s, err)) {

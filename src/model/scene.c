@@ -157,12 +157,15 @@ bool object_equal(const object *a, const object *b)
 
 static bool light_equal(const light *a, const light *b)
 {
-	return v3_eq(a->pos, b->pos) && a->ratio == b->ratio && v3_eq(a->color, b->color);
+	return v3_eq(a->pos, b->pos) && a->ratio == b->ratio && v3_eq(a->color, b->color) && a->kind == b->kind &&
+	       a->intensity == b->intensity && v3_eq(a->dir, b->dir) && a->inner == b->inner && a->outer == b->outer &&
+	       a->range == b->range;
 }
 
 static bool camera_equal(const camera *a, const camera *b)
 {
-	return v3_eq(a->pos, b->pos) && v3_eq(a->dir, b->dir) && a->fov == b->fov;
+	return v3_eq(a->pos, b->pos) && v3_eq(a->dir, b->dir) && a->fov == b->fov && a->vertical == b->vertical &&
+	       a->ortho == b->ortho;
 }
 
 bool scene_equal(const scene *a, const scene *b)
@@ -274,7 +277,7 @@ void scene_remove_light(scene *s, size_t i)
 camera scene_camera(const scene *s)
 {
 	if (s->ncams == 0)
-		return (camera){v3(0, 0, -5), v3(0, 0, 1), 70.0};
+		return (camera){v3(0, 0, -5), v3(0, 0, 1), 70.0, false, 0};
 	return s->cams[s->cam < s->ncams ? s->cam : 0];
 }
 

@@ -12,6 +12,7 @@
 
 #include "rtsh/memory.h"
 #include "rtsh/num.h"
+#include "rtsh/texture.h"
 #include "rtsh/world.h"
 #include "scene/rtfile_priv.h"
 
@@ -712,10 +713,45 @@ bool editor_object_set_key(editor *ed, size_t i, const char *assignment, rt_erro
 		                    !eq ? "not KEY=VALUE" : !k ? "an unknown key" : "a key this object does not take",
 		                    list);
 	}
-	if (k->type != RT_KEY_NUM)
-		return rt_error_set(err, "\"%s\": %s= takes a file, U,V or R,G,B; expected it on the object's line "
-		                         "(add, or edit the .rt file)",
-		                    assignment, k->name);
+	if (k->type == RT_KEY_FILE) {
+		/* An image file, read now (once, by the cache) so that a bad one
+		 * is refused here and not at the next render. */
+		const char *name = eq + 1;
+		if (!*name)
+			return rt_error_set(err, "\"%s\": the file name is empty; expected %s", assignment, k->expect);
+		rt_error ferr;
+		rt_error_clear(&ferr);
+		texture *tx = texture_cache_get(name, strcmp(k->name, "texture") == 0, NULL, &ferr);
+		if (!tx) {
+			char msg[RT_ERROR_MSG_MAX + RT_ERROR_FILE_MAX + 32];
+			rt_error_format(&ferr, msg, sizeof msg);
+			return rt_error_set(err, "\"%s\": %s", assignment, msg);
+		}
+		texture_cache_put(tx);
+		const char *kept = rt_intern(name, strlen(name));
+		if (!kept)
+			return rt_error_set(err, "\"%s\": out of memory", assignment);
+		memcpy((char *)&o + k->offset, &kept, sizeof kept);
+		return editor_set_object(ed, i, &o, err);
+	}
+	if (k->type == RT_KEY_PAIR || k->type == RT_KEY_RGB) {
+		/* U,V or R,G,B, each in the key's range. */
+		int n = k->type == RT_KEY_PAIR ? 2 : 3;
+		double c[3];
+		const char *p = eq + 1;
+		for (int j = 0; j < n; j++) {
+			const char *end = j < n - 1 ? strchr(p, ',') : p + strlen(p);
+			if (!end || num_scan(p, (size_t)(end - p), RT_NUM_MAX, &c[j]) != NUM_OK || c[j] < k->min ||
+			    c[j] > k->max)
+				return rt_error_set(err, "\"%s\" is not valid; expected %s", assignment, k->expect);
+			p = end + 1;
+		}
+		if (strcmp(k->name, "uvscale") == 0 && (c[0] == 0 || c[1] == 0))
+			return rt_error_set(err, "\"%s\" has a zero component; expected %s", assignment, k->expect);
+		if (!rt_key_set_n(k, &o, c, n))
+			return rt_error_set(err, "\"%s\": out of memory", assignment);
+		return editor_set_object(ed, i, &o, err);
+	}
 	double v;
 	if (num_scan_str(eq + 1, RT_NUM_MAX, &v) != NUM_OK || v < k->min || v > k->max ||
 	    (k->is_int && v != floor(v)) || (k->extra && !k->extra(v)))

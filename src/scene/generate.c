@@ -227,12 +227,12 @@ static bool gen_setting(scene *s, uint64_t seed, rt_error *err)
 	gen_rng r = gen_stream(seed, 1);
 	s->has_ambient = true;
 	s->amb = (ambient){0.15, v3(180, 200, 255)};
-	camera cam = {v3(0, 7, -17), v3(0, -4, 17), 60};
+	camera cam = {v3(0, 7, -17), v3(0, -4, 17), 60, false, 0};
 	if (!scene_add_camera(s, &cam, err))
 		return false;
 	int64_t nl = gen_int(&r, 2, 4);
 	for (int64_t i = 0; i < nl; i++) {
-		light l;
+		light l = {0};
 		l.pos = v3((double)gen_int(&r, -90, 90) / 10.0, (double)gen_int(&r, 70, 130) / 10.0,
 		           (double)gen_int(&r, -120, 60) / 10.0);
 		l.ratio = (double)(gen_int(&r, 50, 90) * 2 / nl) / 100.0;

@@ -200,8 +200,20 @@ static bool lex_line(parser *p, const char *s, size_t len)
 			continue;
 		}
 		for (;;) {
-			while (i < len && !is_blank(s[i]) && !comment_at(s, i, len))
+			while (i < len && !is_blank(s[i]) && !comment_at(s, i, len)) {
+				if (s[i] == '"' && out > t.s && out[-1] == '=') {
+					/* KEY="a file name": blanks, '#' and ',' are its own */
+					const char *q = memchr(s + i + 1, '"', len - i - 1);
+					if (!q)
+						return fail(p, (int)i + 1, "a quote that is not closed; expected KEY=\"NAME\"");
+					size_t n = (size_t)(q - (s + i + 1));
+					memcpy(out, s + i + 1, n);
+					out += n;
+					i = (size_t)(q - s) + 1;
+					continue;
+				}
 				*out++ = s[i++];
+			}
 			t.endcol = (int)i + 1;
 			size_t j = i;
 			while (j < len && is_blank(s[j]))
@@ -439,14 +451,68 @@ static bool parse_ambient(parser *p, const elem_def *e)
 	return r >= 0;
 }
 
+/* The key=value fields of a light or camera line: each token after the
+ * positional ones split into its name and a token of its value; -1 when
+ * the name is none of names[] (err set), else its index. */
+static int elem_key(parser *p, const elem_def *e, size_t i, const char *const *names, size_t nnames, unsigned *seen,
+                    tok *val)
+{
+	const tok *t = &p->toks[i];
+	const char *eq = memchr(t->s, '=', t->len);
+	char list[160] = "";
+	for (size_t k = 0; k < nnames; k++)
+		snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s=", k ? " " : "", names[k]);
+	if (p->strict) {
+		fail_tok(p, t, e->name, "key", "is not allowed in strict mode", "no key=value fields");
+		return -1;
+	}
+	if (!eq) {
+		fail(p, t->col, "%s field \"%s\" comes after the key=value fields; expected the key=value fields last",
+		     e->name, quoted(p, t));
+		return -1;
+	}
+	size_t n = (size_t)(eq - t->s);
+	for (size_t k = 0; k < nnames; k++)
+		if (strlen(names[k]) == n && memcmp(names[k], t->s, n) == 0) {
+			if (*seen & (1u << k)) {
+				fail_tok(p, t, e->name, "key", "repeats a key", "each key at most once");
+				return -1;
+			}
+			*seen |= 1u << k;
+			*val = *t;
+			val->s = eq + 1;
+			val->len = t->len - n - 1;
+			val->col = t->col + (int)n + 1;
+			return (int)k;
+		}
+	fail_tok(p, t, e->name, "key", "is unknown", list);
+	return -1;
+}
+
 static bool parse_camera(parser *p, const elem_def *e)
 {
-	camera c;
-	if (!no_keys(p, e) || !count_ok(p, e, 3, 3, e->usage) ||
-	    !get_vec(p, &p->toks[1], e->name, "position", &R_ANY, &c.pos) ||
+	camera c = {0};
+	if (!count_ok(p, e, 3, 3, e->usage) || !get_vec(p, &p->toks[1], e->name, "position", &R_ANY, &c.pos) ||
 	    !get_dir(p, &p->toks[2], e->name, "direction", &c.dir) ||
 	    !get_num(p, &p->toks[3], e->name, "fov", &R_FOV, &c.fov))
 		return false;
+	static const char *const cam_keys[] = {"vertical", "ortho"};
+	unsigned seen = 0;
+	for (size_t i = p->np + 1; i < p->ntoks; i++) {
+		tok v;
+		double x;
+		int k = elem_key(p, e, i, cam_keys, 2, &seen, &v);
+		if (k < 0)
+			return false;
+		if (k == 0) {
+			static const range R_BOOL = {0, 1, false, true, "0 or 1"};
+			if (!get_num(p, &v, e->name, "vertical=", &R_BOOL, &x))
+				return false;
+			c.vertical = x != 0;
+		} else if (!get_num(p, &v, e->name, "ortho=", &R_POS, &c.ortho)) {
+			return false;
+		}
+	}
 	bool clamped;
 	if (!fov_rule(&c.fov, &clamped, p->err)) /* R_FOV has checked [0,180] */
 		return false;
@@ -467,7 +533,8 @@ static bool parse_camera(parser *p, const elem_def *e)
 	bool same = false;
 	if (p->line_c) {
 		const camera *o = &s->cams[p->cam_c];
-		same = v3_eq(o->pos, c.pos) && v3_eq(o->dir, c.dir) && o->fov == c.fov;
+		same = v3_eq(o->pos, c.pos) && v3_eq(o->dir, c.dir) && o->fov == c.fov && o->vertical == c.vertical &&
+		       o->ortho == c.ortho;
 	}
 	int r = once(p, e, "C", &p->line_c, same);
 	if (r > 0) {
@@ -480,12 +547,55 @@ static bool parse_camera(parser *p, const elem_def *e)
 static bool parse_light(parser *p, const elem_def *e)
 {
 	light l = {.color = v3_splat(255)};
-	if (!no_keys(p, e) || !count_ok(p, e, p->strict ? 3 : 2, 3, usage_of(p, e)) ||
+	if (!count_ok(p, e, p->strict ? 3 : 2, 3, usage_of(p, e)) ||
 	    !get_vec(p, &p->toks[1], e->name, "position", &R_ANY, &l.pos) ||
 	    !get_num(p, &p->toks[2], e->name, "ratio", &R_RATIO, &l.ratio))
 		return false;
 	if (p->np == 3 && !get_color(p, &p->toks[3], e->name, "colour", &l.color))
 		return false;
+	/* physical lights: cd= (point; with cone=, a spot) or lux= (a sun) */
+	static const char *const light_keys[] = {"cd", "lux", "dir", "cone", "range"};
+	unsigned seen = 0;
+	int last = 0;
+	for (size_t i = p->np + 1; i < p->ntoks; i++) {
+		tok v;
+		double x[2];
+		int k = elem_key(p, e, i, light_keys, 5, &seen, &v);
+		if (k < 0)
+			return false;
+		last = p->toks[i].col;
+		static const range R_CONE = {0, 90, false, false, "degrees in [0,90]"};
+		if ((k == 0 || k == 1) && !get_num(p, &v, e->name, k ? "lux=" : "cd=", &R_NONNEG, &l.intensity))
+			return false;
+		if (k == 2 && !get_dir(p, &v, e->name, "dir=", &l.dir))
+			return false;
+		if (k == 3) {
+			if (!get_tuple(p, &v, e->name, "cone=", 2, "INNER,OUTER", &R_CONE, x))
+				return false;
+			if (!(x[0] < x[1]))
+				return fail_tok(p, &v, e->name, "cone=", "has inner >= outer",
+				                "INNER,OUTER degrees with INNER < OUTER");
+			l.inner = x[0];
+			l.outer = x[1];
+		}
+		if (k == 4 && !get_num(p, &v, e->name, "range=", &R_NONNEG, &l.range))
+			return false;
+	}
+	if (seen) {
+		bool cd = seen & 1, lux = seen & 2;
+		if (cd == lux)
+			return fail(p, last, "light: %s; expected cd=CANDELA (a point or spot light) or lux=LUX (a sun)",
+			            cd ? "both cd= and lux=" : "dir=, cone= or range= without cd= or lux=");
+		if (lux && (seen & (8 | 16)))
+			return fail(p, last, "light: cone= or range= on a sun (lux=); expected them with cd=");
+		if (lux && !(seen & 4))
+			return fail(p, last, "light: a sun (lux=) without dir=; expected dir=X,Y,Z, where it shines");
+		if ((seen & 8) && !(seen & 4))
+			return fail(p, last, "light: a spot (cone=) without dir=; expected dir=X,Y,Z, where it shines");
+		l.kind = lux ? LIGHT_SUN : (seen & 8) ? LIGHT_SPOT : LIGHT_POINT;
+		if (l.kind == LIGHT_POINT)
+			l.dir = v3(0, 0, 0); /* unused: not kept */
+	}
 	if (p->strict && p->line_l)
 		return fail(p, p->toks[0].col,
 		            "light: a second L line; expected exactly one in strict mode (the first "
@@ -981,10 +1091,10 @@ static bool parse_mesh(parser *p, const elem_def *e)
  * kind's own identifier and then its alias. */
 static const elem_def elements_head[] = {
 	{"A", "ambient", -1, true, parse_ambient, "A RATIO R,G,B", NULL, NULL},
-	{"C", "camera", -1, true, parse_camera, "C POSITION DIRECTION FOV", NULL, NULL},
-	{"c", "camera", -1, false, parse_camera, "c POSITION DIRECTION FOV", NULL, NULL},
-	{"L", "light", -1, true, parse_light, "L POSITION RATIO [R,G,B]", "L POSITION RATIO R,G,B", NULL},
-	{"l", "light", -1, false, parse_light, "l POSITION RATIO [R,G,B]", NULL, NULL},
+	{"C", "camera", -1, true, parse_camera, "C POSITION DIRECTION FOV [vertical=1] [ortho=HALF_HEIGHT]", "C POSITION DIRECTION FOV", NULL},
+	{"c", "camera", -1, false, parse_camera, "c POSITION DIRECTION FOV [vertical=1] [ortho=HALF_HEIGHT]", NULL, NULL},
+	{"L", "light", -1, true, parse_light, "L POSITION RATIO [R,G,B] [cd=CANDELA [dir=X,Y,Z cone=INNER,OUTER] [range=R] | lux=LUX dir=X,Y,Z]", "L POSITION RATIO R,G,B", NULL},
+	{"l", "light", -1, false, parse_light, "l POSITION RATIO [R,G,B] [cd=CANDELA [dir=X,Y,Z cone=INNER,OUTER] [range=R] | lux=LUX dir=X,Y,Z]", NULL, NULL},
 	{"R", "resolution", -1, false, parse_resolution, "R WIDTH HEIGHT", NULL, NULL},
 };
 static const elem_def elements_tail[] = {

@@ -128,7 +128,7 @@ void rt_write_file_name(const char *file, char *out, size_t size)
 	if (n && strncmp(file, dir, n) == 0 && file[n] == '/')
 		name = file + n + 1;
 	else if (n && file[0] != '/' && realpath(file, abs))
-		name = abs;
+		name = strncmp(abs, dir, n) == 0 && abs[n] == '/' ? abs + n + 1 : abs; /* below it after all */
 	bool quote = strpbrk(name, " \t,#\"") != NULL || strstr(name, "//") != NULL || !name[0];
 	snprintf(out, size, "%s%s%s", quote ? "\"" : "", name, quote ? "\"" : "");
 }
@@ -262,6 +262,28 @@ static void fmt_light(sbuf *b, const light *l)
 	sb_vec(b, l->pos);
 	sb_field(b, l->ratio);
 	sb_vec(b, l->color);
+	if (l->kind == LIGHT_MINIRT)
+		return;
+	sb_put(b, l->kind == LIGHT_SUN ? " lux=" : " cd=");
+	sb_num(b, l->intensity);
+	if (l->kind != LIGHT_POINT) {
+		sb_put(b, " dir=");
+		sb_num(b, l->dir.x);
+		sb_put(b, ",");
+		sb_num(b, l->dir.y);
+		sb_put(b, ",");
+		sb_num(b, l->dir.z);
+	}
+	if (l->kind == LIGHT_SPOT) {
+		sb_put(b, " cone=");
+		sb_num(b, l->inner);
+		sb_put(b, ",");
+		sb_num(b, l->outer);
+	}
+	if (l->kind != LIGHT_SUN && l->range > 0) {
+		sb_put(b, " range=");
+		sb_num(b, l->range);
+	}
 }
 
 static void fmt_camera(sbuf *b, const camera *c, const char *id)
@@ -270,6 +292,12 @@ static void fmt_camera(sbuf *b, const camera *c, const char *id)
 	sb_vec(b, c->pos);
 	sb_vec(b, c->dir);
 	sb_field(b, c->fov);
+	if (c->vertical)
+		sb_put(b, " vertical=1");
+	if (c->ortho > 0) {
+		sb_put(b, " ortho=");
+		sb_num(b, c->ortho);
+	}
 }
 
 void rt_format_object(const object *o, char *buf, size_t size)

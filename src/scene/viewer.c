@@ -7,15 +7,160 @@
  * shoulder, a soft ambient and a sky. The model keeps its own materials. `save x.rt` writes it out with a mesh
  * line that references the model.
  */
+#include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
+#include "rtsh/gltf.h"
 #include "rtsh/mesh.h"
 #include "rtsh/rtfile.h"
+#include "rtsh/world.h"
+
+/* --- glTF 2.0 scenes --- */
+
+static bool has_ext(const char *path, const char *ext)
+{
+	const char *slash = strrchr(path, '/'), *dot = strrchr(slash ? slash : path, '.');
+	return dot && strcasecmp(dot + 1, ext) == 0;
+}
+
+/* Appends to the scene text; false when it would not fit. */
+static bool put(char *text, size_t size, size_t *n, const char *fmt, ...) __attribute__((format(printf, 4, 5)));
+static bool put(char *text, size_t size, size_t *n, const char *fmt, ...)
+{
+	va_list ap;
+	va_start(ap, fmt);
+	int k = vsnprintf(text + *n, size - *n, fmt, ap);
+	va_end(ap);
+	if (k < 0 || (size_t)k >= size - *n)
+		return false;
+	*n += (size_t)k;
+	return true;
+}
+
+/* `rtsh scene.glb`: the file as a scene (rtsh(5), "glTF scenes"). Its
+ * triangles are one mesh line placed so that the file's coordinates are the
+ * scene's (the box centred where it is, its longest side its own size);
+ * every camera the nodes place (the first is used) and every
+ * KHR_lights_punctual light, in physical units. A file without a camera is
+ * framed as the model viewer frames a model; one with neither lights nor
+ * emissive materials gets the viewer's stage lighting, and its status line
+ * says so; otherwise it is lit by what it holds, on black, in path mode. */
+static char *gltf_text(const char *path, const rt_load_opts *opts, size_t *len, bool *stage_lit, rt_error *err)
+{
+	mesh *m = mesh_cache_get(path, true, 60, opts ? opts->cancel : NULL, err);
+	if (!m)
+		return NULL;
+	box bb = m->bounds;
+	mesh_cache_put(m);
+	gltf_info gi;
+	if (!gltf_read_info(path, &gi, err))
+		return NULL;
+	vec3 ext = v3_sub(bb.hi, bb.lo), mid = box_center(bb);
+	double longest = v3_max_comp(ext);
+	if (!(longest > 0))
+		longest = 1;
+	const char *slash = strrchr(path, '/');
+	const char *base = slash ? slash + 1 : path;
+	bool quote = strpbrk(base, " \t,#\"") != NULL;
+	bool stage = gi.nlights == 0 && !gi.emissive;
+	*stage_lit = stage;
+	size_t size = 4096 + 256 * (gi.ncams + gi.nlights), n = 0;
+	char *text = malloc(size);
+	if (!text) {
+		rt_error_set(err, "%s: out of memory", path);
+		goto done;
+	}
+	bool ok = put(text, size, &n, "# the glTF scene %s\nmesh %s%s%s %.17g,%.17g,%.17g 0,1,0 %.17g\n", base,
+	              quote ? "\"" : "", base, quote ? "\"" : "", mid.x, mid.y, mid.z, longest);
+	/* the viewer's framing: the bounding sphere from the front, a little
+	 * above and to the right, 50 degrees across a 16:9 image */
+	double radius = 0.5 * v3_len(ext), fov = 50, vhalf = atan(tan(fov * M_PI / 360) * 9.0 / 16.0);
+	double dist = 0.85 * (radius > 0 ? radius : 1) / sin(vhalf);
+	vec3 vdir = v3_norm(v3(0.45, -0.35, -1));
+	if (gi.ncams == 0) {
+		vec3 cam = v3_sub(mid, v3_scale(vdir, dist));
+		ok = ok && put(text, size, &n, "C %.17g,%.17g,%.17g %.17g,%.17g,%.17g %g\n", cam.x, cam.y, cam.z, vdir.x,
+		               vdir.y, vdir.z, fov);
+	}
+	for (size_t i = 0; ok && i < gi.ncams; i++) {
+		const gltf_camera *c = &gi.cams[i];
+		/* rtsh cameras stay upright: a roll is not kept (said once) */
+		vec3 up_ref = fabs(c->fwd.y) > 0.999999 ? v3(0, 0, 1) : v3(0, 1, 0);
+		vec3 right = v3_norm(v3_cross(up_ref, c->fwd)), up = v3_cross(c->fwd, right);
+		double roll = acos(clampd(v3_dot(up, c->up), -1, 1)) * 180 / M_PI;
+		if (roll > 0.5)
+			rt_warn(opts ? opts->warn : NULL, path, 0, 0,
+			        "cameras[%d]: turned %.0f degrees about its axis; rtsh cameras stay upright (the roll is not "
+			        "kept)", c->index, roll);
+		if (c->ortho)
+			ok = put(text, size, &n, "%c %.17g,%.17g,%.17g %.17g,%.17g,%.17g 60 ortho=%.17g\n", i ? 'c' : 'C',
+			         c->pos.x, c->pos.y, c->pos.z, c->fwd.x, c->fwd.y, c->fwd.z, c->ymag);
+		else
+			ok = put(text, size, &n, "%c %.17g,%.17g,%.17g %.17g,%.17g,%.17g %.17g vertical=1\n", i ? 'c' : 'C',
+			         c->pos.x, c->pos.y, c->pos.z, c->fwd.x, c->fwd.y, c->fwd.z, c->yfov * 180 / M_PI);
+	}
+	/* the first camera's shape, when the file gives it */
+	double aspect = gi.ncams == 0 ? 0 : gi.cams[0].ortho ? (gi.cams[0].ymag > 0 ? gi.cams[0].xmag / gi.cams[0].ymag : 0)
+	                                                     : gi.cams[0].aspect;
+	if (ok && aspect > 0.05 && aspect < 20)
+		ok = put(text, size, &n, "R 1280 %d\n", (int)fmax(1, round(1280 / aspect)));
+	for (size_t i = 0; ok && i < gi.nlights; i++) {
+		const gltf_light *l = &gi.lights[i];
+		vec3 c = linear_to_srgb255(v3(l->color[0], l->color[1], l->color[2]));
+		/* a colour brighter than white: the excess goes into the intensity */
+		double top = v3_max_comp(c), k = 1;
+		if (top > 255) {
+			k = v3_max_comp(v3(l->color[0], l->color[1], l->color[2]));
+			c = linear_to_srgb255(v3(l->color[0] / k, l->color[1] / k, l->color[2] / k));
+		}
+		ok = put(text, size, &n, "L %.17g,%.17g,%.17g 1 %.17g,%.17g,%.17g %s=%.17g", l->pos.x, l->pos.y, l->pos.z,
+		         c.x, c.y, c.z, l->type == GLTF_DIRECTIONAL ? "lux" : "cd", l->intensity * k);
+		if (ok && l->type != GLTF_POINT)
+			ok = put(text, size, &n, " dir=%.17g,%.17g,%.17g", l->dir.x, l->dir.y, l->dir.z);
+		if (ok && l->type == GLTF_SPOT)
+			ok = put(text, size, &n, " cone=%.17g,%.17g", l->inner * 180 / M_PI, l->outer * 180 / M_PI);
+		if (ok && l->type != GLTF_DIRECTIONAL && l->range > 0)
+			ok = put(text, size, &n, " range=%.17g", l->range);
+		ok = ok && put(text, size, &n, "\n");
+	}
+	if (ok && stage) {
+		/* the viewer's stage: ambient, a key light above the camera's left
+		 * shoulder, a sky and a floor under the model */
+		vec3 target = mid;
+		double d = gi.ncams > 0 ? v3_len(v3_sub(mid, gi.cams[0].pos)) : dist;
+		vec3 lamp = v3_add(target, v3(1.2 * d, 2.0 * d, 1.5 * d));
+		ok = put(text, size, &n,
+		         "A 0.25 255,255,255\nL %.17g,%.17g,%.17g 0.8 255,250,240\nsky 110,150,210 235,235,240 1\n"
+		         "pl 0,%.17g,0 0,1,0 180,180,180\nset samples 4\n",
+		         lamp.x, lamp.y, lamp.z, bb.lo.y);
+	} else if (ok) {
+		ok = put(text, size, &n, "set mode path\nset samples 64\n");
+	}
+	if (!ok) {
+		rt_error_set(err, "%s: the file name is too long", path);
+		free(text);
+		text = NULL;
+		goto done;
+	}
+	*len = n;
+	if (stage)
+		rt_warn(opts ? opts->warn : NULL, path, 0, 0,
+		        "no lights and no emissive materials: lit by the model viewer's stage lighting");
+done:
+	gltf_info_free(&gi);
+	return text;
+}
+
 
 char *rt_model_text(const char *path, const rt_load_opts *opts, size_t *len, rt_error *err)
 {
+	bool stage;
+	if (has_ext(path, "gltf") || has_ext(path, "glb"))
+		return gltf_text(path, opts, len, &stage, err);
 	mesh *m = mesh_cache_get(path, true, 60, opts ? opts->cancel : NULL, err);
 	if (!m)
 		return NULL;
@@ -66,10 +211,13 @@ char *rt_model_text(const char *path, const rt_load_opts *opts, size_t *len, rt_
 scene *rt_load_model(const char *path, const rt_load_opts *opts, rt_error *err)
 {
 	size_t n;
-	char *text = rt_model_text(path, opts, &n, err);
+	bool gltf = has_ext(path, "gltf") || has_ext(path, "glb"), stage = false;
+	char *text = gltf ? gltf_text(path, opts, &n, &stage, err) : rt_model_text(path, opts, &n, err);
 	if (!text)
 		return NULL;
 	scene *s = rt_load_string(text, n, path, opts, err);
 	free(text);
+	if (s && stage) /* the status line says so */
+		s->note = rt_intern("stage lighting", strlen("stage lighting"));
 	return s;
 }

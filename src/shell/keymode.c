@@ -336,8 +336,11 @@ static void km_mark(keymode *km, uint8_t *img)
 		km->light_behind = !(z > 0);
 		if (km->light_behind)
 			return; /* the status line says so */
-		double u = v3_dot(p, c->right) / (z * c->tan_half);
-		double v = v3_dot(p, c->up) / (z * c->tan_half * ((double)h / w));
+		double tx = cam_tan_x(c, w, h);
+		if (!(tx > 0))
+			return; /* an orthographic view: no marker */
+		double u = v3_dot(p, c->right) / (z * tx);
+		double v = v3_dot(p, c->up) / (z * tx * ((double)h / w));
 		double fx = (u + 1) * 0.5 * w, fy = (1 - v) * 0.5 * h;
 		static const uint8_t white[3] = {255, 255, 255}, dark[3] = {40, 30, 0};
 		if (!(fx >= 0 && fy >= 0 && fx < w && fy < h)) {
@@ -923,6 +926,12 @@ int keymode_tick(keymode *km)
 	return drawn;
 }
 
+void keymode_late_keys(keymode *km, abuf *to)
+{
+	abuf_add(to, km->late.b, km->late.len);
+	abuf_reset(&km->late);
+}
+
 double keymode_timeout(const keymode *km)
 {
 	double t = now(), best = -1;
@@ -1148,8 +1157,7 @@ bool keymode_turntable(shell *sh, double seconds)
 		int b;
 		while ((b = evloop_getc(ev)) >= 0)
 			abuf_char(&pend, (char)b);
-		abuf_add(&pend, km->late.b, km->late.len);
-		abuf_reset(&km->late);
+		keymode_late_keys(km, &pend);
 		if (pend.len && !pend.failed)
 			keys_feed(k, pend.b, pend.len); /* a full pipe: keys typed far ahead are dropped */
 		abuf_reset(&pend);

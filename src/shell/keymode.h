@@ -203,6 +203,9 @@ int keymode_tick(keymode *km);
 /* Seconds until keymode_tick has something to do with no key and no
  * wake-up (a refine or a message to clear); < 0 when nothing. */
 double keymode_timeout(const keymode *km);
+/* Moves the key bytes the output scheduler gave up holding (typed while it
+ * awaited the terminal's answer) to the end of `to`, in order. */
+void keymode_late_keys(keymode *km, abuf *to);
 /* True once a key asked to leave. */
 bool keymode_done(const keymode *km);
 /* A new terminal size: lays out again and repaints. */

@@ -299,8 +299,10 @@ void shell_status_text(shell *sh, char *buf, size_t size)
 		format_seconds(im->seconds, t, sizeof t);
 	int th = render_threads(&sh->set);
 	bool note = sh->notice[0] && now() < sh->notice_until;
-	snprintf(buf, size, " %s%s%s │ %s │ %s │ depth %d │ %dx%d │ %d thread%s │ %s", sh->name, note ? " │ " : "",
-	         note ? sh->notice : "", render_mode_name(sh->set.mode), samples, sh->set.depth, sh->scr ? sh->scr->img_w : 0,
+	const scene *sc = editor_scene(sh->ed);
+	const char *snote = sc && sc->note ? sc->note : NULL; /* the glTF loader's "stage lighting" */
+	snprintf(buf, size, " %s%s%s%s%s │ %s │ %s │ depth %d │ %dx%d │ %d thread%s │ %s", sh->name,
+	         snote ? " │ " : "", snote ? snote : "", note ? " │ " : "", note ? sh->notice : "", render_mode_name(sh->set.mode), samples, sh->set.depth, sh->scr ? sh->scr->img_w : 0,
 	         sh->scr ? sh->scr->img_h : 0, th, th == 1 ? "" : "s", t);
 }
 

@@ -48,6 +48,8 @@ static bool reserve(abuf *a, size_t n)
 
 void abuf_add(abuf *a, const char *s, size_t n)
 {
+	if (n == 0)
+		return; /* nothing to add, and s may be NULL (an empty abuf's b) */
 	if (!reserve(a, n))
 		return;
 	memcpy(a->b + a->len, s, n);

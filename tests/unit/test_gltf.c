@@ -11,10 +11,42 @@
 
 #include <cmocka.h>
 
+#include "core/integrators.h"
 #include "rtsh/gltf.h"
 #include "rtsh/memory.h"
 #include "rtsh/mesh.h"
+#include "rtsh/render.h"
+#include "rtsh/rtfile.h"
+#include "rtsh/world.h"
 #include "testutil.h"
+
+static char tmpdir[64];
+
+static int setup(void **state)
+{
+	(void)state;
+	snprintf(tmpdir, sizeof tmpdir, "/tmp/rtsh-gltf-XXXXXX");
+	return mkdtemp(tmpdir) ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+	(void)state;
+	char cmd[128];
+	snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
+	return system(cmd) == 0 ? 0 : -1;
+}
+
+static const char *tmp_text(const char *name, const char *text)
+{
+	static char p[256];
+	snprintf(p, sizeof p, "%s/%s", tmpdir, name);
+	FILE *f = fopen(p, "w");
+	assert_non_null(f);
+	assert_true(fputs(text, f) >= 0);
+	assert_int_equal(fclose(f), 0);
+	return p;
+}
 
 /* --- writing glTF --- */
 
@@ -351,6 +383,232 @@ static void test_hostile_instancing(void **state)
 	free(nodes);
 }
 
+/* --- the file as a scene: lights in physical units ---------------------- */
+
+/* A scene from a .gltf holding the unit triangle far below (y = -100), a
+ * camera 5 above the origin looking straight down (-90 degrees about X
+ * takes its -Z to -Y) and the given lights; then a Lambertian plane y = 0
+ * of linear albedo a (diffuse 1, no specular) is added to it. */
+static world *lit_plane(const char *lights, const char *light_nodes, double a, scene **out)
+{
+	double h = sqrt(0.5);
+	char rest[2048];
+	snprintf(rest, sizeof rest,
+	         "\"scene\":0,\"scenes\":[{\"nodes\":[0,1%s]}],"
+	         "\"nodes\":[{\"camera\":0,\"translation\":[0,5,0],\"rotation\":[%.17g,0,0,%.17g]},"
+	         "{\"mesh\":0,\"translation\":[0,-100,0]}%s],"
+	         "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.5,\"znear\":0.1}}],"
+	         "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[%s]}},",
+	         light_nodes[0] ? ",2,3" : "", -h, h, light_nodes, lights);
+	char *text = tri_gltf(unit_tri, rest);
+	rt_error err = {0};
+	scene *s = rt_load_file(tmp_text("lit.gltf", text), NULL, &err);
+	free(text);
+	if (!s)
+		fail_msg("%s", err.msg);
+	assert_false(s->has_ambient); /* lit by what it holds, on black */
+	assert_false(s->has_sky);
+	object pl = object_make(OBJ_PLANE, linear_to_srgb255(v3(a, a, a)));
+	pl.dir = v3(0, 1, 0);
+	pl.mat.diffuse = 1;
+	pl.mat.specular = 0;
+	assert_true(scene_add_object(s, &pl, &err));
+	world *w = world_build(s, &err);
+	if (!w)
+		fail_msg("%s", err.msg);
+	*out = s;
+	return w;
+}
+
+/* The radiance the camera's centre pixel (straight down onto the origin)
+ * brings back, by both integrators; path mode adds nothing: the plane's
+ * bounces leave into the black. The image is 1001 pixels wide, so that
+ * the samples' jitter in the pixel moves the point seen by at most 0.0013
+ * units (yfov 0.5 from 5 units): 1e-7 of the value. */
+static void centre_radiance(const world *w, vec3 *whitted, vec3 *path)
+{
+	render_settings set = render_settings_default();
+	set.width = set.height = 1001;
+	set.samples = 1;
+	set.depth = 4;
+	set.mode = MODE_WHITTED;
+	float px[3];
+	render_rect(w, &set, 500, 500, 501, 501, px);
+	*whitted = v3(px[0], px[1], px[2]);
+	set.mode = MODE_PATH;
+	set.samples = 4;
+	render_rect(w, &set, 500, 500, 501, 501, px);
+	*path = v3(px[0], px[1], px[2]);
+}
+
+/* A directional light of E lux shining straight down on a Lambertian plane
+ * of albedo a: the irradiance is E, the radiance a E / pi. E = 3, a = 0.5:
+ * 0.477465. */
+static void test_directional_light_lux(void **state)
+{
+	(void)state;
+	double h = sqrt(0.5);
+	char nodes[256];
+	snprintf(nodes, sizeof nodes,
+	         ",{\"rotation\":[%.17g,0,0,%.17g],\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}},"
+	         "{\"translation\":[0,-200,0],\"extensions\":{\"KHR_lights_punctual\":{\"light\":1}}}",
+	         -h, h);
+	scene *s;
+	/* the second light, a point far below the plane, lights none of it */
+	world *w = lit_plane("{\"type\":\"directional\",\"intensity\":3},{\"type\":\"point\",\"intensity\":1}",
+	                     nodes, 0.5, &s);
+	assert_int_equal(s->nlights, 2);
+	vec3 wh, pa;
+	centre_radiance(w, &wh, &pa);
+	double want = 0.5 * 3 / M_PI;
+	assert_vec_near(wh, v3_splat(want), 1e-5);
+	assert_vec_near(pa, v3_splat(want), 1e-5);
+	world_free(w);
+	scene_free(s);
+}
+
+/* A point light of I candela at height d above a Lambertian plane facing
+ * it: at the point below it the irradiance is I / d^2, the radiance
+ * a I / (pi d^2). I = 40, d = 2, a = 0.25, colour (1, 0.5, 0.25) linear:
+ * 0.795775 x the colour. The same light 4 units up gives a quarter:
+ * inverse-square fall-off (a miniRT light gives the same at any height). */
+static void test_point_light_candela(void **state)
+{
+	(void)state;
+	for (int k = 0; k < 2; k++) {
+		double d = k ? 4 : 2;
+		char nodes[256];
+		snprintf(nodes, sizeof nodes,
+		         ",{\"translation\":[0,%g,0],\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}},"
+		         "{\"translation\":[0,-200,0],\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}}",
+		         d);
+		scene *s;
+		world *w = lit_plane("{\"type\":\"point\",\"intensity\":40,\"color\":[1,0.5,0.25]}", nodes, 0.25, &s);
+		vec3 wh, pa;
+		centre_radiance(w, &wh, &pa);
+		double want = 0.25 * 40 / (M_PI * d * d);
+		vec3 c = v3(want, want * 0.5, want * 0.25);
+		assert_vec_near(wh, c, 1e-5);
+		assert_vec_near(pa, c, 1e-5);
+		world_free(w);
+		scene_free(s);
+	}
+}
+
+/* A spot's smooth cone (KHR_lights_punctual): with cos_o, cos_i the cosines
+ * of its outer and inner angles and cos_t that of the angle off its axis,
+ * the intensity is I x clamp((cos_t - cos_o) / (cos_i - cos_o), 0, 1)^2.
+ * A spot of 40 cd, cones 10 and 20 degrees, 2 above the origin pointing
+ * down: at the origin (on the axis) I; at 15 degrees off the axis, on the
+ * plane at x = 2 tan 15, distance 2 / cos 15, the factor
+ * ((cos 15 - cos 20) / (cos 10 - cos 20))^2; at 25 degrees nothing. */
+static void test_spot_cone(void **state)
+{
+	(void)state;
+	rt_error err = {0};
+	const char *text = "C 0,5,0 0,-1,0 60\nL 0,2,0 1 255,255,255 cd=40 dir=0,-1,0 cone=10,20\n";
+	scene *s = rt_load_string(text, strlen(text), "spot.rt", NULL, &err);
+	if (!s)
+		fail_msg("%s", err.msg);
+	world *w = world_build(s, &err);
+	assert_non_null(w);
+	vec3 wi;
+	double dist;
+	vec3 l = light_at(&w->lights[0], v3(0, 0, 0), &wi, &dist);
+	assert_near(l.x * M_PI, 40 / 4.0, 1e-9); /* pi L = I / d^2 */
+	assert_near(dist, 2, 1e-12);
+	assert_vec_near(wi, v3(0, 1, 0), 1e-12);
+	double t = 15 * M_PI / 180, x = 2 * tan(t), d = 2 / cos(t);
+	double f = (cos(t) - cos(20 * M_PI / 180)) / (cos(10 * M_PI / 180) - cos(20 * M_PI / 180));
+	l = light_at(&w->lights[0], v3(x, 0, 0), &wi, &dist);
+	assert_near(l.x * M_PI, 40 / (d * d) * f * f, 1e-9);
+	l = light_at(&w->lights[0], v3(2 * tan(25 * M_PI / 180), 0, 0), &wi, &dist);
+	assert_near(l.x, 0, 0);
+	/* behind a sun nothing changes with distance: E / pi everywhere */
+	world_free(w);
+	scene_free(s);
+}
+
+/* A camera's yfov: on a 2:1 image the top edge's middle is yfov / 2 from
+ * the axis and the right edge's middle atan(2 tan(yfov / 2)); an
+ * orthographic camera's rays are parallel, the top edge ymag above its
+ * centre and the right edge ymag x 2 to its right. The scene also saves
+ * to a .rt that reloads to the same scene. */
+static void test_camera_frustum(void **state)
+{
+	(void)state;
+	double h = sqrt(0.5);
+	char rest[1024];
+	snprintf(rest, sizeof rest,
+	         "\"nodes\":[{\"mesh\":0},{\"camera\":0,\"translation\":[0,0,5]},"
+	         "{\"camera\":1,\"translation\":[1,2,3],\"rotation\":[0,%.17g,0,%.17g]}],"
+	         "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":1,\"aspectRatio\":2,\"znear\":0.1}},"
+	         "{\"type\":\"orthographic\",\"orthographic\":{\"xmag\":4,\"ymag\":2,\"znear\":0,\"zfar\":9}}],",
+	         h, h);
+	char *text = tri_gltf(unit_tri, rest);
+	rt_error err = {0};
+	const char *path = tmp_text("cams.gltf", text);
+	free(text);
+	scene *s = rt_load_file(path, NULL, &err);
+	if (!s)
+		fail_msg("%s", err.msg);
+	assert_int_equal(s->ncams, 2);
+	/* aspectRatio 2: the file's shape becomes the resolution hint */
+	assert_int_equal(s->hints.width, 1280);
+	assert_int_equal(s->hints.height, 640);
+	cam_view v = cam_view_make(&s->cams[0]);
+	assert_vec_near(v.pos, v3(0, 0, 5), 0);
+	assert_vec_near(v.fwd, v3(0, 0, -1), 0);
+	ray top = cam_ray(&v, 100, 0, 200, 100), right = cam_ray(&v, 200, 50, 200, 100);
+	assert_near(acos(v3_dot(top.d, v.fwd)), 0.5, 1e-12);
+	assert_near(acos(v3_dot(right.d, v.fwd)), atan(2 * tan(0.5)), 1e-12);
+	/* the orthographic camera at (1,2,3) turned 90 degrees about Y looks
+	 * along -X in the file, +X mirrored, from (-1,2,3) */
+	v = cam_view_make(&s->cams[1]);
+	assert_vec_near(v.fwd, v3(1, 0, 0), 1e-12);
+	top = cam_ray(&v, 100, 0, 200, 100);
+	right = cam_ray(&v, 200, 50, 200, 100);
+	assert_vec_near(top.d, v.fwd, 1e-12);
+	assert_vec_near(top.o, v3(-1, 4, 3), 1e-12);
+	assert_vec_near(v3_sub(right.o, v3(-1, 2, 3)), v3_scale(v.right, 4), 1e-12);
+	/* save and load again: the same scene */
+	char rt[256];
+	snprintf(rt, sizeof rt, "%s/cams.rt", tmpdir);
+	assert_true(rt_save(s, rt, &err));
+	scene *t = rt_load_file(rt, NULL, &err);
+	if (!t)
+		fail_msg("%s", err.msg);
+	assert_true(scene_equal(s, t));
+	scene_free(t);
+	scene_free(s);
+}
+
+/* A file with neither lights nor emissive materials gets the model
+ * viewer's stage lighting (ambient, a lamp, the sky, a floor) and a note
+ * for the status line; with no camera it is framed as the viewer frames a
+ * model. */
+static void test_stage_lighting(void **state)
+{
+	(void)state;
+	char *text = tri_gltf(unit_tri, "\"nodes\":[{\"mesh\":0}],");
+	rt_error err = {0};
+	scene *s = rt_load_file(tmp_text("bare.gltf", text), NULL, &err);
+	free(text);
+	if (!s)
+		fail_msg("%s", err.msg);
+	assert_non_null(s->note);
+	assert_string_equal(s->note, "stage lighting");
+	assert_true(s->has_ambient);
+	assert_true(s->has_sky);
+	assert_int_equal(s->nlights, 1);
+	assert_int_equal(s->ncams, 1);
+	/* the camera looks at the middle of the model's box */
+	vec3 mid = v3(-0.5, 0.5, 0.5), d = v3_norm(s->cams[0].dir);
+	vec3 to = v3_norm(v3_sub(mid, s->cams[0].pos));
+	assert_vec_near(to, d, 1e-9);
+	scene_free(s);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -360,6 +618,11 @@ int main(void)
 	    cmocka_unit_test(test_cameras_and_lights),
 	    cmocka_unit_test(test_bad_files),
 	    cmocka_unit_test(test_hostile_instancing),
+	    cmocka_unit_test(test_directional_light_lux),
+	    cmocka_unit_test(test_point_light_candela),
+	    cmocka_unit_test(test_spot_cone),
+	    cmocka_unit_test(test_camera_frustum),
+	    cmocka_unit_test(test_stage_lighting),
 	};
-	return cmocka_run_group_tests(tests, NULL, NULL);
+	return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -35,7 +35,10 @@ static void test_every_format(void **state)
 		unsigned char head[8] = {0};
 		assert_true(fread(head, 1, 8, f) == 8);
 		fclose(f);
-		const char *sig = t->format == IMAGE_PPM ? "P6" : t->format == IMAGE_PFM ? "PF" : "\x89PNG";
+		const char *sig = t->format == IMAGE_PPM    ? "P6"
+		                  : t->format == IMAGE_PFM  ? "PF"
+		                  : t->format == IMAGE_JPEG ? "\xff\xd8\xff" /* SOI, then a marker */
+		                                            : "\x89PNG";
 		assert_memory_equal(head, sig, strlen(sig));
 		if (t->read) {
 			framebuffer *back = image_read(path, &err);
@@ -53,13 +56,13 @@ static void test_every_format(void **state)
 		snprintf(all + used, sizeof all - used, "%s%s", n ? " " : "", t->ext);
 	}
 	assert_true(n >= 3);
-	assert_string_equal(all, ".ppm .pfm .png");
+	assert_string_equal(all, ".ppm .pfm .png .jpg .jpeg");
 	/* an unknown extension: the message lists the table */
 	char path[128];
 	snprintf(path, sizeof path, "%s/x.bmp", dir);
 	rt_error err;
 	assert_false(image_write(path, fb, 0, &err));
-	assert_non_null(strstr(err.msg, "expected .ppm, .pfm or .png"));
+	assert_non_null(strstr(err.msg, "expected .ppm, .pfm, .png, .jpg or .jpeg"));
 	assert_null(image_read(path, &err));
 	assert_non_null(strstr(err.msg, "expected .ppm or .pfm"));
 	char exts[64];

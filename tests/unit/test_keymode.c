@@ -474,6 +474,40 @@ static void test_session(void **state)
 	session_close(&ss);
 }
 
+/* The keys the output scheduler held while it awaited an answer reach the
+ * key decoder (keymode_run's loop, keymode_late_keys); with none held,
+ * nothing, and no null source handed to memcpy: under UBSan `view` stopped
+ * at once there (issue 31, defect 6). */
+static void test_late_keys(void **state)
+{
+	(void)state;
+	session ss;
+	session_open(&ss);
+	run_for(&ss, 0.1);
+	abuf pend;
+	abuf_init(&pend);
+	keymode_late_keys(ss.km, &pend); /* none held: none taken */
+	assert_int_equal(pend.len, 0);
+	assert_false(pend.failed);
+	abuf_str(&pend, "ab");
+	keymode_late_keys(ss.km, &pend);
+	assert_int_equal(pend.len, 2);
+	assert_string_equal(pend.b, "ab");
+	abuf_free(&pend);
+	/* the append buffer itself: adding nothing from nowhere is nothing */
+	abuf a;
+	abuf_init(&a);
+	abuf_add(&a, NULL, 0);
+	assert_int_equal(a.len, 0);
+	assert_false(a.failed);
+	abuf_add(&a, "xy", 2);
+	abuf_add(&a, NULL, 0);
+	assert_int_equal(a.len, 2);
+	assert_string_equal(a.b, "xy");
+	abuf_free(&a);
+	session_close(&ss);
+}
+
 /* Ticks until the output after `from` holds `want` (at most `secs`). */
 static bool run_until(session *ss, size_t from, const char *want, double secs)
 {
@@ -664,6 +698,7 @@ int main(void)
 		cmocka_unit_test(test_turns),         cmocka_unit_test(test_session),
 		cmocka_unit_test(test_key_table),
 		cmocka_unit_test(test_undo_then_another_request),
+		cmocka_unit_test(test_late_keys),
 		cmocka_unit_test(test_path_denoised),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);

@@ -27,7 +27,7 @@ static scene *cam_scene(vec3 pos, vec3 dir, double fov)
 {
 	scene *s = scene_new();
 	assert_non_null(s);
-	camera c = {pos, dir, fov};
+	camera c = {pos, dir, fov, false, 0};
 	assert_true(scene_add_camera(s, &c, NULL));
 	return s;
 }
@@ -368,7 +368,7 @@ static void test_depth1_equals_whitted_diffuse(void **state)
 {
 	(void)state;
 	scene *s = cam_scene(v3(0, 1.5, -6), v3(0, -0.2, 1), 60);
-	light l = {v3(-3, 5, -4), 0.8, v3(255, 230, 200)};
+	light l = {v3(-3, 5, -4), 0.8, v3(255, 230, 200), LIGHT_MINIRT, 0, {0, 0, 0}, 0, 0, 0};
 	assert_true(scene_add_light(s, &l, NULL));
 	object a = obj(OBJ_SPHERE, v3(0, 1, 0), v3_splat(2), v3(200, 120, 60), 0.7);
 	object b = obj(OBJ_CUBE, v3(1.8, 0.5, -1), v3(1, 1, 1), v3(60, 200, 120), 0.9);
@@ -419,7 +419,7 @@ static void test_two_sided(void **state)
 	for (int k = 0; k < 2; k++) {
 		scene *s = cam_scene(v3(0, 0, -3), v3(0, 0, 1), 60);
 		set_ambient(s, 0.3, v3(255, 255, 255));
-		light l = {v3(1, 1, -4), 0.9, v3(255, 255, 255)};
+		light l = {v3(1, 1, -4), 0.9, v3(255, 255, 255), LIGHT_MINIRT, 0, {0, 0, 0}, 0, 0, 0};
 		assert_true(scene_add_light(s, &l, NULL));
 		object r = obj(OBJ_RECT, v3(0, 0, 0), v3(2, 1, 2), v3(180, 180, 180), 0.8);
 		r.dir = k ? v3(0, 0, 1) : v3(0, 0, -1);
@@ -567,7 +567,7 @@ static scene *convergence_scene(void)
 	scene *s = cam_scene(v3(0, 1.2, -4), v3(0, -0.25, 1), 60);
 	s->has_sky = true;
 	s->sky = (sky){.zenith = v3(120, 170, 255), .horizon = v3(255, 255, 255), .strength = 1};
-	light l = {v3(2, 4, -2), 0.7, v3(255, 255, 255)};
+	light l = {v3(2, 4, -2), 0.7, v3(255, 255, 255), LIGHT_MINIRT, 0, {0, 0, 0}, 0, 0, 0};
 	assert_true(scene_add_light(s, &l, NULL));
 	object p = obj(OBJ_PLANE, v3(0, 0, 0), v3(1, 1, 1), v3(200, 200, 200), 0.9);
 	object a = obj(OBJ_SPHERE, v3(-0.7, 0.6, 0), v3_splat(1.2), v3(220, 80, 60), 0.8);
@@ -637,7 +637,7 @@ static scene *material_scene(void)
 	scene *s = cam_scene(v3(0, 1.5, -6), v3(0, -0.2, 1), 70);
 	s->has_sky = true;
 	s->sky = (sky){.zenith = v3(100, 150, 255), .horizon = v3(255, 250, 240), .strength = 1};
-	light l = {v3(-3, 5, -3), 0.8, v3(255, 240, 220)};
+	light l = {v3(-3, 5, -3), 0.8, v3(255, 240, 220), LIGHT_MINIRT, 0, {0, 0, 0}, 0, 0, 0};
 	assert_true(scene_add_light(s, &l, NULL));
 	object p = obj(OBJ_PLANE, v3(0, 0, 0), v3(2, 2, 2), v3(230, 230, 230), 0.9);
 	p.mat.checker = 1;

@@ -378,7 +378,7 @@ static double furnace_centre(const material_pbr *p, vec3 color, int depth, int s
 {
 	scene *s = scene_new();
 	assert_non_null(s);
-	camera c = {v3(0, 0, -10), v3(0, 0, 1), 4};
+	camera c = {.pos = v3(0, 0, -10), .dir = v3(0, 0, 1), .fov = 4};
 	assert_true(scene_add_camera(s, &c, NULL));
 	s->has_ambient = true;
 	s->amb = (ambient){1, v3(255, 255, 255)};

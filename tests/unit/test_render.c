@@ -25,14 +25,14 @@ static double srgb_decode(double code)
 static scene *base_scene(vec3 cam_pos, vec3 cam_dir, double fov)
 {
 	scene *s = scene_new();
-	camera c = {cam_pos, cam_dir, fov};
+	camera c = {cam_pos, cam_dir, fov, false, 0};
 	assert_true(scene_add_camera(s, &c, NULL));
 	return s;
 }
 
 static void add_light(scene *s, vec3 pos, double ratio)
 {
-	light l = {pos, ratio, v3(255, 255, 255)};
+	light l = {.pos = pos, .ratio = ratio, .color = v3(255, 255, 255)};
 	assert_true(scene_add_light(s, &l, NULL));
 }
 

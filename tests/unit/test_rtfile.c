@@ -579,7 +579,9 @@ static const err_case field_errors[] = {
 	{"C 0,0,0 0,0,1 -1\n", 1, 15, "camera fov \"-1\" is out of range"},
 	{"C 0,0,0 0,0,1\n", 1, 14, "camera: too few fields; expected C POSITION DIRECTION FOV"},
 	{"C 0,0,0 0,0,1 70 5\n", 1, 18, "camera: too many fields"},
-	{"C 0,0,0 0,0,1 70 fov=1\n", 1, 18, "camera field \"fov=1\" is a key=value field"},
+	{"C 0,0,0 0,0,1 70 fov=1\n", 1, 18, "camera key \"fov=1\" is unknown; expected vertical= ortho="},
+	{"C 0,0,0 0,0,1 70 ortho=0\n", 1, 24, "camera ortho= \"0\" is not positive"},
+	{"C 0,0,0 0,0,1 70 vertical=1 vertical=1\n", 1, 29, "camera key \"vertical=1\" repeats a key"},
 	{CAM "C 0,0,0 0,0,1 60\n", 2, 1, "camera: a second C line; expected only one (the first is on line 1)"},
 	{CAM "c 0,0,0 0,0,1 x\n", 2, 15, "camera fov \"x\" is not a number"},
 	/* L, l */
@@ -587,6 +589,14 @@ static const err_case field_errors[] = {
 	{CAM "L 0,0,0\n", 2, 8, "light: too few fields; expected L POSITION RATIO [R,G,B]"},
 	{CAM "l 0,0,0 1 1,1,1 1\n", 2, 17, "light: too many fields"},
 	{CAM "L 0,0,0 1 1,1,300\n", 2, 11, "light colour \"1,1,300\" has a component that is out of range"},
+	/* physical lights */
+	{CAM "L 0,0,0 1 lux=3\n", 2, 11, "light: a sun (lux=) without dir=; expected dir=X,Y,Z"},
+	{CAM "L 0,0,0 1 cd=3 lux=3 dir=0,-1,0\n", 2, 22, "light: both cd= and lux="},
+	{CAM "L 0,0,0 1 range=3\n", 2, 11, "without cd= or lux="},
+	{CAM "L 0,0,0 1 cd=-3\n", 2, 14, "light cd= \"-3\" is out of range; expected a number >= 0"},
+	{CAM "L 0,0,0 1 cd=3 dir=0,-1,0 cone=20,10\n", 2, 32, "light cone= \"20,10\" has inner >= outer"},
+	{CAM "L 0,0,0 1 cd=3 cone=10,20\n", 2, 16, "a spot (cone=) without dir="},
+	{CAM "L 0,0,0 1 lux=3 dir=0,-1,0 range=4\n", 2, 28, "cone= or range= on a sun"},
 	/* R */
 	{"R 0 10\n" CAM, 1, 3, "resolution width \"0\" is out of range; expected a whole number in [1,1e9]"},
 	{"R 10 -10\n" CAM, 1, 6, "resolution height \"-10\" is out of range"},
@@ -1133,12 +1143,12 @@ static scene *rand_scene(test_rng *r)
 	}
 	int ncams = 1 + (int)trange(r, 0, 3);
 	for (int i = 0; i < ncams; i++) {
-		camera c = {rand_vec(r, -50, 50), rand_dir(r), trange(r, 1, 179)};
+		camera c = {rand_vec(r, -50, 50), rand_dir(r), trange(r, 1, 179), false, 0};
 		assert_true(scene_add_camera(s, &c, &err));
 	}
 	int nlights = (int)trange(r, 0, 4);
 	for (int i = 0; i < nlights; i++) {
-		light l = {rand_vec(r, -50, 50), trand(r), rand_color(r)};
+		light l = {.pos = rand_vec(r, -50, 50), .ratio = trand(r), .color = rand_color(r)};
 		assert_true(scene_add_light(s, &l, &err));
 	}
 	if (trand(r) < 0.3) {

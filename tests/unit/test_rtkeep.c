@@ -233,7 +233,7 @@ static void test_delete_add_and_hints(void **state)
 	/* Appended ones go at the end; so do new settings and a new light. */
 	o.pos = v3(0, 9, 0);
 	assert_true(scene_add_object(s, &o, &err));
-	light li = {v3(1, 2, 3), 0.5, v3(255, 255, 255)};
+	light li = {v3(1, 2, 3), 0.5, v3(255, 255, 255), LIGHT_MINIRT, 0, {0, 0, 0}, 0, 0, 0};
 	assert_true(scene_add_light(s, &li, &err));
 	s->hints.samples = 16;
 	s->hints.mode = 1;
