@@ -345,13 +345,13 @@ bool cmd_help(shell *sh, int argc, char **argv, const char *rest)
 		for (size_t i = 0; i < sizeof details / sizeof details[0]; i++)
 			if (strcmp(details[i].name, c->name) == 0)
 				shell_out(sh, "%s", details[i].text ? details[i].text : details[i].gen());
-		if (c->run == cmd_add) { /* the elements, from the reader's table */
+		if (strcmp(c->name, "add") == 0) { /* the elements, from the reader's table */
 			const char *usage;
 			shell_out(sh, "elements (rtsh(5)):\n");
 			for (size_t i = 0; rt_element(i, &usage); i++)
 				shell_out(sh, "  %s\n", usage);
 		}
-		if (c->run == cmd_add || c->run == cmd_object) { /* the keys, from the reader's table */
+		if (strcmp(c->name, "add") == 0 || strcmp(c->name, "object") == 0) { /* the keys, from the reader's table */
 			const char *name, *kh;
 			shell_out(sh, "object keys (KEY=VALUE after the fields, or object N set KEY=VALUE):\n");
 			for (size_t i = 0; (name = rt_key_info(i, &kh)); i++)

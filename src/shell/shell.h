@@ -90,9 +90,6 @@ typedef struct shell {
 	evloop *ev;            /* the interactive loop's event loop (term/evloop.h); NULL: none */
 } shell;
 
-/* The shell of shell_main (the signal flags are in signals.h). */
-extern shell *shell_current;
-
 /* Records an error message for the command being run; returns false. */
 bool shell_fail(shell *sh, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 /* Prints to standard output (command results). */
