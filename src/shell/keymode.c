@@ -641,17 +641,24 @@ static void km_spin_step(keymode *km, double t)
 	km_set_camera(km, &c);
 }
 
+/* The encoder's canvas pixels a cell: 1x2 for half blocks, 2x4 for the
+ * other symbol sets, the cell's size in real pixels. */
+static void km_cell_pixels(const keymode *km, double *sx, double *sy)
+{
+	int cw = km->kv.cols, ch = 2 * km->kv.pic_rows;
+	if (km->kv.enc)
+		km->kv.enc->ops->canvas(&km->kv.enc->geom, &cw, &ch);
+	*sx = km->kv.cols > 0 ? (double)cw / km->kv.cols : 1;
+	*sy = km->kv.pic_rows > 0 ? (double)ch / km->kv.pic_rows : 2;
+}
+
 /* The object under the cell (x, y) (1-based): a ray through its middle,
  * as the renderer casts them. */
 static void km_pick(keymode *km, int x, int y)
 {
 	const world *w = km_world(km);
-	/* canvas pixels a cell: 1x2 for half blocks, 2x4 for the other
-	 * symbol sets, the cell's size in real pixels */
-	int cw = km->kv.cols, ch = 2 * km->kv.pic_rows;
-	if (km->kv.enc)
-		km->kv.enc->ops->canvas(&km->kv.enc->geom, &cw, &ch);
-	double sx = km->kv.cols > 0 ? (double)cw / km->kv.cols : 1, sy = km->kv.pic_rows > 0 ? (double)ch / km->kv.pic_rows : 2;
+	double sx, sy;
+	km_cell_pixels(km, &sx, &sy);
 	double px = ((x - 1) + 0.5) * sx - km->kv.img_x, py = ((y - 1) + 0.5) * sy - km->kv.img_y;
 	if (!w || px < 0 || py < 0 || px >= km->kv.img_w || py >= km->kv.img_h)
 		return;
@@ -683,9 +690,10 @@ static void km_apply_drag(keymode *km)
 		/* The scene follows the cursor: at the pivot's distance, a pixel
 		 * of the picture is 2 d tan(fov/2) / width. */
 		cam_view v = cam_view_make(&c);
-		double d = v3_len(v3_sub(c.pos, km->pivot));
+		double d = v3_len(v3_sub(c.pos, km->pivot)), sx, sy;
+		km_cell_pixels(km, &sx, &sy);
 		double u = km->kv.img_w > 0 ? 2.0 * d * v.tan_half / km->kv.img_w : 0;
-		vec3 mv = v3_add(v3_scale(v.right, -dx * u), v3_scale(v.up, 2.0 * dy * u));
+		vec3 mv = v3_add(v3_scale(v.right, -dx * sx * u), v3_scale(v.up, dy * sy * u));
 		c.pos = v3_add(c.pos, mv);
 		km->pivot = v3_add(km->pivot, mv);
 	} else {

@@ -365,8 +365,9 @@ static void after_probe(shell *sh)
 		draw_status(sh);
 		rl_forced_update_display();
 	} else {
-		shell_notice(sh, "%s colours: the terminal did not say it has 24-bit colour (rtsh --color truecolor if it does)",
-		             sh->scr->pal == PALETTE_256 ? "256" : "16");
+		/* Short: the status line's mode and samples stay in sight at 80
+		 * columns (rtsh(1) says the rest). */
+		shell_notice(sh, "%s colours (--color truecolor?)", sh->scr->pal == PALETTE_256 ? "256" : "16");
 	}
 }
 

@@ -142,7 +142,18 @@ int preview_main(const rtsh_options *o)
 	cell_size(&cw, &ch);
 	if (pm == PIXELS_AUTO)
 		pm = isatty(STDOUT_FILENO) ? ask_terminal(&cw, &ch) : PIXELS_OFF;
-	int w = cols, h = 2 * rows;
+	/* The symbol set asked for (--symbols); auto: what the terminal is
+	 * known to draw, half blocks into a pipe (the file manager's terminal
+	 * is not known there). */
+	frame_palette pal = preview_palette(o->color);
+	symbols_kind sym = set.symbols >= SYMBOLS_HALF && set.symbols < SYMBOLS_AUTO ? (symbols_kind)set.symbols
+	                   : isatty(STDOUT_FILENO) ? symbols_choose(getenv("TERM_PROGRAM"), NULL, getenv("VTE_VERSION"),
+	                                                            getenv("TMUX") != NULL)
+	                                           : SYMBOLS_HALF;
+	if (pal == PALETTE_NONE)
+		sym = SYMBOLS_HALF;
+	int sx = sym == SYMBOLS_HALF ? 1 : SYMBOLS_SAMPLE_W, sy = sym == SYMBOLS_HALF ? 2 : SYMBOLS_SAMPLE_H;
+	int w = cols * sx, h = rows * sy;
 	if (pm != PIXELS_OFF) {
 		w = cols * cw;
 		h = rows * ch;
@@ -183,7 +194,7 @@ int preview_main(const rtsh_options *o)
 		if (!pixels_encode(pm, &a, rgb, w, h, cols, rows))
 			a.failed = true;
 	} else {
-		frame *f = frame_new(cols, rows, preview_palette(o->color));
+		frame *f = frame_new_symbols(cols, rows, pal, sym);
 		if (!f) {
 			a.failed = true;
 		} else {

@@ -1,9 +1,10 @@
 /* rtsh — `rtsh --preview COLSxROWS FILE`: a still picture of a model or a
  * scene for a file manager's preview pane, on standard output.
  *
- * The picture is exactly COLS x ROWS cells: ROWS lines of COLS half blocks,
- * each ended by "\e[m\n" (frame_text), or one image of the pixel protocols
- * covering that area (--pixels kitty, sixel or iterm). Nothing else is
+ * The picture is exactly COLS x ROWS cells: ROWS lines of COLS half blocks
+ * (or the glyphs of --symbols quadrant, sextant or octant), each ended by
+ * "\e[m\n" (frame_text), or one image of the pixel protocols covering
+ * that area (--pixels kitty, sixel or iterm). Nothing else is
  * written to standard output: no alternate screen, no cursor movement, and
  * no question to the terminal unless standard output is one and
  * --pixels auto asked for it.

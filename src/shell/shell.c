@@ -1,5 +1,5 @@
 /* rtsh — the shell: set-up, the scene and its settings, full-resolution
- * renders, and shell_main, which picks script or interactive mode. */
+ * renders (shell_main.c picks script or interactive mode). */
 #include "shell/shell.h"
 
 #include <errno.h>
@@ -17,8 +17,6 @@
 #include "shell/progress.h"
 #include "shell/signals.h"
 #include "term/caps.h"
-
-shell *shell_current;
 
 bool shell_fail(shell *sh, const char *fmt, ...)
 {
@@ -347,7 +345,8 @@ static void on_progress(void *ctx, long done, long total)
 static bool same_image_settings(const render_settings *a, const render_settings *b)
 {
 	return a->width == b->width && a->height == b->height && a->samples == b->samples &&
-	       a->depth == b->depth && a->mode == b->mode && a->seed == b->seed;
+	       a->depth == b->depth && a->mode == b->mode && a->seed == b->seed &&
+	       (a->mode != MODE_PATH || (a->denoise == DENOISE_ON) == (b->denoise == DENOISE_ON));
 }
 
 const framebuffer *shell_full_image(shell *sh, bool force)
@@ -566,70 +565,4 @@ void shell_free(shell *sh)
 		free(sh->memo[i].label);
 	free(sh->memo);
 	memset(sh, 0, sizeof *sh);
-}
-
-int shell_main(const rtsh_options *o)
-{
-	bool tty_in = isatty(STDIN_FILENO);
-	bool script = o->commands || o->file || !tty_in;
-	bool then_interactive = !script || (o->interactive && tty_in);
-	bool screen_ok = then_interactive && caps_screen_ok(STDOUT_FILENO);
-	int wake[2] = {-1, -1};
-	if (then_interactive) {
-		if (pipe(wake) != 0) {
-			fprintf(stderr, "rtsh: cannot make a pipe: %s\n", strerror(errno));
-			return 1;
-		}
-		for (int i = 0; i < 2; i++) {
-			fcntl(wake[i], F_SETFL, fcntl(wake[i], F_GETFL) | O_NONBLOCK);
-			fcntl(wake[i], F_SETFD, FD_CLOEXEC);
-		}
-	}
-	shell sh;
-	if (!shell_init(&sh, o, wake[1])) {
-		if (wake[0] >= 0)
-			close(wake[0]), close(wake[1]);
-		return 1;
-	}
-	shell_current = &sh;
-	signals_set_cancel(&sh.cancel);
-	sh.pal = caps_palette(o->color, STDOUT_FILENO);
-	int status = 0;
-	if (script) {
-		signals_script_begin();
-		sh.interactive = false;
-		sh.progress = !o->quiet && isatty(STDERR_FILENO);
-		bool ok;
-		if (o->commands)
-			ok = shell_run_text(&sh, o->commands, "-c", true);
-		else
-			ok = shell_run_file(&sh, o->file ? o->file : "-");
-		if (!ok && !sh.err_reported)
-			fprintf(stderr, "rtsh: %s\n", sh.err);
-		status = ok ? 0 : shell_sig_int ? 130 : 1;
-		signals_script_end();
-		if (sh.quit)
-			then_interactive = false;
-	}
-	if (then_interactive) {
-		if (!screen_ok && isatty(STDOUT_FILENO)) {
-			const char *t = getenv("TERM");
-			fprintf(stderr, "rtsh: this terminal (TERM=%s) cannot show the picture; commands work, "
-			                "and save writes images\n",
-			        t && *t ? t : "unset");
-		}
-		sh.interactive = true;
-		sh.progress = !o->quiet; /* `render` shows its progress in the status line */
-		sh.quit = false;
-		shell_sig_int = 0;
-		int st = shell_interactive(&sh, screen_ok, wake);
-		if (st != 0 || status == 0)
-			status = st;
-	}
-	shell_current = NULL;
-	signals_set_cancel(NULL);
-	shell_free(&sh);
-	if (wake[0] >= 0)
-		close(wake[0]), close(wake[1]);
-	return status;
 }

@@ -41,6 +41,8 @@ static encoder *cells_open(const encoder_geom *g, const encoder_ops *ops, symbol
 	e->fr->x0 = g->x0;
 	e->fr->y0 = g->y0;
 	e->fr->cursor_off = g->cursor_off;
+	if (g->exact)
+		e->fr->lambda = 0;
 	return &e->base;
 }
 

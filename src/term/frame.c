@@ -44,17 +44,16 @@ frame *frame_new_symbols(int cols, int rows, frame_palette pal, symbols_kind sym
 	f->sync = true;
 	f->sym = sym;
 	f->nsub = symbols_table[sym].w * symbols_table[sym].h;
-	f->lambda = sym == SYMBOLS_HALF ? 0 : FRAME_SYMBOLS_LAMBDA;
+	f->lambda = FRAME_LAMBDA;
 	for (unsigned m = 0; m < 1u << f->nsub; m++)
 		f->glyph_len[m] = (uint8_t)symbols_utf8(sym, m, f->glyph[m]);
 	f->cur = calloc(n, sizeof *f->cur);
 	f->shown = calloc(n, sizeof *f->shown);
-	if (sym != SYMBOLS_HALF) {
-		f->px = calloc(n * SYMBOLS_SAMPLE_W * SYMBOLS_SAMPLE_H, 3);
-		f->def = calloc(n * SYMBOLS_SAMPLE_W * SYMBOLS_SAMPLE_H, 1);
-	}
+	size_t ns = n * (sym == SYMBOLS_HALF ? 2 : SYMBOLS_SAMPLE_W * SYMBOLS_SAMPLE_H);
+	f->px = calloc(ns, 3);
+	f->def = calloc(ns, 1);
 	abuf_init(&f->out);
-	if (!f->cur || !f->shown || (sym != SYMBOLS_HALF && (!f->px || !f->def))) {
+	if (!f->cur || !f->shown || !f->px || !f->def) {
 		frame_free(f);
 		return NULL;
 	}
@@ -87,7 +86,8 @@ void frame_clear(frame *f)
 	for (size_t i = 0; i < (size_t)f->cols * (size_t)f->rows; i++)
 		f->cur[i] = blank;
 	if (f->def)
-		memset(f->def, 0, (size_t)f->cols * f->rows * SYMBOLS_SAMPLE_W * SYMBOLS_SAMPLE_H);
+		memset(f->def, 0,
+		       (size_t)f->cols * f->rows * (f->sym == SYMBOLS_HALF ? 2 : SYMBOLS_SAMPLE_W * SYMBOLS_SAMPLE_H));
 }
 
 /* --- palettes --- */
@@ -305,23 +305,35 @@ static void rd_row(frame *f, int cy)
 	size_t cw = (size_t)f->cols * SW;
 	uint32_t fg = UINT32_MAX, bg = UINT32_MAX; /* not known */
 	int n = f->nsub;
+	bool half = f->sym == SYMBOLS_HALF;
 	for (int cx = 0; cx < f->cols; cx++) {
 		frame_cell *c = &f->cur[(size_t)cy * f->cols + cx];
-		size_t at = (size_t)cy * SH * cw + (size_t)cx * SW;
+		float sub[8][3];
 		bool whole = true;
-		for (int y = 0; y < SH && whole; y++)
-			for (int x = 0; x < SW; x++)
-				whole &= f->def[at + y * cw + x] != 0;
+		if (half) {
+			/* the cell's two pixels */
+			for (int k = 0; k < 2; k++) {
+				size_t i = (size_t)(2 * cy + k) * f->cols + cx;
+				whole &= f->def[i] != 0;
+				for (int ch = 0; ch < 3; ch++)
+					sub[k][ch] = f->px[i * 3 + ch];
+			}
+		} else {
+			size_t at = (size_t)cy * SH * cw + (size_t)cx * SW;
+			for (int y = 0; y < SH && whole; y++)
+				for (int x = 0; x < SW; x++)
+					whole &= f->def[at + y * cw + x] != 0;
+			if (whole)
+				symbols_subpixels(f->sym, f->px + at * 3, cw * 3, sub);
+		}
 		if (!whole || c->top == FRAME_DEFAULT || c->bot == FRAME_DEFAULT) {
 			fg = c->top;
 			bg = c->bot;
 			continue;
 		}
-		float sub[8][3];
-		symbols_subpixels(f->sym, f->px + at * 3, cw * 3, sub);
 		/* the fit, and its cost */
 		frame_cell best = *c;
-		bool two = c->mask != 0;
+		bool two = c->mask != 0 && c->top != c->bot;
 		double best_j = cell_error((const float(*)[3])sub, n, c->mask, c->top, c->bot) +
 		                f->lambda * cell_bytes(f, c->top, c->bot, two, fg, bg);
 		frame_cell cand[7];
@@ -385,8 +397,10 @@ static void rd_row(frame *f, int cy)
 				best = cand[k];
 			}
 		}
+		if (half) /* as half blocks hold a cell: mask 1, top over bottom */
+			best = (frame_cell){best.mask & 1 ? best.top : best.bot, best.mask & 2 ? best.top : best.bot, 1};
 		*c = best;
-		if (best.mask == 0) {
+		if (best.mask == 0 || best.top == best.bot) {
 			if (best.top != fg && best.top != bg)
 				bg = best.top;
 		} else {
@@ -456,7 +470,14 @@ void frame_put_image(frame *f, const uint8_t *rgb, int w, int h, int ox, int oy)
 				c->top = v;
 			else
 				c->bot = v;
+			memcpy(f->px + ((size_t)py * f->cols + px) * 3, p, 3);
+			f->def[(size_t)py * f->cols + px] = 1;
 		}
+	}
+	if (f->lambda > 0 && f->pal == PALETTE_TRUECOLOR) {
+		int y0 = oy < 0 ? 0 : oy, y1 = oy + h < ph ? oy + h : ph;
+		for (int cy = y0 / 2; cy < (y1 + 1) / 2; cy++)
+			rd_row(f, cy);
 	}
 }
 

@@ -69,11 +69,13 @@ typedef struct frame {
 	int nsub;          /* subpixels a cell */
 	double flat;       /* symbols: a split that gains at most this much squared
 	                      error over one colour is not worth its bytes (symbols_fit) */
-	double lambda;     /* symbols, truecolor: squared error (sRGB levels over a
-	                      cell's samples) worth a byte (rd_row); 0: the best fit */
-	uint8_t *px;       /* symbols: the canvas, cols*2 x rows*4 samples, sRGB */
-	uint8_t *def;      /* symbols: 1 where the canvas holds a picture's sample,
-	                      0 where it shows the default background */
+	double lambda;     /* truecolor: squared error (sRGB levels, summed over a
+	                      cell's 8 samples' worth of area) worth a byte (rd_row);
+	                      0: every cell its best fit */
+	uint8_t *px;       /* the canvas, cols x rows*2 pixels (symbols: cols*2 x
+	                      rows*4 samples), sRGB */
+	uint8_t *def;      /* 1 where the canvas holds a picture's sample, 0 where
+	                      it shows the default background */
 	char glyph[256][4]; /* the UTF-8 of each mask's glyph ... */
 	uint8_t glyph_len[256]; /* ... and its length */
 	abuf out;
@@ -85,10 +87,10 @@ frame *frame_new(int cols, int rows, frame_palette pal);
 /* The same with symbol set sym (not SYMBOLS_AUTO; PALETTE_NONE takes half
  * blocks, one character a cell). */
 frame *frame_new_symbols(int cols, int rows, frame_palette pal, symbols_kind sym);
-/* frame.lambda of the symbol sets: measured on three scenes (bench
- * symbols rows, bench/README.md), 5 keeps the PSNR within 0.25 dB of the
- * best fit's and sends 0.45-0.8x its bytes. */
-#define FRAME_SYMBOLS_LAMBDA 5.0
+/* frame.lambda's default: measured on three scenes (bench symbols rows,
+ * bench/README.md), 5 keeps the PSNR within 0.25 dB of the best fit's and
+ * sends 0.4-0.8x its bytes. */
+#define FRAME_LAMBDA 5.0
 void frame_free(frame *f);
 /* Forgets what the terminal shows (after the screen was cleared). */
 void frame_invalidate(frame *f);

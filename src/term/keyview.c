@@ -25,12 +25,32 @@ void keyview_free(keyview *v)
 	abuf_free(&v->a);
 }
 
+/* Code points in s (the bars hold single-width characters only). */
+static int text_width(const char *s)
+{
+	int n = 0;
+	for (; *s; s++)
+		n += ((unsigned char)*s & 0xc0) != 0x80;
+	return n;
+}
+
+/* The rows the help bar takes: one, or two where one would cut items off
+ * and the screen has room (40x16 or more). */
+static int bar_rows(const keyview *v, int cols, int rows)
+{
+	int used = 0;
+	for (size_t i = 0; i < v->nbar; i++)
+		used += 2 + text_width(v->bar[i].keys) + 1 + text_width(v->bar[i].what);
+	return used <= cols - 1 || cols < 40 || rows < 16 ? 1 : 2;
+}
+
 void keyview_layout(keyview *v, int cols, int rows, bool help, double aspect)
 {
 	v->cols = cols;
 	v->rows = rows;
 	v->help = help;
-	v->pic_rows = rows - (help ? 2 : 1);
+	v->help_rows = help ? bar_rows(v, cols, rows) : 0;
+	v->pic_rows = rows - 1 - v->help_rows;
 	termout_set_picture(v->out, NULL);
 	encoder_close(v->enc);
 	v->enc = NULL;
@@ -128,27 +148,24 @@ static void put_line(abuf *a, int row, int cols, const char *text, bool reverse)
 		abuf_str(a, "\x1b[K");
 }
 
-/* Code points in s (the bars hold single-width characters only). */
-static int text_width(const char *s)
-{
-	int n = 0;
-	for (; *s; s++)
-		n += ((unsigned char)*s & 0xc0) != 0x80;
-	return n;
-}
-
+/* The help bar from `row` on, over help_rows rows, its items in order;
+ * what does not fit on the last row is left out. */
 static void put_help(const keyview *v, abuf *a, int row)
 {
-	abuf_printf(a, "\x1b[%dH", row + 1);
-	int used = 0;
-	for (size_t i = 0; i < v->nbar; i++) {
-		int w = 2 + text_width(v->bar[i].keys) + 1 + text_width(v->bar[i].what);
-		if (used + w > v->cols - 1) /* never the last cell of the last row */
-			break;
-		abuf_printf(a, "  \x1b[1m%s\x1b[22m %s", v->bar[i].keys, v->bar[i].what);
-		used += w;
+	size_t i = 0;
+	for (int r = 0; r < v->help_rows; r++) {
+		abuf_printf(a, "\x1b[%dH", row + r + 1);
+		bool last = r == v->help_rows - 1;
+		int used = 0;
+		for (; i < v->nbar; i++) {
+			int w = 2 + text_width(v->bar[i].keys) + 1 + text_width(v->bar[i].what);
+			if (used + w > v->cols - (last ? 1 : 0)) /* never the last cell of the last row */
+				break;
+			abuf_printf(a, "  \x1b[1m%s\x1b[22m %s", v->bar[i].keys, v->bar[i].what);
+			used += w;
+		}
+		abuf_str(a, "\x1b[K");
 	}
-	abuf_str(a, "\x1b[K");
 }
 
 void keyview_draw(keyview *v, const char *status)
@@ -164,7 +181,7 @@ void keyview_draw(keyview *v, const char *status)
 			v->enc->ops->invalidate(v->enc);
 		v->status_shown[0] = '\0';
 		if (v->help)
-			put_help(v, a, v->rows - 1);
+			put_help(v, a, v->rows - v->help_rows);
 		v->repaint = false;
 	}
 	if (keyview_status_differs(v, status) && v->rows >= 1) {

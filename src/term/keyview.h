@@ -43,6 +43,7 @@ typedef struct keyview {
 	size_t nbar;
 	int cols, rows;
 	bool help;                 /* the help bar is shown */
+	int help_rows;             /* its rows: two when one would cut it (a screen of 40x16 or more) */
 	int pic_rows;              /* the picture's rows; the status line and help bar follow */
 	int img_w, img_h;          /* the picture in pixels (0: no room for one) ... */
 	int img_x, img_y;          /* ... and its place on the encoder's canvas */

@@ -32,8 +32,9 @@ static size_t escape_len(const char *p, const char *end)
 	return q < end ? (size_t)(q - p) + 1 : (size_t)(end - p);
 }
 
-/* Splits text into display rows of at most cols columns; returns the count
- * and, when out is not NULL, fills it. */
+/* Splits text into display rows of at most cols columns, a long line
+ * broken after the last blank that fits (a word wider than the row is cut
+ * at the width); returns the count and, when out is not NULL, fills it. */
 static int split(const char *text, size_t len, int cols, slice *out)
 {
 	int n = 0;
@@ -41,7 +42,7 @@ static int split(const char *text, size_t len, int cols, slice *out)
 	if (cols < 1)
 		cols = 1;
 	while (p < end) {
-		const char *start = p;
+		const char *start = p, *blank = NULL;
 		int width = 0;
 		while (p < end && *p != '\n') {
 			size_t e = escape_len(p, end);
@@ -50,8 +51,13 @@ static int split(const char *text, size_t len, int cols, slice *out)
 				continue;
 			}
 			bool lead = ((unsigned char)*p & 0xc0) != 0x80;
-			if (lead && width == cols)
+			if (lead && width == cols) {
+				if (*p != ' ' && blank) /* the word goes to the next row */
+					p = blank;
 				break;
+			}
+			if (*p == ' ' && width > 0)
+				blank = p;
 			width += lead;
 			p++;
 		}
@@ -60,8 +66,25 @@ static int split(const char *text, size_t len, int cols, slice *out)
 		n++;
 		if (p < end && *p == '\n')
 			p++;
+		else if (p < end && *p == ' ')
+			p++; /* the blank the row broke at */
 	}
 	return n;
+}
+
+int pager_split(const char *text, size_t len, int cols, size_t *off, size_t *n, int max)
+{
+	int rows = split(text, len, cols, NULL);
+	slice *sl = malloc((size_t)(rows ? rows : 1) * sizeof *sl);
+	if (!sl)
+		return -1;
+	split(text, len, cols, sl);
+	for (int i = 0; i < rows && i < max; i++) {
+		off[i] = (size_t)(sl[i].p - text);
+		n[i] = sl[i].n;
+	}
+	free(sl);
+	return rows;
 }
 
 int pager_rows(const char *text, size_t len, int cols)

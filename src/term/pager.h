@@ -13,9 +13,14 @@
 
 #include "term/evloop.h"
 
-/* The rows text takes on a terminal `cols` wide, long lines wrapped (escape
+/* The rows text takes on a terminal `cols` wide, long lines wrapped at word
+ * boundaries (escape
  * sequences take no room; a code point takes one column). */
 int pager_rows(const char *text, size_t len, int cols);
+/* The same rows: row i is text[off[i] .. off[i] + n[i]) for the first max
+ * of them. A long line breaks after its last blank that fits, a word wider
+ * than the row at the width. Returns the count, -1 when out of memory. */
+int pager_split(const char *text, size_t len, int cols, size_t *off, size_t *n, int max);
 
 /* Shows text on the terminal fd_out (through the loop's output scheduler
  * when it has one), reading keys from the event loop l (its input, a

@@ -253,7 +253,8 @@ static void test_unpaced_parts(void **state)
 	termout *o = termout_new(p.out[1]);
 	evloop *l = evloop_new(p.in[0], p.wake[0]);
 	evloop_set_out(l, o);
-	encoder_geom g = {.cols = COLS, .rows = ROWS, .pal = PALETTE_TRUECOLOR};
+	/* exact: the cells are the image's own pixels, none traded for bytes */
+	encoder_geom g = {.cols = COLS, .rows = ROWS, .pal = PALETTE_TRUECOLOR, .exact = true};
 	encoder *enc = encoder_halfblock.open(&g);
 	assert_non_null(enc);
 	termout_set_picture(o, enc);

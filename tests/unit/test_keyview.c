@@ -9,6 +9,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "shell/keymode.h"
 #include "term/keyview.h"
 
 typedef struct out_file {
@@ -103,21 +104,58 @@ static void test_draw(void **state)
 		px[3 * i + 2] = i < 20 * 6 ? 0 : 255;
 	}
 	keyview_picture(&v, px, true);
-	abuf keys;
-	abuf_init(&keys);
-	termout_pump(o, 0.0, &keys);
+	abuf got;
+	abuf_init(&got);
+	termout_pump(o, 0.0, &got);
 	t = take(&f);
 	assert_non_null(strstr(t, "255;0;0m"));
 	assert_non_null(strstr(t, "0;0;255m"));
 	assert_null(strstr(t, "\x1b[?25h"));
 	/* Nothing changed: nothing more. */
 	keyview_picture(&v, px, true);
-	termout_pump(o, 0.0, &keys);
+	termout_pump(o, 0.0, &got);
 	assert_string_equal(take(&f), "");
 	/* The way out shows the cursor again. */
 	keyview_end(&v);
 	assert_string_equal(take(&f), "\x1b[m\x1b[?25h");
-	abuf_free(&keys);
+	abuf_free(&got);
+	keyview_free(&v);
+	termout_free(o);
+	close(f.fd);
+}
+
+/* key mode's own bar at 80x24 (issue 31, friction 3): it takes two rows
+ * there, so that rotate, size, undo and mode are all shown. */
+static void test_bar_fits(void **state)
+{
+	(void)state;
+	out_file f = {0};
+	FILE *tf = tmpfile();
+	assert_non_null(tf);
+	f.fd = dup(fileno(tf));
+	fclose(tf);
+	termout *o = termout_new(f.fd);
+	keyview_item items[32];
+	size_t n = keymode_help_bar(items, 32);
+	keyview v;
+	keyview_init(&v, o, PALETTE_TRUECOLOR, items, n);
+	keyview_layout(&v, 80, 24, true, 16.0 / 9.0);
+	assert_int_equal(v.help_rows, 2);
+	assert_int_equal(v.pic_rows, 21); /* 24 - the status line - two bar rows */
+	keyview_draw(&v, "status");
+	const char *t = take(&f);
+	assert_non_null(strstr(t, "\x1b[22H\x1b[7mstatus"));
+	const char *r23 = strstr(t, "\x1b[23H"), *r24 = strstr(t, "\x1b[24H");
+	assert_non_null(r23);
+	assert_non_null(r24);
+	const char *words[] = {" back", " move", " turn", " select", " rotate", " size", " undo", " mode"};
+	for (size_t i = 0; i < sizeof words / sizeof words[0]; i++)
+		assert_non_null(strstr(r23, words[i]));
+	keyview_free(&v);
+	/* 240 columns: one row is enough. */
+	keyview_init(&v, o, PALETTE_TRUECOLOR, items, n);
+	keyview_layout(&v, 240, 48, true, 16.0 / 9.0);
+	assert_int_equal(v.help_rows, 1);
 	keyview_free(&v);
 	termout_free(o);
 	close(f.fd);
@@ -127,6 +165,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_layout),
+		cmocka_unit_test(test_bar_fits),
 		cmocka_unit_test(test_draw),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);

@@ -39,10 +39,37 @@ static void test_rows(void **state)
 	assert_int_equal(rows(blocks, 80), 1);
 }
 
+/* Long lines wrap at word boundaries (issue 31, friction 3): "the picture"
+ * never becomes "the pic" / "ture"; a word wider than the row is cut. */
+static void test_word_wrap(void **state)
+{
+	(void)state;
+	const char *t = "samples accumulate while you watch the picture refine";
+	size_t off[8], n[8];
+	/* 20 columns: "samples accumulate " is 19 + ... by hand: */
+	int r = pager_split(t, strlen(t), 20, off, n, 8);
+	assert_int_equal(r, 3);
+	assert_int_equal(n[0], strlen("samples accumulate"));
+	assert_memory_equal(t + off[1], "while you watch the", n[1]);
+	assert_int_equal(n[1], strlen("while you watch the"));
+	assert_memory_equal(t + off[2], "picture refine", n[2]);
+	assert_int_equal(n[2], strlen("picture refine"));
+	/* A word longer than the row: cut at the width. */
+	const char *w = "abcdefghijklmnop qr";
+	r = pager_split(w, strlen(w), 8, off, n, 8);
+	assert_int_equal(r, 3);
+	assert_int_equal(n[0], 8);
+	assert_memory_equal(w + off[1], "ijklmnop", n[1]);
+	assert_memory_equal(w + off[2], "qr", 2);
+	/* A row that ends exactly at a blank: no empty row after it. */
+	assert_int_equal(rows("aaaa bbbb", 4), 2);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_rows),
+		cmocka_unit_test(test_word_wrap),
 	};
 	return cmocka_run_group_tests_name("pager", tests, NULL, NULL);
 }

@@ -92,6 +92,7 @@ static shell *new_shell(rtsh_options *o)
 	o->quiet = true;
 	shell *sh = malloc(sizeof *sh);
 	assert_true(shell_init(sh, o, -1));
+	command_table_install(sh);
 	return sh;
 }
 

@@ -239,7 +239,7 @@ static void test_rate_distortion_ramp(void **state)
 		if (!rd)
 			f->lambda = 0;
 		else
-			assert_near(f->lambda, 5, 0);
+			assert_near(f->lambda, FRAME_LAMBDA, 0);
 		frame_put_image(f, img, cols * 2, rows * 4, 0, 0);
 		for (int i = 0; i < cols * rows; i++) {
 			frame_cell c = f->cur[i];
