@@ -279,6 +279,14 @@ typedef struct mesh_surf {
 	vec3 ng, ns, dpdu, dpdv;
 	double u, v;
 	int mat; /* material of the file, -1 none */
+	/* Smooth meshes: where rays leaving the hit should start, less the hit
+	 * (object space; zero on flat faces). Hanika, "Hacking the Shadow
+	 * Terminator" (Ray Tracing Gems II, 2021): the hit point moved to the
+	 * tangent planes of the corners' normals, as far as it lies below them,
+	 * weighted by the barycentrics, so that shadow and bounce rays leave
+	 * from the smooth surface the normals describe, not from the flat
+	 * triangle, whose neighbours would shadow it along the terminator. */
+	vec3 shift;
 } mesh_surf;
 void mesh_surface(const mesh *m, uint32_t slot, const float b[3], mesh_surf *s);
 

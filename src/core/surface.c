@@ -354,6 +354,13 @@ void surf_inst_finish(const world *w, const prim *p, const ray *r, vec3 nl, hit 
 	h->has_uv = false;
 	if (m->uv && wants_uv(w, h))
 		apply_uv(w, h, s.u, s.v, mat3x4_vector(in->fwd, s.dpdu), mat3x4_vector(in->fwd, s.dpdv));
+	/* smooth meshes: rays leave from the smooth surface (mesh_surf.shift),
+	 * unless they may pass through it (glass), where the point moved out
+	 * would put the far side's rays in front of the face */
+	const mat_lin *ml = &w->mats[h->mat];
+	bool through = ml->family == MAT_PBR ? ml->pbr.transmission > 0 || ml->thin : ml->ior != 0;
+	if (m->n && !through)
+		h->p = v3_add(h->p, mat3x4_vector(in->fwd, s.shift));
 }
 
 /* The linear part of the inverse of a 3x4 matrix's linear part. */

@@ -1,6 +1,7 @@
 /* rtsh-mpi — the tile farm (farm.h). */
 #include "mpi/farm.h"
 
+#include <math.h>
 #include <mpi.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -84,6 +85,7 @@ typedef struct server {
 	_Alignas(64) atomic_ullong rays;
 	atomic_long local;              /* tiles rank 0's threads rendered */
 	_Atomic double busy;
+	_Atomic double slowest; /* the longest tile rank 0 rendered (seconds) */
 } server;
 
 static void add_double(_Atomic double *a, double v)
@@ -112,7 +114,11 @@ static void *server_thread(void *arg)
 		tile_rect(&sv->t, i, r);
 		double t0 = now();
 		render_rect(sv->w, sv->s, r[0], r[1], r[2], r[3], buf);
-		busy += now() - t0;
+		double took = now() - t0;
+		busy += took;
+		for (double old = atomic_load(&sv->slowest); took > old;)
+			if (atomic_compare_exchange_weak(&sv->slowest, &old, took))
+				break;
 		place(&sv->t, i, buf, sv->fb);
 		atomic_fetch_add(&sv->local, 1);
 		atomic_fetch_add(&sv->done, 1);
@@ -139,10 +145,17 @@ static void show_progress(long done, long total, double elapsed)
 	fflush(stderr);
 }
 
+/* What rank 0 knows of each worker's pace, for the deadline (farm_opts). */
+typedef struct pace {
+	double last;     /* when it last sent something (or the farm began) */
+	long held;       /* tiles handed to it and not yet back */
+	double slowest;  /* the longest wait between two of its messages, while it held tiles */
+} pace;
+
 /* Sends a worker up to k tile numbers (list has room for k + 1), with -1
  * after them when none are left; then the worker is told. */
 static void hand_out(server *sv, int worker, int64_t k, int64_t *list, bool *told, int *active,
-                     double *bytes)
+                     double *bytes, pace *pc)
 {
 	int n = 0;
 	while (n < k) {
@@ -154,6 +167,7 @@ static void hand_out(server *sv, int worker, int64_t k, int64_t *list, bool *tol
 			break;
 		}
 		list[n++] = i;
+		pc[worker].held++;
 	}
 	MPI_Send(list, n, MPI_INT64_T, worker, FARM_TILES, MPI_COMM_WORLD);
 	*bytes += (double)n * sizeof *list;
@@ -164,10 +178,14 @@ static void hand_out(server *sv, int worker, int64_t k, int64_t *list, bool *tol
 /* Takes one waiting message from a worker and answers it; false (err set)
  * when the message breaks the protocol. */
 static bool serve_one(server *sv, MPI_Status *ms, char *msg, size_t most, bool *told, int *active,
-                      double *bytes, rt_error *err)
+                      double *bytes, pace *pc, rt_error *err)
 {
 	int src = ms->MPI_SOURCE, count;
 	int64_t one[2];
+	double t = now();
+	if (pc[src].held > 0 && t - pc[src].last > pc[src].slowest)
+		pc[src].slowest = t - pc[src].last;
+	pc[src].last = t;
 	if (ms->MPI_TAG == FARM_ASK) {
 		int64_t k;
 		MPI_Recv(&k, 1, MPI_INT64_T, src, FARM_ASK, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
@@ -177,7 +195,7 @@ static bool serve_one(server *sv, MPI_Status *ms, char *msg, size_t most, bool *
 		int64_t *list = malloc(((size_t)k + 1) * sizeof *list);
 		if (!list)
 			return rt_error_set(err, "out of memory");
-		hand_out(sv, src, k, list, &told[src], active, bytes);
+		hand_out(sv, src, k, list, &told[src], active, bytes, pc);
 		free(list);
 		return true;
 	}
@@ -198,8 +216,10 @@ static bool serve_one(server *sv, MPI_Status *ms, char *msg, size_t most, bool *
 	/* msg is malloc'd and the floats start 8 bytes in: aligned */
 	place(&sv->t, i, (const float *)(void *)(msg + sizeof i), sv->fb);
 	atomic_fetch_add(&sv->done, 1);
+	if (pc[src].held > 0)
+		pc[src].held--;
 	if (!told[src])
-		hand_out(sv, src, 1, one, &told[src], active, bytes);
+		hand_out(sv, src, 1, one, &told[src], active, bytes, pc);
 	return true;
 }
 
@@ -214,23 +234,28 @@ bool farm_serve(const world *w, const render_settings *s, const farm_opts *o, fr
 	atomic_init(&sv.rays, 0);
 	atomic_init(&sv.local, 0);
 	atomic_init(&sv.busy, 0.0);
+	atomic_init(&sv.slowest, 0.0);
 	size_t most = (size_t)o->tile * (size_t)o->tile * 3;
 	int n = o->threads;
 	char *msg = malloc(sizeof(int64_t) + most * sizeof(float));
 	bool *told = calloc((size_t)size, sizeof *told);
+	pace *pc = calloc((size_t)size, sizeof *pc);
 	pthread_t *tid = calloc((size_t)n, sizeof *tid);
 	server_arg *args = calloc((size_t)n, sizeof *args);
 	/* one tile for each thread, and one for this thread if none starts */
 	float *bufs = malloc(((size_t)n + 1) * most * sizeof *bufs);
-	if (!msg || !told || !tid || !args || !bufs) {
+	if (!msg || !told || !pc || !tid || !args || !bufs) {
 		free(msg);
 		free(told);
+		free(pc);
 		free(tid);
 		free(args);
 		free(bufs);
 		return rt_error_set(err, "out of memory for %d tiles of %dx%d", n + 1, o->tile, o->tile);
 	}
 	double t0 = now(), bytes = 0.0, shown = 0.0, cpu0 = thread_cpu();
+	for (int r = 0; r < size; r++)
+		pc[r].last = t0;
 	int started = 0;
 	for (; started < n; started++) {
 		args[started] = (server_arg){&sv, bufs + (size_t)started * most};
@@ -246,7 +271,7 @@ bool farm_serve(const world *w, const render_settings *s, const farm_opts *o, fr
 	long nap = 50;
 	bool ok = true;
 	float *own = started == 0 ? bufs + (size_t)n * most : NULL;
-	double own_busy = 0.0;
+	double own_busy = 0.0, checked = t0;
 	long own_tiles = 0;
 	if (started == 0)
 		world_rays_reset();
@@ -255,7 +280,7 @@ bool farm_serve(const world *w, const render_settings *s, const farm_opts *o, fr
 		MPI_Status ms;
 		MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &ms);
 		if (flag) {
-			ok = serve_one(&sv, &ms, msg, most, told, &active, &bytes, err);
+			ok = serve_one(&sv, &ms, msg, most, told, &active, &bytes, pc, err);
 			if (!ok) /* the threads stop after their tile; the caller aborts */
 				atomic_store(&sv.next, sv.t.count);
 			nap = 50;
@@ -272,10 +297,32 @@ bool farm_serve(const world *w, const render_settings *s, const farm_opts *o, fr
 			double b0 = now();
 			render_rect(w, s, r[0], r[1], r[2], r[3], own);
 			own_busy += now() - b0;
+			if (now() - b0 > atomic_load(&sv.slowest))
+				atomic_store(&sv.slowest, now() - b0);
 			place(&sv.t, i, own, fb);
 			own_tiles++;
 			atomic_fetch_add(&sv.done, 1);
 			continue;
+		}
+		if (o->deadline > 0 && now() - checked >= 0.25) {
+			/* four times a second: is a worker late? */
+			checked = now();
+			double slow = atomic_load(&sv.slowest);
+			for (int r = 1; r < size; r++)
+				slow = fmax(slow, pc[r].slowest);
+			double limit = fmax(o->deadline, FARM_DEADLINE_TILES * slow), t = now();
+			for (int r = 1; ok && slow > 0 && r < size; r++)
+				if ((!told[r] || pc[r].held > 0) && t - pc[r].last > limit) {
+					ok = rt_error_set(err,
+					                  "rank %d on %s sent no tile for %.0f s (stopped, or its host hangs); "
+					                  "expected one within %.0f s (%g x the slowest tile, at least "
+					                  "RTSH_MPI_DEADLINE=%g)",
+					                  r, o->host ? o->host(r) : "?", t - pc[r].last, limit,
+					                  FARM_DEADLINE_TILES, o->deadline);
+					atomic_store(&sv.next, sv.t.count); /* the threads stop after their tile */
+				}
+			if (!ok)
+				break;
 		}
 		sleep_us(nap);
 		if (nap < 1000)
@@ -302,6 +349,7 @@ bool farm_serve(const world *w, const render_settings *s, const farm_opts *o, fr
 	free(args);
 	free(msg);
 	free(told);
+	free(pc);
 	free(tid);
 	return ok;
 }

@@ -26,7 +26,16 @@ typedef struct farm_opts {
 	int delay_us;   /* test mode: each result waits this long before it is sent */
 	int threads;    /* render threads on this rank */
 	bool progress;  /* rank 0: a progress line on standard error */
+	/* Rank 0: a worker that holds tiles (or has not asked yet) and has sent
+	 * nothing for max(deadline, FARM_DEADLINE_TILES x the slowest tile or
+	 * gap between results seen so far) seconds is taken for stopped or hung
+	 * (SIGSTOP, a frozen host): farm_serve fails naming it, and the caller
+	 * ends the job. Before any tile has been timed, no deadline. */
+	double deadline;
+	const char *(*host)(int rank); /* rank 0: a rank's host for messages (NULL: none) */
 } farm_opts;
+
+#define FARM_DEADLINE_TILES 10.0
 
 /* One rank's figures (gathered on rank 0 for -v). */
 typedef struct farm_stats {

@@ -370,6 +370,12 @@ static void on_stop(int sig)
 	raise(sig);
 }
 
+/* A rank's host, for rank 0's messages (farm_opts.host). */
+static const char *host_of(int rank)
+{
+	return stop_ids && rank >= 0 && rank < atomic_load(&stop_nids) ? stop_ids[rank].host : "?";
+}
+
 /* The tile side when RTSH_MPI_TILE does not set one: 32 pixels, halved
  * (down to 8) until there are at least 8 tiles for every render thread of
  * the job, so that the last wave of tiles is a small part of the render
@@ -532,7 +538,15 @@ int main(int argc, char **argv)
 	wait_for(&ar);
 	if (c.tile == 0)
 		c.tile = auto_tile(c.set.width, c.set.height, all_threads);
+	/* rank 0 alone reads the floor of the deadline for a silent rank */
+	long deadline = 30;
+	if (rank == 0 && !env_number("RTSH_MPI_DEADLINE", 30, 1, 86400, &deadline)) {
+		rt_error_set(&err, "RTSH_MPI_DEADLINE is not valid");
+		die(rank, host, "", &err);
+	}
 	farm_opts fo = {
+		.deadline = (double)deadline,
+		.host = host_of,
 		.tile = c.tile,
 		.prefetch = c.prefetch >= 0 ? c.prefetch : threads / 2 > 2 ? threads / 2 : 2,
 		.delay_us = c.delay_us,

@@ -598,7 +598,7 @@ void mesh_surface(const mesh *m, uint32_t slot, const float b[3], mesh_surf *s)
 	s->ng = v3_cross(e1, e2);
 	s->ns = s->ng;
 	s->u = s->v = 0;
-	s->dpdu = s->dpdv = v3(0, 0, 0);
+	s->dpdu = s->dpdv = s->shift = v3(0, 0, 0);
 	uint32_t t = mesh_slot_tri(m, slot);
 	s->mat = m->nmats == 0 ? -1 : m->tmat ? m->tmat[t] : 0;
 	if (!m->tri)
@@ -611,6 +611,22 @@ void mesh_surface(const mesh *m, uint32_t slot, const float b[3], mesh_surf *s)
 		/* a normal on the far side of the face would shade it black */
 		if (v3_dot(n, n) > 0)
 			s->ns = v3_dot(n, s->ng) >= 0 ? n : v3_neg(n);
+		/* the shadow terminator (mesh_surf.shift): p' = p + sum_k b_k
+		 * max(0, -(p - p_k).n_k) n_k, each corner's normal on the side of
+		 * the face the interpolated one is on */
+		vec3 p = v3(0, 0, 0);
+		for (int k = 0; k < 3; k++)
+			p = v3_madd(p, pc[k], b[k]);
+		for (int k = 0; k < 3; k++) {
+			vec3 nk = v3(m->n[i[k]][0], m->n[i[k]][1], m->n[i[k]][2]);
+			double l = v3_len(nk);
+			if (!(l > 0))
+				continue;
+			nk = v3_scale(nk, (v3_dot(nk, s->ns) >= 0 ? 1.0 : -1.0) / l);
+			double d = v3_dot(v3_sub(p, pc[k]), nk);
+			if (d < 0)
+				s->shift = v3_madd(s->shift, nk, -d * b[k]);
+		}
 	}
 	if (m->uv) {
 		const float *a = m->uv[i[0]], *bb = m->uv[i[1]], *c = m->uv[i[2]];
