@@ -345,7 +345,8 @@ static void on_progress(void *ctx, long done, long total)
 static bool same_image_settings(const render_settings *a, const render_settings *b)
 {
 	return a->width == b->width && a->height == b->height && a->samples == b->samples &&
-	       a->depth == b->depth && a->mode == b->mode && a->seed == b->seed;
+	       a->depth == b->depth && a->mode == b->mode && a->seed == b->seed &&
+	       (a->mode != MODE_PATH || (a->denoise == DENOISE_ON) == (b->denoise == DENOISE_ON));
 }
 
 const framebuffer *shell_full_image(shell *sh, bool force)
