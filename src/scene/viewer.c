@@ -41,6 +41,20 @@ static bool put(char *text, size_t size, size_t *n, const char *fmt, ...)
 	return true;
 }
 
+/* A number as the scene text writes it: within 1e-9 of a whole number (a
+ * colour of 254.99999999999997 from the sRGB encoding of 1, a direction's
+ * 2e-16 from a quaternion, -0) the whole number. */
+static double tidy(double x)
+{
+	double r = round(x);
+	return fabs(x - r) < 1e-9 ? r + 0.0 : x;
+}
+
+static vec3 tidy3(vec3 v)
+{
+	return v3(tidy(v.x), tidy(v.y), tidy(v.z));
+}
+
 /* `rtsh scene.glb`: the file as a scene (rtsh(5), "glTF scenes"). Its
  * triangles are one mesh line placed so that the file's coordinates are the
  * scene's (the box centred where it is, its longest side its own size);
@@ -87,7 +101,10 @@ static char *gltf_text(const char *path, const rt_load_opts *opts, size_t *len, 
 		               vdir.y, vdir.z, fov);
 	}
 	for (size_t i = 0; ok && i < gi.ncams; i++) {
-		const gltf_camera *c = &gi.cams[i];
+		gltf_camera cc = gi.cams[i];
+		cc.pos = tidy3(cc.pos);
+		cc.fwd = tidy3(cc.fwd);
+		const gltf_camera *c = &cc;
 		/* rtsh cameras stay upright: a roll is not kept (said once) */
 		vec3 up_ref = fabs(c->fwd.y) > 0.999999 ? v3(0, 0, 1) : v3(0, 1, 0);
 		vec3 right = v3_norm(v3_cross(up_ref, c->fwd)), up = v3_cross(c->fwd, right);
@@ -109,7 +126,10 @@ static char *gltf_text(const char *path, const rt_load_opts *opts, size_t *len, 
 	if (ok && aspect > 0.05 && aspect < 20)
 		ok = put(text, size, &n, "R 1280 %d\n", (int)fmax(1, round(1280 / aspect)));
 	for (size_t i = 0; ok && i < gi.nlights; i++) {
-		const gltf_light *l = &gi.lights[i];
+		gltf_light ll = gi.lights[i];
+		ll.pos = tidy3(ll.pos);
+		ll.dir = tidy3(ll.dir);
+		const gltf_light *l = &ll;
 		vec3 c = linear_to_srgb255(v3(l->color[0], l->color[1], l->color[2]));
 		/* a colour brighter than white: the excess goes into the intensity */
 		double top = v3_max_comp(c), k = 1;
@@ -117,6 +137,7 @@ static char *gltf_text(const char *path, const rt_load_opts *opts, size_t *len, 
 			k = v3_max_comp(v3(l->color[0], l->color[1], l->color[2]));
 			c = linear_to_srgb255(v3(l->color[0] / k, l->color[1] / k, l->color[2] / k));
 		}
+		c = tidy3(c);
 		ok = put(text, size, &n, "L %.17g,%.17g,%.17g 1 %.17g,%.17g,%.17g %s=%.17g", l->pos.x, l->pos.y, l->pos.z,
 		         c.x, c.y, c.z, l->type == GLTF_DIRECTIONAL ? "lux" : "cd", l->intensity * k);
 		if (ok && l->type != GLTF_POINT)

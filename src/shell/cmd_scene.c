@@ -108,8 +108,14 @@ bool cmd_save(shell *sh, int argc, char **argv, const char *rest)
 		else if (!image_write(path, fb, sh->set.exposure, &err))
 			ok = save_failed(sh, &err);
 		else
-			shell_info(sh, "saved %s (%dx%d, %d sample%s, %s)\n", path, fb->w, fb->h, fb->spp,
-			          fb->spp == 1 ? "" : "s", render_mode_name(sh->full_set.mode));
+			/* In path mode the preview is denoised and, under denoise
+			 * auto, the saved image is not: say so, with the way to. */
+			shell_info(sh, "saved %s (%dx%d, %d sample%s, %s%s)\n", path, fb->w, fb->h, fb->spp,
+			           fb->spp == 1 ? "" : "s", render_mode_name(sh->full_set.mode),
+			           sh->full_set.mode == MODE_PATH && sh->full_set.denoise == DENOISE_AUTO
+			               ? "; the raw samples: the preview is denoised, set denoise on denoises saves too"
+			               : sh->full_set.mode == MODE_PATH && sh->full_set.denoise == DENOISE_ON ? ", denoised"
+			                                                                                      : "");
 	} else {
 		char exts[256] = "";
 		const char *const *x = output_extensions();
@@ -173,12 +179,12 @@ bool cmd_set(shell *sh, int argc, char **argv, const char *rest)
 	}
 	char was[64];
 	settings_format(&sh->set, def, was, sizeof was);
+	size_t bit = (size_t)(def - settings_table); /* before the refresh, which reads it */
+	if (bit < sizeof sh->hand_set * 8)
+		sh->hand_set |= 1u << bit;
 	shell_edit_begin(sh);
 	sh->set = s;
 	shell_edit_end(sh);
-	size_t bit = (size_t)(def - settings_table);
-	if (bit < sizeof sh->hand_set * 8)
-		sh->hand_set |= 1u << bit;
 	settings_format(&sh->set, def, val, sizeof val);
 	shell_info(sh, "%s %s%s%s%s\n", def->name, val, strcmp(was, val) ? " (was " : "",
 	           strcmp(was, val) ? was : "", strcmp(was, val) ? ")" : "");

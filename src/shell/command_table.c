@@ -1,8 +1,9 @@
-/* rtsh — the command table (commands.h): one entry per command, alone in
- * its file; the handlers live in commands.c (help, quit, clear),
- * cmd_scene.c and cmd_edit.c, the lookup and argument helpers in
- * commands.c. */
+/* rtsh — the command table (commands.h): one entry per command; the
+ * handlers live in commands.c (help, quit, clear), cmd_scene.c, cmd_step.c
+ * and cmd_edit.c, the lookup and argument helpers in commands.c, which read
+ * the table the shell is handed (command_table_install, below). */
 #include "shell/commands.h"
+#include "shell/suggest.h"
 
 #define SUBS_CAMERA "pos|dir|lookat|fov|move|turn"
 #define SUBS_LIGHT "pos|move|brightness|color"
@@ -10,8 +11,8 @@
 
 const command command_table[] = {
 	{"load", NULL, "load FILE", 1, 1, {"@scene"},
-	 "replace the scene by a .rt file, or by a model (.obj .ply .gltf .glb .stl) on a framed stage; on any "
-	 "error the current scene stays",
+	 "replace the scene by a .rt file, a model (.obj .ply .stl) on a framed stage, or a glTF scene (.gltf "
+	 ".glb: its cameras, lights and materials); on any error the current scene stays",
 	 cmd_load},
 	{"save", NULL, "save FILE.ppm|FILE.pfm|FILE.png|FILE.jpg|FILE.ans|FILE.rt", 1, 1, {"@output"},
 	 "write the image (full resolution, rendered first if needed), the picture as ANSI text, or the scene",
@@ -73,3 +74,19 @@ const command command_table[] = {
 	 cmd_quit},
 };
 const size_t command_count = sizeof command_table / sizeof command_table[0];
+
+const command *command_find(const char *word, char *msg, size_t size)
+{
+	return command_lookup(command_table, command_count, word, msg, size);
+}
+
+bool suggest_command(const char *word, char *buf, size_t size)
+{
+	return suggest_command_in(command_table, command_count, word, buf, size);
+}
+
+void command_table_install(shell *sh)
+{
+	sh->commands = command_table;
+	sh->ncommands = command_count;
+}

@@ -48,17 +48,17 @@ static bool in_list(const char *list, const char *word, size_t len, bool prefix)
 	return false;
 }
 
-const command *command_find(const char *word, char *msg, size_t size)
+const command *command_lookup(const command *table, size_t count, const char *word, char *msg, size_t size)
 {
 	size_t len = strlen(word);
-	for (size_t i = 0; i < command_count; i++)
-		if (strcmp(command_table[i].name, word) == 0 || in_list(command_table[i].aliases, word, len, false))
-			return &command_table[i];
+	for (size_t i = 0; i < count; i++)
+		if (strcmp(table[i].name, word) == 0 || in_list(table[i].aliases, word, len, false))
+			return &table[i];
 	const command *found = NULL;
 	char names[512] = "";
 	int n = 0;
-	for (size_t i = 0; len && i < command_count; i++) {
-		const command *c = &command_table[i];
+	for (size_t i = 0; len && i < count; i++) {
+		const command *c = &table[i];
 		if (strncmp(c->name, word, len) == 0 || in_list(c->aliases, word, len, true)) {
 			found = c;
 			n++;
@@ -77,7 +77,7 @@ const command *command_find(const char *word, char *msg, size_t size)
 			snprintf(last, sizeof names - (size_t)(last - names), " or %s", tail);
 		}
 		snprintf(msg, size, "ambiguous command \"%s\"; could be %s", word, names);
-	} else if (suggest_command(word, names, sizeof names)) {
+	} else if (suggest_command_in(table, count, word, names, sizeof names)) {
 		snprintf(msg, size, "unknown command \"%s\"; did you mean \"%s\"?", word, names);
 	} else {
 		snprintf(msg, size, "unknown command \"%s\"; type help for the list of commands", word);
@@ -292,7 +292,11 @@ bool command_run(shell *sh, const char *text)
 	bool force = wl > 1 && argv[0][wl - 1] == '!';
 	if (force)
 		argv[0][wl - 1] = '\0';
-	const command *c = command_find(argv[0], msg, sizeof msg);
+	if (!sh->commands) {
+		free(buf);
+		return shell_fail(sh, "no command table (command_table_install)");
+	}
+	const command *c = command_lookup(sh->commands, sh->ncommands, argv[0], msg, sizeof msg);
 	if (!c || (force && c->run != cmd_quit)) {
 		if (c)
 			snprintf(msg, sizeof msg, "%s: \"%s!\" is not a command; only quit! takes a \"!\"", c->name,
@@ -331,7 +335,7 @@ bool cmd_help(shell *sh, int argc, char **argv, const char *rest)
 	(void)rest;
 	if (argc == 1) {
 		char msg[256];
-		const command *c = command_find(argv[0], msg, sizeof msg);
+		const command *c = command_lookup(sh->commands, sh->ncommands, argv[0], msg, sizeof msg);
 		if (!c)
 			return shell_fail(sh, "help: %s", msg);
 		for (const char *p = c->usage; *p;) {
@@ -363,8 +367,8 @@ bool cmd_help(shell *sh, int argc, char **argv, const char *rest)
 	}
 	shell_out(sh, "commands (a unique prefix is enough, a typo gets a suggestion; help COMMAND for its "
 	              "usage):\n");
-	for (size_t i = 0; i < command_count; i++) {
-		const command *c = &command_table[i];
+	for (size_t i = 0; i < sh->ncommands; i++) {
+		const command *c = &sh->commands[i];
 		/* A help of several lines: the others under the first. */
 		const char *p = c->help;
 		size_t k = strcspn(p, "\n");

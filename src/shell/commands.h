@@ -4,8 +4,9 @@
  * what to complete for each argument, one line of help and the handler.
  * Lookup (exact names, aliases and unique prefixes), usage errors, `help`,
  * readline completion and the man page's list all come from this table, so
- * a new command is one entry and one function. The table is alone in
- * command_table.c; lookup and the argument helpers are in commands.c.
+ * a new command is one entry and one function. The table is in
+ * command_table.c, above its handlers; lookup and the argument helpers are
+ * in commands.c, below them, and read the table the shell was handed.
  */
 #ifndef RTSH_COMMANDS_H
 #define RTSH_COMMANDS_H
@@ -44,10 +45,16 @@ typedef struct command {
 extern const command command_table[];
 extern const size_t command_count;
 
-/* The command named `word`, one of its aliases, or the one command whose
- * name or alias starts with `word`; NULL otherwise, with a message saying
- * whether it is unknown or ambiguous. */
+/* The command of the `count` in `table` named `word`, one of its aliases,
+ * or the one command whose name or alias starts with `word`; NULL
+ * otherwise, with a message saying whether it is unknown or ambiguous. */
+const command *command_lookup(const command *table, size_t count, const char *word, char *msg, size_t size);
+/* command_lookup in command_table (command_table.c). */
 const command *command_find(const char *word, char *msg, size_t size);
+/* Hands sh the command table (command_table.c): shell_main and the tests
+ * call it after shell_init; command_run, help and the scripts read it from
+ * sh. */
+void command_table_install(shell *sh);
 
 /* Index of the choice in "a|b|c" that `word` names or is a unique prefix of;
  * -1 when none or more than one. */
@@ -74,7 +81,7 @@ bool arg_index(shell *sh, const char *what, const char *word, const char *kind, 
 /* A number: [+-]digits[.digits][e[+-]digits]; no inf, nan or hex. */
 bool parse_number(const char *s, double *out);
 
-/* The handlers (cmd_scene.c, cmd_edit.c, cmd_misc.c). */
+/* The handlers (cmd_scene.c, cmd_step.c, cmd_edit.c, commands.c). */
 bool cmd_load(shell *sh, int argc, char **argv, const char *rest);
 bool cmd_save(shell *sh, int argc, char **argv, const char *rest);
 bool cmd_render(shell *sh, int argc, char **argv, const char *rest);
@@ -99,8 +106,8 @@ bool cmd_help(shell *sh, int argc, char **argv, const char *rest);
 bool cmd_clear(shell *sh, int argc, char **argv, const char *rest);
 bool cmd_quit(shell *sh, int argc, char **argv, const char *rest);
 
-/* Runs one command (no ';'): looks it up, checks the argument count and
- * calls the handler. Blank commands succeed. */
+/* Runs one command (no ';'): looks it up in sh's table, checks the
+ * argument count and calls the handler. Blank commands succeed. */
 bool command_run(shell *sh, const char *text);
 
 #endif

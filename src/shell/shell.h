@@ -88,6 +88,11 @@ typedef struct shell {
 	void (*status_hook)(struct shell *sh); /* redraws the status line (interactive) */
 	int wake[2];           /* the interactive loop's wake-up pipe (read, write); -1: none */
 	evloop *ev;            /* the interactive loop's event loop (term/evloop.h); NULL: none */
+	/* The commands it runs (commands.h): the table is handed down by the
+	 * shell's owner (command_table_install), so that lookup, help and the
+	 * scripts need not call up into the table's file. */
+	const struct command *commands;
+	size_t ncommands;
 } shell;
 
 /* Records an error message for the command being run; returns false. */

@@ -9,6 +9,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "shell/commands.h"
 #include "shell/options.h"
 #include "shell/shell.h"
 #include "shell/signals.h"
@@ -37,6 +38,7 @@ int shell_main(const rtsh_options *o)
 			close(wake[0]), close(wake[1]);
 		return 1;
 	}
+	command_table_install(&sh);
 	signals_set_cancel(&sh.cancel);
 	sh.pal = caps_palette(o->color, STDOUT_FILENO);
 	int status = 0;

@@ -117,14 +117,14 @@ bool suggest_choice(const char *choices, const char *word, char *buf, size_t siz
 	return true;
 }
 
-bool suggest_command(const char *word, char *buf, size_t size)
+bool suggest_command_in(const command *table, size_t count, const char *word, char *buf, size_t size)
 {
 	/* Names first, so that a name wins a tie with an alias. */
 	nearest near = nearest_start(word);
-	for (size_t i = 0; i < command_count; i++)
-		nearest_try(&near, command_table[i].name, strlen(command_table[i].name));
-	for (size_t i = 0; i < command_count; i++)
-		nearest_list(&near, command_table[i].aliases, ' ');
+	for (size_t i = 0; i < count; i++)
+		nearest_try(&near, table[i].name, strlen(table[i].name));
+	for (size_t i = 0; i < count; i++)
+		nearest_list(&near, table[i].aliases, ' ');
 	if (!nearest_ok(&near))
 		return false;
 	snprintf(buf, size, "%.*s", (int)near.best_len, near.best);

@@ -188,12 +188,21 @@ static void pix_invalidate(encoder *b)
  * (issue 31, defect 8). */
 static bool send_strip(pix_enc *e, int k, abuf *out)
 {
+	abuf *outer = out;
 	const encoder_geom *g = &e->base.geom;
 	int x, y, w, h;
 	tile_rect(e, k, &x, &y, &w, &h);
 	int rows = h / g->cell_h, cols = w / g->cell_w;
 	size_t len0 = out->len;
-	abuf_printf(out, "\x1b" "7\x1b[?25l\x1b[%d;%dH", g->y0 + y / g->cell_h + 1, g->x0 + x / g->cell_w + 1);
+	abuf inner;
+	if (g->passthrough) {
+		/* Through tmux: the whole strip, its cursor move in the outer
+		 * terminal's cells, goes as one passthrough. */
+		abuf_init(&inner);
+		out = &inner;
+	}
+	abuf_printf(out, "\x1b" "7\x1b[?25l\x1b[%d;%dH", g->pass_y * g->passthrough + g->y0 + y / g->cell_h + 1,
+	            g->pass_x * g->passthrough + g->x0 + x / g->cell_w + 1);
 	const uint8_t *p = e->rgb + ((size_t)y * e->w + x) * 3;
 	if (w < e->w) { /* a tile narrower than the canvas: its rows together */
 		for (int row = 0; row < h; row++)
@@ -208,7 +217,15 @@ static bool send_strip(pix_enc *e, int k, abuf *out)
 	} else {
 		ok = pixels_encode(e->mode, out, p, w, h, cols, rows);
 	}
-	abuf_str(out, g->cursor_off ? "\x1b" "8" : "\x1b" "8\x1b[?25h");
+	abuf_str(out, g->cursor_off || g->passthrough ? "\x1b" "8" : "\x1b" "8\x1b[?25h");
+	if (g->passthrough) {
+		bool good = ok && !inner.failed;
+		out = outer;
+		if (good)
+			pixels_passthrough(out, inner.b, inner.len);
+		abuf_free(&inner);
+		ok = good;
+	}
 	if (!ok || out->failed) {
 		out->len = len0;
 		return false;
@@ -221,8 +238,13 @@ static bool pix_update(encoder *b, abuf *out, size_t budget)
 	pix_enc *e = (pix_enc *)b;
 	size_t start = out->len;
 	if (e->erase) {
+		abuf del;
+		abuf_init(&del);
 		for (int k = 0; k < e->kitty_used; k++)
-			pixels_kitty_delete(out, PIXELS_KITTY_ID + k);
+			pixels_kitty_delete(e->base.geom.passthrough ? &del : out, PIXELS_KITTY_ID + k);
+		if (e->base.geom.passthrough && !del.failed)
+			pixels_passthrough(out, del.b, del.len);
+		abuf_free(&del);
 		e->kitty_used = 0;
 		e->erase = false;
 	}

@@ -30,6 +30,11 @@ typedef struct encoder_geom {
 	int max_w, max_h;    /* the largest image the terminal takes in pixels
 	                      * (sixel: XTSMGRAPHICS); 0 when not known */
 	frame_palette pal;   /* the colours the terminal takes */
+	bool passthrough;    /* pixel encoders: inside tmux, each image sent
+	                      * through tmux's passthrough to the terminal
+	                      * outside, placed there at the pane's cell
+	                      * (pass_x, pass_y) plus its own */
+	int pass_x, pass_y;
 	bool exact;          /* cell encoders: every cell the best fit of its own
 	                      * pixels, no colour kept from a neighbour to save
 	                      * bytes (frame.lambda 0) */

@@ -3,6 +3,7 @@
 #include "term/pixels.h"
 
 #include <errno.h>
+#include <stdio.h>
 #include <setjmp.h>
 #include <stdlib.h>
 #include <string.h>
@@ -244,6 +245,40 @@ void pixels_caps_env(pixels_caps *c, const char *term_program, const char *lc_te
 	                             strcmp(term_program, "WezTerm") == 0)) ||
 	           (lc_terminal && strcmp(lc_terminal, "iTerm2") == 0);
 	c->tmux = tmux && *tmux;
+}
+
+void pixels_tmux_query(pixels_caps *c)
+{
+	c->passthrough = false;
+	if (!c->tmux)
+		return;
+	/* The pane's own value (set on the pane, its window or globally);
+	 * TMUX_PANE names this pane, not the one the client looks at. */
+	FILE *p = popen("tmux display-message -p -t \"$TMUX_PANE\" "
+	                "'#{allow-passthrough} #{pane_left} #{pane_top}' 2>/dev/null",
+	                "r");
+	if (!p)
+		return;
+	char line[128] = "", on[16] = "";
+	int x = 0, y = 0;
+	if (fgets(line, sizeof line, p) && sscanf(line, "%15s %d %d", on, &x, &y) == 3 &&
+	    (strcmp(on, "1") == 0 || strcmp(on, "on") == 0 || strcmp(on, "all") == 0) && x >= 0 && y >= 0) {
+		c->passthrough = true;
+		c->pane_x = x;
+		c->pane_y = y;
+	}
+	pclose(p);
+}
+
+void pixels_passthrough(abuf *out, const char *b, size_t n)
+{
+	abuf_str(out, "\x1bPtmux;");
+	for (size_t i = 0; i < n; i++) {
+		if (b[i] == 0x1b)
+			abuf_char(out, 0x1b); /* every ESC doubled */
+		abuf_char(out, b[i]);
+	}
+	abuf_str(out, "\x1b\\");
 }
 
 pixels_mode pixels_choose(const pixels_caps *c)

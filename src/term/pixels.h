@@ -81,6 +81,9 @@ bool pixels_iterm(abuf *out, const uint8_t *rgb, int w, int h, int cols, int row
 /* The picture in the given protocol (not PIXELS_OFF/AUTO; enc_pixels.c). */
 bool pixels_encode(pixels_mode m, abuf *out, const uint8_t *rgb, int w, int h, int cols, int rows);
 
+/* tmux's passthrough of n bytes: \ePtmux; the bytes with every ESC doubled
+ * \e\\ (tmux sends them on to the terminal outside as they are). */
+void pixels_passthrough(abuf *out, const char *b, size_t n);
 /* Standard base64 (RFC 4648, with padding) of n bytes. */
 void pixels_base64(abuf *out, const uint8_t *b, size_t n);
 /* A PNG of the picture in memory (libpng, RGB 8-bit); false on failure. */
@@ -96,6 +99,9 @@ typedef struct pixels_caps {
 	bool tmux;            /* inside tmux (TMUX is set) */
 	int sixel_w, sixel_h; /* XTSMGRAPHICS: the largest sixel image; 0 unknown */
 	int cell_w, cell_h;   /* a cell in pixels (CSI 16 t or TIOCGWINSZ); 0 unknown */
+	bool passthrough;     /* inside tmux: its pane lets escape sequences through
+	                       * to the terminal outside (allow-passthrough on) */
+	int pane_x, pane_y;   /* ... and the pane's top-left cell there */
 	char version[64];     /* XTVERSION's answer ("XTerm(379)", "foot(1.16.2)",
 	                       * "tmux 3.3a"); "" unknown */
 } pixels_caps;
@@ -118,6 +124,10 @@ size_t pixels_take_answers(pixels_caps *c, char *buf, size_t n);
 /* What the environment tells: TERM_PROGRAM / LC_TERMINAL, TMUX. */
 void pixels_caps_env(pixels_caps *c, const char *term_program, const char *lc_terminal,
                      const char *tmux);
+/* Inside tmux (c->tmux): asks tmux (`tmux display-message`) whether the
+ * pane lets escape sequences through to the terminal outside and where
+ * the pane is there; fills passthrough, pane_x, pane_y. */
+void pixels_tmux_query(pixels_caps *c);
 /* The protocol for `auto`: kitty, then sixel, then iTerm2, else off (in
  * tmux: sixel only when tmux itself says it has it, else off). */
 pixels_mode pixels_choose(const pixels_caps *c);

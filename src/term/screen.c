@@ -171,6 +171,8 @@ static void put(screen *s, const abuf *a)
 		write_all(s->fd, a->b, a->len);
 }
 
+static bool tmux_passthrough(screen *s);
+
 /* A new picture encoder for the layout (none when there is no room). */
 static void open_encoder(screen *s)
 {
@@ -191,6 +193,18 @@ static void open_encoder(screen *s)
 		if (caps && s->pix_ops == &encoder_sixel) { /* XTSMGRAPHICS' answer */
 			g.max_w = caps->sixel_w;
 			g.max_h = caps->sixel_h;
+		}
+		/* Inside tmux, images that tmux does not draw itself (all but its
+		 * own sixel) go through its passthrough, placed at the pane's
+		 * place outside (asked again: a split or a resize moves it). */
+		if (s->pix_ops && s->tmux_pass > 0) {
+			s->tmux_pass = 0;
+			tmux_passthrough(s);
+		}
+		if (s->pix_ops && s->tmux_pass > 0 && !(s->pix_ops == &encoder_sixel && caps && caps->sixel)) {
+			g.passthrough = true;
+			g.pass_x = s->pass_x;
+			g.pass_y = s->pass_y;
 		}
 		if (s->pix_ops)
 			s->enc = s->pix_ops->open(&g);
@@ -428,6 +442,19 @@ void screen_set_palette(screen *s, frame_palette pal)
 		screen_layout(s, s->aspect, true);
 }
 
+/* Inside tmux: whether the pane lets images through (asked once). */
+static bool tmux_passthrough(screen *s)
+{
+	if (s->tmux_pass == 0) {
+		pixels_caps pc = {.tmux = true};
+		pixels_tmux_query(&pc);
+		s->tmux_pass = pc.passthrough ? 1 : -1;
+		s->pass_x = pc.pane_x;
+		s->pass_y = pc.pane_y;
+	}
+	return s->tmux_pass > 0;
+}
+
 bool screen_set_pixels(screen *s, int mode)
 {
 	s->pixels = mode;
@@ -440,8 +467,23 @@ bool screen_set_pixels(screen *s, int mode)
 			all = *c;
 		pixels_caps_env(&all, getenv("TERM_PROGRAM"), getenv("LC_TERMINAL"), getenv("TMUX"));
 		mode = pixels_choose(&all);
+		/* tmux with passthrough inside kitty (the server started there
+		 * keeps KITTY_WINDOW_ID): kitty's images through tmux. */
+		const char *kw = getenv("KITTY_WINDOW_ID");
+		if (mode == PIXELS_OFF && all.tmux && kw && *kw && tmux_passthrough(s))
+			mode = PIXELS_KITTY;
 	}
+	const char *tm = getenv("TMUX");
+	bool in_tmux = tm && *tm;
+	if (in_tmux && mode != PIXELS_OFF && !(mode == PIXELS_SIXEL && c && c->sixel) && !tmux_passthrough(s))
+		mode = PIXELS_OFF; /* tmux would drop the images: a blank picture */
 	bool cell = false;
+	if (in_tmux && mode != PIXELS_OFF && c && c->cell_w > 0 && s->cell_w > 0 &&
+	    (abs(c->cell_w - s->cell_w) > 1 || abs(c->cell_h - s->cell_h) > 1))
+		/* The cell size tmux's pane has (TIOCGWINSZ) is not the one the
+		 * terminal answered (CSI 16 t): the images would not cover
+		 * their cells. */
+		mode = PIXELS_OFF;
 	if (c && c->cell_w > 0 && c->cell_h > 0 && (c->cell_w != s->cell_w || c->cell_h != s->cell_h)) {
 		s->cell_w = c->cell_w;
 		s->cell_h = c->cell_h;

@@ -53,6 +53,8 @@ typedef struct screen {
 	int pixels;        /* pixels_mode asked for (screen_set_pixels) */
 	const encoder_ops *pix_ops; /* the pixel encoder in use; NULL: half blocks */
 	int cell_w, cell_h; /* a cell in pixels (0: not known) */
+	int tmux_pass;     /* inside tmux: 0 not asked yet, 1 passthrough on, -1 off */
+	int pass_x, pass_y; /* with passthrough: the pane's top-left cell outside */
 	termout *out;      /* every byte of the screen goes out through it */
 	bool active;
 	char status[512];  /* the status line's text */

@@ -24,6 +24,7 @@
 
 #include "rtsh/memory.h"
 #include "rtsh/settings.h"
+#include "shell/commands.h"
 #include "shell/shell.h"
 
 int LLVMFuzzerInitialize(int *argc, char ***argv);
@@ -112,13 +113,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	static shell sh;
 	if (shell_init(&sh, &opts, -1)) {
 		sh.interactive = false;
-		shell_current = &sh;
+		command_table_install(&sh);
 		shell_sig_int = 0;
 		atomic_store(&started_ms, now_ms());
 		atomic_store(&running, &sh);
 		shell_run_text(&sh, text, "-c", true);
 		atomic_store(&running, NULL);
-		shell_current = NULL;
 		shell_free(&sh);
 	}
 	free(text);

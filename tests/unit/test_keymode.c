@@ -15,6 +15,7 @@
 #include "rtsh/edit.h"
 #include "rtsh/rtfile.h"
 #include "rtsh/shape.h"
+#include "shell/commands.h"
 #include "shell/keymode.h"
 #include "shell/options.h"
 #include "term/keys.h"
@@ -381,6 +382,7 @@ static void session_open(session *ss)
 	ss->opt.scene = ss->path;
 	ss->opt.quiet = true;
 	assert_true(shell_init(&ss->sh, &ss->opt, ss->wake[1]));
+	command_table_install(&ss->sh);
 	ss->sh.wake[0] = ss->wake[0];
 	ss->sh.wake[1] = ss->wake[1];
 	ss->sh.set.threads = 2;

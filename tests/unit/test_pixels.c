@@ -480,6 +480,42 @@ static void test_sixel_tiles(void **state)
 	free(rgb);
 }
 
+/* Inside tmux with allow-passthrough on: each tile is one passthrough,
+ * \ePtmux; ... \e\\ with every ESC inside doubled, and its cursor move is
+ * in the outer terminal's cells (the pane's place added). */
+static void test_tmux_passthrough(void **state)
+{
+	(void)state;
+	abuf a;
+	abuf_init(&a);
+	pixels_passthrough(&a, "x\x1b[1;2Hy\x1b\\", 10);
+	assert_int_equal(a.len, 7 + 12 + 2);
+	assert_memory_equal(a.b, "\x1bPtmux;x\x1b\x1b[1;2Hy\x1b\x1b\\\x1b\\", a.len);
+	abuf_free(&a);
+	const int cols = 10, rows = 2, cw = 8, ch = 16;
+	uint8_t *rgb = picture(cols * cw, rows * ch, 0);
+	encoder_geom g = {.cols = cols, .rows = rows, .x0 = 0, .y0 = 1, .cell_w = cw, .cell_h = ch,
+	                  .passthrough = true, .pass_x = 40, .pass_y = 5};
+	encoder *e = encoder_sixel.open(&g);
+	assert_non_null(e);
+	encoder_put(e, rgb, cols * cw, rows * ch, 0, 0);
+	abuf_init(&a);
+	encoder_update(e, &a, 1); /* the first tile (and maybe the second) */
+	/* ESC 7, the cursor hidden, moved to row 5+1+1, column 40+0+1 */
+	const char head[] = "\x1bPtmux;\x1b\x1b" "7\x1b\x1b[?25l\x1b\x1b[7;41H\x1b\x1bP";
+	assert_memory_equal(a.b, head, sizeof head - 1);
+	assert_memory_equal(a.b + a.len - 2, "\x1b\\", 2);
+	/* no ESC alone inside: each one doubled but the last two */
+	for (size_t i = 7; i + 2 < a.len; i++)
+		if (a.b[i] == 0x1b) {
+			assert_true(a.b[i + 1] == 0x1b);
+			i++;
+		}
+	abuf_free(&a);
+	encoder_close(e);
+	free(rgb);
+}
+
 /* --- answers ----------------------------------------------------------------- */
 
 static void test_answers(void **state)
@@ -688,6 +724,7 @@ int main(void)
 		cmocka_unit_test(test_iterm),
 		cmocka_unit_test(test_sixel),
 		cmocka_unit_test(test_sixel_tiles),
+		cmocka_unit_test(test_tmux_passthrough),
 		cmocka_unit_test(test_answers),
 		cmocka_unit_test(test_silent_terminal),
 		cmocka_unit_test(test_sixel_terminal),

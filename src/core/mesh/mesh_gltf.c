@@ -26,6 +26,7 @@
  */
 #include <ctype.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -156,7 +157,13 @@ static bool parse_json(gl *g, const char *json, size_t n, size_t start)
 	if (!mem_check((double)marks * sizeof(cJSON) + (double)n, what, g->err))
 		return false;
 	const char *end = NULL;
+	/* cJSON resets and sets a process-wide error record in every parse:
+	 * one parse at a time (models load on the render service's thread and
+	 * the shell's) */
+	static pthread_mutex_t parse_lock = PTHREAD_MUTEX_INITIALIZER;
+	pthread_mutex_lock(&parse_lock);
 	g->root = cJSON_ParseWithLengthOpts(json, n, &end, false);
+	pthread_mutex_unlock(&parse_lock);
 	if (!g->root) {
 		size_t at = end && end >= json && end <= json + n ? (size_t)(end - json) : 0;
 		return fail(g, NULL, "byte %zu: not valid JSON; expected a JSON object (RFC 8259)", start + at);
