@@ -11,8 +11,8 @@
 
 const command command_table[] = {
 	{"load", NULL, "load FILE", 1, 1, {"@scene"},
-	 "replace the scene by a .rt file, or by a model (.obj .ply .gltf .glb .stl) on a framed stage; on any "
-	 "error the current scene stays",
+	 "replace the scene by a .rt file, a model (.obj .ply .stl) on a framed stage, or a glTF scene (.gltf "
+	 ".glb: its cameras, lights and materials); on any error the current scene stays",
 	 cmd_load},
 	{"save", NULL, "save FILE.ppm|FILE.pfm|FILE.png|FILE.jpg|FILE.ans|FILE.rt", 1, 1, {"@output"},
 	 "write the image (full resolution, rendered first if needed), the picture as ANSI text, or the scene",
