@@ -23,6 +23,7 @@
  * texel.
  */
 #include "surface.h"
+#include "ggx.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -126,6 +127,10 @@ static void gltf_material(const mesh_mat *mm, mat_lin *l)
 		float a = mm->att_color[k];
 		l->pbr.sigma_a[k] = mm->att_dist > 0.0f ? (a > 0.0f ? -logf(a) / mm->att_dist : 1e30f) : 0.0f;
 	}
+	/* the union held the object's Phong fields: the rest of the PBR block
+	 * is set here, not left to their bytes */
+	l->pbr.single = false; /* multiscatter's default */
+	pbr_lin_finish(l);     /* es_avg, es_ready */
 	l->emission = v3(0, 0, 0);
 }
 
