@@ -11,7 +11,8 @@
 # scene's depth as the bounce limit.
 #
 # The .rt reader knows the elements the bench scenes use (C, sky, A, pl, sp,
-# rc, cu, set) with Lambert, emissive and clear glass materials, and stops
+# rc, cu, set) with Lambert, emissive and clear glass materials, and PBR ones
+# (roughness= metallic= transmission= multiscatter=, as a Principled BSDF), and stops
 # with file:line and the reason on anything else. rtsh's axes (y up, camera
 # x to the right) become Blender's (z up): (x, y, z) -> (x, z, y).
 import bmesh
@@ -116,6 +117,43 @@ def material(name, rgb, diffuse, emit, ior):
     return m
 
 
+def principled(name, rgb, kv):
+    """A material of rtsh's PBR family as Blender's Principled BSDF (the
+    glTF metallic-roughness meaning: alpha = roughness^2 in both)."""
+    m = bpy.data.materials.new(name)
+    m.use_nodes = True
+    nt = m.node_tree
+    nt.nodes.clear()
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    s = nt.nodes.new("ShaderNodeBsdfPrincipled")
+    # rtsh's multiscatter=0 is single-scattering GGX; 1 (its default) gives
+    # back the lost energy, as Cycles' multiple-scattering GGX does
+    s.distribution = "GGX" if kv.get("multiscatter", 1.0) == 0 else "MULTI_GGX"
+    s.subsurface_method = "BURLEY"
+    col = lin3(rgb)
+    s.inputs["Base Color"].default_value = col + (1.0,)
+    s.inputs["Metallic"].default_value = kv.get("metallic", 0.0)
+    s.inputs["Roughness"].default_value = kv.get("roughness", 1.0)
+    s.inputs["Transmission"].default_value = kv.get("transmission", 0.0)
+    s.inputs["Transmission Roughness"].default_value = 0.0
+    ior = kv.get("ior", 0.0) or 1.5
+    s.inputs["IOR"].default_value = ior
+    # Principled's specular 0.5 is F0 0.04, ior 1.5's: F0 / 0.08
+    s.inputs["Specular"].default_value = ((ior - 1) / (ior + 1)) ** 2 / 0.08
+    s.inputs["Specular Tint"].default_value = 0.0
+    s.inputs["Sheen"].default_value = 0.0
+    s.inputs["Clearcoat"].default_value = 0.0
+    s.inputs["Subsurface"].default_value = 0.0
+    if kv.get("emit", 0.0) > 0:
+        s.inputs["Emission"].default_value = col + (1.0,)
+        s.inputs["Emission Strength"].default_value = kv["emit"]
+    nt.links.new(s.outputs[0], out.inputs["Surface"])
+    return m
+
+
+PBR_KEYS = ("roughness", "metallic", "transmission", "multiscatter")
+
+
 def mesh_object(name, verts, faces, mat, smooth=False):
     me = bpy.data.meshes.new(name)
     me.from_pydata([to_blender(v) for v in verts], [], faces)
@@ -218,12 +256,14 @@ def build(path, w, h):
             diffuse, spec, refl = float(pos[4]), float(pos[5]), float(pos[7])
             emit, ior, twist = kv.get("emit", 0.0), kv.get("ior", 0.0), math.radians(kv.get("twist", 0.0))
             for k in kv:
-                if k not in ("emit", "ior", "twist"):
-                    die(where + ': "%s" has no Cycles twin; expected emit, ior or twist' % k)
-            if spec != 0 or refl != 0:
-                die(where + ": only Lambert, emissive and glass materials have a Cycles twin (specular and reflective must be 0)")
+                if k not in ("emit", "ior", "twist") + PBR_KEYS:
+                    die(where + ': "%s" has no Cycles twin; expected emit, ior, twist, roughness, metallic, '
+                        "transmission or multiscatter" % k)
+            pbr = any(k in kv for k in PBR_KEYS)
+            if spec != 0 or refl != 0 and not pbr:
+                die(where + ": only Lambert, emissive, glass and PBR materials have a Cycles twin (specular and reflective must be 0)")
             n += 1
-            mat = material("m%d" % n, rgb, diffuse, emit, ior)
+            mat = principled("m%d" % n, rgb, kv) if pbr else material("m%d" % n, rgb, diffuse, emit, ior)
             if kind == "rc":
                 f = xform(p, d, twist, sz)
                 mesh_object("rc%d" % n, [f((-1, 0, -1)), f((1, 0, -1)), f((1, 0, 1)), f((-1, 0, 1))], [(0, 1, 2, 3)], mat)

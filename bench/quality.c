@@ -1,15 +1,18 @@
 /* rtsh — equal-quality benchmarks (`make bench` runs them after the speed
  * table; bench/README.md explains the rows):
  *
- *   quality [--only cycles|preview] [--scene cornell|glass-sky] [--out FILE.tsv]
+ *   quality [--only cycles|preview] [--scene cornell|glass-sky|pbr] [--out FILE.tsv]
  *           [--no-cycles]
  *
  * cycles   rtsh's path mode against Blender's Cycles on the same scenes
- *          (scenes/cornell.rt at 256x256 and bench/glass-sky.rt at 128x128,
- *          rebuilt in Cycles by bench/cycles_scene.py): CPU, one thread, a
+ *          (scenes/cornell.rt at 256x256, bench/glass-sky.rt at 128x128 and
+ *          bench/pbr-spheres.rt at 192x108, rebuilt in Cycles by
+ *          bench/cycles_scene.py): CPU, one thread, a
  *          1-pixel box filter, no adaptive sampling, no denoising, the
  *          scene's bounces.
  *          Each renderer is judged against its own 4096-sample reference
+ *          (2048 for the PBR scene, which also prints the mean radiance
+ *          of every object, rtsh / Cycles)
  *          (rendered once and kept in build/quality/). At 16, 64 and 256
  *          samples it prints the CPU seconds per sample and
  *            eff = (MSE x seconds of rtsh) / (MSE x seconds of Cycles)
@@ -225,9 +228,88 @@ static bool run_cycles(const char *path, const char *name, int w, int h, int thr
 	return rc == 0;
 }
 
-static void bench_cycles_scene(const char *path, const char *name, int W, int H, bool cycles)
+/* The object each pixel shows whole: the camera rays through its centre
+ * and its four corners meet the same object (else -1). */
+static int *object_mask(const world *w, int fw, int fh)
 {
-	const int REF = 4096;
+	int *id = malloc(sizeof *id * (size_t)fw * fh);
+	if (!id)
+		die("memory", NULL);
+	static const double off[5][2] = {{0.5, 0.5}, {0, 0}, {1, 0}, {0, 1}, {1, 1}};
+	for (int y = 0; y < fh; y++)
+		for (int x = 0; x < fw; x++) {
+			int o = -2;
+			for (int k = 0; k < 5 && o != -1; k++) {
+				ray r = cam_ray(&w->cam, x + off[k][0], y + off[k][1], fw, fh);
+				hit h;
+				int ok = world_intersect(w, &r, 0.0, INFINITY, &h) ? (int)h.object : -1;
+				o = o == -2 || o == ok ? ok : -1;
+			}
+			id[y * fw + x] = o;
+		}
+	return id;
+}
+
+/* The mean radiance (all channels) of the pixels of object k. */
+static double object_mean(const framebuffer *fb, const int *id, int k, long *n)
+{
+	double sum = 0;
+	long c = 0;
+	for (long i = 0; i < (long)fb->w * fb->h; i++)
+		if (id[i] == k) {
+			sum += (double)fb->rgb[i * 3] + fb->rgb[i * 3 + 1] + fb->rgb[i * 3 + 2];
+			c++;
+		}
+	*n = c;
+	return c ? sum / (3.0 * c) : 0.0;
+}
+
+/* A short name for object k's material. */
+static void object_label(const object *o, char *buf, size_t n)
+{
+	const material_pbr *p = o->mat.pbr;
+	if (!p)
+		snprintf(buf, n, "%s%s", obj_kind_id(o->kind), o->mat.emission > 0 ? " lamp" : "");
+	else
+		snprintf(buf, n, "%s r=%.2f", p->metallic >= 0.5 ? "metal" : p->transmission >= 0.5 ? "glass" : "plastic",
+		         p->roughness >= 0 ? p->roughness : 1.0);
+}
+
+/* Per object: the mean radiance of rtsh's and Cycles' references and of
+ * their renders at spp samples, and Cycles' own error at spp against its
+ * reference (the noise to compare rtsh's difference with). */
+static void objects_against_cycles(const scene *s, const world *w, const framebuffer *ref, const framebuffer *cref,
+                                   const char *name, int W, int H, int spp, const framebuffer *fb)
+{
+	char cpath[256];
+	snprintf(cpath, sizeof cpath, QDIR "/%s-cycles-%d.pfm", name, spp);
+	rt_error err;
+	framebuffer *cfb = image_read_pfm(cpath, &err);
+	int *id = object_mask(w, W, H);
+	printf("per object, whole pixels only: mean radiance of rtsh / Cycles (references), and at %d spp\n", spp);
+	printf("%4s %-16s %6s %9s %9s %7s %7s %9s\n", "obj", "material", "pixels", "rtsh ref", "cyc ref", "ratio",
+	       "ratio@", "cyc err@");
+	for (size_t k = 0; k < s->nobjs; k++) {
+		long n;
+		double a = object_mean(ref, id, (int)k, &n), b = object_mean(cref, id, (int)k, &n);
+		if (n < 20)
+			continue;
+		double a1 = object_mean(fb, id, (int)k, &n), b1 = cfb ? object_mean(cfb, id, (int)k, &n) : -1;
+		char label[32];
+		object_label(&s->objs[k], label, sizeof label);
+		printf("%4zu %-16s %6ld %9.5f %9.5f %7.4f %7.4f %9.4f\n", k, label, n, a, b, a / b, cfb ? a1 / b1 : -1,
+		       cfb ? b1 / b - 1 : -1);
+		if (tsv)
+			fprintf(tsv, "%s\tobject\t%zu\t%s\t%.6g\t%.6g\t%.4f\t%.4f\t%.4f\n", name, k, label, a, b, a / b,
+			        cfb ? a1 / b1 : -1, cfb ? b1 / b - 1 : -1);
+	}
+	free(id);
+	fb_free(cfb);
+}
+
+static void bench_cycles_scene(const char *path, const char *name, int W, int H, int REF, bool objects,
+                               bool cycles)
+{
 	scene *s = load(path);
 	int depth = s->hints.depth >= 0 ? s->hints.depth : 5;
 	rt_error err;
@@ -278,6 +360,8 @@ static void bench_cycles_scene(const char *path, const char *name, int W, int H,
 		framebuffer *fb = render_timed(w, &set, &t);
 		double m, mo, cm = -1, cmo = -1, ct = -1;
 		mse(fb, ref, edge, &m, &mo);
+		if (objects && cref && i == NSPP - 1)
+			objects_against_cycles(s, w, ref, cref, name, W, H, spps[i], fb);
 		fb_free(fb);
 		if (cref && csec[i] > 0) {
 			snprintf(cpath, sizeof cpath, QDIR "/%s-cycles-%d.pfm", name, spps[i]);
@@ -569,9 +653,11 @@ int main(int argc, char **argv)
 		die(out, NULL);
 	if (!only || strcmp(only, "cycles") == 0) {
 		if (!one || strcmp(one, "cornell") == 0)
-			bench_cycles_scene("scenes/cornell.rt", "cornell", 256, 256, cycles);
+			bench_cycles_scene("scenes/cornell.rt", "cornell", 256, 256, 4096, false, cycles);
 		if (!one || strcmp(one, "glass-sky") == 0)
-			bench_cycles_scene("bench/glass-sky.rt", "glass-sky", 128, 128, cycles);
+			bench_cycles_scene("bench/glass-sky.rt", "glass-sky", 128, 128, 4096, false, cycles);
+		if (!one || strcmp(one, "pbr") == 0)
+			bench_cycles_scene("bench/pbr-spheres.rt", "pbr", 192, 108, 2048, true, cycles);
 	}
 	if (!only || strcmp(only, "preview") == 0)
 		bench_preview();

@@ -26,6 +26,9 @@ void gif_free(gif_anim *g);
 /* Adds a frame of w x h sRGB pixels (3 bytes each, rows top down); false
  * when out of memory. */
 bool gif_add_frame(gif_anim *g, const uint8_t *rgb);
+/* The same from linear radiance (w x h x 3 floats) at an exposure in
+ * stops, sRGB-encoded as the 8-bit image files are (linear_to_srgb8). */
+bool gif_add_linear(gif_anim *g, const float *rgb, double exposure);
 /* The file's bytes so far, with the trailer (valid until the next call). */
 const uint8_t *gif_bytes(gif_anim *g, size_t *len);
 /* Writes the file atomically; false (err set) on failure. */

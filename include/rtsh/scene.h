@@ -104,6 +104,8 @@ typedef struct material_pbr {
 	                             * tints the dielectric's F0 (255,255,255) */
 	vec3 emit_color;            /* emit_color=R,G,B sRGB 0..255: emission colour instead of
 	                             * the base colour (-1,-1,-1 = absent) */
+	int multiscatter;           /* multiscatter= 1: the GGX lobes' energy lost to single
+	                             * scattering is given back (Turquin 2019); 0: not (1) */
 } material_pbr;
 
 /* Every key absent. */

@@ -47,6 +47,7 @@ typedef struct mat_lin {
 			float specular_factor;   /* [0,1] KHR_materials_specular specularFactor */
 			float specular_color[3]; /* linear, its specularColorFactor */
 			float sigma_a[3]; /* volume absorption per scene unit, -ln(att colour) / att distance; 0 none */
+			bool single;      /* multiscatter=0: no energy compensation */
 		} pbr;
 	};
 } mat_lin;

@@ -42,13 +42,13 @@ static void first_surface(const world *w, ray r, double f[7])
 			f[2] += clamp01(tint.z);
 			return;
 		}
-		const mat_lin *m = &w->mats[h.object];
+		const mat_lin *m = &w->mats[h.mat]; /* a model's own material, too */
 		bsdf b;
 		bsdf_make(&b, m, &h, v3_neg(r.d));
 		dist += h.t;
-		double mirror = b.nm < 0.0 ? b.p[2] : 0.0, delta = mirror + b.p[3];
-		if (delta < 0.5 || k == 3 || m->emission.x + m->emission.y + m->emission.z > 0.0) {
-			vec3 a = v3_add(v3_add(b.kd, b.ks), v3_add(b.km, v3_scale(b.kt, b.wg)));
+		vec3 a, tt = v3(0, 0, 0), dir = v3(0, 0, 0);
+		int follow = bsdf_features(&b, &a, &tt, &dir);
+		if (follow == 0 || k == 3 || m->emission.x + m->emission.y + m->emission.z > 0.0) {
 			vec3 e = m->emission;
 			if (e.x + e.y + e.z > 0.0) {
 				/* A lamp's "albedo" is its emission, unclamped: far from any
@@ -67,23 +67,11 @@ static void first_surface(const world *w, ray r, double f[7])
 			f[6] += dist;
 			return;
 		}
-		vec3 refl = v3_sub(v3_scale(b.n, 2.0 * b.cos_o), b.wo);
-		if (mirror >= b.p[3]) {
-			tint = v3_mul(tint, b.km);
-			r = (ray){offset_point(w, h.p, b.n), refl};
-			continue;
-		}
-		/* Snell's law in vector form (pbrt 4th ed. 9.3.2). */
-		double eta = b.front ? b.ior : 1.0 / b.ior;
-		double sin2_t = (1.0 - b.cos_o * b.cos_o) / (eta * eta);
-		tint = v3_mul(tint, sin2_t >= 1.0 ? v3_splat(b.wg) : v3_scale(b.kt, b.wg));
-		if (sin2_t >= 1.0) {
-			r = (ray){offset_point(w, h.p, b.n), refl};
-		} else {
-			double cos_t = sqrt(1.0 - sin2_t);
-			vec3 t = v3_add(v3_scale(b.wo, -1.0 / eta), v3_scale(b.n, b.cos_o / eta - cos_t));
-			r = (ray){offset_point(w, h.p, v3_neg(b.n)), v3_norm(t)};
-		}
+		tint = v3_mul(tint, tt);
+		if (follow == 1)
+			r = (ray){offset_point(w, h.p, b.n), v3_sub(v3_scale(b.n, 2.0 * b.cos_o), b.wo)};
+		else
+			r = (ray){offset_point(w, h.p, v3_neg(b.n)), v3_norm(dir)};
 	}
 }
 

@@ -1,11 +1,13 @@
 /* rtsh — animated GIF files (rtsh/gif.h). */
 #include "rtsh/gif.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "rtsh/atomic.h"
+#include "rtsh/srgb.h"
 
 struct gif_anim {
 	int w, h, delay;
@@ -347,6 +349,20 @@ bool gif_add_frame(gif_anim *g, const uint8_t *rgb)
 	put8(g, (unsigned)min_size);
 	lzw_encode(g, g->idx, n, min_size);
 	return !g->failed;
+}
+
+bool gif_add_linear(gif_anim *g, const float *rgb, double exposure)
+{
+	size_t n = (size_t)g->w * g->h * 3;
+	uint8_t *px = malloc(n);
+	if (!px)
+		return false;
+	double k = exp2(exposure);
+	for (size_t i = 0; i < n; i++)
+		px[i] = linear_to_srgb8(rgb[i] * k);
+	bool ok = gif_add_frame(g, px);
+	free(px);
+	return ok;
 }
 
 const uint8_t *gif_bytes(gif_anim *g, size_t *len)

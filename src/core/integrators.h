@@ -17,14 +17,21 @@ vec3 whitted_radiance(const world *w, const render_settings *s, ray r);
  * camera sample's numbers, from dimension g->dim on. */
 vec3 path_radiance(const world *w, const render_settings *s, ray r, sampler *g);
 
-/* The scattering at one path vertex (path.c): the material's lobes, each
- * with its share of the energy (shares sum to at most 1; see rtsh(5),
- * "Materials"), in the frame of the side the ray arrived on. */
+/* The scattering at one path vertex: the material family's lobes
+ * (material.c; the seeds' Phong family in bsdf_phong.c, the physically
+ * based one in bsdf_pbr.c), in the frame of the side the ray arrived on.
+ * The integrators call bsdf_make / _eval / _pdf / _sample_u and never look
+ * at a family's fields. */
 typedef struct bsdf {
 	vec3 n;        /* unit normal, flipped onto the side of wo */
 	vec3 wo;       /* unit direction back along the arriving ray */
 	double cos_o;  /* n . wo, >= 0 */
 	bool front;    /* wo is on the outward side (glass: entering) */
+	uint8_t family; /* MAT_PHONG or MAT_PBR (world.h) */
+	bool smooth;   /* some non-delta lobe: point lights are seen through it */
+	bool through;  /* a non-delta lobe also transmits: lights below the surface count */
+	vec3 sigma_in; /* absorption per unit inside the volume below (Beer-Lambert), or 0 */
+	/* The Phong family (bsdf_phong.c): */
 	vec3 kd;       /* Lambert: share x albedo */
 	vec3 ks;       /* normalised Phong about the mirror direction: share */
 	double ns;     /* its exponent (shininess) */
@@ -32,10 +39,25 @@ typedef struct bsdf {
 	double nm;     /* its Phong exponent (from fuzz); < 0 for a perfect mirror */
 	vec3 kt;       /* glass transmission tint (reflection is white) */
 	double wg;     /* glass share */
-	double ior;    /* glass refractive index */
+	double ior;    /* glass refractive index (PBR: the dielectric's) */
 	double p[4];   /* lobe choice probabilities: d, s, m, g (sum 1, or all 0) */
 	double total;  /* sum of the lobes' choice weights (0: absorbs everything) */
-	bool smooth;   /* some non-delta lobe: point lights are seen through it */
+	/* The PBR family (bsdf_pbr.c): */
+	struct bsdf_pbr {
+		vec3 t, b;        /* tangents: (t, b, n) a right-handed frame */
+		vec3 base;        /* base colour */
+		double a, ac;     /* GGX alpha of the base and of the coat */
+		double wm, wp, wt; /* metal, opaque dielectric (plastic), transmission weights */
+		double cc;        /* clearcoat weight */
+		vec3 f0;          /* the plastic's F0 (KHR_materials_specular), f90 = sf */
+		double sf;        /* its specularFactor */
+		double cc_o;      /* 1 - cc Fc(cos_o): what the coat lets through toward wo */
+		double pl[6];     /* lobe choice: coat, metal, plastic spec, diffuse, glass, (unused) */
+		bool delta, cdelta; /* the base's / the coat's specular lobes are perfect */
+		bool thin, ms;    /* thin-walled; energy compensation (Turquin 2019) */
+		vec3 kms_m, kms_p; /* Turquin's factors of the metal and the plastic's specular */
+		double kdiff;     /* the plastic's Lambert: (1 - Es(cos_o)) / (1 - Es_avg) */
+	} pb;
 } bsdf;
 
 typedef struct bsdf_sample {
@@ -56,12 +78,61 @@ vec3 bsdf_eval(const bsdf *b, vec3 wi);
 bool bsdf_sample_u(const bsdf *b, const double u[3], bsdf_sample *out);
 /* The same with three numbers from g. */
 bool bsdf_sample_dir(const bsdf *b, rng *g, bsdf_sample *out);
-/* The Phong exponent of a mirror lobe of roughness fuzz in (0,1]. */
-double fuzz_exponent(double fuzz);
-
 /* The mixed density with which bsdf_sample_dir picks the direction wi
  * through a smooth lobe (per steradian; delta lobes are left out). */
 double bsdf_pdf(const bsdf *b, vec3 wi);
+/* True when u[0] matters to bsdf_sample_u (more than one lobe to pick). */
+bool bsdf_has_choice(const bsdf *b);
+/* The denoiser's features (denoise.c): the surface's albedo (what a white
+ * light would come back as, roughly), and 0; or, for a surface that is
+ * mostly a perfect mirror or glass, 1 (look along the reflection) or 2
+ * (along the refraction *dir) with the tint that gives. */
+int bsdf_features(const bsdf *b, vec3 *albedo, vec3 *tint, vec3 *dir);
+/* The Phong exponent of a mirror lobe of roughness fuzz in (0,1]. */
+double fuzz_exponent(double fuzz);
+
+/* One material family (material.c's table, indexed by mat_lin.family). */
+typedef struct mat_family {
+	const char *name;
+	void (*make)(bsdf *b, const mat_lin *m, vec3 albedo);
+	vec3 (*eval)(const bsdf *b, vec3 wi);
+	double (*pdf)(const bsdf *b, vec3 wi);
+	bool (*sample)(const bsdf *b, const double u[3], bsdf_sample *out);
+	bool (*has_choice)(const bsdf *b);
+	int (*features)(const bsdf *b, vec3 *albedo, vec3 *tint, vec3 *dir);
+	/* Whitted shading (whitted.c): what the material sends back along r
+	 * at h from the point lights and ambient, and the mirror / glass rays
+	 * it follows (trace), up to depth. */
+	vec3 (*whitted)(const world *w, const mat_lin *m, const hit *h, ray r, int depth,
+	                vec3 (*trace)(const world *w, ray r, int depth));
+} mat_family;
+extern const mat_family mat_phong_family, mat_pbr_family;
+/* By mat_lin.family (material.c). */
+extern const mat_family *const mat_families[MAT_FAMILY_COUNT];
+
+/* Schlick's approximation of the Fresnel reflectance (whitted.c's). */
+double whitted_schlick(double cos_i, double eta_ratio);
+/* The point lights' direct light at a point (Whitted's convention, no
+ * fall-off): sum over the lights visible from p of f(wi) pi L cos, f the
+ * bsdf b's value (whitted.c). */
+vec3 whitted_lights(const world *w, const bsdf *b, vec3 p);
+
+/* Reflectance of a smooth dielectric for unpolarised light (Born & Wolf
+ * 1.5.2; pbrt 4th ed. 9.3.2). cos_i > 0 on the incident side; eta = eta_t /
+ * eta_i. Sets *cos_t for the refracted ray; 1 on total internal reflection. */
+static inline double fresnel_dielectric(double cos_i, double eta, double *cos_t)
+{
+	double sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
+	if (sin2_t >= 1.0) {
+		*cos_t = 0.0;
+		return 1.0;
+	}
+	double ct = sqrt(1.0 - sin2_t);
+	double rs = (cos_i - eta * ct) / (cos_i + eta * ct);
+	double rp = (eta * cos_i - ct) / (eta * cos_i + ct);
+	*cos_t = ct;
+	return 0.5 * (rs * rs + rp * rp);
+}
 
 /* What a ray that leaves the scene sees: the sky if the scene has one, else
  * black (whitted) or the ambient colour as a uniform sky (path). */

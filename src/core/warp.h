@@ -73,4 +73,15 @@ static inline void warp_disc(double u, double v, double *x, double *y)
 	*y = m ? y1 : x1;
 }
 
+/* Cosine-weighted about n, pdf cos / pi: a uniform point of the unit disc
+ * lifted onto the hemisphere (Malley's method). */
+static inline vec3 warp_cosine(vec3 n, double u, double v)
+{
+	double x, y;
+	warp_disc(u, v, &x, &y);
+	vec3 t, b;
+	basis(n, &t, &b);
+	return v3_add(v3_add(v3_scale(t, x), v3_scale(b, y)), v3_scale(n, sqrt(pos(1.0 - x * x - y * y))));
+}
+
 #endif

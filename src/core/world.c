@@ -44,6 +44,7 @@ mat_lin mat_lin_make(const material *m)
 	l.pbr.clearcoat = (float)p->clearcoat;
 	l.pbr.clearcoat_roughness = (float)p->clearcoat_roughness;
 	l.pbr.specular_factor = (float)p->specular_factor;
+	l.pbr.single = p->multiscatter == 0;
 	vec3 sc = srgb255_to_linear(p->specular_color);
 	l.pbr.specular_color[0] = (float)sc.x;
 	l.pbr.specular_color[1] = (float)sc.y;

@@ -61,6 +61,7 @@ material_pbr material_pbr_absent(void)
 		.specular_factor = 1.0,
 		.specular_color = {255.0, 255.0, 255.0},
 		.emit_color = {-1.0, -1.0, -1.0},
+		.multiscatter = 1,
 	};
 }
 

@@ -25,12 +25,15 @@
 #include "mpi/farm.h"
 #include "mpi/fileset.h"
 #include "mpi/wire.h"
+#include "rtsh/gif.h"
 #include "rtsh/image.h"
+#include "rtsh/orbit.h"
 #include "rtsh/render.h"
 #include "rtsh/rtfile.h"
 #include "rtsh/settings.h"
 #include "rtsh/world.h"
 #include "shell/args.h"
+#include "shell/turntable.h"
 
 #define MSG_MAX (RT_ERROR_MSG_MAX + RT_ERROR_FILE_MAX + 32)
 /* MPI counts are ints: large buffers go in pieces of 1 GiB. */
@@ -114,7 +117,7 @@ static bool folder_writable(const char *path, rt_error *err)
 /* Rank 0: the command line, the scene and its files, the world, the image.
  * Sets c->status to an exit status when the job must not render. */
 static void setup(int argc, char **argv, job_config *c, fileset *files, world **w,
-                  framebuffer **fb, const char **output)
+                  framebuffer **fb, const char **output, int *frames, camera *cam0, vec3 *pivot)
 {
 	char msg[MSG_MAX];
 	rt_error err;
@@ -149,7 +152,14 @@ static void setup(int argc, char **argv, job_config *c, fileset *files, world **
 		c->status = rc;
 		goto out;
 	}
-	if (image_format_of(o.output) == IMAGE_UNKNOWN) {
+	*frames = o.turntable ? o.turntable_frames : 0;
+	if (o.turntable && !turntable_output_ok(o.output)) {
+		fprintf(stderr, "rtsh-mpi: --turntable: output \"%s\" is neither a .gif nor a numbered image name; "
+		        "expected spin.gif or a name with one %%d such as frame%%03d.png\n"
+		        "Try 'rtsh-mpi --help' for more information.\n", o.output);
+		goto out;
+	}
+	if (!o.turntable && image_format_of(o.output) == IMAGE_UNKNOWN) {
 		fprintf(stderr, "rtsh-mpi: output \"%s\" has an unknown type; expected .ppm, .pfm or .png\n"
 		        "Try 'rtsh-mpi --help' for more information.\n", o.output);
 		goto out;
@@ -186,6 +196,8 @@ static void setup(int argc, char **argv, job_config *c, fileset *files, world **
 	if (clamped && c->set.width == cw && c->set.height == ch && !o.quiet)
 		fprintf(stderr, "%s: resolution %dx%d is too large; rendering %dx%d (use -r to choose)\n",
 		        o.scene, s->hints.width, s->hints.height, c->set.width, c->set.height);
+	*cam0 = scene_camera(s);
+	*pivot = orbit_scene_centre(s);
 	*w = world_build(s, &err);
 	scene_free(s);
 	rt_file_source_set(NULL);
@@ -437,8 +449,12 @@ int main(int argc, char **argv)
 	const char *output = NULL;
 	char *packed = NULL;
 	size_t packed_size = 0;
+	int frames = 0;  /* --turntable FRAMES: frames of a turn (0: one image) */
+	camera cam0;
+	vec3 pivot = v3(0, 0, 0);
+	memset(&cam0, 0, sizeof cam0);
 	if (rank == 0) {
-		setup(argc, argv, &c, &files, &w, &fb, &output);
+		setup(argc, argv, &c, &files, &w, &fb, &output, &frames, &cam0, &pivot);
 		stop_output = output;
 		atomic_store(&stop_progress, c.progress);
 		if (c.status < 0) {
@@ -456,6 +472,9 @@ int main(int argc, char **argv)
 	if (rank == 0)
 		wire_put_config(&c, wire);
 	bcast(wire, WIRE_CONFIG_SIZE, MPI_BYTE);
+	int32_t nframes = frames;
+	bcast(&nframes, 1, MPI_INT32_T);
+	frames = nframes;
 	char why[RT_ERROR_MSG_MAX];
 	if (!wire_get_config(&c, wire, why, sizeof why)) {
 		rt_error e;
@@ -501,6 +520,8 @@ int main(int argc, char **argv)
 		scene *s = rt_load_file(files.files[0].path, &lo, &err);
 		if (!s)
 			die(rank, host, "loading the scene rank 0 sent", &err);
+		cam0 = scene_camera(s);
+		pivot = orbit_scene_centre(s);
 		w = world_build(s, &err);
 		scene_free(s);
 		rt_file_source_set(NULL);
@@ -533,11 +554,51 @@ int main(int argc, char **argv)
 		.progress = c.progress != 0,
 	};
 	farm_stats st;
-	bool ok = rank == 0 ? farm_serve(w, &c.set, &fo, fb, &st, &err)
-	                    : farm_work(w, &c.set, &fo, &st, &err);
-	atomic_store(&stop_progress, 0);
-	if (!ok)
+	int status = 0;
+	/* --turntable: every frame is one farmed render job, the world's camera
+	 * turned between them as rtsh turns it (orbit_turntable). */
+	gif_anim *g = rank == 0 && frames > 0 && turntable_is_gif(output)
+	                  ? gif_new(c.set.width, c.set.height,
+	                            TURNTABLE_TURN_CS / frames > TURNTABLE_MIN_CS ? TURNTABLE_TURN_CS / frames
+	                                                                          : TURNTABLE_MIN_CS)
+	                  : NULL;
+	if (rank == 0 && frames > 0 && turntable_is_gif(output) && !g) {
+		rt_error_set(&err, "out of memory for a %dx%d GIF", c.set.width, c.set.height);
 		die(rank, host, "", &err);
+	}
+	for (int k = 0; k < (frames > 0 ? frames : 1); k++) {
+		if (frames > 0) {
+			camera ck = orbit_turntable(cam0, pivot, k, frames);
+			w->cam = cam_view_make(&ck);
+		}
+		bool ok = rank == 0 ? farm_serve(w, &c.set, &fo, fb, &st, &err)
+		                    : farm_work(w, &c.set, &fo, &st, &err);
+		if (!ok)
+			die(rank, host, "", &err);
+		if (frames > 1) {
+			/* every rank done with this frame before any asks for tiles
+			 * of the next: rank 0 serves one frame at a time */
+			MPI_Request b;
+			MPI_Ibarrier(MPI_COMM_WORLD, &b);
+			wait_for(&b);
+		}
+		if (rank == 0 && frames > 0 && status == 0) {
+			char fname[4096];
+			if (g) {
+				if (!gif_add_linear(g, fb->rgb, c.set.exposure)) {
+					fputs("rtsh-mpi: out of memory for the GIF\n", stderr);
+					status = 1;
+				}
+			} else if (turntable_name(output, k, fname, sizeof fname) &&
+			           !image_write(fname, fb, c.set.exposure, &err)) {
+				char msg[MSG_MAX];
+				rt_error_format(&err, msg, sizeof msg);
+				fprintf(stderr, "%s\n", msg);
+				status = 1;
+			}
+		}
+	}
+	atomic_store(&stop_progress, 0);
 	memcpy(st.host, host, sizeof st.host);
 	struct rusage ru;
 	if (getrusage(RUSAGE_SELF, &ru) == 0)
@@ -548,10 +609,15 @@ int main(int argc, char **argv)
 	farm_stats *all = rank == 0 ? calloc((size_t)size, sizeof *all) : NULL;
 	gather(&st, all, (int)sizeof st);
 
-	int status = 0;
 	if (rank == 0) {
 		double rendered = MPI_Wtime() - t0;
-		if (!image_write(output, fb, c.set.exposure, &err)) {
+		if (status == 0 && g && !gif_save(g, output, &err)) {
+			char msg[MSG_MAX];
+			rt_error_format(&err, msg, sizeof msg);
+			fprintf(stderr, "%s\n", msg);
+			status = 1;
+		}
+		if (frames == 0 && !image_write(output, fb, c.set.exposure, &err)) {
 			char msg[MSG_MAX];
 			rt_error_format(&err, msg, sizeof msg);
 			fprintf(stderr, "%s\n", msg);
@@ -565,6 +631,7 @@ int main(int argc, char **argv)
 			        MPI_Wtime() - t0);
 	}
 	free(all);
+	gif_free(g);
 	atomic_store(&stop_nids, 0);
 	free(ids);
 	fb_free(fb);

@@ -108,6 +108,7 @@ const material_pbr *material_pbr_intern(const material_pbr *in, bool *oom)
 	p.specular_factor = in->specular_factor + 0.0;
 	p.specular_color = v3(in->specular_color.x + 0.0, in->specular_color.y + 0.0, in->specular_color.z + 0.0);
 	p.emit_color = v3(in->emit_color.x + 0.0, in->emit_color.y + 0.0, in->emit_color.z + 0.0);
+	p.multiscatter = in->multiscatter;
 	material_pbr absent;
 	memset(&absent, 0, sizeof absent);
 	material_pbr a = material_pbr_absent();
@@ -116,6 +117,7 @@ const material_pbr *material_pbr_intern(const material_pbr *in, bool *oom)
 	absent.specular_factor = a.specular_factor;
 	absent.specular_color = a.specular_color;
 	absent.emit_color = a.emit_color;
+	absent.multiscatter = a.multiscatter;
 	if (memcmp(&p, &absent, sizeof p) == 0)
 		return NULL;
 	pthread_mutex_lock(&pbr_lock);

@@ -72,6 +72,8 @@ const rt_key rt_keys[] = {
 	{"emit_color", PBR(emit_color), false, true, 0, false, 0, 255, -1, NULL,
 	 "emit_color=R,G,B, each in [0,255]", "emission colour (else the colour), times emit", RT_KEY_RGB,
 	 false},
+	{"multiscatter", PBR(multiscatter), true, true, 0, false, 0, 1, 1, NULL, "multiscatter 0 or 1",
+	 "PBR: give back the energy single-scattering GGX loses (1) or not (0)", RT_KEY_NUM, false},
 	{"smooth", offsetof(object, smooth), true, false, 0, false, 0, 1, 1, NULL,
 	 "smooth 0 (flat faces) or 1 (smooth normals)", "mesh: smooth normals (1) or flat faces (0)",
 	 RT_KEY_NUM, true},

@@ -39,7 +39,7 @@ static const struct {
 	{{"color", required_argument, NULL, OPT_COLOR}, false, "WHEN", "auto|truecolor|256|16|none: colour output (default auto)"},
 	{{"preview", required_argument, NULL, OPT_PREVIEW}, true, "COLSxROWS",
 	 "print a still picture of the scene or model, COLS x ROWS cells, and exit (file managers)"},
-	{{"turntable", optional_argument, NULL, OPT_TURNTABLE}, true, "[FRAMES]",
+	{{"turntable", optional_argument, NULL, OPT_TURNTABLE}, false, "[FRAMES]",
 	 "a full turn of the camera about the scene: in the terminal, or FRAMES frames with -o (.gif, frame%03d.png)"},
 	{{"help", no_argument, NULL, 'h'}, false, NULL, "this help"},
 	{{"version", no_argument, NULL, 'V'}, false, NULL, "the version"},

@@ -179,12 +179,12 @@ bool cmd_set(shell *sh, int argc, char **argv, const char *rest)
 	}
 	char was[64];
 	settings_format(&sh->set, def, was, sizeof was);
+	size_t bit = (size_t)(def - settings_table); /* before the refresh, which reads it */
+	if (bit < sizeof sh->hand_set * 8)
+		sh->hand_set |= 1u << bit;
 	shell_edit_begin(sh);
 	sh->set = s;
 	shell_edit_end(sh);
-	size_t bit = (size_t)(def - settings_table);
-	if (bit < sizeof sh->hand_set * 8)
-		sh->hand_set |= 1u << bit;
 	settings_format(&sh->set, def, val, sizeof val);
 	shell_info(sh, "%s %s%s%s%s\n", def->name, val, strcmp(was, val) ? " (was " : "",
 	           strcmp(was, val) ? was : "", strcmp(was, val) ? ")" : "");

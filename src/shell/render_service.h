@@ -47,6 +47,9 @@ typedef struct rsvc rsvc;
 /* The length of the shell preview's passes, so the picture refreshes
  * steadily. */
 #define PREVIEW_PASS_SECONDS 0.1
+/* Path mode: the samples the preview refines to when neither the scene,
+ * -s nor `set samples` chose any (the status line says "preview's own"). */
+#define PREVIEW_PATH_SAMPLES 64
 
 typedef enum rsvc_kind {
 	RSVC_REFINE, /* every sample, in passes that accumulate */

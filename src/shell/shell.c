@@ -219,6 +219,22 @@ static double aspect_of(const render_settings *s)
 	return (double)s->width / s->height;
 }
 
+/* Whether the samples were chosen: by `set samples`, -s or the scene. */
+static bool samples_chosen(const shell *sh)
+{
+	rt_error err;
+	const setting_def *def = settings_find("samples", &err);
+	if (!def)
+		return true;
+	size_t bit = (size_t)(def - settings_table);
+	if (bit < sizeof sh->hand_set * 8 && (sh->hand_set & 1u << bit))
+		return true;
+	for (int i = 0; i < sh->opt->nsettings; i++)
+		if (sh->opt->settings[i].def == def)
+			return true;
+	return editor_scene(sh->ed)->hints.samples > 0;
+}
+
 void shell_refresh(shell *sh)
 {
 	if (!sh->scr || !sh->scr->active) {
@@ -237,10 +253,13 @@ void shell_refresh(shell *sh)
 	}
 	/* A quick pass, then passes of PREVIEW_PASS_SECONDS; path previews are
 	 * denoised unless `set denoise off`. */
+	render_settings pset = sh->set;
+	if (pset.mode == MODE_PATH && pset.samples < PREVIEW_PATH_SAMPLES && !samples_chosen(sh))
+		pset.samples = PREVIEW_PATH_SAMPLES; /* the preview's own target (the status line says so) */
 	rsvc_request req = {
 		.s = editor_scene(sh->ed),
 		.gen = editor_generation(sh->ed),
-		.set = sh->set,
+		.set = pset,
 		.w = sh->scr->img_w,
 		.h = sh->scr->img_h,
 		.kind = RSVC_REFINE,
@@ -291,6 +310,8 @@ void shell_status_text(shell *sh, char *buf, size_t size)
 	} else {
 		snprintf(samples, sizeof samples, "%d/%d spp%s", im->spp, im->target, busy && !im->done ? "…" : "");
 	}
+	if (im->w > 0 && !im->error[0] && im->target > sh->set.samples)
+		strncat(samples, " (preview's own)", sizeof samples - strlen(samples) - 1);
 	if (im->denoised && !im->error[0])
 		strncat(samples, " │ denoised", sizeof samples - strlen(samples) - 1);
 	if (im->w > 0)

@@ -15,58 +15,6 @@
 #include "rtsh/settings.h"
 #include "rtsh/world.h"
 #include "shell/args.h"
-#include "term/frame.h"
-
-bool turntable_name(const char *pat, int index, char *out, size_t size)
-{
-	size_t o = 0;
-	int convs = 0;
-	for (const char *p = pat; *p; p++) {
-		char piece[32];
-		size_t n;
-		if (*p != '%') {
-			piece[0] = *p;
-			n = 1;
-		} else if (p[1] == '%') {
-			piece[0] = '%';
-			n = 1;
-			p++;
-		} else {
-			/* %[0][width]d, width at most 2 digits */
-			const char *q = p + 1;
-			bool zero = *q == '0';
-			if (zero)
-				q++;
-			int width = 0, digits = 0;
-			while (*q >= '0' && *q <= '9' && digits < 3) {
-				width = width * 10 + (*q++ - '0');
-				digits++;
-			}
-			if (*q != 'd' || digits > 2 || ++convs > 1)
-				return false;
-			int k = zero ? snprintf(piece, sizeof piece, "%0*d", width, index)
-			             : snprintf(piece, sizeof piece, "%*d", width, index);
-			if (k < 0 || (size_t)k >= sizeof piece)
-				return false;
-			n = (size_t)k;
-			p = q;
-		}
-		if (o + n >= size)
-			return false;
-		memcpy(out + o, piece, n);
-		o += n;
-	}
-	if (convs != 1 || size == 0)
-		return false;
-	out[o] = '\0';
-	return true;
-}
-
-static bool ends_with(const char *s, const char *suffix)
-{
-	size_t n = strlen(s), m = strlen(suffix);
-	return n >= m && strcasecmp(s + n - m, suffix) == 0;
-}
 
 static int report(const rt_error *err)
 {
@@ -79,13 +27,13 @@ static int report(const rt_error *err)
 int turntable_batch(const rtsh_options *o)
 {
 	int frames = o->turntable_frames;
-	bool gif = ends_with(o->output, ".gif");
+	bool gif = turntable_is_gif(o->output);
 	char name[4096];
 	if (!o->scene) {
 		fprintf(stderr, "rtsh: --turntable needs a scene file\nTry 'rtsh --help' for more information.\n");
 		return 2;
 	}
-	if (!gif && (!turntable_name(o->output, 0, name, sizeof name) || image_format_of(name) == IMAGE_UNKNOWN)) {
+	if (!turntable_output_ok(o->output)) {
 		char exts[128];
 		image_extensions(exts, sizeof exts, false);
 		fprintf(stderr,
@@ -113,9 +61,8 @@ int turntable_batch(const rtsh_options *o)
 	if (delay < TURNTABLE_MIN_CS)
 		delay = TURNTABLE_MIN_CS;
 	gif_anim *g = gif ? gif_new(set.width, set.height, delay) : NULL;
-	uint8_t *rgb = gif ? malloc((size_t)set.width * set.height * 3) : NULL;
 	int rc = 0;
-	if (gif && (!g || !rgb)) {
+	if (gif && !g) {
 		fprintf(stderr, "rtsh: out of memory for a %dx%d GIF\n", set.width, set.height);
 		rc = 1;
 	}
@@ -130,8 +77,7 @@ int turntable_batch(const rtsh_options *o)
 			break;
 		}
 		if (gif) {
-			frame_srgb_from_linear(fb->rgb, (size_t)fb->w * fb->h, set.exposure, rgb);
-			if (!gif_add_frame(g, rgb)) {
+			if (!gif_add_linear(g, fb->rgb, set.exposure)) {
 				fprintf(stderr, "rtsh: out of memory for the GIF\n");
 				rc = 1;
 			}
@@ -152,7 +98,6 @@ int turntable_batch(const rtsh_options *o)
 		fprintf(stderr, "wrote %s: %d frames of %dx%d, a full turn (%d samples, %s)\n", gif ? o->output : "the frames",
 		        frames, set.width, set.height, set.samples, render_mode_name(set.mode));
 	gif_free(g);
-	free(rgb);
 	world_free(w);
 	return rc;
 }

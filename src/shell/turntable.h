@@ -25,6 +25,11 @@
  * an optional 0 flag and width, as in frame%03d.png; %% is a %): false
  * when pat is not such a pattern or the name does not fit. */
 bool turntable_name(const char *pat, int index, char *out, size_t size);
+/* True when out names a GIF (.gif in any case). */
+bool turntable_is_gif(const char *out);
+/* True when out is a turntable's output: a GIF, or a numbered name of an
+ * image format (turntable_name). */
+bool turntable_output_ok(const char *out);
 /* The batch turntable of o->scene to o->output; returns the exit status. */
 int turntable_batch(const rtsh_options *o);
 
