@@ -636,12 +636,13 @@ static int pbr_features(const bsdf *b, vec3 *albedo, vec3 *tint, vec3 *dir)
 static vec3 pbr_whitted(const world *w, const mat_lin *m, const hit *h, ray r, int depth,
                         vec3 (*trace)(const world *w, ray r, int depth))
 {
-	bsdf b;
-	bsdf_make(&b, m, h, v3_neg(r.d));
+	bsdf b; /* bsdf_make's work for this family, without calling back up */
+	bsdf_begin(&b, m, h, v3_neg(r.d));
+	pbr_make(&b, m, hit_albedo(m, h));
 	const struct bsdf_pbr *p = &b.pb;
 	vec3 pt = offset_point(w, h->p, b.n);
 	vec3 c = v3_add(v3_mul(w->ambient, p->base), m->emission);
-	c = v3_add(c, whitted_lights(w, &b, pt));
+	c = v3_add(c, whitted_lights(w, &b, pt, pbr_eval));
 	if (depth <= 0)
 		return c;
 	double co = b.cos_o, ct;

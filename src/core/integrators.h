@@ -110,12 +110,16 @@ extern const mat_family mat_phong_family, mat_pbr_family;
 /* By mat_lin.family (material.c). */
 extern const mat_family *const mat_families[MAT_FAMILY_COUNT];
 
-/* Schlick's approximation of the Fresnel reflectance (whitted.c's). */
+/* Schlick's approximation of the Fresnel reflectance (shading.c). */
 double whitted_schlick(double cos_i, double eta_ratio);
 /* The point lights' direct light at a point (Whitted's convention, no
- * fall-off): sum over the lights visible from p of f(wi) pi L cos, f the
- * bsdf b's value (whitted.c). */
-vec3 whitted_lights(const world *w, const bsdf *b, vec3 p);
+ * fall-off): sum over the lights visible from p of f(wi) pi L cos, f =
+ * eval(b, wi), the family's own BSDF (shading.c: below the families, which
+ * call it from their Whitted shading). */
+vec3 whitted_lights(const world *w, const bsdf *b, vec3 p, vec3 (*eval)(const bsdf *b, vec3 wi));
+/* The frame every bsdf starts from: the normal on wo's side, wo, cos_o and
+ * the family (shading.c); bsdf_make then lets the family fill its lobes. */
+void bsdf_begin(bsdf *b, const mat_lin *m, const hit *h, vec3 wo);
 
 /* Reflectance of a smooth dielectric for unpolarised light (Born & Wolf
  * 1.5.2; pbrt 4th ed. 9.3.2). cos_i > 0 on the incident side; eta = eta_t /
