@@ -12,7 +12,12 @@ const mat_family *const mat_families[MAT_FAMILY_COUNT] = {
 
 void bsdf_make(bsdf *b, const mat_lin *m, const hit *h, vec3 wo)
 {
-	bsdf_begin(b, m, h, wo);
+	*b = (bsdf){0};
+	b->n = h->front ? h->n : v3_neg(h->n);
+	b->wo = wo;
+	b->front = h->front;
+	b->cos_o = pos(v3_dot(b->n, wo));
+	b->family = m->family < MAT_FAMILY_COUNT ? m->family : MAT_PHONG;
 	mat_families[b->family]->make(b, m, hit_albedo(m, h));
 }
 
