@@ -48,6 +48,8 @@ typedef struct mat_lin {
 			float specular_color[3]; /* linear, its specularColorFactor */
 			float sigma_a[3]; /* volume absorption per scene unit, -ln(att colour) / att distance; 0 none */
 			bool single;      /* multiscatter=0: no energy compensation */
+			bool es_ready;    /* es_avg is set (mat_lin_make); else bsdf_make computes it */
+			float es_avg;     /* the plastic's specular layer's hemispherical albedo (bsdf_pbr.c) */
 		} pbr;
 	};
 } mat_lin;

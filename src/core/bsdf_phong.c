@@ -12,6 +12,15 @@
 #include "integrators.h"
 #include "warp.h"
 
+/* Schlick's approximation of the Fresnel reflectance. */
+static double schlick(double cos_i, double eta_ratio)
+{
+	double r0 = (1.0 - eta_ratio) / (1.0 + eta_ratio);
+	r0 *= r0;
+	double x = 1.0 - cos_i;
+	return r0 + (1.0 - r0) * x * x * x * x * x;
+}
+
 /* Proportional to cos^e of the angle to axis, pdf (e + 1) / (2 pi) cos^e
  * (Lafortune & Willems, "Using the modified Phong reflectance model for
  * physically based rendering", 1994): u picks the angle, v the azimuth. */
@@ -132,6 +141,7 @@ static bool phong_sample(const bsdf *b, const double u[3], bsdf_sample *out)
 	out->radiance_scale = 1.0;
 	out->transmit = false;
 	out->delta = false;
+	out->pdf = -1.0;
 	switch (lobe) {
 	case 0: /* Lambert: f cos / pdf = (kd / pi) cos / (cos / pi) */
 		out->wi = warp_cosine(b->n, u[1], u[2]);
@@ -221,7 +231,7 @@ static vec3 phong_whitted(const world *w, const mat_lin *m, const hit *hp, ray r
 		vec3 refl = trace(w, (ray){p, refl_dir}, depth - 1);
 		if (sin2_t >= 1.0)
 			return v3_add(c, refl); /* total internal reflection */
-		double kr = whitted_schlick(cos_i, h.front ? 1.0 / m->ior : m->ior);
+		double kr = schlick(cos_i, h.front ? 1.0 / m->ior : m->ior);
 		vec3 tdir = v3_add(v3_scale(r.d, eta), v3_scale(n, eta * cos_i - sqrt(1.0 - sin2_t)));
 		vec3 q = offset_point(w, h.p, v3_neg(n));
 		vec3 trans = trace(w, (ray){q, v3_norm(tdir)}, depth - 1);

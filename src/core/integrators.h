@@ -66,6 +66,7 @@ typedef struct bsdf_sample {
 	double radiance_scale; /* (eta_i / eta_t)^2 on refraction, else 1 */
 	bool transmit; /* wi goes through the surface */
 	bool delta;    /* from a perfect mirror or glass lobe */
+	double pdf;    /* bsdf_pdf(wi) when the family knows it already, else < 0 */
 } bsdf_sample;
 
 /* The bsdf of material m at hit h seen from wo (unit, pointing away). */
@@ -109,13 +110,6 @@ typedef struct mat_family {
 extern const mat_family mat_phong_family, mat_pbr_family;
 /* By mat_lin.family (material.c). */
 extern const mat_family *const mat_families[MAT_FAMILY_COUNT];
-
-/* Schlick's approximation of the Fresnel reflectance (whitted.c's). */
-double whitted_schlick(double cos_i, double eta_ratio);
-/* The point lights' direct light at a point (Whitted's convention, no
- * fall-off): sum over the lights visible from p of f(wi) pi L cos, f the
- * bsdf b's value (whitted.c). */
-vec3 whitted_lights(const world *w, const bsdf *b, vec3 p);
 
 /* Reflectance of a smooth dielectric for unpolarised light (Born & Wolf
  * 1.5.2; pbrt 4th ed. 9.3.2). cos_i > 0 on the incident side; eta = eta_t /

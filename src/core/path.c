@@ -217,8 +217,11 @@ vec3 path_radiance(const world *w, const render_settings *s, ray r, sampler *g)
 		if (bs.transmit) /* into the volume below, or out of it */
 			sigma = b.front ? b.sigma_in : v3(0, 0, 0);
 		from = r.o;
-		from_pdf = sample_emitters && !bs.delta ? bsdf_pdf(&b, bs.wi) : 0.0;
-		env_from_pdf = b.smooth && w->env && !bs.delta ? bsdf_pdf(&b, bs.wi) : 0.0;
+		double spdf = bs.delta || !(sample_emitters || (b.smooth && w->env)) ? 0.0
+		              : bs.pdf >= 0.0                                       ? bs.pdf
+		                                                                    : bsdf_pdf(&b, bs.wi);
+		from_pdf = sample_emitters && !bs.delta ? spdf : 0.0;
+		env_from_pdf = b.smooth && w->env && !bs.delta ? spdf : 0.0;
 
 		/* Russian roulette after the third bounce: survive with q, weigh
 		 * the survivors by 1 / q. q is the square root of the throughput,

@@ -14,6 +14,7 @@
 #include "emitters.h"
 #include "envmap.h"
 #include "surface.h"
+#include "ggx.h"
 #include "rtsh/shape.h"
 
 mat_lin mat_lin_make(const material *m)
@@ -56,6 +57,7 @@ mat_lin mat_lin_make(const material *m)
 		for (int i = 0; i < 3; i++)
 			l.pbr.sigma_a[i] = (float)(c[i] > 0 ? -log(c[i]) / p->att_dist : 1e30);
 	}
+	pbr_lin_finish(&l);
 	return l;
 }
 

@@ -22,7 +22,8 @@ const command command_table[] = {
 	{"set", NULL, "set\nset KEY\nset KEY VALUE", 0, 2, {"@setting", "@value"},
 	 "list the settings, or show or change one (resolution WxH, samples, depth, mode, threads, seed, exposure,\n"
 	 "denoise auto|on|off: auto denoises path previews only, on also saved images,\n"
-	 "pixels off|kitty|sixel|iterm|auto: the picture in the terminal's real pixels)",
+	 "pixels off|kitty|sixel|iterm|auto: the picture in the terminal's real pixels,\n"
+	 "symbols half|quadrant|sextant|octant|auto: the cells' glyphs without real pixels)",
 	 cmd_set},
 	{"list", "ls", "list [cameras|lights|objects]", 0, 1, {"cameras|lights|objects"},
 	 "the cameras, ambient, lights and objects with their numbers and fields", cmd_list},

@@ -99,6 +99,11 @@ static void add_alternative(list *l, const shell *sh, const char *alt, size_t le
 			add(l, "whitted", text);
 			add(l, "path", text);
 		}
+		if (d && d->type == SETTING_SYMBOLS) {
+			static const char *const sym[] = {"half", "quadrant", "sextant", "octant", "auto"};
+			for (size_t i = 0; i < sizeof sym / sizeof sym[0]; i++)
+				add(l, sym[i], text);
+		}
 	} else if (strcmp(a, "@key") == 0) {
 		const char *name, *kh;
 		char buf[64];

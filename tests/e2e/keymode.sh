@@ -61,8 +61,11 @@ wait_for " view │ k.rt │ camera │" "no key-mode status line"
 [ "$(tmux display -p -t "$s" '#{alternate_on}')" = 1 ] || fail "key mode is not on the alternate screen"
 case $(screen | tail -n 3) in *"rtsh>"*) fail "the prompt shows in key mode" ;; esac
 esc=$(printf '\033')
+# The picture in half blocks (since issue 27 a cell whose two pixels differ by less than their bytes'
+# worth shows one colour, so a flat-shaded scene splits fewer cells: 658 of 7,360 here, against more
+# than 1,000 before).
 n=$(tmux capture-pane -t "$s" -p -e | grep -o '▀\|▄' | wc -l)
-[ "$n" -gt 1000 ] || fail "only $n half blocks in key mode"
+[ "$n" -gt 300 ] || fail "only $n half blocks in key mode"
 
 # The camera flies two steps forward.
 keys Up Up
@@ -94,10 +97,10 @@ screen | grep -q '^ k\.rt │ whitted │' || fail "no shell status line after k
 # The shell's picture comes back (its preview renders again).
 for i in $(seq 1 50); do
 	n=$(tmux capture-pane -t "$s" -p -e | grep -o '▀\|▄' | wc -l)
-	[ "$n" -gt 1000 ] && break
+	[ "$n" -gt 300 ] && break
 	sleep 0.1
 done
-[ "$n" -gt 1000 ] || fail "only $n half blocks after key mode"
+[ "$n" -gt 300 ] || fail "only $n half blocks after key mode"
 
 tmux send-keys -t "$s" "save $TMP/x.rt" Enter
 wait_for "saved the scene to $TMP/x.rt" "save x.rt"
