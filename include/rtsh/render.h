@@ -123,6 +123,11 @@ framebuffer *render_image(const world *w, const render_settings *s, atomic_bool 
  * render_image gives those pixels (rtsh-mpi renders its tiles with it). */
 void render_rect(const world *w, const render_settings *s, int x0, int y0, int x1, int y1,
                  float *out);
+/* The same, and (path mode, feat not NULL) the denoiser's features of those
+ * pixels into feat, DENOISE_FEATURES floats a pixel in the same order, bit
+ * for bit what a render job into a framebuffer with features records. */
+void render_rect_features(const world *w, const render_settings *s, int x0, int y0, int x1, int y1,
+                          float *out, float *feat);
 
 /* The radiance along one camera sample: the integrators (whitted.c, path.c).
  * px, py: pixel; sample: index; the random stream depends only on these and

@@ -146,15 +146,15 @@ void denoise_features(const world *w, const render_settings *s, int px, int py, 
 /* --- the filter ------------------------------------------------------------ */
 
 /* The constants were chosen at 128x96 and 200x120, 8 samples, against
- * 1024-sample references of scenes/cornell.rt, sky-spheres.rt,
+ * 1024-sample references of scenes/cornell.rt, sky-spheres.rt, spot.rt,
  * metal-fuzz.rt and final.rt (bench/quality.c, `--only denoise`).
  *
  * Feature distances: albedo and normals as squared distances over these,
  * depth as the distance off the plane that the pixel's depth and gradient
  * predict, in shares of its depth. */
-#define SIGMA_A2 0.01f
-#define SIGMA_N2 0.08f
-#define SIGMA_Z 0.02f
+#define SIGMA_A2 0.04f
+#define SIGMA_N2 0.16f
+#define SIGMA_Z 0.015f
 /* The regression's window: radius 4 (9x9 pixels). */
 #define WIN 4
 #define TAPS ((2 * WIN + 1) * (2 * WIN + 1))

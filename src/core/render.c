@@ -202,12 +202,23 @@ static void render_tile(shared *sh, long t)
 void render_rect(const world *w, const render_settings *s, int x0, int y0, int x1, int y1,
                  float *out)
 {
+	render_rect_features(w, s, x0, y0, x1, y1, out, NULL);
+}
+
+void render_rect_features(const world *w, const render_settings *s, int x0, int y0, int x1, int y1,
+                          float *out, float *feat)
+{
 	double inv = 1.0 / s->samples;
 	texture_set_pixel_angle(2.0 * cam_tan_x(&w->cam, s->width, s->height) / s->width); /* as render_tile */
 	for (int y = y0; y < y1; y++)
 		for (int x = x0; x < x1; x++) {
 			double acc[3] = {0.0, 0.0, 0.0};
-			pixel_add(w, s, x, y, s->width, s->height, 0, s->samples, acc, NULL);
+			float *f = feat && s->mode == MODE_PATH ? feat : NULL;
+			if (feat) {
+				memset(feat, 0, DENOISE_FEATURES * sizeof *feat);
+				feat += DENOISE_FEATURES;
+			}
+			pixel_add(w, s, x, y, s->width, s->height, 0, s->samples, acc, f);
 			*out++ = (float)(acc[0] * inv);
 			*out++ = (float)(acc[1] * inv);
 			*out++ = (float)(acc[2] * inv);

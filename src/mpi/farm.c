@@ -35,17 +35,27 @@ static void sleep_us(long us)
 	nanosleep(&t, NULL);
 }
 
-/* The tiles of the image, row by row. */
+/* The tiles of the image, row by row. A tile's floats are its pixels'
+ * radiance (3 a pixel), then, when the image is to be denoised, their
+ * features (DENOISE_FEATURES a pixel): rank 0 denoises the whole image. */
 typedef struct tiling {
 	int w, h, side, across;
 	long count;
+	int per; /* floats a pixel */
 } tiling;
 
 static tiling tiling_of(const render_settings *s, int side)
 {
-	tiling t = {s->width, s->height, side, (s->width + side - 1) / side, 0};
+	tiling t = {s->width, s->height, side, (s->width + side - 1) / side, 0, 3};
 	t.count = (long)t.across * ((s->height + side - 1) / side);
+	if (farm_denoises(s))
+		t.per += DENOISE_FEATURES;
 	return t;
+}
+
+bool farm_denoises(const render_settings *s)
+{
+	return s->mode == MODE_PATH && s->denoise == DENOISE_ON;
 }
 
 static void tile_rect(const tiling *t, long i, int r[4])
@@ -60,10 +70,20 @@ static size_t tile_floats(const tiling *t, long i)
 {
 	int r[4];
 	tile_rect(t, i, r);
-	return (size_t)(r[2] - r[0]) * (size_t)(r[3] - r[1]) * 3;
+	return (size_t)(r[2] - r[0]) * (size_t)(r[3] - r[1]) * (size_t)t->per;
 }
 
-/* Copies a tile's floats into the image. */
+/* Renders tile i into px (tile_floats floats). */
+static void render_tile_px(const world *w, const render_settings *s, const tiling *t, long i, float *px)
+{
+	int r[4];
+	tile_rect(t, i, r);
+	size_t n = (size_t)(r[2] - r[0]) * (size_t)(r[3] - r[1]);
+	render_rect_features(w, s, r[0], r[1], r[2], r[3], px, t->per > 3 ? px + n * 3 : NULL);
+}
+
+/* Copies a tile's floats into the image (and its features, when it has
+ * them, into fb->feat). */
 static void place(const tiling *t, long i, const float *px, framebuffer *fb)
 {
 	int r[4];
@@ -71,6 +91,12 @@ static void place(const tiling *t, long i, const float *px, framebuffer *fb)
 	size_t row = (size_t)(r[2] - r[0]) * 3;
 	for (int y = r[1]; y < r[3]; y++, px += row)
 		memcpy(fb->rgb + ((size_t)y * (size_t)fb->w + (size_t)r[0]) * 3, px, row * sizeof *px);
+	if (t->per > 3 && fb->feat) {
+		row = (size_t)(r[2] - r[0]) * DENOISE_FEATURES;
+		for (int y = r[1]; y < r[3]; y++, px += row)
+			memcpy(fb->feat + ((size_t)y * (size_t)fb->w + (size_t)r[0]) * DENOISE_FEATURES, px,
+			       row * sizeof *px);
+	}
 }
 
 /* ---------------------------------------------------------------- rank 0 */
@@ -110,10 +136,8 @@ static void *server_thread(void *arg)
 		long i = atomic_fetch_add(&sv->next, 1);
 		if (i >= sv->t.count)
 			break;
-		int r[4];
-		tile_rect(&sv->t, i, r);
 		double t0 = now();
-		render_rect(sv->w, sv->s, r[0], r[1], r[2], r[3], buf);
+		render_tile_px(sv->w, sv->s, &sv->t, i, buf);
 		double took = now() - t0;
 		busy += took;
 		for (double old = atomic_load(&sv->slowest); took > old;)
@@ -235,7 +259,7 @@ bool farm_serve(const world *w, const render_settings *s, const farm_opts *o, fr
 	atomic_init(&sv.local, 0);
 	atomic_init(&sv.busy, 0.0);
 	atomic_init(&sv.slowest, 0.0);
-	size_t most = (size_t)o->tile * (size_t)o->tile * 3;
+	size_t most = (size_t)o->tile * (size_t)o->tile * (size_t)sv.t.per;
 	int n = o->threads;
 	char *msg = malloc(sizeof(int64_t) + most * sizeof(float));
 	bool *told = calloc((size_t)size, sizeof *told);
@@ -292,10 +316,8 @@ bool farm_serve(const world *w, const render_settings *s, const farm_opts *o, fr
 		}
 		long i = own ? atomic_fetch_add(&sv.next, 1) : sv.t.count;
 		if (i < sv.t.count) {
-			int r[4];
-			tile_rect(&sv.t, i, r);
 			double b0 = now();
-			render_rect(w, s, r[0], r[1], r[2], r[3], own);
+			render_tile_px(w, s, &sv.t, i, own);
 			own_busy += now() - b0;
 			if (now() - b0 > atomic_load(&sv.slowest))
 				atomic_store(&sv.slowest, now() - b0);
@@ -401,11 +423,9 @@ static void *crew_thread(void *arg)
 		char *msg = c->spare[--c->nspare];
 		pthread_mutex_unlock(&c->lock);
 
-		int r[4];
-		tile_rect(&c->t, i, r);
 		memcpy(msg, &i, sizeof i);
 		double t0 = now();
-		render_rect(c->w, c->s, r[0], r[1], r[2], r[3], (float *)(void *)(msg + sizeof i));
+		render_tile_px(c->w, c->s, &c->t, i, (float *)(void *)(msg + sizeof i));
 		double t1 = now();
 
 		pthread_mutex_lock(&c->lock);
@@ -435,8 +455,9 @@ bool farm_work(const world *w, const render_settings *s, const farm_opts *o, far
                rt_error *err)
 {
 	int n = o->threads, k = o->threads + o->prefetch;
-	size_t most = (size_t)o->tile * (size_t)o->tile * 3, msgsize = sizeof(int64_t) + most * sizeof(float);
 	crew c = {.w = w, .s = s, .t = tiling_of(s, o->tile), .delay = o->delay_us * 1e-6, .cap = k};
+	size_t most = (size_t)o->tile * (size_t)o->tile * (size_t)c.t.per;
+	size_t msgsize = sizeof(int64_t) + most * sizeof(float);
 	c.queue = calloc((size_t)k, sizeof *c.queue);
 	int nbuf = 2 * k;
 	c.spare = calloc((size_t)nbuf, sizeof *c.spare);

@@ -6,7 +6,10 @@
  * Messages (all between rank 0 and one worker, in order):
  *   worker -> 0   FARM_ASK      int64 k: send me k tiles (once, at the start)
  *   0 -> worker   FARM_TILES    int64[] tile numbers, -1 last when none are left
- *   worker -> 0   FARM_RESULT   int64 tile number, then the tile's floats;
+ *   worker -> 0   FARM_RESULT   int64 tile number, then the tile's floats:
+ *                               its radiance, 3 a pixel, and when the image
+ *                               is denoised (farm_denoises) the denoiser's
+ *                               features, DENOISE_FEATURES a pixel;
  *                               answered by FARM_TILES with one more tile
  * A worker holds at most threads + prefetch tiles (rendering, queued or
  * waiting to be sent) and never the image. After rank 0 has sent a worker
@@ -18,6 +21,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "rtsh/denoise.h"
 #include "rtsh/render.h"
 
 typedef struct farm_opts {
@@ -53,8 +57,11 @@ typedef struct farm_stats {
 
 /* Both return false (err set) when a message breaks the protocol or memory
  * runs out; the caller then ends the job. */
-/* Rank 0: renders the image into fb (s->width x s->height, rgb only) with
- * the workers of MPI_COMM_WORLD. */
+/* Whether the job's image is denoised (path mode, denoise on, as
+ * render_image): its tiles then carry the features too. */
+bool farm_denoises(const render_settings *s);
+/* Rank 0: renders the image into fb (s->width x s->height; rgb, and feat
+ * when farm_denoises and fb has it) with the workers of MPI_COMM_WORLD. */
 bool farm_serve(const world *w, const render_settings *s, const farm_opts *o, framebuffer *fb,
                 farm_stats *st, rt_error *err);
 /* Every other rank: renders the tiles rank 0 hands out until it says none

@@ -25,6 +25,7 @@
 #include "mpi/farm.h"
 #include "mpi/fileset.h"
 #include "mpi/wire.h"
+#include "rtsh/denoise.h"
 #include "rtsh/gif.h"
 #include "rtsh/image.h"
 #include "rtsh/orbit.h"
@@ -221,6 +222,13 @@ static void setup(int argc, char **argv, job_config *c, fileset *files, world **
 	}
 	free((*fb)->sum); /* one pass: no running sums, as render_image */
 	(*fb)->sum = NULL;
+	if (farm_denoises(&c->set) && !denoise_prepare(*fb)) {
+		fprintf(stderr, "%s: out of memory for the denoiser's features of a %dx%d image\n", o.scene,
+		        c->set.width, c->set.height);
+		fb_free(*fb);
+		*fb = NULL;
+		goto out;
+	}
 	c->progress = !o.quiet && watched();
 	*output = o.output;
 	c->status = -1;
@@ -575,6 +583,14 @@ int main(int argc, char **argv)
 		                    : farm_work(w, &c.set, &fo, &st, &err);
 		if (!ok)
 			die(rank, host, "", &err);
+		if (rank == 0 && fb->feat) {
+			/* --denoise: the whole frame, as rtsh denoises its image */
+			fb->spp = c.set.samples;
+			if (!denoise_image(fb, fb->rgb, threads)) {
+				rt_error_set(&err, "out of memory denoising a %dx%d image", fb->w, fb->h);
+				die(rank, host, "", &err);
+			}
+		}
 		if (frames > 1) {
 			/* every rank done with this frame before any asks for tiles
 			 * of the next: rank 0 serves one frame at a time */

@@ -355,6 +355,7 @@ static void after_probe(shell *sh)
 		draw_status(sh);
 		rl_forced_update_display();
 	}
+	shell_pixels_notice(sh); /* kitty asked for in a tmux pane without passthrough */
 	if (!asked_color)
 		return;
 	if (termout_truecolor(o) == 1) {

@@ -219,6 +219,16 @@ static double aspect_of(const render_settings *s)
 	return (double)s->width / s->height;
 }
 
+void shell_pixels_notice(shell *sh)
+{
+	/* kitty or iTerm2 asked for inside tmux, and half blocks drawn: the
+	 * pane has no passthrough (or no cell size); say so, not a blank. */
+	if ((sh->set.pixels == PIXELS_KITTY || sh->set.pixels == PIXELS_ITERM) && getenv("TMUX") && sh->scr &&
+	    !sh->scr->pix_ops)
+		shell_notice(sh, "%s images do not show in this tmux pane (allow-passthrough on?): half blocks",
+		             sh->set.pixels == PIXELS_KITTY ? "kitty" : "iTerm2");
+}
+
 /* Whether the samples were chosen: by `set samples`, -s or the scene. */
 static bool samples_chosen(const shell *sh)
 {
@@ -245,8 +255,11 @@ void shell_refresh(shell *sh)
 	 * later, in the loop's after_probe. */
 	if (sh->set.symbols != sh->scr->symbols)
 		screen_set_symbols(sh->scr, sh->set.symbols);
-	if (sh->set.pixels == sh->scr->pixels || !screen_set_pixels(sh->scr, sh->set.pixels))
+	bool new_pixels = sh->set.pixels != sh->scr->pixels;
+	if (!new_pixels || !screen_set_pixels(sh->scr, sh->set.pixels))
 		screen_layout(sh->scr, aspect_of(&sh->set), false);
+	if (new_pixels && sh->scr->out && termout_get_state(sh->scr->out) != TERMOUT_PROBING)
+		shell_pixels_notice(sh);
 	if (sh->scr->img_w <= 0 || sh->scr->img_h <= 0) {
 		rsvc_release(sh->rs);
 		return;

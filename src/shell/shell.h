@@ -119,6 +119,9 @@ void shell_edit_begin(shell *sh);
 void shell_edit_end(shell *sh);
 /* Restarts the preview for the current scene, settings and screen size. */
 void shell_refresh(shell *sh);
+/* Says once, in the status line, that kitty or iTerm2 images asked for in
+ * tmux fell back to half blocks. */
+void shell_pixels_notice(shell *sh);
 /* The status line's text. */
 void shell_status_text(shell *sh, char *buf, size_t size);
 
