@@ -29,6 +29,8 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "base/abuf.h" /* write_all */
+
 #define MAX_HOPS 40
 /* The temporary file's name keeps at most this much of the target's name,
  * so that ".NAME.tmp.PID.XXXXXX" stays within NAME_MAX. */
@@ -270,21 +272,6 @@ static void remove_stale(const char *dir, const char *base)
 }
 
 /* --- writing --- */
-
-static bool write_all(int fd, const char *buf, size_t n)
-{
-	while (n > 0) {
-		ssize_t w = write(fd, buf, n);
-		if (w < 0) {
-			if (errno == EINTR)
-				continue;
-			return false;
-		}
-		buf += w;
-		n -= (size_t)w;
-	}
-	return true;
-}
 
 /* Runs the writer into memory; the text (malloc'ed) and its length. */
 static char *make_content(const char *path, file_writer_fn write, void *ctx, size_t *len, rt_error *err)

@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/abuf.h"
 #include "rtsh/image.h"
 #include "rtsh/rtfile.h"
 #include "scene/rtfile_priv.h"
@@ -32,40 +33,6 @@ _Thread_local const char *rt_keep_source;
 #define LOOKAHEAD 64
 /* Formatted lines are shorter than this. */
 #define BODY_MAX 4096
-
-/* --- output --- */
-
-typedef struct obuf {
-	char *b;
-	size_t len, cap;
-	bool failed;
-} obuf;
-
-static void ob_add(obuf *o, const char *s, size_t n)
-{
-	if (o->failed || n == 0)
-		return;
-	if (o->len + n + 1 > o->cap) {
-		size_t cap = o->cap ? o->cap : 4096;
-		while (cap < o->len + n + 1)
-			cap *= 2;
-		char *b = realloc(o->b, cap);
-		if (!b) {
-			o->failed = true;
-			return;
-		}
-		o->b = b;
-		o->cap = cap;
-	}
-	memcpy(o->b + o->len, s, n);
-	o->len += n;
-	o->b[o->len] = '\0';
-}
-
-static void ob_str(obuf *o, const char *s)
-{
-	ob_add(o, s, strlen(s));
-}
 
 /* --- cutting a line as the reader does --- */
 
@@ -496,64 +463,64 @@ static void light_tokens(const light *l, char *buf, size_t size, char **tok, int
 
 /* Numbers and vectors as the writer spells them (fewest digits that read
  * back exactly, in the "C" locale), borrowed from the light formatter. */
-static void put_vec(obuf *o, vec3 v)
+static void put_vec(abuf *o, vec3 v)
 {
 	char buf[256], *tok[4] = {0};
 	light l = {.pos = v};
 	light_tokens(&l, buf, sizeof buf, tok, 4);
-	ob_str(o, tok[1] ? tok[1] : "0,0,0");
+	abuf_str(o, tok[1] ? tok[1] : "0,0,0");
 }
 
-static void put_num(obuf *o, double v)
+static void put_num(abuf *o, double v)
 {
 	char buf[256], *tok[4] = {0};
 	light l = {.ratio = v};
 	light_tokens(&l, buf, sizeof buf, tok, 4);
-	ob_str(o, tok[2] ? tok[2] : "0");
+	abuf_str(o, tok[2] ? tok[2] : "0");
 }
 
-static void put_int(obuf *o, long v)
+static void put_int(abuf *o, long v)
 {
 	char t[32];
 	snprintf(t, sizeof t, "%ld", v);
-	ob_str(o, t);
+	abuf_str(o, t);
 }
 
 /* An object in the extended form, whatever the short form could say. */
-static void put_extended(obuf *o, const object *ob)
+static void put_extended(abuf *o, const object *ob)
 {
 	char f[BODY_MAX];
 	rt_format_object_extended(ob, f, sizeof f);
-	ob_str(o, f);
+	abuf_str(o, f);
 }
 
-static void put_object(obuf *o, const object *ob, bool want_short)
+static void put_object(abuf *o, const object *ob, bool want_short)
 {
 	char f[BODY_MAX];
 	rt_format_object(ob, f, sizeof f);
 	lline l;
 	lex(f, strlen(f), &l);
 	if (want_short || !short_form(f, &l))
-		ob_str(o, f);
+		abuf_str(o, f);
 	else
 		put_extended(o, ob);
 }
 
 /* id: the identifier to keep ("L" or "l", "C" or "c"). */
-static void put_light(obuf *o, const light *li, const char *id)
+static void put_light(abuf *o, const light *li, const char *id)
 {
 	char f[BODY_MAX];
 	rt_format_light(li, f, sizeof f);
-	ob_str(o, id);
-	ob_str(o, f + 1);
+	abuf_str(o, id);
+	abuf_str(o, f + 1);
 }
 
-static void put_camera(obuf *o, const camera *c, const char *id)
+static void put_camera(abuf *o, const camera *c, const char *id)
 {
 	char f[BODY_MAX];
 	rt_format_camera(c, f, sizeof f);
-	ob_str(o, id);
-	ob_str(o, f + 1);
+	abuf_str(o, id);
+	abuf_str(o, f + 1);
 }
 
 static const char *mode_name(int m)
@@ -562,43 +529,43 @@ static const char *mode_name(int m)
 }
 
 /* The body of a once-only element's line; `as_r`: resolution as `R W H`. */
-static void put_once(obuf *o, const scene *s, once_kind k, bool as_r, bool strength)
+static void put_once(abuf *o, const scene *s, once_kind k, bool as_r, bool strength)
 {
 	const scene_hints *h = &s->hints;
 	switch (k) {
 	case ONCE_AMB:
-		ob_str(o, "A ");
+		abuf_str(o, "A ");
 		put_num(o, s->amb.ratio);
-		ob_str(o, " ");
+		abuf_str(o, " ");
 		put_vec(o, s->amb.color);
 		break;
 	case ONCE_SKY:
-		ob_str(o, "sky ");
+		abuf_str(o, "sky ");
 		put_vec(o, s->sky.zenith);
-		ob_str(o, " ");
+		abuf_str(o, " ");
 		put_vec(o, s->sky.horizon);
 		if (strength || s->sky.strength != 1) {
-			ob_str(o, " ");
+			abuf_str(o, " ");
 			put_num(o, s->sky.strength);
 		}
 		break;
 	case ONCE_RES:
-		ob_str(o, as_r ? "R " : "set resolution ");
+		abuf_str(o, as_r ? "R " : "set resolution ");
 		put_int(o, h->width);
-		ob_str(o, as_r ? " " : "x");
+		abuf_str(o, as_r ? " " : "x");
 		put_int(o, h->height);
 		break;
 	case ONCE_SAMPLES:
-		ob_str(o, "set samples ");
+		abuf_str(o, "set samples ");
 		put_int(o, h->samples);
 		break;
 	case ONCE_DEPTH:
-		ob_str(o, "set depth ");
+		abuf_str(o, "set depth ");
 		put_int(o, h->depth);
 		break;
 	case ONCE_MODE:
-		ob_str(o, "set mode ");
-		ob_str(o, mode_name(h->mode));
+		abuf_str(o, "set mode ");
+		abuf_str(o, mode_name(h->mode));
 		break;
 	default:
 		break;
@@ -655,7 +622,7 @@ static bool once_same(const scene *a, const scene *b, once_kind k)
 /* --- writing --- */
 
 typedef struct writer {
-	obuf o;
+	abuf o;
 	const char *src;
 	const char *nl;     /* the line end for new lines */
 	const scene *s;
@@ -671,12 +638,12 @@ typedef struct writer {
 static void new_line(writer *w)
 {
 	if (w->o.len > 0 && w->o.b[w->o.len - 1] != '\n' && w->o.b[w->o.len - 1] != '\r')
-		ob_str(&w->o, w->nl);
+		abuf_str(&w->o, w->nl);
 }
 
 static void end_new_line(writer *w)
 {
-	ob_str(&w->o, w->nl);
+	abuf_str(&w->o, w->nl);
 }
 
 /* Writes the new elements of a list that go before source element `before`
@@ -706,14 +673,14 @@ static void place_new(writer *w, const match *m, size_t n, size_t *next, size_t 
 }
 
 /* The line with its element's new body, keeping indentation and comment. */
-static void rewrite(writer *w, const src_line *sl, const lline *l, const obuf *body)
+static void rewrite(writer *w, const src_line *sl, const lline *l, const abuf *body)
 {
 	const char *s = w->src + sl->at;
-	ob_add(&w->o, s, l->lead);
-	ob_add(&w->o, body->b, body->len);
+	abuf_add(&w->o, s, l->lead);
+	abuf_add(&w->o, body->b, body->len);
 	if (l->tail < sl->len)
-		ob_add(&w->o, s + l->tail, sl->len - l->tail);
-	ob_add(&w->o, s + sl->len, sl->end - sl->at - sl->len);
+		abuf_add(&w->o, s + l->tail, sl->len - l->tail);
+	abuf_add(&w->o, s + sl->len, sl->end - sl->at - sl->len);
 }
 
 /* --- file names in a file written elsewhere --- */
@@ -794,22 +761,22 @@ static bool retarget_files(writer *w, const src_line *sl, const object *o, const
 	lex(text, sl->len, &l);
 	if (l.n > LTOK_MAX)
 		return false;
-	obuf body = {0};
+	abuf body = {0};
 	size_t pos = l.lead;
 	for (size_t k = 0; k < l.n; k++) {
 		const ltok *t = &l.t[k];
-		ob_add(&body, text + pos, t->at - pos);
+		abuf_add(&body, text + pos, t->at - pos);
 		pos = t->at + t->len;
 		char name[4200];
 		const char *eq = k > 0 ? memchr(text + t->at, '=', t->len) : NULL;
 		if (k == 1 && sky_file) {
 			rt_write_file_name(sky_file, name, sizeof name);
-			ob_str(&body, name);
+			abuf_str(&body, name);
 			continue;
 		}
 		if (k == 1 && o && (obj_kind_flags(o->kind) & KIND_MODEL) && o->file && !eq) {
 			rt_write_file_name(o->file, name, sizeof name);
-			ob_str(&body, name);
+			abuf_str(&body, name);
 			continue;
 		}
 		if (eq && o) {
@@ -822,12 +789,12 @@ static bool retarget_files(writer *w, const src_line *sl, const object *o, const
 			const char *f = key ? *(const char *const *)(const void *)((const char *)o + key->offset) : NULL;
 			if (f) {
 				rt_write_file_name(f, name, sizeof name);
-				ob_add(&body, text + t->at, klen + 1);
-				ob_str(&body, name);
+				abuf_add(&body, text + t->at, klen + 1);
+				abuf_str(&body, name);
 				continue;
 			}
 		}
-		ob_add(&body, text + t->at, t->len);
+		abuf_add(&body, text + t->at, t->len);
 	}
 	if (body.failed) {
 		free(body.b);
@@ -840,7 +807,7 @@ static bool retarget_files(writer *w, const src_line *sl, const object *o, const
 
 static void copy_line(writer *w, const src_line *sl)
 {
-	ob_add(&w->o, w->src + sl->at, sl->end - sl->at);
+	abuf_add(&w->o, w->src + sl->at, sl->end - sl->at);
 }
 
 static void write_line(writer *w, const src_line *sl)
@@ -849,7 +816,7 @@ static void write_line(writer *w, const src_line *sl)
 	const scene *s = w->s;
 	const char *text = w->src + sl->at;
 	lline l;
-	obuf body = {0};
+	abuf body = {0};
 	char id[4] = "";
 	switch (sl->kind) {
 	case LK_TEXT:

@@ -35,7 +35,7 @@
 #include "rtsh/shape.h"
 #include "rtsh/world.h"
 #include "shell/commands.h"
-#include "term/abuf.h"
+#include "base/abuf.h"
 #include "term/frame.h"
 #include "term/keys.h"
 #include "term/keyview.h"

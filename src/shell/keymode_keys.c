@@ -10,7 +10,7 @@
 
 #include "rtsh/orbit.h"
 #include "rtsh/shape.h"
-#include "term/abuf.h"
+#include "base/abuf.h"
 #include "term/keys.h"
 
 /* The key table. Each row is one line of `help view` (and of rtsh(1), KEY

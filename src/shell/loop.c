@@ -24,7 +24,7 @@
 #include "term/pager.h"
 #include "shell/signals.h"
 #include "shell/shell.h"
-#include "term/abuf.h"
+#include "base/abuf.h"
 #include "term/caps.h"
 #include "term/evloop.h"
 

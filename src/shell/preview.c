@@ -20,7 +20,7 @@
 #include "rtsh/settings.h"
 #include "rtsh/world.h"
 #include "shell/args.h"
-#include "term/abuf.h"
+#include "base/abuf.h"
 #include "term/caps.h"
 #include "term/frame.h"
 #include "term/pixels.h"

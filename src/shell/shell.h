@@ -25,7 +25,7 @@
 #include "shell/render_service.h"
 #include "shell/signals.h"
 #include "term/frame.h"
-#include "term/abuf.h"
+#include "base/abuf.h"
 #include "term/evloop.h"
 #include "term/screen.h"
 

@@ -18,7 +18,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "term/abuf.h"
+#include "base/abuf.h"
 #include "term/frame.h"
 
 /* Where the picture goes and what the terminal is like. */

@@ -8,7 +8,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "term/abuf.h"
+#include "base/abuf.h"
 
 struct evloop {
 	int in_fd, wake_fd;

@@ -30,7 +30,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "term/abuf.h"
+#include "base/abuf.h"
 #include "term/symbols.h"
 
 typedef enum frame_palette {

@@ -25,7 +25,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "term/abuf.h"
+#include "base/abuf.h"
 #include "term/encoder.h"
 #include "term/frame.h"
 #include "term/out.h"

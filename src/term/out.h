@@ -48,7 +48,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 
-#include "term/abuf.h"
+#include "base/abuf.h"
 #include "term/encoder.h"
 #include "term/pixels.h"
 

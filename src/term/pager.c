@@ -9,7 +9,7 @@
 #include <termios.h>
 #include <unistd.h>
 
-#include "term/abuf.h"
+#include "base/abuf.h"
 #include "term/out.h"
 
 /* Seconds the rest of an escape sequence may take over a slow link. */

@@ -37,7 +37,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "term/abuf.h"
+#include "base/abuf.h"
 
 typedef enum pixels_mode {
 	PIXELS_OFF,   /* half blocks */

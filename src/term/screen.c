@@ -12,7 +12,7 @@
 #include <sys/ioctl.h>
 #include <unistd.h>
 
-#include "term/abuf.h"
+#include "base/abuf.h"
 
 #define ENTER_SEQ "\x1b[?1049h"
 /* Every mode rtsh (or readline) may have set, back to the terminal's

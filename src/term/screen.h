@@ -31,7 +31,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-#include "term/abuf.h"
+#include "base/abuf.h"
 #include "term/encoder.h"
 #include "term/frame.h"
 #include "term/out.h"

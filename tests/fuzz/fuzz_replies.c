@@ -16,7 +16,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "term/abuf.h"
+#include "base/abuf.h"
 #include "term/out.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);

@@ -691,6 +691,48 @@ static void test_undo_then_another_request(void **state)
 	session_close(&ss);
 }
 
+/* The model viewer's keys: the arrows orbit about the scene's centre (the
+ * box of the objects but the plane: x -7.5..10, y and z -2..2, so
+ * (1.25, 0, 0)) or the selected object's, Right turning the model right
+ * (the camera goes to its left), Up tilting its front up (the camera goes
+ * down); Shift+arrows fly as the arrows do elsewhere; f frames; the rest
+ * as everywhere. */
+static void test_model_keys(void **state)
+{
+	(void)state;
+	scene *s = load(scene_text);
+	km_action a = keymode_map_model(KEYS_RIGHT, s, camera_sel, 0.5);
+	assert_int_equal(a.op, KM_ORBIT);
+	assert_near(a.a, -KEYMODE_ORBIT_DEG, 0);
+	assert_near(a.b, 0, 0);
+	assert_vec_near(a.d, v3(1.25, 0, 0), 1e-12);
+	a = keymode_map_model(KEYS_UP, s, camera_sel, 0.5);
+	assert_int_equal(a.op, KM_ORBIT);
+	assert_near(a.b, -KEYMODE_ORBIT_DEG, 0);
+	km_sel two = {KM_SEL_OBJECT, 1};
+	assert_vec_near(keymode_map_model(KEYS_LEFT, s, two, 0.5).d, v3(8, 0, 0), 1e-12);
+	assert_int_equal(keymode_map_model(KEYS_SHIFT_UP, s, camera_sel, 0.5).op, KM_MOVE);
+	assert_vec_near(keymode_map_model(KEYS_SHIFT_UP, s, camera_sel, 0.5).d, keymode_map(KEYS_UP, s, camera_sel, 0.5).d, 0);
+	assert_int_equal(keymode_map_model('f', s, camera_sel, 0.5).op, KM_FRAME);
+	assert_int_equal(keymode_map_model('F', s, camera_sel, 0.5).op, KM_MOVE);
+	assert_int_equal(keymode_map_model('0', s, camera_sel, 0.5).op, KM_HOME);
+	assert_true(keymode_is_edit(KM_ORBIT));
+	/* Applied: the camera at (0,0,-10) goes to its left on the circle of
+	 * radius |(-1.25, 0, -10)| about the centre, by 5 degrees. */
+	editor *ed = editor_new(s, "k.rt");
+	assert_non_null(ed);
+	rt_error err;
+	a = keymode_map_model(KEYS_RIGHT, editor_scene(ed), camera_sel, 0.5);
+	assert_true(keymode_apply(ed, &a, &err));
+	camera c = scene_camera(editor_scene(ed));
+	double r = sqrt(1.25 * 1.25 + 100), az = atan2(-1.25, -10) + deg_to_rad(5);
+	assert_vec_near(c.pos, v3(1.25 + r * sin(az), 0, r * cos(az)), 1e-9);
+	/* it looked along +Z, not at the centre: its heading turns by the same
+	 * 5 degrees */
+	assert_vec_near(v3_norm(c.dir), v3(sin(deg_to_rad(5)), 0, cos(deg_to_rad(5))), 1e-9);
+	editor_free(ed);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -699,6 +741,7 @@ int main(void)
 		cmocka_unit_test(test_axis_euler),    cmocka_unit_test(test_apply),
 		cmocka_unit_test(test_turns),         cmocka_unit_test(test_session),
 		cmocka_unit_test(test_key_table),
+		cmocka_unit_test(test_model_keys),
 		cmocka_unit_test(test_undo_then_another_request),
 		cmocka_unit_test(test_late_keys),
 		cmocka_unit_test(test_path_denoised),

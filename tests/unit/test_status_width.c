@@ -8,7 +8,7 @@
 #include <locale.h>
 #include <wchar.h>
 
-#include "term/abuf.h"
+#include "base/abuf.h"
 #include "term/screen.h"
 
 /* The columns the text takes, by wcwidth, and whether it is valid UTF-8. */

@@ -1,6 +1,7 @@
-/* rtsh — an append buffer: a frame or a status line is built here and sent
- * with one write(). Allocation failure is sticky: the buffer is marked
- * failed, later appends do nothing and the caller drops the output. */
+/* rtsh — an append buffer (base layer): a frame, a status line or a file's
+ * text is built here and sent with one write(). Allocation failure is
+ * sticky: the buffer is marked failed, later appends do nothing and the
+ * caller drops the output. The text stays NUL-terminated. */
 #ifndef RTSH_ABUF_H
 #define RTSH_ABUF_H
 

@@ -1,5 +1,5 @@
 /* rtsh — the append buffer (abuf.h). */
-#include "term/abuf.h"
+#include "base/abuf.h"
 
 #include <errno.h>
 #include <stdarg.h>
