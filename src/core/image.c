@@ -86,6 +86,21 @@ static bool write_pfm(FILE *f, void *vctx, rt_error *err)
 	return ok || rt_error_at(err, c->path, 0, 0, "write failed");
 }
 
+/* libpng's errors end in our message, not on its own line on stderr (the
+ * error pointer is a char[160]); its warnings (none for what we write) are
+ * dropped. */
+static void png_error_kept(png_structp png, png_const_charp msg)
+{
+	snprintf(png_get_error_ptr(png), 160, "%s", msg);
+	png_longjmp(png, 1);
+}
+
+static void png_warning_dropped(png_structp png, png_const_charp msg)
+{
+	(void)png;
+	(void)msg;
+}
+
 static bool write_png(FILE *f, void *vctx, rt_error *err)
 {
 	image_ctx *c = vctx;
@@ -96,7 +111,8 @@ static bool write_png(FILE *f, void *vctx, rt_error *err)
 		free(rows);
 		return rt_error_at(err, c->path, 0, 0, "out of memory");
 	}
-	png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
+	char why[160] = "";
+	png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, why, png_error_kept, png_warning_dropped);
 	png_infop info = png ? png_create_info_struct(png) : NULL;
 	bool ok = false;
 	if (png && info && !setjmp(png_jmpbuf(png))) {
@@ -114,7 +130,11 @@ static bool write_png(FILE *f, void *vctx, rt_error *err)
 	png_destroy_write_struct(&png, &info);
 	free(rows);
 	free(px);
-	return ok || rt_error_at(err, c->path, 0, 0, "PNG encoding failed");
+	/* a failed write is named by the writer's errno (the caller checks
+	 * the file); libpng's own words otherwise */
+	if (!ok && ferror(f))
+		return rt_error_at(err, c->path, 0, 0, "write failed");
+	return ok || rt_error_at(err, c->path, 0, 0, "PNG encoding failed%s%s", why[0] ? ": " : "", why);
 }
 
 /* stb_image_write's output goes to the file; a failed write is kept. */

@@ -75,11 +75,25 @@ static void png_flush_none(png_structp png)
 	(void)png;
 }
 
+/* libpng must not print on the terminal the picture is drawn on: its
+ * errors only end the encode (false), its warnings are dropped. */
+static void png_error_silent(png_structp png, png_const_charp msg)
+{
+	(void)msg;
+	png_longjmp(png, 1);
+}
+
+static void png_warning_silent(png_structp png, png_const_charp msg)
+{
+	(void)png;
+	(void)msg;
+}
+
 bool pixels_png(abuf *out, const uint8_t *rgb, int w, int h)
 {
 	if (w < 1 || h < 1)
 		return false;
-	png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
+	png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, png_error_silent, png_warning_silent);
 	png_infop info = png ? png_create_info_struct(png) : NULL;
 	if (!info) {
 		png_destroy_write_struct(&png, NULL);
