@@ -222,14 +222,17 @@ static void km_start(keymode *km, bool refine)
 	const world *w = km_world(km);
 	if (!w)
 		return;
+	/* refinement goes to the preview's target (path mode's own when no
+	 * samples were chosen); a frame while keys arrive takes sh->set's */
+	render_settings set = refine ? shell_preview_settings(sh) : sh->set;
 	rsvc_request r = {
 		.world = w,
 		.gen = km->wgen,
-		.set = sh->set,
+		.set = set,
 		.w = km->kv.img_w,
 		.h = km->kv.img_h,
 	};
-	km_cur c = {.gen = km->wgen, .set = sh->set, .refine = refine, .w_px = km->kv.img_w, .h_px = km->kv.img_h};
+	km_cur c = {.gen = km->wgen, .set = set, .refine = refine, .w_px = km->kv.img_w, .h_px = km->kv.img_h};
 	if (refine) {
 		/* Goes on from the samples already in when only their number
 		 * changed. */
@@ -901,7 +904,7 @@ int keymode_tick(keymode *km)
 		km->want_refine = false;
 		/* A fast frame at full resolution with one sample is final. */
 		const km_cur *c = &km->cur;
-		bool final = c->seq != 0 && !c->refine && km->ratio_i == 0 && km->sh->set.samples == 1 &&
+		bool final = c->seq != 0 && !c->refine && km->ratio_i == 0 && shell_preview_settings(km->sh).samples == 1 &&
 		             c->gen == editor_generation(km->sh->ed) && c->set.mode == km->sh->set.mode &&
 		             c->set.depth == km->sh->set.depth && c->w_px == km->kv.img_w && c->h_px == km->kv.img_h;
 		if (final)

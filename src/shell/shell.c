@@ -245,6 +245,14 @@ static bool samples_chosen(const shell *sh)
 	return editor_scene(sh->ed)->hints.samples > 0;
 }
 
+render_settings shell_preview_settings(const shell *sh)
+{
+	render_settings pset = sh->set;
+	if (pset.mode == MODE_PATH && pset.samples < PREVIEW_PATH_SAMPLES && !samples_chosen(sh))
+		pset.samples = PREVIEW_PATH_SAMPLES; /* the preview's own target (the status line says so) */
+	return pset;
+}
+
 void shell_refresh(shell *sh)
 {
 	if (!sh->scr || !sh->scr->active) {
@@ -266,9 +274,7 @@ void shell_refresh(shell *sh)
 	}
 	/* A quick pass, then passes of PREVIEW_PASS_SECONDS; path previews are
 	 * denoised unless `set denoise off`. */
-	render_settings pset = sh->set;
-	if (pset.mode == MODE_PATH && pset.samples < PREVIEW_PATH_SAMPLES && !samples_chosen(sh))
-		pset.samples = PREVIEW_PATH_SAMPLES; /* the preview's own target (the status line says so) */
+	render_settings pset = shell_preview_settings(sh);
 	rsvc_request req = {
 		.s = editor_scene(sh->ed),
 		.gen = editor_generation(sh->ed),

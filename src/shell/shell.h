@@ -119,6 +119,10 @@ void shell_edit_begin(shell *sh);
 void shell_edit_end(shell *sh);
 /* Restarts the preview for the current scene, settings and screen size. */
 void shell_refresh(shell *sh);
+/* The settings a preview refines with: the shell's, with path mode's own
+ * target of samples (PREVIEW_PATH_SAMPLES) when nobody chose any. The
+ * shell's preview and key mode's refinement both use it. */
+render_settings shell_preview_settings(const shell *sh);
 /* Says once, in the status line, that kitty or iTerm2 images asked for in
  * tmux fell back to half blocks. */
 void shell_pixels_notice(shell *sh);
