@@ -531,6 +531,12 @@ static void test_path_denoised(void **state)
 	session_open(&ss);
 	ss.sh.set.samples = 4;
 	ss.sh.set.depth = 3;
+	/* chosen, as `set samples 4` marks them (else path mode refines to
+	 * the preview's own 64) */
+	rt_error err;
+	const setting_def *def = settings_find("samples", &err);
+	assert_non_null(def);
+	ss.sh.hand_set |= 1u << (def - settings_table);
 	run_for(&ss, 0.2);
 	keymode_key(ss.km, 'm');
 	assert_int_equal(ss.sh.set.mode, MODE_PATH);
