@@ -10,6 +10,7 @@
 
 #include "integrators.h"
 #include "rtsh/denoise.h"
+#include "rtsh/srgb.h"
 #include "rtsh/texture.h"
 
 const char *render_mode_name(render_mode m)
@@ -89,6 +90,7 @@ void fb_free(framebuffer *fb)
 	free(fb->rgb);
 	free(fb->sum);
 	free(fb->feat);
+	free(fb->srgb8);
 	free(fb);
 }
 
@@ -196,6 +198,9 @@ static void render_tile(shared *sh, long t)
 			fb->rgb[i] = (float)(acc[0] * inv);
 			fb->rgb[i + 1] = (float)(acc[1] * inv);
 			fb->rgb[i + 2] = (float)(acc[2] * inv);
+			if (fb->srgb8) /* the expression of image.c's encoder: the same codes */
+				for (int c = 0; c < 3; c++)
+					fb->srgb8[i + c] = linear_to_srgb8(fb->rgb[i + c] * fb->srgb8_gain);
 		}
 }
 
@@ -341,8 +346,8 @@ render_status render_run(render_job *job, rt_error *err)
 	return RENDER_DONE;
 }
 
-framebuffer *render_image(const world *w, const render_settings *s, atomic_bool *cancel,
-                          render_progress_fn progress, void *ctx, rt_error *err)
+static framebuffer *render_image_with(const world *w, const render_settings *s, atomic_bool *cancel,
+                                      render_progress_fn progress, void *ctx, bool srgb8, rt_error *err)
 {
 	framebuffer *fb = fb_new(s->width, s->height);
 	if (!fb) {
@@ -359,6 +364,11 @@ framebuffer *render_image(const world *w, const render_settings *s, atomic_bool 
 		             s->width, s->height);
 		fb_free(fb);
 		return NULL;
+	}
+	if (srgb8 && !denoise) {
+		/* no zeroing: every tile writes its codes (a failed render frees them) */
+		fb->srgb8 = malloc((size_t)fb->w * (size_t)fb->h * 3);
+		fb->srgb8_gain = exp2(s->exposure);
 	}
 	render_job job = {
 		.w = w,
@@ -383,4 +393,16 @@ framebuffer *render_image(const world *w, const render_settings *s, atomic_bool 
 		return NULL;
 	}
 	return fb;
+}
+
+framebuffer *render_image(const world *w, const render_settings *s, atomic_bool *cancel,
+                          render_progress_fn progress, void *ctx, rt_error *err)
+{
+	return render_image_with(w, s, cancel, progress, ctx, false, err);
+}
+
+framebuffer *render_image_srgb8(const world *w, const render_settings *s, atomic_bool *cancel,
+                                render_progress_fn progress, void *ctx, rt_error *err)
+{
+	return render_image_with(w, s, cancel, progress, ctx, true, err);
 }
