@@ -167,6 +167,17 @@ static void pixel_add(const world *w, const render_settings *s, int x, int y, in
 		denoise_features(w, s, x, y, fw, fh, s0, s1, ra, fa, feat);
 }
 
+/* The 8-bit codes of a finished tile (framebuffer.srgb8), by the expression
+ * of image.c's encoder: the same codes it would make. */
+static void tile_srgb8(framebuffer *fb, int x0, int y0, int x1, int y1)
+{
+	for (int y = y0; y < y1; y++) {
+		size_t i0 = ((size_t)y * (size_t)fb->w + (size_t)x0) * 3, i1 = i0 + (size_t)(x1 - x0) * 3;
+		for (size_t i = i0; i < i1; i++)
+			fb->srgb8[i] = linear_to_srgb8(fb->rgb[i] * fb->srgb8_gain);
+	}
+}
+
 static void render_tile(shared *sh, long t)
 {
 	render_job *job = sh->job;
@@ -198,10 +209,9 @@ static void render_tile(shared *sh, long t)
 			fb->rgb[i] = (float)(acc[0] * inv);
 			fb->rgb[i + 1] = (float)(acc[1] * inv);
 			fb->rgb[i + 2] = (float)(acc[2] * inv);
-			if (fb->srgb8) /* the expression of image.c's encoder: the same codes */
-				for (int c = 0; c < 3; c++)
-					fb->srgb8[i + c] = linear_to_srgb8(fb->rgb[i + c] * fb->srgb8_gain);
 		}
+	if (fb->srgb8)
+		tile_srgb8(fb, x0, y0, x1, y1);
 }
 
 void render_rect(const world *w, const render_settings *s, int x0, int y0, int x1, int y1,
