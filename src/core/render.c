@@ -160,7 +160,7 @@ static void pixel_add(const world *w, const render_settings *s, int x, int y, in
 		if (feat) {
 			denoise_radiance(c, k, ra);
 			if (k < DENOISE_FEATURE_SAMPLES) /* what this sample's ray first sees */
-				denoise_sample(w, render_sample_ray(w, s, x, y, fw, fh, k), fa);
+				denoise_sample(w, render_sample_ray(w, s, x, y, fw, fh, k), k, fa);
 		}
 	}
 	if (feat)
