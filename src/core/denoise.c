@@ -100,7 +100,7 @@ static double direct_feature(const world *w, const bsdf *b, vec3 p, uint32_t sel
  * surface seen in it, the albedo tinted by the mirror's or the glass's
  * colour, the depth the length of the whole path. Glass is followed along the refracted ray unless the
  * reflection is total. */
-static void first_surface(const world *w, ray r, double f[8])
+static void first_surface(const world *w, ray r, bool direct, double f[8])
 {
 	vec3 tint = v3(1, 1, 1);
 	uint64_t bits[2];
@@ -140,11 +140,11 @@ static void first_surface(const world *w, ray r, double f[8])
 			f[4] += b.n.y;
 			f[5] += b.n.z;
 			f[6] += dist;
-			if (!(e.x + e.y + e.z > 0.0))
+			if (direct && !(e.x + e.y + e.z > 0.0))
 				f[7] += direct_feature(w, &b, offset_point(w, h.p, b.n), h.object, r1, r2) * lum_d(tint);
 			return;
 		}
-		if (b.smooth) /* a glossy lobe looked through: its own highlights */
+		if (direct && b.smooth) /* a glossy lobe looked through: its own highlights */
 			f[7] += direct_feature(w, &b, offset_point(w, h.p, b.n), h.object, r1, r2) * lum_d(tint);
 		tint = v3_mul(tint, tt);
 		if (follow == 1)
@@ -166,7 +166,7 @@ static inline double albedo_divisor(double a)
 void denoise_sample(const world *w, ray r, int k, double *acc)
 {
 	double f[8] = {0};
-	first_surface(w, r, f);
+	first_surface(w, r, true, f);
 	for (int q = 0; q < 8; q++)
 		acc[q] += f[q];
 	acc[8] += f[0] * f[0] + f[1] * f[1] + f[2] * f[2];
@@ -217,14 +217,14 @@ void denoise_features(const world *w, const render_settings *s, int px, int py, 
 	}
 	if (n1 < DENOISE_FEATURE_SAMPLES || !features_vary(f))
 		return;
-	/* An edge: more camera positions, the radiance samples' own. */
+	/* An edge: more camera positions, the radiance samples' own (the
+	 * direct light stays the mean of the first ones). */
 	double sum[10];
 	for (int k = 0; k < 10; k++)
 		sum[k] = (double)f[k] * n1;
-	sum[7] = (double)f[14] * n1;
 	for (int k = n1; k < DENOISE_EDGE_SAMPLES; k++) {
 		double one[8] = {0};
-		first_surface(w, render_sample_ray(w, s, px, py, fw, fh, k), one);
+		first_surface(w, render_sample_ray(w, s, px, py, fw, fh, k), false, one);
 		for (int q = 0; q < 8; q++)
 			sum[q] += one[q];
 		sum[8] += one[0] * one[0] + one[1] * one[1] + one[2] * one[2];
@@ -233,7 +233,6 @@ void denoise_features(const world *w, const render_settings *s, int px, int py, 
 	for (int k = 0; k < 10; k++)
 		if (k != 7)
 			f[k] = (float)(sum[k] / DENOISE_EDGE_SAMPLES);
-	f[14] = (float)(sum[7] / DENOISE_EDGE_SAMPLES);
 }
 
 /* --- the filter ------------------------------------------------------------ */
@@ -574,30 +573,58 @@ static void regression_rows(job *j, int y0, int y1)
 					nt++;
 				}
 			}
-			/* The normal equations, row by row, so that a row's sums stay
-			 * in registers; the lower triangle is what solve reads. */
-			float m[NU][MIX_NU], rhs[NU][NRHS], beta[NU][NRHS];
-			for (int r = 0; r < NU; r++) {
-				v4 s[4] = {{0}};
-				for (int t = 0; t < nt; t++) {
-					v4 wv = v4_splat(tw[t] * tv[t][r]);
-					s[0] += wv * v4_load(tv[t]);
-					s[1] += wv * v4_load(tv[t] + 4);
-					s[2] += wv * v4_load(td[t]);
-					s[3] += wv * v4_load(td[t] + 4);
-				}
-				float row[16];
-				memcpy(row, s, sizeof row);
-				memcpy(m[r], row, sizeof m[r]);
-				memcpy(rhs[r], row + 8, sizeof rhs[r]);
+			/* The normal equations in one pass over the taps, their lower
+			 * triangle (what solve reads) in twelve registers. */
+			v4 a[12] = {{0}};
+			for (int t = 0; t < nt; t++) {
+				v4 v0 = v4_load(tv[t]), v1 = v4_load(tv[t] + 4);
+				v4 w0 = v4_splat(tw[t]) * v0, w1 = v4_splat(tw[t]) * v1;
+				a[0] += v4_splat(w0[0]) * v0;
+				a[1] += v4_splat(w0[1]) * v0;
+				a[2] += v4_splat(w0[2]) * v0;
+				a[3] += v4_splat(w0[3]) * v0;
+				a[4] += v4_splat(w1[0]) * v0;
+				a[5] += v4_splat(w1[0]) * v1;
+				a[6] += v4_splat(w1[1]) * v0;
+				a[7] += v4_splat(w1[1]) * v1;
+				a[8] += v4_splat(w1[2]) * v0;
+				a[9] += v4_splat(w1[2]) * v1;
+				a[10] += v4_splat(w1[3]) * v0;
+				a[11] += v4_splat(w1[3]) * v1;
+			}
+			float m[NU][MIX_NU], e0[NU][NRHS] = {{1.0f}}, z[NU][NRHS];
+			for (int r = 0; r < 4; r++)
+				memcpy(m[r], &a[r], sizeof a[r]);
+			for (int r = 4; r < NU; r++) {
+				memcpy(m[r], &a[4 + 2 * (r - 4)], sizeof a[0]);
+				memcpy(m[r] + 4, &a[5 + 2 * (r - 4)], sizeof a[0]);
 			}
 			float ridge = m[0][0] * RIDGE;
 			for (int r = 1; r < NU; r++)
 				m[r][r] += ridge;
+			/* The fit at the pixel is sum_t h_t y_t, with h_t the tap's
+			 * weight times z . (its regressors), M z = (1, 0, ..., 0): one
+			 * solve for all the right-hand sides. */
+			bool ok = solve(NU, m, 1, e0, z);
+			float beta[1][NRHS];
+			if (ok) {
+				v4 z0 = {z[0][0], z[1][0], z[2][0], z[3][0]}, z1 = {z[4][0], z[5][0], z[6][0], z[7][0]};
+				v4 f0 = {0}, f1 = {0};
+				for (int t = 0; t < nt; t++) {
+					v4 p = z0 * v4_load(tv[t]) + z1 * v4_load(tv[t] + 4);
+					v4 hv = v4_splat(tw[t] * (p[0] + p[1] + p[2] + p[3]));
+					f0 += hv * v4_load(td[t]);
+					f1 += hv * v4_load(td[t] + 4);
+				}
+				float fs[8];
+				memcpy(fs, &f0, sizeof f0);
+				memcpy(fs + 4, &f1, sizeof f1);
+				memcpy(beta[0], fs, sizeof beta[0]);
+			}
 			const chan *r0 = j->t[i].h;
 			float am = lum(j->am + i * 3), am2 = am * am;
 			float *fit = j->fit + i * 3, *err = j->err + i * NCAND;
-			if (!solve(NU, m, j->halves ? NRHS : 3, rhs, beta)) {
+			if (!ok) {
 				memcpy(fit, r0[CH_ALL].c, sizeof r0[CH_ALL].c);
 				err[CAND_RAW] = 0.0f; /* the raw pixel */
 				err[CAND_FIT] = INFINITY;
