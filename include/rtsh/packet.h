@@ -1,6 +1,6 @@
 /* rtsh — coherent rays traced together (issue 29): camera rays and shadow
  * rays toward a point light, up to PACKET_MAX at a time, through the
- * world's object tree (src/core/bvh/packet.c).
+ * world's object tree (src/core/packet.c).
  *
  * The packet walks the tree once for all its rays: an interval test
  * (the rays' origins and inverse directions as intervals, Wald et al.,

@@ -1,5 +1,5 @@
 /* rtsh — the primitive tests that the single-ray walk (world.c) and the
- * packet walk (bvh/packet.c) share, so that both give the same bits, and
+ * packet walk (packet.c) share, so that both give the same bits, and
  * the roundings of a double to the floats the tree's slab tests use.
  * Private to src/core. */
 #ifndef RTSH_PRIM_HIT_H
