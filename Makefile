@@ -174,11 +174,11 @@ test-unit: $(BIN) $(TEST_BIN)
 test-scripts: $(BIN)
 	@sh tests/run-scripts.sh ./$(BIN)
 
-$(EMBREE_BIN): bench/embree_primary.c $(LIB)
+$(EMBREE_BIN): bench/embree_primary.c bench/embree_packets.h $(LIB)
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -o $@ $< $(LIB) -lembree3 $(LDLIBS_CORE)
 
-$(EMBREE_MESH_BIN): bench/embree_mesh.c bench/mesh_rays.h $(LIB)
+$(EMBREE_MESH_BIN): bench/embree_mesh.c bench/mesh_rays.h bench/embree_packets.h $(LIB)
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -o $@ $< $(LIB) -lembree3 $(LDLIBS_CORE)
 

@@ -233,9 +233,29 @@ static double run_rtsh(const char *scene_path, int w, int h, int threads)
 	return rc == 0 ? t : -1;
 }
 
-/* Runs the Embree harness once; Mrays/s of its timed pass, < 0 if absent. */
-static double run_embree(const char *scene_path, int w, int h, double *seconds)
+/* Embree's packet calls in the harnesses' output (bench/embree_packets.h):
+ * "packet N mrays M seconds S" for N = 4, 8, 16 into mr[k], sec[k], k = 0..2. */
+#define EMBREE_PACKETS 3
+static const char *const packet_tiles[EMBREE_PACKETS] = {"2x2", "2x4", "4x4"};
+
+static void parse_packet(const char *line, double mr[EMBREE_PACKETS], double sec[EMBREE_PACKETS])
 {
+	int n;
+	double m, s;
+	if (sscanf(line, "packet %d mrays %lf seconds %lf", &n, &m, &s) == 3 && (n == 4 || n == 8 || n == 16)) {
+		int k = n == 4 ? 0 : n == 8 ? 1 : 2;
+		mr[k] = m;
+		sec[k] = s;
+	}
+}
+
+/* Runs the Embree harness once; Mrays/s of its timed pass, < 0 if absent;
+ * its packet rows into pm, ps (-1 when missing). */
+static double run_embree(const char *scene_path, int w, int h, double *seconds, double pm[EMBREE_PACKETS],
+                         double ps[EMBREE_PACKETS])
+{
+	for (int k = 0; k < EMBREE_PACKETS; k++)
+		pm[k] = ps[k] = -1;
 	char exe[512], cmd[1200];
 	snprintf(exe, sizeof exe, "%s/embree_primary", bench_dir);
 	if (access(exe, X_OK) != 0)
@@ -252,6 +272,7 @@ static double run_embree(const char *scene_path, int w, int h, double *seconds)
 			mrays = m;
 			*seconds = s;
 		}
+		parse_packet(line, pm, ps);
 	}
 	return pclose(p) == 0 ? mrays : -1;
 }
@@ -346,16 +367,23 @@ static void bench_primary(void)
 	scene *s = load(path);
 	world *wd = build(s);
 	double t[MAX_RUNS], tb[MAX_RUNS], te[MAX_RUNS], em[MAX_RUNS];
-	int ne = 0;
+	double pkm[EMBREE_PACKETS][MAX_RUNS], pks[EMBREE_PACKETS][MAX_RUNS];
+	int ne = 0, npk[EMBREE_PACKETS] = {0};
 	long hits;
 	primary_pass(wd, w, h, false, &hits); /* warm up */
 	for (int i = 0; i < runs; i++) {
 		t[i] = primary_pass(wd, w, h, false, &hits);
 		tb[i] = primary_pass(wd, w, h, true, &hits);
-		double sec = 0, m = quick ? -1 : run_embree(path, w, h, &sec);
+		double sec = 0, pm[EMBREE_PACKETS], ps[EMBREE_PACKETS];
+		double m = quick ? -1 : run_embree(path, w, h, &sec, pm, ps);
 		if (m > 0) {
 			em[ne] = m;
 			te[ne++] = sec;
+			for (int k = 0; k < EMBREE_PACKETS; k++)
+				if (pm[k] > 0) {
+					pkm[k][npk[k]] = pm[k];
+					pks[k][npk[k]++] = ps[k];
+				}
 		}
 	}
 	double rays = (double)w * h * 1e-6;
@@ -368,6 +396,16 @@ static void bench_primary(void)
 		double me = median(em, ne), se = median(te, ne);
 		r = add_row("grid.rt", "embree-primary", w, h, 1, 1, ne, se, me);
 		snprintf(r->note, sizeof r->note, "Embree 3 rtcIntersect1; rtsh %.2fx Embree", (rays / m) / me);
+		for (int k = 0; k < EMBREE_PACKETS; k++) {
+			if (!npk[k])
+				continue;
+			char mode[32];
+			snprintf(mode, sizeof mode, "embree-packet%d", 4 << k);
+			double pm = median(pkm[k], npk[k]), ps = median(pks[k], npk[k]);
+			r = add_row("grid.rt", mode, w, h, 1, 1, npk[k], ps, pm);
+			snprintf(r->note, sizeof r->note, "rtcIntersect%d, %s-pixel tiles, coherent flag; rtsh primary %.2fx",
+			         4 << k, packet_tiles[k], (rays / m) / pm);
+		}
 	} else if (!quick) {
 		r = add_row("grid.rt", "embree-primary", w, h, 1, 1, 0, -1, -1);
 		snprintf(r->note, sizeof r->note, "no %s/embree_primary (needs embree3/rtcore.h)", bench_dir);
@@ -998,8 +1036,10 @@ static void bench_keymode(void)
 
 /* Runs the Embree mesh harness once: 0 on success. */
 static int run_embree_mesh(const char *model, int w, int h, double *build, double *bytes, double *primary,
-                           double *sec)
+                           double *sec, double pm[EMBREE_PACKETS], double ps[EMBREE_PACKETS])
 {
+	for (int k = 0; k < EMBREE_PACKETS; k++)
+		pm[k] = ps[k] = -1;
 	char exe[512], cmd[1400];
 	snprintf(exe, sizeof exe, "%s/embree_mesh", bench_dir);
 	if (access(exe, X_OK) != 0)
@@ -1015,6 +1055,7 @@ static int run_embree_mesh(const char *model, int w, int h, double *build, doubl
 		if (sscanf(line, "build %lf bytes %lf primary %lf hits %ld secondary %lf", build, bytes, primary, &hits,
 		           sec) == 5)
 			got = 1;
+		parse_packet(line, pm, ps);
 	}
 	return pclose(p) == 0 && got ? 0 : -1;
 }
@@ -1131,7 +1172,8 @@ static void bench_mesh(void)
 	double tp[MAX_RUNS], ts[MAX_RUNS], tpk[MAX_RUNS], tpu[MAX_RUNS], tsk[MAX_RUNS], be[MAX_RUNS], byte_e = -1, pe[MAX_RUNS],
 	    se[MAX_RUNS];
 	double sink = 0; /* the kernel rows' normals, so that none is left out */
-	int ne = 0;
+	int ne = 0, npk[EMBREE_PACKETS] = {0};
+	double pkm[EMBREE_PACKETS][MAX_RUNS], pks[EMBREE_PACKETS][MAX_RUNS];
 	ray *sr = malloc((size_t)w * h * sizeof *sr);
 	if (!sr)
 		fail("secondary rays", NULL);
@@ -1169,8 +1211,13 @@ static void bench_mesh(void)
 				sink += world_trace_ng(wd, &sr[k], &th).x;
 		}
 		tsk[i] = cpu_now() - t0;
-		double eb, ebytes, ep, es;
-		if (!quick && run_embree_mesh(BUNNY, w, h, &eb, &ebytes, &ep, &es) == 0) {
+		double eb, ebytes, ep, es, pm[EMBREE_PACKETS], ps[EMBREE_PACKETS];
+		if (!quick && run_embree_mesh(BUNNY, w, h, &eb, &ebytes, &ep, &es, pm, ps) == 0) {
+			for (int k = 0; k < EMBREE_PACKETS; k++)
+				if (pm[k] > 0) {
+					pkm[k][npk[k]] = pm[k];
+					pks[k][npk[k]++] = ps[k];
+				}
 			be[ne] = eb;
 			pe[ne] = ep;
 			se[ne++] = es;
@@ -1210,6 +1257,17 @@ static void bench_mesh(void)
 	r = add_row("bunny 69k tris", "tri-diffuse-hit", w, h, 1, 1, runs, ms, mrs);
 	if (ne)
 		snprintf(r->note, sizeof r->note, "CPU time; world_intersect (with the hit record): %.2fx Embree", mrs / es);
+	for (int k = 0; k < EMBREE_PACKETS; k++) {
+		if (!npk[k])
+			continue;
+		char mode[32];
+		snprintf(mode, sizeof mode, "embree-packet%d", 4 << k);
+		double pm = median(pkm[k], npk[k]), ps = median(pks[k], npk[k]);
+		r = add_row("bunny 69k tris", mode, w, h, 1, 1, npk[k], ps, pm);
+		snprintf(r->note, sizeof r->note,
+		         "rtcIntersect%d, %s-pixel tiles, coherent flag (CPU time); rtsh tri-primary %.2fx, rtcIntersect1 %.2f",
+		         4 << k, packet_tiles[k], mrpk / pm, ep);
+	}
 	if (!ne && !quick) {
 		r = add_row("bunny 69k tris", "embree-mesh", 0, 0, 0, 1, 0, -1, -1);
 		snprintf(r->note, sizeof r->note, "no %s/embree_mesh (needs embree3/rtcore.h)", bench_dir);
