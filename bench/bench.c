@@ -414,6 +414,28 @@ static void bench_primary(void)
 	scene_free(s);
 }
 
+/* Embree 3's build of the spheres-N scene (bench/embree_build): seconds, or
+ * < 0 when the harness is absent or fails; its bytes in *bytes. */
+static double run_embree_build(size_t n, double *bytes)
+{
+	char exe[512], cmd[1200];
+	snprintf(exe, sizeof exe, "%s/embree_build", bench_dir);
+	if (access(exe, X_OK) != 0)
+		return -1;
+	snprintf(cmd, sizeof cmd, "%s %zu 2>&1", exe, n);
+	FILE *p = popen(cmd, "r");
+	if (!p)
+		return -1;
+	char line[256];
+	double t = -1;
+	while (fgets(line, sizeof line, p))
+		if (sscanf(line, "build %lf bytes %lf", &t, bytes) == 2)
+			break;
+	while (fgets(line, sizeof line, p))
+		;
+	return pclose(p) == 0 ? t : -1;
+}
+
 static void bench_spheres(void)
 {
 	static const size_t full[] = {10, 1000, 100000, 1000000};
@@ -448,6 +470,16 @@ static void bench_spheres(void)
 		snprintf(r->note, sizeof r->note, "%zu B/object: model %zu + world %zu; %zu BVH nodes", 
 		         (s->nobjs * sizeof(object) + world_memory(wd)) / s->nobjs, sizeof(object),
 		         world_memory(wd) / s->nobjs, wd->tree->nnodes);
+		/* Embree's build of the same spheres, right after rtsh's (the
+		 * harness takes the median of its own three builds) */
+		double ebytes = 0, eb = quick ? -1 : run_embree_build(n, &ebytes);
+		if (eb > 0) {
+			r = add_row(name, "embree-build", -1, -1, 0, 1, 3, eb, -1);
+			snprintf(r->note, sizeof r->note,
+			         "Embree 3 spheres, default (medium) quality, 1 thread: rtsh world_build %.2fx its time; "
+			         "%.0f B/sphere",
+			         median(tb, bruns) / eb, ebytes / (double)n);
+		}
 		render_settings set1 = settings(w, h, 1), set2 = settings(w, h, 2);
 		uint64_t rays = count_rays(wd, set1, fb);
 		double t1[MAX_RUNS], t2[MAX_RUNS];
