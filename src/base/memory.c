@@ -5,6 +5,7 @@
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <sys/mman.h>
 #include <sys/resource.h>
 #include <unistd.h>
@@ -128,4 +129,14 @@ void mem_huge_pages(void *p, size_t bytes)
 	(void)p;
 	(void)bytes;
 #endif
+}
+
+char *mem_dupz(const void *p, size_t n)
+{
+	char *d = malloc(n + 1);
+	if (d) {
+		memcpy(d, p, n);
+		d[n] = '\0';
+	}
+	return d;
 }
