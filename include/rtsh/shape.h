@@ -70,9 +70,13 @@ typedef struct shape_kind {
 	bool (*occluded)(vec3 o, vec3 d, double tube, double tmin, double tmax);
 	/* The object-space bounds (within [-1,1]^3; infinite when unbounded). */
 	box (*bounds)(double tube);
-	/* The surface parameterisation textures use, at an object-space point
-	 * p of the surface: u, v in [0,1] and the unit tangent along u. */
-	void (*uv)(vec3 p, double tube, double *u, double *v, vec3 *tangent);
+	/* The texture coordinates (rtsh(5), "Texture coordinates") at the
+	 * object-space point q of the surface, whose object-space normal there
+	 * is nl (as intersect gave it, not normalised): u and v before uvscale
+	 * and uvoffset, and the object-space tangents dq/du and dq/dv (normal
+	 * and bump maps). NULL: the disc's planar u = (x + 1) / 2, v = (z + 1) / 2
+	 * (uv_planar). */
+	void (*uv)(vec3 q, vec3 nl, double tube, double *u, double *v, vec3 *dqdu, vec3 *dqdv);
 	/* Traced in world space from its centre and radius when its scale is
 	 * uniform with no shear or texture (the sphere). */
 	bool world_sphere;
@@ -94,6 +98,10 @@ const shape_kind *shape_kind_of(obj_kind k);
 /* The kind whose form (or alias) has the identifier id, and that form;
  * NULL if none. */
 const shape_kind *shape_kind_find(const char *id, obj_kind *k, const shape_form **form);
+
+/* The texture coordinates of kind k at the object-space point q with the
+ * object-space normal nl: its uv, or the planar ones when it has none. */
+void shape_uv(obj_kind k, vec3 q, vec3 nl, double tube, double *u, double *v, vec3 *dqdu, vec3 *dqdv);
 
 /* The unit shape's object-space bounds (all of them fit [-1,1]^3). */
 box shape_local_bounds(obj_kind k, double tube);

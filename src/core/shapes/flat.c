@@ -65,7 +65,7 @@ const shape_kind disc_kind = {
 	.intersect = disc_intersect,
 	.occluded = disc_occluded,
 	.bounds = unit_flat_bounds,
-	.uv = uv_flat,
+	.uv = uv_planar,
 	.cost = 8,
 	.recipe = {true, {50, -1, 0}, {100, 0, 0}, 0, 0},
 };
@@ -77,7 +77,7 @@ const shape_kind rect_kind = {
 	.intersect = rect_intersect,
 	.occluded = rect_occluded,
 	.bounds = unit_flat_bounds,
-	.uv = uv_flat,
+	.uv = uv_planar,
 	.cost = 8,
 	.recipe = {true, {50, -1, 50}, {120, 0, 120}, 0, 0},
 };

@@ -13,11 +13,13 @@ box unit_cube_bounds(double tube);
 /* The square [-1,1] x {0} x [-1,1] (flat shapes). */
 box unit_flat_bounds(double tube);
 
-/* The angle about +Y of p as u in [0,1) (0 on +X, a quarter on +Z), and the
- * unit tangent along it ((1,0,0) on the axis). */
-double around_y(vec3 p, vec3 *tangent);
-/* u = (x+1)/2, v = (z+1)/2, tangent +X: flat shapes and caps. */
-void uv_flat(vec3 p, double tube, double *u, double *v, vec3 *tangent);
+/* Texture coordinates (shape_kind.uv). The planar u = (x + 1) / 2,
+ * v = (z + 1) / 2: the disc, the rectangle, the caps (and kinds with no uv
+ * of their own). */
+void uv_planar(vec3 q, vec3 nl, double tube, double *u, double *v, vec3 *dqdu, vec3 *dqdv);
+/* The cylinder's and cone's: around the side the sphere's u and
+ * v = (y + 1) / 2, the caps planar. */
+void uv_capped_side(vec3 q, vec3 nl, double tube, double *u, double *v, vec3 *dqdu, vec3 *dqdv);
 
 /* The short-form reader and writer of kinds sized by one number in every
  * direction (the sphere: DIAMETER; scale = that x 3). */

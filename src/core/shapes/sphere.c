@@ -24,12 +24,19 @@ static bool sphere_occluded(vec3 o, vec3 d, double tube, double tmin, double tma
 	return (t0 > tmin && t0 < tmax) || (t1 > tmin && t1 < tmax);
 }
 
-static void sphere_uv(vec3 p, double tube, double *u, double *v, vec3 *tangent)
+/* Equirectangular: u = 1/2 + atan2(x, -z) / 2pi, v = 1/2 + asin(y) / pi (the
+ * image's middle column faces -Z, where the default camera is; north is +Y). */
+static void sphere_uv(vec3 q, vec3 nl, double tube, double *u, double *v, vec3 *dqdu, vec3 *dqdv)
 {
+	(void)nl;
 	(void)tube;
-	*u = around_y(p, tangent);
-	double l = v3_len(p);
-	*v = l > 0.0 ? 0.5 + asin(clampd(p.y / l, -1.0, 1.0)) / RT_PI : 0.5;
+	double len = v3_len(q);
+	vec3 s = len > 0 ? v3_scale(q, 1.0 / len) : v3(0, 1, 0);
+	double c = sqrt(s.x * s.x + s.z * s.z);
+	*u = 0.5 + atan2(s.x, -s.z) / (2 * M_PI);
+	*v = 0.5 + asin(clampd(s.y, -1, 1)) / M_PI;
+	*dqdu = v3_scale(v3(-q.z, 0, q.x), 2 * M_PI);
+	*dqdv = c > 0 ? v3_scale(v3(-s.x * s.y / c, c, -s.z * s.y / c), M_PI * len) : v3(0, 0, 0);
 }
 
 const shape_kind sphere_kind = {

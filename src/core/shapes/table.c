@@ -51,6 +51,12 @@ const shape_kind mesh_kind = {
 	.recipe = {.use = false},
 };
 
+void shape_uv(obj_kind k, vec3 q, vec3 nl, double tube, double *u, double *v, vec3 *dqdu, vec3 *dqdv)
+{
+	const shape_kind *d = shape_kind_of(k);
+	(d && d->uv ? d->uv : uv_planar)(q, nl, tube, u, v, dqdu, dqdv);
+}
+
 box shape_local_bounds(obj_kind k, double tube)
 {
 	return shape_kinds[k]->bounds(tube);
