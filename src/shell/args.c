@@ -99,7 +99,7 @@ void args_usage(FILE *f, args_kind kind, const char *prog)
 			snprintf(left, sizeof left, "-%c, --%s=VALUE", c, settings_table[i].name);
 		else
 			snprintf(left, sizeof left, "    --%s%s", settings_table[i].name,
-			         settings_table[i].type == SETTING_DENOISE ? "[=VALUE]" : "=VALUE");
+			         (settings_table[i].flags & SETTING_BARE_ON) ? "[=VALUE]" : "=VALUE");
 		fprintf(f, "  %-28s %s\n", left, settings_table[i].help);
 	}
 	if (kind == ARGS_RTSH)
@@ -196,7 +196,7 @@ int args_parse(int argc, char **argv, args_kind kind, const char *prog, rtsh_opt
 	for (size_t i = 0; i < settings_count; i++)
 		longs[n++] = (struct option){settings_table[i].name,
 		                             /* --denoise alone means on */
-		                             settings_table[i].type == SETTING_DENOISE ? optional_argument
+		                             (settings_table[i].flags & SETTING_BARE_ON) ? optional_argument
 		                                                                       : required_argument,
 		                             NULL, OPT_SETTING + (int)i};
 	/* '-': operands come back in order as option 1 (so options may follow
