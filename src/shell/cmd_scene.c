@@ -101,7 +101,7 @@ bool cmd_save(shell *sh, int argc, char **argv, const char *rest)
 			abuf_free(&a);
 			frame_free(f);
 		}
-	} else if (image_format_of(path) != IMAGE_UNKNOWN) {
+	} else if (image_type_of(path)) {
 		const framebuffer *fb = shell_full_image(sh, false);
 		if (!fb)
 			ok = false;
