@@ -92,7 +92,10 @@ static int batch_render(const rtsh_options *o)
 	batch_progress ps = {.w = set.width, .h = set.height, .samples = set.samples, .shown = false};
 	clock_gettime(CLOCK_MONOTONIC, &ps.start);
 	bool bar = !o->quiet && isatty(STDERR_FILENO);
-	framebuffer *fb = render_image(w, &set, NULL, bar ? show_progress : NULL, &ps, &err);
+	/* the 8-bit codes are made by the render's threads as tiles finish */
+	bool eight = image_format_of(o->output) != IMAGE_PFM;
+	framebuffer *fb = (eight ? render_image_srgb8 : render_image)(w, &set, NULL, bar ? show_progress : NULL,
+	                                                               &ps, &err);
 	world_free(w);
 	if (ps.shown)
 		fputc('\n', stderr);

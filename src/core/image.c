@@ -31,28 +31,36 @@ typedef struct image_ctx {
 	const char *path;
 } image_ctx;
 
-static uint8_t *encode_rows(const image_ctx *c)
+/* The 8-bit codes of the image: the framebuffer's own when its render wrote
+ * them with this gain (render.h), else a new array (*owned set). */
+static uint8_t *encode_rows(const image_ctx *c, bool *owned)
 {
 	const framebuffer *fb = c->fb;
+	*owned = false;
+	if (fb->srgb8 && fb->srgb8_gain == c->gain)
+		return fb->srgb8;
 	size_t n = (size_t)fb->w * (size_t)fb->h * 3;
 	uint8_t *px = malloc(n);
 	if (!px)
 		return NULL;
 	for (size_t i = 0; i < n; i++)
 		px[i] = linear_to_srgb8(fb->rgb[i] * c->gain);
+	*owned = true;
 	return px;
 }
 
 static bool write_ppm(FILE *f, void *vctx, rt_error *err)
 {
 	image_ctx *c = vctx;
-	uint8_t *px = encode_rows(c);
+	bool owned;
+	uint8_t *px = encode_rows(c, &owned);
 	if (!px)
 		return rt_error_at(err, c->path, 0, 0, "out of memory");
 	fprintf(f, "P6\n%d %d\n255\n", c->fb->w, c->fb->h);
 	size_t n = (size_t)c->fb->w * (size_t)c->fb->h * 3;
 	bool ok = fwrite(px, 1, n, f) == n;
-	free(px);
+	if (owned)
+		free(px);
 	return ok || rt_error_at(err, c->path, 0, 0, "write failed");
 }
 
@@ -100,10 +108,12 @@ static void png_warning_dropped(png_structp png, png_const_charp msg)
 static bool write_png(FILE *f, void *vctx, rt_error *err)
 {
 	image_ctx *c = vctx;
-	uint8_t *px = encode_rows(c);
+	bool owned;
+	uint8_t *px = encode_rows(c, &owned);
 	png_bytep *rows = malloc((size_t)c->fb->h * sizeof *rows);
 	if (!px || !rows) {
-		free(px);
+		if (owned)
+			free(px);
 		free(rows);
 		return rt_error_at(err, c->path, 0, 0, "out of memory");
 	}
@@ -125,7 +135,8 @@ static bool write_png(FILE *f, void *vctx, rt_error *err)
 	}
 	png_destroy_write_struct(&png, &info);
 	free(rows);
-	free(px);
+	if (owned)
+		free(px);
 	/* a failed write is named by the writer's errno (the caller checks
 	 * the file); libpng's own words otherwise */
 	if (!ok && ferror(f))
@@ -144,12 +155,14 @@ static void jpeg_out(void *ctx, void *data, int size)
 static bool write_jpeg(FILE *f, void *vctx, rt_error *err)
 {
 	image_ctx *c = vctx;
-	uint8_t *px = encode_rows(c);
+	bool owned;
+	uint8_t *px = encode_rows(c, &owned);
 	if (!px)
 		return rt_error_at(err, c->path, 0, 0, "out of memory");
 	/* Quality 92: no blocks a person sees on a rendered picture. */
 	int ok = stbi_write_jpg_to_func(jpeg_out, f, c->fb->w, c->fb->h, 3, px, 92);
-	free(px);
+	if (owned)
+		free(px);
 	if (!ok)
 		return rt_error_at(err, c->path, 0, 0, "JPEG encoding failed");
 	return !ferror(f) || rt_error_at(err, c->path, 0, 0, "write failed");
