@@ -93,7 +93,7 @@ static int batch_render(const rtsh_options *o)
 	clock_gettime(CLOCK_MONOTONIC, &ps.start);
 	bool bar = !o->quiet && isatty(STDERR_FILENO);
 	/* the 8-bit codes are made by the render's threads as tiles finish */
-	bool eight = image_format_of(o->output) != IMAGE_PFM;
+	bool eight = !image_type_of(o->output)->linear;
 	framebuffer *fb = (eight ? render_image_srgb8 : render_image)(w, &set, NULL, bar ? show_progress : NULL,
 	                                                               &ps, &err);
 	world_free(w);

@@ -26,6 +26,7 @@ typedef struct image_type {
 	bool (*write)(FILE *f, void *ctx, rt_error *err); /* image.c's encoder */
 	framebuffer *(*read)(const char *path, rt_error *err); /* NULL: not read */
 	const char *help;   /* one line */
+	bool linear;        /* keeps linear radiance (PFM); else 8-bit sRGB codes */
 } image_type;
 
 /* The i-th format, NULL past the last; the format of path by its

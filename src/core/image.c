@@ -171,11 +171,11 @@ static bool write_jpeg(FILE *f, void *vctx, rt_error *err)
 /* The formats, by extension: a new one is a line here (and its encoder
  * above, its decoder below). */
 static const image_type types[] = {
-	{".ppm", "PPM", write_ppm, image_read_ppm, "8-bit sRGB, binary netpbm (P6)"},
-	{".pfm", "PFM", write_pfm, image_read_pfm, "linear 32-bit float, as rendered"},
-	{".png", "PNG", write_png, NULL, "8-bit sRGB, libpng"},
-	{".jpg", "JPEG", write_jpeg, NULL, "8-bit sRGB, baseline, quality 92 (stb_image_write)"},
-	{".jpeg", "JPEG", write_jpeg, NULL, "8-bit sRGB, as .jpg"},
+	{".ppm", "PPM", write_ppm, image_read_ppm, "8-bit sRGB, binary netpbm (P6)", false},
+	{".pfm", "PFM", write_pfm, image_read_pfm, "linear 32-bit float, as rendered", true},
+	{".png", "PNG", write_png, NULL, "8-bit sRGB, libpng", false},
+	{".jpg", "JPEG", write_jpeg, NULL, "8-bit sRGB, baseline, quality 92 (stb_image_write)", false},
+	{".jpeg", "JPEG", write_jpeg, NULL, "8-bit sRGB, as .jpg", false},
 };
 #define NTYPES (sizeof types / sizeof types[0])
 
