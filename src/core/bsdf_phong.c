@@ -252,10 +252,19 @@ static bool phong_has_choice(const bsdf *b)
 }
 
 /* A surface that is mostly a perfect mirror or glass is looked through. */
+/* A metal lobe at least this narrow (Phong exponent: fuzz <= 0.157) is
+ * looked through like a perfect mirror by the denoiser's features: what
+ * its reflection shows has edges (a checkered floor, a lamp) that the
+ * metal's own albedo and normal do not. Chosen on scenes/metal-fuzz.rt
+ * (8 samples, 128x96 and 200x120: 10% and 8% less RMS error denoised;
+ * exponents 30 and 200 within 1% of each other). */
+#define FEATURE_GLOSS_MIN 200.0
+
 static int phong_features(const bsdf *b, vec3 *albedo, vec3 *tint, vec3 *dir)
 {
 	*albedo = v3_add(v3_add(b->kd, b->ks), v3_add(b->km, v3_scale(b->kt, b->wg)));
-	double mirror = b->nm < 0.0 ? b->p[2] : 0.0, delta = mirror + b->p[3];
+	double mirror = b->nm < 0.0 || b->nm >= FEATURE_GLOSS_MIN ? b->p[2] : 0.0;
+	double delta = mirror + b->p[3];
 	if (delta < 0.5)
 		return 0;
 	if (mirror >= b->p[3]) {

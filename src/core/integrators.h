@@ -16,6 +16,10 @@ vec3 whitted_radiance(const world *w, const render_settings *s, ray r);
 /* A Monte-Carlo estimate of the radiance along r (path.c); g gives the
  * camera sample's numbers, from dimension g->dim on. */
 vec3 path_radiance(const world *w, const render_settings *s, ray r, sampler *g);
+/* The same two with the camera ray's first hit already traced (a packet,
+ * packet.h): found says whether r hit anything, *h what (unread when not). */
+vec3 whitted_radiance_first(const world *w, const render_settings *s, ray r, bool found, const hit *h);
+vec3 path_radiance_first(const world *w, const render_settings *s, ray r, sampler *g, bool found, const hit *h);
 
 /* The scattering at one path vertex: the material family's lobes
  * (material.c; the seeds' Phong family in bsdf_phong.c, the physically
@@ -86,7 +90,8 @@ double bsdf_pdf(const bsdf *b, vec3 wi);
 bool bsdf_has_choice(const bsdf *b);
 /* The denoiser's features (denoise.c): the surface's albedo (what a white
  * light would come back as, roughly), and 0; or, for a surface that is
- * mostly a perfect mirror or glass, 1 (look along the reflection) or 2
+ * mostly a perfect mirror, a narrow glossy metal lobe or glass, 1 (look
+ * along the mirror reflection) or 2
  * (along the refraction *dir) with the tint that gives. */
 int bsdf_features(const bsdf *b, vec3 *albedo, vec3 *tint, vec3 *dir);
 /* The Phong exponent of a mirror lobe of roughness fuzz in (0,1]. */
