@@ -438,7 +438,7 @@ static void finish_plane(const world *w, const prim_plane *pl, const ray *r, dou
 	                  m[2][0] * q.x + m[2][1] * q.y + m[2][2] * q.z + m[2][3]};
 	h->front = v3_dot(pl->n, r->d) < 0.0;
 	h->n = pl->n;
-	surf_shape_uv(w, OBJ_PLANE, sh->inv, pl->n, h);
+	surf_shape_uv(w, sh, pl->n, h);
 }
 
 /* Fills the hit record for the primitive found nearest. */
@@ -481,7 +481,7 @@ static void finish_hit(const world *w, const prim *p, const ray *r, double t, ve
 	h->front = v3_dot(n, r->d) < 0.0;
 	h->n = n;
 	if (shp) {
-		surf_shape_uv(w, shp->kind, shp->inv, nl, h);
+		surf_shape_uv(w, shp, nl, h);
 	} else {
 		const prim_tri *tr = &w->tris[p->u.index];
 		surf_triangle_uv(w, tr->v0, tr->e1, tr->e2, h);
