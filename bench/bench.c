@@ -383,28 +383,29 @@ static void bench_primary(void)
  * answers. Returns the seconds of the camera rays; *shadow_sec those of
  * the shadow rays (the camera rays' time for them not counted), *nshadow
  * their count. */
-static double packet_pass(const world *wd, int w, int h, bool packet, double *shadow_sec, long *nshadow)
+static double packet_pass(const world *wd, int w, int h, bool packet, int bw, int bh, double *shadow_sec,
+                          long *nshadow)
 {
 	double tc = 0, ts = 0;
 	long ns = 0;
 	vec3 lamp = wd->nlights ? wd->lights[0].pos : v3(0, 10, 0);
-	int nb = (w + 3) / 4;
+	int nb = (w + bw - 1) / bw;
 	ray *sr = malloc((size_t)nb * PACKET_MAX * sizeof *sr);
 	double *dist = malloc((size_t)nb * PACKET_MAX * sizeof *dist);
 	int *cnt = malloc((size_t)nb * sizeof *cnt);
 	if (!sr || !dist || !cnt)
 		fail("packet_pass: out of memory", NULL);
-	for (int y0 = 0; y0 < h; y0 += 4) {
+	for (int y0 = 0; y0 < h; y0 += bh) {
 		/* a row of blocks: camera rays (timed), their shadow rays made,
 		 * then traced (timed) */
 		double t0 = now();
 		for (int b = 0; b < nb; b++) {
-			int x0 = 4 * b, n = 0, m = 0;
+			int x0 = bw * b, n = 0, m = 0;
 			ray r[PACKET_MAX];
 			hit hh[PACKET_MAX];
 			bool found[PACKET_MAX];
-			for (int y = y0; y < y0 + 4 && y < h; y++)
-				for (int x = x0; x < x0 + 4 && x < w; x++, n++)
+			for (int y = y0; y < y0 + bh && y < h; y++)
+				for (int x = x0; x < x0 + bw && x < w; x++, n++)
 					r[n] = cam_ray(&wd->cam, x + 0.5, y + 0.5, w, h);
 			if (packet)
 				world_intersect_packet(wd, n, r, 0.0, INFINITY, hh, found);
@@ -446,30 +447,37 @@ static double packet_pass(const world *wd, int w, int h, bool packet, double *sh
 	return tc;
 }
 
-/* Packets against single rays on the grid, interleaved run by run. */
+/* Packets against single rays on the grid, interleaved run by run; and
+ * packets of 4 (2x2 pixels) and 8 (4x2) against 16 (4x4). */
 static void bench_packets(void)
 {
 	const char *path = "scenes/grid.rt";
 	int w = quick ? 320 : 1920, h = quick ? 180 : 1080;
 	scene *s = load(path);
 	world *wd = build(s);
-	double tc[2][MAX_RUNS], ts[2][MAX_RUNS];
+	static const int shape[4][2] = {{4, 4}, {4, 4}, {2, 2}, {4, 2}}; /* single, then 16, 4, 8 */
+	double tc[4][MAX_RUNS], ts[4][MAX_RUNS];
 	long ns = 0;
-	packet_pass(wd, w, h, true, &ts[0][0], &ns); /* warm up */
+	packet_pass(wd, w, h, true, 4, 4, &ts[0][0], &ns); /* warm up */
 	for (int i = 0; i < runs; i++)
-		for (int k = 0; k < 2; k++)
-			tc[k][i] = packet_pass(wd, w, h, k == 1, &ts[k][i], &ns);
+		for (int k = 0; k < 4; k++)
+			tc[k][i] = packet_pass(wd, w, h, k > 0, shape[k][0], shape[k][1], &ts[k][i], &ns);
 	double rays = (double)w * h * 1e-6, srays = (double)ns * 1e-6;
-	double c0 = median(tc[0], runs), c1 = median(tc[1], runs);
-	double s0 = median(ts[0], runs), s1 = median(ts[1], runs);
-	row *r = add_row("grid.rt", "primary-single", w, h, 1, 1, runs, c0, rays / c0);
+	double c[4], sh[4];
+	for (int k = 0; k < 4; k++) {
+		c[k] = median(tc[k], runs);
+		sh[k] = median(ts[k], runs);
+	}
+	row *r = add_row("grid.rt", "primary-single", w, h, 1, 1, runs, c[0], rays / c[0]);
 	snprintf(r->note, sizeof r->note, "world_intersect_coherent, 4x4 blocks (the packet rows' twin)");
-	r = add_row("grid.rt", "primary-packet", w, h, 1, 1, runs, c1, rays / c1);
-	snprintf(r->note, sizeof r->note, "world_intersect_packet, 16 rays: %.2fx single", c0 / c1);
-	r = add_row("grid.rt", "shadow-single", w, h, 1, 1, runs, s0, srays / s0);
+	r = add_row("grid.rt", "primary-packet", w, h, 1, 1, runs, c[1], rays / c[1]);
+	snprintf(r->note, sizeof r->note, "world_intersect_packet, 16 rays (4x4): %.2fx single; 8 (4x2): %.2fx, 4 (2x2): %.2fx",
+	         c[0] / c[1], c[0] / c[3], c[0] / c[2]);
+	r = add_row("grid.rt", "shadow-single", w, h, 1, 1, runs, sh[0], srays / sh[0]);
 	snprintf(r->note, sizeof r->note, "world_occluded, from each camera hit to the light");
-	r = add_row("grid.rt", "shadow-packet", w, h, 1, 1, runs, s1, srays / s1);
-	snprintf(r->note, sizeof r->note, "world_occluded_packet: %.2fx single", s0 / s1);
+	r = add_row("grid.rt", "shadow-packet", w, h, 1, 1, runs, sh[1], srays / sh[1]);
+	snprintf(r->note, sizeof r->note, "world_occluded_packet, 16 rays: %.2fx single; 8: %.2fx, 4: %.2fx", sh[0] / sh[1],
+	         sh[0] / sh[3], sh[0] / sh[2]);
 	world_free(wd);
 	scene_free(s);
 }
