@@ -19,44 +19,6 @@ const char *render_mode_name(render_mode m)
 	return m == MODE_PATH ? "path" : "whitted";
 }
 
-render_settings render_settings_default(void)
-{
-	return (render_settings){
-		.width = 1280,
-		.height = 720,
-		.samples = 1,
-		.depth = 5,
-		.threads = 0,
-		.mode = MODE_WHITTED,
-		.seed = 1,
-		.exposure = 0.0,
-		.denoise = DENOISE_AUTO,
-		.symbols = 4, /* auto */
-	};
-}
-
-bool render_settings_apply_hints(render_settings *s, const scene_hints *h)
-{
-	bool clamped = false;
-	if (h->width > 0 && h->height > 0) {
-		double w = h->width, hh = h->height, big = fmax(w, hh);
-		if (big > RENDER_HINT_MAX_DIM) {
-			w = fmax(1.0, round(w * RENDER_HINT_MAX_DIM / big));
-			hh = fmax(1.0, round(hh * RENDER_HINT_MAX_DIM / big));
-			clamped = true;
-		}
-		s->width = (int)w;
-		s->height = (int)hh;
-	}
-	if (h->samples > 0)
-		s->samples = h->samples;
-	if (h->depth >= 0)
-		s->depth = h->depth;
-	if (h->mode >= 0)
-		s->mode = (render_mode)h->mode;
-	return clamped;
-}
-
 int render_threads(const render_settings *s)
 {
 	if (s->threads > 0)

@@ -16,6 +16,7 @@
 #include "envmap.h"
 #include "surface.h"
 #include "ggx.h"
+#include "rtsh/memory.h"
 #include "rtsh/shape.h"
 
 mat_lin mat_lin_make(const material *m)
@@ -145,6 +146,10 @@ static bool reorder(world *w, const uint32_t *order)
 		free(tris);
 		return false;
 	}
+	/* walked in tree order by every ray: huge pages spare the TLB */
+	mem_huge_pages(prims, w->nprims * sizeof *prims);
+	mem_huge_pages(shapes, w->nshapes * sizeof *shapes);
+	mem_huge_pages(tris, w->ntris * sizeof *tris);
 	for (size_t i = 0; i < w->nprims; i++)
 		prims[i] = w->prims[order[i]];
 	size_t ns = 0, nt = 0;
@@ -212,6 +217,7 @@ world *world_build_cancel(const scene *s, const atomic_bool *cancel, rt_error *e
 	size_t nbounded = s->nobjs - nplanes;
 	w->lights = calloc(s->nlights ? s->nlights : 1, sizeof *w->lights);
 	w->mats = calloc(s->nobjs ? s->nobjs : 1, sizeof *w->mats);
+	mem_huge_pages(w->mats, s->nobjs * sizeof *w->mats); /* read at every hit */
 	w->prims = malloc((nbounded ? nbounded : 1) * sizeof *w->prims);
 	w->planes = malloc((nplanes ? nplanes : 1) * sizeof *w->planes);
 	w->shapes = malloc((nshapes ? nshapes : 1) * sizeof *w->shapes);
@@ -438,7 +444,7 @@ static void finish_plane(const world *w, const prim_plane *pl, const ray *r, dou
 	                  m[2][0] * q.x + m[2][1] * q.y + m[2][2] * q.z + m[2][3]};
 	h->front = v3_dot(pl->n, r->d) < 0.0;
 	h->n = pl->n;
-	surf_shape_uv(w, OBJ_PLANE, sh->inv, pl->n, h);
+	surf_shape_uv(w, sh, pl->n, h);
 }
 
 /* Fills the hit record for the primitive found nearest. */
@@ -481,7 +487,7 @@ static void finish_hit(const world *w, const prim *p, const ray *r, double t, ve
 	h->front = v3_dot(n, r->d) < 0.0;
 	h->n = n;
 	if (shp) {
-		surf_shape_uv(w, shp->kind, shp->inv, nl, h);
+		surf_shape_uv(w, shp, nl, h);
 	} else {
 		const prim_tri *tr = &w->tris[p->u.index];
 		surf_triangle_uv(w, tr->v0, tr->e1, tr->e2, h);
