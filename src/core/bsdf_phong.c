@@ -188,6 +188,10 @@ static bool phong_sample(const bsdf *b, const double u[3], bsdf_sample *out)
 	}
 }
 
+/* Set by whitted.c around the first hit's shading (integrators.h); kept
+ * here, beside its reader, so that this file calls nothing of whitted.c. */
+_Thread_local whitted_shadows whitted_shadow_hint;
+
 /* Whitted shading: ambient x colour + emission, diffuse and Phong per
  * visible point light, then the mirror or the glass rays. */
 static vec3 phong_whitted(const world *w, const mat_lin *m, const hit *hp, ray r, int depth,

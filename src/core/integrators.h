@@ -31,7 +31,7 @@ void whitted_shadow_packets(const world *w, int n, const hit *h, const bool *fou
 /* What the Phong family's Whitted shading (bsdf_phong.c) is told of its
  * shadow rays: when `h` is the hit it shades, the answers for the lights of
  * `known` (whitted_shadow_packets). Set by whitted_radiance_first around
- * the first hit's shading only; per thread. */
+ * the first hit's shading only; per thread (defined in bsdf_phong.c). */
 typedef struct whitted_shadows {
 	const hit *h;
 	uint32_t known, blocked;

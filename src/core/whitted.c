@@ -38,8 +38,6 @@ vec3 whitted_radiance(const world *w, const render_settings *s, ray r)
 	return trace_at(w, r, s->depth, true);
 }
 
-_Thread_local whitted_shadows whitted_shadow_hint;
-
 vec3 whitted_radiance_first(const world *w, const render_settings *s, ray r, bool found, const hit *h,
                             uint32_t known, uint32_t blocked)
 {
