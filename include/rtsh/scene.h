@@ -168,6 +168,8 @@ typedef struct camera {
 	bool vertical; /* vertical=1: fov is the vertical angle (glTF's yfov) */
 	double ortho;  /* ortho=H > 0: an orthographic view H high above and below
 	                * the centre (glTF's ymag); 0: perspective */
+	double roll;   /* roll=DEG: the camera turned about its axis, its up
+	                * towards its right (glTF cameras); 0: upright */
 } camera;
 
 typedef struct ambient {

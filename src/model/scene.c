@@ -165,7 +165,7 @@ static bool light_equal(const light *a, const light *b)
 static bool camera_equal(const camera *a, const camera *b)
 {
 	return v3_eq(a->pos, b->pos) && v3_eq(a->dir, b->dir) && a->fov == b->fov && a->vertical == b->vertical &&
-	       a->ortho == b->ortho;
+	       a->ortho == b->ortho && a->roll == b->roll;
 }
 
 bool scene_equal(const scene *a, const scene *b)
@@ -277,7 +277,7 @@ void scene_remove_light(scene *s, size_t i)
 camera scene_camera(const scene *s)
 {
 	if (s->ncams == 0)
-		return (camera){v3(0, 0, -5), v3(0, 0, 1), 70.0, false, 0};
+		return (camera){v3(0, 0, -5), v3(0, 0, 1), 70.0, false, 0, 0};
 	return s->cams[s->cam < s->ncams ? s->cam : 0];
 }
 

@@ -298,6 +298,10 @@ static void fmt_camera(sbuf *b, const camera *c, const char *id)
 		sb_put(b, " ortho=");
 		sb_num(b, c->ortho);
 	}
+	if (c->roll != 0) {
+		sb_put(b, " roll=");
+		sb_num(b, c->roll);
+	}
 }
 
 void rt_format_object(const object *o, char *buf, size_t size)

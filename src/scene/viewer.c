@@ -105,20 +105,22 @@ static char *gltf_text(const char *path, const rt_load_opts *opts, size_t *len, 
 		cc.pos = tidy3(cc.pos);
 		cc.fwd = tidy3(cc.fwd);
 		const gltf_camera *c = &cc;
-		/* rtsh cameras stay upright: a roll is not kept (said once) */
+		/* the camera's roll: the angle from rtsh's upright up (camera.c)
+		 * to the file's, towards the camera's right */
 		vec3 up_ref = fabs(c->fwd.y) > 0.999999 ? v3(0, 0, 1) : v3(0, 1, 0);
 		vec3 right = v3_norm(v3_cross(up_ref, c->fwd)), up = v3_cross(c->fwd, right);
-		double roll = acos(clampd(v3_dot(up, c->up), -1, 1)) * 180 / M_PI;
-		if (roll > 0.5)
-			rt_warn(opts ? opts->warn : NULL, path, 0, 0,
-			        "cameras[%d]: turned %.0f degrees about its axis; rtsh cameras stay upright (the roll is not "
-			        "kept)", c->index, roll);
+		double roll = atan2(v3_dot(c->up, right), v3_dot(c->up, up)) * 180 / M_PI;
+		if (fabs(roll) < 1e-9)
+			roll = 0;
 		if (c->ortho)
-			ok = put(text, size, &n, "%c %.17g,%.17g,%.17g %.17g,%.17g,%.17g 60 ortho=%.17g\n", i ? 'c' : 'C',
+			ok = put(text, size, &n, "%c %.17g,%.17g,%.17g %.17g,%.17g,%.17g 60 ortho=%.17g", i ? 'c' : 'C',
 			         c->pos.x, c->pos.y, c->pos.z, c->fwd.x, c->fwd.y, c->fwd.z, c->ymag);
 		else
-			ok = put(text, size, &n, "%c %.17g,%.17g,%.17g %.17g,%.17g,%.17g %.17g vertical=1\n", i ? 'c' : 'C',
+			ok = put(text, size, &n, "%c %.17g,%.17g,%.17g %.17g,%.17g,%.17g %.17g vertical=1", i ? 'c' : 'C',
 			         c->pos.x, c->pos.y, c->pos.z, c->fwd.x, c->fwd.y, c->fwd.z, c->yfov * 180 / M_PI);
+		if (ok && roll != 0)
+			ok = put(text, size, &n, " roll=%.17g", roll);
+		ok = ok && put(text, size, &n, "\n");
 	}
 	/* the first camera's shape, when the file gives it */
 	double aspect = gi.ncams == 0 ? 0 : gi.cams[0].ortho ? (gi.cams[0].ymag > 0 ? gi.cams[0].xmag / gi.cams[0].ymag : 0)

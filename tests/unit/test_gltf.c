@@ -583,6 +583,49 @@ static void test_camera_frustum(void **state)
 	scene_free(s);
 }
 
+/* A camera turned 90 degrees about its own axis (the node's rotation about
+ * Z: the camera's up +Y goes to -X in the file, +X once the reader mirrors
+ * X; its right +X goes to +Y). rtsh's upright camera looking along -Z has
+ * right = (0,1,0) x (0,0,-1) = (-1,0,0) and up (0,1,0): the file's up is
+ * minus the upright right, a roll of -90 degrees (the up turned towards the
+ * left). The view's up is then (1,0,0) and its right (0,1,0), and the save
+ * keeps the roll. */
+static void test_camera_roll(void **state)
+{
+	(void)state;
+	double h = sqrt(0.5);
+	char rest[1024];
+	snprintf(rest, sizeof rest,
+	         "\"nodes\":[{\"mesh\":0},{\"camera\":0,\"translation\":[0,0,5],\"rotation\":[0,0,%.17g,%.17g]}],"
+	         "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":1,\"aspectRatio\":2,\"znear\":0.1}}],",
+	         h, h);
+	char *text = tri_gltf(unit_tri, rest);
+	rt_error err = {0};
+	const char *path = tmp_text("roll.gltf", text);
+	free(text);
+	scene *s = rt_load_file(path, NULL, &err);
+	if (!s)
+		fail_msg("%s", err.msg);
+	assert_int_equal(s->ncams, 1);
+	assert_near(s->cams[0].roll, -90, 1e-9);
+	cam_view v = cam_view_make(&s->cams[0]);
+	assert_vec_near(v.fwd, v3(0, 0, -1), 1e-12);
+	assert_vec_near(v.up, v3(1, 0, 0), 1e-12);
+	assert_vec_near(v.right, v3(0, 1, 0), 1e-12);
+	/* the middle of the top row: up by tan(yfov / 2) */
+	ray top = cam_ray(&v, 100, 0, 200, 100);
+	assert_vec_near(top.d, v3_norm(v3(tan(0.5), 0, -1)), 1e-12);
+	char rt[256];
+	snprintf(rt, sizeof rt, "%s/roll.rt", tmpdir);
+	assert_true(rt_save(s, rt, &err));
+	scene *t = rt_load_file(rt, NULL, &err);
+	if (!t)
+		fail_msg("%s", err.msg);
+	assert_true(scene_equal(s, t));
+	scene_free(t);
+	scene_free(s);
+}
+
 /* A file with neither lights nor emissive materials gets the model
  * viewer's stage lighting (ambient, a lamp, the sky, a floor) and a note
  * for the status line; with no camera it is framed as the viewer frames a
@@ -622,6 +665,7 @@ int main(void)
 	    cmocka_unit_test(test_point_light_candela),
 	    cmocka_unit_test(test_spot_cone),
 	    cmocka_unit_test(test_camera_frustum),
+	    cmocka_unit_test(test_camera_roll),
 	    cmocka_unit_test(test_stage_lighting),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
