@@ -139,6 +139,7 @@ typedef struct object {
 	bool file_colors;
 	int smooth;       /* smooth= 0 flat faces, 1 smooth normals (1) */
 	double crease;    /* crease= degrees beyond which an edge stays sharp (60) */
+	int node;         /* node= a glTF file's node alone (its index), -1 the whole file */
 } object;
 
 /* The kinds of light: the miniRT light (no fall-off, `ratio` x colour),

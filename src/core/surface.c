@@ -72,7 +72,7 @@ bool surf_begin(world *w, const scene *s, rt_error *err)
 		const object *o = &s->objs[i];
 		if (!(obj_kind_flags(o->kind) & KIND_MODEL))
 			continue;
-		mesh *m = mesh_cache_get(o->file ? o->file : "", o->smooth != 0, o->crease, w->cancel, err);
+		mesh *m = mesh_cache_get_node(o->file ? o->file : "", o->node, o->smooth != 0, o->crease, w->cancel, err);
 		if (!m) {
 			char msg[RT_ERROR_MSG_MAX];
 			rt_error_format(err, msg, sizeof msg);

@@ -626,6 +626,64 @@ static void test_camera_roll(void **state)
 	scene_free(s);
 }
 
+/* Nodes as objects: two nodes place the unit triangle, the second moved by
+ * (5,0,0). Each becomes a mesh object of its own (node=0, node=1). Node 1's
+ * triangle, mirrored in X, is (-6,0,0) (-5,1,0) (-5,0,1): its plane is
+ * (x + 6) - y - z = 0, so the ray along +Z through x = -5.5, y = 0.2 meets
+ * it at z = 0.3 (barycentric 0.2 and 0.3, inside), from z = -10 at
+ * t = 10.3. Moved up by 1 as any object is moved, the ray through y = 1.2
+ * meets it at the same z. save keeps node=. */
+static void test_nodes_as_objects(void **state)
+{
+	(void)state;
+	char *text = tri_gltf(unit_tri, "\"nodes\":[{\"mesh\":0},{\"mesh\":0,\"translation\":[5,0,0]},"
+	                                "{\"camera\":0,\"translation\":[0,0,9]}],"
+	                                "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":1}}],");
+	rt_error err = {0};
+	const char *path = tmp_text("nodes.gltf", text);
+	free(text);
+	scene *s = rt_load_file(path, NULL, &err);
+	if (!s)
+		fail_msg("%s", err.msg);
+	assert_int_equal(s->nobjs, 3); /* and the stage's floor (no lights): y = 0, under the rays */
+	assert_int_equal(s->objs[0].node, 0);
+	assert_int_equal(s->objs[1].node, 1);
+	world *w = world_build(s, &err);
+	if (!w)
+		fail_msg("%s", err.msg);
+	hit h;
+	ray r = {v3(-5.5, 0.2, -10), v3(0, 0, 1)};
+	assert_true(world_intersect(w, &r, 0, INFINITY, &h));
+	assert_int_equal(h.object, 1);
+	assert_near(h.t, 10.3, 1e-6);
+	world_free(w);
+	s->objs[1].pos = v3_add(s->objs[1].pos, v3(0, 1, 0));
+	w = world_build(s, &err);
+	if (!w)
+		fail_msg("%s", err.msg);
+	r.o = v3(-5.5, 1.2, -10);
+	assert_true(world_intersect(w, &r, 0, INFINITY, &h));
+	assert_int_equal(h.object, 1);
+	assert_near(h.t, 10.3, 1e-6);
+	r.o = v3(-5.5, 0.2, -10); /* where it was: nothing now */
+	assert_false(world_intersect(w, &r, 0, INFINITY, &h));
+	world_free(w);
+	char rt[256];
+	snprintf(rt, sizeof rt, "%s/nodes.rt", tmpdir);
+	assert_true(rt_save(s, rt, &err));
+	scene *t = rt_load_file(rt, NULL, &err);
+	if (!t)
+		fail_msg("%s", err.msg);
+	assert_true(scene_equal(s, t));
+	assert_int_equal(t->objs[1].node, 1);
+	scene_free(t);
+	scene_free(s);
+	/* a node the scene does not place, and node= on another format */
+	mesh *m = mesh_read_gltf_node(path, 7, &err);
+	assert_null(m);
+	assert_non_null(strstr(err.msg, "node 7: not a node the scene places"));
+}
+
 /* A file with neither lights nor emissive materials gets the model
  * viewer's stage lighting (ambient, a lamp, the sky, a floor) and a note
  * for the status line; with no camera it is framed as the viewer frames a
@@ -666,6 +724,7 @@ int main(void)
 	    cmocka_unit_test(test_spot_cone),
 	    cmocka_unit_test(test_camera_frustum),
 	    cmocka_unit_test(test_camera_roll),
+	    cmocka_unit_test(test_nodes_as_objects),
 	    cmocka_unit_test(test_stage_lighting),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
