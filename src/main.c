@@ -13,6 +13,7 @@
 #include "rtsh/world.h"
 #include "shell/args.h"
 #include "shell/preview.h"
+#include "shell/progress.h"
 #include "shell/turntable.h"
 
 static int usage_error(const char *fmt, const char *arg)
@@ -23,10 +24,11 @@ static int usage_error(const char *fmt, const char *arg)
 	return 2;
 }
 
-typedef struct progress_state {
+typedef struct batch_progress {
 	struct timespec start;
+	int w, h, samples;
 	bool shown;
-} progress_state;
+} batch_progress;
 
 static double since(const struct timespec *t0)
 {
@@ -35,22 +37,12 @@ static double since(const struct timespec *t0)
 	return (double)(t.tv_sec - t0->tv_sec) + (t.tv_nsec - t0->tv_nsec) * 1e-9;
 }
 
-/* A progress bar with an ETA on standard error. */
+/* The progress line (shell/progress.h) on standard error. */
 static void show_progress(void *ctx, long done, long total)
 {
-	progress_state *p = ctx;
-	double el = since(&p->start), frac = total ? (double)done / total : 1.0;
-	const int width = 30;
-	int fill = (int)(frac * width + 0.5);
-	char bar[64];
-	for (int i = 0; i < width; i++)
-		bar[i] = i < fill ? '#' : '.';
-	bar[width] = '\0';
-	if (done > 0 && done < total)
-		fprintf(stderr, "\r[%s] %3d%%  %.1fs, about %.1fs left ", bar, (int)(frac * 100), el,
-		        el / frac - el);
-	else
-		fprintf(stderr, "\r[%s] %3d%%  %.1fs                  ", bar, (int)(frac * 100), el);
+	batch_progress *p = ctx;
+	progress_state ps = {p->w, p->h, p->samples, done, total, since(&p->start)};
+	progress_print(stderr, &ps);
 	p->shown = true;
 }
 
@@ -97,10 +89,13 @@ static int batch_render(const rtsh_options *o)
 		fprintf(stderr, "%s: %s\n", o->scene, msg);
 		return 1;
 	}
-	progress_state ps = {.shown = false};
+	batch_progress ps = {.w = set.width, .h = set.height, .samples = set.samples, .shown = false};
 	clock_gettime(CLOCK_MONOTONIC, &ps.start);
 	bool bar = !o->quiet && isatty(STDERR_FILENO);
-	framebuffer *fb = render_image(w, &set, NULL, bar ? show_progress : NULL, &ps, &err);
+	/* the 8-bit codes are made by the render's threads as tiles finish */
+	bool eight = image_format_of(o->output) != IMAGE_PFM;
+	framebuffer *fb = (eight ? render_image_srgb8 : render_image)(w, &set, NULL, bar ? show_progress : NULL,
+	                                                               &ps, &err);
 	world_free(w);
 	if (ps.shown)
 		fputc('\n', stderr);

@@ -4,7 +4,8 @@
  * (denoise_prepare) also records, for every pixel, the mean over its first
  * DENOISE_FEATURE_SAMPLES samples' own camera rays of what they first see:
  * the surface's albedo, its normal and its distance. Through perfect
- * mirrors and glass the features are those of the surface seen in them, so
+ * mirrors, glass and metals of little fuzz (a Phong lobe of exponent 200
+ * or more) the features are those of the surface seen in them, so
  * reflections keep their own edges. Where those first rays disagree (an
  * edge runs through the pixel) DENOISE_EDGE_SAMPLES camera positions are
  * taken (first hits only), so that the features of an edge pixel are as

@@ -51,7 +51,8 @@ framebuffer *image_read(const char *path, rt_error *err);
 bool image_write(const char *path, const framebuffer *fb, double exposure, rt_error *err);
 
 /* Readers for tests and tools: a new framebuffer with linear values (PPM
- * codes are sRGB-decoded). NULL with err set on failure. */
+ * codes are sRGB-decoded), through the textures' one netpbm/PFM reader
+ * (image_load_netpbm, texture.h). NULL with err set on failure. */
 framebuffer *image_read_pfm(const char *path, rt_error *err);
 framebuffer *image_read_ppm(const char *path, rt_error *err);
 

@@ -72,6 +72,12 @@ typedef struct framebuffer {
 	int spp;
 	float *feat;  /* optional: the first hit's features for the denoiser
 	               * (denoise.h), recorded by path-mode jobs; NULL: none */
+	uint8_t *srgb8; /* optional: w*h*3 8-bit sRGB codes of rgb x srgb8_gain,
+	                 * written by render jobs as each tile finishes, so that an
+	                 * 8-bit file's encode is not left to one thread after the
+	                 * render (image.c uses them when its gain is the same);
+	                 * whoever changes rgb outside a job frees them; NULL: none */
+	double srgb8_gain;
 } framebuffer;
 
 /* NULL when out of memory or the size is not in 1..RENDER_MAX_DIM. */
@@ -116,6 +122,11 @@ render_status render_run(render_job *job, rt_error *err);
  * samples. NULL (err set) on failure or cancellation. */
 framebuffer *render_image(const world *w, const render_settings *s, atomic_bool *cancel,
                           render_progress_fn progress, void *ctx, rt_error *err);
+/* The same, and fb->srgb8 filled with the codes of rgb x 2^s->exposure as the
+ * tiles finish (left NULL when the image is denoised after its render): for
+ * an 8-bit file written next (batch mode). */
+framebuffer *render_image_srgb8(const world *w, const render_settings *s, atomic_bool *cancel,
+                                render_progress_fn progress, void *ctx, rt_error *err);
 
 /* Renders the pixels x0 <= x < x1, y0 <= y < y1 of the s->width x s->height
  * image, all s->samples samples, on the calling thread, into out: (x1-x0) x

@@ -77,7 +77,7 @@ const char *rt_element(size_t i, const char **usage);
 /* The i-th key=value field objects take (the reader's one table of keys):
  * its name, and in *help one line saying what it does and its range. NULL
  * past the last. A new material key is one line of that table
- * (src/scene/rtfile_read.c, rt_keys). */
+ * (src/scene/keys.c, rt_keys). */
 const char *rt_key_info(size_t i, const char **help);
 
 /* Writes the scene as .rt text; load(write(s)) is equal to s (scene_equal). */

@@ -45,6 +45,11 @@ float *image_load_rgb(const char *path, bool srgb, int *w, int *h, rt_error *err
 /* The same from memory; the format from `path`'s extension (fuzzing). */
 float *image_decode_rgb(const char *path, const unsigned char *buf, size_t len, bool srgb, int *w, int *h,
                         rt_error *err);
+/* The one netpbm and PFM reader, for a file on disk whatever its name:
+ * pfm false, PPM/PGM (P2 P3 P5 P6, 8 or 16 bits, sRGB-decoded); pfm true,
+ * PFM (PF colour, Pf grey, linear; non-finite values read as 0). image.c's
+ * image_read_ppm and image_read_pfm read rendered pictures back with it. */
+float *image_load_netpbm(const char *path, bool pfm, int *w, int *h, rt_error *err);
 /* True when the extension is one image_load_rgb reads. */
 bool image_format_known(const char *path);
 

@@ -193,11 +193,11 @@ static bool phong_sample(const bsdf *b, const double u[3], bsdf_sample *out)
 static vec3 phong_whitted(const world *w, const mat_lin *m, const hit *hp, ray r, int depth,
                           vec3 (*trace)(const world *w, ray r, int depth))
 {
-	hit h = *hp;
-	vec3 n = h.front ? h.n : v3_neg(h.n);
-	vec3 albedo = hit_albedo(m, &h);
+	const hit *h = hp; /* read in place: a copy cost 3% of a grid render's instructions */
+	vec3 n = h->front ? h->n : v3_neg(h->n);
+	vec3 albedo = hit_albedo(m, h);
 	vec3 v = v3_neg(r.d);
-	vec3 p = offset_point(w, h.p, n);
+	vec3 p = offset_point(w, h->p, n);
 
 	vec3 c = v3_add(v3_mul(w->ambient, albedo), m->emission);
 	for (size_t i = 0; i < w->nlights; i++) {
@@ -224,16 +224,16 @@ static vec3 phong_whitted(const world *w, const mat_lin *m, const hit *hp, ray r
 
 	if (m->ior >= 1.0) {
 		/* A dielectric: Fresnel-weighted mirror and refracted rays. */
-		double eta = h.front ? 1.0 / m->ior : m->ior;
+		double eta = h->front ? 1.0 / m->ior : m->ior;
 		double cos_i = fmin(v3_dot(v, n), 1.0);
 		double sin2_t = eta * eta * (1.0 - cos_i * cos_i);
 		vec3 refl_dir = v3_reflect(r.d, n);
 		vec3 refl = trace(w, (ray){p, refl_dir}, depth - 1);
 		if (sin2_t >= 1.0)
 			return v3_add(c, refl); /* total internal reflection */
-		double kr = schlick(cos_i, h.front ? 1.0 / m->ior : m->ior);
+		double kr = schlick(cos_i, h->front ? 1.0 / m->ior : m->ior);
 		vec3 tdir = v3_add(v3_scale(r.d, eta), v3_scale(n, eta * cos_i - sqrt(1.0 - sin2_t)));
-		vec3 q = offset_point(w, h.p, v3_neg(n));
+		vec3 q = offset_point(w, h->p, v3_neg(n));
 		vec3 trans = trace(w, (ray){q, v3_norm(tdir)}, depth - 1);
 		return v3_add(c, v3_add(v3_scale(refl, kr), v3_scale(v3_mul(trans, albedo), 1.0 - kr)));
 	}
@@ -252,10 +252,19 @@ static bool phong_has_choice(const bsdf *b)
 }
 
 /* A surface that is mostly a perfect mirror or glass is looked through. */
+/* A metal lobe at least this narrow (Phong exponent: fuzz <= 0.157) is
+ * looked through like a perfect mirror by the denoiser's features: what
+ * its reflection shows has edges (a checkered floor, a lamp) that the
+ * metal's own albedo and normal do not. Chosen on scenes/metal-fuzz.rt
+ * (8 samples, 128x96 and 200x120: 10% and 8% less RMS error denoised;
+ * exponents 30 and 200 within 1% of each other). */
+#define FEATURE_GLOSS_MIN 200.0
+
 static int phong_features(const bsdf *b, vec3 *albedo, vec3 *tint, vec3 *dir)
 {
 	*albedo = v3_add(v3_add(b->kd, b->ks), v3_add(b->km, v3_scale(b->kt, b->wg)));
-	double mirror = b->nm < 0.0 ? b->p[2] : 0.0, delta = mirror + b->p[3];
+	double mirror = b->nm < 0.0 || b->nm >= FEATURE_GLOSS_MIN ? b->p[2] : 0.0;
+	double delta = mirror + b->p[3];
 	if (delta < 0.5)
 		return 0;
 	if (mirror >= b->p[3]) {

@@ -24,10 +24,10 @@ static double clamp01(double v)
 }
 
 /* What the camera ray r shows first, in f (albedo, normal, depth). A
- * surface that is mostly a perfect mirror or glass is looked through (up to
- * four times): its features are those of the surface seen in it, the albedo
- * tinted by the mirror's or the glass's colour, the depth the length of the
- * whole path. Glass is followed along the refracted ray unless the
+ * surface that is mostly a perfect mirror, a metal of little fuzz or glass
+ * is looked through (up to four times): its features are those of the
+ * surface seen in it, the albedo tinted by the mirror's or the glass's
+ * colour, the depth the length of the whole path. Glass is followed along the refracted ray unless the
  * reflection is total. */
 static void first_surface(const world *w, ray r, double f[7])
 {

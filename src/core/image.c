@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "rtsh/filesrc.h"
+#include "rtsh/texture.h"
 
 /* The extension of path ("" when none). */
 static const char *extension(const char *path)
@@ -35,28 +36,36 @@ typedef struct image_ctx {
 	const char *path;
 } image_ctx;
 
-static uint8_t *encode_rows(const image_ctx *c)
+/* The 8-bit codes of the image: the framebuffer's own when its render wrote
+ * them with this gain (render.h), else a new array (*owned set). */
+static uint8_t *encode_rows(const image_ctx *c, bool *owned)
 {
 	const framebuffer *fb = c->fb;
+	*owned = false;
+	if (fb->srgb8 && fb->srgb8_gain == c->gain)
+		return fb->srgb8;
 	size_t n = (size_t)fb->w * (size_t)fb->h * 3;
 	uint8_t *px = malloc(n);
 	if (!px)
 		return NULL;
 	for (size_t i = 0; i < n; i++)
 		px[i] = linear_to_srgb8(fb->rgb[i] * c->gain);
+	*owned = true;
 	return px;
 }
 
 static bool write_ppm(FILE *f, void *vctx, rt_error *err)
 {
 	image_ctx *c = vctx;
-	uint8_t *px = encode_rows(c);
+	bool owned;
+	uint8_t *px = encode_rows(c, &owned);
 	if (!px)
 		return rt_error_at(err, c->path, 0, 0, "out of memory");
 	fprintf(f, "P6\n%d %d\n255\n", c->fb->w, c->fb->h);
 	size_t n = (size_t)c->fb->w * (size_t)c->fb->h * 3;
 	bool ok = fwrite(px, 1, n, f) == n;
-	free(px);
+	if (owned)
+		free(px);
 	return ok || rt_error_at(err, c->path, 0, 0, "write failed");
 }
 
@@ -104,10 +113,12 @@ static void png_warning_dropped(png_structp png, png_const_charp msg)
 static bool write_png(FILE *f, void *vctx, rt_error *err)
 {
 	image_ctx *c = vctx;
-	uint8_t *px = encode_rows(c);
+	bool owned;
+	uint8_t *px = encode_rows(c, &owned);
 	png_bytep *rows = malloc((size_t)c->fb->h * sizeof *rows);
 	if (!px || !rows) {
-		free(px);
+		if (owned)
+			free(px);
 		free(rows);
 		return rt_error_at(err, c->path, 0, 0, "out of memory");
 	}
@@ -129,7 +140,8 @@ static bool write_png(FILE *f, void *vctx, rt_error *err)
 	}
 	png_destroy_write_struct(&png, &info);
 	free(rows);
-	free(px);
+	if (owned)
+		free(px);
 	/* a failed write is named by the writer's errno (the caller checks
 	 * the file); libpng's own words otherwise */
 	if (!ok && ferror(f))
@@ -148,12 +160,14 @@ static void jpeg_out(void *ctx, void *data, int size)
 static bool write_jpeg(FILE *f, void *vctx, rt_error *err)
 {
 	image_ctx *c = vctx;
-	uint8_t *px = encode_rows(c);
+	bool owned;
+	uint8_t *px = encode_rows(c, &owned);
 	if (!px)
 		return rt_error_at(err, c->path, 0, 0, "out of memory");
 	/* Quality 92: no blocks a person sees on a rendered picture. */
 	int ok = stbi_write_jpg_to_func(jpeg_out, f, c->fb->w, c->fb->h, 3, px, 92);
-	free(px);
+	if (owned)
+		free(px);
 	if (!ok)
 		return rt_error_at(err, c->path, 0, 0, "JPEG encoding failed");
 	return !ferror(f) || rt_error_at(err, c->path, 0, 0, "write failed");
@@ -223,116 +237,35 @@ framebuffer *image_read(const char *path, rt_error *err)
 	return t->read(path, err);
 }
 
-/* Reads the netpbm header "MAGIC W H MAX" (whitespace and # comments). */
-static bool read_header(FILE *f, const char *magic, int *w, int *h, double *max)
+/* The pixels of texture/image_read.c's one netpbm/PFM reader, as a
+ * framebuffer. */
+static framebuffer *read_netpbm(const char *path, bool pfm, rt_error *err)
 {
-	char m[3] = {0};
-	if (fread(m, 1, 2, f) != 2 || memcmp(m, magic, 2) != 0)
-		return false;
-	double v[3];
-	for (int i = 0; i < 3; i++) {
-		int ch;
-		while ((ch = fgetc(f)) != EOF && (ch == ' ' || ch == '\t' || ch == '\r' || ch == '\n' || ch == '#'))
-			if (ch == '#')
-				while ((ch = fgetc(f)) != EOF && ch != '\n')
-					;
-		if (ch == EOF)
-			return false;
-		ungetc(ch, f);
-		if (fscanf(f, "%lf", &v[i]) != 1)
-			return false;
+	int w, h;
+	float *rgb = image_load_netpbm(path, pfm, &w, &h, err);
+	if (!rgb)
+		return NULL;
+	framebuffer *fb = fb_new(w, h);
+	if (!fb) {
+		free(rgb);
+		rt_error_at(err, path, 0, 0, "the image is %dx%d pixels; expected at most %dx%d", w, h,
+		            RENDER_MAX_DIM, RENDER_MAX_DIM);
+		return NULL;
 	}
-	fgetc(f); /* the single whitespace before the data */
-	if (!(v[0] >= 1 && v[0] <= RENDER_MAX_DIM && v[1] >= 1 && v[1] <= RENDER_MAX_DIM))
-		return false;
-	*w = (int)v[0];
-	*h = (int)v[1];
-	*max = v[2];
-	return true;
-}
-
-/* True when the rest of a regular file holds `need` bytes: a header that
- * promises a 16384x16384 image in a 20-byte file allocates nothing. */
-static bool data_fits(FILE *f, double need)
-{
-	struct stat st;
-	long at = ftell(f);
-	return fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode) || at < 0 ||
-	       (double)st.st_size - (double)at >= need;
+	free(fb->rgb);
+	fb->rgb = rgb;
+	return fb;
 }
 
 framebuffer *image_read_pfm(const char *path, rt_error *err)
 {
-	const char *kind;
-	FILE *f = rt_file_open_regular(path, &kind);
-	if (!f) {
-		if (kind)
-			rt_error_at(err, path, 0, 0, "is %s; expected a regular file", kind);
-		else
-			rt_error_at(err, path, 0, 0, "cannot open (%s)", strerror(errno));
-		return NULL;
-	}
-	int w, h;
-	double scale;
-	framebuffer *fb = NULL;
-	if (!read_header(f, "PF", &w, &h, &scale) || !data_fits(f, 12.0 * w * h) || !(fb = fb_new(w, h))) {
-		fclose(f);
-		rt_error_at(err, path, 0, 0, "not a PFM colour image; expected PF W H SCALE");
-		return NULL;
-	}
-	bool big = scale > 0;
-	for (int y = h - 1; y >= 0; y--)
-		for (int i = 0; i < w * 3; i++) {
-			uint8_t b[4];
-			if (fread(b, 1, 4, f) != 4) {
-				fclose(f);
-				fb_free(fb);
-				rt_error_at(err, path, 0, 0, "PFM data ends early");
-				return NULL;
-			}
-			uint32_t bits = big ? (uint32_t)b[0] << 24 | (uint32_t)b[1] << 16 | (uint32_t)b[2] << 8 | b[3]
-			                    : (uint32_t)b[3] << 24 | (uint32_t)b[2] << 16 | (uint32_t)b[1] << 8 | b[0];
-			float v;
-			memcpy(&v, &bits, 4);
-			fb->rgb[(size_t)y * w * 3 + i] = v;
-		}
-	fclose(f);
-	fb->spp = 0;
+	framebuffer *fb = read_netpbm(path, true, err);
+	if (fb)
+		fb->spp = 0;
 	return fb;
 }
 
 framebuffer *image_read_ppm(const char *path, rt_error *err)
 {
-	const char *kind;
-	FILE *f = rt_file_open_regular(path, &kind);
-	if (!f) {
-		if (kind)
-			rt_error_at(err, path, 0, 0, "is %s; expected a regular file", kind);
-		else
-			rt_error_at(err, path, 0, 0, "cannot open (%s)", strerror(errno));
-		return NULL;
-	}
-	int w, h;
-	double max;
-	framebuffer *fb = NULL;
-	if (!read_header(f, "P6", &w, &h, &max) || max != 255 || !data_fits(f, 3.0 * w * h) ||
-	    !(fb = fb_new(w, h))) {
-		fclose(f);
-		rt_error_at(err, path, 0, 0, "not an 8-bit PPM image; expected P6 W H 255");
-		return NULL;
-	}
-	size_t n = (size_t)w * h * 3;
-	uint8_t *px = malloc(n);
-	bool ok = px && fread(px, 1, n, f) == n;
-	fclose(f);
-	if (!ok) {
-		free(px);
-		fb_free(fb);
-		rt_error_at(err, path, 0, 0, "PPM data ends early");
-		return NULL;
-	}
-	for (size_t i = 0; i < n; i++)
-		fb->rgb[i] = (float)srgb8_to_linear(px[i]);
-	free(px);
-	return fb;
+	return read_netpbm(path, false, err);
 }

@@ -86,7 +86,8 @@ double bsdf_pdf(const bsdf *b, vec3 wi);
 bool bsdf_has_choice(const bsdf *b);
 /* The denoiser's features (denoise.c): the surface's albedo (what a white
  * light would come back as, roughly), and 0; or, for a surface that is
- * mostly a perfect mirror or glass, 1 (look along the reflection) or 2
+ * mostly a perfect mirror, a narrow glossy metal lobe or glass, 1 (look
+ * along the mirror reflection) or 2
  * (along the refraction *dir) with the tint that gives. */
 int bsdf_features(const bsdf *b, vec3 *albedo, vec3 *tint, vec3 *dir);
 /* The Phong exponent of a mirror lobe of roughness fuzz in (0,1]. */

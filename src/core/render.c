@@ -10,6 +10,7 @@
 
 #include "integrators.h"
 #include "rtsh/denoise.h"
+#include "rtsh/srgb.h"
 #include "rtsh/texture.h"
 
 const char *render_mode_name(render_mode m)
@@ -89,6 +90,7 @@ void fb_free(framebuffer *fb)
 	free(fb->rgb);
 	free(fb->sum);
 	free(fb->feat);
+	free(fb->srgb8);
 	free(fb);
 }
 
@@ -165,6 +167,17 @@ static void pixel_add(const world *w, const render_settings *s, int x, int y, in
 		denoise_features(w, s, x, y, fw, fh, s0, s1, ra, fa, feat);
 }
 
+/* The 8-bit codes of a finished tile (framebuffer.srgb8), by the expression
+ * of image.c's encoder: the same codes it would make. */
+static void tile_srgb8(framebuffer *fb, int x0, int y0, int x1, int y1)
+{
+	for (int y = y0; y < y1; y++) {
+		size_t i0 = ((size_t)y * (size_t)fb->w + (size_t)x0) * 3, i1 = i0 + (size_t)(x1 - x0) * 3;
+		for (size_t i = i0; i < i1; i++)
+			fb->srgb8[i] = linear_to_srgb8(fb->rgb[i] * fb->srgb8_gain);
+	}
+}
+
 static void render_tile(shared *sh, long t)
 {
 	render_job *job = sh->job;
@@ -197,6 +210,8 @@ static void render_tile(shared *sh, long t)
 			fb->rgb[i + 1] = (float)(acc[1] * inv);
 			fb->rgb[i + 2] = (float)(acc[2] * inv);
 		}
+	if (fb->srgb8)
+		tile_srgb8(fb, x0, y0, x1, y1);
 }
 
 void render_rect(const world *w, const render_settings *s, int x0, int y0, int x1, int y1,
@@ -341,8 +356,8 @@ render_status render_run(render_job *job, rt_error *err)
 	return RENDER_DONE;
 }
 
-framebuffer *render_image(const world *w, const render_settings *s, atomic_bool *cancel,
-                          render_progress_fn progress, void *ctx, rt_error *err)
+static framebuffer *render_image_with(const world *w, const render_settings *s, atomic_bool *cancel,
+                                      render_progress_fn progress, void *ctx, bool srgb8, rt_error *err)
 {
 	framebuffer *fb = fb_new(s->width, s->height);
 	if (!fb) {
@@ -359,6 +374,11 @@ framebuffer *render_image(const world *w, const render_settings *s, atomic_bool 
 		             s->width, s->height);
 		fb_free(fb);
 		return NULL;
+	}
+	if (srgb8 && !denoise) {
+		/* no zeroing: every tile writes its codes (a failed render frees them) */
+		fb->srgb8 = malloc((size_t)fb->w * (size_t)fb->h * 3);
+		fb->srgb8_gain = exp2(s->exposure);
 	}
 	render_job job = {
 		.w = w,
@@ -383,4 +403,16 @@ framebuffer *render_image(const world *w, const render_settings *s, atomic_bool 
 		return NULL;
 	}
 	return fb;
+}
+
+framebuffer *render_image(const world *w, const render_settings *s, atomic_bool *cancel,
+                          render_progress_fn progress, void *ctx, rt_error *err)
+{
+	return render_image_with(w, s, cancel, progress, ctx, false, err);
+}
+
+framebuffer *render_image_srgb8(const world *w, const render_settings *s, atomic_bool *cancel,
+                                render_progress_fn progress, void *ctx, rt_error *err)
+{
+	return render_image_with(w, s, cancel, progress, ctx, true, err);
 }

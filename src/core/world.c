@@ -653,6 +653,80 @@ static inline int push_hits(const bvh_node *n, unsigned m, const float tn[4], wa
 	return sp;
 }
 
+/* The one walk of the scene's BVH, below the planes. any: an occlusion
+ * test, true at the first primitive hit (children in mask order, nothing
+ * pruned); otherwise the nearest hit: *tmax, *best and *best_n follow it,
+ * children nearest first, and entries a nearer hit rules out are dropped.
+ * Inlined with `any` constant, so each caller gets its own loop. */
+static inline __attribute__((always_inline)) bool walk(const world *w, const ray *r, double tmin, double *tmax_io,
+                                                       bool any, bool coherent, const prim **best, vec3 *best_n)
+{
+	const bvh *tree = w->tree;
+	const bvh_node *nodes = tree->nodes;
+	double tmax = *tmax_io, t;
+	vec3 nl;
+	bvh_ray q;
+	ray_prepare(r, &q);
+	float ftmin = to_float_down(tmin), ftmax = to_float_up(tmax);
+	walk_entry stack[BVH_STACK];
+	int sp = 0;
+	uint32_t child = tree->root, meta = tree->root_meta;
+	for (;;) {
+		if (meta) {
+			const prim *p = &w->prims[child];
+			uint32_t count = meta & ~BVH_LEAF;
+			for (uint32_t k = 0; k < count; k++)
+				if (any) {
+					if (prim_occluded(w, &p[k], r, tmin, tmax))
+						return true;
+				} else if (prim_hit(w, &p[k], r, tmin, tmax, &t, &nl, coherent)) {
+					tmax = t;
+					ftmax = to_float_up(tmax);
+					*best = &p[k];
+					*best_n = nl;
+				}
+		} else {
+			const bvh_node *n = &nodes[child];
+			float tn[BVH_WIDTH];
+			unsigned m = bvh_slab4(n, &q, ftmin, ftmax, tn);
+			if (m) {
+				if (any) {
+					/* any hit will do: no sorting, the first child now */
+					int k = __builtin_ctz(m);
+					for (unsigned rest = m & (m - 1); rest; rest &= rest - 1) {
+						int j = __builtin_ctz(rest);
+						stack[sp++] = (walk_entry){n->child[j], n->meta[j], tn[j], 0};
+					}
+					child = n->child[k];
+					meta = n->meta[k];
+					continue;
+				}
+				if (m & (m - 1)) {
+					/* several: the nearest now, the others later */
+					sp = push_hits(n, m, tn, stack, sp) - 1;
+				} else {
+					int k = __builtin_ctz(m);
+					stack[sp] = (walk_entry){n->child[k], n->meta[k], 0, 0};
+				}
+				child = stack[sp].child;
+				meta = stack[sp].meta;
+				continue;
+			}
+		}
+		/* the next entry that a nearer hit has not ruled out */
+		if (!any)
+			while (sp > 0 && stack[sp - 1].t > (double)BVH_SLAB_SLACK * tmax)
+				sp--;
+		if (sp == 0)
+			break;
+		sp--;
+		child = stack[sp].child;
+		meta = stack[sp].meta;
+	}
+	*tmax_io = tmax;
+	return false;
+}
+
 /* The nearest hit's primitive, distance and local data (world.h). */
 static inline __attribute__((always_inline)) bool trace(const world *w, const ray *r, double tmin, double tmax,
                                                         trace_hit *th, bool coherent)
@@ -677,51 +751,7 @@ static inline __attribute__((always_inline)) bool trace(const world *w, const ra
 			best_n = nl;
 		}
 	} else if (w->nprims) {
-		const bvh *tree = w->tree;
-		const bvh_node *nodes = tree->nodes;
-		bvh_ray q;
-		ray_prepare(r, &q);
-		float ftmin = to_float_down(tmin), ftmax = to_float_up(tmax);
-		walk_entry stack[BVH_STACK];
-		int sp = 0;
-		uint32_t child = tree->root, meta = tree->root_meta;
-		for (;;) {
-			if (meta) {
-				const prim *p = &w->prims[child];
-				uint32_t count = meta & ~BVH_LEAF;
-				for (uint32_t k = 0; k < count; k++)
-					if (prim_hit(w, &p[k], r, tmin, tmax, &t, &nl, coherent)) {
-						tmax = t;
-						ftmax = to_float_up(tmax);
-						best = &p[k];
-						best_n = nl;
-					}
-			} else {
-				const bvh_node *n = &nodes[child];
-				float tn[BVH_WIDTH];
-				unsigned m = bvh_slab4(n, &q, ftmin, ftmax, tn);
-				if (m) {
-					if (m & (m - 1)) {
-						/* several: the nearest now, the others later */
-						sp = push_hits(n, m, tn, stack, sp) - 1;
-					} else {
-						int k = __builtin_ctz(m);
-						stack[sp] = (walk_entry){n->child[k], n->meta[k], 0, 0};
-					}
-					child = stack[sp].child;
-					meta = stack[sp].meta;
-					continue;
-				}
-			}
-			/* the next entry that a nearer hit has not ruled out */
-			while (sp > 0 && stack[sp - 1].t > (double)BVH_SLAB_SLACK * tmax)
-				sp--;
-			if (sp == 0)
-				break;
-			sp--;
-			child = stack[sp].child;
-			meta = stack[sp].meta;
-		}
+		walk(w, r, tmin, &tmax, false, coherent, &best, &best_n);
 	}
 	/* a primitive hit after the planes is nearer than all of them */
 	th->t = tmax;
@@ -805,43 +835,7 @@ bool world_occluded(const world *w, const ray *r, double tmin, double tmax)
 		return false;
 	if (w->nprims == 1 && w->prims[0].tag == PRIM_MESH)
 		return surf_inst_occluded(w, &w->prims[0], r, tmin, tmax); /* as in world_intersect */
-	const bvh *tree = w->tree;
-	const bvh_node *nodes = tree->nodes;
-	bvh_ray q;
-	ray_prepare(r, &q);
-	float ftmin = to_float_down(tmin), ftmax = to_float_up(tmax);
-	walk_entry stack[BVH_STACK];
-	int sp = 0;
-	uint32_t child = tree->root, meta = tree->root_meta;
-	for (;;) {
-		if (meta) {
-			const prim *p = &w->prims[child];
-			uint32_t count = meta & ~BVH_LEAF;
-			for (uint32_t k = 0; k < count; k++)
-				if (prim_occluded(w, &p[k], r, tmin, tmax))
-					return true;
-		} else {
-			const bvh_node *n = &nodes[child];
-			float tn[BVH_WIDTH];
-			unsigned m = bvh_slab4(n, &q, ftmin, ftmax, tn);
-			if (m) {
-				/* any hit will do: no sorting, the first child now */
-				int k = __builtin_ctz(m);
-				for (unsigned rest = m & (m - 1); rest; rest &= rest - 1) {
-					int j = __builtin_ctz(rest);
-					stack[sp++] = (walk_entry){n->child[j], n->meta[j], tn[j], 0};
-				}
-				child = n->child[k];
-				meta = n->meta[k];
-				continue;
-			}
-		}
-		if (sp == 0)
-			return false;
-		sp--;
-		child = stack[sp].child;
-		meta = stack[sp].meta;
-	}
+	return walk(w, r, tmin, &tmax, true, false, NULL, NULL);
 }
 
 bool world_intersect_brute(const world *w, const ray *r, double tmin, double tmax, hit *h)

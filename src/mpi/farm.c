@@ -11,6 +11,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "shell/progress.h"
 
 enum { FARM_ASK = 1, FARM_TILES = 2, FARM_RESULT = 3 };
 
@@ -152,21 +153,11 @@ static void *server_thread(void *arg)
 	return NULL;
 }
 
-static void show_progress(long done, long total, double elapsed)
+/* The progress line (shell/progress.h) on standard error. */
+static void show_progress(const render_settings *s, long done, long total, double elapsed)
 {
-	const int width = 30;
-	double frac = total ? (double)done / (double)total : 1.0;
-	int fill = (int)(frac * width + 0.5);
-	char bar[64];
-	for (int i = 0; i < width; i++)
-		bar[i] = i < fill ? '#' : '.';
-	bar[width] = '\0';
-	if (done > 0 && done < total)
-		fprintf(stderr, "\r[%s] %3d%%  %.1fs, about %.1fs left ", bar, (int)(frac * 100),
-		        elapsed, elapsed / frac - elapsed);
-	else
-		fprintf(stderr, "\r[%s] %3d%%  %.1fs                  ", bar, (int)(frac * 100), elapsed);
-	fflush(stderr);
+	progress_state ps = {s->width, s->height, s->samples, done, total, elapsed};
+	progress_print(stderr, &ps);
 }
 
 /* What rank 0 knows of each worker's pace, for the deadline (farm_opts). */
@@ -312,7 +303,7 @@ bool farm_serve(const world *w, const render_settings *s, const farm_opts *o, fr
 		}
 		if (o->progress && now() - shown >= 0.1) {
 			shown = now();
-			show_progress(atomic_load(&sv.done), sv.t.count, shown - t0);
+			show_progress(s, atomic_load(&sv.done), sv.t.count, shown - t0);
 		}
 		long i = own ? atomic_fetch_add(&sv.next, 1) : sv.t.count;
 		if (i < sv.t.count) {
@@ -353,7 +344,7 @@ bool farm_serve(const world *w, const render_settings *s, const farm_opts *o, fr
 	for (int i = 0; i < started; i++)
 		pthread_join(tid[i], NULL);
 	if (o->progress) {
-		show_progress(atomic_load(&sv.done), sv.t.count, now() - t0);
+		show_progress(s, atomic_load(&sv.done), sv.t.count, now() - t0);
 		fputc('\n', stderr);
 	}
 	if (started == 0)

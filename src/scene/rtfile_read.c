@@ -1086,6 +1086,10 @@ static bool parse_mesh(parser *p, const elem_def *e)
 		rt_error_format(&merr, msg, sizeof msg);
 		return fail(p, t[1].col, "mesh file \"%s\": %s", quoted(p, &t[1]), msg);
 	}
+	/* the reader's warning (a missing mtllib, say) with this line; the
+	 * model viewer's own scene (named after the model) says it itself */
+	if (m->warning && strcmp(p->name, o.file) != 0)
+		rt_warn(p->warn, p->name, p->line, t[1].col, "mesh file \"%s\": %s", quoted(p, &t[1]), m->warning);
 	mesh_cache_put(m);
 	return add_object(p, e, &o, NULL);
 }

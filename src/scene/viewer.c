@@ -6,7 +6,17 @@
  * a little above and to the right, a key light above the camera's left
  * shoulder, a soft ambient and a sky. The model keeps its own materials. `save x.rt` writes it out with a mesh
  * line that references the model.
+ *
+ * Two rules for models that do not say everything (rtsh(1), "The model
+ * viewer"): the front is the file's +Z side (glTF's convention, and
+ * Blender's OBJ export), except that a model deeper than wide whose top
+ * leans clearly to -Z (an animal with its head at -Z, such as Spot) is
+ * turned to face the camera (twist=180); and a model with texture
+ * coordinates but no materials takes as its colour texture the one image
+ * beside it whose name starts with the model's stem (spot_texture.png for
+ * spot_triangulated.obj), which the status line names.
  */
+#include <dirent.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -19,6 +29,7 @@
 #include "rtsh/gltf.h"
 #include "rtsh/mesh.h"
 #include "rtsh/rtfile.h"
+#include "rtsh/texture.h"
 #include "rtsh/world.h"
 
 /* --- glTF 2.0 scenes --- */
@@ -228,7 +239,80 @@ done:
 }
 
 
-char *rt_model_text(const char *path, const rt_load_opts *opts, size_t *len, rt_error *err)
+/* The front rule: true when the model is deeper (Z) than wide (X) and the
+ * corners in the highest tenth of its height lie on average more than a
+ * quarter of its half-depth behind the box's centre (-Z): the model then
+ * faces -Z, and the viewer turns it about +Y. */
+static bool faces_back(const mesh *m)
+{
+	box bb = m->bounds;
+	vec3 ext = v3_sub(bb.hi, bb.lo);
+	if (!(ext.z > ext.x) || !(ext.y > 0))
+		return false;
+	double band = bb.hi.y - 0.1 * ext.y, sum = 0;
+	size_t n = 0;
+	for (uint32_t slot = 0; slot < 4 * m->nblk; slot++) {
+		vec3 c[3];
+		mesh_corners(m, slot, c);
+		for (int k = 0; k < 3; k++)
+			if (c[k].y >= band) {
+				sum += c[k].z;
+				n++;
+			}
+	}
+	double mid = 0.5 * (bb.lo.z + bb.hi.z);
+	return n > 0 && sum / (double)n < mid - 0.25 * 0.5 * ext.z;
+}
+
+/* The texture rule: for a model with texture coordinates and no materials,
+ * the one image in its folder whose name starts with the model's stem (its
+ * name up to the first '_', '-', '.' or blank) followed by one of those
+ * characters. Writes its name (no folder) to out; false when there is none,
+ * or several (said as a warning). */
+static bool beside_texture(const char *path, const mesh *m, const rt_load_opts *opts, char *out, size_t size)
+{
+	if (!m->uv || m->nmats > 0)
+		return false;
+	const char *slash = strrchr(path, '/');
+	const char *base = slash ? slash + 1 : path;
+	size_t stem = strcspn(base, "_-. ");
+	if (stem == 0 || stem == strlen(base))
+		return false;
+	char dir[4096];
+	int dn = slash ? snprintf(dir, sizeof dir, "%.*s", (int)(slash - path + 1), path) : snprintf(dir, sizeof dir, "./");
+	if (dn < 0 || (size_t)dn >= sizeof dir)
+		return false;
+	DIR *d = opendir(dir);
+	if (!d)
+		return false;
+	int found = 0;
+	struct dirent *e;
+	while ((e = readdir(d)) != NULL) {
+		const char *nm = e->d_name;
+		if (strncmp(nm, base, stem) != 0 || !nm[stem] || !strchr("_-. ", nm[stem]) || !image_format_known(nm))
+			continue;
+		char full[8192];
+		struct stat st;
+		int fn = snprintf(full, sizeof full, "%s%s", dir, nm);
+		if (fn < 0 || (size_t)fn >= sizeof full || stat(full, &st) != 0 || !S_ISREG(st.st_mode))
+			continue;
+		if (found++ == 0 && strlen(nm) < size)
+			memcpy(out, nm, strlen(nm) + 1);
+		else if (found == 1)
+			found = 2; /* too long a name: not taken */
+	}
+	closedir(d);
+	if (found > 1)
+		rt_warn(opts ? opts->warn : NULL, NULL, 0, 0,
+		        "%s: %d images beside it start with \"%.*s\": none taken as its texture (use texture=)", base, found,
+		        (int)stem, base);
+	return found == 1;
+}
+
+/* rt_model_text, with the name of the texture the texture rule took in tex
+ * ("" when none). */
+static char *model_text(const char *path, const rt_load_opts *opts, size_t *len, char *tex, size_t tex_size,
+                        rt_error *err)
 {
 	bool stage;
 	if (has_ext(path, "gltf") || has_ext(path, "glb"))
@@ -239,6 +323,8 @@ char *rt_model_text(const char *path, const rt_load_opts *opts, size_t *len, rt_
 	if (m->warning) /* a missing material library, say */
 		rt_warn(opts ? opts->warn : NULL, NULL, 0, 0, "%s", m->warning);
 	vec3 ext = v3_sub(m->bounds.hi, m->bounds.lo);
+	bool turned = faces_back(m);
+	bool textured = beside_texture(path, m, opts, tex, tex_size);
 	mesh_cache_put(m);
 	double longest = v3_max_comp(ext);
 	if (!(longest > 0))
@@ -255,6 +341,7 @@ char *rt_model_text(const char *path, const rt_load_opts *opts, size_t *len, rt_
 	const char *slash = strrchr(path, '/');
 	const char *base = slash ? slash + 1 : path;
 	bool quote = strpbrk(base, " \t,#\"") != NULL;
+	bool tquote = textured && strpbrk(tex, " \t,#\"") != NULL;
 	char *text = malloc(8192);
 	if (!text) {
 		rt_error_set(err, "out of memory");
@@ -267,10 +354,11 @@ char *rt_model_text(const char *path, const rt_load_opts *opts, size_t *len, rt_
 	                 "L %.6g,%.6g,%.6g 0.8 255,250,240\n"
 	                 "sky 110,150,210 235,235,240 1\n"
 	                 "pl 0,0,0 0,1,0 180,180,180\n"
-	                 "mesh %s%s%s 0,%.6g,0 0,1,0 2\n"
+	                 "mesh %s%s%s 0,%.6g,0 0,1,0 2%s%s%s%s%s\n"
 	                 "set samples 4\n",
 	                 base, cam.x, cam.y, cam.z, dir.x, dir.y, dir.z, fov, lamp.x, lamp.y, lamp.z,
-	                 quote ? "\"" : "", base, quote ? "\"" : "", e.y / 2);
+	                 quote ? "\"" : "", base, quote ? "\"" : "", e.y / 2, turned ? " twist=180" : "",
+	                 textured ? " texture=" : "", tquote ? "\"" : "", textured ? tex : "", tquote ? "\"" : "");
 	if (n < 0 || n >= 8192) {
 		free(text);
 		rt_error_set(err, "%s: the file name is too long", path);
@@ -280,16 +368,28 @@ char *rt_model_text(const char *path, const rt_load_opts *opts, size_t *len, rt_
 	return text;
 }
 
+char *rt_model_text(const char *path, const rt_load_opts *opts, size_t *len, rt_error *err)
+{
+	char tex[1024] = "";
+	return model_text(path, opts, len, tex, sizeof tex, err);
+}
+
 scene *rt_load_model(const char *path, const rt_load_opts *opts, rt_error *err)
 {
 	size_t n;
 	bool gltf = has_ext(path, "gltf") || has_ext(path, "glb"), stage = false;
-	char *text = gltf ? gltf_text(path, opts, &n, &stage, err) : rt_model_text(path, opts, &n, err);
+	char tex[1024] = "";
+	char *text = gltf ? gltf_text(path, opts, &n, &stage, err) : model_text(path, opts, &n, tex, sizeof tex, err);
 	if (!text)
 		return NULL;
 	scene *s = rt_load_string(text, n, path, opts, err);
 	free(text);
 	if (s && stage) /* the status line says so */
 		s->note = rt_intern("stage lighting", strlen("stage lighting"));
+	if (s && tex[0]) { /* the texture rule's image, named in the status line */
+		char note[1100];
+		int k = snprintf(note, sizeof note, "texture %s", tex);
+		s->note = rt_intern(note, (size_t)k < sizeof note ? (size_t)k : sizeof note - 1);
+	}
 	return s;
 }

@@ -441,14 +441,22 @@ static void km_status_text(keymode *km, char *buf, size_t size)
 		snprintf(res, sizeof res, " (1/%g res)", ratios[km->ratio_i]);
 	double f = km_fps(km);
 	if (f > 0)
-		snprintf(fps, sizeof fps, " │ %.0f fps", f);
+		snprintf(fps, sizeof fps, "%.0f fps", f);
 	if (km->have_img)
-		snprintf(t, sizeof t, " │ %.0f ms", im->pass_seconds * 1000);
+		snprintf(t, sizeof t, "%.0f ms", im->pass_seconds * 1000);
 	/* A message goes right after the selection, where it is not cut off. */
 	bool msg = km->msg[0] && now() < km->msg_until;
-	snprintf(buf, size, " view │ %s │ %s%s%s │ %s │ %s │ depth %d │ %dx%d%s%s%s │ step %.3g", sh->name, sel,
-	         msg ? " │ " : "", msg ? km->msg : "", render_mode_name(sh->set.mode), spp, sh->set.depth,
-	         km->kv.img_w, km->kv.img_h, res, fps, t, km->step);
+	char depth[32], size_s[96], step[48];
+	snprintf(depth, sizeof depth, "depth %d", sh->set.depth);
+	snprintf(size_s, sizeof size_s, "%dx%d%s", km->kv.img_w, km->kv.img_h, res);
+	snprintf(step, sizeof step, "step %.3g", km->step);
+	/* Fitted to the width (issue 31, friction 3): the timings go first,
+	 * then the depth, the size, the scene's name and the mode; the
+	 * selection, a message, the samples and the step stay. */
+	const char *fields[] = {"view", sh->name, sel, msg ? km->msg : "", render_mode_name(sh->set.mode), spp,
+	                        depth, size_s, fps, t, step};
+	const int drop[] = {0, 5, 0, 0, 6, 0, 3, 4, 2, 1, 0};
+	keyview_fit_status(buf, size, fields, drop, sizeof fields / sizeof fields[0], km->kv.cols > 0 ? km->kv.cols : 80);
 }
 
 /* Puts the newest image (scaled up to the picture size) with the marks

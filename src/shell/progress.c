@@ -50,3 +50,11 @@ void progress_text(const progress_state *p, int bar, char *buf, size_t size)
 	snprintf(buf, size, "%s%d%% %d/%d spp %s%s%s", bars, (int)(frac * 100), (int)spp, p->samples, el, left,
 	         speed);
 }
+
+void progress_print(FILE *f, const progress_state *p)
+{
+	char line[160];
+	progress_text(p, 30, line, sizeof line);
+	fprintf(f, "\r%-78s", line);
+	fflush(f);
+}

@@ -7,6 +7,7 @@
 #define RTSH_PROGRESS_H
 
 #include <stddef.h>
+#include <stdio.h>
 
 typedef struct progress_state {
 	int w, h;        /* the image */
@@ -20,5 +21,11 @@ typedef struct progress_state {
 void progress_text(const progress_state *p, int bar, char *buf, size_t size);
 /* "950 ms", "12 s", "2m05s": a duration for the status line. */
 void progress_duration(double seconds, char *buf, size_t size);
+
+/* The same text on a terminal's standard error, for batch mode (main.c)
+ * and rtsh-mpi's rank 0 (farm.c): "\r", the text with a bar of 30, padded
+ * with blanks over a longer line before it. The shell's status line is the
+ * third output (shell.c). */
+void progress_print(FILE *f, const progress_state *p);
 
 #endif

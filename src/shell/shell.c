@@ -17,6 +17,7 @@
 #include "shell/progress.h"
 #include "shell/signals.h"
 #include "term/caps.h"
+#include "term/keyview.h"
 
 bool shell_fail(shell *sh, const char *fmt, ...)
 {
@@ -339,9 +340,18 @@ void shell_status_text(shell *sh, char *buf, size_t size)
 	bool note = sh->notice[0] && now() < sh->notice_until;
 	const scene *sc = editor_scene(sh->ed);
 	const char *snote = sc && sc->note ? sc->note : NULL; /* the glTF loader's "stage lighting" */
-	snprintf(buf, size, " %s%s%s%s%s │ %s │ %s │ depth %d │ %dx%d │ %d thread%s │ %s", sh->name,
-	         snote ? " │ " : "", snote ? snote : "", note ? " │ " : "", note ? sh->notice : "", render_mode_name(sh->set.mode), samples, sh->set.depth, sh->scr ? sh->scr->img_w : 0,
-	         sh->scr ? sh->scr->img_h : 0, th, th == 1 ? "" : "s", t);
+	char depth[32], size_s[48], threads[32];
+	snprintf(depth, sizeof depth, "depth %d", sh->set.depth);
+	snprintf(size_s, sizeof size_s, "%dx%d", sh->scr ? sh->scr->img_w : 0, sh->scr ? sh->scr->img_h : 0);
+	snprintf(threads, sizeof threads, "%d thread%s", th, th == 1 ? "" : "s");
+	/* Fitted to the width: the threads go first, then the depth, the
+	 * size, the time, the scene's note and its name; a notice, the mode
+	 * and the samples stay. */
+	const char *fields[] = {sh->name, snote ? snote : "", note ? sh->notice : "", render_mode_name(sh->set.mode),
+	                        samples, depth, size_s, threads, t};
+	const int drop[] = {6, 5, 0, 0, 0, 2, 3, 1, 4};
+	keyview_fit_status(buf, size, fields, drop, sizeof fields / sizeof fields[0],
+	                   sh->scr && sh->scr->cols > 0 ? sh->scr->cols : 1 << 20);
 }
 
 /* --- full-resolution images --- */

@@ -193,6 +193,34 @@ void keyview_draw(keyview *v, const char *status)
 		termout_text(v->out, a->b, a->len);
 }
 
+void keyview_fit_status(char *buf, size_t size, const char *const *fields, const int *drop, size_t n, int cols)
+{
+	bool out[32] = {false};
+	if (n > 32)
+		n = 32;
+	for (;;) {
+		size_t len = 0;
+		buf[0] = '\0';
+		for (size_t i = 0; i < n; i++) {
+			if (out[i] || !fields[i][0])
+				continue;
+			int k = snprintf(buf + len, size - len, "%s%s", len ? " │ " : " ", fields[i]);
+			if (k < 0 || (size_t)k >= size - len)
+				break;
+			len += (size_t)k;
+		}
+		if (text_width(buf) <= cols)
+			return;
+		size_t worst = n;
+		for (size_t i = 0; i < n; i++)
+			if (!out[i] && fields[i][0] && drop[i] > 0 && (worst == n || drop[i] < drop[worst]))
+				worst = i;
+		if (worst == n)
+			return;
+		out[worst] = true;
+	}
+}
+
 void keyview_end(keyview *v)
 {
 	termout_text(v->out, "\x1b[m\x1b[?25h", 9);

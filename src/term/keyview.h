@@ -83,5 +83,10 @@ bool keyview_status_differs(const keyview *v, const char *text);
 void keyview_draw(keyview *v, const char *status);
 /* Gives the screen back: attributes reset, the cursor shown. */
 void keyview_end(keyview *v);
+/* A status line that fits: " " and the n fields joined by " │ " (empty
+ * fields left out) into buf; while it is wider than cols columns, the field
+ * of the lowest drop rank > 0 is left out (1 first; 0: never). What still
+ * does not fit is cut where the line is drawn. */
+void keyview_fit_status(char *buf, size_t size, const char *const *fields, const int *drop, size_t n, int cols);
 
 #endif

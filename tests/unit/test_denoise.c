@@ -540,18 +540,27 @@ static void test_threads(void **state)
  * camera at the origin looks along +z at a mirror at z = 2; behind the
  * camera a wall at z = -3 faces it. The centre pixel sees the wall's
  * albedo, its normal (0,0,1) and the depth 2 + 5 = 7; without the mirror
- * (a white wall at z = 2) the features are that wall's at depth 2. */
+ * (a white wall at z = 2) the features are that wall's at depth 2. A white
+ * metal of fuzz 0.1 (Phong exponent 5 / 0.1^2 - 2 = 498, at least 200) is
+ * looked through as the mirror is (its Schlick tint at normal incidence is
+ * its colour, white); one of fuzz 0.5 (exponent 18) shows itself: albedo
+ * its tint, white. */
 static void test_features_through_mirror(void **state)
 {
 	(void)state;
-	const char *texts[2] = {
+	const char *texts[4] = {
 		"C 0,0,0 0,0,1 10\npl 0,0,2 0,0,-1 1,1,1 255,255,255 0 0 1 1\n"
 		"pl 0,0,-3 0,0,1 1,1,1 180,100,50 1 0 1 0\n",
 		"C 0,0,0 0,0,1 10\npl 0,0,2 0,0,-1 1,1,1 255,255,255 1 0 1 0\n",
+		"C 0,0,0 0,0,1 10\npl 0,0,2 0,0,-1 1,1,1 255,255,255 0 0 1 1 metal=1 fuzz=0.1\n"
+		"pl 0,0,-3 0,0,1 1,1,1 180,100,50 1 0 1 0\n",
+		"C 0,0,0 0,0,1 10\npl 0,0,2 0,0,-1 1,1,1 255,255,255 0 0 1 1 metal=1 fuzz=0.5\n"
+		"pl 0,0,-3 0,0,1 1,1,1 180,100,50 1 0 1 0\n",
 	};
-	vec3 albedo[2] = {srgb255_to_linear(v3(180, 100, 50)), v3(1, 1, 1)};
-	const double normal_z[2] = {1, -1}, depth[2] = {7, 2};
-	for (int c = 0; c < 2; c++) {
+	vec3 wall = srgb255_to_linear(v3(180, 100, 50));
+	vec3 albedo[4] = {wall, v3(1, 1, 1), wall, v3(1, 1, 1)};
+	const double normal_z[4] = {1, -1, 1, -1}, depth[4] = {7, 2, 7, 2};
+	for (int c = 0; c < 4; c++) {
 		scene *s = load_text(texts[c]);
 		world *w = world_build(s, NULL);
 		assert_non_null(w);

@@ -161,11 +161,42 @@ static void test_bar_fits(void **state)
 	close(f.fd);
 }
 
+/* keyview_fit_status (issue 31, friction 3: key mode's status line was cut
+ * at 80 columns): fields leave in their drop order until the line fits;
+ * rank 0 stays. Widths counted by hand: " a │ bb │ ccc" is 1+1+3+2+3+3 = 13. */
+static void test_fit_status(void **state)
+{
+	(void)state;
+	const char *fields[] = {"a", "bb", "", "ccc"};
+	const int drop[] = {0, 2, 1, 1};
+	char buf[64];
+	keyview_fit_status(buf, sizeof buf, fields, drop, 4, 13);
+	assert_string_equal(buf, " a │ bb │ ccc"); /* the empty field is left out */
+	keyview_fit_status(buf, sizeof buf, fields, drop, 4, 12);
+	assert_string_equal(buf, " a │ bb"); /* ccc (rank 1) first */
+	keyview_fit_status(buf, sizeof buf, fields, drop, 4, 6);
+	assert_string_equal(buf, " a"); /* then bb */
+	keyview_fit_status(buf, sizeof buf, fields, drop, 4, 1);
+	assert_string_equal(buf, " a"); /* rank 0 is never left out */
+	/* key mode's fields: the timings, depth and size go first */
+	const char *km[] = {"view", "spot_triangulated.obj", "camera", "", "path", "12/64 spp… │ denoised", "depth 5",
+	                    "1280x720 (1/4 res)", "30 fps", "12 ms", "step 0.05"};
+	const int kd[] = {0, 5, 0, 0, 6, 0, 3, 4, 2, 1, 0};
+	char line[256];
+	/* at 81 the name fits (5+24+9+7+24+12 = 81 columns) ... */
+	keyview_fit_status(line, sizeof line, km, kd, 11, 81);
+	assert_string_equal(line, " view │ spot_triangulated.obj │ camera │ path │ 12/64 spp… │ denoised │ step 0.05");
+	/* ... at 80 it goes too */
+	keyview_fit_status(line, sizeof line, km, kd, 11, 80);
+	assert_string_equal(line, " view │ camera │ path │ 12/64 spp… │ denoised │ step 0.05");
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_layout),
 		cmocka_unit_test(test_bar_fits),
+		cmocka_unit_test(test_fit_status),
 		cmocka_unit_test(test_draw),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);

@@ -50,11 +50,31 @@ static void test_duration(void **state)
 	assert_string_equal(b, "0 ms");
 }
 
+/* Batch mode's and rtsh-mpi's output: the same text with a bar of 30, after
+ * a carriage return, padded to 78 columns (a shorter line covers a longer). */
+static void test_print(void **state)
+{
+	(void)state;
+	char out[256] = "";
+	FILE *f = fmemopen(out, sizeof out, "w");
+	assert_non_null(f);
+	progress_state p = {100, 100, 4, 1, 2, 1.0}; /* half done in 1 s: 1 s left */
+	progress_print(f, &p);
+	fclose(f);
+	const char *want = "[###############...............] 50% 2/4 spp 1.0 s, 1.0 s left 0.0 Mrays/s";
+	assert_int_equal(out[0], '\r');
+	assert_memory_equal(out + 1, want, strlen(want));
+	assert_int_equal(strlen(out), 1 + 78);
+	for (size_t i = 1 + strlen(want); i < strlen(out); i++)
+		assert_int_equal(out[i], ' ');
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_text),
 		cmocka_unit_test(test_duration),
+		cmocka_unit_test(test_print),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -336,6 +336,58 @@ static void test_srgb(void **state)
 	assert_near(l.z, 1, 1e-15);
 }
 
+/* render_image_srgb8: the codes its threads write as tiles finish are the
+ * sRGB encoding (linear_to_srgb8) of each float of rgb times 2^exposure,
+ * for any thread count, and a PPM written from it holds those codes. */
+static void test_srgb8_in_tiles(void **state)
+{
+	(void)state;
+	scene *s = base_scene(v3(0, 0, -5), v3(0, 0, 1), 60);
+	add_light(s, v3(3, 2, -5), 0.7);
+	object o = sphere(v3(0, 0, 0), 2.0, v3(200, 120, 40));
+	assert_true(scene_add_object(s, &o, NULL));
+	world *wd = world_build(s, NULL);
+	assert_non_null(wd);
+	render_settings set = render_settings_default();
+	set.width = 37; /* not a multiple of the tile */
+	set.height = 21;
+	set.exposure = 0.5;
+	char dir[] = "/tmp/rtsh-test-XXXXXX";
+	assert_non_null(mkdtemp(dir));
+	char path[256];
+	snprintf(path, sizeof path, "%s/a.ppm", dir);
+	for (int threads = 1; threads <= 2; threads++) {
+		set.threads = threads;
+		framebuffer *fb = render_image_srgb8(wd, &set, NULL, NULL, NULL, NULL);
+		assert_non_null(fb);
+		assert_non_null(fb->srgb8);
+		double gain = pow(2.0, 0.5);
+		for (int i = 0; i < 37 * 21 * 3; i++)
+			assert_int_equal(fb->srgb8[i], linear_to_srgb8(fb->rgb[i] * gain));
+		assert_true(image_write(path, fb, 0.5, NULL));
+		FILE *f = fopen(path, "rb");
+		assert_non_null(f);
+		unsigned char buf[64 + 37 * 21 * 3];
+		size_t n = fread(buf, 1, sizeof buf, f);
+		fclose(f);
+		size_t head = strlen("P6\n37 21\n255\n");
+		assert_int_equal(n, head + 37 * 21 * 3);
+		assert_memory_equal(buf + head, fb->srgb8, 37 * 21 * 3);
+		/* another exposure: the file is encoded from rgb, not from these codes */
+		assert_true(image_write(path, fb, 0.0, NULL));
+		framebuffer *back = image_read_ppm(path, NULL);
+		assert_non_null(back);
+		for (int i = 0; i < 37 * 21 * 3; i++)
+			assert_near(back->rgb[i], srgb_decode(linear_to_srgb8(fb->rgb[i])), 1e-6);
+		fb_free(back);
+		fb_free(fb);
+	}
+	unlink(path);
+	rmdir(dir);
+	world_free(wd);
+	scene_free(s);
+}
+
 static void test_image_files(void **state)
 {
 	(void)state;
@@ -461,6 +513,7 @@ int main(void)
 		cmocka_unit_test(test_cancel),
 		cmocka_unit_test(test_srgb),
 		cmocka_unit_test(test_image_files),
+		cmocka_unit_test(test_srgb8_in_tiles),
 		cmocka_unit_test(test_basic_silhouette),
 	};
 	return cmocka_run_group_tests_name("render", tests, NULL, NULL);

@@ -473,6 +473,18 @@ float *image_decode_rgb(const char *path, const unsigned char *buf, size_t len, 
 	}
 }
 
+float *image_load_netpbm(const char *path, bool pfm, int *w, int *h, rt_error *err)
+{
+	size_t len;
+	char *buf = rt_file_read_disk(path, "image", &len, err);
+	if (!buf)
+		return NULL;
+	const unsigned char *b = (const unsigned char *)buf;
+	float *out = pfm ? read_pfm(path, b, len, w, h, err) : read_ppm(path, b, len, true, w, h, err);
+	free(buf);
+	return out;
+}
+
 float *image_load_rgb(const char *path, bool srgb, int *w, int *h, rt_error *err)
 {
 	if (format_of(path) == F_NONE)
