@@ -184,6 +184,10 @@ bool surf_material(world *w, const object *o, uint32_t i, rt_error *err)
 			return false;
 		if (!mm->map_norm && mm->tex_norm)
 			t.nmap = mm->tex_norm;
+		if (mm->gltf && mm->map_mr && !hold_texture(w, mm->map_mr, false, &t.mr, err))
+			return false;
+		if (mm->gltf && !mm->map_mr && mm->tex_mr)
+			t.mr = mm->tex_mr;
 		if (mm->map_bump) {
 			if (!hold_texture(w, mm->map_bump, false, &t.bump, err))
 				return false;
@@ -191,7 +195,7 @@ bool surf_material(world *w, const object *o, uint32_t i, rt_error *err)
 			t.bumpscale = mm->bump_scale * 0.01;
 		}
 		l.tx = NULL;
-		if (t.tex || t.nmap || t.bump) {
+		if (t.tex || t.nmap || t.bump || t.mr) {
 			w->mtex[w->nmtex] = t;
 			l.tx = &w->mtex[w->nmtex++];
 		}

@@ -684,6 +684,117 @@ static void test_nodes_as_objects(void **state)
 	assert_non_null(strstr(err.msg, "node 7: not a node the scene places"));
 }
 
+/* --- a PNG of one texel, for textures the tests embed --- */
+
+static uint32_t crc32_of(const unsigned char *p, size_t n)
+{
+	uint32_t c = 0xffffffffu;
+	for (size_t i = 0; i < n; i++) {
+		c ^= p[i];
+		for (int k = 0; k < 8; k++)
+			c = c & 1 ? 0xedb88320u ^ (c >> 1) : c >> 1;
+	}
+	return c ^ 0xffffffffu;
+}
+
+static void put32(unsigned char *p, uint32_t v)
+{
+	p[0] = (unsigned char)(v >> 24);
+	p[1] = (unsigned char)(v >> 16);
+	p[2] = (unsigned char)(v >> 8);
+	p[3] = (unsigned char)v;
+}
+
+/* A 1x1 8-bit RGB PNG of (r, g, b): the IDAT a zlib stream of one stored
+ * block (filter byte 0 and the texel); 69 bytes into out. */
+static size_t png_1x1(unsigned char r, unsigned char g, unsigned char b, unsigned char *out)
+{
+	static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+	size_t n = 0;
+	memcpy(out, sig, 8);
+	n = 8;
+	unsigned char ihdr[17] = {'I', 'H', 'D', 'R', 0, 0, 0, 1, 0, 0, 0, 1, 8, 2, 0, 0, 0};
+	put32(out + n, 13);
+	memcpy(out + n + 4, ihdr, 17);
+	put32(out + n + 21, crc32_of(ihdr, 17));
+	n += 25;
+	unsigned char raw[4] = {0, r, g, b};
+	uint32_t a = 1, b2 = 0; /* adler32 */
+	for (int i = 0; i < 4; i++) {
+		a = (a + raw[i]) % 65521;
+		b2 = (b2 + a) % 65521;
+	}
+	unsigned char idat[4 + 2 + 5 + 4 + 4] = {'I', 'D', 'A', 'T', 0x78, 0x01, 0x01, 4, 0, 0xfb, 0xff};
+	memcpy(idat + 11, raw, 4);
+	put32(idat + 15, b2 << 16 | a);
+	put32(out + n, sizeof idat - 4);
+	memcpy(out + n + 4, idat, sizeof idat);
+	put32(out + n + 4 + sizeof idat, crc32_of(idat, sizeof idat));
+	n += 4 + sizeof idat + 4;
+	unsigned char iend[4] = {'I', 'E', 'N', 'D'};
+	put32(out + n, 0);
+	memcpy(out + n + 4, iend, 4);
+	put32(out + n + 8, crc32_of(iend, 4));
+	return n + 12;
+}
+
+/* The metallic-roughness texture in shading: a triangle with uv, metallic
+ * 0.5 and roughness 0.8, and a texture of one texel (R, G, B) = (0, 128,
+ * 255), read linear (glTF: G scales roughness, B metallic). At any point:
+ * roughness 0.8 x 128/255 = 0.40157, metallic 0.5 x 255/255 = 0.5. */
+static void test_metallic_roughness_texture(void **state)
+{
+	(void)state;
+	unsigned char bin[68];
+	const float pos[9] = {-1, -1, 0, 1, -1, 0, 0, 1, 0}, uv[6] = {0, 0, 1, 0, 0.5f, 1};
+	const uint16_t idx[4] = {0, 1, 2, 0};
+	memcpy(bin, pos, 36);
+	memcpy(bin + 36, uv, 24);
+	memcpy(bin + 60, idx, 8);
+	char data[128], png64[128];
+	b64(bin, sizeof bin, data);
+	unsigned char png[80];
+	size_t npng = png_1x1(0, 128, 255, png);
+	b64(png, npng, png64);
+	char text[4096];
+	snprintf(text, sizeof text,
+	         "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0},{\"camera\":0,\"translation\":[0,0,5]}],"
+	         "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":1}}],"
+	         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"indices\":2,"
+	         "\"material\":0}]}],"
+	         "\"materials\":[{\"pbrMetallicRoughness\":{\"metallicFactor\":0.5,\"roughnessFactor\":0.8,"
+	         "\"metallicRoughnessTexture\":{\"index\":0}}}],"
+	         "\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],"
+	         "\"buffers\":[{\"byteLength\":68,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
+	         "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":24},"
+	         "{\"buffer\":0,\"byteOffset\":60,\"byteLength\":6}],"
+	         "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+	         "{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"},"
+	         "{\"bufferView\":2,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}",
+	         png64, data);
+	rt_error err = {0};
+	scene *s = rt_load_file(tmp_text("mr.gltf", text), NULL, &err);
+	if (!s)
+		fail_msg("%s", err.msg);
+	world *w = world_build(s, &err);
+	if (!w)
+		fail_msg("%s", err.msg);
+	hit h;
+	ray r = {v3(0, -0.2, 5), v3(0, 0, -1)};
+	assert_true(world_intersect(w, &r, 0, INFINITY, &h));
+	assert_true(h.has_uv);
+	const mat_lin *m = &w->mats[h.mat];
+	assert_int_equal(m->family, MAT_PBR);
+	assert_near(m->pbr.roughness, 0.8, 1e-6);
+	assert_near(m->pbr.metallic, 0.5, 1e-6);
+	mat_lin tmp;
+	const mat_lin *t = hit_material(m, &h, &tmp);
+	assert_near(t->pbr.roughness, 0.8 * 128.0 / 255.0, 1e-6);
+	assert_near(t->pbr.metallic, 0.5, 1e-6);
+	world_free(w);
+	scene_free(s);
+}
+
 /* A file with neither lights nor emissive materials gets the model
  * viewer's stage lighting (ambient, a lamp, the sky, a floor) and a note
  * for the status line; with no camera it is framed as the viewer frames a
@@ -725,6 +836,7 @@ int main(void)
 	    cmocka_unit_test(test_camera_frustum),
 	    cmocka_unit_test(test_camera_roll),
 	    cmocka_unit_test(test_nodes_as_objects),
+	    cmocka_unit_test(test_metallic_roughness_texture),
 	    cmocka_unit_test(test_stage_lighting),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
