@@ -4,6 +4,7 @@
 
 #include <stdlib.h>
 
+#include "rtsh/mesh.h"
 #include "warp.h"
 
 /* --- emissive surfaces: sampled directly and found by the paths, the two
@@ -33,6 +34,113 @@ static double solid_angle_reach2(const emitter *e)
 	return SOLID_ANGLE_REACH * SOLID_ANGLE_REACH * (uu + vv);
 }
 
+/* The world material of triangle t of instance in (object i). */
+static uint32_t tri_mat(const prim_inst *in, size_t i, uint32_t t)
+{
+	if (in->mat_base == UINT32_MAX)
+		return (uint32_t)i;
+	return in->mat_base + (in->mesh->tmat ? in->mesh->tmat[t] : 0);
+}
+
+/* Walks the emissive triangles of the models: counts them, or (put) adds
+ * them to w->emitters material by material, each material's in one run. */
+static size_t mesh_walk(world *w, const scene *s, bool put)
+{
+	size_t total = 0, k = 0;
+	/* the model objects in order are the instances (surface.c) */
+	for (size_t i = 0; i < s->nobjs && k < w->ninsts; i++) {
+		if (!(obj_kind_flags(s->objs[i].kind) & KIND_MODEL))
+			continue;
+		const prim_inst *in = &w->insts[k++];
+		const mesh *m = in->mesh;
+		if (!m || !m->blk)
+			continue;
+		uint32_t nm = in->mat_base == UINT32_MAX ? 1 : (m->nmats ? m->nmats : 1);
+		for (uint32_t mi = 0; mi < nm; mi++) {
+			uint32_t wm = in->mat_base == UINT32_MAX ? (uint32_t)i : in->mat_base + mi;
+			if (wm >= w->nmats || !(max3(w->mats[wm].emission) > 0.0))
+				continue;
+			size_t first = w->nemitters, run = 0;
+			uint32_t last = UINT32_MAX;
+			/* each triangle once: a leaf's last block repeats its last */
+			for (uint32_t slot = 0; slot < 4 * m->nblk; slot++) {
+				uint32_t t = mesh_slot_tri(m, slot);
+				if (t == last || tri_mat(in, i, t) != wm)
+					continue;
+				last = t;
+				vec3 c[3];
+				mesh_corners(m, slot, c);
+				const double(*f)[4] = in->fwd;
+				for (int j = 0; j < 3; j++) {
+					vec3 q = c[j];
+					c[j] = v3(f[0][0] * q.x + f[0][1] * q.y + f[0][2] * q.z + f[0][3],
+					          f[1][0] * q.x + f[1][1] * q.y + f[1][2] * q.z + f[1][3],
+					          f[2][0] * q.x + f[2][1] * q.y + f[2][2] * q.z + f[2][3]);
+				}
+				emitter e = {.object = UINT32_MAX, .mat = wm, .run = 1, .shape = EMITTER_TRIANGLE, .c = c[0]};
+				e.u = v3_sub(c[1], c[0]);
+				e.v = v3_sub(c[2], c[0]);
+				vec3 nn = v3_cross(e.u, e.v);
+				e.area = 0.5 * v3_len(nn);
+				if (!(e.area > 0.0) || !v3_finite(nn))
+					continue;
+				e.n = v3_norm(nn);
+				e.reach2 = solid_angle_reach2(&e);
+				if (put)
+					w->emitters[w->nemitters++] = e;
+				run++;
+			}
+			if (put && run > 0) {
+				w->emitters[first].run = (uint32_t)run;
+				w->mats[wm].light = (int32_t)first;
+			}
+			total += run;
+		}
+	}
+	return total;
+}
+
+/* A model's emissive triangles are sampled too, MESH_EMITTERS of them in
+ * all at most (a lamp made of a few triangles; a model whose every
+ * triangle glows is left to the paths, as before). The count, and (put)
+ * the emitters added. */
+#define MESH_EMITTERS 1024
+
+static size_t mesh_emitters(world *w, const scene *s, bool put)
+{
+	size_t n = mesh_walk(w, s, false);
+	if (n == 0 || n > MESH_EMITTERS)
+		return 0;
+	if (put)
+		mesh_walk(w, s, true);
+	return n;
+}
+
+const emitter *emitter_at(const world *w, int32_t first, vec3 p)
+{
+	const emitter *e = &w->emitters[first], *best = e;
+	if (e->run <= 1)
+		return e;
+	double bd = INFINITY;
+	for (uint32_t j = 0; j < e->run; j++) {
+		const emitter *x = &w->emitters[(uint32_t)first + j];
+		/* p's barycentrics in the triangle c + a u + b v; how far outside */
+		vec3 d = v3_sub(p, x->c);
+		double uu = v3_dot(x->u, x->u), uv = v3_dot(x->u, x->v), vv = v3_dot(x->v, x->v);
+		double du = v3_dot(d, x->u), dv = v3_dot(d, x->v), det = uu * vv - uv * uv;
+		if (!(det > 0.0))
+			continue;
+		double a = (vv * du - uv * dv) / det, b = (uu * dv - uv * du) / det;
+		double out = fmax(fmax(-a, -b), a + b - 1.0);
+		out = fmax(out, 0.0) + fabs(v3_dot(d, x->n)) / sqrt(fmax(uu, vv));
+		if (out < bd) {
+			bd = out;
+			best = x;
+		}
+	}
+	return best;
+}
+
 bool emitters_build(world *w, const scene *s, rt_error *err)
 {
 	w->emitters = NULL;
@@ -44,7 +152,7 @@ bool emitters_build(world *w, const scene *s, rt_error *err)
 			const mat_lin *m = &w->mats[i];
 			if (!(max3(m->emission) > 0.0))
 				continue;
-			emitter e = {.object = (uint32_t)i};
+			emitter e = {.object = (uint32_t)i, .mat = (uint32_t)i, .run = 1};
 			bool plain = true; /* uniform scale, no shear */
 			for (int k = 0; k < 6; k++)
 				plain = plain && o->shear[k] == 0.0;
@@ -87,6 +195,7 @@ bool emitters_build(world *w, const scene *s, rt_error *err)
 				n++;
 			}
 		}
+		n += mesh_emitters(w, s, pass == 1);
 		if (pass == 0) {
 			if (n == 0)
 				return true;

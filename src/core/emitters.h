@@ -22,7 +22,10 @@ typedef enum emitter_shape {
 } emitter_shape;
 
 struct emitter {
-	uint32_t object; /* the scene object */
+	uint32_t object; /* the scene object (UINT32_MAX: a model's triangle) */
+	uint32_t mat;    /* its material in world.mats */
+	uint32_t run;    /* the first emitter of a material: the emitters of that
+	                  * material from here (a model's triangles); else 1 */
 	uint32_t shape;  /* emitter_shape */
 	vec3 c, u, v;    /* sphere: centre; flat shapes: see emitter_shape */
 	vec3 n;          /* flat shapes: unit normal */
@@ -37,6 +40,11 @@ struct emitter {
  * and triangles and points their materials at them (world_build calls it
  * last). False (err set) when out of memory. */
 bool emitters_build(world *w, const scene *s, rt_error *err);
+
+/* The emitter of material m (m->light = first) that a path met at p: the
+ * one of its run whose triangle holds p (a model's lamp of several
+ * triangles), else first's. */
+const emitter *emitter_at(const world *w, int32_t first, vec3 p);
 
 /* The density (per steradian) with which emitter_sample picks the
  * direction d (unit) from p towards e, whose surface it meets at distance t

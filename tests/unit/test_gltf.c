@@ -795,6 +795,72 @@ static void test_metallic_roughness_texture(void **state)
 	scene_free(s);
 }
 
+/* A lamp made of a glTF mesh is sampled directly, as the .rt emitters are:
+ * a 2 x 2 square of two triangles, emissiveFactor 1 x
+ * KHR_materials_emissive_strength 2 (Le = 2), 1 above a Lambert floor of
+ * albedo 0.8 at the origin, seen by a narrow camera at depth 1. By hand,
+ * the form factor from the origin to a parallel rectangle whose corner is
+ * straight above it, sides a and b at height h, X = a/h, Y = b/h, is
+ *   F = (X / sqrt(1+X^2) atan(Y / sqrt(1+X^2)) + Y / sqrt(1+Y^2) atan(X / sqrt(1+Y^2))) / (2 pi);
+ * the square is four such (X = Y = 1): F = 4 (2 / sqrt 2) atan(1 / sqrt 2) / (2 pi)
+ * = 0.554128, and the floor sends back 0.8 Le F. The two triangles are the
+ * world's emitters; the paths alone give the same. */
+static void test_mesh_lamp(void **state)
+{
+	(void)state;
+	unsigned char bin[60];
+	const float pos[12] = {-1, 0, -1, 1, 0, -1, 1, 0, 1, -1, 0, 1};
+	const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+	memcpy(bin, pos, 48);
+	memcpy(bin + 48, idx, 12);
+	char data[128];
+	b64(bin, sizeof bin, data);
+	char text[2048];
+	snprintf(text, sizeof text,
+	         "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0}],"
+	         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":0}]}],"
+	         "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1]},\"emissiveFactor\":[1,1,1],"
+	         "\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":2}}}],"
+	         "\"buffers\":[{\"byteLength\":60,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
+	         "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":12}],"
+	         "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
+	         "{\"bufferView\":1,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}]}",
+	         data);
+	tmp_text("lamp.gltf", text);
+	const char *rt = tmp_text("lamp.rt", "C 0,0.5,-4 0,-0.5,4 0.2\npl 0,0,0 0,1,0 1,1,1 255,255,255 0.8 0 1 0\n"
+	                                     "mesh lamp.gltf 0,1,0 0,1,0 2\n");
+	rt_error err = {0};
+	scene *s = rt_load_file(rt, NULL, &err);
+	if (!s)
+		fail_msg("%s", err.msg);
+	double f = 4 * (2 / sqrt(2)) * atan(1 / sqrt(2)) / (2 * M_PI), want = 0.8 * 2 * f;
+	double got[2];
+	for (int k = 0; k < 2; k++) {
+		world *w = world_build(s, &err);
+		if (!w)
+			fail_msg("%s", err.msg);
+		assert_int_equal(w->nemitters, 2);
+		if (k)
+			w->nemitters = 0;
+		render_settings set = render_settings_default();
+		set.width = set.height = 1;
+		set.samples = k ? 400000 : 20000;
+		set.depth = 1;
+		set.threads = 2;
+		set.mode = MODE_PATH;
+		set.seed = 5;
+		framebuffer *fb = render_image(w, &set, NULL, NULL, NULL, &err);
+		assert_non_null(fb);
+		got[k] = fb->rgb[1];
+		fb_free(fb);
+		world_free(w);
+	}
+	print_message("expected %.5f, sampled %.5f, paths only %.5f\n", want, got[0], got[1]);
+	assert_near(got[0], want, 0.005 * want);
+	assert_near(got[1], want, 0.01 * want);
+	scene_free(s);
+}
+
 /* A file with neither lights nor emissive materials gets the model
  * viewer's stage lighting (ambient, a lamp, the sky, a floor) and a note
  * for the status line; with no camera it is framed as the viewer frames a
@@ -837,6 +903,7 @@ int main(void)
 	    cmocka_unit_test(test_camera_roll),
 	    cmocka_unit_test(test_nodes_as_objects),
 	    cmocka_unit_test(test_metallic_roughness_texture),
+	    cmocka_unit_test(test_mesh_lamp),
 	    cmocka_unit_test(test_stage_lighting),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
