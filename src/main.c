@@ -58,7 +58,7 @@ static int batch_render(const rtsh_options *o)
 {
 	rt_error err;
 	char msg[RT_ERROR_MSG_MAX + RT_ERROR_FILE_MAX + 32];
-	if (image_format_of(o->output) == IMAGE_UNKNOWN) {
+	if (!image_type_of(o->output)) {
 		char exts[128], fmt[512]; /* the extensions from image.c's table of formats */
 		image_extensions(exts, sizeof exts, false);
 		snprintf(fmt, sizeof fmt, "output \"%%s\" has an unknown type; expected %s", exts);
@@ -93,7 +93,7 @@ static int batch_render(const rtsh_options *o)
 	clock_gettime(CLOCK_MONOTONIC, &ps.start);
 	bool bar = !o->quiet && isatty(STDERR_FILENO);
 	/* the 8-bit codes are made by the render's threads as tiles finish */
-	bool eight = image_format_of(o->output) != IMAGE_PFM;
+	bool eight = !image_type_of(o->output)->linear;
 	framebuffer *fb = (eight ? render_image_srgb8 : render_image)(w, &set, NULL, bar ? show_progress : NULL,
 	                                                               &ps, &err);
 	world_free(w);

@@ -16,33 +16,30 @@
 #include "rtsh/render.h"
 #include "rtsh/srgb.h" /* linear_to_srgb8: the 8-bit formats */
 
-typedef enum image_format {
-	IMAGE_UNKNOWN,
-	IMAGE_PPM,
-	IMAGE_PFM,
-	IMAGE_PNG,
-	IMAGE_JPEG,
-} image_format;
-
-/* By the path's extension (case-insensitive). */
-image_format image_format_of(const char *path);
-
-/* One image file format: the table in image.c, by extension. */
+/* One image file format: a row of the table in image.c, by extension.
+ * Adding a format is its encoder (and decoder) in image.c and one row:
+ * `save`, `rtsh -o`, rtsh-mpi, their messages, usage texts and completion
+ * list the table. */
 typedef struct image_type {
 	const char *ext;    /* ".ppm" */
-	const char *name;   /* "PPM" */
-	image_format format;
+	const char *name;   /* "PPM"; rows of one format share it (".jpg", ".jpeg") */
 	bool (*write)(FILE *f, void *ctx, rt_error *err); /* image.c's encoder */
 	framebuffer *(*read)(const char *path, rt_error *err); /* NULL: not read */
 	const char *help;   /* one line */
+	bool linear;        /* keeps linear radiance (PFM); else 8-bit sRGB codes */
 } image_type;
 
-/* The i-th format, NULL past the last; the format of path, or NULL. */
+/* The i-th format, NULL past the last; the format of path by its
+ * extension (case-insensitive), or NULL. */
 const image_type *image_type_at(size_t i);
 const image_type *image_type_of(const char *path);
 /* The extensions as a message lists them (".ppm, .pfm or .png"); only
  * those read back when `readable`. */
 void image_extensions(char *buf, size_t size, bool readable);
+/* The extensions of the formats written, each after prefix, joined by sep:
+ * ("FILE", "|") "FILE.ppm|FILE.pfm|FILE.png|FILE.jpg"; only the first
+ * extension of a format (not .jpeg) when first_only. */
+void image_extensions_join(char *buf, size_t size, const char *prefix, const char *sep, bool first_only);
 /* Reads any readable format, by extension. */
 framebuffer *image_read(const char *path, rt_error *err);
 

@@ -48,4 +48,8 @@ bool mem_check(double bytes, const char *what, rt_error *err);
  * when out of memory. */
 bool mem_grow(void **a, size_t *cap, size_t need, size_t size);
 
+/* A copy of the n bytes at p with a NUL after them (they may hold NULs:
+ * file contents), or NULL when out of memory. */
+char *mem_dupz(const void *p, size_t n);
+
 #endif

@@ -114,8 +114,10 @@ typedef struct render_job {
 } render_job;
 
 /* Runs the job to the end or until cancelled. On RENDER_DONE the fb holds
- * sample_end samples per pixel; on RENDER_CANCELLED the fb is unchanged in
- * spp but may hold a partial pass in rgb (the front end shows or drops it). */
+ * sample_end samples per pixel; on RENDER_CANCELLED its spp is 0 (the sums
+ * mix two passes, so the next pass starts again from sample 0) and rgb may
+ * hold a partial pass (the front end shows or drops it). test_cancel stops
+ * a pass in flight and checks the picture rendered again is the same. */
 render_status render_run(render_job *job, rt_error *err);
 
 /* Convenience: a new framebuffer of s->width x s->height with all s->samples

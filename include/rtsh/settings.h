@@ -15,19 +15,28 @@ typedef enum setting_type {
 	SETTING_INT,
 	SETTING_U64,
 	SETTING_DOUBLE,
-	SETTING_RESOLUTION, /* WxH */
-	SETTING_MODE,       /* whitted|path */
-	SETTING_DENOISE,    /* auto|on|off (denoise_mode) */
-	SETTING_PIXELS,     /* off|kitty|sixel|iterm|auto (pixels_mode) */
-	SETTING_SYMBOLS,    /* half|quadrant|sextant|octant|auto (symbols_kind) */
+	SETTING_RESOLUTION, /* WxH: render_settings.width and .height */
+	SETTING_ENUM,       /* one of `choices`, stored as an int: its index */
 } setting_type;
 
+/* setting_def.flags */
+enum {
+	SETTING_BARE_ON = 1, /* the command line's --NAME alone means --NAME=on */
+};
+
+/* One setting: adding one is a field in render_settings (render.h) and a
+ * row of settings_table (settings.c). `set`, its completion and help, the
+ * long option --NAME, the defaults (render_settings_default) and rtsh-mpi's
+ * wire (src/mpi/wire.c) all read the row. */
 typedef struct setting_def {
 	const char *name;
 	setting_type type;
-	double min, max; /* inclusive range for numbers (and each of W, H) */
-	size_t offset;   /* of the value in render_settings (W for a resolution) */
+	double min, max;  /* inclusive range for numbers (and each of W, H) */
+	size_t offset;    /* of the value in render_settings (W for a resolution) */
 	const char *help;
+	const char *def;  /* the default, as `set` would read it */
+	const char *const *choices; /* SETTING_ENUM: the names, in order, NULL-terminated */
+	unsigned flags;   /* SETTING_* above */
 } setting_def;
 
 extern const setting_def settings_table[];
@@ -41,5 +50,13 @@ const setting_def *settings_find(const char *name, rt_error *err);
 bool settings_set(render_settings *s, const setting_def *def, const char *value, rt_error *err);
 /* Writes the setting's current value ("64", "1920x1080", "path") to buf. */
 void settings_format(const render_settings *s, const setting_def *def, char *buf, size_t size);
+/* The number of choices of a SETTING_ENUM (0 for other types). */
+int settings_choices(const setting_def *def);
+/* The choices joined by sep ("whitted|path"), at most size bytes. */
+void settings_choices_text(const setting_def *def, const char *sep, const char *last, char *buf, size_t size);
+
+/* The value of an integer-like setting (INT, ENUM) in s, and setting it. */
+int settings_get_int(const render_settings *s, const setting_def *def);
+void settings_put_int(render_settings *s, const setting_def *def, int v);
 
 #endif

@@ -57,6 +57,36 @@ typedef struct shape_recipe {
 	short tube_lo, tube_hi;
 } shape_recipe;
 
+/* An emissive object of one kind in world space, as its kind samples it
+ * for the path tracer's direct lighting (emitters.c, path.c). */
+typedef struct shape_light {
+	vec3 c, u, v;  /* sphere: the centre; flat kinds: c + a u + b v, their
+	                * kind saying which a and b */
+	vec3 n;        /* flat kinds: the unit normal */
+	double r;      /* sphere: the radius */
+	double area;   /* flat kinds */
+	double reach2; /* flat kinds: sampled by the solid angle they subtend from
+	                * points closer to c than sqrt(reach2), by area beyond
+	                * (0: always by area) */
+} shape_light;
+
+/* How a kind's emissive objects are sampled directly (all NULL: they are
+ * found by the paths only). Multiple importance sampling (Veach & Guibas
+ * 1995) weighs these samples against the paths', so pdf must be the
+ * density sample draws with. */
+typedef struct shape_light_ops {
+	/* o's light in world space; false when o is not sampled directly (a
+	 * sphere scaled unevenly, a degenerate shape): found by the paths only. */
+	bool (*make)(const object *o, shape_light *l);
+	/* A direction *wi from p towards l from the uniform numbers (u1, u2),
+	 * its density *pdf per steradian and the distance *t to l along it;
+	 * false when there is none (p inside a sphere, a degenerate sample). */
+	bool (*sample)(const shape_light *l, vec3 p, double u1, double u2, vec3 *wi, double *pdf, double *t);
+	/* The density per steradian with which sample picks the unit direction
+	 * d from p, meeting l at distance t. */
+	double (*pdf)(const shape_light *l, vec3 p, vec3 d, double t);
+} shape_light_ops;
+
 /* One kind of shape (kinds.def names it, its geometry file defines it). */
 typedef struct shape_kind {
 	shape_form form;   /* the kind's own identifier */
@@ -70,9 +100,15 @@ typedef struct shape_kind {
 	bool (*occluded)(vec3 o, vec3 d, double tube, double tmin, double tmax);
 	/* The object-space bounds (within [-1,1]^3; infinite when unbounded). */
 	box (*bounds)(double tube);
-	/* The surface parameterisation textures use, at an object-space point
-	 * p of the surface: u, v in [0,1] and the unit tangent along u. */
-	void (*uv)(vec3 p, double tube, double *u, double *v, vec3 *tangent);
+	/* The texture coordinates (rtsh(5), "Texture coordinates") at the
+	 * object-space point q of the surface, whose object-space normal there
+	 * is nl (as intersect gave it, not normalised): u and v before uvscale
+	 * and uvoffset, and the object-space tangents dq/du and dq/dv (normal
+	 * and bump maps). NULL: the disc's planar u = (x + 1) / 2, v = (z + 1) / 2
+	 * (uv_planar). */
+	void (*uv)(vec3 q, vec3 nl, double tube, double *u, double *v, vec3 *dqdu, vec3 *dqdv);
+	/* Emissive objects of the kind sampled as lights (path mode). */
+	shape_light_ops light;
 	/* Traced in world space from its centre and radius when its scale is
 	 * uniform with no shear or texture (the sphere). */
 	bool world_sphere;
@@ -94,6 +130,10 @@ const shape_kind *shape_kind_of(obj_kind k);
 /* The kind whose form (or alias) has the identifier id, and that form;
  * NULL if none. */
 const shape_kind *shape_kind_find(const char *id, obj_kind *k, const shape_form **form);
+
+/* The texture coordinates of kind k at the object-space point q with the
+ * object-space normal nl: its uv, or the planar ones when it has none. */
+void shape_uv(obj_kind k, vec3 q, vec3 nl, double tube, double *u, double *v, vec3 *dqdu, vec3 *dqdv);
 
 /* The unit shape's object-space bounds (all of them fit [-1,1]^3). */
 box shape_local_bounds(obj_kind k, double tube);

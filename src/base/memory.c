@@ -5,6 +5,7 @@
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -112,4 +113,14 @@ bool mem_grow(void **a, size_t *cap, size_t need, size_t size)
 	*a = p;
 	*cap = c;
 	return true;
+}
+
+char *mem_dupz(const void *p, size_t n)
+{
+	char *d = malloc(n + 1);
+	if (d) {
+		memcpy(d, p, n);
+		d[n] = '\0';
+	}
+	return d;
 }

@@ -24,11 +24,6 @@ static const char *extension(const char *path)
 	return !dot || (slash && dot < slash) ? "" : dot;
 }
 
-image_format image_format_of(const char *path)
-{
-	const image_type *t = image_type_of(path);
-	return t ? t->format : IMAGE_UNKNOWN;
-}
 
 typedef struct image_ctx {
 	const framebuffer *fb;
@@ -176,11 +171,11 @@ static bool write_jpeg(FILE *f, void *vctx, rt_error *err)
 /* The formats, by extension: a new one is a line here (and its encoder
  * above, its decoder below). */
 static const image_type types[] = {
-	{".ppm", "PPM", IMAGE_PPM, write_ppm, image_read_ppm, "8-bit sRGB, binary netpbm (P6)"},
-	{".pfm", "PFM", IMAGE_PFM, write_pfm, image_read_pfm, "linear 32-bit float, as rendered"},
-	{".png", "PNG", IMAGE_PNG, write_png, NULL, "8-bit sRGB, libpng"},
-	{".jpg", "JPEG", IMAGE_JPEG, write_jpeg, NULL, "8-bit sRGB, baseline, quality 92 (stb_image_write)"},
-	{".jpeg", "JPEG", IMAGE_JPEG, write_jpeg, NULL, "8-bit sRGB, as .jpg"},
+	{".ppm", "PPM", write_ppm, image_read_ppm, "8-bit sRGB, binary netpbm (P6)", false},
+	{".pfm", "PFM", write_pfm, image_read_pfm, "linear 32-bit float, as rendered", true},
+	{".png", "PNG", write_png, NULL, "8-bit sRGB, libpng", false},
+	{".jpg", "JPEG", write_jpeg, NULL, "8-bit sRGB, baseline, quality 92 (stb_image_write)", false},
+	{".jpeg", "JPEG", write_jpeg, NULL, "8-bit sRGB, as .jpg", false},
 };
 #define NTYPES (sizeof types / sizeof types[0])
 
@@ -210,6 +205,19 @@ void image_extensions(char *buf, size_t size, bool readable)
 		k++;
 		used += (size_t)snprintf(buf + used, used < size ? size - used : 0, "%s%s",
 		                         k == 1 ? "" : k == n ? " or " : ", ", types[i].ext);
+	}
+}
+
+void image_extensions_join(char *buf, size_t size, const char *prefix, const char *sep, bool first_only)
+{
+	size_t used = 0;
+	if (size)
+		buf[0] = '\0';
+	for (size_t i = 0; i < NTYPES; i++) {
+		if (first_only && i > 0 && strcmp(types[i].name, types[i - 1].name) == 0)
+			continue;
+		used += (size_t)snprintf(buf + used, used < size ? size - used : 0, "%s%s%s", used ? sep : "", prefix,
+		                         types[i].ext);
 	}
 }
 

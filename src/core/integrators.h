@@ -16,6 +16,10 @@ vec3 whitted_radiance(const world *w, const render_settings *s, ray r);
 /* A Monte-Carlo estimate of the radiance along r (path.c); g gives the
  * camera sample's numbers, from dimension g->dim on. */
 vec3 path_radiance(const world *w, const render_settings *s, ray r, sampler *g);
+/* The same two with the camera ray's first hit already traced (a packet,
+ * packet.h): found says whether r hit anything, *h what (unread when not). */
+vec3 whitted_radiance_first(const world *w, const render_settings *s, ray r, bool found, const hit *h);
+vec3 path_radiance_first(const world *w, const render_settings *s, ray r, sampler *g, bool found, const hit *h);
 
 /* The scattering at one path vertex: the material family's lobes
  * (material.c; the seeds' Phong family in bsdf_phong.c, the physically

@@ -148,6 +148,13 @@ static vec3 sky_light(const world *w, const bsdf *b, vec3 p, vec3 pdn, sampler *
 
 vec3 path_radiance(const world *w, const render_settings *s, ray r, sampler *g)
 {
+	hit h;
+	bool found = world_intersect_coherent(w, &r, 0.0, INFINITY, &h);
+	return path_radiance_first(w, s, r, g, found, &h);
+}
+
+vec3 path_radiance_first(const world *w, const render_settings *s, ray r, sampler *g, bool found, const hit *first)
+{
 	/* Each bounce has its own dimensions whatever happens at it: the light
 	 * (2), the bsdf (3) and Russian roulette (1). */
 	const uint32_t dim0 = g->dim;
@@ -166,7 +173,10 @@ vec3 path_radiance(const world *w, const render_settings *s, ray r, sampler *g)
 	for (int bounce = 0;; bounce++) {
 		g->dim = dim0 + 6u * (uint32_t)bounce;
 		hit h;
-		if (!(bounce == 0 ? world_intersect_coherent : world_intersect)(w, &r, 0.0, INFINITY, &h)) {
+		bool met = bounce == 0 ? found : world_intersect(w, &r, 0.0, INFINITY, &h);
+		if (bounce == 0 && found)
+			h = *first;
+		if (!met) {
 			vec3 bg = world_background(w, r.d, MODE_PATH);
 			if (w->env && env_from_pdf > 0.0) {
 				double pe = envmap_pdf(w->env, r.d);

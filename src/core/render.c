@@ -10,50 +10,13 @@
 
 #include "integrators.h"
 #include "rtsh/denoise.h"
+#include "rtsh/packet.h"
 #include "rtsh/srgb.h"
 #include "rtsh/texture.h"
 
 const char *render_mode_name(render_mode m)
 {
 	return m == MODE_PATH ? "path" : "whitted";
-}
-
-render_settings render_settings_default(void)
-{
-	return (render_settings){
-		.width = 1280,
-		.height = 720,
-		.samples = 1,
-		.depth = 5,
-		.threads = 0,
-		.mode = MODE_WHITTED,
-		.seed = 1,
-		.exposure = 0.0,
-		.denoise = DENOISE_AUTO,
-		.symbols = 4, /* auto */
-	};
-}
-
-bool render_settings_apply_hints(render_settings *s, const scene_hints *h)
-{
-	bool clamped = false;
-	if (h->width > 0 && h->height > 0) {
-		double w = h->width, hh = h->height, big = fmax(w, hh);
-		if (big > RENDER_HINT_MAX_DIM) {
-			w = fmax(1.0, round(w * RENDER_HINT_MAX_DIM / big));
-			hh = fmax(1.0, round(hh * RENDER_HINT_MAX_DIM / big));
-			clamped = true;
-		}
-		s->width = (int)w;
-		s->height = (int)hh;
-	}
-	if (h->samples > 0)
-		s->samples = h->samples;
-	if (h->depth >= 0)
-		s->depth = h->depth;
-	if (h->mode >= 0)
-		s->mode = (render_mode)h->mode;
-	return clamped;
 }
 
 int render_threads(const render_settings *s)
@@ -143,29 +106,61 @@ typedef struct shared {
 	pthread_cond_t finished;
 } shared;
 
-/* Adds samples [s0, s1) of pixel (x, y) of an fw x fh image to acc, in
- * sample order: render_tile and render_rect share it, so a tile rendered
- * anywhere holds the same bits as the whole image. feat: the pixel's
+/* Adds samples [s0, s1) of the pixels of block [x0, x1) x [y0, y1) (at
+ * most PACKET_MAX of them, row by row) of an fw x fh image to acc[i], each
+ * pixel's in sample order: render_tile and render_rect share it, so a tile
+ * rendered anywhere holds the same bits as the whole image. The block's
+ * camera rays of one sample are traced together as a packet (packet.h),
+ * which finds the same hits as single rays to the bit. feat[i]: pixel i's
  * features for the denoiser (denoise.h), updated with these samples; NULL:
  * none. */
-static void pixel_add(const world *w, const render_settings *s, int x, int y, int fw, int fh,
-                      int s0, int s1, double acc[3], float *feat)
+static void block_add(const world *w, const render_settings *s, int x0, int y0, int x1, int y1, int fw, int fh,
+                      int s0, int s1, double (*acc)[3], float *const *feat)
 {
-	double fa[DENOISE_ACC] = {0}, ra[DENOISE_RACC] = {0};
-	for (int k = s0; k < s1; k++) {
-		vec3 c = render_sample(w, s, x, y, fw, fh, k);
-		acc[0] += c.x;
-		acc[1] += c.y;
-		acc[2] += c.z;
-		if (feat) {
-			denoise_radiance(c, k, ra);
-			if (k < DENOISE_FEATURE_SAMPLES) /* what this sample's ray first sees */
-				denoise_sample(w, render_sample_ray(w, s, x, y, fw, fh, k), fa);
-		}
+	double fa[PACKET_MAX][DENOISE_ACC], ra[PACKET_MAX][DENOISE_RACC];
+	int n = (x1 - x0) * (y1 - y0);
+	bool any_feat = false;
+	for (int i = 0; i < n; i++)
+		any_feat |= feat[i] != NULL;
+	if (any_feat) {
+		memset(fa, 0, sizeof fa);
+		memset(ra, 0, sizeof ra);
 	}
-	if (feat)
-		denoise_features(w, s, x, y, fw, fh, s0, s1, ra, fa, feat);
+	for (int k = s0; k < s1; k++) {
+		ray r[PACKET_MAX];
+		sampler sp[PACKET_MAX];
+		hit h[PACKET_MAX];
+		bool found[PACKET_MAX];
+		for (int y = y0, i = 0; y < y1; y++)
+			for (int x = x0; x < x1; x++, i++)
+				r[i] = camera_sample_ray(w, s, x, y, fw, fh, k, &sp[i]);
+		world_intersect_packet(w, n, r, 0.0, INFINITY, h, found);
+		for (int y = y0, i = 0; y < y1; y++)
+			for (int x = x0; x < x1; x++, i++) {
+				vec3 c = s->mode == MODE_PATH ? path_radiance_first(w, s, r[i], &sp[i], found[i], &h[i])
+				                              : whitted_radiance_first(w, s, r[i], found[i], &h[i]);
+				/* A NaN or infinity from a degenerate case must not poison the pixel. */
+				if (!v3_finite(c))
+					c = v3(0, 0, 0);
+				acc[i][0] += c.x;
+				acc[i][1] += c.y;
+				acc[i][2] += c.z;
+				if (feat[i]) {
+					denoise_radiance(c, k, ra[i]);
+					if (k < DENOISE_FEATURE_SAMPLES) /* what this sample's ray first sees */
+						denoise_sample(w, render_sample_ray(w, s, x, y, fw, fh, k), fa[i]);
+				}
+			}
+	}
+	for (int y = y0, i = 0; y < y1; y++)
+		for (int x = x0; x < x1; x++, i++)
+			if (feat[i])
+				denoise_features(w, s, x, y, fw, fh, s0, s1, ra[i], fa[i], feat[i]);
 }
+
+/* The blocks of PACKET_MAX pixels, 4 x 4, that render_tile and render_rect
+ * walk their rectangles in. */
+#define BLOCK_SIDE 4
 
 /* The 8-bit codes of a finished tile (framebuffer.srgb8), by the expression
  * of image.c's encoder: the same codes it would make. */
@@ -187,28 +182,38 @@ static void render_tile(shared *sh, long t)
 	int y1 = y0 + RENDER_TILE < fb->h ? y0 + RENDER_TILE : fb->h;
 	double inv = 1.0 / job->sample_end;
 	texture_set_pixel_angle(2.0 * cam_tan_x(&job->w->cam, fb->w, fb->h) / fb->w); /* texture footprints */
-	for (int y = y0; y < y1; y++)
-		for (int x = x0; x < x1; x++) {
-			size_t i = ((size_t)y * (size_t)fb->w + (size_t)x) * 3;
-			/* A first pass starts from zero whatever the sums hold (a
-			 * cancelled pass leaves them half done). */
-			double acc[3] = {0.0, 0.0, 0.0};
-			if (job->sample_begin > 0) {
-				acc[0] = fb->sum[i];
-				acc[1] = fb->sum[i + 1];
-				acc[2] = fb->sum[i + 2];
-			}
-			bool feat = fb->feat && job->set.mode == MODE_PATH;
-			pixel_add(job->w, &job->set, x, y, fb->w, fb->h, job->sample_begin, job->sample_end,
-			          acc, feat ? fb->feat + i / 3 * DENOISE_FEATURES : NULL);
-			if (fb->sum) {
-				fb->sum[i] = acc[0];
-				fb->sum[i + 1] = acc[1];
-				fb->sum[i + 2] = acc[2];
-			}
-			fb->rgb[i] = (float)(acc[0] * inv);
-			fb->rgb[i + 1] = (float)(acc[1] * inv);
-			fb->rgb[i + 2] = (float)(acc[2] * inv);
+	bool feat = fb->feat && job->set.mode == MODE_PATH;
+	for (int by = y0; by < y1; by += BLOCK_SIDE)
+		for (int bx = x0; bx < x1; bx += BLOCK_SIDE) {
+			int ex = bx + BLOCK_SIDE < x1 ? bx + BLOCK_SIDE : x1, ey = by + BLOCK_SIDE < y1 ? by + BLOCK_SIDE : y1;
+			double acc[PACKET_MAX][3];
+			float *fp[PACKET_MAX];
+			for (int y = by, k = 0; y < ey; y++)
+				for (int x = bx; x < ex; x++, k++) {
+					size_t i = ((size_t)y * (size_t)fb->w + (size_t)x) * 3;
+					/* A first pass starts from zero whatever the sums hold (a
+					 * cancelled pass leaves them half done). */
+					acc[k][0] = acc[k][1] = acc[k][2] = 0.0;
+					if (job->sample_begin > 0) {
+						acc[k][0] = fb->sum[i];
+						acc[k][1] = fb->sum[i + 1];
+						acc[k][2] = fb->sum[i + 2];
+					}
+					fp[k] = feat ? fb->feat + i / 3 * DENOISE_FEATURES : NULL;
+				}
+			block_add(job->w, &job->set, bx, by, ex, ey, fb->w, fb->h, job->sample_begin, job->sample_end, acc, fp);
+			for (int y = by, k = 0; y < ey; y++)
+				for (int x = bx; x < ex; x++, k++) {
+					size_t i = ((size_t)y * (size_t)fb->w + (size_t)x) * 3;
+					if (fb->sum) {
+						fb->sum[i] = acc[k][0];
+						fb->sum[i + 1] = acc[k][1];
+						fb->sum[i + 2] = acc[k][2];
+					}
+					fb->rgb[i] = (float)(acc[k][0] * inv);
+					fb->rgb[i + 1] = (float)(acc[k][1] * inv);
+					fb->rgb[i + 2] = (float)(acc[k][2] * inv);
+				}
 		}
 	if (fb->srgb8)
 		tile_srgb8(fb, x0, y0, x1, y1);
@@ -225,18 +230,30 @@ void render_rect_features(const world *w, const render_settings *s, int x0, int 
 {
 	double inv = 1.0 / s->samples;
 	texture_set_pixel_angle(2.0 * cam_tan_x(&w->cam, s->width, s->height) / s->width); /* as render_tile */
-	for (int y = y0; y < y1; y++)
-		for (int x = x0; x < x1; x++) {
-			double acc[3] = {0.0, 0.0, 0.0};
-			float *f = feat && s->mode == MODE_PATH ? feat : NULL;
-			if (feat) {
-				memset(feat, 0, DENOISE_FEATURES * sizeof *feat);
-				feat += DENOISE_FEATURES;
-			}
-			pixel_add(w, s, x, y, s->width, s->height, 0, s->samples, acc, f);
-			*out++ = (float)(acc[0] * inv);
-			*out++ = (float)(acc[1] * inv);
-			*out++ = (float)(acc[2] * inv);
+	size_t row = (size_t)(x1 - x0);
+	for (int by = y0; by < y1; by += BLOCK_SIDE)
+		for (int bx = x0; bx < x1; bx += BLOCK_SIDE) {
+			int ex = bx + BLOCK_SIDE < x1 ? bx + BLOCK_SIDE : x1, ey = by + BLOCK_SIDE < y1 ? by + BLOCK_SIDE : y1;
+			double acc[PACKET_MAX][3] = {{0}};
+			float *fp[PACKET_MAX];
+			for (int y = by, k = 0; y < ey; y++)
+				for (int x = bx; x < ex; x++, k++) {
+					size_t i = (size_t)(y - y0) * row + (size_t)(x - x0);
+					fp[k] = NULL;
+					if (feat) {
+						memset(feat + i * DENOISE_FEATURES, 0, DENOISE_FEATURES * sizeof *feat);
+						if (s->mode == MODE_PATH)
+							fp[k] = feat + i * DENOISE_FEATURES;
+					}
+				}
+			block_add(w, s, bx, by, ex, ey, s->width, s->height, 0, s->samples, acc, fp);
+			for (int y = by, k = 0; y < ey; y++)
+				for (int x = bx; x < ex; x++, k++) {
+					float *o = out + ((size_t)(y - y0) * row + (size_t)(x - x0)) * 3;
+					o[0] = (float)(acc[k][0] * inv);
+					o[1] = (float)(acc[k][1] * inv);
+					o[2] = (float)(acc[k][2] * inv);
+				}
 		}
 }
 

@@ -4,6 +4,7 @@
 #include "rtsh/num.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stddef.h>
 #include <inttypes.h>
 #include <stdio.h>
@@ -12,31 +13,108 @@
 
 #include "rtsh/memory.h"
 
+/* The names of render_mode's values, in order. */
+static const char *const mode_names[] = {"whitted", "path", NULL};
 /* The names of the denoise_mode values, in order. */
-static const char *const denoise_names[] = {"auto", "on", "off"};
+static const char *const denoise_names[] = {"auto", "on", "off", NULL};
 /* The names of term/pixels.h's pixels_mode values, in order. */
-static const char *const pixels_names[] = {"off", "kitty", "sixel", "iterm", "auto"};
+static const char *const pixels_names[] = {"off", "kitty", "sixel", "iterm", "auto", NULL};
 /* The names of term/symbols.h's symbols_kind values, in order. */
-static const char *const symbols_names[] = {"half", "quadrant", "sextant", "octant", "auto"};
+static const char *const symbols_names[] = {"half", "quadrant", "sextant", "octant", "auto", NULL};
+
+_Static_assert(sizeof(render_mode) == sizeof(int), "an enum setting is stored as an int");
 
 const setting_def settings_table[] = {
 #define AT(field) offsetof(render_settings, field)
-	{"resolution", SETTING_RESOLUTION, 1, RENDER_MAX_DIM, AT(width), "full-resolution image size, WxH"},
-	{"samples", SETTING_INT, 1, 1000000, AT(samples), "samples (rays or paths) per pixel"},
-	{"depth", SETTING_INT, 0, 1000, AT(depth), "reflection depth (whitted) or bounces (path)"},
-	{"mode", SETTING_MODE, 0, 1, AT(mode), "render mode: whitted or path"},
-	{"threads", SETTING_INT, 0, 256, AT(threads), "render threads; 0 = one per online CPU"},
-	{"seed", SETTING_U64, 0, 0, AT(seed), "random seed of the sampler"},
-	{"exposure", SETTING_DOUBLE, -20, 20, AT(exposure), "exposure in stops: output = radiance x 2^exposure"},
-	{"denoise", SETTING_DENOISE, 0, 2, AT(denoise),
-	 "path mode: denoise auto (previews only), on (saved images too) or off"},
-	{"pixels", SETTING_PIXELS, 0, 4, AT(pixels),
-	 "the picture in real pixels: off (half blocks), kitty, sixel, iterm, or auto (ask the terminal)"},
-	{"symbols", SETTING_SYMBOLS, 0, 4, AT(symbols),
-	 "the cells' glyphs: half, quadrant, sextant, octant, or auto (what the terminal is known to draw)"},
+	{"resolution", SETTING_RESOLUTION, 1, RENDER_MAX_DIM, AT(width), "full-resolution image size, WxH", "1280x720", NULL, 0},
+	{"samples", SETTING_INT, 1, 1000000, AT(samples), "samples (rays or paths) per pixel", "1", NULL, 0},
+	{"depth", SETTING_INT, 0, 1000, AT(depth), "reflection depth (whitted) or bounces (path)", "5", NULL, 0},
+	{"mode", SETTING_ENUM, 0, 0, AT(mode), "render mode: whitted or path", "whitted", mode_names, 0},
+	{"threads", SETTING_INT, 0, 256, AT(threads), "render threads; 0 = one per online CPU", "0", NULL, 0},
+	{"seed", SETTING_U64, 0, 0, AT(seed), "random seed of the sampler", "1", NULL, 0},
+	{"exposure", SETTING_DOUBLE, -20, 20, AT(exposure), "exposure in stops: output = radiance x 2^exposure", "0", NULL, 0},
+	{"denoise", SETTING_ENUM, 0, 0, AT(denoise),
+	 "path mode: denoise auto (previews only), on (saved images too) or off", "auto", denoise_names,
+	 SETTING_BARE_ON},
+	{"pixels", SETTING_ENUM, 0, 0, AT(pixels),
+	 "the picture in real pixels: off (half blocks), kitty, sixel, iterm, or auto (ask the terminal)", "off",
+	 pixels_names, 0},
+	{"symbols", SETTING_ENUM, 0, 0, AT(symbols),
+	 "the cells' glyphs: half, quadrant, sextant, octant, or auto (what the terminal is known to draw)", "auto",
+	 symbols_names, 0},
 #undef AT
 };
 const size_t settings_count = sizeof settings_table / sizeof settings_table[0];
+
+static bool set_value(render_settings *s, const setting_def *def, const char *value, bool check_memory,
+                      rt_error *err);
+
+render_settings render_settings_default(void)
+{
+	render_settings s;
+	memset(&s, 0, sizeof s);
+	rt_error err;
+	for (size_t i = 0; i < settings_count; i++)
+		set_value(&s, &settings_table[i], settings_table[i].def, false, &err);
+	return s;
+}
+
+bool render_settings_apply_hints(render_settings *s, const scene_hints *h)
+{
+	bool clamped = false;
+	if (h->width > 0 && h->height > 0) {
+		double w = h->width, hh = h->height, big = fmax(w, hh);
+		if (big > RENDER_HINT_MAX_DIM) {
+			w = fmax(1.0, round(w * RENDER_HINT_MAX_DIM / big));
+			hh = fmax(1.0, round(hh * RENDER_HINT_MAX_DIM / big));
+			clamped = true;
+		}
+		s->width = (int)w;
+		s->height = (int)hh;
+	}
+	if (h->samples > 0)
+		s->samples = h->samples;
+	if (h->depth >= 0)
+		s->depth = h->depth;
+	if (h->mode >= 0)
+		s->mode = (render_mode)h->mode;
+	return clamped;
+}
+
+int settings_choices(const setting_def *def)
+{
+	int n = 0;
+	if (def->type == SETTING_ENUM)
+		while (def->choices[n])
+			n++;
+	return n;
+}
+
+void settings_choices_text(const setting_def *def, const char *sep, const char *last, char *buf, size_t size)
+{
+	int n = settings_choices(def);
+	size_t at = 0;
+	if (size)
+		buf[0] = '\0';
+	for (int i = 0; i < n && at < size; i++) {
+		int k = snprintf(buf + at, size - at, "%s%s", i == 0 ? "" : i == n - 1 ? last : sep, def->choices[i]);
+		if (k < 0)
+			break;
+		at += (size_t)k;
+	}
+}
+
+int settings_get_int(const render_settings *s, const setting_def *def)
+{
+	int v;
+	memcpy(&v, (const char *)s + def->offset, sizeof v);
+	return v;
+}
+
+void settings_put_int(render_settings *s, const setting_def *def, int v)
+{
+	memcpy((char *)s + def->offset, &v, sizeof v);
+}
 
 const setting_def *settings_find(const char *name, rt_error *err)
 {
@@ -79,7 +157,9 @@ static bool parse_long(const char *s, double min, double max, long *out)
 	return num_scan_long(s, (long)min, (long)max, out) == NUM_OK;
 }
 
-bool settings_set(render_settings *s, const setting_def *def, const char *value, rt_error *err)
+/* settings_set; a resolution's memory is checked when check_memory. */
+static bool set_value(render_settings *s, const setting_def *def, const char *value, bool check_memory,
+                      rt_error *err)
 {
 	long a, b;
 	switch (def->type) {
@@ -119,46 +199,30 @@ bool settings_set(render_settings *s, const setting_def *def, const char *value,
 			                    value, def->min, def->max);
 		char what[64];
 		snprintf(what, sizeof what, "a %ldx%ld image", a, b);
-		if (!mem_check((double)a * (double)b * MEM_PER_PIXEL, what, err))
+		if (check_memory && !mem_check((double)a * (double)b * MEM_PER_PIXEL, what, err))
 			return false;
 		s->width = (int)a;
 		s->height = (int)b;
 		return true;
 	}
-	case SETTING_MODE:
-		if (strcmp(value, "whitted") == 0)
-			s->mode = MODE_WHITTED;
-		else if (strcmp(value, "path") == 0)
-			s->mode = MODE_PATH;
-		else
-			return rt_error_set(err, "mode \"%s\" is not valid; expected whitted or path", value);
-		return true;
-	case SETTING_DENOISE:
-		for (int i = 0; i < 3; i++)
-			if (strcmp(value, denoise_names[i]) == 0) {
-				s->denoise = i;
+	case SETTING_ENUM: {
+		int n = settings_choices(def);
+		for (int k = 0; k < n; k++)
+			if (strcmp(value, def->choices[k]) == 0) {
+				settings_put_int(s, def, k);
 				return true;
 			}
-		return rt_error_set(err, "denoise \"%s\" is not valid; expected auto, on or off", value);
-	case SETTING_PIXELS:
-		for (int i = 0; i < 5; i++)
-			if (strcmp(value, pixels_names[i]) == 0) {
-				s->pixels = i;
-				return true;
-			}
-		return rt_error_set(err, "pixels \"%s\" is not valid; expected off, kitty, sixel, iterm or auto",
-		                    value);
-	case SETTING_SYMBOLS:
-		for (int i = 0; i < 5; i++)
-			if (strcmp(value, symbols_names[i]) == 0) {
-				s->symbols = i;
-				return true;
-			}
-		return rt_error_set(err,
-		                    "symbols \"%s\" is not valid; expected half, quadrant, sextant, octant or auto",
-		                    value);
+		char names[256];
+		settings_choices_text(def, ", ", " or ", names, sizeof names);
+		return rt_error_set(err, "%s \"%s\" is not valid; expected %s", def->name, value, names);
+	}
 	}
 	return rt_error_set(err, "internal: setting %s has no type", def->name);
+}
+
+bool settings_set(render_settings *s, const setting_def *def, const char *value, rt_error *err)
+{
+	return set_value(s, def, value, true, err);
 }
 
 void settings_format(const render_settings *s, const setting_def *def, char *buf, size_t size)
@@ -176,17 +240,10 @@ void settings_format(const render_settings *s, const setting_def *def, char *buf
 	case SETTING_RESOLUTION:
 		snprintf(buf, size, "%dx%d", s->width, s->height);
 		return;
-	case SETTING_MODE:
-		snprintf(buf, size, "%s", render_mode_name(s->mode));
+	case SETTING_ENUM: {
+		int v = settings_get_int(s, def), n = settings_choices(def);
+		snprintf(buf, size, "%s", v >= 0 && v < n ? def->choices[v] : "?");
 		return;
-	case SETTING_DENOISE:
-		snprintf(buf, size, "%s", denoise_names[s->denoise >= 0 && s->denoise < 3 ? s->denoise : 0]);
-		return;
-	case SETTING_PIXELS:
-		snprintf(buf, size, "%s", pixels_names[s->pixels >= 0 && s->pixels < 5 ? s->pixels : 0]);
-		return;
-	case SETTING_SYMBOLS:
-		snprintf(buf, size, "%s", symbols_names[s->symbols >= 0 && s->symbols < 5 ? s->symbols : 4]);
-		return;
+	}
 	}
 }

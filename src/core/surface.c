@@ -1,18 +1,8 @@
 /* rtsh — meshes and textures in the world (surface.h).
  *
- * Texture coordinates per shape (rtsh(5), "Texture coordinates"); the
- * object-space point q and normal of the unit shape give them:
- *   sphere          u = 1/2 + atan2(x, -z) / 2pi, v = 1/2 + asin(y) / pi
- *                   (equirectangular: u = 1/2, the image's middle column,
- *                   faces -Z, where the default camera is; north is +Y)
- *   cylinder, cone  the side as the sphere's u, v = (y + 1) / 2; the caps
- *                   planar as the disc
- *   cube            each face the whole image: X faces (z, y), Y faces
- *                   (x, z), Z faces (x, y), each mapped from [-1,1] to [0,1]
- *   disc, rect      u = (x + 1) / 2, v = (z + 1) / 2
- *   plane           u = x, v = z in scene units (one repeat per unit)
- *   triangle        u, v the barycentric weights of the 2nd and 3rd vertex
- *   mesh            the file's vt
+ * Texture coordinates: each shape kind gives its own (shape_kind.uv, in
+ * src/core/shapes/; rtsh(5), "Texture coordinates"), the triangle's are the
+ * barycentric weights of its 2nd and 3rd vertex and a mesh's the file's vt;
  * then u x uvscale + uvoffset.
  *
  * Normal maps are tangent space (red along +u, green along +v, blue the
@@ -387,70 +377,16 @@ static vec3 inv_vector(const double (*m)[4], vec3 v)
 	                1.0 / det);
 }
 
-void surf_shape_uv(const world *w, uint32_t kind, const double (*inv)[4], vec3 nl, hit *h)
+void surf_shape_uv(const world *w, const prim_shape *sh, vec3 nl, hit *h)
 {
 	h->mat = h->object;
 	h->has_uv = false;
 	if (!wants_uv(w, h))
 		return;
-	vec3 q = h->local;
-	double u = 0, v = 0;
-	vec3 du = v3(0, 0, 0), dv = v3(0, 0, 0);
-	const double tau = 2 * M_PI;
-	double ax = fabs(nl.x), ay = fabs(nl.y), az = fabs(nl.z);
-	switch (kind) {
-	case OBJ_SPHERE: {
-		double len = v3_len(q);
-		vec3 s = len > 0 ? v3_scale(q, 1.0 / len) : v3(0, 1, 0);
-		double c = sqrt(s.x * s.x + s.z * s.z);
-		u = 0.5 + atan2(s.x, -s.z) / tau;
-		v = 0.5 + asin(clampd(s.y, -1, 1)) / M_PI;
-		du = v3_scale(v3(-q.z, 0, q.x), tau);
-		dv = c > 0 ? v3_scale(v3(-s.x * s.y / c, c, -s.z * s.y / c), M_PI * len) : v3(0, 0, 0);
-		break;
-	}
-	case OBJ_CYLINDER:
-	case OBJ_CONE:
-		if (ay > fmax(ax, az) * 4 && fabs(q.y) > 0.999) {
-			u = (q.x + 1) / 2;
-			v = (q.z + 1) / 2;
-			du = v3(2, 0, 0);
-			dv = v3(0, 0, 2);
-		} else {
-			u = 0.5 + atan2(q.x, -q.z) / tau;
-			v = (q.y + 1) / 2;
-			du = v3_scale(v3(-q.z, 0, q.x), tau);
-			dv = v3(0, 2, 0);
-		}
-		break;
-	case OBJ_CUBE:
-		if (ax >= ay && ax >= az) {
-			u = (q.z + 1) / 2, v = (q.y + 1) / 2;
-			du = v3(0, 0, 2), dv = v3(0, 2, 0);
-		} else if (ay >= az) {
-			u = (q.x + 1) / 2, v = (q.z + 1) / 2;
-			du = v3(2, 0, 0), dv = v3(0, 0, 2);
-		} else {
-			u = (q.x + 1) / 2, v = (q.y + 1) / 2;
-			du = v3(2, 0, 0), dv = v3(0, 2, 0);
-		}
-		break;
-	case OBJ_PLANE:
-		/* object units are scene units; x / 2 because the unit plane is
-		 * scaled by 1/2 like every unit shape (scene.c, object_xform) */
-		u = q.x;
-		v = q.z;
-		du = v3(1, 0, 0);
-		dv = v3(0, 0, 1);
-		break;
-	default: /* disc, rect */
-		u = (q.x + 1) / 2;
-		v = (q.z + 1) / 2;
-		du = v3(2, 0, 0);
-		dv = v3(0, 0, 2);
-		break;
-	}
-	apply_uv(w, h, u, v, inv_vector(inv, du), inv_vector(inv, dv));
+	double u, v;
+	vec3 du, dv;
+	shape_uv((obj_kind)sh->kind, h->local, nl, sh->tube, &u, &v, &du, &dv);
+	apply_uv(w, h, u, v, inv_vector(sh->inv, du), inv_vector(sh->inv, dv));
 }
 
 void surf_triangle_uv(const world *w, vec3 v0, vec3 e1, vec3 e2, hit *h)

@@ -39,10 +39,10 @@ static inline bool surf_inst_occluded(const world *w, const prim *p, const ray *
 void surf_inst_finish(const world *w, const prim *p, const ray *r, vec3 nl, hit *h);
 /* The geometric normal of that hit in world space, not unit. */
 vec3 surf_inst_ng(const world *w, const prim *p, vec3 nl);
-/* Texture coordinates of a unit shape of kind `kind` (or a world-space
- * triangle: its vertex, edges) at h, when its material has a texture;
- * inv is the world-to-object matrix (NULL for triangles). */
-void surf_shape_uv(const world *w, uint32_t kind, const double (*inv)[4], vec3 nl, hit *h);
+/* Texture coordinates of the unit shape sh at h (its kind's, shape.h), or
+ * of a world-space triangle (its vertex, edges), when h's material has a
+ * texture; nl is the object-space normal the shape's intersect gave. */
+void surf_shape_uv(const world *w, const prim_shape *sh, vec3 nl, hit *h);
 void surf_triangle_uv(const world *w, vec3 v0, vec3 e1, vec3 e2, hit *h);
 void surf_free(world *w);
 size_t surf_memory(const world *w);

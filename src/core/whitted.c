@@ -11,14 +11,20 @@
 
 static vec3 trace(const world *w, ray r, int depth);
 
+static vec3 shade(const world *w, ray r, int depth, bool found, const hit *h)
+{
+	if (!found)
+		return world_background(w, r.d, MODE_WHITTED);
+	const mat_lin *m = &w->mats[h->mat];
+	return mat_families[m->family]->whitted(w, m, h, r, depth, trace);
+}
+
 /* first: r is a camera ray (world_intersect_coherent) */
 static vec3 trace_at(const world *w, ray r, int depth, bool first)
 {
 	hit h;
-	if (!(first ? world_intersect_coherent : world_intersect)(w, &r, 0.0, INFINITY, &h))
-		return world_background(w, r.d, MODE_WHITTED);
-	const mat_lin *m = &w->mats[h.mat];
-	return mat_families[m->family]->whitted(w, m, &h, r, depth, trace);
+	bool found = (first ? world_intersect_coherent : world_intersect)(w, &r, 0.0, INFINITY, &h);
+	return shade(w, r, depth, found, &h);
 }
 
 static vec3 trace(const world *w, ray r, int depth)
@@ -29,4 +35,9 @@ static vec3 trace(const world *w, ray r, int depth)
 vec3 whitted_radiance(const world *w, const render_settings *s, ray r)
 {
 	return trace_at(w, r, s->depth, true);
+}
+
+vec3 whitted_radiance_first(const world *w, const render_settings *s, ray r, bool found, const hit *h)
+{
+	return shade(w, r, s->depth, found, h);
 }

@@ -11,6 +11,7 @@
 #endif
 
 #include "core/bvh/bvh.h"
+#include "core/prim_hit.h"
 #include "emitters.h"
 #include "envmap.h"
 #include "surface.h"
@@ -360,30 +361,6 @@ static inline void to_object(const prim_shape *sh, const ray *r, vec3 *o, vec3 *
 	            m[2][0] * r->d.x + m[2][1] * r->d.y + m[2][2] * r->d.z};
 }
 
-/* The nearest hit of a world-space sphere in (tmin, tmax); the stable
- * quadratic of Numerical Recipes 5.6. */
-static inline bool sphere_hit(const prim *p, const ray *r, double tmin, double tmax, double *t)
-{
-	vec3 oc = v3_sub(r->o, p->u.sph.c);
-	double b = v3_dot(oc, r->d), a = v3_dot(r->d, r->d);
-	double c = v3_dot(oc, oc) - p->u.sph.r * p->u.sph.r;
-	double disc = b * b - a * c;
-	if (disc < 0.0)
-		return false;
-	double q = -(b + copysign(sqrt(disc), b));
-	double t0 = q / a, t1 = q != 0.0 ? c / q : t0;
-	if (t0 > t1) {
-		double tmp = t0;
-		t0 = t1;
-		t1 = tmp;
-	}
-	double tt = t0 > tmin ? t0 : t1;
-	if (!(tt > tmin && tt < tmax))
-		return false;
-	*t = tt;
-	return true;
-}
-
 /* A triangle or a transformed shape (spheres are tested inline): *t and,
  * for a shape, the unnormalised normal in its object space (*nl). */
 static bool other_hit(const world *w, const prim *p, const ray *r, double tmin, double tmax, double *t,
@@ -436,20 +413,15 @@ static inline bool prim_occluded(const world *w, const prim *p, const ray *r, do
 	return other_occluded(w, p, r, tmin, tmax);
 }
 
-/* A plane: the unit plane's test (plane.c) with the ray's object-space
- * height and slope computed from row 1 of the matrix only. */
-static inline bool plane_hit(const prim_plane *pl, const ray *r, double tmin, double tmax, double *t)
+bool world_prim_hit(const world *w, const prim *p, const ray *r, double tmin, double tmax, double *t, vec3 *nl,
+                    bool coherent)
 {
-	const double *h = pl->h;
-	double oy = h[0] * r->o.x + h[1] * r->o.y + h[2] * r->o.z + h[3];
-	double dy = h[0] * r->d.x + h[1] * r->d.y + h[2] * r->d.z;
-	if (dy == 0.0)
-		return false;
-	double tt = -oy / dy;
-	if (!(tt > tmin && tt < tmax))
-		return false;
-	*t = tt;
-	return true;
+	return prim_hit(w, p, r, tmin, tmax, t, nl, coherent);
+}
+
+bool world_prim_occluded(const world *w, const prim *p, const ray *r, double tmin, double tmax)
+{
+	return prim_occluded(w, p, r, tmin, tmax);
 }
 
 /* The hit record of a plane. */
@@ -466,7 +438,7 @@ static void finish_plane(const world *w, const prim_plane *pl, const ray *r, dou
 	                  m[2][0] * q.x + m[2][1] * q.y + m[2][2] * q.z + m[2][3]};
 	h->front = v3_dot(pl->n, r->d) < 0.0;
 	h->n = pl->n;
-	surf_shape_uv(w, OBJ_PLANE, sh->inv, pl->n, h);
+	surf_shape_uv(w, sh, pl->n, h);
 }
 
 /* Fills the hit record for the primitive found nearest. */
@@ -509,7 +481,7 @@ static void finish_hit(const world *w, const prim *p, const ray *r, double t, ve
 	h->front = v3_dot(n, r->d) < 0.0;
 	h->n = n;
 	if (shp) {
-		surf_shape_uv(w, shp->kind, shp->inv, nl, h);
+		surf_shape_uv(w, shp, nl, h);
 	} else {
 		const prim_tri *tr = &w->tris[p->u.index];
 		surf_triangle_uv(w, tr->v0, tr->e1, tr->e2, h);
@@ -528,6 +500,11 @@ void world_rays_reset(void)
 uint64_t world_rays_traced(void)
 {
 	return rays_traced;
+}
+
+void world_rays_count(int n)
+{
+	rays_traced += (uint64_t)(int64_t)n;
 }
 
 size_t world_memory(const world *w)
@@ -558,24 +535,6 @@ size_t world_memory(const world *w)
  * On x86-64 the four children are tested at once in SSE registers; the
  * scalar loop is the same test for other machines (GCC 12 vectorises it,
  * but the explicit version measured faster). */
-
-/* A float <= v and a float >= v (a step of |f| 2^-23 covers the rounding;
- * cheaper than nextafterf, which is a library call). */
-static inline float to_float_down(double v)
-{
-	float f = (float)v;
-	if ((double)f <= v)
-		return f;
-	return f == INFINITY ? FLT_MAX : f - (fabsf(f) * 0x1p-23f + 0x1p-149f);
-}
-
-static inline float to_float_up(double v)
-{
-	float f = (float)v;
-	if ((double)f >= v)
-		return f;
-	return f == -INFINITY ? -FLT_MAX : f + (fabsf(f) * 0x1p-23f + 0x1p-149f);
-}
 
 static inline void ray_prepare(const ray *r, bvh_ray *q)
 {

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rtsh/memory.h"
 #include "rtsh/rtfile.h"
 
 void fileset_free(fileset *fs)
@@ -16,16 +17,6 @@ void fileset_free(fileset *fs)
 	}
 	free(fs->files);
 	*fs = (fileset){0};
-}
-
-static char *dup_bytes(const char *p, size_t len)
-{
-	char *c = malloc(len + 1);
-	if (c) {
-		memcpy(c, p, len);
-		c[len] = '\0';
-	}
-	return c;
 }
 
 /* Takes ownership of path and data (freed on failure). */
@@ -62,12 +53,12 @@ char *fileset_record(void *ctx, const char *path, size_t *len, rt_error *err)
 	const file_entry *e = find(fs, path);
 	if (e) {
 		*len = e->len;
-		return dup_bytes(e->data, e->len);
+		return mem_dupz(e->data, e->len);
 	}
 	char *data = rt_read_file(path, NULL, len, err);
 	if (!data)
 		return NULL;
-	char *copy = dup_bytes(data, *len), *name = dup_bytes(path, strlen(path));
+	char *copy = mem_dupz(data, *len), *name = mem_dupz(path, strlen(path));
 	if (!copy || !name || !add(fs, name, copy, *len)) {
 		if (!copy || !name) {
 			free(copy);
@@ -87,7 +78,7 @@ char *fileset_serve(void *ctx, const char *path, size_t *len, rt_error *err)
 		rt_error_at(err, path, 0, 0, "not among the files rank 0 sent; expected a file rank 0 read");
 		return NULL;
 	}
-	char *c = dup_bytes(e->data, e->len);
+	char *c = mem_dupz(e->data, e->len);
 	if (!c) {
 		rt_error_at(err, path, 0, 0, "out of memory");
 		return NULL;
@@ -101,7 +92,7 @@ static bool keep(fileset *fs, const char *path, const char *data, size_t len)
 {
 	if (find(fs, path))
 		return true;
-	char *copy = dup_bytes(data, len), *name = dup_bytes(path, strlen(path));
+	char *copy = mem_dupz(data, len), *name = mem_dupz(path, strlen(path));
 	if (!copy || !name) {
 		free(copy);
 		free(name);
@@ -116,7 +107,7 @@ static char *src_record(void *ctx, const char *path, const char *what, size_t *l
 	const file_entry *e = find(fs, path);
 	if (e) {
 		*len = e->len;
-		return dup_bytes(e->data, e->len);
+		return mem_dupz(e->data, e->len);
 	}
 	char *data = rt_file_read_disk(path, what, len, err);
 	if (data && !keep(fs, path, data, *len)) {
@@ -140,7 +131,7 @@ static char *src_serve(void *ctx, const char *path, const char *what, size_t *le
 		rt_error_set(err, "%s: cannot read the %s: not among the files rank 0 sent", path, what);
 		return NULL;
 	}
-	char *c = dup_bytes(e->data, e->len);
+	char *c = mem_dupz(e->data, e->len);
 	if (!c) {
 		rt_error_set(err, "%s: out of memory reading the %s", path, what);
 		return NULL;
@@ -217,7 +208,7 @@ bool fileset_unpack(fileset *fs, const char *buf, size_t size)
 		p += pl;
 		if (!get_u64(&p, end, &dl) || dl > (uint64_t)(end - p) || memchr(path, '\0', pl))
 			return false;
-		if (!add(fs, dup_bytes(path, pl), dup_bytes(p, dl), dl))
+		if (!add(fs, mem_dupz(path, pl), mem_dupz(p, dl), dl))
 			return false;
 		p += dl;
 	}

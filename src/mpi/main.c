@@ -42,15 +42,17 @@
 
 static void usage(FILE *f)
 {
-	fputs("usage: mpirun -n N [--hostfile HOSTS] rtsh-mpi SCENE.rt -o OUT [OPTIONS]\n"
-	      "Renders SCENE.rt to OUT (.ppm .pfm .png) across the ranks of an MPI job; the\n"
+	char exts[128]; /* image.c's table of formats */
+	image_extensions_join(exts, sizeof exts, "", " ", false);
+	fprintf(f, "usage: mpirun -n N [--hostfile HOSTS] rtsh-mpi SCENE.rt -o OUT [OPTIONS]\n"
+	      "Renders SCENE.rt to OUT (%s) across the ranks of an MPI job; the\n"
 	      "output is the same, byte for byte, as `rtsh SCENE.rt -o OUT [OPTIONS]`.\n"
 	      "  -v, --verbose                per-rank figures at the end: tiles, seconds,\n"
 	      "                               Mrays/s, bytes sent\n"
 	      "  -t N                         render threads per rank (0: the node's CPUs\n"
 	      "                               shared among its ranks)\n"
 	      "and rtsh's batch options:\n",
-	      f);
+	      exts);
 	args_usage(f, ARGS_BATCH, "rtsh-mpi");
 	fputs("See rtsh-mpi(1).\n", f);
 }
@@ -160,9 +162,11 @@ static void setup(int argc, char **argv, job_config *c, fileset *files, world **
 		        "Try 'rtsh-mpi --help' for more information.\n", o.output);
 		goto out;
 	}
-	if (!o.turntable && image_format_of(o.output) == IMAGE_UNKNOWN) {
-		fprintf(stderr, "rtsh-mpi: output \"%s\" has an unknown type; expected .ppm, .pfm or .png\n"
-		        "Try 'rtsh-mpi --help' for more information.\n", o.output);
+	if (!o.turntable && !image_type_of(o.output)) {
+		char exts[128];
+		image_extensions(exts, sizeof exts, false);
+		fprintf(stderr, "rtsh-mpi: output \"%s\" has an unknown type; expected %s\n"
+		        "Try 'rtsh-mpi --help' for more information.\n", o.output, exts);
 		goto out;
 	}
 	long tile, prefetch, delay; /* tile 0: auto_tile; prefetch -1: half the threads, at least 2 */

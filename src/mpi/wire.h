@@ -5,11 +5,14 @@
  * version of rtsh-mpi read the same values or refuse with a message; no
  * padding, pointer or struct layout is ever sent.
  *
- * Layout (version 2), WIRE_CONFIG_SIZE bytes, zeros after the fields:
+ * Layout (version 3), WIRE_CONFIG_SIZE bytes, zeros after the fields:
  *   "RTSHMPI\0"  u32 version  u32 length of what follows
  *   i32 status verbose progress strict tile prefetch delay_us
- *   render_settings: i32 width height samples depth threads mode
- *                    u64 seed  f64 exposure  i32 denoise pixels symbols
+ *   render_settings: every row of the settings table (settings.h), in its
+ *                    order, by its type: i32 for a whole number or a
+ *                    choice, u64, f64, or i32 W and H for a resolution
+ *                    (today: width height samples depth mode threads
+ *                    seed exposure denoise pixels symbols)
  *   u64 files (bytes of the packed file set)
  */
 #ifndef RTSH_MPI_WIRE_H
@@ -21,7 +24,7 @@
 
 #include "rtsh/render.h"
 
-#define WIRE_VERSION 2
+#define WIRE_VERSION 3
 /* Every rank receives this many bytes: more than version 1 needs, so that a
  * newer version can add fields and still be told apart. */
 #define WIRE_CONFIG_SIZE 256

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rtsh/memory.h"
 #include "rtsh/scene.h"
 
 static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
@@ -60,10 +61,8 @@ const char *rt_intern(const char *s, size_t n)
 		}
 	}
 	if (!out && 2 * (nset + 1) <= cap) {
-		char *d = malloc(n + 1);
+		char *d = mem_dupz(s, n);
 		if (d) {
-			memcpy(d, s, n);
-			d[n] = '\0';
 			insert(set, cap, d);
 			nset++;
 			out = d;

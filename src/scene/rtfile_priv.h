@@ -12,6 +12,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "rtsh/atomic.h"
 #include "rtsh/rules.h"
 #include "rtsh/scene.h"
 
@@ -48,6 +49,10 @@ extern _Thread_local const char *rt_write_dir;
  * (relative to it when below it, else as stored, made absolute when a
  * relative name would not be found from there; quoted when needed). */
 void rt_write_file_name(const char *file, char *out, size_t size);
+/* Writes path atomically through write(ctx) with rt_write_dir the new
+ * file's folder ("" when the path names none, and with no_dot for "." too),
+ * for rt_save and rt_save_keeping. */
+bool rt_save_in_folder(const char *path, bool no_dot, file_writer_fn write, void *ctx, rt_error *err);
 
 extern const rt_key rt_keys[];
 extern const size_t rt_nkeys;

@@ -423,10 +423,8 @@ static bool save_writer(FILE *f, void *ctx, rt_error *err)
 	return rt_write(c->s, f, err);
 }
 
-bool rt_save(const scene *s, const char *path, rt_error *err)
+bool rt_save_in_folder(const char *path, bool no_dot, file_writer_fn write, void *ctx, rt_error *err)
 {
-	save_ctx c = {s};
-	/* file names below the new file's folder are written relative to it */
 	char dir[4096] = "";
 	const char *slash = strrchr(path, '/');
 	if (slash) {
@@ -435,12 +433,17 @@ bool rt_save(const scene *s, const char *path, rt_error *err)
 			memcpy(dir, path, n);
 			dir[n] = '\0';
 		}
-	} else {
-		snprintf(dir, sizeof dir, ".");
 	}
 	const char *old = rt_write_dir;
-	rt_write_dir = strcmp(dir, ".") == 0 ? "" : dir;
-	bool ok = file_write_atomic(path, save_writer, &c, err);
+	rt_write_dir = no_dot && strcmp(dir, ".") == 0 ? "" : dir;
+	bool ok = file_write_atomic(path, write, ctx, err);
 	rt_write_dir = old;
 	return ok;
+}
+
+bool rt_save(const scene *s, const char *path, rt_error *err)
+{
+	save_ctx c = {s};
+	/* file names below the new file's folder are written relative to it */
+	return rt_save_in_folder(path, true, save_writer, &c, err);
 }

@@ -1040,18 +1040,5 @@ bool rt_save_keeping(const scene *s, const char *src, size_t len, const char *pa
 {
 	keep_ctx c = {s, src, len};
 	/* file names are written (and checked) relative to the new file's folder */
-	char dir[4096] = "";
-	const char *slash = strrchr(path, '/');
-	if (slash) {
-		size_t n = slash == path ? 1 : (size_t)(slash - path);
-		if (n < sizeof dir) {
-			memcpy(dir, path, n);
-			dir[n] = '\0';
-		}
-	}
-	const char *old = rt_write_dir;
-	rt_write_dir = dir;
-	bool ok = file_write_atomic(path, keep_writer, &c, err);
-	rt_write_dir = old;
-	return ok;
+	return rt_save_in_folder(path, false, keep_writer, &c, err);
 }

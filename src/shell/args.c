@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rtsh/image.h"
+
 /* Long options that are not settings get these codes (past any char). */
 enum {
 	OPT_STRICT = 0x100,
@@ -30,7 +32,7 @@ static const struct {
 	bool shell;
 	const char *arg, *help;
 } fixed[] = {
-	{{"output", required_argument, NULL, 'o'}, false, "OUT", "render at full resolution to OUT (.ppm .pfm .png), exit"},
+	{{"output", required_argument, NULL, 'o'}, false, "OUT", "render at full resolution to OUT (@images), exit"},
 	{{"command", required_argument, NULL, 'c'}, true, "'CMD; CMD'", "run shell commands, then exit"},
 	{{"file", required_argument, NULL, 'f'}, true, "FILE", "run a command file (- = standard input), then exit"},
 	{{"interactive", no_argument, NULL, 'i'}, true, NULL, "with -c or -f: stay in the interactive shell afterwards"},
@@ -66,15 +68,30 @@ static char short_of(const char *setting)
 	return 0;
 }
 
+/* A help text with "@images" replaced by the image formats' extensions
+ * (image.c's table). */
+static void put_help(FILE *f, const char *left, const char *help)
+{
+	const char *at = strstr(help, "@images");
+	char exts[128];
+	image_extensions_join(exts, sizeof exts, "", " ", false);
+	if (at)
+		fprintf(f, "  %-28s %.*s%s%s\n", left, (int)(at - help), help, exts, at + strlen("@images"));
+	else
+		fprintf(f, "  %-28s %s\n", left, help);
+}
+
 void args_usage(FILE *f, args_kind kind, const char *prog)
 {
+	char exts[128];
+	image_extensions_join(exts, sizeof exts, "", " ", false);
 	if (kind == ARGS_RTSH)
 		fprintf(f,
 		        "usage: %s [OPTIONS] [SCENE.rt]\n"
 		        "  %s                      open the shell on the built-in showcase scene\n"
 		        "  %s SCENE.rt             open the shell on SCENE.rt\n"
-		        "  %s SCENE.rt -o OUT      render at full resolution to OUT (.ppm .pfm .png), exit\n",
-		        prog, prog, prog, prog);
+		        "  %s SCENE.rt -o OUT      render at full resolution to OUT (%s), exit\n",
+		        prog, prog, prog, prog, exts);
 	else
 		fprintf(f, "usage: %s [OPTIONS] SCENE.rt -o OUT\n", prog);
 	fputs("options (GNU style: -s4 or -s 4, --samples=4 or --samples 4, -qi, options after the scene):\n", f);
@@ -89,7 +106,7 @@ void args_usage(FILE *f, args_kind kind, const char *prog)
 		else
 			snprintf(left, sizeof left, "    --%s%s%s", fixed[i].opt.name, fixed[i].arg ? " " : "",
 			         fixed[i].arg ? fixed[i].arg : "");
-		fprintf(f, "  %-28s %s\n", left, fixed[i].help);
+		put_help(f, left, fixed[i].help);
 	}
 	fputs("settings (the shell's `set NAME VALUE`; they win over the scene's own):\n", f);
 	for (size_t i = 0; i < settings_count; i++) {
@@ -99,7 +116,7 @@ void args_usage(FILE *f, args_kind kind, const char *prog)
 			snprintf(left, sizeof left, "-%c, --%s=VALUE", c, settings_table[i].name);
 		else
 			snprintf(left, sizeof left, "    --%s%s", settings_table[i].name,
-			         settings_table[i].type == SETTING_DENOISE ? "[=VALUE]" : "=VALUE");
+			         (settings_table[i].flags & SETTING_BARE_ON) ? "[=VALUE]" : "=VALUE");
 		fprintf(f, "  %-28s %s\n", left, settings_table[i].help);
 	}
 	if (kind == ARGS_RTSH)
@@ -196,7 +213,7 @@ int args_parse(int argc, char **argv, args_kind kind, const char *prog, rtsh_opt
 	for (size_t i = 0; i < settings_count; i++)
 		longs[n++] = (struct option){settings_table[i].name,
 		                             /* --denoise alone means on */
-		                             settings_table[i].type == SETTING_DENOISE ? optional_argument
+		                             (settings_table[i].flags & SETTING_BARE_ON) ? optional_argument
 		                                                                       : required_argument,
 		                             NULL, OPT_SETTING + (int)i};
 	/* '-': operands come back in order as option 1 (so options may follow

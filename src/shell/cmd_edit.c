@@ -45,6 +45,17 @@ static int pick_sub(shell *sh, const char *cmd, const char *kind, const char *ch
 		return true;                                             \
 	} while (0)
 
+/* An edit of item i by a vector: `v` read as hint says ("X,Y,Z"; NULL: a
+ * colour R,G,B), then the editor's call. */
+typedef bool (*vec_edit)(editor *ed, size_t i, vec3 v, rt_error *err);
+static bool edit_vec(shell *sh, const char *what, size_t i, const char *v, const char *hint, vec_edit call)
+{
+	vec3 p;
+	if (hint ? !arg_vec(sh, what, v, hint, &p) : !arg_color(sh, what, v, &p))
+		return false;
+	EDIT(sh, what, call(sh->ed, i, p, &err_));
+}
+
 static bool need_value(shell *sh, const char *what, const char *usage, int argc, int want)
 {
 	if (argc != want)
@@ -127,88 +138,92 @@ bool cmd_camera(shell *sh, int argc, char **argv, const char *rest)
 	}
 }
 
+/* What `light N ...` and `object N ...` share. */
+typedef struct item_cmd {
+	const char *name, *list; /* "light", "lights" (the `list` subject) */
+	const char *kind, *usage, *subs;
+	const char *const *names; /* the subcommands in `subs` order */
+	void (*fields)(shell *sh, size_t i);
+} item_cmd;
+
+/* No N lists the items; N alone shows its fields; otherwise the index in *i,
+ * `what` ("light pos") and the subcommand's number are found. Returns the
+ * subcommand, or -1 when the command is over with *result. */
+static int item_sub(shell *sh, const item_cmd *c, size_t count, int argc, char **argv, size_t *i, char *what,
+                    size_t wsize, bool *result)
+{
+	*result = false;
+	if (argc == 0) {
+		char *a[] = {(char *)c->list};
+		*result = cmd_list(sh, 1, a, "");
+		return -1;
+	}
+	if (!arg_index(sh, c->name, argv[0], c->name, count, i))
+		return -1;
+	if (argc == 1) {
+		c->fields(sh, *i);
+		*result = true;
+		return -1;
+	}
+	if (argc < 3) {
+		shell_fail(sh, "%s: too few arguments; usage: %s", c->name, c->usage);
+		return -1;
+	}
+	int sub = pick_sub(sh, c->name, c->kind, c->subs, argv[1]);
+	if (sub >= 0)
+		snprintf(what, wsize, "%s %s", c->name, c->names[sub]);
+	return sub;
+}
+
 bool cmd_light(shell *sh, int argc, char **argv, const char *rest)
 {
 	(void)rest;
-	const scene *s = editor_scene(sh->ed);
-	if (argc == 0) {
-		char *a[] = {"lights"};
-		return cmd_list(sh, 1, a, "");
-	}
-	size_t i;
-	if (!arg_index(sh, "light", argv[0], "light", s->nlights, &i))
-		return false;
-	if (argc == 1) {
-		answer_light_fields(sh, i);
-		return true;
-	}
-	if (argc < 3)
-		return shell_fail(sh, "light: too few arguments; usage: light N pos|move|brightness|color VALUE");
-	int sub = pick_sub(sh, "light", "a light command", SUBS_LIGHT, argv[1]);
-	if (sub < 0)
-		return false;
 	static const char *const names[] = {"pos", "move", "brightness", "color"};
+	static const item_cmd c = {"light", "lights", "a light command", "light N pos|move|brightness|color VALUE",
+	                           SUBS_LIGHT, names, answer_light_fields};
+	size_t i;
 	char what[32];
-	snprintf(what, sizeof what, "light %s", names[sub]);
+	bool result;
+	int sub = item_sub(sh, &c, editor_scene(sh->ed)->nlights, argc, argv, &i, what, sizeof what, &result);
+	if (sub < 0)
+		return result;
 	const char *v = argv[2];
-	vec3 p;
 	double d;
 	switch (sub) {
 	case 0:
-		if (!arg_vec(sh, what, v, "X,Y,Z", &p))
-			return false;
-		EDIT(sh, what, editor_light_pos(sh->ed, i, p, &err_));
+		return edit_vec(sh, what, i, v, "X,Y,Z", editor_light_pos);
 	case 1:
-		if (!arg_vec(sh, what, v, "DX,DY,DZ", &p))
-			return false;
-		EDIT(sh, what, editor_light_move(sh->ed, i, p, &err_));
+		return edit_vec(sh, what, i, v, "DX,DY,DZ", editor_light_move);
 	case 2:
 		if (!arg_number(sh, what, v, 0, 1, &d))
 			return false;
 		EDIT(sh, what, editor_light_brightness(sh->ed, i, d, &err_));
 	default:
-		if (!arg_color(sh, what, v, &p))
-			return false;
-		EDIT(sh, what, editor_light_color(sh->ed, i, p, &err_));
+		return edit_vec(sh, what, i, v, NULL, editor_light_color);
 	}
 }
 
 bool cmd_object(shell *sh, int argc, char **argv, const char *rest)
 {
 	(void)rest;
-	const scene *s = editor_scene(sh->ed);
-	if (argc == 0) {
-		char *a[] = {"objects"};
-		return cmd_list(sh, 1, a, "");
-	}
-	size_t i;
-	if (!arg_index(sh, "object", argv[0], "object", s->nobjs, &i))
-		return false;
-	if (argc == 1) {
-		answer_object_fields(sh, i);
-		return true;
-	}
-	if (argc < 3)
-		return shell_fail(sh, "object: too few arguments; usage: object N move|rotate|scale|color VALUE");
-	int sub = pick_sub(sh, "object", "an object command", SUBS_OBJECT, argv[1]);
-	if (sub < 0)
-		return false;
 	static const char *const names[] = {"move", "rotate", "scale", "color", "set"};
+	static const item_cmd c = {"object", "objects", "an object command", "object N move|rotate|scale|color VALUE",
+	                           SUBS_OBJECT, names, answer_object_fields};
+	size_t i;
 	char what[32];
-	snprintf(what, sizeof what, "object %s", names[sub]);
+	bool result;
+	int sub = item_sub(sh, &c, editor_scene(sh->ed)->nobjs, argc, argv, &i, what, sizeof what, &result);
+	if (sub < 0)
+		return result;
 	if (sub == 4) /* KEY=VALUE, from the reader's table of keys (rtfile.h) */
 		EDIT(sh, what, editor_object_set_key(sh->ed, i, argv[2], &err_));
 	const char *v = argv[2];
 	vec3 p;
 	switch (sub) {
 	case 0:
-		if (!arg_vec(sh, what, v, "DX,DY,DZ", &p))
-			return false;
-		EDIT(sh, what, editor_object_move(sh->ed, i, p, &err_));
+		return edit_vec(sh, what, i, v, "DX,DY,DZ", editor_object_move);
 	case 1:
-		if (!arg_vec(sh, what, v, "RX,RY,RZ in degrees", &p))
-			return false;
-		EDIT(sh, what, editor_object_rotate(sh->ed, i, p, &err_));
+		return edit_vec(sh, what, i, v, "RX,RY,RZ in degrees", editor_object_rotate);
 	case 2:
 		if (!arg_vec(sh, what, v, "SX,SY,SZ (factors > 0)", &p))
 			return false;
@@ -216,9 +231,7 @@ bool cmd_object(shell *sh, int argc, char **argv, const char *rest)
 			return shell_fail(sh, "%s: %s has a factor <= 0; expected SX,SY,SZ with each > 0", what, v);
 		EDIT(sh, what, editor_object_scale(sh->ed, i, p, &err_));
 	default:
-		if (!arg_color(sh, what, v, &p))
-			return false;
-		EDIT(sh, what, editor_object_color(sh->ed, i, p, &err_));
+		return edit_vec(sh, what, i, v, NULL, editor_object_color);
 	}
 }
 

@@ -101,7 +101,7 @@ bool cmd_save(shell *sh, int argc, char **argv, const char *rest)
 			abuf_free(&a);
 			frame_free(f);
 		}
-	} else if (image_format_of(path) != IMAGE_UNKNOWN) {
+	} else if (image_type_of(path)) {
 		const framebuffer *fb = shell_full_image(sh, false);
 		if (!fb)
 			ok = false;
@@ -171,10 +171,12 @@ bool cmd_set(shell *sh, int argc, char **argv, const char *rest)
 	}
 	render_settings s = sh->set;
 	if (!settings_set(&s, def, argv[1], &err)) {
-		char near[32];
-		if (def->type == SETTING_MODE && suggest_choice("whitted|path", argv[1], near, sizeof near))
-			return shell_fail(sh, "set: mode \"%s\" is not valid; did you mean \"%s\"? (expected "
-			                  "whitted or path)", argv[1], near);
+		char near[32], choices[256], expected[256];
+		settings_choices_text(def, "|", "|", choices, sizeof choices);
+		settings_choices_text(def, ", ", " or ", expected, sizeof expected);
+		if (def->type == SETTING_ENUM && suggest_choice(choices, argv[1], near, sizeof near))
+			return shell_fail(sh, "set: %s \"%s\" is not valid; did you mean \"%s\"? (expected %s)", def->name,
+			                  argv[1], near, expected);
 		return shell_fail(sh, "set: %s", err.msg);
 	}
 	char was[64];

@@ -14,16 +14,13 @@ const command command_table[] = {
 	 "replace the scene by a .rt file, a model (.obj .ply .stl) on a framed stage, or a glTF scene (.gltf "
 	 ".glb: its cameras, lights and materials); on any error the current scene stays",
 	 cmd_load},
-	{"save", NULL, "save FILE.ppm|FILE.pfm|FILE.png|FILE.jpg|FILE.ans|FILE.rt", 1, 1, {"@output"},
+	{"save", NULL, "save @images|FILE.ans|FILE.rt", 1, 1, {"@output"}, /* @images: image.c's formats */
 	 "write the image (full resolution, rendered first if needed), the picture as ANSI text, or the scene",
 	 cmd_save},
 	{"render", NULL, "render", 0, 0, {NULL},
 	 "render at full resolution now, with progress; Ctrl-C stops it", cmd_render},
 	{"set", NULL, "set\nset KEY\nset KEY VALUE", 0, 2, {"@setting", "@value"},
-	 "list the settings, or show or change one (resolution WxH, samples, depth, mode, threads, seed, exposure,\n"
-	 "denoise auto|on|off: auto denoises path previews only, on also saved images,\n"
-	 "pixels off|kitty|sixel|iterm|auto: the picture in the terminal's real pixels,\n"
-	 "symbols half|quadrant|sextant|octant|auto: the cells' glyphs without real pixels)",
+	 "list the settings, or show or change one (help set: each with its values)",
 	 cmd_set},
 	{"list", "ls", "list [cameras|lights|objects]", 0, 1, {"cameras|lights|objects"},
 	 "the cameras, ambient, lights and objects with their numbers and fields", cmd_list},

@@ -10,11 +10,33 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rtsh/image.h"
 #include "rtsh/num.h"
 #include "rtsh/rtfile.h"
 #include "shell/answer.h"
 #include "shell/keymode.h"
 #include "shell/suggest.h"
+
+/* `help set`: the settings table (settings.h), each with its values. */
+static const char *settings_help(void)
+{
+	static char text[4096];
+	size_t used = 0;
+	used += (size_t)snprintf(text, sizeof text, "settings:\n");
+	for (size_t i = 0; i < settings_count && used < sizeof text; i++) {
+		const setting_def *d = &settings_table[i];
+		char values[256];
+		if (d->type == SETTING_ENUM)
+			settings_choices_text(d, "|", "|", values, sizeof values);
+		else
+			snprintf(values, sizeof values, "%s", d->type == SETTING_RESOLUTION ? "WxH"
+			                                      : d->type == SETTING_DOUBLE   ? "NUMBER"
+			                                                                    : "N");
+		used += (size_t)snprintf(text + used, sizeof text - used, "  %-10s %-34s %s\n", d->name, values,
+		                         d->help);
+	}
+	return text;
+}
 
 /* More for `help COMMAND` than its usage and one line (text, or made by
  * gen from a table). */
@@ -23,6 +45,7 @@ static const struct {
 	const char *(*gen)(void);
 } details[] = {
 	{"view", NULL, keymode_help_text},
+	{"set", NULL, settings_help},
 	{"add", "examples: add sp 0,1,0 1 255,0,0 texture=earth.png\n"
 	        "          add mesh bunny.obj 0,0.5,0 0,1,0 1 200,200,200 smooth=1 crease=60\n"
 	        "          add sky sky.hdr 1 90   (an HDR sky, turned 90 degrees)\n"
@@ -256,13 +279,30 @@ bool arg_index(shell *sh, const char *what, const char *word, const char *kind, 
 	return true;
 }
 
+/* The k bytes of a usage line at p with "@images" replaced by the image
+ * formats the table in image.c writes: "FILE.ppm|FILE.pfm|...". */
+static void usage_text(const char *p, size_t k, char *buf, size_t size)
+{
+	snprintf(buf, size, "%.*s", (int)k, p);
+	char *at = strstr(buf, "@images");
+	if (!at)
+		return;
+	char exts[256], rest[256];
+	image_extensions_join(exts, sizeof exts, "FILE", "|", true);
+	snprintf(rest, sizeof rest, "%s", at + 7);
+	size_t l = (size_t)(at - buf);
+	snprintf(at, size - l, "%s%s", exts, rest);
+}
+
 /* "usage: a | b | c" from the usage lines. */
 static void usage_line(const command *c, char *buf, size_t size)
 {
 	snprintf(buf, size, "usage: ");
 	for (const char *p = c->usage; *p;) {
 		size_t k = strcspn(p, "\n"), l = strlen(buf);
-		snprintf(buf + l, size - l, "%s%.*s", p == c->usage ? "" : " | ", (int)k, p);
+		snprintf(buf + l, size - l, "%s", p == c->usage ? "" : " | ");
+		l = strlen(buf);
+		usage_text(p, k, buf + l, size - l);
 		p += k;
 		if (*p == '\n')
 			p++;
@@ -340,7 +380,9 @@ bool cmd_help(shell *sh, int argc, char **argv, const char *rest)
 			return shell_fail(sh, "help: %s", msg);
 		for (const char *p = c->usage; *p;) {
 			size_t k = strcspn(p, "\n");
-			shell_out(sh, "%s%.*s\n", p == c->usage ? "usage: " : "       ", (int)k, p);
+			char line[512];
+			usage_text(p, k, line, sizeof line);
+			shell_out(sh, "%s%s\n", p == c->usage ? "usage: " : "       ", line);
 			p += k;
 			if (*p == '\n')
 				p++;

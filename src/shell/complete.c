@@ -95,15 +95,8 @@ static void add_alternative(list *l, const shell *sh, const char *alt, size_t le
 	} else if (strcmp(a, "@value") == 0) {
 		rt_error err;
 		const setting_def *d = nwords >= 2 ? settings_find(words[1], &err) : NULL;
-		if (d && d->type == SETTING_MODE) {
-			add(l, "whitted", text);
-			add(l, "path", text);
-		}
-		if (d && d->type == SETTING_SYMBOLS) {
-			static const char *const sym[] = {"half", "quadrant", "sextant", "octant", "auto"};
-			for (size_t i = 0; i < sizeof sym / sizeof sym[0]; i++)
-				add(l, sym[i], text);
-		}
+		for (int i = 0; d && i < settings_choices(d); i++)
+			add(l, d->choices[i], text);
 	} else if (strcmp(a, "@key") == 0) {
 		const char *name, *kh;
 		char buf[64];

@@ -128,14 +128,7 @@ static const km_key *find_key(int key)
 double keymode_step(const scene *s)
 {
 	camera c = scene_camera(s);
-	box b = box_point(c.pos);
-	for (size_t i = 0; i < s->nobjs; i++) {
-		if (s->objs[i].kind == OBJ_PLANE)
-			continue;
-		box o = object_bounds(&s->objs[i]);
-		if (!box_is_empty(o) && v3_finite(o.lo) && v3_finite(o.hi))
-			b = box_union(b, o);
-	}
+	box b = box_union(box_point(c.pos), orbit_scene_bounds(s));
 	for (size_t i = 0; i < s->nlights; i++)
 		b = box_add(b, s->lights[i].pos);
 	double side = v3_max_comp(v3_sub(b.hi, b.lo));

@@ -9,7 +9,6 @@
 #include <string.h>
 #include <sys/ioctl.h>
 #include <sys/stat.h>
-#include <termios.h>
 #include <unistd.h>
 
 #include "rtsh/filesrc.h"
@@ -46,23 +45,16 @@ static int fail(const char *file, const char *what)
 	return 1;
 }
 
-/* --pixels auto on a terminal: ask it (raw mode for the answers), at most
- * a second. */
+/* --pixels auto on a terminal: ask it, at most a second (pixels_probe
+ * puts it in raw mode for the answers and back). */
 static pixels_mode ask_terminal(int *cell_w, int *cell_h)
 {
 	pixels_caps c = {0};
-	struct termios saved;
-	if (isatty(STDIN_FILENO) && tcgetattr(STDIN_FILENO, &saved) == 0) {
-		struct termios t = saved;
-		t.c_lflag &= ~(tcflag_t)(ICANON | ECHO);
-		t.c_cc[VMIN] = 0;
-		t.c_cc[VTIME] = 0;
-		tcsetattr(STDIN_FILENO, TCSANOW, &t);
+	if (isatty(STDIN_FILENO)) {
 		abuf keys;
 		abuf_init(&keys);
 		pixels_probe(STDIN_FILENO, STDOUT_FILENO, 1.0, &c, &keys);
 		abuf_free(&keys);
-		tcsetattr(STDIN_FILENO, TCSANOW, &saved);
 	}
 	pixels_caps_env(&c, getenv("TERM_PROGRAM"), getenv("LC_TERMINAL"), getenv("TMUX"));
 	if (c.cell_w > 0 && c.cell_h > 0) {

@@ -63,5 +63,5 @@ bool turntable_output_ok(const char *out)
 {
 	char name[4096];
 	return turntable_is_gif(out) ||
-	       (turntable_name(out, 0, name, sizeof name) && image_format_of(name) != IMAGE_UNKNOWN);
+	       (turntable_name(out, 0, name, sizeof name) && image_type_of(name));
 }

@@ -80,6 +80,8 @@ static uint64_t strip_hash(const pix_enc *e, int k)
 	return v | 1; /* never 0, which means "not known" */
 }
 
+static void pix_close(encoder *b);
+
 static encoder *pix_open_mode(const encoder_geom *g, const encoder_ops *ops, pixels_mode mode)
 {
 	int w, h;
@@ -112,12 +114,7 @@ static encoder *pix_open_mode(const encoder_geom *g, const encoder_ops *ops, pix
 	e->shown = calloc((size_t)e->nstrips, sizeof *e->shown);
 	e->stale = calloc((size_t)e->nstrips, sizeof *e->stale);
 	if (!e->rgb || !e->want || !e->shown || !e->stale || (e->ncols > 1 && !e->tmp)) {
-		free(e->rgb);
-		free(e->tmp);
-		free(e->want);
-		free(e->shown);
-		free(e->stale);
-		free(e);
+		pix_close(&e->base);
 		return NULL;
 	}
 	/* The terminal shows the background (the screen was cleared). */

@@ -2,7 +2,9 @@
  * Ctrl-C in the shell): loading a scene with a large model, generating,
  * building a world. The flag is set before the call, or from another thread
  * while the work runs; the call then fails with "stopped", keeps nothing in
- * the caches, and the same call without the flag succeeds after. */
+ * the caches, and the same call without the flag succeeds after. And a
+ * render pass stopped in flight: rendering again gives the picture of a
+ * render never stopped, to the byte. */
 #include "testutil.h"
 
 #include <pthread.h>
@@ -12,6 +14,7 @@
 
 #include "rtsh/generate.h"
 #include "rtsh/mesh.h"
+#include "rtsh/render.h"
 #include "rtsh/rtfile.h"
 #include "rtsh/world.h"
 
@@ -155,12 +158,103 @@ static void test_world_build_stops(void **state)
 	scene_free(s);
 }
 
+/* The progress callback of the pass to stop: the first time it hears of
+ * some tiles done and some not, it sets the flag (the render is then in
+ * flight: its threads are between tiles). */
+typedef struct stopper {
+	atomic_bool *cancel;
+	long done_then, total;
+} stopper;
+
+static void stop_in_flight(void *ctx, long done, long total)
+{
+	stopper *st = ctx;
+	if (st->done_then == 0 && done > 0 && done < total) {
+		st->done_then = done;
+		st->total = total;
+		atomic_store(st->cancel, true);
+	}
+}
+
+/* Passes 0..4 and 4..samples into fb: the second with `cancel` and `progress`. */
+static render_status two_passes(const world *w, const render_settings *set, framebuffer *fb, int samples,
+                                atomic_bool *cancel, stopper *st)
+{
+	rt_error err;
+	render_job a = {.w = w, .set = *set, .fb = fb, .sample_begin = 0, .sample_end = 4};
+	a.set.samples = samples;
+	assert_int_equal(render_run(&a, &err), RENDER_DONE);
+	render_job b = a;
+	b.sample_begin = 4;
+	b.sample_end = samples;
+	b.cancel = cancel;
+	b.progress = st ? stop_in_flight : NULL;
+	b.progress_ctx = st;
+	return render_run(&b, &err);
+}
+
+static void test_render_stops_in_flight(void **state)
+{
+	(void)state;
+	rt_error err;
+	scene *s = scene_generate(60, 11, NULL, &err);
+	assert_non_null(s);
+	world *w = world_build(s, &err);
+	assert_non_null(w);
+	render_settings set = render_settings_default();
+	set.width = 160;
+	set.height = 120; /* 80 tiles */
+	set.mode = MODE_PATH;
+	set.threads = 2;
+	/* The second pass must outlast the first progress report (about
+	 * 100 ms): longer and longer until it is stopped in flight. */
+	int samples = 8;
+	framebuffer *fb = fb_new(set.width, set.height), *ref = fb_new(set.width, set.height);
+	assert_non_null(fb);
+	assert_non_null(ref);
+	atomic_bool cancel;
+	stopper st;
+	render_status got = RENDER_DONE;
+	for (; samples <= 4096; samples *= 2) {
+		atomic_init(&cancel, false);
+		st = (stopper){&cancel, 0, 0};
+		got = two_passes(w, &set, fb, samples, &cancel, &st);
+		if (got != RENDER_DONE)
+			break;
+	}
+	assert_int_equal(got, RENDER_CANCELLED);
+	assert_true(st.done_then > 0 && st.done_then < st.total);
+	print_message("stopped at %ld of %ld tiles of the pass 4..%d\n", st.done_then, st.total, samples);
+	/* the cancelled pass mixed two passes' sums: the next starts over */
+	assert_int_equal(fb->spp, 0);
+	/* rendering again, without the flag, after the stop */
+	atomic_store(&cancel, false);
+	assert_int_equal(two_passes(w, &set, fb, samples, &cancel, NULL), RENDER_DONE);
+	/* a render never stopped, into a framebuffer of its own */
+	assert_int_equal(two_passes(w, &set, ref, samples, NULL, NULL), RENDER_DONE);
+	assert_int_equal(fb->spp, samples);
+	assert_int_equal(ref->spp, samples);
+	size_t n = (size_t)set.width * set.height * 3;
+	assert_memory_equal(fb->rgb, ref->rgb, n * sizeof *fb->rgb);
+	assert_memory_equal(fb->sum, ref->sum, n * sizeof *fb->sum);
+	/* and the picture is a picture: not all black */
+	double total = 0;
+	for (size_t i = 0; i < n; i++)
+		total += ref->rgb[i];
+	assert_true(total > 0);
+	fb_free(fb);
+	fb_free(ref);
+	world_release(w);
+	scene_free(s);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 	    cmocka_unit_test(test_load_stops),
 	    cmocka_unit_test(test_generate_stops),
 	    cmocka_unit_test(test_world_build_stops),
+	    cmocka_unit_test(test_render_stops_in_flight),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -1,6 +1,6 @@
 /* rtsh — tests of the direct sampling of flat emitters by solid angle
- * (core/emitters.c), each against formulas derived independently of the
- * sampling code:
+ * (the shape kinds' light ops, src/core/shapes/light.c), each against
+ * formulas derived independently of the sampling code:
  *   - the solid angle of a rectangle seen from a point on its axis,
  *     4 asin(ab / sqrt((a^2 + d^2)(b^2 + d^2))) for half-sides a, b at
  *     distance d; off the axis, the sum over two triangles;
@@ -76,7 +76,7 @@ static void test_rect_on_axis(void **state)
 		world *w = one_emitter(rect(v3(0, 2, 0), a, b), &e);
 		double d = ds[k];
 		vec3 p = v3(0, 2 - d, 0);
-		assert_true(v3_len2(v3_sub(e->c, p)) < e->reach2);
+		assert_true(v3_len2(v3_sub(e->l.c, p)) < e->l.reach2);
 		double want = 4 * asin(a * b / sqrt((a * a + d * d) * (b * b + d * d)));
 		vec3 wi;
 		double pdf, t;
@@ -98,7 +98,7 @@ static void check_uniform(const emitter *e, vec3 p, double want, part_fn part, c
 {
 	const int n = 300;
 	int count[8] = {0}, total = 0;
-	assert_true(v3_len2(v3_sub(e->c, p)) < e->reach2); /* near: by solid angle */
+	assert_true(v3_len2(v3_sub(e->l.c, p)) < e->l.reach2); /* near: by solid angle */
 	for (int i = 0; i < n; i++)
 		for (int j = 0; j < n; j++) {
 			vec3 wi;
@@ -109,7 +109,7 @@ static void check_uniform(const emitter *e, vec3 p, double want, part_fn part, c
 			assert_near(1 / pdf, want, 1e-9 * want);
 			vec3 q = v3_madd(p, wi, t);
 			/* on the shape's plane */
-			assert_near(v3_dot(v3_sub(q, e->c), e->n), 0, 1e-9);
+			assert_near(v3_dot(v3_sub(q, e->l.c), e->l.n), 0, 1e-9);
 			int k = part(q, ctx);
 			assert_true(k >= 0 && k < nparts);
 			count[k]++;
@@ -234,7 +234,7 @@ static void test_disc_on_axis(void **state)
 		world *w = one_emitter(o, &e);
 		double d = ds[k];
 		vec3 p = v3(0, 2 - d, 0);
-		assert_true(v3_len2(v3_sub(e->c, p)) < e->reach2);
+		assert_true(v3_len2(v3_sub(e->l.c, p)) < e->l.reach2);
 		double square = 4 * asin(r * r / (r * r + d * d)), disc = 2 * RT_PI * (1 - d / sqrt(d * d + r * r));
 		const int n = 400;
 		int in = 0;
@@ -262,7 +262,7 @@ static void test_far_by_area(void **state)
 	world *w = one_emitter(rect(v3(0, 2, 0), 0.3, 0.2), &e);
 	vec3 p = v3(1, -20, 3), wi;
 	double pdf, t;
-	assert_false(v3_len2(v3_sub(e->c, p)) < e->reach2);
+	assert_false(v3_len2(v3_sub(e->l.c, p)) < e->l.reach2);
 	assert_true(emitter_sample(e, p, 0.25, 0.75, &wi, &pdf, &t));
 	vec3 q = v3_madd(p, wi, t);
 	assert_near(q.y, 2, 1e-9);

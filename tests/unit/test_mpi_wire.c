@@ -87,9 +87,9 @@ static void test_round_trip(void **state)
 }
 
 /* The bytes, from the layout in wire.h: header 16 bytes, seven i32 (28),
- * then width at 44, height 48, samples 52, depth 56, threads 60, mode 64,
- * seed 68, exposure 76, denoise 84, pixels 88, symbols 92, files 96;
- * little-endian. */
+ * then the settings in the settings table's order: width at 44, height 48,
+ * samples 52, depth 56, mode 60, threads 64, seed 68, exposure 76,
+ * denoise 84, pixels 88, symbols 92; files 96; little-endian. */
 static void test_layout(void **state)
 {
 	(void)state;
@@ -107,7 +107,7 @@ static void test_layout(void **state)
 	unsigned char buf[WIRE_CONFIG_SIZE];
 	memset(buf, 0xee, sizeof buf);
 	wire_put_config(&a, buf);
-	static const unsigned char head[16] = {'R', 'T', 'S', 'H', 'M', 'P', 'I', 0, 2, 0, 0, 0, 88, 0, 0, 0};
+	static const unsigned char head[16] = {'R', 'T', 'S', 'H', 'M', 'P', 'I', 0, 3, 0, 0, 0, 88, 0, 0, 0};
 	assert_memory_equal(buf, head, 16);
 	static const unsigned char status[4] = {0xff, 0xff, 0xff, 0xff}, tile[4] = {0x0d, 0x0c, 0x0b, 0x0a},
 	                           prefetch[4] = {0xfe, 0xff, 0xff, 0xff}, width[4] = {0x34, 0x12, 0, 0},
@@ -119,7 +119,7 @@ static void test_layout(void **state)
 	assert_memory_equal(buf + 32, tile, 4);
 	assert_memory_equal(buf + 36, prefetch, 4);
 	assert_memory_equal(buf + 44, width, 4);
-	assert_memory_equal(buf + 64, mode, 4);
+	assert_memory_equal(buf + 60, mode, 4);
 	assert_memory_equal(buf + 68, seed, 8);
 	assert_memory_equal(buf + 76, exposure, 8);
 	assert_memory_equal(buf + 96, files, 8);
@@ -156,7 +156,10 @@ static void test_refused(void **state)
 	buf[8] = 1; /* version 1 (before `symbols`) */
 	expect_refused(buf, "version 1");
 	memcpy(buf, good, sizeof buf);
-	buf[64] = 7; /* mode */
+	buf[8] = 2; /* version 2 (mode after threads) */
+	expect_refused(buf, "version 2");
+	memcpy(buf, good, sizeof buf);
+	buf[60] = 7; /* mode */
 	expect_refused(buf, "mode = 7");
 	memcpy(buf, good, sizeof buf);
 	memset(buf + 44, 0, 4); /* width 0 */

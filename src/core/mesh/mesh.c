@@ -99,6 +99,17 @@ static void mat_free(mesh_mat *m)
 	free(m->map_emit);
 }
 
+/* The materials and embedded textures a builder, then its mesh, holds. */
+static void mats_texs_free(mesh_mat *mats, size_t nmats, texture **texs, size_t ntexs)
+{
+	for (size_t i = 0; i < nmats; i++)
+		mat_free(&mats[i]);
+	free(mats);
+	for (size_t i = 0; i < ntexs; i++)
+		texture_free(texs[i]);
+	free(texs);
+}
+
 void mb_free(mesh_builder *b)
 {
 	free(b->v);
@@ -106,12 +117,7 @@ void mb_free(mesh_builder *b)
 	free(b->vn);
 	free(b->c);
 	free(b->fm);
-	for (size_t i = 0; i < b->nmats; i++)
-		mat_free(&b->mats[i]);
-	free(b->mats);
-	for (size_t i = 0; i < b->ntexs; i++)
-		texture_free(b->texs[i]);
-	free(b->texs);
+	mats_texs_free(b->mats, b->nmats, b->texs, b->ntexs);
 	free(b->warning);
 	memset(b, 0, sizeof *b);
 }
@@ -283,12 +289,7 @@ void mesh_free(mesh *m)
 	free(m->uv);
 	free(m->tri);
 	free(m->tmat);
-	for (uint32_t i = 0; i < m->nmats; i++)
-		mat_free(&m->mats[i]);
-	free(m->mats);
-	for (uint32_t i = 0; i < m->ntexs; i++)
-		texture_free(m->texs[i]);
-	free(m->texs);
+	mats_texs_free(m->mats, m->nmats, m->texs, m->ntexs);
 	free(m->warning);
 	free(m->nodes);
 	free(m->blk);
@@ -500,6 +501,45 @@ bool mesh_prepare(mesh *m, bool smooth, double crease_deg, rt_error *err)
 	return mesh_prepare_cancel(m, smooth, crease_deg, NULL, err);
 }
 
+/* Numbers the n items that the count indices in idx name in the order the
+ * indices first use them, the unused ones after in their own order; idx is
+ * rewritten to the new numbers, and the arrays *a and *b (n items of asize
+ * and bsize bytes; either may be NULL) are permuted to match. With memory
+ * short nothing changes (the order is only for speed). */
+static void renumber_by_first_use(uint32_t *idx, size_t count, uint32_t n, void **a, size_t asize, void **b,
+                                  size_t bsize)
+{
+	uint32_t *new_of = malloc((size_t)n * sizeof *new_of);
+	char *na = *a ? malloc((size_t)n * asize) : NULL, *nb = *b ? malloc((size_t)n * bsize) : NULL;
+	if (!new_of || (*a && !na) || (*b && !nb)) {
+		free(new_of);
+		free(na);
+		free(nb);
+		return;
+	}
+	memset(new_of, 0xff, (size_t)n * sizeof *new_of);
+	uint32_t next = 0;
+	for (size_t j = 0; j < count; j++) {
+		uint32_t v = idx[j];
+		if (new_of[v] == UINT32_MAX)
+			new_of[v] = next++;
+		idx[j] = new_of[v];
+	}
+	for (uint32_t v = 0; v < n; v++) {
+		if (new_of[v] == UINT32_MAX)
+			new_of[v] = next++; /* triangles: in no leaf (none is); vertices: unused */
+		if (na)
+			memcpy(na + (size_t)new_of[v] * asize, (const char *)*a + (size_t)v * asize, asize);
+		if (nb)
+			memcpy(nb + (size_t)new_of[v] * bsize, (const char *)*b + (size_t)v * bsize, bsize);
+	}
+	free(*a);
+	free(*b);
+	*a = na;
+	*b = nb;
+	free(new_of);
+}
+
 bool mesh_prepare_cancel(mesh *m, bool smooth, double crease_deg, const atomic_bool *cancel, rt_error *err)
 {
 	char what[300];
@@ -516,65 +556,11 @@ bool mesh_prepare_cancel(mesh *m, bool smooth, double crease_deg, const atomic_b
 		return false;
 	/* triangles, then vertices, in the order the blocks first use them, so
 	 * that shading a leaf's triangles finds their data close together */
-	uint32_t *newt = malloc((size_t)m->ntris * sizeof *newt);
-	uint32_t(*tri)[3] = malloc((size_t)m->ntris * sizeof *tri);
-	uint16_t *tmat = m->tmat ? malloc((size_t)m->ntris * sizeof *tmat) : NULL;
-	if (newt && tri && (!m->tmat || tmat)) {
-		memset(newt, 0xff, (size_t)m->ntris * sizeof *newt);
-		uint32_t next = 0;
-		for (uint32_t k = 0; k < m->nblk; k++)
-			for (int l = 0; l < 4; l++) {
-				uint32_t t = m->btri[k][l];
-				if (newt[t] == UINT32_MAX)
-					newt[t] = next++;
-				m->btri[k][l] = newt[t];
-			}
-		for (uint32_t t = 0; t < m->ntris; t++) {
-			if (newt[t] == UINT32_MAX)
-				newt[t] = next++; /* in no leaf (none: every triangle has one) */
-			memcpy(tri[newt[t]], m->tri[t], sizeof *tri);
-			if (tmat)
-				tmat[newt[t]] = m->tmat[t];
-		}
-		free(m->tri);
-		free(m->tmat);
-		m->tri = tri;
-		m->tmat = tmat;
-	} else {
-		free(tri);
-		free(tmat);
-	}
-	free(newt);
-	uint32_t *newid = malloc((size_t)m->nverts * sizeof *newid);
-	float(*n)[3] = m->n ? malloc((size_t)m->nverts * sizeof *n) : NULL;
-	float(*uv)[2] = m->uv ? malloc((size_t)m->nverts * sizeof *uv) : NULL;
-	if (newid && (!m->n || n) && (!m->uv || uv)) {
-		memset(newid, 0xff, (size_t)m->nverts * sizeof *newid);
-		uint32_t next = 0;
-		for (uint32_t t = 0; t < m->ntris; t++)
-			for (int k = 0; k < 3; k++) {
-				uint32_t v = m->tri[t][k];
-				if (newid[v] == UINT32_MAX)
-					newid[v] = next++;
-				m->tri[t][k] = newid[v];
-			}
-		for (uint32_t v = 0; v < m->nverts; v++) {
-			if (newid[v] == UINT32_MAX)
-				newid[v] = next++; /* unused by any triangle */
-			if (n)
-				memcpy(n[newid[v]], m->n[v], sizeof *n);
-			if (uv)
-				memcpy(uv[newid[v]], m->uv[v], sizeof *uv);
-		}
-		free(m->n);
-		free(m->uv);
-		m->n = n;
-		m->uv = uv;
-	} else {
-		free(n);
-		free(uv);
-	}
-	free(newid);
+	if (m->nblk)
+		renumber_by_first_use(&m->btri[0][0], (size_t)m->nblk * 4, m->ntris, (void **)&m->tri, sizeof *m->tri,
+		                      (void **)&m->tmat, sizeof *m->tmat);
+	renumber_by_first_use(&m->tri[0][0], (size_t)m->ntris * 3, m->nverts, (void **)&m->n, sizeof *m->n,
+	                      (void **)&m->uv, sizeof *m->uv);
 	/* the blocks hold the positions from now on, and the corners' indices
 	 * serve only to interpolate normals and uv */
 	free(m->p);

@@ -15,6 +15,7 @@
 
 #include "core/mesh/mesh_io.h"
 #include "rtsh/filesrc.h"
+#include "rtsh/memory.h"
 #include "rtsh/mesh.h"
 #include "rtsh/srgb.h"
 
@@ -52,15 +53,6 @@ static bool keyword(cursor *c, const char *w)
 	return true;
 }
 
-static char *dup_n(const char *s, size_t n)
-{
-	char *d = malloc(n + 1);
-	if (d) {
-		memcpy(d, s, n);
-		d[n] = '\0';
-	}
-	return d;
-}
 
 /* --- MTL --- */
 
@@ -105,7 +97,7 @@ static char *map_file(cursor *c, const char *dir, float *bm)
 	size_t n = rest_of_line(c, &f);
 	if (n == 0)
 		return NULL;
-	char *rel = dup_n(f, n);
+	char *rel = mem_dupz(f, n);
 	if (!rel)
 		return NULL;
 	for (char *q = rel; *q; q++)
@@ -145,7 +137,7 @@ static bool read_mtl(mesh_builder *b, const char *path, const char *dir, const c
 			const char *name;
 			size_t n = rest_of_line(&c, &name);
 			mesh_mat m = mat_default();
-			m.name = dup_n(name, n);
+			m.name = mem_dupz(name, n);
 			if (!m.name || b->nmats >= 65535 ||
 			    !(b->nmats < b->cmats || (b->mats = realloc(b->mats, (b->cmats = 2 * b->cmats + 4) *
 			                                                               sizeof *b->mats)))) {
@@ -303,7 +295,7 @@ static bool use_material(obj_reader *r, const char *name, size_t n)
 	if (r->b.nmats >= 65535)
 		return bad(r, "%s: more than 65535 materials", "usemtl");
 	mesh_mat m = mat_default();
-	m.name = dup_n(name, n);
+	m.name = mem_dupz(name, n);
 	mesh_mat *mats = realloc(r->b.mats, (r->b.nmats + 1) * sizeof *mats);
 	if (!m.name || !mats) {
 		free(m.name);
@@ -365,7 +357,7 @@ mesh *mesh_parse_obj(const char *name, const char *dir, const char *buf, size_t 
 			if (keyword(&c, "mtllib")) {
 				const char *n;
 				size_t nn = rest_of_line(&c, &n);
-				char *rel = dup_n(n, nn);
+				char *rel = mem_dupz(n, nn);
 				char *path = rel ? path_join(dir, rel) : NULL;
 				char *mdir = path ? path_dir(path) : NULL;
 				ok = mdir && read_mtl(&r.b, path, mdir, r.name, r.line);

@@ -1,5 +1,5 @@
 /* rtsh — what the shape files share (shapes.h): the usual bounds, surface
- * parameterisations and short forms, and the stable quadratic. */
+ * texture coordinates and short forms, and the stable quadratic. */
 #include "shapes.h"
 
 box unit_cube_bounds(double tube)
@@ -14,20 +14,27 @@ box unit_flat_bounds(double tube)
 	return (box){v3(-1, 0, -1), v3(1, 0, 1)};
 }
 
-double around_y(vec3 p, vec3 *tangent)
+void uv_planar(vec3 q, vec3 nl, double tube, double *u, double *v, vec3 *dqdu, vec3 *dqdv)
 {
-	double rho = sqrt(p.x * p.x + p.z * p.z);
-	*tangent = rho > 0.0 ? v3(-p.z / rho, 0, p.x / rho) : v3(1, 0, 0);
-	double u = atan2(p.z, p.x) / (2.0 * RT_PI);
-	return u < 0.0 ? u + 1.0 : u;
+	(void)nl;
+	(void)tube;
+	*u = (q.x + 1) / 2;
+	*v = (q.z + 1) / 2;
+	*dqdu = v3(2, 0, 0);
+	*dqdv = v3(0, 0, 2);
 }
 
-void uv_flat(vec3 p, double tube, double *u, double *v, vec3 *tangent)
+void uv_capped_side(vec3 q, vec3 nl, double tube, double *u, double *v, vec3 *dqdu, vec3 *dqdv)
 {
-	(void)tube;
-	*u = clampd(0.5 * (p.x + 1.0), 0.0, 1.0);
-	*v = clampd(0.5 * (p.z + 1.0), 0.0, 1.0);
-	*tangent = v3(1, 0, 0);
+	double ax = fabs(nl.x), ay = fabs(nl.y), az = fabs(nl.z);
+	if (ay > fmax(ax, az) * 4 && fabs(q.y) > 0.999) {
+		uv_planar(q, nl, tube, u, v, dqdu, dqdv);
+		return;
+	}
+	*u = 0.5 + atan2(q.x, -q.z) / (2 * M_PI);
+	*v = (q.y + 1) / 2;
+	*dqdu = v3_scale(v3(-q.z, 0, q.x), 2 * M_PI);
+	*dqdv = v3(0, 2, 0);
 }
 
 void read_uniform(object *o, const double *sizes)

@@ -63,24 +63,13 @@ static bool cone_occluded(vec3 o, vec3 d, double tube, double tmin, double tmax)
 	return cone_intersect(o, d, tube, tmin, tmax, &t, &n);
 }
 
-/* Around the side, v up the axis; the base as a flat shape. */
-static void cone_uv(vec3 p, double tube, double *u, double *v, vec3 *tangent)
-{
-	if (p.y <= -1.0 + 1e-9) {
-		uv_flat(p, tube, u, v, tangent);
-		return;
-	}
-	*u = around_y(p, tangent);
-	*v = clampd(0.5 * (p.y + 1.0), 0.0, 1.0);
-}
-
 const shape_kind cone_kind = {
 	.form = {"co", "cone", false, true, false, 4, "CENTER AXIS DIAMETER HEIGHT",
 	         {"center", "axis", "diameter", "height"}, "pdss", read_tube, write_tube},
 	.intersect = cone_intersect,
 	.occluded = cone_occluded,
 	.bounds = unit_cube_bounds,
-	.uv = cone_uv,
+	.uv = uv_capped_side,
 	.cost = 8,
 	.recipe = {true, {40, 60, 0}, {100, 140, 0}, 0, 0},
 };

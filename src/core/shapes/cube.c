@@ -74,24 +74,22 @@ static bool cube_occluded(vec3 o, vec3 d, double tube, double tmin, double tmax)
 	return (t0 > tmin && t0 < tmax) || (t1 > tmin && t1 < tmax);
 }
 
-/* Each face [0,1]^2 in its two other coordinates, the tangent along the
- * first of them. */
-static void cube_uv(vec3 p, double tube, double *u, double *v, vec3 *tangent)
+/* Each face the whole image: the X faces (z, y), the Y faces (x, z), the Z
+ * faces (x, y), each from [-1,1] to [0,1]; the face is the normal's
+ * largest axis. */
+static void cube_uv(vec3 q, vec3 nl, double tube, double *u, double *v, vec3 *dqdu, vec3 *dqdv)
 {
 	(void)tube;
-	double ax = fabs(p.x), ay = fabs(p.y), az = fabs(p.z);
+	double ax = fabs(nl.x), ay = fabs(nl.y), az = fabs(nl.z);
 	if (ax >= ay && ax >= az) {
-		*u = 0.5 * (p.z + 1.0);
-		*v = 0.5 * (p.y + 1.0);
-		*tangent = v3(0, 0, 1);
+		*u = (q.z + 1) / 2, *v = (q.y + 1) / 2;
+		*dqdu = v3(0, 0, 2), *dqdv = v3(0, 2, 0);
 	} else if (ay >= az) {
-		*u = 0.5 * (p.x + 1.0);
-		*v = 0.5 * (p.z + 1.0);
-		*tangent = v3(1, 0, 0);
+		*u = (q.x + 1) / 2, *v = (q.z + 1) / 2;
+		*dqdu = v3(2, 0, 0), *dqdv = v3(0, 0, 2);
 	} else {
-		*u = 0.5 * (p.x + 1.0);
-		*v = 0.5 * (p.y + 1.0);
-		*tangent = v3(1, 0, 0);
+		*u = (q.x + 1) / 2, *v = (q.y + 1) / 2;
+		*dqdu = v3(2, 0, 0), *dqdv = v3(0, 2, 0);
 	}
 }
 

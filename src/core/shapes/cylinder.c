@@ -45,24 +45,13 @@ static bool cylinder_occluded(vec3 o, vec3 d, double tube, double tmin, double t
 	return cylinder_intersect(o, d, tube, tmin, tmax, &t, &n);
 }
 
-/* Around the side, v up the axis; the caps as flat shapes. */
-static void cylinder_uv(vec3 p, double tube, double *u, double *v, vec3 *tangent)
-{
-	if (fabs(p.y) >= 1.0 - 1e-9 && p.x * p.x + p.z * p.z < 1.0 - 1e-9) {
-		uv_flat(p, tube, u, v, tangent);
-		return;
-	}
-	*u = around_y(p, tangent);
-	*v = clampd(0.5 * (p.y + 1.0), 0.0, 1.0);
-}
-
 const shape_kind cylinder_kind = {
 	.form = {"cy", "cylinder", true, true, false, 4, "CENTER AXIS DIAMETER HEIGHT",
 	         {"center", "axis", "diameter", "height"}, "pdss", read_tube, write_tube},
 	.intersect = cylinder_intersect,
 	.occluded = cylinder_occluded,
 	.bounds = unit_cube_bounds,
-	.uv = cylinder_uv,
+	.uv = uv_capped_side,
 	.cost = 8,
 	.recipe = {true, {40, 60, 0}, {100, 140, 0}, 0, 0},
 };

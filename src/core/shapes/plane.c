@@ -29,13 +29,16 @@ static box plane_bounds(double tube)
 	return (box){v3_splat(-INFINITY), v3_splat(INFINITY)};
 }
 
-/* Unit squares of the plane's own (world-size) units. */
-static void plane_uv(vec3 p, double tube, double *u, double *v, vec3 *tangent)
+/* Tiled: u = x, v = z, one repeat per scene unit (the plane's object units
+ * are scene units: object_xform does not scale it). */
+static void plane_uv(vec3 q, vec3 nl, double tube, double *u, double *v, vec3 *dqdu, vec3 *dqdv)
 {
+	(void)nl;
 	(void)tube;
-	*u = p.x - floor(p.x);
-	*v = p.z - floor(p.z);
-	*tangent = v3(1, 0, 0);
+	*u = q.x;
+	*v = q.z;
+	*dqdu = v3(1, 0, 0);
+	*dqdv = v3(0, 0, 1);
 }
 
 static void plane_read(object *o, const double *sizes)

@@ -13,11 +13,41 @@ box unit_cube_bounds(double tube);
 /* The square [-1,1] x {0} x [-1,1] (flat shapes). */
 box unit_flat_bounds(double tube);
 
-/* The angle about +Y of p as u in [0,1) (0 on +X, a quarter on +Z), and the
- * unit tangent along it ((1,0,0) on the axis). */
-double around_y(vec3 p, vec3 *tangent);
-/* u = (x+1)/2, v = (z+1)/2, tangent +X: flat shapes and caps. */
-void uv_flat(vec3 p, double tube, double *u, double *v, vec3 *tangent);
+/* Texture coordinates (shape_kind.uv). The planar u = (x + 1) / 2,
+ * v = (z + 1) / 2: the disc, the rectangle, the caps (and kinds with no uv
+ * of their own). */
+void uv_planar(vec3 q, vec3 nl, double tube, double *u, double *v, vec3 *dqdu, vec3 *dqdv);
+/* The cylinder's and cone's: around the side the sphere's u and
+ * v = (y + 1) / 2, the caps planar. */
+void uv_capped_side(vec3 q, vec3 nl, double tube, double *u, double *v, vec3 *dqdu, vec3 *dqdv);
+
+/* Lights (shape_light_ops, light.c). A flat light c + a u + b v with its
+ * area set: its unit normal and reach (triangle: a, b >= 0, a + b <= 1;
+ * else a parallelogram's a, b in [-1,1]); false when it is degenerate. */
+bool light_flat_finish(shape_light *l, bool triangle);
+/* p is close enough to l to sample it by solid angle. */
+static inline bool light_near(const shape_light *l, vec3 p)
+{
+	return v3_len2(v3_sub(l->c, p)) < l->reach2;
+}
+/* The density per steradian of area sampling, direction d, distance t. */
+static inline double light_area_pdf(const shape_light *l, vec3 d, double t)
+{
+	double cos_l = fabs(v3_dot(l->n, d));
+	return cos_l > 0.0 ? t * t / (cos_l * l->area) : 0.0;
+}
+/* The direction from p to the point c + a u + b v of l, its distance and
+ * its density by the kind's pdf; false when degenerate or of density 0. */
+bool light_area_sample(const shape_light *l, vec3 p, double a, double b,
+                       double (*pdf)(const shape_light *, vec3, vec3, double), vec3 *wi, double *pdf_out, double *t);
+/* By the solid angle of the rectangle (u, v orthogonal) or triangle seen
+ * from p: its density, or a sample (disc: from the square around it, a
+ * point outside the disc has *pdf 0). False when degenerate seen from p. */
+bool light_rect_solid_pdf(const shape_light *l, vec3 p, double *pdf);
+bool light_rect_solid_sample(const shape_light *l, vec3 p, double u1, double u2, bool disc, vec3 *wi, double *pdf,
+                             double *t);
+bool light_tri_solid_pdf(const shape_light *l, vec3 p, double *pdf);
+bool light_tri_solid_sample(const shape_light *l, vec3 p, double u1, double u2, vec3 *wi, double *pdf, double *t);
 
 /* The short-form reader and writer of kinds sized by one number in every
  * direction (the sphere: DIAMETER; scale = that x 3). */

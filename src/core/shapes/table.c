@@ -30,14 +30,6 @@ const shape_kind *shape_kind_find(const char *id, obj_kind *k, const shape_form 
 	return NULL;
 }
 
-/* The triangle is defined by its world-space vertices (tri_intersect). */
-const shape_kind triangle_kind = {
-	.form = {"tr", "triangle", false, false, true, 3, "P1 P2 P3",
-	         {"first point", "second point", "third point"}, "ppp", NULL, NULL},
-	.bounds = unit_cube_bounds,
-	.recipe = {.use = true}, /* generate.c places the vertices */
-};
-
 /* A mesh is a model file (mesh.h) placed like a unit shape: in object
  * space the model's box is centred on the origin with its longest side 2,
  * so within the unit cube. Its .rt line (FILE, a size of one or three
@@ -50,6 +42,12 @@ const shape_kind mesh_kind = {
 	.cost = 32, /* a ray into its object space and down its own tree */
 	.recipe = {.use = false},
 };
+
+void shape_uv(obj_kind k, vec3 q, vec3 nl, double tube, double *u, double *v, vec3 *dqdu, vec3 *dqdv)
+{
+	const shape_kind *d = shape_kind_of(k);
+	(d && d->uv ? d->uv : uv_planar)(q, nl, tube, u, v, dqdu, dqdv);
+}
 
 box shape_local_bounds(obj_kind k, double tube)
 {
@@ -67,27 +65,4 @@ box object_bounds(const object *o)
 	if (!object_xform(o, &x))
 		return box_empty();
 	return xf_box(&x, shape_local_bounds(o->kind, o->tube));
-}
-
-bool tri_intersect(vec3 v0, vec3 e1, vec3 e2, vec3 o, vec3 d, double tmin, double tmax, double *t)
-{
-	/* Moller & Trumbore, "Fast, minimum storage ray/triangle intersection", 1997. */
-	vec3 p = v3_cross(d, e2);
-	double det = v3_dot(e1, p);
-	if (det == 0.0)
-		return false;
-	double inv = 1.0 / det;
-	vec3 s = v3_sub(o, v0);
-	double u = v3_dot(s, p) * inv;
-	if (u < 0.0 || u > 1.0)
-		return false;
-	vec3 q = v3_cross(s, e1);
-	double v = v3_dot(d, q) * inv;
-	if (v < 0.0 || u + v > 1.0)
-		return false;
-	double tt = v3_dot(e2, q) * inv;
-	if (!(tt > tmin && tt < tmax))
-		return false;
-	*t = tt;
-	return true;
 }

@@ -160,15 +160,6 @@ static box torus_bounds(double k)
 	return (box){v3(-1, -r, -1), v3(1, r, 1)};
 }
 
-/* u around the axis, v around the tube (0 on the outer equator, a quarter
- * on top), the tangent along u. */
-static void torus_uv(vec3 p, double k, double *u, double *v, vec3 *tangent)
-{
-	*u = around_y(p, tangent);
-	double w = atan2(p.y, sqrt(p.x * p.x + p.z * p.z) - 1.0 / (1.0 + k)) / (2.0 * RT_PI);
-	*v = w < 0.0 ? w + 1.0 : w;
-}
-
 /* to CENTER AXIS DIAMETER TUBE_DIAMETER: the outer diameter D + d in every
  * direction, and the ratio d / D. */
 static void torus_read(object *o, const double *sizes)
@@ -193,7 +184,7 @@ const shape_kind torus_kind = {
 	.intersect = torus_intersect,
 	.occluded = torus_occluded,
 	.bounds = torus_bounds,
-	.uv = torus_uv,
+	.uv = uv_planar, /* planar, seen along its axis (rtsh(5)) */
 	.cost = 40,
 	.recipe = {true, {50, 0, 0}, {100, 0, 0}, 20, 60},
 };

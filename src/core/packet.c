@@ -1,0 +1,449 @@
+/* rtsh — packets of coherent rays through the world's object tree
+ * (rtsh/packet.h).
+ *
+ * One walk of the 4-wide tree (bvh.h) for up to PACKET_MAX rays whose
+ * directions share each axis's sign:
+ *   - the node test is the single ray's slab test (world.c) done on
+ *     intervals: per axis, the lowest near-plane origin and inverse
+ *     directions of the packet give a distance no greater than any ray's
+ *     own float distance, and the highest far ones one no smaller
+ *     (rounding to nearest is monotonic, so the bounds hold for the
+ *     rounded values too). A child that no ray of the packet could enter
+ *     by its own test is skipped; one that some ray might enter is visited
+ *     by all. So the packet visits at least every leaf a ray alone would
+ *     visit, and never misses what a single ray finds.
+ *   - at a leaf every ray whose nearest hit so far could still be beaten
+ *     meets every primitive with the single ray's own test (prim_hit.h);
+ *     spheres, the common case, first as a vector pre-test of their
+ *     discriminant, two rays per SSE2 register, with the same operations
+ *     in the same order as sphere_hit, then sphere_hit itself for the rays
+ *     that pass.
+ * The nearest distance does not depend on the order of the walk; which of
+ * two primitives at the same distance wins does (the single ray keeps the
+ * first it meets). Each ray therefore also accepts a primitive at exactly
+ * its current distance, and notes the tie: a ray with a tie at the end is
+ * traced again alone. The same for the planes beside the tree: they are
+ * tested first, in the same order, with the same strict test. */
+#include "rtsh/packet.h"
+
+#include <string.h>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+#include "core/bvh/bvh.h"
+#include "core/prim_hit.h"
+
+/* The state of a packet's walk: the rays by component (for the vector
+ * sphere pre-test, padded to an even count) and each ray's best hit. */
+typedef struct pk_state {
+	int n;
+	_Alignas(16) double ox[PACKET_MAX], oy[PACKET_MAX], oz[PACKET_MAX];
+	_Alignas(16) double dx[PACKET_MAX], dy[PACKET_MAX], dz[PACKET_MAX];
+	_Alignas(16) double dd[PACKET_MAX]; /* d . d, as sphere_hit computes it */
+	double tmax[PACKET_MAX];            /* the nearest hit so far (or the query's tmax) */
+	const prim *best[PACKET_MAX];
+	vec3 nl[PACKET_MAX];
+	bool tie[PACKET_MAX];
+} pk_state;
+
+/* The interval form of bvh_ray: per axis, the near- and far-plane origins
+ * that give the lowest near and highest far distances of any ray, the
+ * inverse directions' range, and the rows of the node's boxes to read. */
+typedef struct pk_ray {
+	__m128 on[3], of[3], ilo[3], ihi[3];
+	int near[3], far[3];
+} pk_ray;
+
+/* The smallest double above t >= 0 (+inf stays): a primitive at exactly
+ * the distance found so far is still reported (offer). */
+static inline double next_up(double t)
+{
+	if (!(t < INFINITY))
+		return t;
+	uint64_t u;
+	memcpy(&u, &t, sizeof u);
+	u = t > 0.0 ? u + 1 : 1;
+	memcpy(&t, &u, sizeof t);
+	return t;
+}
+
+/* The same rounding of a ray's origin and inverse direction as world.c's
+ * ray_prepare (scalar form): on[a] and of[a] bracket the origin so that the
+ * near plane's distance can only come down and the far plane's go up. */
+static inline void ray_floats(const ray *r, float on[3], float of[3], float inv[3])
+{
+	double o[3] = {r->o.x, r->o.y, r->o.z}, d[3] = {r->d.x, r->d.y, r->d.z};
+	for (int a = 0; a < 3; a++) {
+		float iv = (float)(1.0 / d[a]);
+		float f = (float)o[a], e = fabsf(f) * 0x1p-23f + 0x1p-149f;
+		float up = f + e, down = f - e;
+		bool neg = signbit(iv);
+		on[a] = neg ? down : up;
+		of[a] = neg ? up : down;
+		inv[a] = iv;
+	}
+}
+
+/* Fills q for rays r[0..n); false when the packet is not coherent enough
+ * for the interval test: a direction component of another sign than the
+ * first ray's, a zero component, an inverse that is not finite. */
+static bool packet_prepare(const ray *r, int n, pk_ray *q)
+{
+	float on_lo[3], on_hi[3], of_lo[3], of_hi[3], ilo[3], ihi[3];
+	int neg[3];
+	for (int i = 0; i < n; i++) {
+		float on[3], of[3], inv[3];
+		ray_floats(&r[i], on, of, inv);
+		for (int a = 0; a < 3; a++) {
+			if (!isfinite(inv[a]) || inv[a] == 0.0f || !isfinite(on[a]) || !isfinite(of[a]))
+				return false;
+			if (i == 0) {
+				neg[a] = signbit(inv[a]) != 0;
+				on_lo[a] = on_hi[a] = on[a];
+				of_lo[a] = of_hi[a] = of[a];
+				ilo[a] = ihi[a] = inv[a];
+				continue;
+			}
+			if ((signbit(inv[a]) != 0) != neg[a])
+				return false;
+			on_lo[a] = fminf(on_lo[a], on[a]);
+			on_hi[a] = fmaxf(on_hi[a], on[a]);
+			of_lo[a] = fminf(of_lo[a], of[a]);
+			of_hi[a] = fmaxf(of_hi[a], of[a]);
+			ilo[a] = fminf(ilo[a], inv[a]);
+			ihi[a] = fmaxf(ihi[a], inv[a]);
+		}
+	}
+	for (int a = 0; a < 3; a++) {
+		/* near distance (b - o) inv: lowest with the origin farthest
+		 * along the direction; far distance: highest with it farthest back */
+		q->on[a] = _mm_set1_ps(neg[a] ? on_lo[a] : on_hi[a]);
+		q->of[a] = _mm_set1_ps(neg[a] ? of_hi[a] : of_lo[a]);
+		q->ilo[a] = _mm_set1_ps(ilo[a]);
+		q->ihi[a] = _mm_set1_ps(ihi[a]);
+		q->near[a] = a + (neg[a] ? BVH_HI_X : BVH_LO_X);
+		q->far[a] = a + (neg[a] ? BVH_LO_X : BVH_HI_X);
+	}
+	return true;
+}
+
+/* The interval slab test of node n's four children: bit k set when some
+ * ray of the packet may enter child k within [tmin, tmax]; tn[k] no more
+ * than where any of them enters it. */
+static inline unsigned packet_slab4(const bvh_node *n, const pk_ray *q, float tmin, float tmax, float tn[4])
+{
+	__m128 t0 = _mm_set1_ps(tmin), t1 = _mm_set1_ps(tmax);
+	for (int a = 0; a < 3; a++) {
+		__m128 x = _mm_sub_ps(_mm_load_ps(n->b[q->near[a]]), q->on[a]);
+		__m128 y = _mm_sub_ps(_mm_load_ps(n->b[q->far[a]]), q->of[a]);
+		__m128 lo = _mm_min_ps(_mm_mul_ps(x, q->ilo[a]), _mm_mul_ps(x, q->ihi[a]));
+		__m128 hi = _mm_max_ps(_mm_mul_ps(y, q->ilo[a]), _mm_mul_ps(y, q->ihi[a]));
+		t0 = _mm_max_ps(lo, t0);
+		t1 = _mm_min_ps(hi, t1);
+	}
+	_mm_storeu_ps(tn, t0);
+	return (unsigned)_mm_movemask_ps(_mm_cmple_ps(t0, _mm_mul_ps(t1, _mm_set1_ps(BVH_SLAB_SLACK))));
+}
+
+/* Ray i meets primitive p: a nearer hit replaces its best, one at the same
+ * distance from another primitive is a tie. */
+static inline void offer(pk_state *s, int i, const prim *p, double t, vec3 nl)
+{
+	if (t < s->tmax[i]) {
+		s->tmax[i] = t;
+		s->best[i] = p;
+		s->nl[i] = nl;
+		s->tie[i] = false;
+	} else if (t == s->tmax[i] && s->best[i] && p != s->best[i]) {
+		/* (at the distance of a plane or of the query's tmax, a single
+		 * ray keeps the plane or nothing: not a tie) */
+		s->tie[i] = true;
+	}
+}
+
+static void leaf_spheres(pk_state *s, const prim *p, const ray *r, double tmin)
+{
+	vec3 zero = {0, 0, 0};
+#if defined(__SSE2__)
+	const __m128d cx = _mm_set1_pd(p->u.sph.c.x), cy = _mm_set1_pd(p->u.sph.c.y), cz = _mm_set1_pd(p->u.sph.c.z);
+	const __m128d rr = _mm_set1_pd(p->u.sph.r * p->u.sph.r), zd = _mm_setzero_pd();
+	for (int i = 0; i < s->n; i += 2) {
+		/* sphere_hit's discriminant, term by term */
+		__m128d ocx = _mm_sub_pd(_mm_load_pd(&s->ox[i]), cx);
+		__m128d ocy = _mm_sub_pd(_mm_load_pd(&s->oy[i]), cy);
+		__m128d ocz = _mm_sub_pd(_mm_load_pd(&s->oz[i]), cz);
+		__m128d dx = _mm_load_pd(&s->dx[i]), dy = _mm_load_pd(&s->dy[i]), dz = _mm_load_pd(&s->dz[i]);
+		__m128d b = _mm_add_pd(_mm_add_pd(_mm_mul_pd(ocx, dx), _mm_mul_pd(ocy, dy)), _mm_mul_pd(ocz, dz));
+		__m128d c = _mm_sub_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(ocx, ocx), _mm_mul_pd(ocy, ocy)), _mm_mul_pd(ocz, ocz)), rr);
+		__m128d disc = _mm_sub_pd(_mm_mul_pd(b, b), _mm_mul_pd(_mm_load_pd(&s->dd[i]), c));
+		/* !(disc < 0): NaN goes on to sphere_hit, as there */
+		unsigned m = (unsigned)_mm_movemask_pd(_mm_cmpnlt_pd(disc, zd));
+		for (; m; m &= m - 1) {
+			int j = i + __builtin_ctz(m);
+			double t;
+			if (j < s->n && sphere_hit(p, &r[j], tmin, next_up(s->tmax[j]), &t))
+				offer(s, j, p, t, zero);
+		}
+	}
+#else
+	for (int i = 0; i < s->n; i++) {
+		double t;
+		if (sphere_hit(p, &r[i], tmin, next_up(s->tmax[i]), &t))
+			offer(s, i, p, t, zero);
+	}
+#endif
+}
+
+static inline float packet_far(const pk_state *s)
+{
+	double m = s->tmax[0];
+	for (int i = 1; i < s->n; i++)
+		m = s->tmax[i] > m ? s->tmax[i] : m;
+	return to_float_up(m);
+}
+
+typedef struct pk_entry {
+	uint32_t child, meta;
+	float t;
+	uint32_t pad;
+} pk_entry;
+
+static void packet_walk(const world *w, pk_state *s, const ray *r, const pk_ray *q, double tmin)
+{
+	const bvh *tree = w->tree;
+	const bvh_node *nodes = tree->nodes;
+	float ftmin = to_float_down(tmin), ftmax = packet_far(s);
+	pk_entry stack[BVH_STACK];
+	int sp = 0;
+	uint32_t child = tree->root, meta = tree->root_meta;
+	for (;;) {
+		if (meta) {
+			const prim *p = &w->prims[child];
+			uint32_t count = meta & ~BVH_LEAF;
+			for (uint32_t k = 0; k < count; k++) {
+				if (p[k].tag == PRIM_SPHERE) {
+					leaf_spheres(s, &p[k], r, tmin);
+					continue;
+				}
+				for (int i = 0; i < s->n; i++) {
+					double t;
+					vec3 nl = {0, 0, 0};
+					if (world_prim_hit(w, &p[k], &r[i], tmin, next_up(s->tmax[i]), &t, &nl, true))
+						offer(s, i, &p[k], t, nl);
+				}
+			}
+			ftmax = packet_far(s);
+		} else {
+			const bvh_node *n = &nodes[child];
+			float tn[BVH_WIDTH];
+			unsigned m = packet_slab4(n, q, ftmin, ftmax, tn);
+			if (m) {
+				int idx[BVH_WIDTH], c = 0;
+				for (unsigned b = m; b; b &= b - 1) { /* farthest first, nearest on top */
+					int k = __builtin_ctz(b), j = c++;
+					while (j > 0 && tn[idx[j - 1]] < tn[k]) {
+						idx[j] = idx[j - 1];
+						j--;
+					}
+					idx[j] = k;
+				}
+				for (int i = 0; i < c - 1; i++)
+					stack[sp++] = (pk_entry){n->child[idx[i]], n->meta[idx[i]], tn[idx[i]], 0};
+				child = n->child[idx[c - 1]];
+				meta = n->meta[idx[c - 1]];
+				continue;
+			}
+		}
+		while (sp > 0 && stack[sp - 1].t > ftmax * BVH_SLAB_SLACK)
+			sp--;
+		if (sp == 0)
+			break;
+		sp--;
+		child = stack[sp].child;
+		meta = stack[sp].meta;
+	}
+}
+
+void world_trace_packet(const world *w, int n, const ray *r, double tmin, double tmax, trace_hit *th, bool *found)
+{
+	pk_ray q;
+	bool lone_model = w->nprims == 1 && w->prims[0].tag == PRIM_MESH;
+	if (n < 2 || n > PACKET_MAX || !w->nprims || lone_model || !packet_prepare(r, n, &q)) {
+		for (int i = 0; i < n; i++)
+			found[i] = world_trace_coherent(w, &r[i], tmin, tmax, &th[i]);
+		return;
+	}
+	world_rays_count(n);
+	pk_state s;
+	s.n = n;
+	const prim_plane *best_plane[PACKET_MAX];
+	for (int i = 0; i < n; i++) {
+		double t = tmax, tp;
+		best_plane[i] = NULL;
+		for (size_t k = 0; k < w->nplanes; k++)
+			if (plane_hit(&w->planes[k], &r[i], tmin, t, &tp)) {
+				t = tp;
+				best_plane[i] = &w->planes[k];
+			}
+		s.tmax[i] = t;
+		s.best[i] = NULL;
+		s.tie[i] = false;
+		s.ox[i] = r[i].o.x;
+		s.oy[i] = r[i].o.y;
+		s.oz[i] = r[i].o.z;
+		s.dx[i] = r[i].d.x;
+		s.dy[i] = r[i].d.y;
+		s.dz[i] = r[i].d.z;
+		s.dd[i] = v3_dot(r[i].d, r[i].d);
+	}
+	if (n & 1) { /* the vector pre-test reads an even count; the pad is never offered */
+		s.ox[n] = s.ox[0];
+		s.oy[n] = s.oy[0];
+		s.oz[n] = s.oz[0];
+		s.dx[n] = s.dx[0];
+		s.dy[n] = s.dy[0];
+		s.dz[n] = s.dz[0];
+		s.dd[n] = s.dd[0];
+	}
+	packet_walk(w, &s, r, &q, tmin);
+	for (int i = 0; i < n; i++) {
+		if (s.tie[i]) {
+			world_rays_count(-1);
+			found[i] = world_trace_coherent(w, &r[i], tmin, tmax, &th[i]);
+			continue;
+		}
+		th[i].t = s.tmax[i];
+		th[i].prim = s.best[i];
+		th[i].plane = s.best[i] ? NULL : best_plane[i];
+		th[i].nl = s.best[i] ? s.nl[i] : (vec3){0, 0, 0};
+		found[i] = s.best[i] || best_plane[i];
+	}
+}
+
+void world_intersect_packet(const world *w, int n, const ray *r, double tmin, double tmax, hit *h, bool *found)
+{
+	trace_hit th[PACKET_MAX];
+	world_trace_packet(w, n, r, tmin, tmax, th, found);
+	for (int i = 0; i < n; i++)
+		if (found[i])
+			world_finish(w, &r[i], &th[i], &h[i]);
+}
+
+/* --- any hit: shadow rays --- */
+
+/* The rays of s not yet known to be blocked: bit i for ray i. */
+static void leaf_occluded(const world *w, pk_state *s, unsigned *live, const prim *p, const ray *r, double tmin)
+{
+	if (p->tag != PRIM_SPHERE) {
+		for (unsigned m = *live; m; m &= m - 1) {
+			int i = __builtin_ctz(m);
+			if (world_prim_occluded(w, p, &r[i], tmin, s->tmax[i]))
+				*live &= ~(1u << i);
+		}
+		return;
+	}
+	const __m128d cx = _mm_set1_pd(p->u.sph.c.x), cy = _mm_set1_pd(p->u.sph.c.y), cz = _mm_set1_pd(p->u.sph.c.z);
+	const __m128d rr = _mm_set1_pd(p->u.sph.r * p->u.sph.r), zd = _mm_setzero_pd();
+	for (int i = 0; i < s->n; i += 2) {
+		if (!(*live >> i & 3u))
+			continue;
+		__m128d ocx = _mm_sub_pd(_mm_load_pd(&s->ox[i]), cx);
+		__m128d ocy = _mm_sub_pd(_mm_load_pd(&s->oy[i]), cy);
+		__m128d ocz = _mm_sub_pd(_mm_load_pd(&s->oz[i]), cz);
+		__m128d dx = _mm_load_pd(&s->dx[i]), dy = _mm_load_pd(&s->dy[i]), dz = _mm_load_pd(&s->dz[i]);
+		__m128d b = _mm_add_pd(_mm_add_pd(_mm_mul_pd(ocx, dx), _mm_mul_pd(ocy, dy)), _mm_mul_pd(ocz, dz));
+		__m128d c = _mm_sub_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(ocx, ocx), _mm_mul_pd(ocy, ocy)), _mm_mul_pd(ocz, ocz)), rr);
+		__m128d disc = _mm_sub_pd(_mm_mul_pd(b, b), _mm_mul_pd(_mm_load_pd(&s->dd[i]), c));
+		unsigned m = (unsigned)_mm_movemask_pd(_mm_cmpnlt_pd(disc, zd)) & (*live >> i);
+		for (; m; m &= m - 1) {
+			int j = i + __builtin_ctz(m);
+			double t;
+			if (sphere_hit(p, &r[j], tmin, s->tmax[j], &t))
+				*live &= ~(1u << j);
+		}
+	}
+}
+
+void world_occluded_packet(const world *w, int n, const ray *r, double tmin, const double *tmax, bool *occ)
+{
+	pk_ray q;
+	bool lone_model = w->nprims == 1 && w->prims[0].tag == PRIM_MESH;
+	if (n < 2 || n > PACKET_MAX || lone_model || !packet_prepare(r, n, &q)) {
+		for (int i = 0; i < n; i++)
+			occ[i] = world_occluded(w, &r[i], tmin, tmax[i]);
+		return;
+	}
+	world_rays_count(n);
+	pk_state s;
+	s.n = n;
+	unsigned live = 0;
+	for (int i = 0; i < n; i++) {
+		double t;
+		bool blocked = false;
+		for (size_t k = 0; k < w->nplanes && !blocked; k++)
+			blocked = plane_hit(&w->planes[k], &r[i], tmin, tmax[i], &t);
+		occ[i] = blocked;
+		live |= (unsigned)!blocked << i;
+		s.tmax[i] = tmax[i];
+		s.ox[i] = r[i].o.x;
+		s.oy[i] = r[i].o.y;
+		s.oz[i] = r[i].o.z;
+		s.dx[i] = r[i].d.x;
+		s.dy[i] = r[i].d.y;
+		s.dz[i] = r[i].d.z;
+		s.dd[i] = v3_dot(r[i].d, r[i].d);
+	}
+	if (n & 1) {
+		s.ox[n] = s.ox[0];
+		s.oy[n] = s.oy[0];
+		s.oz[n] = s.oz[0];
+		s.dx[n] = s.dx[0];
+		s.dy[n] = s.dy[0];
+		s.dz[n] = s.dz[0];
+		s.dd[n] = s.dd[0];
+	}
+	if (w->nprims && live) {
+		const bvh_node *nodes = w->tree->nodes;
+		float ftmin = to_float_down(tmin);
+		double far = 0;
+		for (int i = 0; i < n; i++)
+			far = tmax[i] > far ? tmax[i] : far;
+		float ftmax = to_float_up(far);
+		pk_entry stack[BVH_STACK];
+		int sp = 0;
+		uint32_t child = w->tree->root, meta = w->tree->root_meta;
+		for (;;) {
+			if (meta) {
+				const prim *p = &w->prims[child];
+				uint32_t count = meta & ~BVH_LEAF;
+				for (uint32_t k = 0; k < count && live; k++)
+					leaf_occluded(w, &s, &live, &p[k], r, tmin);
+				if (!live)
+					break;
+			} else {
+				float tn[BVH_WIDTH];
+				unsigned m = packet_slab4(&nodes[child], &q, ftmin, ftmax, tn);
+				if (m) {
+					const bvh_node *nd = &nodes[child];
+					int k = __builtin_ctz(m);
+					for (unsigned rest = m & (m - 1); rest; rest &= rest - 1) {
+						int j = __builtin_ctz(rest);
+						stack[sp++] = (pk_entry){nd->child[j], nd->meta[j], tn[j], 0};
+					}
+					child = nd->child[k];
+					meta = nd->meta[k];
+					continue;
+				}
+			}
+			if (sp == 0)
+				break;
+			sp--;
+			child = stack[sp].child;
+			meta = stack[sp].meta;
+		}
+	}
+	for (int i = 0; i < n; i++)
+		occ[i] = occ[i] || !(live >> i & 1u);
+}
