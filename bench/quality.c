@@ -203,7 +203,7 @@ static bool run_cycles(const char *path, const char *blend, int depth, const cha
 {
 	char cmd[1024];
 	int len = blend ? snprintf(cmd, sizeof cmd,
-	                           "nice -n 10 blender -b --factory-startup %s -P bench/gltf_scene.py -- render "
+	                           "blender -b --factory-startup %s -P bench/gltf_scene.py -- render "
 	                           "%dx%d %d %d %d " QDIR "/%s-%s",
 	                           blend, w, h, threads, seed, depth, name, tag)
 	                : snprintf(cmd, sizeof cmd,
@@ -444,7 +444,7 @@ static void bench_gltf(bool cycles)
 			return;
 		}
 		fprintf(stderr, "quality: building %s in Blender (once)\n", glb);
-		if (system("nice -n 10 blender -b --factory-startup -P bench/gltf_scene.py -- build " QDIR
+		if (system("blender -b --factory-startup -P bench/gltf_scene.py -- build " QDIR
 		           "/pbr-gltf >" QDIR "/pbr-gltf-build.log 2>&1") != 0 ||
 		    !exists(glb)) {
 			printf("\npbr-gltf: Blender could not build or export the scene (%s; the exporter needs "
