@@ -55,6 +55,7 @@ typedef struct mesh_mat {
 	float specular_color[3]; /* ... specularColorFactor (1,1,1) */
 	char *map_mr, *map_emit;             /* metallic-roughness, emissive textures */
 	struct texture *tex_mr, *tex_emit;   /* ... embedded */
+	float uvx[2];         /* ... its rotation's cross terms: u' += uvx[0] v, v' += uvx[1] u */
 	float uvs[2], uvo[2]; /* KHR_texture_transform of the base colour texture, in
 	                       * rtsh's uv (v up): uv x uvs + uvo; (1,1), (0,0) */
 } mesh_mat;

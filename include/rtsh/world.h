@@ -66,6 +66,7 @@ typedef struct mat_tex {
 	bool tint;         /* tex x albedo (texture= with a colour); else tex alone */
 	double bumpscale;
 	double uvs[2], uvo[2]; /* uv x uvs + uvo */
+	double uvx[2];     /* and the cross terms: u' += uvx[0] v, v' += uvx[1] u (a glTF rotation; 0 none) */
 } mat_tex;
 
 typedef struct light_lin {

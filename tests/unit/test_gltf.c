@@ -795,6 +795,68 @@ static void test_metallic_roughness_texture(void **state)
 	scene_free(s);
 }
 
+/* KHR_texture_transform with a rotation. The triangle of the test above,
+ * hit at (0, -0.2): barycentrics 0.3 and 0.4 for the second and third
+ * corners, so the file's uv there is 0.3 (1,0) + 0.4 (0.5,1) = (0.5, 0.4).
+ * Offset (0.1, 0.2), rotation pi/2, scale (2, 0.5), by the extension's
+ * formula (u' = o_u + cos s_u u - sin s_v v, v' = o_v + sin s_u u + cos s_v v):
+ * u' = 0.1 - 0.5 x 0.4 = -0.1 and v' = 0.2 + 2 x 0.5 = 1.2, which rtsh's v
+ * (up) makes 1 - 1.2 = -0.2. The tangents follow: dp/du' and dp/dv' map back
+ * to the moves of the hit point that change u' or v' alone. */
+static void test_texture_rotation(void **state)
+{
+	(void)state;
+	unsigned char bin[68];
+	const float pos[9] = {-1, -1, 0, 1, -1, 0, 0, 1, 0}, uv[6] = {0, 0, 1, 0, 0.5f, 1};
+	const uint16_t idx[4] = {0, 1, 2, 0};
+	memcpy(bin, pos, 36);
+	memcpy(bin + 36, uv, 24);
+	memcpy(bin + 60, idx, 8);
+	char data[128], png64[128];
+	b64(bin, sizeof bin, data);
+	unsigned char png[80];
+	b64(png, png_1x1(200, 100, 50, png), png64);
+	char text[4096];
+	snprintf(text, sizeof text,
+	         "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0},{\"camera\":0,\"translation\":[0,0,5]}],"
+	         "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":1}}],"
+	         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"indices\":2,"
+	         "\"material\":0}]}],"
+	         "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0,\"extensions\":"
+	         "{\"KHR_texture_transform\":{\"offset\":[0.1,0.2],\"rotation\":%.17g,\"scale\":[2,0.5]}}}}}],"
+	         "\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],"
+	         "\"buffers\":[{\"byteLength\":68,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
+	         "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":24},"
+	         "{\"buffer\":0,\"byteOffset\":60,\"byteLength\":6}],"
+	         "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+	         "{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"},"
+	         "{\"bufferView\":2,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}",
+	         M_PI / 2, png64, data);
+	rt_error err = {0};
+	scene *s = rt_load_file(tmp_text("rot.gltf", text), NULL, &err);
+	if (!s)
+		fail_msg("%s", err.msg);
+	world *w = world_build(s, &err);
+	if (!w)
+		fail_msg("%s", err.msg);
+	hit h;
+	ray r = {v3(0, -0.2, 5), v3(0, 0, -1)};
+	assert_true(world_intersect(w, &r, 0, INFINITY, &h));
+	assert_true(h.has_uv);
+	assert_near(h.u, -0.1, 1e-6);
+	assert_near(h.v, -0.2, 1e-6);
+	/* a step along dp/du' changes u' by its length and v' not at all: seen
+	 * through a second hit a little along it */
+	vec3 step = v3_scale(h.dpdu, 1e-3);
+	hit h2;
+	ray r2 = {v3_add(r.o, step), r.d};
+	assert_true(world_intersect(w, &r2, 0, INFINITY, &h2));
+	assert_near(h2.u - h.u, 1e-3, 1e-7);
+	assert_near(h2.v - h.v, 0, 1e-7);
+	world_free(w);
+	scene_free(s);
+}
+
 /* A lamp made of a glTF mesh is sampled directly, as the .rt emitters are:
  * a 2 x 2 square of two triangles, emissiveFactor 1 x
  * KHR_materials_emissive_strength 2 (Le = 2), 1 above a Lambert floor of
@@ -904,6 +966,7 @@ int main(void)
 	    cmocka_unit_test(test_nodes_as_objects),
 	    cmocka_unit_test(test_metallic_roughness_texture),
 	    cmocka_unit_test(test_mesh_lamp),
+	    cmocka_unit_test(test_texture_rotation),
 	    cmocka_unit_test(test_stage_lighting),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);

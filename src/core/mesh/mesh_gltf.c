@@ -1134,19 +1134,30 @@ static bool material(gl *g, mesh_builder *b, texture **cache, size_t i, mesh_mat
 		return false;
 	const cJSON *tt = key(key(bt, "extensions"), "KHR_texture_transform");
 	if (tt) {
-		/* glTF: uv' = T(offset) R(rotation) S(scale) uv, with v down; in
-		 * rtsh's v (up, 1 - v): v' = (1 - offset_v - scale_v) + scale_v v.
-		 * A rotation is not carried (mat_tex has none) */
+		/* glTF: uv' = T(offset) R(rotation) S(scale) uv, v down, R's
+		 * columns (cos r, sin r) and (-sin r, cos r) (the extension's GLSL):
+		 *   u' = o_u + c s_u u - s s_v v,  v' = o_v + s s_u u + c s_v v;
+		 * in rtsh's v (up: 1 - v on both sides)
+		 *   u' = (o_u - s s_v) + c s_u u + s s_v v
+		 *   v' = (1 - o_v - c s_v) - s s_u u + c s_v v */
 		static const double o0[2] = {0, 0}, s0[2] = {1, 1};
-		double off[2], sc[2];
+		double off[2], sc[2], rot;
 		snprintf(w2, sizeof w2, "%s.pbrMetallicRoughness.baseColorTexture.extensions.KHR_texture_transform", where);
 		if (!get_nums(g, tt, "offset", w2, 2, -1e300, 1e300, o0, off) ||
-		    !get_nums(g, tt, "scale", w2, 2, -1e300, 1e300, s0, sc))
+		    !get_nums(g, tt, "scale", w2, 2, -1e300, 1e300, s0, sc) ||
+		    !get_num(g, tt, "rotation", w2, -1e300, 1e300, 0, &rot))
 			return false;
-		m->uvs[0] = (float)sc[0];
-		m->uvs[1] = (float)sc[1];
-		m->uvo[0] = (float)off[0];
-		m->uvo[1] = (float)(1 - off[1] - sc[1]);
+		double cr = cos(rot), sn = sin(rot);
+		if (rot == 0) {
+			cr = 1;
+			sn = 0;
+		}
+		m->uvs[0] = (float)(cr * sc[0]);
+		m->uvs[1] = (float)(cr * sc[1]);
+		m->uvx[0] = (float)(sn * sc[1]);
+		m->uvx[1] = (float)(-sn * sc[0]);
+		m->uvo[0] = (float)(off[0] - sn * sc[1]);
+		m->uvo[1] = (float)(1 - off[1] - cr * sc[1]);
 	}
 	snprintf(w2, sizeof w2, "%s.pbrMetallicRoughness.metallicRoughnessTexture", where);
 	if (!tex_info(g, b, cache, key(pbr, "metallicRoughnessTexture"), w2, false, &m->map_mr, &m->tex_mr))
