@@ -135,10 +135,13 @@ static void block_add(const world *w, const render_settings *s, int x0, int y0, 
 			for (int x = x0; x < x1; x++, i++)
 				r[i] = camera_sample_ray(w, s, x, y, fw, fh, k, &sp[i]);
 		world_intersect_packet(w, n, r, 0.0, INFINITY, h, found);
+		uint32_t known[PACKET_MAX], blocked[PACKET_MAX];
+		if (s->mode != MODE_PATH)
+			whitted_shadow_packets(w, n, h, found, known, blocked);
 		for (int y = y0, i = 0; y < y1; y++)
 			for (int x = x0; x < x1; x++, i++) {
 				vec3 c = s->mode == MODE_PATH ? path_radiance_first(w, s, r[i], &sp[i], found[i], &h[i])
-				                              : whitted_radiance_first(w, s, r[i], found[i], &h[i]);
+				                              : whitted_radiance_first(w, s, r[i], found[i], &h[i], known[i], blocked[i]);
 				/* A NaN or infinity from a degenerate case must not poison the pixel. */
 				if (!v3_finite(c))
 					c = v3(0, 0, 0);

@@ -9,6 +9,7 @@
 #include <strings.h>
 #include <sys/stat.h>
 
+#include "base/readhelp.h"
 #include "rtsh/filesrc.h"
 #include "rtsh/memory.h"
 
@@ -131,10 +132,16 @@ mesh *mesh_cache_get_node(const char *path, long node, bool smooth, double creas
 		}
 	}
 	pthread_mutex_unlock(&cache_lock);
+	/* the readers poll the flag every few thousand elements (the builder,
+	 * mesh.c); assimp's own parse (STL) runs to its end */
+	const atomic_bool *outer = read_cancel_set(cancel);
 	mesh *m = load_node(path, node, err);
+	read_cancel_set(outer);
+	if (!m && cancel && atomic_load(cancel))
+		rt_error_set(err, "stopped");
 	if (!m)
 		return NULL;
-	/* the reader itself runs to its end; a stopped model is not cached */
+	/* a stopped model is not cached */
 	if (cancel && atomic_load(cancel)) {
 		mesh_free(m);
 		rt_error_set(err, "stopped");
