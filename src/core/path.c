@@ -247,3 +247,6 @@ vec3 path_radiance_first(const world *w, const render_settings *s, ray r, sample
 	}
 	return radiance;
 }
+
+/* Path mode samples every pixel and gives the denoiser its features. */
+const integrator path_integrator = {path_radiance, path_radiance_first, true, true};

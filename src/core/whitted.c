@@ -41,3 +41,19 @@ vec3 whitted_radiance_first(const world *w, const render_settings *s, ray r, boo
 {
 	return shade(w, r, s->depth, found, h);
 }
+
+static vec3 whitted_camera(const world *w, const render_settings *s, ray r, sampler *g)
+{
+	(void)g;
+	return whitted_radiance(w, s, r);
+}
+
+static vec3 whitted_camera_first(const world *w, const render_settings *s, ray r, sampler *g, bool found,
+                                 const hit *h)
+{
+	(void)g;
+	return whitted_radiance_first(w, s, r, found, h);
+}
+
+/* Whitted draws no random numbers: one sample is the pixel's centre. */
+const integrator whitted_integrator = {whitted_camera, whitted_camera_first, false, false};
