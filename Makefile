@@ -49,6 +49,7 @@ FRONTLIB  := $(BUILD)/librtsh-front.a
 
 TEST_SRC  := $(sort $(wildcard tests/unit/test_*.c))
 TEST_BIN  := $(TEST_SRC:tests/unit/%.c=$(BUILD)/tests/%)
+EXAMPLE_BIN := $(patsubst examples/%.c,$(BUILD)/examples/%,$(sort $(wildcard examples/*.c)))
 # The link simulator (tests/link): a program on a pty behind a slow wire.
 LINKSIM   := $(BUILD)/tests/linksim
 BENCH_SRC := bench/bench.c
@@ -57,6 +58,7 @@ BENCH_BIN := $(BUILD)/bench/bench
 # only when embree3/rtcore.h is installed (apt-get install libembree-dev).
 EMBREE_BIN := $(BUILD)/bench/embree_primary
 EMBREE_MESH_BIN := $(BUILD)/bench/embree_mesh
+EMBREE_BUILD_BIN := $(BUILD)/bench/embree_build
 # Equal-quality rows (rtsh against Blender's Cycles, preview time to an
 # error): bench/quality.c, run by `make bench` after the speed table.
 QUALITY_BIN := $(BUILD)/bench/quality
@@ -156,7 +158,14 @@ $(BENCH_BIN): $(BENCH_SRC) $(FRONTLIB) $(LIB)
 run: all
 	./$(BIN)
 
-test-bins: $(TEST_BIN) $(LINKSIM)
+test-bins: $(TEST_BIN) $(LINKSIM) $(EXAMPLE_BIN)
+
+# The embedding example: the public header (include/rtsh/rtsh.h) and
+# librtsh.a only, no -Isrc; tests/scripts/example.test runs it.
+$(BUILD)/examples/%: examples/%.c $(LIB)
+	@mkdir -p $(@D)
+	@echo "  CC      $@"
+	@$(CC) -Iinclude $(CFLAGS) $(LDFLAGS) -o $@ $< $(LIB) $(LDLIBS_CORE)
 
 $(LINKSIM): tests/link/linksim.c
 	@mkdir -p $(@D)
@@ -174,17 +183,21 @@ test-unit: $(BIN) $(TEST_BIN)
 test-scripts: $(BIN)
 	@sh tests/run-scripts.sh ./$(BIN)
 
-$(EMBREE_BIN): bench/embree_primary.c $(LIB)
+$(EMBREE_BIN): bench/embree_primary.c bench/embree_packets.h $(LIB)
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -o $@ $< $(LIB) -lembree3 $(LDLIBS_CORE)
 
-$(EMBREE_MESH_BIN): bench/embree_mesh.c bench/mesh_rays.h $(LIB)
+$(EMBREE_MESH_BIN): bench/embree_mesh.c bench/mesh_rays.h bench/embree_packets.h $(LIB)
+	@mkdir -p $(@D)
+	$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -o $@ $< $(LIB) -lembree3 $(LDLIBS_CORE)
+
+$(EMBREE_BUILD_BIN): bench/embree_build.c $(LIB)
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(LDFLAGS) -o $@ $< $(LIB) -lembree3 $(LDLIBS_CORE)
 
 bench: all $(BENCH_BIN)
 	@if printf '#include <embree3/rtcore.h>\n' | $(CC) -E -x c - >/dev/null 2>&1; then \
-		$(MAKE) --no-print-directory $(EMBREE_BIN) $(EMBREE_MESH_BIN); \
+		$(MAKE) --no-print-directory $(EMBREE_BIN) $(EMBREE_MESH_BIN) $(EMBREE_BUILD_BIN); \
 	else echo "bench: no embree3/rtcore.h, so no Embree row (apt-get install libembree-dev)"; fi
 	./$(BENCH_BIN) --out $(BUILD)/bench.tsv
 	@sh bench/mpi.sh --out $(BUILD)/bench-mpi.tsv

@@ -43,6 +43,7 @@
 #include "rtsh/world.h"
 #include "shell/keymode.h"
 #include "shell/options.h"
+#include "term/encoder.h"
 #include "term/frame.h"
 #include "term/keys.h"
 #include "term/pixels.h"
@@ -232,9 +233,29 @@ static double run_rtsh(const char *scene_path, int w, int h, int threads)
 	return rc == 0 ? t : -1;
 }
 
-/* Runs the Embree harness once; Mrays/s of its timed pass, < 0 if absent. */
-static double run_embree(const char *scene_path, int w, int h, double *seconds)
+/* Embree's packet calls in the harnesses' output (bench/embree_packets.h):
+ * "packet N mrays M seconds S" for N = 4, 8, 16 into mr[k], sec[k], k = 0..2. */
+#define EMBREE_PACKETS 3
+static const char *const packet_tiles[EMBREE_PACKETS] = {"2x2", "2x4", "4x4"};
+
+static void parse_packet(const char *line, double mr[EMBREE_PACKETS], double sec[EMBREE_PACKETS])
 {
+	int n;
+	double m, s;
+	if (sscanf(line, "packet %d mrays %lf seconds %lf", &n, &m, &s) == 3 && (n == 4 || n == 8 || n == 16)) {
+		int k = n == 4 ? 0 : n == 8 ? 1 : 2;
+		mr[k] = m;
+		sec[k] = s;
+	}
+}
+
+/* Runs the Embree harness once; Mrays/s of its timed pass, < 0 if absent;
+ * its packet rows into pm, ps (-1 when missing). */
+static double run_embree(const char *scene_path, int w, int h, double *seconds, double pm[EMBREE_PACKETS],
+                         double ps[EMBREE_PACKETS])
+{
+	for (int k = 0; k < EMBREE_PACKETS; k++)
+		pm[k] = ps[k] = -1;
 	char exe[512], cmd[1200];
 	snprintf(exe, sizeof exe, "%s/embree_primary", bench_dir);
 	if (access(exe, X_OK) != 0)
@@ -251,6 +272,7 @@ static double run_embree(const char *scene_path, int w, int h, double *seconds)
 			mrays = m;
 			*seconds = s;
 		}
+		parse_packet(line, pm, ps);
 	}
 	return pclose(p) == 0 ? mrays : -1;
 }
@@ -345,16 +367,23 @@ static void bench_primary(void)
 	scene *s = load(path);
 	world *wd = build(s);
 	double t[MAX_RUNS], tb[MAX_RUNS], te[MAX_RUNS], em[MAX_RUNS];
-	int ne = 0;
+	double pkm[EMBREE_PACKETS][MAX_RUNS], pks[EMBREE_PACKETS][MAX_RUNS];
+	int ne = 0, npk[EMBREE_PACKETS] = {0};
 	long hits;
 	primary_pass(wd, w, h, false, &hits); /* warm up */
 	for (int i = 0; i < runs; i++) {
 		t[i] = primary_pass(wd, w, h, false, &hits);
 		tb[i] = primary_pass(wd, w, h, true, &hits);
-		double sec = 0, m = quick ? -1 : run_embree(path, w, h, &sec);
+		double sec = 0, pm[EMBREE_PACKETS], ps[EMBREE_PACKETS];
+		double m = quick ? -1 : run_embree(path, w, h, &sec, pm, ps);
 		if (m > 0) {
 			em[ne] = m;
 			te[ne++] = sec;
+			for (int k = 0; k < EMBREE_PACKETS; k++)
+				if (pm[k] > 0) {
+					pkm[k][npk[k]] = pm[k];
+					pks[k][npk[k]++] = ps[k];
+				}
 		}
 	}
 	double rays = (double)w * h * 1e-6;
@@ -367,12 +396,44 @@ static void bench_primary(void)
 		double me = median(em, ne), se = median(te, ne);
 		r = add_row("grid.rt", "embree-primary", w, h, 1, 1, ne, se, me);
 		snprintf(r->note, sizeof r->note, "Embree 3 rtcIntersect1; rtsh %.2fx Embree", (rays / m) / me);
+		for (int k = 0; k < EMBREE_PACKETS; k++) {
+			if (!npk[k])
+				continue;
+			char mode[32];
+			snprintf(mode, sizeof mode, "embree-packet%d", 4 << k);
+			double pm = median(pkm[k], npk[k]), ps = median(pks[k], npk[k]);
+			r = add_row("grid.rt", mode, w, h, 1, 1, npk[k], ps, pm);
+			snprintf(r->note, sizeof r->note, "rtcIntersect%d, %s-pixel tiles, coherent flag; rtsh primary %.2fx",
+			         4 << k, packet_tiles[k], (rays / m) / pm);
+		}
 	} else if (!quick) {
 		r = add_row("grid.rt", "embree-primary", w, h, 1, 1, 0, -1, -1);
 		snprintf(r->note, sizeof r->note, "no %s/embree_primary (needs embree3/rtcore.h)", bench_dir);
 	}
 	world_free(wd);
 	scene_free(s);
+}
+
+/* Embree 3's build of the spheres-N scene (bench/embree_build): seconds, or
+ * < 0 when the harness is absent or fails; its bytes in *bytes. */
+static double run_embree_build(size_t n, double *bytes)
+{
+	char exe[512], cmd[1200];
+	snprintf(exe, sizeof exe, "%s/embree_build", bench_dir);
+	if (access(exe, X_OK) != 0)
+		return -1;
+	snprintf(cmd, sizeof cmd, "%s %zu 2>&1", exe, n);
+	FILE *p = popen(cmd, "r");
+	if (!p)
+		return -1;
+	char line[256];
+	double t = -1;
+	while (fgets(line, sizeof line, p))
+		if (sscanf(line, "build %lf bytes %lf", &t, bytes) == 2)
+			break;
+	while (fgets(line, sizeof line, p))
+		;
+	return pclose(p) == 0 ? t : -1;
 }
 
 static void bench_spheres(void)
@@ -409,6 +470,16 @@ static void bench_spheres(void)
 		snprintf(r->note, sizeof r->note, "%zu B/object: model %zu + world %zu; %zu BVH nodes", 
 		         (s->nobjs * sizeof(object) + world_memory(wd)) / s->nobjs, sizeof(object),
 		         world_memory(wd) / s->nobjs, wd->tree->nnodes);
+		/* Embree's build of the same spheres, right after rtsh's (the
+		 * harness takes the median of its own three builds) */
+		double ebytes = 0, eb = quick ? -1 : run_embree_build(n, &ebytes);
+		if (eb > 0) {
+			r = add_row(name, "embree-build", -1, -1, 0, 1, 3, eb, -1);
+			snprintf(r->note, sizeof r->note,
+			         "Embree 3 spheres, default (medium) quality, 1 thread: rtsh world_build %.2fx its time; "
+			         "%.0f B/sphere",
+			         median(tb, bruns) / eb, ebytes / (double)n);
+		}
 		render_settings set1 = settings(w, h, 1), set2 = settings(w, h, 2);
 		uint64_t rays = count_rays(wd, set1, fb);
 		double t1[MAX_RUNS], t2[MAX_RUNS];
@@ -924,7 +995,9 @@ static long keymode_pump(keymode *km, int wake, double seconds, bool until_frame
 	return frames;
 }
 
-static void bench_keymode(void)
+/* cols x cell_rows cells; sym: the picture's symbols (encoder_symbols), or -1
+ * for keymode_new's own (half blocks) with the row named as before issue 29 */
+static void bench_keymode_at(int cols, int cell_rows, int sym)
 {
 	rtsh_options o;
 	memset(&o, 0, sizeof o);
@@ -941,9 +1014,11 @@ static void bench_keymode(void)
 	sh.wake[0] = p[0];
 	sh.wake[1] = p[1];
 	termout *to = termout_new(out);
-	keymode *km = to ? keymode_new(&sh, to, PALETTE_TRUECOLOR, 160, 48) : NULL;
+	keymode *km = to ? keymode_new(&sh, to, PALETTE_TRUECOLOR, cols, cell_rows) : NULL;
 	if (!km)
 		fail("keymode_new", NULL);
+	if (sym >= 0)
+		keymode_set_encoder(km, encoder_symbols((symbols_kind)sym), 0, 0, 0, 0);
 	int kruns = quick ? 5 : 41;
 	double t[MAX_RUNS];
 	keymode_pump(km, p[0], 0.5, false);
@@ -962,10 +1037,14 @@ static void bench_keymode(void)
 		keymode_key(km, i % 2 ? KEYS_LEFT : KEYS_RIGHT);
 		frames += keymode_pump(km, p[0], 1.0 / 30, false);
 	}
-	row *r = add_row("showcase.rt", "key-to-frame", 160, 90, 1, render_threads(&sh.set), kruns, m, -1);
+	static const char *const names[] = {"half", "quadrant", "sextant", "octant"};
+	char mode[40];
+	snprintf(mode, sizeof mode, sym < 0 ? "key-to-frame" : "key-to-frame-%s", sym < 0 ? "" : names[sym]);
+	/* the first row keeps the size it was listed under before (160x90) */
+	row *r = add_row("showcase.rt", mode, cols, sym < 0 ? 90 : cell_rows, 1, render_threads(&sh.set), kruns, m, -1);
 	snprintf(r->note, sizeof r->note,
-	         "view at 160x48 cells: key to first frame; %.0f frames/s at 30 Hz repeat; target < 50 ms",
-	         frames / 2.0);
+	         "view at %dx%d cells: key to first frame; %.0f frames/s at 30 Hz repeat; target < 50 ms", cols,
+	         cell_rows, frames / 2.0);
 	keymode_free(km);
 	termout_free(to);
 	shell_free(&sh);
@@ -974,14 +1053,25 @@ static void bench_keymode(void)
 	close(p[1]);
 }
 
+/* The row of issue 6 (160x48 cells, half blocks), and issue 29's at 200x60
+ * cells with half blocks and with octants (2x4 samples a cell). */
+static void bench_keymode(void)
+{
+	bench_keymode_at(160, 48, -1);
+	bench_keymode_at(200, 60, SYMBOLS_HALF);
+	bench_keymode_at(200, 60, SYMBOLS_OCTANT);
+}
+
 /* --- triangle meshes beside Embree 3 (issue 10) --- */
 
 #define BUNNY "../shared/models/stanford-bunny.obj"
 
 /* Runs the Embree mesh harness once: 0 on success. */
 static int run_embree_mesh(const char *model, int w, int h, double *build, double *bytes, double *primary,
-                           double *sec)
+                           double *sec, double pm[EMBREE_PACKETS], double ps[EMBREE_PACKETS])
 {
+	for (int k = 0; k < EMBREE_PACKETS; k++)
+		pm[k] = ps[k] = -1;
 	char exe[512], cmd[1400];
 	snprintf(exe, sizeof exe, "%s/embree_mesh", bench_dir);
 	if (access(exe, X_OK) != 0)
@@ -997,6 +1087,7 @@ static int run_embree_mesh(const char *model, int w, int h, double *build, doubl
 		if (sscanf(line, "build %lf bytes %lf primary %lf hits %ld secondary %lf", build, bytes, primary, &hits,
 		           sec) == 5)
 			got = 1;
+		parse_packet(line, pm, ps);
 	}
 	return pclose(p) == 0 && got ? 0 : -1;
 }
@@ -1113,7 +1204,8 @@ static void bench_mesh(void)
 	double tp[MAX_RUNS], ts[MAX_RUNS], tpk[MAX_RUNS], tpu[MAX_RUNS], tsk[MAX_RUNS], be[MAX_RUNS], byte_e = -1, pe[MAX_RUNS],
 	    se[MAX_RUNS];
 	double sink = 0; /* the kernel rows' normals, so that none is left out */
-	int ne = 0;
+	int ne = 0, npk[EMBREE_PACKETS] = {0};
+	double pkm[EMBREE_PACKETS][MAX_RUNS], pks[EMBREE_PACKETS][MAX_RUNS];
 	ray *sr = malloc((size_t)w * h * sizeof *sr);
 	if (!sr)
 		fail("secondary rays", NULL);
@@ -1151,8 +1243,13 @@ static void bench_mesh(void)
 				sink += world_trace_ng(wd, &sr[k], &th).x;
 		}
 		tsk[i] = cpu_now() - t0;
-		double eb, ebytes, ep, es;
-		if (!quick && run_embree_mesh(BUNNY, w, h, &eb, &ebytes, &ep, &es) == 0) {
+		double eb, ebytes, ep, es, pm[EMBREE_PACKETS], ps[EMBREE_PACKETS];
+		if (!quick && run_embree_mesh(BUNNY, w, h, &eb, &ebytes, &ep, &es, pm, ps) == 0) {
+			for (int k = 0; k < EMBREE_PACKETS; k++)
+				if (pm[k] > 0) {
+					pkm[k][npk[k]] = pm[k];
+					pks[k][npk[k]++] = ps[k];
+				}
 			be[ne] = eb;
 			pe[ne] = ep;
 			se[ne++] = es;
@@ -1192,6 +1289,17 @@ static void bench_mesh(void)
 	r = add_row("bunny 69k tris", "tri-diffuse-hit", w, h, 1, 1, runs, ms, mrs);
 	if (ne)
 		snprintf(r->note, sizeof r->note, "CPU time; world_intersect (with the hit record): %.2fx Embree", mrs / es);
+	for (int k = 0; k < EMBREE_PACKETS; k++) {
+		if (!npk[k])
+			continue;
+		char mode[32];
+		snprintf(mode, sizeof mode, "embree-packet%d", 4 << k);
+		double pm = median(pkm[k], npk[k]), ps = median(pks[k], npk[k]);
+		r = add_row("bunny 69k tris", mode, w, h, 1, 1, npk[k], ps, pm);
+		snprintf(r->note, sizeof r->note,
+		         "rtcIntersect%d, %s-pixel tiles, coherent flag (CPU time); rtsh tri-primary %.2fx, rtcIntersect1 %.2f",
+		         4 << k, packet_tiles[k], mrpk / pm, ep);
+	}
 	if (!ne && !quick) {
 		r = add_row("bunny 69k tris", "embree-mesh", 0, 0, 0, 1, 0, -1, -1);
 		snprintf(r->note, sizeof r->note, "no %s/embree_mesh (needs embree3/rtcore.h)", bench_dir);

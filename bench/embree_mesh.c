@@ -11,7 +11,9 @@
  *   build S bytes B primary M hits H secondary M2
  * build: rtcCommitScene in seconds; bytes: what Embree allocated for the
  * scene (its memory monitor); primary and secondary: Mrays/s of
- * rtcIntersect1 on the rays of mesh_rays.h.
+ * rtcIntersect1 on the rays of mesh_rays.h. Then the camera rays in packets
+ * of 4, 8 and 16 with the coherent flag (embree_packets.h), a line each:
+ *   packet N mrays M seconds S hits H
  */
 #include <stdatomic.h>
 #include <stdio.h>
@@ -21,6 +23,7 @@
 
 #include <embree3/rtcore.h>
 
+#include "embree_packets.h"
 #include "mesh_rays.h"
 #include "rtsh/mesh.h"
 
@@ -160,6 +163,7 @@ int main(int argc, char **argv)
 	}
 	printf("build %.6f bytes %lld primary %.4f hits %ld secondary %.4f\n", median3(tbuild), scene_bytes,
 	       (double)w * h / median3(tprim) * 1e-6, hits, (double)sec_rays / median3(tsec) * 1e-6);
+	embree_packet_rows(sc, &cv, w, h, CLOCK_PROCESS_CPUTIME_ID);
 	rtcReleaseScene(sc);
 	rtcReleaseDevice(dev);
 	mesh_free(m);

@@ -12,26 +12,35 @@
  * well antialiased as that many samples would make its colour.
  *
  * A lamp's albedo feature is its emission, far from any surface's, so that
- * no filter mixes a lamp with what lies next to it. The job also keeps the
- * mean radiance and squared brightness of the even-numbered samples: with
- * those of all of them they split the samples into two independent halves.
+ * no filter mixes a lamp with what lies next to it. A further feature is
+ * the direct light the surface sends to the eye (the point lights exactly,
+ * each lamp from 2x2 stratified points, shadowed; through a glossy metal
+ * that is looked through, its own highlight too): it explains shadows and
+ * highlights that albedo and normal do not. The job also keeps the mean
+ * radiance and squared brightness of the even-numbered samples: with
+ * those of all of them they split the samples into two independent halves,
+ * and the albedo at the even samples' and all the samples' own positions.
  *
  * denoise_image is a feature regression after NFOR (Bitterli et al.,
  * "Nonlinearly Weighted First-order Regression for Denoising Monte Carlo
- * Renderings", EGSR 2016), with its colour weights left out. The radiance is divided by
- * the albedo (textures are not blurred, only the lighting); around each
- * pixel a first-order model of the lighting in screen position, normal and
- * depth is fitted by least squares over 9x9 pixels, each weighted by how
- * alike its albedo, normal and depth (off the pixel's plane) are to the
- * pixel's, and evaluated at the pixel. No weight depends on the noise, so
- * the fit of each half depends on that half's samples alone, and the other
- * half's raw pixel estimates the fit's squared error without bias (NFOR's
- * cross-buffer estimate: half a's fit against half b's pixel is off by a's
- * error plus b's noise, whose variance the samples give). Per pixel the fit
- * or the raw pixel is kept, whichever the estimate, averaged over 9x9
- * pixels, says is closer: shadows and highlights the features do not see
- * stay sharp. Last, a pixel that is part one surface, part another is
- * regressed on the features of its 3x3 window: it gets the mix of its
+ * Renderings", EGSR 2016), with its colour weights left out. The radiance
+ * is divided by the albedo (textures are not blurred, only the lighting):
+ * with at most DENOISE_FEATURE_SAMPLES samples by the albedo at the
+ * samples' own positions (each half by its own), so that how many samples
+ * met which surface at an edge is no noise of the lighting, and multiplied
+ * again by the features' better antialiased albedo. Around each pixel a
+ * first-order model of the lighting in screen position, normal, depth and
+ * direct light is fitted by least squares over 9x9 pixels, each weighted
+ * by how alike its albedo, normal and depth (off the pixel's plane) are to
+ * the pixel's, and evaluated at the pixel. No weight depends on the noise,
+ * so the fit of each half depends on that half's samples alone, and the
+ * other half's raw pixel estimates the fit's squared error without bias
+ * (NFOR's cross-buffer estimate: half a's fit against half b's pixel is
+ * off by a's error plus b's noise, whose variance the samples give). Per
+ * pixel the fit or the raw pixel's lighting is kept, whichever the estimate,
+ * averaged over 9x9 pixels, says is closer: shadows and highlights the features do
+ * not see stay sharp. Last, a pixel that is part one surface, part another
+ * is regressed on the features of its 3x3 window: it gets the mix of its
  * neighbours that its features say. With one sample there are no halves:
  * the fit is taken.
  *
@@ -57,10 +66,14 @@
  *   10-12 the mean radiance of the pixel's even-numbered samples, 13 the
  *        mean of their squared brightness: with the means over all of them
  *        (framebuffer.rgb, 7) they split the samples into two independent
- *        halves, each filtered with weights that the other one gives.
- * 0-6, 8 and 9 are means over the first DENOISE_FEATURE_SAMPLES samples'
- * camera rays, or over DENOISE_EDGE_SAMPLES positions where those disagree. */
-#define DENOISE_FEATURES 14
+ *        halves,
+ *   14   the direct light's brightness (see above),
+ *   15-17 the mean albedo at the even-numbered samples' own camera rays,
+ *        18-20 at all of them (the first DENOISE_FEATURE_SAMPLES).
+ * 0-6, 8, 9 and 14 are means over the first DENOISE_FEATURE_SAMPLES
+ * samples' camera rays, or over DENOISE_EDGE_SAMPLES positions where those
+ * disagree. */
+#define DENOISE_FEATURES 21
 /* The features are the mean of at most this many samples per pixel... */
 #define DENOISE_FEATURE_SAMPLES 8
 /* ...or of this many camera positions (first hits only, no paths) at a
@@ -68,8 +81,10 @@
  * is multiplied by again after filtering is then as well antialiased as
  * that many samples would make it. */
 #define DENOISE_EDGE_SAMPLES 64
-/* Doubles of a pixel's feature sums over a run of its samples (denoise_sample). */
-#define DENOISE_ACC 10
+/* Doubles of a pixel's feature sums over a run of its samples
+ * (denoise_sample): 0-6 and 8-9 as the features, 7 the direct light, 10-12
+ * the albedo of the even-numbered samples. */
+#define DENOISE_ACC 13
 
 /* Gives fb its feature buffer (cleared) if it has none, so that path-mode
  * render jobs into it record features; false when out of memory. */
@@ -94,9 +109,9 @@ static inline void denoise_radiance(vec3 c, int k, double *ra)
 	}
 }
 
-/* Adds to acc (DENOISE_ACC doubles, laid out like the features) what the
- * camera ray r of one sample first sees. */
-void denoise_sample(const world *w, ray r, double *acc);
+/* Adds to acc (DENOISE_ACC doubles) what the camera ray r of sample k
+ * first sees. */
+void denoise_sample(const world *w, ray r, int k, double *acc);
 
 /* Updates the features f of pixel (px, py) of an fw x fh image (those of
  * samples [0, begin)) with samples [begin, end): acc holds denoise_sample's

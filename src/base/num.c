@@ -6,6 +6,7 @@
 #include <locale.h>
 #include <math.h>
 #include <pthread.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -45,6 +46,66 @@ static const char *scan_decimal(const char *s, const char *end)
 	return q;
 }
 
+/* Exactly representable powers of ten: 10^22 < 2^53 * 2^22 is the last whose
+ * odd part (5^22 < 2^53) fits a double's 53 bits. */
+static const double exact_pow10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                                       1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+                                       1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+
+/* The value of a decimal that scan_decimal accepted, when it can be had
+ * exactly without strtod: at most 15 significant digits m (so m < 2^53 is
+ * an exact double) and a decimal exponent e with |e| <= 22 (so 10^|e| is
+ * exact); then m * 10^e or m / 10^-e is one correctly rounded IEEE
+ * operation, the same double strtod gives (Clinger, "How to read floating
+ * point numbers accurately", PLDI 1990: the fast path). False otherwise:
+ * the caller asks strtod. */
+static bool decimal_fast(const char *s, const char *end, double *out)
+{
+	const char *q = s;
+	bool neg = false;
+	if (*q == '+' || *q == '-')
+		neg = *q++ == '-';
+	uint64_t m = 0;
+	int digits = 0, exp10 = 0;
+	for (; q < end && is_digit(*q); q++) {
+		if (digits || *q != '0') { /* leading zeros are not significant */
+			if (++digits > 15)
+				return false;
+			m = m * 10 + (uint64_t)(*q - '0');
+		}
+	}
+	if (q < end && *q == '.')
+		for (q++; q < end && is_digit(*q); q++) {
+			exp10--;
+			if (digits || *q != '0') {
+				if (++digits > 15)
+					return false;
+				m = m * 10 + (uint64_t)(*q - '0');
+			}
+		}
+	if (q < end) { /* the exponent: (e|E) [+-] DIGITS */
+		q++;
+		bool eneg = false;
+		if (*q == '+' || *q == '-')
+			eneg = *q++ == '-';
+		int e = 0;
+		for (; q < end; q++) {
+			if (e > 1000)
+				return false; /* far outside the fast path (and no overflow) */
+			e = e * 10 + (*q - '0');
+		}
+		exp10 += eneg ? -e : e;
+	}
+	if (m == 0)
+		exp10 = 0; /* zero whatever the exponent */
+	if (exp10 < -22 || exp10 > 22)
+		return false;
+	double v = (double)m;
+	v = exp10 >= 0 ? v * exact_pow10[exp10] : v / exact_pow10[-exp10];
+	*out = neg ? -v : v;
+	return true;
+}
+
 static locale_t c_locale;
 static pthread_once_t c_once = PTHREAD_ONCE_INIT;
 
@@ -59,6 +120,13 @@ num_status num_scan(const char *s, size_t len, double max, double *out)
 		return NUM_EMPTY;
 	if (scan_decimal(s, s + len) != s + len)
 		return NUM_BAD;
+	double fast;
+	if (decimal_fast(s, s + len, &fast)) {
+		if (!(fabs(fast) <= max))
+			return NUM_BIG;
+		*out = fast;
+		return NUM_OK;
+	}
 	/* The syntax is checked: strtod reads exactly these bytes (in the "C"
 	 * locale). Short ones from a copy ("0" before an 'x' would start a hex
 	 * number); long ones in place, where the text after them (',', 'x',

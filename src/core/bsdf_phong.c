@@ -258,7 +258,7 @@ static bool phong_has_choice(const bsdf *b)
  * metal's own albedo and normal do not. Chosen on scenes/metal-fuzz.rt
  * (8 samples, 128x96 and 200x120: 10% and 8% less RMS error denoised;
  * exponents 30 and 200 within 1% of each other). */
-#define FEATURE_GLOSS_MIN 200.0
+#define FEATURE_GLOSS_MIN 200
 
 static int phong_features(const bsdf *b, vec3 *albedo, vec3 *tint, vec3 *dir)
 {

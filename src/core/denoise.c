@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "emitters.h"
 #include "integrators.h"
 
 /* --- features -------------------------------------------------------------- */
@@ -23,15 +24,89 @@ static double clamp01(double v)
 	return v > 0.0 ? (v < 1.0 ? v : 1.0) : 0.0;
 }
 
+/* A number in [0, 1) from the bits of x (splitmix64's finaliser). */
+static double hash_unit(uint64_t x)
+{
+	x ^= x >> 30;
+	x *= 0xbf58476d1ce4e5b9u;
+	x ^= x >> 27;
+	x *= 0x94d049bb133111ebu;
+	x ^= x >> 31;
+	return (double)(x >> 11) * 0x1.0p-53;
+}
+
+static double lum_d(vec3 c)
+{
+	return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
+}
+
+/* Emitters sampled for the direct-light feature at most (more: these many
+ * picked, their light scaled up). */
+#define DIRECT_EMITTERS 4
+
+/* The direct light that the point lights and the lamps send through b at p
+ * (on object self) toward the eye, as brightness: the point lights
+ * exactly, each lamp from 2x2 stratified points of the solid angle (or
+ * area) emitter_sample maps them to, shifted by the numbers r1, r2. No
+ * weight of multiple importance sampling: the full direct light. */
+static double direct_feature(const world *w, const bsdf *b, vec3 p, uint32_t self, double r1, double r2)
+{
+	double sum = 0.0;
+	if (!b->smooth)
+		return 0.0;
+	for (size_t i = 0; i < w->nlights; i++) {
+		vec3 wi;
+		double dist;
+		vec3 lr = light_at(&w->lights[i], p, &wi, &dist);
+		double c = v3_dot(b->n, wi);
+		if (!(lr.x > 0.0 || lr.y > 0.0 || lr.z > 0.0) || c <= 0.0)
+			continue;
+		vec3 f = bsdf_eval(b, wi);
+		ray sr = {p, wi};
+		if (lum_d(f) <= 0.0 || world_occluded(w, &sr, 0.0, dist))
+			continue;
+		sum += lum_d(v3_mul(f, v3_scale(lr, RT_PI * c)));
+	}
+	size_t ne = w->nemitters, pick = ne < DIRECT_EMITTERS ? ne : DIRECT_EMITTERS;
+	for (size_t k = 0; k < pick; k++) {
+		size_t ei = ne <= DIRECT_EMITTERS ? k : (size_t)((k + r1) * (double)ne / DIRECT_EMITTERS);
+		const emitter *e = &w->emitters[ei < ne ? ei : ne - 1];
+		if (e->object == self)
+			continue;
+		double part = 0.0;
+		for (int q = 0; q < 4; q++) {
+			double u1 = (q & 1) * 0.5 + 0.5 * r1, u2 = (q >> 1) * 0.5 + 0.5 * r2;
+			vec3 wi;
+			double pdf, t;
+			if (!emitter_sample(e, p, u1, u2, &wi, &pdf, &t) || !(pdf > 0.0))
+				continue;
+			double c = v3_dot(b->n, wi);
+			if (c <= 0.0)
+				continue;
+			vec3 f = bsdf_eval(b, wi);
+			ray sr = {p, wi};
+			if (lum_d(f) <= 0.0 || world_occluded(w, &sr, 0.0, t * (1.0 - 1e-7)))
+				continue;
+			part += lum_d(v3_mul(f, w->mats[e->object].emission)) * c / pdf;
+		}
+		sum += part * 0.25 * (double)ne / (double)pick;
+	}
+	return sum;
+}
+
 /* What the camera ray r shows first, in f (albedo, normal, depth). A
  * surface that is mostly a perfect mirror, a metal of little fuzz or glass
  * is looked through (up to four times): its features are those of the
  * surface seen in it, the albedo tinted by the mirror's or the glass's
  * colour, the depth the length of the whole path. Glass is followed along the refracted ray unless the
  * reflection is total. */
-static void first_surface(const world *w, ray r, double f[7])
+static void first_surface(const world *w, ray r, bool direct, double f[8])
 {
 	vec3 tint = v3(1, 1, 1);
+	uint64_t bits[2];
+	memcpy(&bits[0], &r.d.x, sizeof bits[0]);
+	memcpy(&bits[1], &r.d.y, sizeof bits[1]);
+	double r1 = hash_unit(bits[0] ^ (bits[1] << 1)), r2 = hash_unit(bits[1] ^ 0x9e3779b97f4a7c15u ^ bits[0] >> 3);
 	double dist = 0.0;
 	for (int k = 0;; k++) {
 		hit h;
@@ -65,8 +140,12 @@ static void first_surface(const world *w, ray r, double f[7])
 			f[4] += b.n.y;
 			f[5] += b.n.z;
 			f[6] += dist;
+			if (direct && !(e.x + e.y + e.z > 0.0))
+				f[7] += direct_feature(w, &b, offset_point(w, h.p, b.n), h.object, r1, r2) * lum_d(tint);
 			return;
 		}
+		if (direct && b.smooth) /* a glossy lobe looked through: its own highlights */
+			f[7] += direct_feature(w, &b, offset_point(w, h.p, b.n), h.object, r1, r2) * lum_d(tint);
 		tint = v3_mul(tint, tt);
 		if (follow == 1)
 			r = (ray){offset_point(w, h.p, b.n), v3_sub(v3_scale(b.n, 2.0 * b.cos_o), b.wo)};
@@ -84,14 +163,17 @@ static inline double albedo_divisor(double a)
 	return a > ALBEDO_MIN ? a : 1.0;
 }
 
-void denoise_sample(const world *w, ray r, double *acc)
+void denoise_sample(const world *w, ray r, int k, double *acc)
 {
-	double f[7] = {0};
-	first_surface(w, r, f);
-	for (int k = 0; k < 7; k++)
-		acc[k] += f[k];
+	double f[8] = {0};
+	first_surface(w, r, true, f);
+	for (int q = 0; q < 8; q++)
+		acc[q] += f[q];
 	acc[8] += f[0] * f[0] + f[1] * f[1] + f[2] * f[2];
 	acc[9] += f[6] * f[6];
+	if (!(k & 1))
+		for (int q = 0; q < 3; q++)
+			acc[10 + q] += f[q];
 }
 
 /* Whether the first hits of a pixel's samples differ: albedo or depth
@@ -121,24 +203,34 @@ void denoise_features(const world *w, const render_settings *s, int px, int py, 
 	int n1 = end < DENOISE_FEATURE_SAMPLES ? end : DENOISE_FEATURE_SAMPLES;
 	if (n1 <= n0)
 		return;
-	for (int k = 0; k < DENOISE_ACC; k++)
+	for (int k = 0; k < 10; k++)
 		if (k != 7)
 			f[k] = (float)(((double)f[k] * n0 + acc[k]) / n1);
+	f[14] = (float)(((double)f[14] * n0 + acc[7]) / n1);
+	/* the albedo of the radiance samples' own positions: the even ones
+	 * and all of them */
+	int ne0 = (n0 + 1) / 2, ne1 = (n1 + 1) / 2;
+	for (int k = 0; k < 3; k++) {
+		if (ne1 > ne0)
+			f[15 + k] = (float)(((double)f[15 + k] * ne0 + acc[10 + k]) / ne1);
+		f[18 + k] = f[k];
+	}
 	if (n1 < DENOISE_FEATURE_SAMPLES || !features_vary(f))
 		return;
-	/* An edge: more camera positions, the radiance samples' own. */
-	double sum[DENOISE_ACC];
-	for (int k = 0; k < DENOISE_ACC; k++)
+	/* An edge: more camera positions, the radiance samples' own (the
+	 * direct light stays the mean of the first ones). */
+	double sum[10];
+	for (int k = 0; k < 10; k++)
 		sum[k] = (double)f[k] * n1;
 	for (int k = n1; k < DENOISE_EDGE_SAMPLES; k++) {
-		double one[7] = {0};
-		first_surface(w, render_sample_ray(w, s, px, py, fw, fh, k), one);
-		for (int q = 0; q < 7; q++)
+		double one[8] = {0};
+		first_surface(w, render_sample_ray(w, s, px, py, fw, fh, k), false, one);
+		for (int q = 0; q < 8; q++)
 			sum[q] += one[q];
 		sum[8] += one[0] * one[0] + one[1] * one[1] + one[2] * one[2];
 		sum[9] += one[6] * one[6];
 	}
-	for (int k = 0; k < DENOISE_ACC; k++)
+	for (int k = 0; k < 10; k++)
 		if (k != 7)
 			f[k] = (float)(sum[k] / DENOISE_EDGE_SAMPLES);
 }
@@ -159,8 +251,8 @@ void denoise_features(const world *w, const render_settings *s, int px, int py, 
 #define WIN 4
 #define TAPS ((2 * WIN + 1) * (2 * WIN + 1))
 /* Its unknowns: a constant, the slopes along x and y, along the normal's
- * three components and along the depth. */
-#define NU 7
+ * three components, along the depth and along the direct light. */
+#define NU 8
 /* The slopes are held back by a ridge of this share of the weights. */
 #define RIDGE 1e-3f
 /* The candidates' errors are averaged over (2 PICK_R + 1)^2 pixels. */
@@ -176,6 +268,7 @@ typedef struct guide {
 	float f[6];   /* albedo / sqrt(SIGMA_A2), normal / sqrt(SIGMA_N2) */
 	float z;      /* depth */
 	float gx, gy; /* the depth's gradient per pixel */
+	float d;      /* the direct light over the albedo */
 } guide;
 
 /* A pixel's value in one chain: radiance over albedo, and the variance of
@@ -207,6 +300,7 @@ typedef struct job {
 	float *out;
 	float n[NCH];           /* samples in each chain */
 	bool halves;            /* at least two samples: two independent halves */
+	bool own;               /* every sample's position has its albedo (features 15-20) */
 	int threads;            /* workers sharing the rows, this thread included */
 	pthread_barrier_t bar;  /* between the passes */
 	pthread_mutex_t lock;
@@ -257,19 +351,34 @@ static void setup_rows(job *j, int y0, int y1)
 				am[k] = (float)albedo_divisor(f[k]);
 			}
 			g->z = f[6];
+			g->d = f[14] / lum(am);
 			g->gx = depth_slope(f + 6, x, w, DENOISE_FEATURES);
 			g->gy = depth_slope(f + 6, y, h, DENOISE_FEATURES * w);
 			j->mixed[i] = features_vary(f);
 			texel *t = &j->t[i];
+			bool own = j->own;
 			for (int k = 0; k < 3; k++) {
 				float c = fb->rgb[i * 3 + k], a = c, b = c;
 				if (j->halves) {
 					a = f[10 + k];
 					b = (c * j->n[CH_ALL] - a * j->n[CH_A]) / j->n[CH_B];
 				}
-				t->h[CH_A].c[k] = isfinite(a) ? a / am[k] : 0.0f;
-				t->h[CH_B].c[k] = isfinite(b) ? b / am[k] : 0.0f;
-				t->h[CH_ALL].c[k] = isfinite(c) ? c / am[k] : 0.0f;
+				/* Divided by the albedo at the samples' own positions
+				 * where they are all the samples (each half by its
+				 * own), so that how many of them met which surface is
+				 * no noise of the lighting; multiplied again by the
+				 * features' (better antialiased) albedo. */
+				float da = am[k], db = am[k], dc = am[k];
+				if (own && f[k] > ALBEDO_MIN) {
+					float sa = f[15 + k], sc = f[18 + k];
+					float sb = (sc * j->n[CH_ALL] - sa * j->n[CH_A]) / j->n[CH_B];
+					da = sa > ALBEDO_MIN ? sa : am[k];
+					db = sb > ALBEDO_MIN ? sb : am[k];
+					dc = sc > ALBEDO_MIN ? sc : am[k];
+				}
+				t->h[CH_A].c[k] = isfinite(a) ? a / da : 0.0f;
+				t->h[CH_B].c[k] = isfinite(b) ? b / db : 0.0f;
+				t->h[CH_ALL].c[k] = isfinite(c) ? c / dc : 0.0f;
 			}
 			/* all the samples' colour and each half's brightness */
 			float *d = j->data + i * 8;
@@ -427,6 +536,8 @@ static void regression_rows(job *j, int y0, int y1)
 			size_t i = (size_t)y * w + x;
 			const guide *gp = &j->g[i];
 			float inv_z = 1.0f / (SIGMA_Z * gp->z + 1e-6f);
+			/* the direct light's slope, in shares of its value */
+			float dscale = 1.0f / (0.5f * fabsf(gp->d) + 0.05f);
 			/* The taps with a weight: each one's weight, regressors and
 			 * data (rows of 8 floats, SIMD-friendly). */
 			float tw[TAPS], tv[TAPS][8], td[TAPS][8];
@@ -457,35 +568,63 @@ static void regression_rows(job *j, int y0, int y1)
 					v[4] = gq->f[4] - gp->f[4];
 					v[5] = gq->f[5] - gp->f[5];
 					v[6] = (gq->z - gp->z) * inv_z;
-					v[7] = 0.0f;
+					v[7] = (gq->d - gp->d) * dscale;
 					memcpy(td[nt], j->data + q * 8, sizeof td[nt]);
 					nt++;
 				}
 			}
-			/* The normal equations, row by row, so that a row's sums stay
-			 * in registers; the lower triangle is what solve reads. */
-			float m[NU][MIX_NU], rhs[NU][NRHS], beta[NU][NRHS];
-			for (int r = 0; r < NU; r++) {
-				v4 s[4] = {{0}};
-				for (int t = 0; t < nt; t++) {
-					v4 wv = v4_splat(tw[t] * tv[t][r]);
-					s[0] += wv * v4_load(tv[t]);
-					s[1] += wv * v4_load(tv[t] + 4);
-					s[2] += wv * v4_load(td[t]);
-					s[3] += wv * v4_load(td[t] + 4);
-				}
-				float row[16];
-				memcpy(row, s, sizeof row);
-				memcpy(m[r], row, sizeof m[r]);
-				memcpy(rhs[r], row + 8, sizeof rhs[r]);
+			/* The normal equations in one pass over the taps, their lower
+			 * triangle (what solve reads) in twelve registers. */
+			v4 a[12] = {{0}};
+			for (int t = 0; t < nt; t++) {
+				v4 v0 = v4_load(tv[t]), v1 = v4_load(tv[t] + 4);
+				v4 w0 = v4_splat(tw[t]) * v0, w1 = v4_splat(tw[t]) * v1;
+				a[0] += v4_splat(w0[0]) * v0;
+				a[1] += v4_splat(w0[1]) * v0;
+				a[2] += v4_splat(w0[2]) * v0;
+				a[3] += v4_splat(w0[3]) * v0;
+				a[4] += v4_splat(w1[0]) * v0;
+				a[5] += v4_splat(w1[0]) * v1;
+				a[6] += v4_splat(w1[1]) * v0;
+				a[7] += v4_splat(w1[1]) * v1;
+				a[8] += v4_splat(w1[2]) * v0;
+				a[9] += v4_splat(w1[2]) * v1;
+				a[10] += v4_splat(w1[3]) * v0;
+				a[11] += v4_splat(w1[3]) * v1;
+			}
+			float m[NU][MIX_NU], e0[NU][NRHS] = {{1.0f}}, z[NU][NRHS];
+			for (int r = 0; r < 4; r++)
+				memcpy(m[r], &a[r], sizeof a[r]);
+			for (int r = 4; r < NU; r++) {
+				memcpy(m[r], &a[4 + 2 * (r - 4)], sizeof a[0]);
+				memcpy(m[r] + 4, &a[5 + 2 * (r - 4)], sizeof a[0]);
 			}
 			float ridge = m[0][0] * RIDGE;
 			for (int r = 1; r < NU; r++)
 				m[r][r] += ridge;
+			/* The fit at the pixel is sum_t h_t y_t, with h_t the tap's
+			 * weight times z . (its regressors), M z = (1, 0, ..., 0): one
+			 * solve for all the right-hand sides. */
+			bool ok = solve(NU, m, 1, e0, z);
+			float beta[1][NRHS];
+			if (ok) {
+				v4 z0 = {z[0][0], z[1][0], z[2][0], z[3][0]}, z1 = {z[4][0], z[5][0], z[6][0], z[7][0]};
+				v4 f0 = {0}, f1 = {0};
+				for (int t = 0; t < nt; t++) {
+					v4 p = z0 * v4_load(tv[t]) + z1 * v4_load(tv[t] + 4);
+					v4 hv = v4_splat(tw[t] * (p[0] + p[1] + p[2] + p[3]));
+					f0 += hv * v4_load(td[t]);
+					f1 += hv * v4_load(td[t] + 4);
+				}
+				float fs[8];
+				memcpy(fs, &f0, sizeof f0);
+				memcpy(fs + 4, &f1, sizeof f1);
+				memcpy(beta[0], fs, sizeof beta[0]);
+			}
 			const chan *r0 = j->t[i].h;
 			float am = lum(j->am + i * 3), am2 = am * am;
 			float *fit = j->fit + i * 3, *err = j->err + i * NCAND;
-			if (!solve(NU, m, j->halves ? NRHS : 3, rhs, beta)) {
+			if (!ok) {
 				memcpy(fit, r0[CH_ALL].c, sizeof r0[CH_ALL].c);
 				err[CAND_RAW] = 0.0f; /* the raw pixel */
 				err[CAND_FIT] = INFINITY;
@@ -671,6 +810,7 @@ bool denoise_image(const framebuffer *fb, float *out, int threads)
 		threads = h;
 	job j = {.fb = fb, .out = out};
 	j.halves = fb->spp >= 2;
+	j.own = fb->spp <= DENOISE_FEATURE_SAMPLES;
 	j.n[CH_A] = j.halves ? (float)((fb->spp + 1) / 2) : 1.0f;
 	j.n[CH_B] = j.halves ? (float)(fb->spp / 2) : 1.0f;
 	j.n[CH_ALL] = fb->spp > 1 ? (float)fb->spp : 1.0f;

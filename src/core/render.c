@@ -144,7 +144,7 @@ static void block_add(const world *w, const render_settings *s, int x0, int y0, 
 				if (feat[i]) {
 					denoise_radiance(c, k, ra[i]);
 					if (k < DENOISE_FEATURE_SAMPLES) /* what this sample's ray first sees */
-						denoise_sample(w, render_sample_ray(w, s, x, y, fw, fh, k), fa[i]);
+						denoise_sample(w, render_sample_ray(w, s, x, y, fw, fh, k), k, fa[i]);
 				}
 			}
 	}

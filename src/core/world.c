@@ -16,6 +16,7 @@
 #include "envmap.h"
 #include "surface.h"
 #include "ggx.h"
+#include "rtsh/memory.h"
 #include "rtsh/shape.h"
 
 mat_lin mat_lin_make(const material *m)
@@ -145,6 +146,10 @@ static bool reorder(world *w, const uint32_t *order)
 		free(tris);
 		return false;
 	}
+	/* walked in tree order by every ray: huge pages spare the TLB */
+	mem_huge_pages(prims, w->nprims * sizeof *prims);
+	mem_huge_pages(shapes, w->nshapes * sizeof *shapes);
+	mem_huge_pages(tris, w->ntris * sizeof *tris);
 	for (size_t i = 0; i < w->nprims; i++)
 		prims[i] = w->prims[order[i]];
 	size_t ns = 0, nt = 0;
@@ -212,6 +217,7 @@ world *world_build_cancel(const scene *s, const atomic_bool *cancel, rt_error *e
 	size_t nbounded = s->nobjs - nplanes;
 	w->lights = calloc(s->nlights ? s->nlights : 1, sizeof *w->lights);
 	w->mats = calloc(s->nobjs ? s->nobjs : 1, sizeof *w->mats);
+	mem_huge_pages(w->mats, s->nobjs * sizeof *w->mats); /* read at every hit */
 	w->prims = malloc((nbounded ? nbounded : 1) * sizeof *w->prims);
 	w->planes = malloc((nplanes ? nplanes : 1) * sizeof *w->planes);
 	w->shapes = malloc((nshapes ? nshapes : 1) * sizeof *w->shapes);

@@ -76,6 +76,8 @@ typedef struct parser {
 	size_t cap_text;
 	char quote[96];   /* a token shortened for a message */
 	char usage[256], usage42[128]; /* an object element's usage lines */
+	const shape_form *usage_form;  /* whose they are (NULL: none yet): a file of
+	                                * a million spheres writes them once */
 	char *dir;        /* the .rt file's folder ("" = the current one) */
 } parser;
 
@@ -1120,13 +1122,16 @@ static elem_def object_element(parser *p, obj_kind k, const shape_form *f)
 	char *u = p->usage, *u42 = p->usage42;
 	size_t n = sizeof p->usage;
 	int used = 0;
-	if (f->nfields)
-		used = snprintf(u, n, "%s %s R,G,B%s", f->id, f->usage,
-		                f->material ? " [DIFFUSE SPECULAR SHININESS REFLECTIVE]" : "");
-	if (f->extended)
-		snprintf(u + used, n - (size_t)used, "%s%s" EXT_TAIL, used ? " or " : "", f->id);
-	if (f->strict && f->nfields)
-		snprintf(u42, sizeof p->usage42, "%s %s R,G,B", f->id, f->usage);
+	if (p->usage_form != f) {
+		p->usage_form = f;
+		if (f->nfields)
+			used = snprintf(u, n, "%s %s R,G,B%s", f->id, f->usage,
+			                f->material ? " [DIFFUSE SPECULAR SHININESS REFLECTIVE]" : "");
+		if (f->extended)
+			snprintf(u + used, n - (size_t)used, "%s%s" EXT_TAIL, used ? " or " : "", f->id);
+		if (f->strict && f->nfields)
+			snprintf(u42, sizeof p->usage42, "%s %s R,G,B", f->id, f->usage);
+	}
 	bool (*parse)(parser *, const elem_def *) =
 	    obj_kind_flags(k) & KIND_VERTICES ? parse_triangle : f->nfields ? parse_form : parse_extended;
 	return (elem_def){f->id, f->name, (int)k, f->strict, parse, u, f->strict && f->nfields ? u42 : NULL,

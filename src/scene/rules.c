@@ -96,12 +96,15 @@ bool object_rules(const object *o, rt_error *err)
 				return out_of_range(err, what, o->tri[i]);
 			}
 	} else {
-		snprintf(what, sizeof what, "%s position", name);
-		if (!vec_within(o->pos))
+		/* the names are made only for a message: a million objects load */
+		if (!vec_within(o->pos)) {
+			snprintf(what, sizeof what, "%s position", name);
 			return out_of_range(err, what, o->pos);
-		snprintf(what, sizeof what, "%s direction", name);
-		if (!vec_within(o->dir))
+		}
+		if (!vec_within(o->dir)) {
+			snprintf(what, sizeof what, "%s direction", name);
 			return out_of_range(err, what, o->dir);
+		}
 		if (!vec_within(o->scale))
 			return rt_error_set(err, "%s scaling %g,%g,%g is out of range; expected sizes in "
 			                         "(0," RT_NUM_MAX_TEXT "]",

@@ -1047,6 +1047,12 @@ keymode *keymode_new(shell *sh, termout *out, frame_palette pal, int cols, int r
 	return km;
 }
 
+void keymode_set_encoder(keymode *km, const encoder_ops *ops, int cell_w, int cell_h, int max_w, int max_h)
+{
+	keyview_set_encoder(&km->kv, ops, cell_w, cell_h, max_w, max_h);
+	km_layout(km);
+}
+
 void keymode_free(keymode *km)
 {
 	if (!km)
@@ -1150,8 +1156,7 @@ bool keymode_turntable(shell *sh, double seconds)
 		/* The shell's picture: real pixels or its symbol set. */
 		const pixels_caps *pc = termout_pixels(out);
 		const encoder_ops *ops = scr->pix_ops ? scr->pix_ops : encoder_symbols(scr->sym);
-		keyview_set_encoder(&km->kv, ops, scr->cell_w, scr->cell_h, pc ? pc->sixel_w : 0, pc ? pc->sixel_h : 0);
-		km_layout(km);
+		keymode_set_encoder(km, ops, scr->cell_w, scr->cell_h, pc ? pc->sixel_w : 0, pc ? pc->sixel_h : 0);
 	}
 	if (km)
 		keymode_spin(km, seconds);

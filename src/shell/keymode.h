@@ -181,6 +181,9 @@ typedef struct keymode keymode;
  * when a frame is ready; the shell's preview does not run until
  * keymode_free. NULL (the shell's error set) on failure. */
 keymode *keymode_new(shell *sh, termout *out, frame_palette pal, int cols, int rows);
+/* The picture's encoder (keyview_set_encoder's arguments) and a new layout
+ * for it: what the shell's screen uses (its symbols or real pixels). */
+void keymode_set_encoder(keymode *km, const encoder_ops *ops, int cell_w, int cell_h, int max_w, int max_h);
 /* Ends the session: cancels its render, closes an open undo group, frees
  * it. The render service stays held (the caller restarts the preview). */
 void keymode_free(keymode *km);

@@ -565,12 +565,44 @@ static void test_features_through_mirror(void **state)
 		world *w = world_build(s, NULL);
 		assert_non_null(w);
 		double f[DENOISE_ACC] = {0};
-		denoise_sample(w, cam_ray(&w->cam, 4.5, 4.5, 9, 9), f);
+		denoise_sample(w, cam_ray(&w->cam, 4.5, 4.5, 9, 9), 0, f);
 		assert_near(f[0], albedo[c].x, 1e-5);
 		assert_near(f[1], albedo[c].y, 1e-5);
 		assert_near(f[2], albedo[c].z, 1e-5);
 		assert_near(f[5], normal_z[c], 1e-3);
 		assert_near(f[6], depth[c], 1e-3);
+		world_free(w);
+		scene_free(s);
+	}
+}
+
+/* The direct-light feature (acc[7]): a white Lambertian wall at z = 2
+ * facing the camera at the origin, a point light of ratio 0.5 at (0, 1, 0).
+ * The centre pixel's ray meets the wall at (0, 0, 2); the light is seen
+ * from there along (0, 1, -2) / sqrt 5, at cos 2 / sqrt 5 to the normal:
+ * albedo 1 / pi x (pi x 0.5) x cos = 0.5 x 2 / sqrt 5 (rtsh(5): a white
+ * Lambertian surface facing a light sends back ratio x colour). A small
+ * sphere at (0, 0.5, 1), between the two and off the camera ray, puts the
+ * point in its shadow: 0. */
+static void test_direct_feature(void **state)
+{
+	(void)state;
+	const char *texts[2] = {
+		"C 0,0,0 0,0,1 10\nL 0,1,0 0.5 255,255,255\npl 0,0,2 0,0,-1 1,1,1 255,255,255 1 0 1 0\n",
+		"C 0,0,0 0,0,1 10\nL 0,1,0 0.5 255,255,255\npl 0,0,2 0,0,-1 1,1,1 255,255,255 1 0 1 0\n"
+		"sp 0,0.5,1 0.2 255,255,255\n",
+	};
+	const double want[2] = {0.5 * 2.0 / sqrt(5.0), 0.0};
+	for (int c = 0; c < 2; c++) {
+		scene *s = load_text(texts[c]);
+		world *w = world_build(s, NULL);
+		assert_non_null(w);
+		double f[DENOISE_ACC] = {0};
+		denoise_sample(w, cam_ray(&w->cam, 4.5, 4.5, 9, 9), 0, f);
+		assert_near(f[7], want[c], 1e-4);
+		assert_near(f[6], 2.0, 1e-4); /* the wall, not the sphere */
+		/* sample 0 is even: its albedo is also the even samples' */
+		assert_near(f[10], f[0], 1e-12);
 		world_free(w);
 		scene_free(s);
 	}
@@ -665,6 +697,7 @@ int main(void)
 		cmocka_unit_test(test_feature_edge),
 		cmocka_unit_test(test_threads),
 		cmocka_unit_test(test_features_through_mirror),
+		cmocka_unit_test(test_direct_feature),
 		cmocka_unit_test(test_features_in_passes),
 		cmocka_unit_test(test_modes),
 		cmocka_unit_test(test_setting),

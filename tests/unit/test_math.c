@@ -223,11 +223,71 @@ static void test_add_decimal(void **state)
 	assert_false(signbit(num_add_decimal(-0.001, 0.001))); /* 0, not -0 */
 }
 
+/* num_scan reads a decimal to the double strtod gives (correctly rounded,
+ * C library): its exact short path (at most 15 digits, |exponent| <= 22)
+ * and its strtod path agree with strtod on random decimals of 1 to 20
+ * digits, either side of the point, with exponents, signs and zeros; and
+ * the values worked by hand. */
+static void test_scan_matches_strtod(void **state)
+{
+	(void)state;
+	double v;
+	assert_int_equal(num_scan_str("0.1", 1e9, &v), NUM_OK);
+	assert_true(v == 0.1);
+	assert_int_equal(num_scan_str("-0", 1e9, &v), NUM_OK);
+	assert_true(v == 0 && signbit(v));
+	assert_int_equal(num_scan_str("-0.000e30", 1e9, &v), NUM_OK);
+	assert_true(v == 0 && signbit(v));
+	assert_int_equal(num_scan_str("123456789012345", 1e20, &v), NUM_OK);
+	assert_true(v == 123456789012345.0);
+	assert_int_equal(num_scan_str("9007199254740993", 1e20, &v), NUM_OK); /* 2^53 + 1: ties to even */
+	assert_true(v == 9007199254740992.0);
+	assert_int_equal(num_scan_str("1e22", 1e30, &v), NUM_OK);
+	assert_true(v == 1e22);
+	assert_int_equal(num_scan_str("1e23", 1e30, &v), NUM_OK); /* past the exact powers */
+	assert_true(v == 1e23);
+	assert_int_equal(num_scan_str("2.5e-3", 1, &v), NUM_OK);
+	assert_true(v == 0.0025);
+	assert_int_equal(num_scan_str("1e5", 1e4, &v), NUM_BIG);
+	assert_int_equal(num_scan_str("1e99999999999", 1e300, &v), NUM_BIG);
+	assert_int_equal(num_scan_str("0e99999999999", 1, &v), NUM_OK);
+	assert_true(v == 0);
+	uint64_t x = 88172645463325252ull; /* xorshift64 (Marsaglia 2003) */
+	for (int i = 0; i < 200000; i++) {
+		char t[64];
+		size_t n = 0;
+		x ^= x << 13, x ^= x >> 7, x ^= x << 17;
+		uint64_t r = x;
+		if (r & 1)
+			t[n++] = r & 2 ? '-' : '+';
+		r >>= 2;
+		int whole = (int)(r % 12), frac = (int)((r >> 4) % 12);
+		r >>= 8;
+		if (whole == 0 && frac == 0)
+			whole = 1;
+		for (int k = 0; k < whole; k++, r = r * 6364136223846793005ull + 1442695040888963407ull)
+			t[n++] = (char)('0' + (r >> 59) % 10 * (k > 0 || (r >> 40) % 4 != 0));
+		if (frac) {
+			t[n++] = '.';
+			for (int k = 0; k < frac; k++, r = r * 6364136223846793005ull + 1442695040888963407ull)
+				t[n++] = (char)('0' + (r >> 59) % 10);
+		}
+		if ((x >> 60) % 3 == 0)
+			n += (size_t)snprintf(t + n, sizeof t - n, "e%d", (int)((x >> 32) % 61) - 30);
+		t[n] = '\0';
+		double want = strtod(t, NULL);
+		assert_int_equal(num_scan_str(t, 1e300, &v), NUM_OK);
+		if (memcmp(&v, &want, sizeof v) != 0)
+			fail_msg("%s: num_scan %.17g, strtod %.17g", t, v, want);
+	}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_inverse_product_is_identity),
 		cmocka_unit_test(test_add_decimal),
+		cmocka_unit_test(test_scan_matches_strtod),
 		cmocka_unit_test(test_singular_matrices_are_refused),
 		cmocka_unit_test(test_points_vectors_normals),
 		cmocka_unit_test(test_transform_composition),

@@ -28,6 +28,7 @@
  * children (world.c's trees are 4 wide, a mesh's 8, mesh_tree.c).
  */
 #include "core/bvh/bvh.h"
+#include "rtsh/memory.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -817,6 +818,7 @@ bvh *bvh_build(const box *bounds, const float *costs, size_t n, uint32_t *order,
 	bytes = (used * sizeof(bvh_node) + 63) / 64 * 64;
 	bvh_node *fit = aligned_alloc(64, bytes);
 	if (fit) {
+		mem_huge_pages(fit, bytes); /* every ray's walk: huge pages spare the TLB */
 		memcpy(fit, wide, used * sizeof *fit);
 		free(wide);
 		wide = fit;
