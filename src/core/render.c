@@ -132,9 +132,15 @@ static void block_add(const world *w, const render_settings *s, int x0, int y0, 
 			for (int x = x0; x < x1; x++, i++)
 				r[i] = camera_sample_ray(w, s, in->sampled, x, y, fw, fh, k, &sp[i]);
 		world_intersect_packet(w, n, r, 0.0, INFINITY, h, found);
+		uint32_t known[PACKET_MAX], blocked[PACKET_MAX];
+		if (in->shadow_packets)
+			in->shadow_packets(w, n, h, found, known, blocked);
+		else
+			for (int i = 0; i < n; i++)
+				known[i] = blocked[i] = 0;
 		for (int y = y0, i = 0; y < y1; y++)
 			for (int x = x0; x < x1; x++, i++) {
-				vec3 c = in->radiance_first(w, s, r[i], &sp[i], found[i], &h[i]);
+				vec3 c = in->radiance_first(w, s, r[i], &sp[i], found[i], &h[i], known[i], blocked[i]);
 				/* A NaN or infinity from a degenerate case must not poison the pixel. */
 				if (!v3_finite(c))
 					c = v3(0, 0, 0);

@@ -196,7 +196,7 @@ world *world_build_cancel(const scene *s, const atomic_bool *cancel, rt_error *e
 		w->ambient = v3_scale(srgb255_to_linear(s->amb.color), s->amb.ratio);
 	w->has_sky = s->has_sky;
 	if (s->has_sky && s->sky.file) {
-		envmap *env = envmap_new(s->sky.file, s->sky.strength, s->sky.rotation, err);
+		envmap *env = envmap_new(s->sky.file, s->sky.strength, s->sky.rotation, cancel, err);
 		if (!env) {
 			world_free(w);
 			return NULL;

@@ -9,6 +9,7 @@
 #include <strings.h>
 #include <sys/stat.h>
 
+#include "base/readhelp.h"
 #include "rtsh/filesrc.h"
 #include "rtsh/memory.h"
 
@@ -113,10 +114,16 @@ mesh *mesh_cache_get(const char *path, bool smooth, double crease_deg, const ato
 		}
 	}
 	pthread_mutex_unlock(&cache_lock);
+	/* the readers poll the flag every few thousand elements (the builder,
+	 * mesh.c); assimp's own parse (STL) runs to its end */
+	const atomic_bool *outer = read_cancel_set(cancel);
 	mesh *m = mesh_load(path, err);
+	read_cancel_set(outer);
+	if (!m && cancel && atomic_load(cancel))
+		rt_error_set(err, "stopped");
 	if (!m)
 		return NULL;
-	/* the reader itself runs to its end; a stopped model is not cached */
+	/* a stopped model is not cached */
 	if (cancel && atomic_load(cancel)) {
 		mesh_free(m);
 		rt_error_set(err, "stopped");
