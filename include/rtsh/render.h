@@ -48,6 +48,9 @@ typedef struct render_settings {
 	uint64_t seed;
 	double exposure;   /* stops; output = radiance x 2^exposure */
 	int denoise;       /* denoise_mode */
+	/* The terminal's choices (SETTING_TERMINAL rows): `set` keeps them here
+	 * beside the rest, but no renderer reads them and rtsh-mpi's wire
+	 * leaves them out. */
 	int pixels;        /* the shell's picture: off (half blocks), kitty, sixel,
 	                    * iterm, auto (term/pixels.h, pixels_mode) */
 	int symbols;       /* the cells' glyphs when not in real pixels: half,

@@ -36,10 +36,10 @@ const setting_def settings_table[] = {
 	 SETTING_BARE_ON},
 	{"pixels", SETTING_ENUM, 0, 0, AT(pixels),
 	 "the picture in real pixels: off (half blocks), kitty, sixel, iterm, or auto (ask the terminal)", "off",
-	 pixels_names, 0},
+	 pixels_names, SETTING_TERMINAL},
 	{"symbols", SETTING_ENUM, 0, 0, AT(symbols),
 	 "the cells' glyphs: half, quadrant, sextant, octant, or auto (what the terminal is known to draw)", "auto",
-	 symbols_names, 0},
+	 symbols_names, SETTING_TERMINAL},
 #undef AT
 };
 const size_t settings_count = sizeof settings_table / sizeof settings_table[0];
