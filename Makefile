@@ -49,6 +49,7 @@ FRONTLIB  := $(BUILD)/librtsh-front.a
 
 TEST_SRC  := $(sort $(wildcard tests/unit/test_*.c))
 TEST_BIN  := $(TEST_SRC:tests/unit/%.c=$(BUILD)/tests/%)
+EXAMPLE_BIN := $(patsubst examples/%.c,$(BUILD)/examples/%,$(sort $(wildcard examples/*.c)))
 # The link simulator (tests/link): a program on a pty behind a slow wire.
 LINKSIM   := $(BUILD)/tests/linksim
 BENCH_SRC := bench/bench.c
@@ -157,7 +158,14 @@ $(BENCH_BIN): $(BENCH_SRC) $(FRONTLIB) $(LIB)
 run: all
 	./$(BIN)
 
-test-bins: $(TEST_BIN) $(LINKSIM)
+test-bins: $(TEST_BIN) $(LINKSIM) $(EXAMPLE_BIN)
+
+# The embedding example: the public header (include/rtsh/rtsh.h) and
+# librtsh.a only, no -Isrc; tests/scripts/example.test runs it.
+$(BUILD)/examples/%: examples/%.c $(LIB)
+	@mkdir -p $(@D)
+	@echo "  CC      $@"
+	@$(CC) -Iinclude $(CFLAGS) $(LDFLAGS) -o $@ $< $(LIB) $(LDLIBS_CORE)
 
 $(LINKSIM): tests/link/linksim.c
 	@mkdir -p $(@D)

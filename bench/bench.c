@@ -37,6 +37,7 @@
 #include "rtsh/denoise.h"
 #include "mesh_rays.h"
 #include "rtsh/mesh.h"
+#include "rtsh/packet.h"
 #include "rtsh/generate.h"
 #include "rtsh/render.h"
 #include "rtsh/rtfile.h"
@@ -360,13 +361,32 @@ static double primary_pass(const world *wd, int w, int h, bool brute, long *hits
 	return now() - t0;
 }
 
+/* primary_pass's rays and hit records traced as packets of 4x4 pixels
+ * (world_intersect_packet, packet.h): the same hits. */
+static double primary_packet_pass(const world *wd, int w, int h)
+{
+	double t0 = now();
+	for (int y0 = 0; y0 < h; y0 += 4)
+		for (int x0 = 0; x0 < w; x0 += 4) {
+			ray r[PACKET_MAX];
+			hit hh[PACKET_MAX];
+			bool found[PACKET_MAX];
+			int n = 0;
+			for (int y = y0; y < y0 + 4 && y < h; y++)
+				for (int x = x0; x < x0 + 4 && x < w; x++)
+					r[n++] = cam_ray(&wd->cam, x + 0.5, y + 0.5, w, h);
+			world_intersect_packet(wd, n, r, 0.0, INFINITY, hh, found);
+		}
+	return now() - t0;
+}
+
 static void bench_primary(void)
 {
 	const char *path = "scenes/grid.rt";
 	int w = quick ? 320 : 1920, h = quick ? 180 : 1080;
 	scene *s = load(path);
 	world *wd = build(s);
-	double t[MAX_RUNS], tb[MAX_RUNS], te[MAX_RUNS], em[MAX_RUNS];
+	double t[MAX_RUNS], tb[MAX_RUNS], tp[MAX_RUNS], te[MAX_RUNS], em[MAX_RUNS];
 	double pkm[EMBREE_PACKETS][MAX_RUNS], pks[EMBREE_PACKETS][MAX_RUNS];
 	int ne = 0, npk[EMBREE_PACKETS] = {0};
 	long hits;
@@ -374,6 +394,7 @@ static void bench_primary(void)
 	for (int i = 0; i < runs; i++) {
 		t[i] = primary_pass(wd, w, h, false, &hits);
 		tb[i] = primary_pass(wd, w, h, true, &hits);
+		tp[i] = primary_packet_pass(wd, w, h);
 		double sec = 0, pm[EMBREE_PACKETS], ps[EMBREE_PACKETS];
 		double m = quick ? -1 : run_embree(path, w, h, &sec, pm, ps);
 		if (m > 0) {
@@ -392,6 +413,16 @@ static void bench_primary(void)
 	snprintf(r->note, sizeof r->note, "camera rays only, %.0f%% hit", 100.0 * (double)hits / ((double)w * h));
 	r = add_row("grid.rt", "primary-brute", w, h, 1, 1, runs, mb, rays / mb);
 	snprintf(r->note, sizeof r->note, "every primitive tested");
+	double mp = median(tp, runs), best = -1;
+	for (int k = 0; k < EMBREE_PACKETS; k++)
+		if (npk[k] && median(pkm[k], npk[k]) > best)
+			best = median(pkm[k], npk[k]);
+	r = add_row("grid.rt", "primary-packet16", w, h, 1, 1, runs, mp, rays / mp);
+	if (best > 0)
+		snprintf(r->note, sizeof r->note, "world_intersect_packet, 4x4 pixels: %.2fx primary, %.2fx Embree's best packet call",
+		         m / mp, (rays / mp) / best);
+	else
+		snprintf(r->note, sizeof r->note, "world_intersect_packet, 4x4 pixels: %.2fx primary", m / mp);
 	if (ne) {
 		double me = median(em, ne), se = median(te, ne);
 		r = add_row("grid.rt", "embree-primary", w, h, 1, 1, ne, se, me);
@@ -410,6 +441,112 @@ static void bench_primary(void)
 		r = add_row("grid.rt", "embree-primary", w, h, 1, 1, 0, -1, -1);
 		snprintf(r->note, sizeof r->note, "no %s/embree_primary (needs embree3/rtcore.h)", bench_dir);
 	}
+	world_free(wd);
+	scene_free(s);
+}
+
+/* The camera rays of a w x h image through pixel centres in 4 x 4 blocks,
+ * and shadow rays from their hits toward the first light: single rays
+ * (world_intersect_coherent, world_occluded) or packets
+ * (world_intersect_packet, world_occluded_packet, packet.h), the same
+ * answers. Returns the seconds of the camera rays; *shadow_sec those of
+ * the shadow rays (the camera rays' time for them not counted), *nshadow
+ * their count. */
+static double packet_pass(const world *wd, int w, int h, bool packet, int bw, int bh, double *shadow_sec,
+                          long *nshadow)
+{
+	double tc = 0, ts = 0;
+	long ns = 0;
+	vec3 lamp = wd->nlights ? wd->lights[0].pos : v3(0, 10, 0);
+	int nb = (w + bw - 1) / bw;
+	ray *sr = malloc((size_t)nb * PACKET_MAX * sizeof *sr);
+	double *dist = malloc((size_t)nb * PACKET_MAX * sizeof *dist);
+	int *cnt = malloc((size_t)nb * sizeof *cnt);
+	if (!sr || !dist || !cnt)
+		fail("packet_pass: out of memory", NULL);
+	for (int y0 = 0; y0 < h; y0 += bh) {
+		/* a row of blocks: camera rays (timed), their shadow rays made,
+		 * then traced (timed) */
+		double t0 = now();
+		for (int b = 0; b < nb; b++) {
+			int x0 = bw * b, n = 0, m = 0;
+			ray r[PACKET_MAX];
+			hit hh[PACKET_MAX];
+			bool found[PACKET_MAX];
+			for (int y = y0; y < y0 + bh && y < h; y++)
+				for (int x = x0; x < x0 + bw && x < w; x++, n++)
+					r[n] = cam_ray(&wd->cam, x + 0.5, y + 0.5, w, h);
+			if (packet)
+				world_intersect_packet(wd, n, r, 0.0, INFINITY, hh, found);
+			else
+				for (int i = 0; i < n; i++)
+					found[i] = world_intersect_coherent(wd, &r[i], 0.0, INFINITY, &hh[i]);
+			ray *q = sr + (size_t)b * PACKET_MAX;
+			double *d = dist + (size_t)b * PACKET_MAX;
+			for (int i = 0; i < n; i++)
+				if (found[i]) {
+					vec3 p = v3_madd(hh[i].p, hh[i].n, 1e-7);
+					vec3 to = v3_sub(lamp, p);
+					d[m] = v3_len(to);
+					q[m] = (ray){p, v3_scale(to, 1.0 / d[m])};
+					m++;
+				}
+			cnt[b] = m;
+			ns += m;
+		}
+		double t1 = now();
+		for (int b = 0; b < nb; b++) {
+			bool occ[PACKET_MAX];
+			const ray *q = sr + (size_t)b * PACKET_MAX;
+			const double *d = dist + (size_t)b * PACKET_MAX;
+			if (packet)
+				world_occluded_packet(wd, cnt[b], q, 0.0, d, occ);
+			else
+				for (int i = 0; i < cnt[b]; i++)
+					occ[i] = world_occluded(wd, &q[i], 0.0, d[i]);
+		}
+		ts += now() - t1;
+		tc += t1 - t0;
+	}
+	free(sr);
+	free(dist);
+	free(cnt);
+	*shadow_sec = ts;
+	*nshadow = ns;
+	return tc;
+}
+
+/* Packets against single rays on the grid, interleaved run by run; and
+ * packets of 4 (2x2 pixels) and 8 (4x2) against 16 (4x4). */
+static void bench_packets(void)
+{
+	const char *path = "scenes/grid.rt";
+	int w = quick ? 320 : 1920, h = quick ? 180 : 1080;
+	scene *s = load(path);
+	world *wd = build(s);
+	static const int shape[4][2] = {{4, 4}, {4, 4}, {2, 2}, {4, 2}}; /* single, then 16, 4, 8 */
+	double tc[4][MAX_RUNS], ts[4][MAX_RUNS];
+	long ns = 0;
+	packet_pass(wd, w, h, true, 4, 4, &ts[0][0], &ns); /* warm up */
+	for (int i = 0; i < runs; i++)
+		for (int k = 0; k < 4; k++)
+			tc[k][i] = packet_pass(wd, w, h, k > 0, shape[k][0], shape[k][1], &ts[k][i], &ns);
+	double rays = (double)w * h * 1e-6, srays = (double)ns * 1e-6;
+	double c[4], sh[4];
+	for (int k = 0; k < 4; k++) {
+		c[k] = median(tc[k], runs);
+		sh[k] = median(ts[k], runs);
+	}
+	row *r = add_row("grid.rt", "primary-single", w, h, 1, 1, runs, c[0], rays / c[0]);
+	snprintf(r->note, sizeof r->note, "world_intersect_coherent, 4x4 blocks (the packet rows' twin)");
+	r = add_row("grid.rt", "primary-packet", w, h, 1, 1, runs, c[1], rays / c[1]);
+	snprintf(r->note, sizeof r->note, "world_intersect_packet, 16 rays (4x4): %.2fx single; 8 (4x2): %.2fx, 4 (2x2): %.2fx",
+	         c[0] / c[1], c[0] / c[3], c[0] / c[2]);
+	r = add_row("grid.rt", "shadow-single", w, h, 1, 1, runs, sh[0], srays / sh[0]);
+	snprintf(r->note, sizeof r->note, "world_occluded, from each camera hit to the light");
+	r = add_row("grid.rt", "shadow-packet", w, h, 1, 1, runs, sh[1], srays / sh[1]);
+	snprintf(r->note, sizeof r->note, "world_occluded_packet, 16 rays: %.2fx single; 8: %.2fx, 4: %.2fx", sh[0] / sh[1],
+	         sh[0] / sh[3], sh[0] / sh[2]);
 	world_free(wd);
 	scene_free(s);
 }
@@ -1392,6 +1529,8 @@ int main(int argc, char **argv)
 		bench_grid();
 	if (!only || strcmp(only, "primary") == 0)
 		bench_primary();
+	if (!only || strcmp(only, "packets") == 0)
+		bench_packets();
 	if (!only || strcmp(only, "spheres") == 0)
 		bench_spheres();
 	if (!only || strcmp(only, "load") == 0)

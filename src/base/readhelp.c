@@ -9,6 +9,25 @@
 #include <string.h>
 #include <sys/stat.h>
 
+static _Thread_local const atomic_bool *read_cancel;
+static _Thread_local unsigned read_calls;
+
+const atomic_bool *read_cancel_set(const atomic_bool *cancel)
+{
+	const atomic_bool *old = read_cancel;
+	read_cancel = cancel;
+	return old;
+}
+
+bool read_cancelled(void)
+{
+	return read_cancel && atomic_load_explicit(read_cancel, memory_order_relaxed);
+}
+
+bool read_poll(void)
+{
+	return (++read_calls & 4095) == 0 && read_cancelled();
+}
 
 char *path_join(const char *dir, const char *rel)
 {

@@ -2,6 +2,7 @@
 #ifndef RTSH_READHELP_H
 #define RTSH_READHELP_H
 
+#include <stdatomic.h>
 #include <stdbool.h>
 
 /* A newly allocated path: rel joined to dir (rel unchanged if absolute or
@@ -15,5 +16,15 @@ char *path_dir(const char *path);
 bool scan_double(const char **s, const char *end, double *out);
 /* A decimal integer (optionally signed). */
 bool scan_long(const char **s, const char *end, long *out);
+
+/* Ctrl-C during a read (issue 31, defect 3): the flag the readers on this
+ * thread poll, set around a read by the caches (mesh_cache_get,
+ * texture_cache_get); NULL: none. Returns the one it replaces. */
+const atomic_bool *read_cancel_set(const atomic_bool *cancel);
+/* True when this thread's flag is set (checked on every call). */
+bool read_cancelled(void);
+/* read_cancelled, but the flag is looked at only every 4096th call: for a
+ * reader's inner loop (a line, an element, a row). */
+bool read_poll(void);
 
 #endif

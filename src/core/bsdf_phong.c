@@ -188,30 +188,35 @@ static bool phong_sample(const bsdf *b, const double u[3], bsdf_sample *out)
 	}
 }
 
+/* Set by whitted.c around the first hit's shading (integrators.h); kept
+ * here, beside its reader, so that this file calls nothing of whitted.c. */
+_Thread_local whitted_shadows whitted_shadow_hint;
+
 /* Whitted shading: ambient x colour + emission, diffuse and Phong per
  * visible point light, then the mirror or the glass rays. */
 static vec3 phong_whitted(const world *w, const mat_lin *m, const hit *hp, ray r, int depth,
                           vec3 (*trace)(const world *w, ray r, int depth))
 {
 	const hit *h = hp; /* read in place: a copy cost 3% of a grid render's instructions */
-	vec3 n = h->front ? h->n : v3_neg(h->n);
+	vec3 n, p;
+	phong_whitted_frame(w, h, &n, &p);
 	vec3 albedo = hit_albedo(m, h);
 	vec3 v = v3_neg(r.d);
-	vec3 p = offset_point(w, h->p, n);
+	/* the first hit's shadow rays may have been traced as packets */
+	const whitted_shadows *ws = whitted_shadow_hint.h == hp ? &whitted_shadow_hint : NULL;
 
 	vec3 c = v3_add(v3_mul(w->ambient, albedo), m->emission);
 	for (size_t i = 0; i < w->nlights; i++) {
-		vec3 ld;
-		double dist;
-		vec3 lr = light_at(&w->lights[i], p, &ld, &dist); /* physical lights fall off */
-		if (!(lr.x > 0.0 || lr.y > 0.0 || lr.z > 0.0))
+		ray sr;
+		double dist, ndl;
+		vec3 lr;
+		if (!phong_light_ray(w, i, p, n, &sr, &dist, &lr, &ndl))
 			continue;
-		double ndl = v3_dot(n, ld);
-		if (ndl <= 0.0)
+		bool blocked = ws && i < 32 && (ws->known >> i & 1u) ? (ws->blocked >> i & 1u) != 0
+		                                                     : world_occluded(w, &sr, 0.0, dist);
+		if (blocked)
 			continue;
-		ray sr = {p, ld};
-		if (world_occluded(w, &sr, 0.0, dist))
-			continue;
+		vec3 ld = sr.d;
 		c = v3_add(c, v3_mul(lr, v3_scale(albedo, m->diffuse * ndl)));
 		if (m->specular > 0.0) {
 			double rv = v3_dot(v3_reflect(v3_neg(ld), n), v);

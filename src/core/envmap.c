@@ -30,14 +30,14 @@ struct envmap {
 
 static const double PI = 3.14159265358979323846;
 
-envmap *envmap_new(const char *path, double strength, double rotation_deg, rt_error *err)
+envmap *envmap_new(const char *path, double strength, double rotation_deg, const atomic_bool *cancel, rt_error *err)
 {
 	envmap *e = calloc(1, sizeof *e);
 	if (!e) {
 		rt_error_set(err, "out of memory loading the sky");
 		return NULL;
 	}
-	e->tex = texture_cache_get(path, false, NULL, err);
+	e->tex = texture_cache_get(path, false, cancel, err);
 	if (!e->tex) {
 		free(e);
 		return NULL;
@@ -62,6 +62,11 @@ envmap *envmap_new(const char *path, double strength, double rotation_deg, rt_er
 	}
 	double total = 0;
 	for (int y = 0; y < l->h; y++) {
+		if (cancel && atomic_load_explicit(cancel, memory_order_relaxed)) { /* Ctrl-C */
+			envmap_free(e);
+			rt_error_set(err, "stopped");
+			return NULL;
+		}
 		double st = sin(PI * (y + 0.5) / l->h);
 		double *c = &e->cond[(size_t)y * (l->w + 1)];
 		c[0] = 0;

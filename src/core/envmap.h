@@ -8,8 +8,9 @@
 typedef struct envmap envmap;
 
 /* A sky from image `path` (linear), radiance x strength, turned by
- * rotation_deg about +Y. NULL (err set) on failure. */
-envmap *envmap_new(const char *path, double strength, double rotation_deg, rt_error *err);
+ * rotation_deg about +Y; stops ("stopped") soon after *cancel is set
+ * (NULL: never). NULL (err set) on failure. */
+envmap *envmap_new(const char *path, double strength, double rotation_deg, const atomic_bool *cancel, rt_error *err);
 void envmap_free(envmap *e);
 /* The radiance arriving from direction d (any length). */
 vec3 envmap_eval(const envmap *e, vec3 d);

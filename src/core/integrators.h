@@ -6,9 +6,39 @@
 #include "sampler.h"
 
 /* The camera ray of sample `sample` of pixel (px, py) of an fw x fh image,
- * and in *sp the sampler the integrator goes on with (camera.c). */
-ray camera_sample_ray(const world *w, const render_settings *s, int px, int py, int fw, int fh, int sample,
-                      sampler *sp);
+ * and in *sp the sampler the integrator goes on with (camera.c); sampled:
+ * the integrator draws numbers (integrator.sampled). */
+ray camera_sample_ray(const world *w, const render_settings *s, bool sampled, int px, int py, int fw, int fh,
+                      int sample, sampler *sp);
+
+/* One integrator (integrators.def names it, its file defines it). */
+typedef struct integrator {
+	/* The radiance arriving along the camera ray r (unit direction); g:
+	 * the camera sample's sampler, from dimension g->dim on. */
+	vec3 (*radiance)(const world *w, const render_settings *s, ray r, sampler *g);
+	/* The same when r's first hit is known (packets, render.c): found, h,
+	 * and the answers of the shadow packets for it (known, blocked; 0 and 0
+	 * without shadow_packets). */
+	vec3 (*radiance_first)(const world *w, const render_settings *s, ray r, sampler *g, bool found, const hit *h,
+	                       uint32_t known, uint32_t blocked);
+	/* The shadow rays of a packet's first hits traced as packets (or NULL):
+	 * whitted_shadow_packets below. */
+	void (*shadow_packets)(const world *w, int n, const hit *h, const bool *found, uint32_t *known,
+	                       uint32_t *blocked);
+	/* It draws sampler numbers: each camera ray gets its pixel's sampler
+	 * even at one sample per pixel (else a single sample is the pixel's
+	 * centre). */
+	bool sampled;
+	/* It gives the denoiser its features (denoise.h): `denoise` applies. */
+	bool features;
+} integrator;
+
+#define RT_INTEGRATOR(e, name, desc) extern const integrator desc;
+#include "rtsh/integrators.def"
+#undef RT_INTEGRATOR
+
+/* The integrator of mode m (the first for an unknown m). */
+const integrator *integrator_of(render_mode m);
 
 /* Radiance arriving along r (unit direction) by ambient + Phong + hard
  * shadows + mirror reflection / refraction up to s->depth (whitted.c). */
@@ -17,8 +47,26 @@ vec3 whitted_radiance(const world *w, const render_settings *s, ray r);
  * camera sample's numbers, from dimension g->dim on. */
 vec3 path_radiance(const world *w, const render_settings *s, ray r, sampler *g);
 /* The same two with the camera ray's first hit already traced (a packet,
- * packet.h): found says whether r hit anything, *h what (unread when not). */
-vec3 whitted_radiance_first(const world *w, const render_settings *s, ray r, bool found, const hit *h);
+ * packet.h): found says whether r hit anything, *h what (unread when not);
+ * Whitted's with the answers of its shadow rays toward the lights of
+ * `known` too (whitted_shadow_packets). */
+vec3 whitted_radiance_first(const world *w, const render_settings *s, ray r, bool found, const hit *h,
+                            uint32_t known, uint32_t blocked);
+/* Whitted's shadow rays from the first hits of a packet's camera rays,
+ * traced as packets, one per light (whitted.c): bit l of known[i] says
+ * that ray i's shading will ask about light l (l < 32, a Phong surface),
+ * bit l of blocked[i] the answer world_occluded would give. */
+void whitted_shadow_packets(const world *w, int n, const hit *h, const bool *found, uint32_t *known,
+                            uint32_t *blocked);
+/* What the Phong family's Whitted shading (bsdf_phong.c) is told of its
+ * shadow rays: when `h` is the hit it shades, the answers for the lights of
+ * `known` (whitted_shadow_packets). Set by whitted_radiance_first around
+ * the first hit's shading only; per thread (defined in bsdf_phong.c). */
+typedef struct whitted_shadows {
+	const hit *h;
+	uint32_t known, blocked;
+} whitted_shadows;
+extern _Thread_local whitted_shadows whitted_shadow_hint;
 vec3 path_radiance_first(const world *w, const render_settings *s, ray r, sampler *g, bool found, const hit *h);
 
 /* The scattering at one path vertex: the material family's lobes
@@ -139,6 +187,10 @@ vec3 world_background(const world *w, vec3 dir, render_mode mode);
 
 /* The surface colour at a hit (the checker texture applied). */
 vec3 hit_albedo(const mat_lin *m, const hit *h);
+/* The material at a hit: m, or *tmp holding m with its textures of
+ * parameters applied (glTF's metallic-roughness texture: roughness x G,
+ * metallic x B). */
+const mat_lin *hit_material(const mat_lin *m, const hit *h, mat_lin *tmp);
 
 /* A point just off the surface on the side of n, for spawning rays. */
 static inline vec3 offset_point(const world *w, vec3 p, vec3 n)
@@ -147,6 +199,31 @@ static inline vec3 offset_point(const world *w, vec3 p, vec3 n)
 	double m = ax > ay ? ax : ay;
 	double e = w->eps + 1e-12 * (m > az ? m : az);
 	return v3_madd(p, n, e);
+}
+
+/* The shading point and normal of the Phong family's Whitted shading at
+ * h, and the shadow ray toward light l from there: false when the light
+ * sends nothing to p or is behind the surface (no ray is traced); else *sr,
+ * its length *dist, the radiance *lr arriving and n . l (*ndl). Whitted's
+ * shadow packets make the same rays with it. */
+static inline void phong_whitted_frame(const world *w, const hit *h, vec3 *n, vec3 *p)
+{
+	*n = h->front ? h->n : v3_neg(h->n);
+	*p = offset_point(w, h->p, *n);
+}
+
+static inline bool phong_light_ray(const world *w, size_t l, vec3 p, vec3 n, ray *sr, double *dist, vec3 *lr,
+                                   double *ndl)
+{
+	vec3 ld;
+	*lr = light_at(&w->lights[l], p, &ld, dist); /* physical lights fall off */
+	if (!(lr->x > 0.0 || lr->y > 0.0 || lr->z > 0.0))
+		return false;
+	*ndl = v3_dot(n, ld);
+	if (*ndl <= 0.0)
+		return false;
+	*sr = (ray){p, ld};
+	return true;
 }
 
 #endif

@@ -69,62 +69,65 @@ static inline double next_up(double t)
 	return t;
 }
 
-/* The same rounding of a ray's origin and inverse direction as world.c's
- * ray_prepare (scalar form): on[a] and of[a] bracket the origin so that the
- * near plane's distance can only come down and the far plane's go up. */
-static inline void ray_floats(const ray *r, float on[3], float of[3], float inv[3])
-{
-	double o[3] = {r->o.x, r->o.y, r->o.z}, d[3] = {r->d.x, r->d.y, r->d.z};
-	for (int a = 0; a < 3; a++) {
-		float iv = (float)(1.0 / d[a]);
-		float f = (float)o[a], e = fabsf(f) * 0x1p-23f + 0x1p-149f;
-		float up = f + e, down = f - e;
-		bool neg = signbit(iv);
-		on[a] = neg ? down : up;
-		of[a] = neg ? up : down;
-		inv[a] = iv;
-	}
-}
-
 /* Fills q for rays r[0..n); false when the packet is not coherent enough
  * for the interval test: a direction component of another sign than the
- * first ray's, a zero component, an inverse that is not finite. */
+ * first ray's, a zero or NaN component, an inverse or origin that is not
+ * finite. Each ray's origin and inverse direction are rounded as world.c's
+ * ray_prepare rounds them (on and of bracket the origin so that the near
+ * plane's distance can only come down and the far plane's go up), three
+ * axes in one register, and the packet keeps their lowest and highest. */
 static bool packet_prepare(const ray *r, int n, pk_ray *q)
 {
-	float on_lo[3], on_hi[3], of_lo[3], of_hi[3], ilo[3], ihi[3];
-	int neg[3];
+	const __m128d one = _mm_set1_pd(1.0);
+	const __m128 sign = _mm_set1_ps(-0.0f), ulp = _mm_set1_ps(0x1p-23f), tiny = _mm_set1_ps(0x1p-149f);
+	const __m128 big = _mm_set1_ps(FLT_MAX);
+	__m128 on_lo = _mm_set1_ps(INFINITY), on_hi = _mm_set1_ps(-INFINITY), of_lo = on_lo, of_hi = on_hi;
+	__m128 ilo = on_lo, ihi = on_hi;
+	__m128 bad = _mm_setzero_ps();
+	int neg_and = 7, neg_or = 0;
 	for (int i = 0; i < n; i++) {
-		float on[3], of[3], inv[3];
-		ray_floats(&r[i], on, of, inv);
-		for (int a = 0; a < 3; a++) {
-			if (!isfinite(inv[a]) || inv[a] == 0.0f || !isfinite(on[a]) || !isfinite(of[a]))
-				return false;
-			if (i == 0) {
-				neg[a] = signbit(inv[a]) != 0;
-				on_lo[a] = on_hi[a] = on[a];
-				of_lo[a] = of_hi[a] = of[a];
-				ilo[a] = ihi[a] = inv[a];
-				continue;
-			}
-			if ((signbit(inv[a]) != 0) != neg[a])
-				return false;
-			on_lo[a] = fminf(on_lo[a], on[a]);
-			on_hi[a] = fmaxf(on_hi[a], on[a]);
-			of_lo[a] = fminf(of_lo[a], of[a]);
-			of_hi[a] = fmaxf(of_hi[a], of[a]);
-			ilo[a] = fminf(ilo[a], inv[a]);
-			ihi[a] = fmaxf(ihi[a], inv[a]);
-		}
+		__m128 inv = _mm_movelh_ps(_mm_cvtpd_ps(_mm_div_pd(one, _mm_loadu_pd(&r[i].d.x))),
+		                           _mm_cvtpd_ps(_mm_div_sd(one, _mm_load_sd(&r[i].d.z))));
+		__m128 f = _mm_movelh_ps(_mm_cvtpd_ps(_mm_loadu_pd(&r[i].o.x)), _mm_cvtpd_ps(_mm_load_sd(&r[i].o.z)));
+		__m128 e = _mm_add_ps(_mm_mul_ps(_mm_andnot_ps(sign, f), ulp), tiny);
+		__m128 es = _mm_xor_ps(e, _mm_and_ps(inv, sign));
+		__m128 on = _mm_add_ps(f, es), of = _mm_sub_ps(f, es);
+		/* |x| <= FLT_MAX fails for infinities and NaN; the inverse must
+		 * also not be zero */
+		__m128 ai = _mm_andnot_ps(sign, inv);
+		bad = _mm_or_ps(bad, _mm_cmpnle_ps(ai, big));
+		bad = _mm_or_ps(bad, _mm_cmpeq_ps(ai, _mm_setzero_ps()));
+		bad = _mm_or_ps(bad, _mm_cmpnle_ps(_mm_andnot_ps(sign, on), big));
+		bad = _mm_or_ps(bad, _mm_cmpnle_ps(_mm_andnot_ps(sign, of), big));
+		int neg = _mm_movemask_ps(inv) & 7;
+		neg_and &= neg;
+		neg_or |= neg;
+		on_lo = _mm_min_ps(on_lo, on);
+		on_hi = _mm_max_ps(on_hi, on);
+		of_lo = _mm_min_ps(of_lo, of);
+		of_hi = _mm_max_ps(of_hi, of);
+		ilo = _mm_min_ps(ilo, inv);
+		ihi = _mm_max_ps(ihi, inv);
 	}
+	if ((_mm_movemask_ps(bad) & 7) || neg_and != neg_or)
+		return false;
+	float a_on_lo[4], a_on_hi[4], a_of_lo[4], a_of_hi[4], a_ilo[4], a_ihi[4];
+	_mm_storeu_ps(a_on_lo, on_lo);
+	_mm_storeu_ps(a_on_hi, on_hi);
+	_mm_storeu_ps(a_of_lo, of_lo);
+	_mm_storeu_ps(a_of_hi, of_hi);
+	_mm_storeu_ps(a_ilo, ilo);
+	_mm_storeu_ps(a_ihi, ihi);
 	for (int a = 0; a < 3; a++) {
+		bool neg = neg_and >> a & 1;
 		/* near distance (b - o) inv: lowest with the origin farthest
 		 * along the direction; far distance: highest with it farthest back */
-		q->on[a] = _mm_set1_ps(neg[a] ? on_lo[a] : on_hi[a]);
-		q->of[a] = _mm_set1_ps(neg[a] ? of_hi[a] : of_lo[a]);
-		q->ilo[a] = _mm_set1_ps(ilo[a]);
-		q->ihi[a] = _mm_set1_ps(ihi[a]);
-		q->near[a] = a + (neg[a] ? BVH_HI_X : BVH_LO_X);
-		q->far[a] = a + (neg[a] ? BVH_LO_X : BVH_HI_X);
+		q->on[a] = _mm_set1_ps(neg ? a_on_lo[a] : a_on_hi[a]);
+		q->of[a] = _mm_set1_ps(neg ? a_of_hi[a] : a_of_lo[a]);
+		q->ilo[a] = _mm_set1_ps(a_ilo[a]);
+		q->ihi[a] = _mm_set1_ps(a_ihi[a]);
+		q->near[a] = a + (neg ? BVH_HI_X : BVH_LO_X);
+		q->far[a] = a + (neg ? BVH_LO_X : BVH_HI_X);
 	}
 	return true;
 }

@@ -8,6 +8,7 @@
  * Lights have no distance fall-off, as in miniRT: a light of ratio r and
  * colour c lights a surface facing it with r * c. */
 #include "integrators.h"
+#include "rtsh/packet.h"
 
 static vec3 trace(const world *w, ray r, int depth);
 
@@ -37,7 +38,57 @@ vec3 whitted_radiance(const world *w, const render_settings *s, ray r)
 	return trace_at(w, r, s->depth, true);
 }
 
-vec3 whitted_radiance_first(const world *w, const render_settings *s, ray r, bool found, const hit *h)
+vec3 whitted_radiance_first(const world *w, const render_settings *s, ray r, bool found, const hit *h,
+                            uint32_t known, uint32_t blocked)
 {
-	return shade(w, r, s->depth, found, h);
+	whitted_shadow_hint = (whitted_shadows){h, known, blocked};
+	vec3 c = shade(w, r, s->depth, found, h);
+	whitted_shadow_hint = (whitted_shadows){NULL, 0, 0};
+	return c;
 }
+
+void whitted_shadow_packets(const world *w, int n, const hit *h, const bool *found, uint32_t *known,
+                            uint32_t *blocked)
+{
+	vec3 nn[PACKET_MAX], p[PACKET_MAX];
+	bool phong[PACKET_MAX];
+	for (int i = 0; i < n; i++) {
+		known[i] = blocked[i] = 0;
+		phong[i] = found[i] && w->mats[h[i].mat].family == MAT_PHONG;
+		if (phong[i])
+			phong_whitted_frame(w, &h[i], &nn[i], &p[i]);
+	}
+	for (size_t l = 0; l < w->nlights && l < 32; l++) {
+		ray sr[PACKET_MAX];
+		double dist[PACKET_MAX];
+		int who[PACKET_MAX], m = 0;
+		for (int i = 0; i < n; i++) {
+			vec3 lr;
+			double ndl;
+			if (phong[i] && phong_light_ray(w, l, p[i], nn[i], &sr[m], &dist[m], &lr, &ndl))
+				who[m++] = i;
+		}
+		bool occ[PACKET_MAX];
+		world_occluded_packet(w, m, sr, 0.0, dist, occ);
+		for (int k = 0; k < m; k++) {
+			known[who[k]] |= 1u << l;
+			blocked[who[k]] |= (uint32_t)occ[k] << l;
+		}
+	}
+}
+
+static vec3 whitted_camera(const world *w, const render_settings *s, ray r, sampler *g)
+{
+	(void)g;
+	return whitted_radiance(w, s, r);
+}
+
+static vec3 whitted_camera_first(const world *w, const render_settings *s, ray r, sampler *g, bool found,
+                                 const hit *h, uint32_t known, uint32_t blocked)
+{
+	(void)g;
+	return whitted_radiance_first(w, s, r, found, h, known, blocked);
+}
+
+/* Whitted draws no random numbers: one sample is the pixel's centre. */
+const integrator whitted_integrator = {whitted_camera, whitted_camera_first, whitted_shadow_packets, false, false};

@@ -36,29 +36,37 @@
 #define FRAME_GAP_MAX 5.0
 #define PROMPT "rtsh> "
 
-static shell *active;     /* the shell readline's line handler runs commands in */
-static shell_history hist;
+/* What one interactive session holds beside the shell (sh->ev is its event
+ * loop): everything is passed to the functions below, except to readline's
+ * hooks (the line handler, getc, input-available), which take no context:
+ * they reach it through rl_loop, set for the duration of shell_interactive
+ * and nothing else. */
+typedef struct loop {
+	shell *sh;
+	shell_history hist;
+	bool asked_color; /* the start-up probe asks for truecolor */
+	bool probe_seen;  /* its answers are in */
+} loop;
+
+static loop *rl_loop;
 
 static double now(void)
 {
 	return evloop_now();
 }
 
-/* The event loop: keys (answers taken out) for readline through
- * loop_getc, wake-ups, the output scheduler. */
-static evloop *ev;
-
-/* readline's input: the next key byte, waiting for one if need be. */
+/* readline's input: the next key byte from the event loop (keys, the
+ * terminal's answers taken out), waiting for one if need be. */
 static int loop_getc(FILE *f)
 {
 	(void)f;
-	int c = evloop_getc_wait(ev);
+	int c = evloop_getc_wait(rl_loop->sh->ev);
 	return c < 0 ? EOF : c;
 }
 
 static int loop_input_available(void)
 {
-	return evloop_has_keys(ev);
+	return evloop_has_keys(rl_loop->sh->ev);
 }
 
 /* Readers waiting inside the loop give up on SIGTERM (readline: as at the
@@ -110,7 +118,7 @@ static void draw_picture(shell *sh)
 	double t0 = now();
 	screen_picture(scr, sh->srgb, im->w, im->h);
 	termout_picture_final(scr->out, im->done);
-	evloop_pump(ev);
+	evloop_pump(sh->ev);
 	sh->last_draw = now();
 	sh->frame_cost = sh->last_draw - t0;
 	draw_status(sh); /* the status line tells about the picture shown */
@@ -153,9 +161,9 @@ static void show_output(shell *sh, const abuf *out)
 		 * the picture waits (screen_clear_all) until the layout comes
 		 * back. */
 		screen_clear_all(scr);
-		evloop_set_interrupt(ev, stop_paging, NULL);
-		bool left = pager_show(ev, scr->fd, out->b, out->len, scr->cols, scr->rows, &at);
-		evloop_set_interrupt(ev, stop_reading, NULL);
+		evloop_set_interrupt(sh->ev, stop_paging, NULL);
+		bool left = pager_show(sh->ev, scr->fd, out->b, out->len, scr->cols, scr->rows, &at);
+		evloop_set_interrupt(sh->ev, stop_reading, NULL);
 		if (left || shell_sig_term || shell_sig_int)
 			break;
 		/* Continued after Ctrl-Z, or the window changed size: the pager
@@ -183,9 +191,10 @@ static double frame_gap(const shell *sh)
  * (a paste of several lines) an error goes to `out` too, after the
  * output of the lines before it, so that each message stays next to its
  * line. */
-static bool run_one(shell *sh, const char *line, abuf *out, bool inline_errors)
+static bool run_one(loop *lp, const char *line, abuf *out, bool inline_errors)
 {
-	history_add_line(&hist, line);
+	shell *sh = lp->sh;
+	history_add_line(&lp->hist, line);
 	if (sh->scr && sh->scr->active)
 		sh->capture = sh->notes = out; /* warnings too, in their place */
 	bool ok = shell_run_line(sh, line);
@@ -205,10 +214,11 @@ static bool run_one(shell *sh, const char *line, abuf *out, bool inline_errors)
 
 static void on_line(char *line)
 {
-	shell *sh = active;
+	loop *lp = rl_loop;
+	shell *sh = lp->sh;
 	if (!line) { /* Ctrl-D or end of input */
 		fputs("\n", stdout);
-		if (!evloop_eof(ev) && shell_quit_asks(sh)) {
+		if (!evloop_eof(sh->ev) && shell_quit_asks(sh)) {
 			/* Ctrl-D again leaves. */
 			static const char q[] = "the scene has edits not saved (save FILE.rt keeps them); Ctrl-D again, "
 			                        "or quit!, leaves without them\n";
@@ -255,9 +265,9 @@ static void on_line(char *line)
 		if (shell_sig_int || (several && atomic_load(&sh->cancel))) {
 			left += p[strspn(p, " \t")] != '\0';
 		} else if (!several) {
-			ok = run_one(sh, p, &out, false);
+			ok = run_one(lp, p, &out, false);
 		} else if (p[strspn(p, " \t")]) {
-			run_one(sh, p, &out, true);
+			run_one(lp, p, &out, true);
 			fflush(stdout);
 		}
 		p = next;
@@ -334,19 +344,18 @@ static void relayout(shell *sh)
 	rl_forced_update_display();
 }
 
-static bool asked_color, probe_seen;
-
 /* Once the start-up answers are in (or did not come): truecolor when the
  * terminal said so, and the one-time notices. */
-static void after_probe(shell *sh)
+static void after_probe(loop *lp)
 {
+	shell *sh = lp->sh;
 	termout *o = sh->scr->out;
 	const char *n = termout_notice(o);
 	if (n)
 		shell_notice(sh, "%s", n);
-	if (probe_seen || termout_get_state(o) == TERMOUT_PROBING)
+	if (lp->probe_seen || termout_get_state(o) == TERMOUT_PROBING)
 		return;
-	probe_seen = true;
+	lp->probe_seen = true;
 	bool sym = sh->set.symbols == SYMBOLS_AUTO && screen_set_symbols(sh->scr, sh->set.symbols);
 	if ((sh->set.pixels != PIXELS_OFF && screen_set_pixels(sh->scr, sh->set.pixels)) || sym) {
 		/* The answers told the cell size or, for auto, the protocol: the
@@ -356,7 +365,7 @@ static void after_probe(shell *sh)
 		rl_forced_update_display();
 	}
 	shell_pixels_notice(sh); /* kitty asked for in a tmux pane without passthrough */
-	if (!asked_color)
+	if (!lp->asked_color)
 		return;
 	if (termout_truecolor(o) == 1) {
 		/* The same picture in other colours: drawn again, not rendered
@@ -376,7 +385,8 @@ int shell_interactive(shell *sh, bool use_screen, const int wake[2])
 {
 	int wake_fd = wake[0];
 	setlocale(LC_CTYPE, "");
-	active = sh;
+	loop lp = {.sh = sh};
+	rl_loop = &lp;
 	sh->wake[0] = wake[0];
 	sh->wake[1] = wake[1];
 
@@ -384,12 +394,13 @@ int shell_interactive(shell *sh, bool use_screen, const int wake[2])
 	frame_palette pal = caps_palette(sh->opt->color, STDOUT_FILENO);
 	if (use_screen && screen_enter(&scr, STDOUT_FILENO, pal, (double)sh->set.width / sh->set.height))
 		sh->scr = &scr;
-	ev = evloop_new(STDIN_FILENO, wake_fd);
+	evloop *ev = evloop_new(STDIN_FILENO, wake_fd);
 	if (!ev) {
 		if (sh->scr)
 			screen_leave(sh->scr);
 		sh->scr = NULL;
 		fputs("rtsh: out of memory\n", stderr);
+		rl_loop = NULL;
 		return 1;
 	}
 	evloop_set_out(ev, sh->scr ? sh->scr->out : NULL);
@@ -397,9 +408,8 @@ int shell_interactive(shell *sh, bool use_screen, const int wake[2])
 	sh->ev = ev;
 	/* Ask the terminal (over SSH, COLORTERM is not there to tell): the
 	 * answers set the pacing and, maybe, truecolor. */
-	asked_color = sh->scr && sh->opt->color == COLOR_AUTO && pal != PALETTE_TRUECOLOR && pal != PALETTE_NONE;
-	probe_seen = false;
-	history_setup(&hist, stderr);
+	lp.asked_color = sh->scr && sh->opt->color == COLOR_AUTO && pal != PALETTE_TRUECOLOR && pal != PALETTE_NONE;
+	history_setup(&lp.hist, stderr);
 	signals_interactive_begin(STDIN_FILENO, wake[1]);
 
 	rl_catch_signals = 0;
@@ -421,7 +431,7 @@ int shell_interactive(shell *sh, bool use_screen, const int wake[2])
 	if (sh->scr && !getenv("RTSH_NO_PACING")) {
 		termout_ask_pixels(scr.out, sh->set.pixels != PIXELS_OFF);
 		termout_ask_version(scr.out, sh->set.symbols == SYMBOLS_AUTO);
-		termout_probe(scr.out, asked_color, now());
+		termout_probe(scr.out, lp.asked_color, now());
 	}
 
 	/* rtsh --turntable: key mode spinning from the start. */
@@ -465,7 +475,7 @@ int shell_interactive(shell *sh, bool use_screen, const int wake[2])
 			interrupt(sh);
 		}
 		if (sh->scr && sh->scr->out)
-			after_probe(sh);
+			after_probe(&lp);
 		if (rsvc_take(sh->rs, &sh->img))
 			sh->redraw = true;
 		if (sh->redraw && now() - sh->last_draw >= frame_gap(sh))
@@ -479,7 +489,7 @@ int shell_interactive(shell *sh, bool use_screen, const int wake[2])
 		}
 	}
 	rl_callback_handler_remove();
-	history_finish(&hist);
+	history_finish(&lp.hist);
 	sh->status_hook = NULL;
 	rsvc_hold(sh->rs);
 	if (sh->scr) {
@@ -489,8 +499,7 @@ int shell_interactive(shell *sh, bool use_screen, const int wake[2])
 	signals_interactive_end();
 	sh->ev = NULL;
 	evloop_free(ev);
-	ev = NULL;
 	sh->wake[0] = sh->wake[1] = -1;
-	active = NULL;
+	rl_loop = NULL;
 	return status;
 }

@@ -21,6 +21,13 @@ typedef enum color_mode {
  * COLORTERM is "truecolor" or "24bit" or terminfo has the RGB or Tc flag;
  * then 256 or 16 colours by terminfo's `colors`. */
 frame_palette caps_palette(color_mode mode, int fd);
+/* Inside tmux ($TMUX set) with `auto`, before terminfo: tmux answers no
+ * XTGETTCAP from a pane (3.3a to 3.6b), but its client's terminal features
+ * say RGB when that terminal has truecolor: caps_palette asks `tmux
+ * display-message -p '#{client_termfeatures}'` (at most 0.5 s, once) and
+ * takes truecolor when the list holds RGB. True when the comma-separated
+ * list `features` (tmux's answer, a newline may end it) holds RGB. */
+bool caps_features_rgb(const char *features);
 
 /* True when fd is a terminal that can show the full-screen shell: TERM is
  * set and not "dumb". */

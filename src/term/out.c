@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -293,8 +294,19 @@ static void dcs_answer(termout *o, const char *p, size_t n, double now)
 		}
 		answered(o, Q_RQSS, now);
 	} else if (n >= 3 && p[1] == '+' && p[2] == 'r') {
-		if (p[0] == '1')
-			o->truecolor = 1; /* RGB or Tc is there */
+		/* XTGETTCAP: "1+r" then NAME[=VALUE] in hex, ';' between: RGB
+		 * (524742) or Tc (5463) is there; "0+r": not known */
+		for (size_t i = 3; p[0] == '1' && i < n;) {
+			size_t j = i;
+			while (j < n && p[j] != '=' && p[j] != ';')
+				j++;
+			if ((j - i == 6 && strncasecmp(p + i, "524742", 6) == 0) ||
+			    (j - i == 4 && strncasecmp(p + i, "5463", 4) == 0))
+				o->truecolor = 1;
+			while (j < n && p[j] != ';')
+				j++;
+			i = j + 1;
+		}
 		answered(o, Q_TCAP, now);
 	}
 }

@@ -3,19 +3,8 @@
 # space is inserted quoted, so that the command then works; `save out` Tab
 # shows what it can write (out.png, out.rt, ...), not just "out.".
 set -u
-sock=rtsh-e2e-$$
-tmux() { command tmux -L "$sock" "$@"; }
 s=rtsh-complete-$$
-fail() { echo "FAIL: $*"; tmux kill-server 2>/dev/null; exit 1; }
-screen() { tmux capture-pane -t "$s" -p; }
-wait_for() {
-	for i in $(seq 1 300); do
-		case $(screen) in *"$1"*) return 0 ;; esac
-		sleep 0.1
-	done
-	fail "$2; the screen ends with:
-$(screen | grep -v '^ *$' | tail -n 6)"
-}
+. tests/e2e/lib.sh
 mkdir -p "$TMP/my scenes"
 cat >"$TMP/my scenes/one.rt" <<'SCENE'
 A 0.3 255,255,255

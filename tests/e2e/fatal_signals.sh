@@ -17,18 +17,9 @@
 # were too.
 set -u
 s=rtsh-fatal-$$
-fail() { echo "FAIL: $*"; tmux kill-session -t "$s" 2>/dev/null; tmux kill-session -t "$s-keep" 2>/dev/null; exit 1; }
+. tests/e2e/lib.sh
 F='#{alternate_on} #{cursor_flag} #{keypad_flag} #{keypad_cursor_flag} #{mouse_any_flag} #{mouse_button_flag} #{mouse_standard_flag} #{mouse_sgr_flag} #{mouse_all_flag} #{mouse_utf8_flag} #{insert_flag} #{origin_flag} #{wrap_flag}'
 flags() { tmux display -p -t "$s" "$F"; }
-screen() { tmux capture-pane -t "$s" -p; }
-wait_for() {
-	for i in $(seq 1 300); do
-		case $(screen) in *"$1"*) return 0 ;; esac
-		sleep 0.1
-	done
-	fail "$2; the screen ends with:
-$(screen | grep -v '^ *$' | tail -n 6)"
-}
 
 cat >"$TMP/s.rt" <<'E'
 A 0.3 255,255,255

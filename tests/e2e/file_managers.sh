@@ -7,8 +7,7 @@
 # (apt-get install -y fzf lf ranger).
 set -u
 s=rtsh-fm-$$
-fail() { echo "FAIL: $*"; tmux kill-session -t "$s" 2>/dev/null; exit 1; }
-screen() { tmux capture-pane -t "$s" -p; }
+. tests/e2e/lib.sh
 snippet() { awk -v name="$1" '$0 == "<!-- snippet " name " -->" { f = 1; next } f && /^```/ { if (c++) exit; next } f' README.md; }
 # blocks: the half blocks on the screen
 blocks() { screen | grep -o '▀\|▄\|█' | wc -l; }

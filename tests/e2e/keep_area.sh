@@ -4,20 +4,8 @@
 # the prompt are on screen again afterwards, also a command's output that
 # came just before a render stopped by Ctrl-Z.
 set -u
-# A tmux server of its own: other tests' servers come and go.
-sock=rtsh-e2e-$$
-tmux() { command tmux -L "$sock" "$@"; }
 s=rtsh-keep-$$
-fail() { echo "FAIL: $*"; tmux kill-session -t "$s" 2>/dev/null; exit 1; }
-screen() { tmux capture-pane -t "$s" -p; }
-wait_for() {
-	for i in $(seq 1 300); do
-		case $(screen) in *"$1"*) return 0 ;; esac
-		sleep 0.1
-	done
-	fail "$2; the screen ends with:
-$(screen | grep -v '^ *$' | tail -n 6)"
-}
+. tests/e2e/lib.sh
 # kept WHAT: the area shows the commands and output of before, and a prompt.
 kept() {
 	for i in $(seq 1 50); do

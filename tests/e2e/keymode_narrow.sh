@@ -25,8 +25,12 @@ tmux new-session -d -s "$s" -x 80 -y 24 \
 wait_for "rtsh>" "no prompt"
 tmux send-keys -t "$s" view Enter
 wait_for " view │ " "no key-mode status line"
-wait_for "spp" "no samples in the status line"
-line=$(screen | grep ' view │ ')
+# the status line itself, once it shows samples (before: "rendering")
+for i in $(seq 1 100); do
+	line=$(screen | grep ' view │ ')
+	case $line in *spp*) break ;; esac
+	sleep 0.1
+done
 case $line in *"camera"*"spp"*"step "[0-9]*) ;; *) fail "the status line is cut: $line" ;; esac
 w=$(printf '%s' "$line" | sed 's/ *$//' | wc -m)
 [ "$w" -le 80 ] || fail "the status line is $w columns wide: $line"

@@ -4,20 +4,8 @@
 # line is its own command (its own history entry, its own error), and the
 # prompt comes back at the bottom of the command area.
 set -u
-# A tmux server of its own: other tests' servers come and go.
-sock=rtsh-e2e-$$
-tmux() { command tmux -L "$sock" "$@"; }
 s=rtsh-paste-$$
-fail() { echo "FAIL: $*"; tmux kill-session -t "$s" 2>/dev/null; exit 1; }
-screen() { tmux capture-pane -t "$s" -p; }
-wait_for() {
-	for i in $(seq 1 300); do
-		case $(screen) in *"$1"*) return 0 ;; esac
-		sleep 0.1
-	done
-	fail "$2; the screen ends with:
-$(screen | grep -v '^ *$' | tail -n 6)"
-}
+. tests/e2e/lib.sh
 cat >"$TMP/s.rt" <<'SCENE'
 A 0.3 255,255,255
 C 0,0,-10 0,0,1 70

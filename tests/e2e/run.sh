@@ -1,6 +1,6 @@
 #!/bin/sh
-# End-to-end tests under tmux: each tests/e2e/*.sh (but this one) drives the
-# real binary in a tmux session. Skipped with a message where tmux is missing.
+# End-to-end tests under tmux: each tests/e2e/*.sh (but this one and lib.sh,
+# the helpers) drives the real binary in a tmux session. Skipped with a message where tmux is missing.
 set -u
 rtsh=$1
 case $rtsh in /*) ;; *) rtsh="$PWD/$rtsh" ;; esac
@@ -12,7 +12,7 @@ if ! command -v tmux >/dev/null 2>&1; then
 fi
 passed=0 failed=0
 for t in tests/e2e/*.sh; do
-	[ "$(basename "$t")" = run.sh ] && continue
+	case $(basename "$t") in run.sh | lib.sh) continue ;; esac
 	tmp=$(mktemp -d)
 	if out=$(RTSH="$rtsh" TMP="$tmp" sh "$t" 2>&1); then
 		passed=$((passed + 1)); echo "[       OK ] $t"

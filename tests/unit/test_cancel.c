@@ -12,7 +12,9 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "core/envmap.h"
 #include "rtsh/generate.h"
+#include "rtsh/texture.h"
 #include "rtsh/mesh.h"
 #include "rtsh/render.h"
 #include "rtsh/rtfile.h"
@@ -158,6 +160,137 @@ static void test_world_build_stops(void **state)
 	scene_free(s);
 }
 
+/* The readers stop in the middle of a file (issue 31, defect 3: they ran to
+ * their end before the flag was looked at). Each file below is valid up to
+ * a fault in its last element: with the flag set before the read, the
+ * reader stops before it gets there, so the error is "stopped", not the
+ * fault (a reader that runs to its end reports the fault). */
+static char *tmp_file(const char *name)
+{
+	static char path[8][160];
+	static int k;
+	char *p = path[k++ % 8];
+	snprintf(p, sizeof path[0], "%s/%s", tmpdir, name);
+	return p;
+}
+
+static void expect_stopped_mesh(const char *path)
+{
+	atomic_bool cancel;
+	atomic_init(&cancel, true);
+	rt_error err;
+	assert_null(mesh_cache_get(path, true, 60, &cancel, &err));
+	if (strcmp(err.msg, "stopped") != 0)
+		fail_msg("%s: \"%s\", expected \"stopped\"", path, err.msg);
+	/* without the flag the fault is found: the file is read to its end */
+	assert_null(mesh_cache_get(path, true, 60, NULL, &err));
+	assert_null(strstr(err.msg, "stopped"));
+}
+
+static void test_readers_stop(void **state)
+{
+	(void)state;
+	const int n = 20000; /* elements: several times the 4096 between polls */
+	/* OBJ: n vertices and triangles, then a face with index 0 */
+	FILE *f = fopen(tmp_file("bad.obj"), "w");
+	assert_non_null(f);
+	for (int i = 0; i < n; i++)
+		fprintf(f, "v %d %d %d\n", i % 7, i % 11, i % 13);
+	for (int i = 1; i + 2 <= n; i += 3)
+		fprintf(f, "f %d %d %d\n", i, i + 1, i + 2);
+	fprintf(f, "f 1 2 0\n");
+	fclose(f);
+	expect_stopped_mesh(tmp_file("bad.obj"));
+	/* ASCII PLY: the last face's index is past the vertices */
+	f = fopen(tmp_file("bad.ply"), "w");
+	assert_non_null(f);
+	fprintf(f, "ply\nformat ascii 1.0\nelement vertex %d\nproperty float x\nproperty float y\nproperty float z\n"
+	           "element face %d\nproperty list uchar int vertex_indices\nend_header\n", n, n / 3);
+	for (int i = 0; i < n; i++)
+		fprintf(f, "%d %d %d\n", i % 7, i % 11, i % 13);
+	for (int i = 0; i + 1 < n / 3; i++)
+		fprintf(f, "3 %d %d %d\n", 3 * i, 3 * i + 1, 3 * i + 2);
+	fprintf(f, "3 0 1 %d\n", n);
+	fclose(f);
+	expect_stopped_mesh(tmp_file("bad.ply"));
+	/* binary PLY: the same */
+	f = fopen(tmp_file("badb.ply"), "wb");
+	assert_non_null(f);
+	fprintf(f, "ply\nformat binary_little_endian 1.0\nelement vertex %d\nproperty float x\nproperty float y\n"
+	           "property float z\nelement face %d\nproperty list uchar int vertex_indices\nend_header\n", n, n / 3);
+	for (int i = 0; i < n; i++) {
+		float v[3] = {(float)(i % 7), (float)(i % 11), (float)(i % 13)};
+		fwrite(v, sizeof v, 1, f);
+	}
+	for (int i = 0; i < n / 3; i++) {
+		unsigned char c = 3;
+		int32_t t[3] = {3 * i, 3 * i + 1, i + 1 < n / 3 ? 3 * i + 2 : n};
+		fwrite(&c, 1, 1, f);
+		fwrite(t, sizeof t, 1, f);
+	}
+	fclose(f);
+	expect_stopped_mesh(tmp_file("badb.ply"));
+	/* .gltf with an external .bin: n positions, then indices whose last is
+	 * past them */
+	f = fopen(tmp_file("bad.bin"), "wb");
+	assert_non_null(f);
+	for (int i = 0; i < n; i++) {
+		float v[3] = {(float)(i % 7), (float)(i % 11), (float)(i % 13)};
+		fwrite(v, sizeof v, 1, f);
+	}
+	int ni = 3 * (n / 3);
+	for (int i = 0; i < ni; i++) {
+		uint32_t k = i + 1 < ni ? (uint32_t)i : (uint32_t)n;
+		fwrite(&k, 4, 1, f);
+	}
+	fclose(f);
+	f = fopen(tmp_file("bad.gltf"), "w");
+	assert_non_null(f);
+	fprintf(f, "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+	           "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
+	           "\"buffers\":[{\"uri\":\"bad.bin\",\"byteLength\":%d}],"
+	           "\"bufferViews\":[{\"buffer\":0,\"byteLength\":%d},{\"buffer\":0,\"byteOffset\":%d,\"byteLength\":%d}],"
+	           "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":%d,\"type\":\"VEC3\","
+	           "\"min\":[0,0,0],\"max\":[6,10,12]},"
+	           "{\"bufferView\":1,\"componentType\":5125,\"count\":%d,\"type\":\"SCALAR\"}]}\n",
+	        12 * n + 4 * ni, 12 * n, 12 * n, 4 * ni, n, ni);
+	fclose(f);
+	expect_stopped_mesh(tmp_file("bad.gltf"));
+	/* an ASCII PPM of 100x100 whose last value is not a number */
+	f = fopen(tmp_file("bad.ppm"), "w");
+	assert_non_null(f);
+	fprintf(f, "P3\n100 100\n255\n");
+	for (int i = 0; i < 3 * 100 * 100 - 1; i++)
+		fprintf(f, "%d\n", i % 256);
+	fprintf(f, "x\n");
+	fclose(f);
+	atomic_bool cancel;
+	atomic_init(&cancel, true);
+	rt_error err;
+	assert_null(texture_cache_get(tmp_file("bad.ppm"), true, &cancel, &err));
+	assert_string_equal(err.msg, "stopped");
+	assert_null(texture_cache_get(tmp_file("bad.ppm"), true, NULL, &err));
+	assert_non_null(strstr(err.msg, "expected pixel value"));
+	/* an HDR sky (a valid PPM here) stops in its decoder or, once cached,
+	 * in the sky's distribution: envmap_new looks at the flag */
+	f = fopen(tmp_file("sky.ppm"), "w");
+	assert_non_null(f);
+	fprintf(f, "P3\n100 100\n255\n");
+	for (int i = 0; i < 3 * 100 * 100; i++)
+		fprintf(f, "%d\n", i % 256);
+	fclose(f);
+	assert_null(envmap_new(tmp_file("sky.ppm"), 1, 0, &cancel, &err)); /* in the decoder */
+	assert_string_equal(err.msg, "stopped");
+	texture *t = texture_cache_get(tmp_file("sky.ppm"), false, NULL, &err);
+	assert_non_null(t); /* now cached: */
+	assert_null(envmap_new(tmp_file("sky.ppm"), 1, 0, &cancel, &err)); /* in the distribution */
+	assert_string_equal(err.msg, "stopped");
+	envmap *e = envmap_new(tmp_file("sky.ppm"), 1, 0, NULL, &err);
+	assert_non_null(e);
+	envmap_free(e);
+	texture_cache_put(t);
+}
+
 /* The progress callback of the pass to stop: the first time it hears of
  * some tiles done and some not, it sets the flag (the render is then in
  * flight: its threads are between tiles). */
@@ -254,6 +387,7 @@ int main(void)
 	    cmocka_unit_test(test_load_stops),
 	    cmocka_unit_test(test_generate_stops),
 	    cmocka_unit_test(test_world_build_stops),
+	    cmocka_unit_test(test_readers_stop),
 	    cmocka_unit_test(test_render_stops_in_flight),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);

@@ -11,6 +11,7 @@
 
 #include "term/encoder.h"
 #include "term/frame.h"
+#include "term/caps.h"
 #include "term/out.h"
 
 static int write_end = -1;
@@ -90,6 +91,59 @@ static void test_answers_out_of_keys(void **state)
 	assert_int_equal(keys.len, 7);
 	abuf_free(&keys);
 	close_out(o, rd);
+}
+
+/* XTGETTCAP's answer (DCS 1 + r NAME[=VALUE] ST, names in hex; issue 31,
+ * friction 6): RGB (524742, with xterm's value 8/8/8) or Tc (5463) is
+ * truecolor; another name, or "0+r" (not known), is not. */
+static bool tcap_says(const char *answer)
+{
+	int rd;
+	termout *o = open_out(&rd);
+	char buf[4096];
+	abuf keys;
+	abuf_init(&keys);
+	termout_probe(o, true, 0.0);
+	feed(o, "\x1bP1$r0;48;5;16m\x1b\\", 0.01, &keys); /* DECRQSS: no 24-bit SGR */
+	feed(o, answer, 0.02, &keys);
+	feed(o, "\x1b[?1;2c", 0.03, &keys);
+	assert_int_equal(keys.len, 0);
+	bool tc = termout_truecolor(o) == 1;
+	abuf_free(&keys);
+	drain(rd, buf, sizeof buf);
+	close_out(o, rd);
+	return tc;
+}
+
+static void test_xtgettcap_answer(void **state)
+{
+	(void)state;
+	assert_true(tcap_says("\x1bP1+r524742=382F382F38\x1b\\"));
+	assert_true(tcap_says("\x1bP1+r524742\x1b\\"));
+	assert_true(tcap_says("\x1bP1+r5463\x1b\\"));
+	assert_true(tcap_says("\x1bP1+r636F6C6F7273=323536;524742=382F382F38\x1b\\")); /* colors, then RGB */
+	assert_true(tcap_says("\x1bP1+r524742\a"));
+	assert_false(tcap_says("\x1bP0+r524742\x1b\\"));
+	assert_false(tcap_says("\x1bP0+r\x1b\\"));
+	assert_false(tcap_says("\x1bP1+r636F6C6F7273=323536\x1b\\")); /* colors=256 alone */
+	assert_false(tcap_says("\x1bP1+r52474\x1b\\"));                /* a name cut short */
+}
+
+/* tmux's client features (caps_features_rgb): what `tmux display-message -p
+ * '#{client_termfeatures}'` printed here, tmux 3.3a attached from an
+ * xterm-256color terminal with terminal-features ',xterm*:RGB', and
+ * without. */
+static void test_tmux_features(void **state)
+{
+	(void)state;
+	assert_true(caps_features_rgb("256,bpaste,ccolour,clipboard,cstyle,focus,mouse,overline,RGB,strikethrough,title,"
+	                              "usstyle\n"));
+	assert_false(caps_features_rgb("256,bpaste,ccolour,clipboard,cstyle,focus,mouse,overline,strikethrough,title,"
+	                               "usstyle\n"));
+	assert_true(caps_features_rgb("RGB"));
+	assert_false(caps_features_rgb(""));   /* a detached session: no client */
+	assert_false(caps_features_rgb("\n"));
+	assert_false(caps_features_rgb("RGBA,xRGB"));
 }
 
 static void test_probe_without_color_and_timeout(void **state)
@@ -448,6 +502,8 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_answers_out_of_keys),
 		cmocka_unit_test(test_probe_without_color_and_timeout),
+		cmocka_unit_test(test_xtgettcap_answer),
+		cmocka_unit_test(test_tmux_features),
 		cmocka_unit_test(test_paced_slices_and_overtaking),
 		cmocka_unit_test(test_pipelined_slices),
 	};

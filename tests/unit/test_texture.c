@@ -317,7 +317,7 @@ static void test_sky_pdf(void **state)
 		}
 	}
 	rt_error err = {0};
-	envmap *e = envmap_new(tmp_write("band.pfm", buf, (size_t)n), 1, 30, &err);
+	envmap *e = envmap_new(tmp_write("band.pfm", buf, (size_t)n), 1, 30, NULL, &err);
 	assert_non_null(e);
 	test_rng r = {11};
 	for (int i = 0; i < 2000; i++) {

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/readhelp.h"
 #include "core/bvh/bvh.h"
 #include "rtsh/memory.h"
 #include "rtsh/texture.h"
@@ -40,12 +41,12 @@ static bool bgrow(mesh_builder *b, void **a, size_t *cap, size_t need, size_t si
 
 const char *mb_failure(const mesh_builder *b)
 {
-	return b->over ? b->limit.msg : "out of memory";
+	return read_cancelled() ? "stopped" : b->over ? b->limit.msg : "out of memory";
 }
 
 bool mb_vertex(mesh_builder *b, const float p[3])
 {
-	if (!bgrow(b, (void **)&b->v, &b->cv, b->nv + 1, sizeof *b->v))
+	if (read_poll() || !bgrow(b, (void **)&b->v, &b->cv, b->nv + 1, sizeof *b->v))
 		return false;
 	memcpy(b->v[b->nv++], p, sizeof *b->v);
 	return true;
@@ -53,7 +54,7 @@ bool mb_vertex(mesh_builder *b, const float p[3])
 
 bool mb_uv(mesh_builder *b, const float t[2])
 {
-	if (!bgrow(b, (void **)&b->vt, &b->cvt, b->nvt + 1, sizeof *b->vt))
+	if (read_poll() || !bgrow(b, (void **)&b->vt, &b->cvt, b->nvt + 1, sizeof *b->vt))
 		return false;
 	memcpy(b->vt[b->nvt++], t, sizeof *b->vt);
 	return true;
@@ -61,7 +62,7 @@ bool mb_uv(mesh_builder *b, const float t[2])
 
 bool mb_normal(mesh_builder *b, const float n[3])
 {
-	if (!bgrow(b, (void **)&b->vn, &b->cvn, b->nvn + 1, sizeof *b->vn))
+	if (read_poll() || !bgrow(b, (void **)&b->vn, &b->cvn, b->nvn + 1, sizeof *b->vn))
 		return false;
 	memcpy(b->vn[b->nvn++], n, sizeof *b->vn);
 	return true;
@@ -69,7 +70,7 @@ bool mb_normal(mesh_builder *b, const float n[3])
 
 bool mb_triangle(mesh_builder *b, int32_t c[3][3])
 {
-	if (!bgrow(b, (void **)&b->c, &b->cc, b->nc + 3, sizeof *b->c) ||
+	if (read_poll() || !bgrow(b, (void **)&b->c, &b->cc, b->nc + 3, sizeof *b->c) ||
 	    !bgrow(b, (void **)&b->fm, &b->cf, b->nf + 1, sizeof *b->fm))
 		return false;
 	memcpy(b->c[b->nc], c, 3 * sizeof *b->c);

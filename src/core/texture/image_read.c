@@ -218,7 +218,12 @@ static float *read_ppm(const char *path, const unsigned char *buf, size_t len, b
 		rt_error_set(err, "%s: out of memory (%ldx%ld image)", path, x, y);
 		return NULL;
 	}
-	for (size_t i = 0; i < n; i++)
+	for (size_t i = 0; i < n; i++) {
+		if (read_poll()) { /* Ctrl-C: every 4096 pixels */
+			free(out);
+			rt_error_set(err, "stopped");
+			return NULL;
+		}
 		for (int c = 0; c < comp; c++) {
 			long v;
 			if (binary) {
@@ -237,6 +242,7 @@ static float *read_ppm(const char *path, const unsigned char *buf, size_t len, b
 			else
 				out[3 * i + (size_t)c] = lf;
 		}
+	}
 	*w = (int)x;
 	*h = (int)y;
 	return out;
@@ -280,6 +286,11 @@ static float *read_pfm(const char *path, const unsigned char *buf, size_t len, i
 	}
 	bool little = scale < 0;
 	for (long row = 0; row < y; row++) {
+		if (read_cancelled()) { /* Ctrl-C */
+			free(out);
+			rt_error_set(err, "stopped");
+			return NULL;
+		}
 		long dst = y - 1 - row; /* the file's rows run bottom to top */
 		for (long col = 0; col < x; col++)
 			for (int k = 0; k < comp; k++) {

@@ -7,6 +7,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "base/readhelp.h"
 #include "rtsh/filesrc.h"
 
 static _Thread_local double pixel_angle;
@@ -48,10 +49,10 @@ texture *texture_make(float *rgb, int w, int h, rt_error *err)
 		if (a->w == 1 && a->h == 1)
 			break;
 		int nw = a->w > 1 ? a->w / 2 : 1, nh = a->h > 1 ? a->h / 2 : 1;
-		float *o = malloc((size_t)nw * (size_t)nh * 3 * sizeof *o);
-		if (!o) {
+		float *o = read_cancelled() ? NULL : malloc((size_t)nw * (size_t)nh * 3 * sizeof *o);
+		if (!o) { /* or Ctrl-C, looked at once a level */
 			texture_free(t);
-			rt_error_set(err, "out of memory building mip-maps");
+			rt_error_set(err, read_cancelled() ? "stopped" : "out of memory building mip-maps");
 			return NULL;
 		}
 		for (int y = 0; y < nh; y++)
@@ -163,10 +164,16 @@ texture *texture_cache_get(const char *path, bool srgb, const atomic_bool *cance
 		}
 	}
 	pthread_mutex_unlock(&lock);
+	/* the PPM and PFM decoders and the mip chain poll the flag; stb_image's
+	 * (PNG, JPEG, HDR, ...) run to their end */
+	const atomic_bool *outer = read_cancel_set(cancel);
 	texture *t = texture_load(path, srgb, err);
+	read_cancel_set(outer);
+	if (!t && cancel && atomic_load(cancel))
+		rt_error_set(err, "stopped");
 	if (!t)
 		return NULL;
-	/* the decoder runs to its end; a stopped image is not cached */
+	/* a stopped image is not cached */
 	if (cancel && atomic_load(cancel)) {
 		texture_free(t);
 		rt_error_set(err, "stopped");
