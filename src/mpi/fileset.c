@@ -73,38 +73,42 @@ static char *recorded(fileset *fs, const char *path, char *data, size_t *len, rt
 	return data;
 }
 
-/* The other ranks' reads: a copy of the kept file, or NULL with err
- * set (words: the scene file's or the core's). */
-static char *served(const fileset *fs, const char *path, size_t *len, rt_error *err, const char *what)
+/* True when path is kept: *copy its copy (NULL when memory ran out). */
+static bool kept(const fileset *fs, const char *path, size_t *len, char **copy)
 {
 	const file_entry *e = find(fs, path);
-	if (!e) {
-		if (what)
-			rt_error_set(err, "%s: cannot read the %s: not among the files rank 0 sent", path, what);
-		else
-			rt_error_at(err, path, 0, 0, "not among the files rank 0 sent; expected a file rank 0 read");
-		return NULL;
+	if (e) {
+		*len = e->len;
+		*copy = mem_dupz(e->data, e->len);
 	}
-	char *c = mem_dupz(e->data, e->len);
-	if (!c) {
-		if (what)
-			rt_error_set(err, "%s: out of memory reading the %s", path, what);
-		else
-			rt_error_at(err, path, 0, 0, "out of memory");
-		return NULL;
-	}
-	*len = e->len;
-	return c;
+	return e != NULL;
+}
+
+/* The other ranks' reads: a copy of the kept file, or NULL with err
+ * set (in the words of the core's file source, or with what NULL the
+ * scene loader's). */
+static char *served(const fileset *fs, const char *path, size_t *len, rt_error *err, const char *what)
+{
+	char *c = NULL;
+	bool there = kept(fs, path, len, &c);
+	if (c)
+		return c;
+	if (what)
+		rt_error_set(err, there ? "%s: out of memory reading the %s"
+		                        : "%s: cannot read the %s: not among the files rank 0 sent",
+		             path, what);
+	else
+		rt_error_at(err, path, 0, 0,
+		            there ? "out of memory" : "not among the files rank 0 sent; expected a file rank 0 read");
+	return NULL;
 }
 
 char *fileset_record(void *ctx, const char *path, size_t *len, rt_error *err)
 {
 	fileset *fs = ctx;
-	const file_entry *e = find(fs, path);
-	if (e) {
-		*len = e->len;
-		return mem_dupz(e->data, e->len);
-	}
+	char *copy;
+	if (kept(fs, path, len, &copy))
+		return copy;
 	return recorded(fs, path, rt_read_file(path, NULL, len, err), len, err, "file");
 }
 
@@ -116,11 +120,9 @@ char *fileset_serve(void *ctx, const char *path, size_t *len, rt_error *err)
 static char *src_record(void *ctx, const char *path, const char *what, size_t *len, rt_error *err)
 {
 	fileset *fs = ctx;
-	const file_entry *e = find(fs, path);
-	if (e) {
-		*len = e->len;
-		return mem_dupz(e->data, e->len);
-	}
+	char *copy;
+	if (kept(fs, path, len, &copy))
+		return copy;
 	return recorded(fs, path, rt_file_read_disk(path, what, len, err), len, err, what);
 }
 
