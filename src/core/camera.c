@@ -12,6 +12,12 @@ cam_view cam_view_make(const camera *c)
 	vec3 up_ref = fabs(v.fwd.y) > 0.999999 ? v3(0, 0, 1) : v3(0, 1, 0);
 	v.right = v3_norm(v3_cross(up_ref, v.fwd));
 	v.up = v3_cross(v.fwd, v.right);
+	if (c->roll != 0) { /* the up turned towards the right by roll degrees */
+		double a = deg_to_rad(c->roll), ca = cos(a), sa = sin(a);
+		vec3 r = v.right, u = v.up;
+		v.up = v3_add(v3_scale(u, ca), v3_scale(r, sa));
+		v.right = v3_sub(v3_scale(r, ca), v3_scale(u, sa));
+	}
 	double fov = clampd(c->fov, 0.01, 179.99);
 	v.tan_half = tan(deg_to_rad(fov) * 0.5);
 	v.vertical = c->vertical;

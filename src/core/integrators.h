@@ -157,6 +157,10 @@ vec3 world_background(const world *w, vec3 dir, render_mode mode);
 
 /* The surface colour at a hit (the checker texture applied). */
 vec3 hit_albedo(const mat_lin *m, const hit *h);
+/* The material at a hit: m, or *tmp holding m with its textures of
+ * parameters applied (glTF's metallic-roughness texture: roughness x G,
+ * metallic x B). */
+const mat_lin *hit_material(const mat_lin *m, const hit *h, mat_lin *tmp);
 
 /* A point just off the surface on the side of n, for spawning rays. */
 static inline vec3 offset_point(const world *w, vec3 p, vec3 n)

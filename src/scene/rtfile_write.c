@@ -298,6 +298,10 @@ static void fmt_camera(sbuf *b, const camera *c, const char *id)
 		sb_put(b, " ortho=");
 		sb_num(b, c->ortho);
 	}
+	if (c->roll != 0) {
+		sb_put(b, " roll=");
+		sb_num(b, c->roll);
+	}
 }
 
 /* One element's line into buf, its numbers in the "C" locale: the object o
