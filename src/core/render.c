@@ -170,9 +170,8 @@ static void block_add(const world *w, const render_settings *s, int x0, int y0, 
 static void tile_srgb8(framebuffer *fb, int x0, int y0, int x1, int y1)
 {
 	for (int y = y0; y < y1; y++) {
-		size_t i0 = ((size_t)y * (size_t)fb->w + (size_t)x0) * 3, i1 = i0 + (size_t)(x1 - x0) * 3;
-		for (size_t i = i0; i < i1; i++)
-			fb->srgb8[i] = linear_to_srgb8(fb->rgb[i] * fb->srgb8_gain);
+		size_t i0 = ((size_t)y * (size_t)fb->w + (size_t)x0) * 3;
+		linear_to_srgb8_n(fb->rgb + i0, fb->srgb8_gain, fb->srgb8 + i0, (size_t)(x1 - x0) * 3);
 	}
 }
 

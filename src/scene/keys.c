@@ -3,6 +3,7 @@
  * read. A new material key is a line of rt_keys (and its field in
  * scene.h's material, and a paragraph in rtsh(5)). */
 #include <math.h>
+#include <pthread.h>
 #include <stddef.h>
 #include <string.h>
 
@@ -100,20 +101,33 @@ bool rt_key_applies(const rt_key *k, obj_kind kind)
 	return !k->needs || (f & k->needs);
 }
 
+/* The absent PBR block, made once: rt_key_get reads it for every PBR key of
+ * every object without one (the rules of a million loaded spheres). */
+static material_pbr absent_pbr;
+static pthread_once_t absent_once = PTHREAD_ONCE_INIT;
+
+static void absent_init(void)
+{
+	absent_pbr = material_pbr_absent();
+}
+
 /* Where key k's value is in o: in the object, or in o's PBR block (the
  * absent one when o has none). */
-static const char *key_src(const rt_key *k, const object *o, material_pbr *tmp)
+static const char *key_src(const rt_key *k, const object *o)
 {
 	if (!(k->offset & RT_KEY_PBR))
 		return (const char *)o + k->offset;
-	*tmp = o->mat.pbr ? *o->mat.pbr : material_pbr_absent();
-	return (const char *)tmp + (k->offset & ~RT_KEY_PBR);
+	const material_pbr *pb = o->mat.pbr;
+	if (!pb) {
+		pthread_once(&absent_once, absent_init);
+		pb = &absent_pbr;
+	}
+	return (const char *)pb + (k->offset & ~RT_KEY_PBR);
 }
 
 double rt_key_get(const rt_key *k, const object *o)
 {
-	material_pbr tmp;
-	const char *base = key_src(k, o, &tmp);
+	const char *base = key_src(k, o);
 	if (k->is_int)
 		return *(const int *)(const void *)base;
 	return *(const double *)(const void *)base;
@@ -121,8 +135,7 @@ double rt_key_get(const rt_key *k, const object *o)
 
 void rt_key_get_n(const rt_key *k, const object *o, double *v, int n)
 {
-	material_pbr tmp;
-	memcpy(v, key_src(k, o, &tmp), (size_t)n * sizeof *v);
+	memcpy(v, key_src(k, o), (size_t)n * sizeof *v);
 }
 
 /* Writes n doubles (or one int) into o's field of key k. */
