@@ -468,6 +468,8 @@ static vec3 pbr_whitted(const world *w, const mat_lin *m, const hit *h, ray r, i
 	b.front = h->front;
 	b.cos_o = pos(v3_dot(b.n, b.wo));
 	b.family = MAT_PBR;
+	mat_lin tmp;
+	m = hit_material(m, h, &tmp);
 	pbr_make(&b, m, hit_albedo(m, h));
 	const struct bsdf_pbr *p = &b.pb;
 	vec3 pt = offset_point(w, h->p, b.n);

@@ -120,14 +120,15 @@ static vec3 emitter_light(const world *w, const bsdf *b, vec3 p, vec3 pdn, uint3
 	if (!emitter_sample(e, p, u1, u2, &wi, &pdf, &t))
 		return v3(0, 0, 0);
 	/* nothing may stand between: an any-hit query that stops just short
-	 * of the emitter's surface */
+	 * of the emitter's surface (of a model's triangle, whose
+	 * single-precision test may find it a little nearer than t, shorter) */
 	vec3 f;
 	double cos_i;
-	if (!unoccluded_eval(w, b, p, pdn, wi, t * (1.0 - 1e-7), &f, &cos_i))
+	if (!unoccluded_eval(w, b, p, pdn, wi, t * (1.0 - (e->object == UINT32_MAX ? 1e-5 : 1e-7)), &f, &cos_i))
 		return v3(0, 0, 0);
 	double pdf_l = pdf / (double)w->nemitters;
 	double weight = power_weight(pdf_l, bsdf_pdf(b, wi));
-	return v3_mul(f, v3_scale(w->mats[e->object].emission, cos_i * weight / pdf_l));
+	return v3_mul(f, v3_scale(w->mats[e->mat].emission, cos_i * weight / pdf_l));
 }
 
 /* Next-event estimation toward the sky from p (pdn below the surface, for a
@@ -193,7 +194,7 @@ vec3 path_radiance_first(const world *w, const render_settings *s, ray r, sample
 			thr = v3_mul(thr, v3(exp(-sigma.x * h.t), exp(-sigma.y * h.t), exp(-sigma.z * h.t)));
 		const mat_lin *m = &w->mats[h.mat];
 		if (m->light >= 0 && from_pdf > 0.0) {
-			double pdf_l = emitter_pdf(&w->emitters[m->light], from, r.d, h.t) /
+			double pdf_l = emitter_pdf(emitter_at(w, m->light, h.p), from, r.d, h.t) /
 			               (double)w->nemitters;
 			radiance = v3_add(radiance, v3_mul(thr, v3_scale(m->emission,
 			                                                 power_weight(from_pdf, pdf_l))));
@@ -252,3 +253,13 @@ vec3 path_radiance_first(const world *w, const render_settings *s, ray r, sample
 	}
 	return radiance;
 }
+
+static vec3 path_camera_first(const world *w, const render_settings *s, ray r, sampler *g, bool found,
+                              const hit *h, uint32_t known, uint32_t blocked)
+{
+	(void)known, (void)blocked;
+	return path_radiance_first(w, s, r, g, found, h);
+}
+
+/* Path mode samples every pixel and gives the denoiser its features. */
+const integrator path_integrator = {path_radiance, path_camera_first, NULL, true, true};

@@ -80,6 +80,9 @@ const rt_key rt_keys[] = {
 	 RT_KEY_NUM, true},
 	{"crease", offsetof(object, crease), false, false, 0, false, 0, 180, 60, NULL,
 	 "crease in degrees, [0,180]", "mesh: edges sharper than this stay sharp, degrees", RT_KEY_NUM, true},
+	{"node", offsetof(object, node), true, false, 0, false, 0, 16777215, -1, NULL,
+	 "node an index into the glTF file's nodes", "mesh: one node of a glTF file alone (its index)", RT_KEY_NUM,
+	 true},
 };
 const size_t rt_nkeys = sizeof rt_keys / sizeof rt_keys[0];
 
