@@ -43,8 +43,8 @@ ray cam_ray(const cam_view *c, double fx, double fy, int w, int h)
 
 /* The sampler is left positioned after the two dimensions that place the
  * sample in its pixel. */
-ray camera_sample_ray(const world *w, const render_settings *s, int px, int py, int fw, int fh, int sample,
-                      sampler *sp)
+ray camera_sample_ray(const world *w, const render_settings *s, bool sampled, int px, int py, int fw, int fh,
+                      int sample, sampler *sp)
 {
 	uint64_t pixel = (uint64_t)py * (uint64_t)fw + (uint64_t)px;
 	double u = 0.5, v = 0.5;
@@ -53,18 +53,11 @@ ray camera_sample_ray(const world *w, const render_settings *s, int px, int py, 
 	 * Every pixel has its own scrambles, the same for all its samples, so
 	 * that its first 2^k positions are stratified (sampler.h). */
 	*sp = (sampler){0, 0, 0, 0};
-	if (s->samples > 1 || s->mode == MODE_PATH) {
+	if (s->samples > 1 || sampled) {
 		*sp = sampler_for(s->seed, pixel, (uint32_t)sample);
 		if (s->samples > 1)
 			samp_2d(sp, &u, &v);
 		sp->dim = 2;
 	}
 	return cam_ray(&w->cam, px + u, py + v, fw, fh);
-}
-
-ray render_sample_ray(const world *w, const render_settings *s, int px, int py, int fw, int fh,
-                      int sample)
-{
-	sampler sp;
-	return camera_sample_ray(w, s, px, py, fw, fh, sample, &sp);
 }

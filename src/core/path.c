@@ -253,3 +253,13 @@ vec3 path_radiance_first(const world *w, const render_settings *s, ray r, sample
 	}
 	return radiance;
 }
+
+static vec3 path_camera_first(const world *w, const render_settings *s, ray r, sampler *g, bool found,
+                              const hit *h, uint32_t known, uint32_t blocked)
+{
+	(void)known, (void)blocked;
+	return path_radiance_first(w, s, r, g, found, h);
+}
+
+/* Path mode samples every pixel and gives the denoiser its features. */
+const integrator path_integrator = {path_radiance, path_camera_first, NULL, true, true};

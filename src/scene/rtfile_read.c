@@ -723,13 +723,16 @@ static bool parse_set(parser *p, const elem_def *e)
 			hn->depth = (int)d;
 		break;
 	case 2: {
-		int m;
-		if (strcmp(v->s, "whitted") == 0)
-			m = MODE_WHITTED;
-		else if (strcmp(v->s, "path") == 0)
-			m = MODE_PATH;
-		else
-			return fail_tok(p, v, "set", "mode", "is unknown", "whitted or path");
+		int m = 0; /* the integrators' names (integrators.def) */
+		while (m < MODE_COUNT && strcmp(v->s, render_mode_names[m]) != 0)
+			m++;
+		if (m == MODE_COUNT) {
+			char names[256] = "";
+			for (int j = 0; j < MODE_COUNT; j++)
+				snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s",
+				         j == 0 ? "" : j == MODE_COUNT - 1 ? " or " : ", ", render_mode_names[j]);
+			return fail_tok(p, v, "set", "mode", "is unknown", names);
+		}
 		r = once(p, e, "set mode", &p->line_set[2], hn->mode == m);
 		if (r > 0)
 			hn->mode = m;

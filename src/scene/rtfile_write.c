@@ -362,8 +362,8 @@ static void write_scene(const scene *s, FILE *f)
 		fprintf(f, "set samples %d\n", h->samples);
 	if (h->depth >= 0)
 		fprintf(f, "set depth %d\n", h->depth);
-	if (h->mode == MODE_WHITTED || h->mode == MODE_PATH)
-		fprintf(f, "set mode %s\n", h->mode == MODE_PATH ? "path" : "whitted");
+	if (h->mode >= 0 && h->mode < MODE_COUNT)
+		fprintf(f, "set mode %s\n", render_mode_name((render_mode)h->mode));
 	if (s->has_ambient) {
 		sb_put(&b, "A");
 		sb_field(&b, s->amb.ratio);
