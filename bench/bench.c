@@ -361,13 +361,32 @@ static double primary_pass(const world *wd, int w, int h, bool brute, long *hits
 	return now() - t0;
 }
 
+/* primary_pass's rays and hit records traced as packets of 4x4 pixels
+ * (world_intersect_packet, packet.h): the same hits. */
+static double primary_packet_pass(const world *wd, int w, int h)
+{
+	double t0 = now();
+	for (int y0 = 0; y0 < h; y0 += 4)
+		for (int x0 = 0; x0 < w; x0 += 4) {
+			ray r[PACKET_MAX];
+			hit hh[PACKET_MAX];
+			bool found[PACKET_MAX];
+			int n = 0;
+			for (int y = y0; y < y0 + 4 && y < h; y++)
+				for (int x = x0; x < x0 + 4 && x < w; x++)
+					r[n++] = cam_ray(&wd->cam, x + 0.5, y + 0.5, w, h);
+			world_intersect_packet(wd, n, r, 0.0, INFINITY, hh, found);
+		}
+	return now() - t0;
+}
+
 static void bench_primary(void)
 {
 	const char *path = "scenes/grid.rt";
 	int w = quick ? 320 : 1920, h = quick ? 180 : 1080;
 	scene *s = load(path);
 	world *wd = build(s);
-	double t[MAX_RUNS], tb[MAX_RUNS], te[MAX_RUNS], em[MAX_RUNS];
+	double t[MAX_RUNS], tb[MAX_RUNS], tp[MAX_RUNS], te[MAX_RUNS], em[MAX_RUNS];
 	double pkm[EMBREE_PACKETS][MAX_RUNS], pks[EMBREE_PACKETS][MAX_RUNS];
 	int ne = 0, npk[EMBREE_PACKETS] = {0};
 	long hits;
@@ -375,6 +394,7 @@ static void bench_primary(void)
 	for (int i = 0; i < runs; i++) {
 		t[i] = primary_pass(wd, w, h, false, &hits);
 		tb[i] = primary_pass(wd, w, h, true, &hits);
+		tp[i] = primary_packet_pass(wd, w, h);
 		double sec = 0, pm[EMBREE_PACKETS], ps[EMBREE_PACKETS];
 		double m = quick ? -1 : run_embree(path, w, h, &sec, pm, ps);
 		if (m > 0) {
@@ -393,6 +413,16 @@ static void bench_primary(void)
 	snprintf(r->note, sizeof r->note, "camera rays only, %.0f%% hit", 100.0 * (double)hits / ((double)w * h));
 	r = add_row("grid.rt", "primary-brute", w, h, 1, 1, runs, mb, rays / mb);
 	snprintf(r->note, sizeof r->note, "every primitive tested");
+	double mp = median(tp, runs), best = -1;
+	for (int k = 0; k < EMBREE_PACKETS; k++)
+		if (npk[k] && median(pkm[k], npk[k]) > best)
+			best = median(pkm[k], npk[k]);
+	r = add_row("grid.rt", "primary-packet16", w, h, 1, 1, runs, mp, rays / mp);
+	if (best > 0)
+		snprintf(r->note, sizeof r->note, "world_intersect_packet, 4x4 pixels: %.2fx primary, %.2fx Embree's best packet call",
+		         m / mp, (rays / mp) / best);
+	else
+		snprintf(r->note, sizeof r->note, "world_intersect_packet, 4x4 pixels: %.2fx primary", m / mp);
 	if (ne) {
 		double me = median(em, ne), se = median(te, ne);
 		r = add_row("grid.rt", "embree-primary", w, h, 1, 1, ne, se, me);

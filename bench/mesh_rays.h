@@ -17,7 +17,7 @@ static inline camera bench_mesh_camera(box b)
 	double r = 0.5 * v3_len(e), fov = 40;
 	vec3 dir = v3_norm(v3(-0.45, -0.3, -1));
 	double dist = 0.8 * r / sin(atan(tan(fov * RT_PI / 360) * 9.0 / 16.0));
-	return (camera){v3_sub(c, v3_scale(dir, dist)), dir, fov, false, 0};
+	return (camera){v3_sub(c, v3_scale(dir, dist)), dir, fov, false, 0, 0};
 }
 
 static inline uint64_t bench_mix(uint64_t z)

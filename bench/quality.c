@@ -134,7 +134,7 @@ static unsigned char *edge_mask(const world *w, int fw, int fh)
 			ray r = cam_ray(&w->cam, x + 0.5, y + 0.5, fw, fh);
 			hit h;
 			bool hit_it = world_intersect(w, &r, 0.0, INFINITY, &h);
-			vec3 e = hit_it ? w->mats[h.object].emission : v3(1, 1, 1);
+			vec3 e = hit_it ? w->mats[h.mat].emission : v3(1, 1, 1);
 			em[y * fw + x] = e.x > 0 || e.y > 0 || e.z > 0;
 		}
 	for (int y = 0; y < fh; y++)
@@ -187,6 +187,8 @@ static double mean(const framebuffer *fb)
 /* --- rtsh against Cycles ---------------------------------------------------- */
 
 #define NSPP 3
+/* the glTF row's references (both renderers) */
+#define GLTF_REF 2048
 static const int spps[NSPP] = {16, 64, 256};
 
 static bool have_blender(void)
@@ -196,14 +198,18 @@ static bool have_blender(void)
 
 /* Runs bench/cycles_scene.py; fills secs[] for spps (< 0 when missing) and
  * writes QDIR/NAME-cycles-SPP.pfm. */
-static bool run_cycles(const char *path, const char *name, int w, int h, int threads, int seed,
-                       const char *tag, const int *spp, int n, double *secs)
+static bool run_cycles(const char *path, const char *blend, int depth, const char *name, int w, int h,
+                       int threads, int seed, const char *tag, const int *spp, int n, double *secs)
 {
 	char cmd[1024];
-	int len = snprintf(cmd, sizeof cmd,
-	                   "blender -b --factory-startup -P bench/cycles_scene.py -- %s %dx%d %d %d "
-	                   QDIR "/%s-%s",
-	                   path, w, h, threads, seed, name, tag);
+	int len = blend ? snprintf(cmd, sizeof cmd,
+	                           "blender -b --factory-startup %s -P bench/gltf_scene.py -- render "
+	                           "%dx%d %d %d %d " QDIR "/%s-%s",
+	                           blend, w, h, threads, seed, depth, name, tag)
+	                : snprintf(cmd, sizeof cmd,
+	                           "blender -b --factory-startup -P bench/cycles_scene.py -- %s %dx%d %d %d "
+	                           QDIR "/%s-%s",
+	                           path, w, h, threads, seed, name, tag);
 	for (int i = 0; i < n; i++)
 		len += snprintf(cmd + len, sizeof cmd - (size_t)len, " %d", spp[i]);
 	snprintf(cmd + len, sizeof cmd - (size_t)len, " 2>&1");
@@ -220,7 +226,7 @@ static bool run_cycles(const char *path, const char *name, int w, int h, int thr
 			for (int i = 0; i < n; i++)
 				if (spp[i] == s)
 					secs[i] = t;
-		} else if (strstr(line, "cycles_scene.py:") || strstr(line, "Error")) {
+		} else if (strstr(line, "_scene.py:") || strstr(line, "Error")) {
 			fprintf(stderr, "quality: blender: %s", line);
 		}
 	}
@@ -228,9 +234,11 @@ static bool run_cycles(const char *path, const char *name, int w, int h, int thr
 	return rc == 0;
 }
 
-/* The object each pixel shows whole: the camera rays through its centre
- * and its four corners meet the same object (else -1). */
-static int *object_mask(const world *w, int fw, int fh)
+/* The object (by_mat: the material, which tells the parts of a glTF file
+ * read as one object apart) each pixel shows whole: the camera rays through
+ * its centre and its four corners meet the same object (else -1). mat[k]
+ * (nmat entries) gets the material object k shows. */
+static int *object_mask(const world *w, int fw, int fh, bool by_mat, uint32_t *mat, size_t nmat)
 {
 	int *id = malloc(sizeof *id * (size_t)fw * fh);
 	if (!id)
@@ -242,7 +250,9 @@ static int *object_mask(const world *w, int fw, int fh)
 			for (int k = 0; k < 5 && o != -1; k++) {
 				ray r = cam_ray(&w->cam, x + off[k][0], y + off[k][1], fw, fh);
 				hit h;
-				int ok = world_intersect(w, &r, 0.0, INFINITY, &h) ? (int)h.object : -1;
+				int ok = world_intersect(w, &r, 0.0, INFINITY, &h) ? (int)(by_mat ? h.mat : h.object) : -1;
+				if (ok >= 0 && (size_t)ok < nmat)
+					mat[ok] = h.mat;
 				o = o == -2 || o == ok ? ok : -1;
 			}
 			id[y * fw + x] = o;
@@ -275,6 +285,19 @@ static void object_label(const object *o, char *buf, size_t n)
 		         p->roughness >= 0 ? p->roughness : 1.0);
 }
 
+/* A short name for world material k (a glTF file's). */
+static void mat_label(const mat_lin *m, char *buf, size_t n)
+{
+	if (m->emission.x > 0 || m->emission.y > 0 || m->emission.z > 0)
+		snprintf(buf, n, "lamp");
+	else if (m->family != MAT_PBR)
+		snprintf(buf, n, "phong");
+	else
+		snprintf(buf, n, "%s r=%.2f",
+		         m->pbr.metallic >= 0.5f ? "metal" : m->pbr.transmission >= 0.5f ? "glass" : "plastic",
+		         (double)m->pbr.roughness);
+}
+
 /* Per object: the mean radiance of rtsh's and Cycles' references and of
  * their renders at spp samples, and Cycles' own error at spp against its
  * reference (the noise to compare rtsh's difference with). */
@@ -285,18 +308,26 @@ static void objects_against_cycles(const scene *s, const world *w, const framebu
 	snprintf(cpath, sizeof cpath, QDIR "/%s-cycles-%d.pfm", name, spp);
 	rt_error err;
 	framebuffer *cfb = image_read_pfm(cpath, &err);
-	int *id = object_mask(w, W, H);
+	bool by_mat = s->nobjs == 1; /* one glTF file: its materials */
+	size_t nk = by_mat ? w->nmats : s->nobjs;
+	uint32_t *mat = calloc(nk ? nk : 1, sizeof *mat);
+	if (!mat)
+		die("memory", NULL);
+	int *id = object_mask(w, W, H, by_mat, mat, nk);
 	printf("per object, whole pixels only: mean radiance of rtsh / Cycles (references), and at %d spp\n", spp);
 	printf("%4s %-16s %6s %9s %9s %7s %7s %9s\n", "obj", "material", "pixels", "rtsh ref", "cyc ref", "ratio",
 	       "ratio@", "cyc err@");
-	for (size_t k = 0; k < s->nobjs; k++) {
+	for (size_t k = 0; k < nk; k++) {
 		long n;
 		double a = object_mean(ref, id, (int)k, &n), b = object_mean(cref, id, (int)k, &n);
 		if (n < 20)
 			continue;
 		double a1 = object_mean(fb, id, (int)k, &n), b1 = cfb ? object_mean(cfb, id, (int)k, &n) : -1;
 		char label[32];
-		object_label(&s->objs[k], label, sizeof label);
+		if (by_mat || (obj_kind_flags(s->objs[k].kind) & KIND_MODEL)) /* a glTF node: its material */
+			mat_label(&w->mats[mat[k]], label, sizeof label);
+		else
+			object_label(&s->objs[k], label, sizeof label);
 		printf("%4zu %-16s %6ld %9.5f %9.5f %7.4f %7.4f %9.4f\n", k, label, n, a, b, a / b, cfb ? a1 / b1 : -1,
 		       cfb ? b1 / b - 1 : -1);
 		if (tsv)
@@ -304,14 +335,19 @@ static void objects_against_cycles(const scene *s, const world *w, const framebu
 			        cfb ? a1 / b1 : -1, cfb ? b1 / b - 1 : -1);
 	}
 	free(id);
+	free(mat);
 	fb_free(cfb);
 }
 
-static void bench_cycles_scene(const char *path, const char *name, int W, int H, int REF, bool objects,
-                               bool cycles)
+/* path: the scene rtsh renders; blend: NULL (bench/cycles_scene.py
+ * rebuilds the .rt in Cycles) or the .blend that Cycles renders (the glTF
+ * row: path is its export); depth: 0 = the scene's. */
+static void bench_cycles_scene(const char *path, const char *blend, int depth, const char *name, int W, int H,
+                               int REF, bool objects, bool cycles)
 {
 	scene *s = load(path);
-	int depth = s->hints.depth >= 0 ? s->hints.depth : 5;
+	if (depth <= 0)
+		depth = s->hints.depth >= 0 ? s->hints.depth : 5;
 	rt_error err;
 	world *w = world_build(s, &err);
 	if (!w)
@@ -337,12 +373,12 @@ static void bench_cycles_scene(const char *path, const char *name, int W, int H,
 			fprintf(stderr, "quality: rendering the Cycles reference %s (once; minutes)\n", cpath);
 			double t;
 			const int one = REF;
-			if (!run_cycles(path, name, W, H, 2, 4242, "cycles-ref", &one, 1, &t))
+			if (!run_cycles(path, blend, depth, name, W, H, 2, 4242, "cycles-ref", &one, 1, &t))
 				why = "blender failed on the reference";
 		}
 		if (!why && !(cref = image_read_pfm(cpath, &err)))
 			why = "no Cycles reference";
-		if (!why && !run_cycles(path, name, W, H, 1, 7, "cycles", spps, NSPP, csec))
+		if (!why && !run_cycles(path, blend, depth, name, W, H, 1, 7, "cycles", spps, NSPP, csec))
 			why = "blender failed";
 	}
 	printf("\n%s, %dx%d, depth %d, one thread, against each renderer's own %d-sample reference\n",
@@ -393,6 +429,31 @@ static void bench_cycles_scene(const char *path, const char *name, int W, int H,
 	fb_free(ref);
 	world_free(w);
 	scene_free(s);
+}
+
+/* The glTF row (issue 26): bench/gltf_scene.py builds the scene in Blender
+ * and exports it with Blender's glTF exporter (once, kept in QDIR); rtsh
+ * renders the .glb from its own camera and lamp, Cycles the .blend. */
+static void bench_gltf(bool cycles)
+{
+	const char *glb = QDIR "/pbr-gltf.glb", *blend = QDIR "/pbr-gltf.blend";
+	if (!exists(glb) || !exists(blend)) {
+		if (!cycles || !have_blender()) {
+			printf("\npbr-gltf: skipped (%s); the scene is built by Blender\n",
+			       cycles ? "blender is not installed" : "--no-cycles");
+			return;
+		}
+		fprintf(stderr, "quality: building %s in Blender (once)\n", glb);
+		if (system("blender -b --factory-startup -P bench/gltf_scene.py -- build " QDIR
+		           "/pbr-gltf >" QDIR "/pbr-gltf-build.log 2>&1") != 0 ||
+		    !exists(glb)) {
+			printf("\npbr-gltf: Blender could not build or export the scene (%s; the exporter needs "
+			       "python3-numpy)\n",
+			       QDIR "/pbr-gltf-build.log");
+			return;
+		}
+	}
+	bench_cycles_scene(glb, blend, 8, "pbr-gltf", 192, 108, GLTF_REF, true, cycles);
 }
 
 /* --- the progressive preview ------------------------------------------------ */
@@ -653,11 +714,13 @@ int main(int argc, char **argv)
 		die(out, NULL);
 	if (!only || strcmp(only, "cycles") == 0) {
 		if (!one || strcmp(one, "cornell") == 0)
-			bench_cycles_scene("scenes/cornell.rt", "cornell", 256, 256, 4096, false, cycles);
+			bench_cycles_scene("scenes/cornell.rt", NULL, 0, "cornell", 256, 256, 4096, false, cycles);
 		if (!one || strcmp(one, "glass-sky") == 0)
-			bench_cycles_scene("bench/glass-sky.rt", "glass-sky", 128, 128, 4096, false, cycles);
+			bench_cycles_scene("bench/glass-sky.rt", NULL, 0, "glass-sky", 128, 128, 4096, false, cycles);
 		if (!one || strcmp(one, "pbr") == 0)
-			bench_cycles_scene("bench/pbr-spheres.rt", "pbr", 192, 108, 2048, true, cycles);
+			bench_cycles_scene("bench/pbr-spheres.rt", NULL, 0, "pbr", 192, 108, 2048, true, cycles);
+		if (!one || strcmp(one, "gltf") == 0)
+			bench_gltf(cycles);
 	}
 	if (!only || strcmp(only, "preview") == 0)
 		bench_preview();

@@ -44,6 +44,8 @@ typedef struct gltf_info {
 	gltf_light *lights;
 	size_t nlights;
 	bool emissive;      /* a material of a mesh the scene places emits */
+	long *mesh_nodes;   /* the nodes with a mesh the scene places, in walk order */
+	size_t nmesh_nodes;
 } gltf_info;
 
 /* Reads the cameras and lights of a .gltf or .glb; false (err set) when the

@@ -55,6 +55,7 @@ typedef struct mesh_mat {
 	float specular_color[3]; /* ... specularColorFactor (1,1,1) */
 	char *map_mr, *map_emit;             /* metallic-roughness, emissive textures */
 	struct texture *tex_mr, *tex_emit;   /* ... embedded */
+	float uvx[2];         /* ... its rotation's cross terms: u' += uvx[0] v, v' += uvx[1] u */
 	float uvs[2], uvo[2]; /* KHR_texture_transform of the base colour texture, in
 	                       * rtsh's uv (v up): uv x uvs + uvo; (1,1), (0,0) */
 } mesh_mat;
@@ -130,6 +131,11 @@ mesh *mesh_read_obj(const char *path, rt_error *err);
 mesh *mesh_read_ply(const char *path, rt_error *err);
 mesh *mesh_read_assimp(const char *path, rt_error *err);
 mesh *mesh_read_gltf(const char *path, rt_error *err);
+/* Only the triangles of node `node` (an index into the file's nodes, placed
+ * by its scene) with the node's whole transform, all the file's materials:
+ * a glTF node as an object of its own. node < 0: the whole scene. */
+mesh *mesh_read_gltf_node(const char *path, long node, rt_error *err);
+mesh *mesh_parse_gltf_node(const char *name, const char *dir, const char *buf, size_t len, long node, rt_error *err);
 /* The same readers on a buffer, `name` used in messages (fuzzing, tests). */
 mesh *mesh_parse_obj(const char *name, const char *dir, const char *buf, size_t len, rt_error *err);
 mesh *mesh_parse_ply(const char *name, const char *buf, size_t len, rt_error *err);
@@ -166,6 +172,10 @@ size_t mesh_memory(const mesh *m);
  * and file version (size and mtime): loaded once. mesh_cache_put releases
  * one reference. Thread-safe. */
 mesh *mesh_cache_get(const char *path, bool smooth, double crease_deg, const atomic_bool *cancel, rt_error *err);
+/* The same for node `node` of a glTF file (mesh_read_gltf_node); node < 0:
+ * the whole file (mesh_cache_get). */
+mesh *mesh_cache_get_node(const char *path, long node, bool smooth, double crease_deg, const atomic_bool *cancel,
+                          rt_error *err);
 void mesh_cache_put(mesh *m);
 
 /* --- the builder the readers share --- */

@@ -17,12 +17,18 @@
 #include "rtsh/error.h"
 #include "rtsh/world.h"
 
+/* The integrators (integrators.def): MODE_WHITTED, MODE_PATH, ... */
 typedef enum render_mode {
-	MODE_WHITTED,
-	MODE_PATH,
+#define RT_INTEGRATOR(e, name, desc) MODE_##e,
+#include "rtsh/integrators.def"
+#undef RT_INTEGRATOR
+	MODE_COUNT
 } render_mode;
 
+/* The integrator's name, the `mode` setting's value ("whitted"). */
 const char *render_mode_name(render_mode m);
+/* The names, NULL-terminated (the `mode` setting's values). */
+extern const char *const render_mode_names[MODE_COUNT + 1];
 
 /* When path-mode images are denoised (denoise.h). */
 typedef enum denoise_mode {
@@ -42,6 +48,9 @@ typedef struct render_settings {
 	uint64_t seed;
 	double exposure;   /* stops; output = radiance x 2^exposure */
 	int denoise;       /* denoise_mode */
+	/* The terminal's choices (SETTING_TERMINAL rows): `set` keeps them here
+	 * beside the rest, but no renderer reads them and rtsh-mpi's wire
+	 * leaves them out. */
 	int pixels;        /* the shell's picture: off (half blocks), kitty, sixel,
 	                    * iterm, auto (term/pixels.h, pixels_mode) */
 	int symbols;       /* the cells' glyphs when not in real pixels: half,

@@ -139,6 +139,7 @@ typedef struct object {
 	bool file_colors;
 	int smooth;       /* smooth= 0 flat faces, 1 smooth normals (1) */
 	double crease;    /* crease= degrees beyond which an edge stays sharp (60) */
+	int node;         /* node= a glTF file's node alone (its index), -1 the whole file */
 } object;
 
 /* The kinds of light: the miniRT light (no fall-off, `ratio` x colour),
@@ -168,6 +169,8 @@ typedef struct camera {
 	bool vertical; /* vertical=1: fov is the vertical angle (glTF's yfov) */
 	double ortho;  /* ortho=H > 0: an orthographic view H high above and below
 	                * the centre (glTF's ymag); 0: perspective */
+	double roll;   /* roll=DEG: the camera turned about its axis, its up
+	                * towards its right (glTF cameras); 0: upright */
 } camera;
 
 typedef struct ambient {

@@ -22,6 +22,9 @@ typedef enum setting_type {
 /* setting_def.flags */
 enum {
 	SETTING_BARE_ON = 1, /* the command line's --NAME alone means --NAME=on */
+	SETTING_TERMINAL = 2, /* the terminal's choice (pixels, symbols): the render
+	                       * core never reads it, and rtsh-mpi's wire leaves
+	                       * it out */
 };
 
 /* One setting: adding one is a field in render_settings (render.h) and a

@@ -4,6 +4,7 @@
 #ifndef RTSH_SRGB_H
 #define RTSH_SRGB_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "rtsh/math.h"
@@ -21,5 +22,8 @@ vec3 linear_to_srgb255(vec3 c);
 /* Linear [0,1] to 8-bit sRGB, rounded, clamped; exact inverse of srgb8_to_linear
  * on the 256 codes. */
 uint8_t linear_to_srgb8(double v);
+/* out[i] = linear_to_srgb8(in[i] * gain) for i < n: the same codes, without
+ * a call per value (image files, and render tiles as they finish). */
+void linear_to_srgb8_n(const float *in, double gain, uint8_t *out, size_t n);
 
 #endif

@@ -13,97 +13,72 @@
 
 static bool is_digit(char c) { return c >= '0' && c <= '9'; }
 
-/* The end of the decimal number that starts at s, or NULL if none does. */
-static const char *scan_decimal(const char *s, const char *end)
-{
-	const char *q = s;
-	if (q < end && (*q == '+' || *q == '-'))
-		q++;
-	size_t ndig = 0;
-	while (q < end && is_digit(*q)) {
-		q++;
-		ndig++;
-	}
-	if (q < end && *q == '.') {
-		q++;
-		while (q < end && is_digit(*q)) {
-			q++;
-			ndig++;
-		}
-	}
-	if (ndig == 0)
-		return NULL;
-	if (q < end && (*q == 'e' || *q == 'E')) {
-		q++;
-		if (q < end && (*q == '+' || *q == '-'))
-			q++;
-		const char *e0 = q;
-		while (q < end && is_digit(*q))
-			q++;
-		if (q == e0)
-			return NULL;
-	}
-	return q;
-}
-
 /* Exactly representable powers of ten: 10^22 < 2^53 * 2^22 is the last whose
  * odd part (5^22 < 2^53) fits a double's 53 bits. */
 static const double exact_pow10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
                                        1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
                                        1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
 
-/* The value of a decimal that scan_decimal accepted, when it can be had
- * exactly without strtod: at most 15 significant digits m (so m < 2^53 is
- * an exact double) and a decimal exponent e with |e| <= 22 (so 10^|e| is
- * exact); then m * 10^e or m / 10^-e is one correctly rounded IEEE
- * operation, the same double strtod gives (Clinger, "How to read floating
- * point numbers accurately", PLDI 1990: the fast path). False otherwise:
- * the caller asks strtod. */
-static bool decimal_fast(const char *s, const char *end, double *out)
+/* Reads the decimal s[0..end) of num.h's grammar in one pass: -1 when it
+ * is not one; 1 with its value in *out when that can be had exactly without
+ * strtod: at most 15 significant digits m (so m < 2^53 is an exact double)
+ * and a decimal exponent e with |e| <= 22 (so 10^|e| is exact), when m *
+ * 10^e or m / 10^-e is one correctly rounded IEEE operation, the same
+ * double strtod gives (Clinger, "How to read floating point numbers
+ * accurately", PLDI 1990: the fast path); 0 when strtod must read it. */
+static int decimal_read(const char *s, const char *end, double *out)
 {
 	const char *q = s;
-	bool neg = false;
-	if (*q == '+' || *q == '-')
+	bool neg = false, slow = false;
+	if (q < end && (*q == '+' || *q == '-'))
 		neg = *q++ == '-';
 	uint64_t m = 0;
-	int digits = 0, exp10 = 0;
-	for (; q < end && is_digit(*q); q++) {
-		if (digits || *q != '0') { /* leading zeros are not significant */
-			if (++digits > 15)
-				return false;
-			m = m * 10 + (uint64_t)(*q - '0');
-		}
-	}
-	if (q < end && *q == '.')
-		for (q++; q < end && is_digit(*q); q++) {
-			exp10--;
-			if (digits || *q != '0') {
-				if (++digits > 15)
-					return false;
+	int ndig = 0, sig = 0, exp10 = 0;
+	for (; q < end && is_digit(*q); q++, ndig++)
+		if (sig || *q != '0') { /* leading zeros are not significant */
+			if (++sig > 15)
+				slow = true;
+			else
 				m = m * 10 + (uint64_t)(*q - '0');
+		}
+	if (q < end && *q == '.')
+		for (q++; q < end && is_digit(*q); q++, ndig++) {
+			exp10--;
+			if (sig || *q != '0') {
+				if (++sig > 15)
+					slow = true;
+				else
+					m = m * 10 + (uint64_t)(*q - '0');
 			}
 		}
-	if (q < end) { /* the exponent: (e|E) [+-] DIGITS */
+	if (ndig == 0)
+		return -1;
+	if (q < end && (*q == 'e' || *q == 'E')) {
 		q++;
 		bool eneg = false;
-		if (*q == '+' || *q == '-')
+		if (q < end && (*q == '+' || *q == '-'))
 			eneg = *q++ == '-';
+		const char *e0 = q;
 		int e = 0;
-		for (; q < end; q++) {
-			if (e > 1000)
-				return false; /* far outside the fast path (and no overflow) */
-			e = e * 10 + (*q - '0');
-		}
+		for (; q < end && is_digit(*q); q++)
+			if (e <= 1000) /* far outside the fast path: no overflow */
+				e = e * 10 + (*q - '0');
+		if (q == e0)
+			return -1;
+		if (e > 1000)
+			slow = true;
 		exp10 += eneg ? -e : e;
 	}
-	if (m == 0)
+	if (q != end)
+		return -1;
+	if (m == 0 && !slow)
 		exp10 = 0; /* zero whatever the exponent */
-	if (exp10 < -22 || exp10 > 22)
-		return false;
+	if (slow || exp10 < -22 || exp10 > 22)
+		return 0;
 	double v = (double)m;
 	v = exp10 >= 0 ? v * exact_pow10[exp10] : v / exact_pow10[-exp10];
 	*out = neg ? -v : v;
-	return true;
+	return 1;
 }
 
 static locale_t c_locale;
@@ -118,10 +93,11 @@ num_status num_scan(const char *s, size_t len, double max, double *out)
 {
 	if (len == 0)
 		return NUM_EMPTY;
-	if (scan_decimal(s, s + len) != s + len)
-		return NUM_BAD;
 	double fast;
-	if (decimal_fast(s, s + len, &fast)) {
+	int got = decimal_read(s, s + len, &fast);
+	if (got < 0)
+		return NUM_BAD;
+	if (got > 0) {
 		if (!(fabs(fast) <= max))
 			return NUM_BIG;
 		*out = fast;

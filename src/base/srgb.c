@@ -74,6 +74,15 @@ static void srgb_tables(void)
 	}
 }
 
+/* The code of v in (0, 1), the tables made. */
+static inline uint8_t srgb8_of(double v)
+{
+	int code = srgb_bucket[(int)(v * SRGB_BUCKETS)];
+	while (v >= srgb_threshold[code + 1])
+		code++;
+	return (uint8_t)code;
+}
+
 uint8_t linear_to_srgb8(double v)
 {
 	if (!(v > 0.0))
@@ -81,8 +90,14 @@ uint8_t linear_to_srgb8(double v)
 	if (v >= 1.0)
 		return 255;
 	pthread_once(&srgb_once, srgb_tables);
-	int code = srgb_bucket[(int)(v * SRGB_BUCKETS)];
-	while (v >= srgb_threshold[code + 1])
-		code++;
-	return (uint8_t)code;
+	return srgb8_of(v);
+}
+
+void linear_to_srgb8_n(const float *in, double gain, uint8_t *out, size_t n)
+{
+	pthread_once(&srgb_once, srgb_tables);
+	for (size_t i = 0; i < n; i++) {
+		double v = in[i] * gain; /* linear_to_srgb8(in[i] * gain), inline */
+		out[i] = !(v > 0.0) ? 0 : v >= 1.0 ? 255 : srgb8_of(v);
+	}
 }

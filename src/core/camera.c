@@ -12,6 +12,12 @@ cam_view cam_view_make(const camera *c)
 	vec3 up_ref = fabs(v.fwd.y) > 0.999999 ? v3(0, 0, 1) : v3(0, 1, 0);
 	v.right = v3_norm(v3_cross(up_ref, v.fwd));
 	v.up = v3_cross(v.fwd, v.right);
+	if (c->roll != 0) { /* the up turned towards the right by roll degrees */
+		double a = deg_to_rad(c->roll), ca = cos(a), sa = sin(a);
+		vec3 r = v.right, u = v.up;
+		v.up = v3_add(v3_scale(u, ca), v3_scale(r, sa));
+		v.right = v3_sub(v3_scale(r, ca), v3_scale(u, sa));
+	}
 	double fov = clampd(c->fov, 0.01, 179.99);
 	v.tan_half = tan(deg_to_rad(fov) * 0.5);
 	v.vertical = c->vertical;
@@ -37,8 +43,8 @@ ray cam_ray(const cam_view *c, double fx, double fy, int w, int h)
 
 /* The sampler is left positioned after the two dimensions that place the
  * sample in its pixel. */
-ray camera_sample_ray(const world *w, const render_settings *s, int px, int py, int fw, int fh, int sample,
-                      sampler *sp)
+ray camera_sample_ray(const world *w, const render_settings *s, bool sampled, int px, int py, int fw, int fh,
+                      int sample, sampler *sp)
 {
 	uint64_t pixel = (uint64_t)py * (uint64_t)fw + (uint64_t)px;
 	double u = 0.5, v = 0.5;
@@ -47,18 +53,11 @@ ray camera_sample_ray(const world *w, const render_settings *s, int px, int py, 
 	 * Every pixel has its own scrambles, the same for all its samples, so
 	 * that its first 2^k positions are stratified (sampler.h). */
 	*sp = (sampler){0, 0, 0, 0};
-	if (s->samples > 1 || s->mode == MODE_PATH) {
+	if (s->samples > 1 || sampled) {
 		*sp = sampler_for(s->seed, pixel, (uint32_t)sample);
 		if (s->samples > 1)
 			samp_2d(sp, &u, &v);
 		sp->dim = 2;
 	}
 	return cam_ray(&w->cam, px + u, py + v, fw, fh);
-}
-
-ray render_sample_ray(const world *w, const render_settings *s, int px, int py, int fw, int fh,
-                      int sample)
-{
-	sampler sp;
-	return camera_sample_ray(w, s, px, py, fw, fh, sample, &sp);
 }

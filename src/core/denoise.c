@@ -87,7 +87,7 @@ static double direct_feature(const world *w, const bsdf *b, vec3 p, uint32_t sel
 			ray sr = {p, wi};
 			if (lum_d(f) <= 0.0 || world_occluded(w, &sr, 0.0, t * (1.0 - 1e-7)))
 				continue;
-			part += lum_d(v3_mul(f, w->mats[e->object].emission)) * c / pdf;
+			part += lum_d(v3_mul(f, w->mats[e->mat].emission)) * c / pdf;
 		}
 		sum += part * 0.25 * (double)ne / (double)pick;
 	}

@@ -16,8 +16,11 @@
 /* An emissive object the path tracer samples directly: one whose kind
  * can (shape.h, shape_light_ops). */
 struct emitter {
-	uint32_t object; /* the scene object */
+	uint32_t object; /* the scene object (UINT32_MAX: a model's triangle) */
 	uint32_t kind;   /* its obj_kind, whose light ops sample it */
+	uint32_t mat;    /* its material in world.mats */
+	uint32_t run;    /* the first emitter of a material: the emitters of that
+	                  * material from here (a model's triangles); else 1 */
 	shape_light l;   /* its geometry in world space */
 };
 
@@ -26,6 +29,11 @@ struct emitter {
  * their materials at them (world_build calls it last). False (err set)
  * when out of memory. */
 bool emitters_build(world *w, const scene *s, rt_error *err);
+
+/* The emitter of a material (first = its light) that a path met at p: the
+ * one of its run whose triangle holds p (a model's lamp of several
+ * triangles), else first's. */
+const emitter *emitter_at(const world *w, int32_t first, vec3 p);
 
 /* The density (per steradian) with which emitter_sample picks the
  * direction d (unit) from p towards e, whose surface it meets at distance t;

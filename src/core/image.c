@@ -43,8 +43,7 @@ static uint8_t *encode_rows(const image_ctx *c, bool *owned)
 	uint8_t *px = malloc(n);
 	if (!px)
 		return NULL;
-	for (size_t i = 0; i < n; i++)
-		px[i] = linear_to_srgb8(fb->rgb[i] * c->gain);
+	linear_to_srgb8_n(fb->rgb, c->gain, px, n);
 	*owned = true;
 	return px;
 }

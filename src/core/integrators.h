@@ -6,9 +6,39 @@
 #include "sampler.h"
 
 /* The camera ray of sample `sample` of pixel (px, py) of an fw x fh image,
- * and in *sp the sampler the integrator goes on with (camera.c). */
-ray camera_sample_ray(const world *w, const render_settings *s, int px, int py, int fw, int fh, int sample,
-                      sampler *sp);
+ * and in *sp the sampler the integrator goes on with (camera.c); sampled:
+ * the integrator draws numbers (integrator.sampled). */
+ray camera_sample_ray(const world *w, const render_settings *s, bool sampled, int px, int py, int fw, int fh,
+                      int sample, sampler *sp);
+
+/* One integrator (integrators.def names it, its file defines it). */
+typedef struct integrator {
+	/* The radiance arriving along the camera ray r (unit direction); g:
+	 * the camera sample's sampler, from dimension g->dim on. */
+	vec3 (*radiance)(const world *w, const render_settings *s, ray r, sampler *g);
+	/* The same when r's first hit is known (packets, render.c): found, h,
+	 * and the answers of the shadow packets for it (known, blocked; 0 and 0
+	 * without shadow_packets). */
+	vec3 (*radiance_first)(const world *w, const render_settings *s, ray r, sampler *g, bool found, const hit *h,
+	                       uint32_t known, uint32_t blocked);
+	/* The shadow rays of a packet's first hits traced as packets (or NULL):
+	 * whitted_shadow_packets below. */
+	void (*shadow_packets)(const world *w, int n, const hit *h, const bool *found, uint32_t *known,
+	                       uint32_t *blocked);
+	/* It draws sampler numbers: each camera ray gets its pixel's sampler
+	 * even at one sample per pixel (else a single sample is the pixel's
+	 * centre). */
+	bool sampled;
+	/* It gives the denoiser its features (denoise.h): `denoise` applies. */
+	bool features;
+} integrator;
+
+#define RT_INTEGRATOR(e, name, desc) extern const integrator desc;
+#include "rtsh/integrators.def"
+#undef RT_INTEGRATOR
+
+/* The integrator of mode m (the first for an unknown m). */
+const integrator *integrator_of(render_mode m);
 
 /* Radiance arriving along r (unit direction) by ambient + Phong + hard
  * shadows + mirror reflection / refraction up to s->depth (whitted.c). */
@@ -157,6 +187,13 @@ vec3 world_background(const world *w, vec3 dir, render_mode mode);
 
 /* The surface colour at a hit (the checker texture applied). */
 vec3 hit_albedo(const mat_lin *m, const hit *h);
+/* The material at a hit: m, or *tmp holding m with its textures of
+ * parameters applied (glTF's metallic-roughness texture: roughness x G,
+ * metallic x B). */
+const mat_lin *hit_material(const mat_lin *m, const hit *h, mat_lin *tmp);
+/* The emitted radiance at a hit: the emission, times glTF's emissive
+ * texture there when the material has one. */
+vec3 hit_emission(const mat_lin *m, const hit *h);
 
 /* A point just off the surface on the side of n, for spawning rays. */
 static inline vec3 offset_point(const world *w, vec3 p, vec3 n)

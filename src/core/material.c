@@ -18,6 +18,8 @@ void bsdf_make(bsdf *b, const mat_lin *m, const hit *h, vec3 wo)
 	b->front = h->front;
 	b->cos_o = pos(v3_dot(b->n, wo));
 	b->family = m->family < MAT_FAMILY_COUNT ? m->family : MAT_PHONG;
+	mat_lin tmp;
+	m = hit_material(m, h, &tmp);
 	mat_families[b->family]->make(b, m, hit_albedo(m, h));
 }
 

@@ -71,6 +71,32 @@ static double power_weight(double a, double b)
 	return a * a / (a * a + b * b);
 }
 
+/* The part of next-event estimation both kinds of light share: the bsdf
+ * toward wi in *f and the cosine in *cos_i, false when either is nothing
+ * or something stands between p and distance tmax along wi. Below the
+ * surface, through a rough transmission only, from the other side (pdn;
+ * the direction from p is kept: the two points are a rounding error
+ * apart). */
+static inline bool unoccluded_eval(const world *w, const bsdf *b, vec3 p, vec3 pdn, vec3 wi, double tmax,
+                                   vec3 *f, double *cos_i)
+{
+	double c = v3_dot(b->n, wi);
+	if (c <= 0.0) {
+		if (!b->through)
+			return false;
+		c = -c;
+		p = pdn;
+	}
+	*f = bsdf_eval(b, wi);
+	if (f->x <= 0.0 && f->y <= 0.0 && f->z <= 0.0)
+		return false;
+	ray sr = {p, wi};
+	if (world_occluded(w, &sr, 0.0, tmax))
+		return false;
+	*cos_i = c;
+	return true;
+}
+
 /* Next-event estimation toward one emitter picked uniformly: a direction
  * from the emitter's solid angle (spheres: the uniform cone they subtend)
  * or area (flat shapes), the emission if nothing is in between, weighted
@@ -93,27 +119,16 @@ static vec3 emitter_light(const world *w, const bsdf *b, vec3 p, vec3 pdn, uint3
 	double pdf, t;
 	if (!emitter_sample(e, p, u1, u2, &wi, &pdf, &t))
 		return v3(0, 0, 0);
-	double cos_i = v3_dot(b->n, wi);
-	if (cos_i <= 0.0) {
-		/* below the surface: through a rough transmission only, from
-		 * the other side (the direction from p is kept: the two points
-		 * are a rounding error apart) */
-		if (!b->through)
-			return v3(0, 0, 0);
-		cos_i = -cos_i;
-		p = pdn;
-	}
-	vec3 f = bsdf_eval(b, wi);
-	if (f.x <= 0.0 && f.y <= 0.0 && f.z <= 0.0)
-		return v3(0, 0, 0);
-	/* Nothing may stand between: an any-hit query that stops just short
-	 * of the emitter's surface. */
-	ray sr = {p, wi};
-	if (world_occluded(w, &sr, 0.0, t * (1.0 - 1e-7)))
+	/* nothing may stand between: an any-hit query that stops just short
+	 * of the emitter's surface (of a model's triangle, whose
+	 * single-precision test may find it a little nearer than t, shorter) */
+	vec3 f;
+	double cos_i;
+	if (!unoccluded_eval(w, b, p, pdn, wi, t * (1.0 - (e->object == UINT32_MAX ? 1e-5 : 1e-7)), &f, &cos_i))
 		return v3(0, 0, 0);
 	double pdf_l = pdf / (double)w->nemitters;
 	double weight = power_weight(pdf_l, bsdf_pdf(b, wi));
-	return v3_mul(f, v3_scale(w->mats[e->object].emission, cos_i * weight / pdf_l));
+	return v3_mul(f, v3_scale(w->mats[e->mat].emission, cos_i * weight / pdf_l));
 }
 
 /* Next-event estimation toward the sky from p (pdn below the surface, for a
@@ -128,18 +143,9 @@ static vec3 sky_light(const world *w, const bsdf *b, vec3 p, vec3 pdn, sampler *
 	vec3 wi = envmap_sample(e, u1, u2, &pdf);
 	if (!(pdf > 0))
 		return v3(0, 0, 0);
-	double cos_i = v3_dot(b->n, wi);
-	if (cos_i <= 0) {
-		if (!b->through) /* below: through a rough transmission only */
-			return v3(0, 0, 0);
-		cos_i = -cos_i;
-		p = pdn;
-	}
-	vec3 f = bsdf_eval(b, wi);
-	if (f.x <= 0 && f.y <= 0 && f.z <= 0)
-		return v3(0, 0, 0);
-	ray sr = {p, wi};
-	if (world_occluded(w, &sr, 0.0, INFINITY))
+	vec3 f;
+	double cos_i;
+	if (!unoccluded_eval(w, b, p, pdn, wi, INFINITY, &f, &cos_i))
 		return v3(0, 0, 0);
 	double wt = power_weight(pdf, bsdf_pdf(b, wi));
 	return v3_mul(f, v3_scale(envmap_eval(e, wi), cos_i * wt / pdf));
@@ -188,12 +194,12 @@ vec3 path_radiance_first(const world *w, const render_settings *s, ray r, sample
 			thr = v3_mul(thr, v3(exp(-sigma.x * h.t), exp(-sigma.y * h.t), exp(-sigma.z * h.t)));
 		const mat_lin *m = &w->mats[h.mat];
 		if (m->light >= 0 && from_pdf > 0.0) {
-			double pdf_l = emitter_pdf(&w->emitters[m->light], from, r.d, h.t) /
+			double pdf_l = emitter_pdf(emitter_at(w, m->light, h.p), from, r.d, h.t) /
 			               (double)w->nemitters;
-			radiance = v3_add(radiance, v3_mul(thr, v3_scale(m->emission,
+			radiance = v3_add(radiance, v3_mul(thr, v3_scale(hit_emission(m, &h),
 			                                                 power_weight(from_pdf, pdf_l))));
 		} else {
-			radiance = v3_add(radiance, v3_mul(thr, m->emission));
+			radiance = v3_add(radiance, v3_mul(thr, hit_emission(m, &h)));
 		}
 		if (bounce >= s->depth)
 			break;
@@ -247,3 +253,13 @@ vec3 path_radiance_first(const world *w, const render_settings *s, ray r, sample
 	}
 	return radiance;
 }
+
+static vec3 path_camera_first(const world *w, const render_settings *s, ray r, sampler *g, bool found,
+                              const hit *h, uint32_t known, uint32_t blocked)
+{
+	(void)known, (void)blocked;
+	return path_radiance_first(w, s, r, g, found, h);
+}
+
+/* Path mode samples every pixel and gives the denoiser its features. */
+const integrator path_integrator = {path_radiance, path_camera_first, NULL, true, true};

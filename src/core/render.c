@@ -14,11 +14,6 @@
 #include "rtsh/srgb.h"
 #include "rtsh/texture.h"
 
-const char *render_mode_name(render_mode m)
-{
-	return m == MODE_PATH ? "path" : "whitted";
-}
-
 int render_threads(const render_settings *s)
 {
 	if (s->threads > 0)
@@ -84,8 +79,9 @@ framebuffer *fb_reuse(framebuffer **fb, int w, int h)
 vec3 render_sample(const world *w, const render_settings *s, int px, int py, int fw, int fh, int sample)
 {
 	sampler sp;
-	ray r = camera_sample_ray(w, s, px, py, fw, fh, sample, &sp);
-	vec3 c = s->mode == MODE_PATH ? path_radiance(w, s, r, &sp) : whitted_radiance(w, s, r);
+	const integrator *in = integrator_of(s->mode);
+	ray r = camera_sample_ray(w, s, in->sampled, px, py, fw, fh, sample, &sp);
+	vec3 c = in->radiance(w, s, r, &sp);
 	/* A NaN or infinity from a degenerate case must not poison the pixel. */
 	if (!v3_finite(c))
 		c = v3(0, 0, 0);
@@ -119,6 +115,7 @@ static void block_add(const world *w, const render_settings *s, int x0, int y0, 
 {
 	double fa[PACKET_MAX][DENOISE_ACC], ra[PACKET_MAX][DENOISE_RACC];
 	int n = (x1 - x0) * (y1 - y0);
+	const integrator *in = integrator_of(s->mode);
 	bool any_feat = false;
 	for (int i = 0; i < n; i++)
 		any_feat |= feat[i] != NULL;
@@ -133,15 +130,17 @@ static void block_add(const world *w, const render_settings *s, int x0, int y0, 
 		bool found[PACKET_MAX];
 		for (int y = y0, i = 0; y < y1; y++)
 			for (int x = x0; x < x1; x++, i++)
-				r[i] = camera_sample_ray(w, s, x, y, fw, fh, k, &sp[i]);
+				r[i] = camera_sample_ray(w, s, in->sampled, x, y, fw, fh, k, &sp[i]);
 		world_intersect_packet(w, n, r, 0.0, INFINITY, h, found);
 		uint32_t known[PACKET_MAX], blocked[PACKET_MAX];
-		if (s->mode != MODE_PATH)
-			whitted_shadow_packets(w, n, h, found, known, blocked);
+		if (in->shadow_packets)
+			in->shadow_packets(w, n, h, found, known, blocked);
+		else
+			for (int i = 0; i < n; i++)
+				known[i] = blocked[i] = 0;
 		for (int y = y0, i = 0; y < y1; y++)
 			for (int x = x0; x < x1; x++, i++) {
-				vec3 c = s->mode == MODE_PATH ? path_radiance_first(w, s, r[i], &sp[i], found[i], &h[i])
-				                              : whitted_radiance_first(w, s, r[i], found[i], &h[i], known[i], blocked[i]);
+				vec3 c = in->radiance_first(w, s, r[i], &sp[i], found[i], &h[i], known[i], blocked[i]);
 				/* A NaN or infinity from a degenerate case must not poison the pixel. */
 				if (!v3_finite(c))
 					c = v3(0, 0, 0);
@@ -170,9 +169,8 @@ static void block_add(const world *w, const render_settings *s, int x0, int y0, 
 static void tile_srgb8(framebuffer *fb, int x0, int y0, int x1, int y1)
 {
 	for (int y = y0; y < y1; y++) {
-		size_t i0 = ((size_t)y * (size_t)fb->w + (size_t)x0) * 3, i1 = i0 + (size_t)(x1 - x0) * 3;
-		for (size_t i = i0; i < i1; i++)
-			fb->srgb8[i] = linear_to_srgb8(fb->rgb[i] * fb->srgb8_gain);
+		size_t i0 = ((size_t)y * (size_t)fb->w + (size_t)x0) * 3;
+		linear_to_srgb8_n(fb->rgb + i0, fb->srgb8_gain, fb->srgb8 + i0, (size_t)(x1 - x0) * 3);
 	}
 }
 
@@ -185,7 +183,7 @@ static void render_tile(shared *sh, long t)
 	int y1 = y0 + RENDER_TILE < fb->h ? y0 + RENDER_TILE : fb->h;
 	double inv = 1.0 / job->sample_end;
 	texture_set_pixel_angle(2.0 * cam_tan_x(&job->w->cam, fb->w, fb->h) / fb->w); /* texture footprints */
-	bool feat = fb->feat && job->set.mode == MODE_PATH;
+	bool feat = fb->feat && integrator_of(job->set.mode)->features;
 	for (int by = y0; by < y1; by += BLOCK_SIDE)
 		for (int bx = x0; bx < x1; bx += BLOCK_SIDE) {
 			int ex = bx + BLOCK_SIDE < x1 ? bx + BLOCK_SIDE : x1, ey = by + BLOCK_SIDE < y1 ? by + BLOCK_SIDE : y1;
@@ -245,7 +243,7 @@ void render_rect_features(const world *w, const render_settings *s, int x0, int 
 					fp[k] = NULL;
 					if (feat) {
 						memset(feat + i * DENOISE_FEATURES, 0, DENOISE_FEATURES * sizeof *feat);
-						if (s->mode == MODE_PATH)
+						if (integrator_of(s->mode)->features)
 							fp[k] = feat + i * DENOISE_FEATURES;
 					}
 				}
@@ -388,7 +386,7 @@ static framebuffer *render_image_with(const world *w, const render_settings *s, 
 	/* One pass makes the whole image: no running sums are needed. */
 	free(fb->sum);
 	fb->sum = NULL;
-	bool denoise = s->mode == MODE_PATH && s->denoise == DENOISE_ON;
+	bool denoise = integrator_of(s->mode)->features && s->denoise == DENOISE_ON;
 	if (denoise && !denoise_prepare(fb)) {
 		rt_error_set(err, "out of memory for the denoiser's features of a %dx%d image",
 		             s->width, s->height);

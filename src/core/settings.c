@@ -13,8 +13,6 @@
 
 #include "rtsh/memory.h"
 
-/* The names of render_mode's values, in order. */
-static const char *const mode_names[] = {"whitted", "path", NULL};
 /* The names of the denoise_mode values, in order. */
 static const char *const denoise_names[] = {"auto", "on", "off", NULL};
 /* The names of term/pixels.h's pixels_mode values, in order. */
@@ -29,7 +27,7 @@ const setting_def settings_table[] = {
 	{"resolution", SETTING_RESOLUTION, 1, RENDER_MAX_DIM, AT(width), "full-resolution image size, WxH", "1280x720", NULL, 0},
 	{"samples", SETTING_INT, 1, 1000000, AT(samples), "samples (rays or paths) per pixel", "1", NULL, 0},
 	{"depth", SETTING_INT, 0, 1000, AT(depth), "reflection depth (whitted) or bounces (path)", "5", NULL, 0},
-	{"mode", SETTING_ENUM, 0, 0, AT(mode), "render mode: whitted or path", "whitted", mode_names, 0},
+	{"mode", SETTING_ENUM, 0, 0, AT(mode), "render mode: whitted or path", "whitted", render_mode_names, 0},
 	{"threads", SETTING_INT, 0, 256, AT(threads), "render threads; 0 = one per online CPU", "0", NULL, 0},
 	{"seed", SETTING_U64, 0, 0, AT(seed), "random seed of the sampler", "1", NULL, 0},
 	{"exposure", SETTING_DOUBLE, -20, 20, AT(exposure), "exposure in stops: output = radiance x 2^exposure", "0", NULL, 0},
@@ -38,10 +36,10 @@ const setting_def settings_table[] = {
 	 SETTING_BARE_ON},
 	{"pixels", SETTING_ENUM, 0, 0, AT(pixels),
 	 "the picture in real pixels: off (half blocks), kitty, sixel, iterm, or auto (ask the terminal)", "off",
-	 pixels_names, 0},
+	 pixels_names, SETTING_TERMINAL},
 	{"symbols", SETTING_ENUM, 0, 0, AT(symbols),
 	 "the cells' glyphs: half, quadrant, sextant, octant, or auto (what the terminal is known to draw)", "auto",
-	 symbols_names, 0},
+	 symbols_names, SETTING_TERMINAL},
 #undef AT
 };
 const size_t settings_count = sizeof settings_table / sizeof settings_table[0];

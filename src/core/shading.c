@@ -16,6 +16,29 @@ vec3 world_background(const world *w, vec3 dir, render_mode mode)
 	return mode == MODE_PATH ? w->ambient : v3(0, 0, 0);
 }
 
+const mat_lin *hit_material(const mat_lin *m, const hit *h, mat_lin *tmp)
+{
+	if (m->family != MAT_PBR || !m->tx || !m->tx->mr || !h->has_uv)
+		return m;
+	double du = v3_len(h->dpdu);
+	double width = du > 0 ? h->t * texture_pixel_angle() / du : 0;
+	vec3 c = texture_lookup(m->tx->mr, h->u, h->v, width);
+	*tmp = *m;
+	tmp->pbr.roughness = (float)(m->pbr.roughness * clampd(c.y, 0.0, 1.0));
+	tmp->pbr.metallic = (float)(m->pbr.metallic * clampd(c.z, 0.0, 1.0));
+	tmp->pbr.es_ready = false; /* the plastic's specular albedo for this roughness: bsdf_pbr.c */
+	return tmp;
+}
+
+vec3 hit_emission(const mat_lin *m, const hit *h)
+{
+	if (!m->tx || !m->tx->emit || !h->has_uv)
+		return m->emission;
+	double du = v3_len(h->dpdu);
+	double width = du > 0 ? h->t * texture_pixel_angle() / du : 0;
+	return v3_mul(m->emission, texture_lookup(m->tx->emit, h->u, h->v, width));
+}
+
 vec3 hit_albedo(const mat_lin *m, const hit *h)
 {
 	if (m->tx && m->tx->tex && h->has_uv) {

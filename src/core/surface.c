@@ -62,7 +62,7 @@ bool surf_begin(world *w, const scene *s, rt_error *err)
 		const object *o = &s->objs[i];
 		if (!(obj_kind_flags(o->kind) & KIND_MODEL))
 			continue;
-		mesh *m = mesh_cache_get(o->file ? o->file : "", o->smooth != 0, o->crease, w->cancel, err);
+		mesh *m = mesh_cache_get_node(o->file ? o->file : "", o->node, o->smooth != 0, o->crease, w->cancel, err);
 		if (!m) {
 			char msg[RT_ERROR_MSG_MAX];
 			rt_error_format(err, msg, sizeof msg);
@@ -168,12 +168,21 @@ bool surf_material(world *w, const object *o, uint32_t i, rt_error *err)
 		if (mm->gltf && (mm->map_kd || mm->tex_kd)) /* KHR_texture_transform, then the object's */
 			for (int a = 0; a < 2; a++) {
 				t.uvo[a] += mm->uvo[a] * t.uvs[a];
+				t.uvx[a] = mm->uvx[a] * t.uvs[a];
 				t.uvs[a] *= mm->uvs[a];
 			}
 		if (mm->map_norm && !hold_texture(w, mm->map_norm, false, &t.nmap, err))
 			return false;
 		if (!mm->map_norm && mm->tex_norm)
 			t.nmap = mm->tex_norm;
+		if (mm->gltf && mm->map_mr && !hold_texture(w, mm->map_mr, false, &t.mr, err))
+			return false;
+		if (mm->gltf && !mm->map_mr && mm->tex_mr)
+			t.mr = mm->tex_mr;
+		if (mm->gltf && mm->map_emit && !hold_texture(w, mm->map_emit, true, &t.emit, err))
+			return false;
+		if (mm->gltf && !mm->map_emit && mm->tex_emit)
+			t.emit = mm->tex_emit;
 		if (mm->map_bump) {
 			if (!hold_texture(w, mm->map_bump, false, &t.bump, err))
 				return false;
@@ -181,7 +190,7 @@ bool surf_material(world *w, const object *o, uint32_t i, rt_error *err)
 			t.bumpscale = mm->bump_scale * 0.01;
 		}
 		l.tx = NULL;
-		if (t.tex || t.nmap || t.bump) {
+		if (t.tex || t.nmap || t.bump || t.mr || t.emit) {
 			w->mtex[w->nmtex] = t;
 			l.tx = &w->mtex[w->nmtex++];
 		}
@@ -299,8 +308,16 @@ static void apply_uv(const world *w, hit *h, double u, double v, vec3 dpdu, vec3
 	h->has_uv = true;
 	h->u = u * m->uvs[0] + m->uvo[0];
 	h->v = v * m->uvs[1] + m->uvo[1];
-	h->dpdu = v3_scale(dpdu, 1.0 / m->uvs[0]);
-	h->dpdv = v3_scale(dpdv, 1.0 / m->uvs[1]);
+	if (m->uvx[0] != 0 || m->uvx[1] != 0) { /* a glTF rotation: the inverse map carries the tangents */
+		h->u += v * m->uvx[0];
+		h->v += u * m->uvx[1];
+		double a = m->uvs[0], b = m->uvx[0], c = m->uvx[1], d = m->uvs[1], det = a * d - b * c;
+		h->dpdu = v3_scale(v3_sub(v3_scale(dpdu, d), v3_scale(dpdv, c)), 1.0 / det);
+		h->dpdv = v3_scale(v3_sub(v3_scale(dpdv, a), v3_scale(dpdu, b)), 1.0 / det);
+	} else {
+		h->dpdu = v3_scale(dpdu, 1.0 / m->uvs[0]);
+		h->dpdv = v3_scale(dpdv, 1.0 / m->uvs[1]);
+	}
 	perturb(w, h);
 }
 

@@ -76,3 +76,19 @@ void whitted_shadow_packets(const world *w, int n, const hit *h, const bool *fou
 		}
 	}
 }
+
+static vec3 whitted_camera(const world *w, const render_settings *s, ray r, sampler *g)
+{
+	(void)g;
+	return whitted_radiance(w, s, r);
+}
+
+static vec3 whitted_camera_first(const world *w, const render_settings *s, ray r, sampler *g, bool found,
+                                 const hit *h, uint32_t known, uint32_t blocked)
+{
+	(void)g;
+	return whitted_radiance_first(w, s, r, found, h, known, blocked);
+}
+
+/* Whitted draws no random numbers: one sample is the pixel's centre. */
+const integrator whitted_integrator = {whitted_camera, whitted_camera_first, whitted_shadow_packets, false, false};

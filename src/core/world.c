@@ -217,7 +217,6 @@ world *world_build_cancel(const scene *s, const atomic_bool *cancel, rt_error *e
 	size_t nbounded = s->nobjs - nplanes;
 	w->lights = calloc(s->nlights ? s->nlights : 1, sizeof *w->lights);
 	w->mats = calloc(s->nobjs ? s->nobjs : 1, sizeof *w->mats);
-	mem_huge_pages(w->mats, s->nobjs * sizeof *w->mats); /* read at every hit */
 	w->prims = malloc((nbounded ? nbounded : 1) * sizeof *w->prims);
 	w->planes = malloc((nplanes ? nplanes : 1) * sizeof *w->planes);
 	w->shapes = malloc((nshapes ? nshapes : 1) * sizeof *w->shapes);

@@ -148,7 +148,7 @@ bool object_equal(const object *a, const object *b)
 		if (a->shear[i] != b->shear[i])
 			return false;
 	if (a->file != b->file || a->file_colors != b->file_colors || a->smooth != b->smooth ||
-	    a->crease != b->crease)
+	    a->crease != b->crease || a->node != b->node)
 		return false;
 	return v3_eq(a->pos, b->pos) && v3_eq(a->dir, b->dir) && a->twist == b->twist &&
 	       (!(obj_kind_flags(a->kind) & KIND_TUBE) || a->tube == b->tube) &&
@@ -165,7 +165,7 @@ static bool light_equal(const light *a, const light *b)
 static bool camera_equal(const camera *a, const camera *b)
 {
 	return v3_eq(a->pos, b->pos) && v3_eq(a->dir, b->dir) && a->fov == b->fov && a->vertical == b->vertical &&
-	       a->ortho == b->ortho;
+	       a->ortho == b->ortho && a->roll == b->roll;
 }
 
 bool scene_equal(const scene *a, const scene *b)
@@ -277,7 +277,7 @@ void scene_remove_light(scene *s, size_t i)
 camera scene_camera(const scene *s)
 {
 	if (s->ncams == 0)
-		return (camera){v3(0, 0, -5), v3(0, 0, 1), 70.0, false, 0};
+		return (camera){v3(0, 0, -5), v3(0, 0, 1), 70.0, false, 0, 0};
 	return s->cams[s->cam < s->ncams ? s->cam : 0];
 }
 
@@ -292,6 +292,7 @@ object object_make(obj_kind k, vec3 color)
 	o.mat = material_default(color);
 	o.smooth = 1;
 	o.crease = 60;
+	o.node = -1;
 	if ((obj_kind_flags(k) & KIND_VERTICES)) {
 		o.tri[0] = v3(-0.5, -0.5, 0);
 		o.tri[1] = v3(0.5, -0.5, 0);

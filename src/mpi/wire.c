@@ -92,13 +92,21 @@ static size_t setting_bytes(const setting_def *d)
 	return d->type == SETTING_INT || d->type == SETTING_ENUM ? 4 : 8;
 }
 
-/* The bytes after the header: the job's fields and every setting of the
- * settings table, in the table's order. */
+/* What ranks render with: every row of the settings table but the
+ * terminal's choices. */
+static bool on_wire(const setting_def *d)
+{
+	return !(d->flags & SETTING_TERMINAL);
+}
+
+/* The bytes after the header: the job's fields and every setting on the
+ * wire, in the table's order. */
 static size_t body_bytes(void)
 {
 	size_t n = JOB_BYTES;
 	for (size_t i = 0; i < settings_count; i++)
-		n += setting_bytes(&settings_table[i]);
+		if (on_wire(&settings_table[i]))
+			n += setting_bytes(&settings_table[i]);
 	return n;
 }
 
@@ -183,7 +191,8 @@ void wire_put_config(const job_config *c, unsigned char buf[WIRE_CONFIG_SIZE])
 	put_i32(&w, c->prefetch);
 	put_i32(&w, c->delay_us);
 	for (size_t i = 0; i < settings_count; i++)
-		put_setting(&w, &c->set, &settings_table[i]);
+		if (on_wire(&settings_table[i]))
+			put_setting(&w, &c->set, &settings_table[i]);
 	put_u64(&w, c->files);
 }
 
@@ -206,6 +215,7 @@ bool wire_get_config(job_config *c, const unsigned char buf[WIRE_CONFIG_SIZE], c
 	}
 	job_config k;
 	memset(&k, 0, sizeof k);
+	k.set = render_settings_default(); /* the terminal's choices: not sent */
 	k.status = get_i32(&r);
 	k.verbose = get_i32(&r);
 	k.progress = get_i32(&r);
@@ -217,7 +227,8 @@ bool wire_get_config(job_config *c, const unsigned char buf[WIRE_CONFIG_SIZE], c
 	/* the settings of a job to render are checked against the table's
 	 * ranges; a job that only ends the ranks (status >= 0) uses none */
 	for (size_t i = 0; i < settings_count; i++)
-		ok = get_setting(&r, &k.set, &settings_table[i], k.status < 0, ok ? why : NULL, ok ? whylen : 0) && ok;
+		if (on_wire(&settings_table[i]))
+			ok = get_setting(&r, &k.set, &settings_table[i], k.status < 0, ok ? why : NULL, ok ? whylen : 0) && ok;
 	k.files = get_u64(&r);
 	ok = ok && in_range("status", k.status, -1, 255, why, whylen) &&
 	     in_range("tile", k.tile, 0, 1024, why, whylen) &&

@@ -5,14 +5,16 @@
  * version of rtsh-mpi read the same values or refuse with a message; no
  * padding, pointer or struct layout is ever sent.
  *
- * Layout (version 3), WIRE_CONFIG_SIZE bytes, zeros after the fields:
+ * Layout (version 4), WIRE_CONFIG_SIZE bytes, zeros after the fields:
  *   "RTSHMPI\0"  u32 version  u32 length of what follows
  *   i32 status verbose progress strict tile prefetch delay_us
- *   render_settings: every row of the settings table (settings.h), in its
+ *   render_settings: every row of the settings table (settings.h) but the
+ *                    terminal's choices (SETTING_TERMINAL: pixels,
+ *                    symbols; the receiver has their defaults), in its
  *                    order, by its type: i32 for a whole number or a
  *                    choice, u64, f64, or i32 W and H for a resolution
  *                    (today: width height samples depth mode threads
- *                    seed exposure denoise pixels symbols)
+ *                    seed exposure denoise)
  *   u64 files (bytes of the packed file set)
  */
 #ifndef RTSH_MPI_WIRE_H
@@ -24,7 +26,7 @@
 
 #include "rtsh/render.h"
 
-#define WIRE_VERSION 3
+#define WIRE_VERSION 4
 /* Every rank receives this many bytes: more than version 1 needs, so that a
  * newer version can add fields and still be told apart. */
 #define WIRE_CONFIG_SIZE 256
@@ -40,7 +42,8 @@ typedef struct job_config {
 /* Encodes c into buf (WIRE_CONFIG_SIZE bytes). */
 void wire_put_config(const job_config *c, unsigned char buf[WIRE_CONFIG_SIZE]);
 /* Decodes buf into *c; false, with why (what is wrong, what was expected),
- * when it is not a version-1 configuration or a value is out of range. */
+ * when it is not a configuration of this WIRE_VERSION or a value is out of
+ * range. */
 bool wire_get_config(job_config *c, const unsigned char buf[WIRE_CONFIG_SIZE], char *why,
                      size_t whylen);
 

@@ -227,7 +227,7 @@ static bool gen_setting(scene *s, uint64_t seed, rt_error *err)
 	gen_rng r = gen_stream(seed, 1);
 	s->has_ambient = true;
 	s->amb = (ambient){0.15, v3(180, 200, 255)};
-	camera cam = {v3(0, 7, -17), v3(0, -4, 17), 60, false, 0};
+	camera cam = {v3(0, 7, -17), v3(0, -4, 17), 60, false, 0, 0};
 	if (!scene_add_camera(s, &cam, err))
 		return false;
 	int64_t nl = gen_int(&r, 2, 4);

@@ -3,6 +3,7 @@
  * read. A new material key is a line of rt_keys (and its field in
  * scene.h's material, and a paragraph in rtsh(5)). */
 #include <math.h>
+#include <pthread.h>
 #include <stddef.h>
 #include <string.h>
 
@@ -79,6 +80,9 @@ const rt_key rt_keys[] = {
 	 RT_KEY_NUM, true},
 	{"crease", offsetof(object, crease), false, false, 0, false, 0, 180, 60, NULL,
 	 "crease in degrees, [0,180]", "mesh: edges sharper than this stay sharp, degrees", RT_KEY_NUM, true},
+	{"node", offsetof(object, node), true, false, 0, false, 0, 16777215, -1, NULL,
+	 "node an index into the glTF file's nodes", "mesh: one node of a glTF file alone (its index)", RT_KEY_NUM,
+	 true},
 };
 const size_t rt_nkeys = sizeof rt_keys / sizeof rt_keys[0];
 
@@ -100,20 +104,33 @@ bool rt_key_applies(const rt_key *k, obj_kind kind)
 	return !k->needs || (f & k->needs);
 }
 
+/* The absent PBR block, made once: rt_key_get reads it for every PBR key of
+ * every object without one (the rules of a million loaded spheres). */
+static material_pbr absent_pbr;
+static pthread_once_t absent_once = PTHREAD_ONCE_INIT;
+
+static void absent_init(void)
+{
+	absent_pbr = material_pbr_absent();
+}
+
 /* Where key k's value is in o: in the object, or in o's PBR block (the
  * absent one when o has none). */
-static const char *key_src(const rt_key *k, const object *o, material_pbr *tmp)
+static const char *key_src(const rt_key *k, const object *o)
 {
 	if (!(k->offset & RT_KEY_PBR))
 		return (const char *)o + k->offset;
-	*tmp = o->mat.pbr ? *o->mat.pbr : material_pbr_absent();
-	return (const char *)tmp + (k->offset & ~RT_KEY_PBR);
+	const material_pbr *pb = o->mat.pbr;
+	if (!pb) {
+		pthread_once(&absent_once, absent_init);
+		pb = &absent_pbr;
+	}
+	return (const char *)pb + (k->offset & ~RT_KEY_PBR);
 }
 
 double rt_key_get(const rt_key *k, const object *o)
 {
-	material_pbr tmp;
-	const char *base = key_src(k, o, &tmp);
+	const char *base = key_src(k, o);
 	if (k->is_int)
 		return *(const int *)(const void *)base;
 	return *(const double *)(const void *)base;
@@ -121,8 +138,7 @@ double rt_key_get(const rt_key *k, const object *o)
 
 void rt_key_get_n(const rt_key *k, const object *o, double *v, int n)
 {
-	material_pbr tmp;
-	memcpy(v, key_src(k, o, &tmp), (size_t)n * sizeof *v);
+	memcpy(v, key_src(k, o), (size_t)n * sizeof *v);
 }
 
 /* Writes n doubles (or one int) into o's field of key k. */

@@ -498,12 +498,12 @@ static bool parse_camera(parser *p, const elem_def *e)
 	    !get_dir(p, &p->toks[2], e->name, "direction", &c.dir) ||
 	    !get_num(p, &p->toks[3], e->name, "fov", &R_FOV, &c.fov))
 		return false;
-	static const char *const cam_keys[] = {"vertical", "ortho"};
+	static const char *const cam_keys[] = {"vertical", "ortho", "roll"};
 	unsigned seen = 0;
 	for (size_t i = p->np + 1; i < p->ntoks; i++) {
 		tok v;
 		double x;
-		int k = elem_key(p, e, i, cam_keys, 2, &seen, &v);
+		int k = elem_key(p, e, i, cam_keys, 3, &seen, &v);
 		if (k < 0)
 			return false;
 		if (k == 0) {
@@ -511,6 +511,10 @@ static bool parse_camera(parser *p, const elem_def *e)
 			if (!get_num(p, &v, e->name, "vertical=", &R_BOOL, &x))
 				return false;
 			c.vertical = x != 0;
+		} else if (k == 2) {
+			static const range R_ROLL = {-180, 180, false, false, "an angle in degrees from -180 to 180"};
+			if (!get_num(p, &v, e->name, "roll=", &R_ROLL, &c.roll))
+				return false;
 		} else if (!get_num(p, &v, e->name, "ortho=", &R_POS, &c.ortho)) {
 			return false;
 		}
@@ -536,7 +540,7 @@ static bool parse_camera(parser *p, const elem_def *e)
 	if (p->line_c) {
 		const camera *o = &s->cams[p->cam_c];
 		same = v3_eq(o->pos, c.pos) && v3_eq(o->dir, c.dir) && o->fov == c.fov && o->vertical == c.vertical &&
-		       o->ortho == c.ortho;
+		       o->ortho == c.ortho && o->roll == c.roll;
 	}
 	int r = once(p, e, "C", &p->line_c, same);
 	if (r > 0) {
@@ -719,13 +723,16 @@ static bool parse_set(parser *p, const elem_def *e)
 			hn->depth = (int)d;
 		break;
 	case 2: {
-		int m;
-		if (strcmp(v->s, "whitted") == 0)
-			m = MODE_WHITTED;
-		else if (strcmp(v->s, "path") == 0)
-			m = MODE_PATH;
-		else
-			return fail_tok(p, v, "set", "mode", "is unknown", "whitted or path");
+		int m = 0; /* the integrators' names (integrators.def) */
+		while (m < MODE_COUNT && strcmp(v->s, render_mode_names[m]) != 0)
+			m++;
+		if (m == MODE_COUNT) {
+			char names[256] = "";
+			for (int j = 0; j < MODE_COUNT; j++)
+				snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s",
+				         j == 0 ? "" : j == MODE_COUNT - 1 ? " or " : ", ", render_mode_names[j]);
+			return fail_tok(p, v, "set", "mode", "is unknown", names);
+		}
 		r = once(p, e, "set mode", &p->line_set[2], hn->mode == m);
 		if (r > 0)
 			hn->mode = m;
@@ -1097,8 +1104,8 @@ static bool parse_mesh(parser *p, const elem_def *e)
  * kind's own identifier and then its alias. */
 static const elem_def elements_head[] = {
 	{"A", "ambient", -1, true, parse_ambient, "A RATIO R,G,B", NULL, NULL},
-	{"C", "camera", -1, true, parse_camera, "C POSITION DIRECTION FOV [vertical=1] [ortho=HALF_HEIGHT]", "C POSITION DIRECTION FOV", NULL},
-	{"c", "camera", -1, false, parse_camera, "c POSITION DIRECTION FOV [vertical=1] [ortho=HALF_HEIGHT]", NULL, NULL},
+	{"C", "camera", -1, true, parse_camera, "C POSITION DIRECTION FOV [vertical=1] [ortho=HALF_HEIGHT] [roll=DEG]", "C POSITION DIRECTION FOV", NULL},
+	{"c", "camera", -1, false, parse_camera, "c POSITION DIRECTION FOV [vertical=1] [ortho=HALF_HEIGHT] [roll=DEG]", NULL, NULL},
 	{"L", "light", -1, true, parse_light, "L POSITION RATIO [R,G,B] [cd=CANDELA [dir=X,Y,Z cone=INNER,OUTER] [range=R] | lux=LUX dir=X,Y,Z]", "L POSITION RATIO R,G,B", NULL},
 	{"l", "light", -1, false, parse_light, "l POSITION RATIO [R,G,B] [cd=CANDELA [dir=X,Y,Z cone=INNER,OUTER] [range=R] | lux=LUX dir=X,Y,Z]", NULL, NULL},
 	{"R", "resolution", -1, false, parse_resolution, "R WIDTH HEIGHT", NULL, NULL},

@@ -298,42 +298,46 @@ static void fmt_camera(sbuf *b, const camera *c, const char *id)
 		sb_put(b, " ortho=");
 		sb_num(b, c->ortho);
 	}
+	if (c->roll != 0) {
+		sb_put(b, " roll=");
+		sb_num(b, c->roll);
+	}
+}
+
+/* One element's line into buf, its numbers in the "C" locale: the object o
+ * (ext: in the extended form), else the light l, else the camera c. */
+static void format_one(char *buf, size_t size, const object *o, bool ext, const light *l, const camera *c)
+{
+	rt_numloc loc;
+	rt_numloc_enter(&loc);
+	sbuf b = sb_make(buf, size);
+	if (o)
+		fmt_object(&b, o, ext);
+	else if (l)
+		fmt_light(&b, l);
+	else
+		fmt_camera(&b, c, "C");
+	rt_numloc_leave(&loc);
 }
 
 void rt_format_object(const object *o, char *buf, size_t size)
 {
-	rt_numloc loc;
-	rt_numloc_enter(&loc);
-	sbuf b = sb_make(buf, size);
-	fmt_object(&b, o, false);
-	rt_numloc_leave(&loc);
+	format_one(buf, size, o, false, NULL, NULL);
 }
 
 void rt_format_object_extended(const object *o, char *buf, size_t size)
 {
-	rt_numloc loc;
-	rt_numloc_enter(&loc);
-	sbuf b = sb_make(buf, size);
-	fmt_object(&b, o, true);
-	rt_numloc_leave(&loc);
+	format_one(buf, size, o, true, NULL, NULL);
 }
 
 void rt_format_light(const light *l, char *buf, size_t size)
 {
-	rt_numloc loc;
-	rt_numloc_enter(&loc);
-	sbuf b = sb_make(buf, size);
-	fmt_light(&b, l);
-	rt_numloc_leave(&loc);
+	format_one(buf, size, NULL, false, l, NULL);
 }
 
 void rt_format_camera(const camera *c, char *buf, size_t size)
 {
-	rt_numloc loc;
-	rt_numloc_enter(&loc);
-	sbuf b = sb_make(buf, size);
-	fmt_camera(&b, c, "C");
-	rt_numloc_leave(&loc);
+	format_one(buf, size, NULL, false, NULL, c);
 }
 
 /* Longer than any line the formatters make. */
@@ -358,8 +362,8 @@ static void write_scene(const scene *s, FILE *f)
 		fprintf(f, "set samples %d\n", h->samples);
 	if (h->depth >= 0)
 		fprintf(f, "set depth %d\n", h->depth);
-	if (h->mode == MODE_WHITTED || h->mode == MODE_PATH)
-		fprintf(f, "set mode %s\n", h->mode == MODE_PATH ? "path" : "whitted");
+	if (h->mode >= 0 && h->mode < MODE_COUNT)
+		fprintf(f, "set mode %s\n", render_mode_name((render_mode)h->mode));
 	if (s->has_ambient) {
 		sb_put(&b, "A");
 		sb_field(&b, s->amb.ratio);

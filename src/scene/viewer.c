@@ -25,6 +25,7 @@
 #include <strings.h>
 #include <sys/stat.h>
 
+#include "rtsh/filesrc.h"
 #include "rtsh/gltf.h"
 #include "rtsh/mesh.h"
 #include "rtsh/rtfile.h"
@@ -75,16 +76,52 @@ static vec3 tidy3(vec3 v)
  * framed as the model viewer frames a model; one with neither lights nor
  * emissive materials gets the viewer's stage lighting, and its status line
  * says so; otherwise it is lit by what it holds, on black, in path mode. */
+/* A file with from 2 to NODE_OBJECTS nodes with meshes is read as one
+ * object a node (`mesh FILE ... node=K`, so that the shell's edit commands
+ * move them one by one), when reading the file once a node stays within
+ * NODE_BYTES; otherwise as one object. */
+#define NODE_OBJECTS 64
+#define NODE_BYTES (256.0 * 1024 * 1024)
+
+/* The bounds of each node's triangles (nb[k] for gi->mesh_nodes[k]) and
+ * their union, or false when a node cannot be read alone (then the file is
+ * one object). */
+static bool node_bounds(const char *path, const gltf_info *gi, const rt_load_opts *opts, box *nb, box *all)
+{
+	struct stat st;
+	if (gi->nmesh_nodes < 2 || gi->nmesh_nodes > NODE_OBJECTS || rt_file_stat(path, &st) != 0 ||
+	    (double)st.st_size * (double)gi->nmesh_nodes > NODE_BYTES)
+		return false;
+	for (size_t k = 0; k < gi->nmesh_nodes; k++) {
+		rt_error e = {0};
+		mesh *m = mesh_cache_get_node(path, gi->mesh_nodes[k], true, 60, opts ? opts->cancel : NULL, &e);
+		if (!m)
+			return false;
+		nb[k] = m->bounds;
+		mesh_cache_put(m);
+		*all = k == 0 ? nb[k] : box_union(*all, nb[k]);
+	}
+	return true;
+}
+
 static char *gltf_text(const char *path, const rt_load_opts *opts, size_t *len, bool *stage_lit, rt_error *err)
 {
-	mesh *m = mesh_cache_get(path, true, 60, opts ? opts->cancel : NULL, err);
-	if (!m)
-		return NULL;
-	box bb = m->bounds;
-	mesh_cache_put(m);
 	gltf_info gi;
 	if (!gltf_read_info(path, &gi, err))
 		return NULL;
+	box bb = {v3(0, 0, 0), v3(0, 0, 0)};
+	box *nb = gi.nmesh_nodes ? malloc(gi.nmesh_nodes * sizeof *nb) : NULL;
+	bool split = nb && node_bounds(path, &gi, opts, nb, &bb);
+	if (!split) {
+		mesh *m = mesh_cache_get(path, true, 60, opts ? opts->cancel : NULL, err);
+		if (!m) {
+			free(nb);
+			gltf_info_free(&gi);
+			return NULL;
+		}
+		bb = m->bounds;
+		mesh_cache_put(m);
+	}
 	vec3 ext = v3_sub(bb.hi, bb.lo), mid = box_center(bb);
 	double longest = v3_max_comp(ext);
 	if (!(longest > 0))
@@ -94,14 +131,24 @@ static char *gltf_text(const char *path, const rt_load_opts *opts, size_t *len, 
 	bool quote = strpbrk(base, " \t,#\"") != NULL;
 	bool stage = gi.nlights == 0 && !gi.emissive;
 	*stage_lit = stage;
-	size_t size = 4096 + 256 * (gi.ncams + gi.nlights), n = 0;
+	size_t size = 4096 + 256 * (gi.ncams + gi.nlights) + (split ? (160 + strlen(base)) * gi.nmesh_nodes : 0), n = 0;
 	char *text = malloc(size);
 	if (!text) {
 		rt_error_set(err, "%s: out of memory", path);
 		goto done;
 	}
-	bool ok = put(text, size, &n, "# the glTF scene %s\nmesh %s%s%s %.17g,%.17g,%.17g 0,1,0 %.17g\n", base,
-	              quote ? "\"" : "", base, quote ? "\"" : "", mid.x, mid.y, mid.z, longest);
+	bool ok = put(text, size, &n, "# the glTF scene %s\n", base);
+	if (!split)
+		ok = ok && put(text, size, &n, "mesh %s%s%s %.17g,%.17g,%.17g 0,1,0 %.17g\n", quote ? "\"" : "", base,
+		               quote ? "\"" : "", mid.x, mid.y, mid.z, longest);
+	/* a node: its triangles' box centred where it is, its longest side its
+	 * own size (surface.c places a model so) */
+	for (size_t k = 0; split && ok && k < gi.nmesh_nodes; k++) {
+		vec3 c = box_center(nb[k]);
+		double l = v3_max_comp(v3_sub(nb[k].hi, nb[k].lo));
+		ok = put(text, size, &n, "mesh %s%s%s %.17g,%.17g,%.17g 0,1,0 %.17g node=%ld\n", quote ? "\"" : "", base,
+		         quote ? "\"" : "", c.x, c.y, c.z, l > 0 ? l : 1, gi.mesh_nodes[k]);
+	}
 	/* the viewer's framing: the bounding sphere from the front, a little
 	 * above and to the right, 50 degrees across a 16:9 image */
 	double radius = 0.5 * v3_len(ext), fov = 50, vhalf = atan(tan(fov * M_PI / 360) * 9.0 / 16.0);
@@ -117,20 +164,22 @@ static char *gltf_text(const char *path, const rt_load_opts *opts, size_t *len, 
 		cc.pos = tidy3(cc.pos);
 		cc.fwd = tidy3(cc.fwd);
 		const gltf_camera *c = &cc;
-		/* rtsh cameras stay upright: a roll is not kept (said once) */
+		/* the camera's roll: the angle from rtsh's upright up (camera.c)
+		 * to the file's, towards the camera's right */
 		vec3 up_ref = fabs(c->fwd.y) > 0.999999 ? v3(0, 0, 1) : v3(0, 1, 0);
 		vec3 right = v3_norm(v3_cross(up_ref, c->fwd)), up = v3_cross(c->fwd, right);
-		double roll = acos(clampd(v3_dot(up, c->up), -1, 1)) * 180 / M_PI;
-		if (roll > 0.5)
-			rt_warn(opts ? opts->warn : NULL, path, 0, 0,
-			        "cameras[%d]: turned %.0f degrees about its axis; rtsh cameras stay upright (the roll is not "
-			        "kept)", c->index, roll);
+		double roll = atan2(v3_dot(c->up, right), v3_dot(c->up, up)) * 180 / M_PI;
+		if (fabs(roll) < 1e-9)
+			roll = 0;
 		if (c->ortho)
-			ok = put(text, size, &n, "%c %.17g,%.17g,%.17g %.17g,%.17g,%.17g 60 ortho=%.17g\n", i ? 'c' : 'C',
+			ok = put(text, size, &n, "%c %.17g,%.17g,%.17g %.17g,%.17g,%.17g 60 ortho=%.17g", i ? 'c' : 'C',
 			         c->pos.x, c->pos.y, c->pos.z, c->fwd.x, c->fwd.y, c->fwd.z, c->ymag);
 		else
-			ok = put(text, size, &n, "%c %.17g,%.17g,%.17g %.17g,%.17g,%.17g %.17g vertical=1\n", i ? 'c' : 'C',
+			ok = put(text, size, &n, "%c %.17g,%.17g,%.17g %.17g,%.17g,%.17g %.17g vertical=1", i ? 'c' : 'C',
 			         c->pos.x, c->pos.y, c->pos.z, c->fwd.x, c->fwd.y, c->fwd.z, c->yfov * 180 / M_PI);
+		if (ok && roll != 0)
+			ok = put(text, size, &n, " roll=%.17g", roll);
+		ok = ok && put(text, size, &n, "\n");
 	}
 	/* the first camera's shape, when the file gives it */
 	double aspect = gi.ncams == 0 ? 0 : gi.cams[0].ortho ? (gi.cams[0].ymag > 0 ? gi.cams[0].xmag / gi.cams[0].ymag : 0)
@@ -184,6 +233,7 @@ static char *gltf_text(const char *path, const rt_load_opts *opts, size_t *len, 
 		rt_warn(opts ? opts->warn : NULL, path, 0, 0,
 		        "no lights and no emissive materials: lit by the model viewer's stage lighting");
 done:
+	free(nb);
 	gltf_info_free(&gi);
 	return text;
 }

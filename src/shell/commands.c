@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "rtsh/image.h"
+#include "rtsh/mesh.h"
 #include "rtsh/num.h"
 #include "rtsh/rtfile.h"
 #include "shell/answer.h"
@@ -38,6 +39,30 @@ static const char *settings_help(void)
 	return text;
 }
 
+/* `help load` and `help save`: the formats, from the model readers' table
+ * (mesh_load.c) and the image table (image.c). */
+static const char *load_help(void)
+{
+	static char text[512];
+	char models[256];
+	mesh_format_list(models, sizeof models);
+	snprintf(text, sizeof text, "model formats: %s\n", models);
+	return text;
+}
+
+static const char *save_help(void)
+{
+	static char text[2048];
+	size_t used = (size_t)snprintf(text, sizeof text, "image formats:\n");
+	const image_type *t;
+	for (size_t i = 0; (t = image_type_at(i)) && used < sizeof text; i++)
+		used += (size_t)snprintf(text + used, sizeof text - used, "  %-6s %s\n", t->ext, t->help);
+	if (used < sizeof text)
+		snprintf(text + used, sizeof text - used, "  %-6s %s\n  %-6s %s\n", ".ans",
+		         "the picture as ANSI text (the terminal's cells)", ".rt", "the scene");
+	return text;
+}
+
 /* More for `help COMMAND` than its usage and one line (text, or made by
  * gen from a table). */
 static const struct {
@@ -46,6 +71,8 @@ static const struct {
 } details[] = {
 	{"view", NULL, keymode_help_text},
 	{"set", NULL, settings_help},
+	{"load", NULL, load_help},
+	{"save", NULL, save_help},
 	{"add", "examples: add sp 0,1,0 1 255,0,0 texture=earth.png\n"
 	        "          add mesh bunny.obj 0,0.5,0 0,1,0 1 200,200,200 smooth=1 crease=60\n"
 	        "          add sky sky.hdr 1 90   (an HDR sky, turned 90 degrees)\n"

@@ -22,6 +22,7 @@
 #include "base/abuf.h"
 #include "term/caps.h"
 #include "term/frame.h"
+#include "term/encoder.h"
 #include "term/pixels.h"
 
 #define STR(x) #x
@@ -183,7 +184,8 @@ int preview_main(const rtsh_options *o)
 	abuf a;
 	abuf_init(&a);
 	if (pm != PIXELS_OFF) {
-		if (!pixels_encode(pm, &a, rgb, w, h, cols, rows))
+		const encoder_ops *e = encoder_pixels(pm); /* by name, encoder.c's table */
+		if (!e || !e->picture(&a, rgb, w, h, cols, rows))
 			a.failed = true;
 	} else {
 		frame *f = frame_new_symbols(cols, rows, pal, sym);

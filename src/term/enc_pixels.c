@@ -300,16 +300,31 @@ static encoder *iterm_open(const encoder_geom *g)
 	return pix_open_mode(g, &encoder_iterm, PIXELS_ITERM);
 }
 
-#define PIXEL_OPS(NAME, OPEN)                                                                      \
+static bool kitty_picture(abuf *out, const uint8_t *rgb, int w, int h, int cols, int rows)
+{
+	return pixels_encode(PIXELS_KITTY, out, rgb, w, h, cols, rows);
+}
+
+static bool sixel_picture(abuf *out, const uint8_t *rgb, int w, int h, int cols, int rows)
+{
+	return pixels_encode(PIXELS_SIXEL, out, rgb, w, h, cols, rows);
+}
+
+static bool iterm_picture(abuf *out, const uint8_t *rgb, int w, int h, int cols, int rows)
+{
+	return pixels_encode(PIXELS_ITERM, out, rgb, w, h, cols, rows);
+}
+
+#define PIXEL_OPS(NAME, OPEN, PICTURE)                                                             \
 	{                                                                                          \
 		.name = NAME, .canvas = pix_canvas, .open = OPEN, .close = pix_close, .put = pix_put, \
 		.clear = pix_clear, .invalidate = pix_invalidate, .update = pix_update,            \
-		.dirty = pix_dirty, .keep_shown = pix_keep_shown,                                  \
+		.dirty = pix_dirty, .keep_shown = pix_keep_shown, .picture = PICTURE,              \
 	}
 
-const encoder_ops encoder_kitty = PIXEL_OPS("kitty", kitty_open);
-const encoder_ops encoder_sixel = PIXEL_OPS("sixel", sixel_open);
-const encoder_ops encoder_iterm = PIXEL_OPS("iterm", iterm_open);
+const encoder_ops encoder_kitty = PIXEL_OPS("kitty", kitty_open, kitty_picture);
+const encoder_ops encoder_sixel = PIXEL_OPS("sixel", sixel_open, sixel_picture);
+const encoder_ops encoder_iterm = PIXEL_OPS("iterm", iterm_open, iterm_picture);
 
 /* One picture in the given protocol, for callers that hold no encoder
  * (the batch preview). */

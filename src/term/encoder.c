@@ -22,6 +22,14 @@ const encoder_ops *encoder_find(const char *name)
 	return NULL;
 }
 
+const encoder_ops *encoder_pixels(pixels_mode m)
+{
+	if (m == PIXELS_OFF || m == PIXELS_AUTO)
+		return NULL;
+	const encoder_ops *e = encoder_find(pixels_mode_name(m));
+	return e && e->picture ? e : NULL;
+}
+
 const encoder_ops *encoder_symbols(symbols_kind k)
 {
 	switch (k) {

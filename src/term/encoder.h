@@ -20,6 +20,7 @@
 
 #include "base/abuf.h"
 #include "term/frame.h"
+#include "term/pixels.h"
 
 /* Where the picture goes and what the terminal is like. */
 typedef struct encoder_geom {
@@ -43,7 +44,7 @@ typedef struct encoder_geom {
 typedef struct encoder encoder;
 
 typedef struct encoder_ops {
-	const char *name;
+	const char *name;    /* a pixel encoder's: its value of the `pixels` setting */
 	/* The pixel canvas of an area: half blocks give cols x 2*rows. */
 	void (*canvas)(const encoder_geom *g, int *w, int *h);
 	/* A new encoder, every cell at the default background; NULL when
@@ -67,6 +68,10 @@ typedef struct encoder_ops {
 	/* Lossy damage: parts that moved by at most tol (sRGB levels) need
 	 * not be sent; 0: exact. NULL when the encoder is always exact. */
 	void (*set_lossy)(encoder *e, int tol);
+	/* Pixel encoders: one whole picture of w x h sRGB pixels over cols x
+	 * rows cells, for callers that hold no encoder (the batch preview);
+	 * false when out of memory. NULL for cell encoders. */
+	bool (*picture)(abuf *out, const uint8_t *rgb, int w, int h, int cols, int rows);
 } encoder_ops;
 
 /* Every encoder starts with this. */
@@ -88,6 +93,9 @@ extern const encoder_ops encoder_kitty, encoder_sixel, encoder_iterm;
 extern const encoder_ops *const encoder_table[];
 /* The encoder called name, or NULL. */
 const encoder_ops *encoder_find(const char *name);
+/* The pixel encoder of a `pixels` value other than off and auto (by its
+ * name, pixels.h); NULL when there is none. */
+const encoder_ops *encoder_pixels(pixels_mode m);
 
 /* Shorthands for e->ops->... */
 static inline void encoder_close(encoder *e)

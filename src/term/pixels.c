@@ -15,17 +15,27 @@
 
 #include <png.h>
 
-static const char *const mode_names[] = {"off", "kitty", "sixel", "iterm", "auto"};
+#include "rtsh/settings.h"
+
+/* The names are the `pixels` setting's choices (settings.c): off, kitty,
+ * sixel, iterm, auto, then any other pixel encoder's (encoder.c). */
+static const setting_def *pixels_setting(void)
+{
+	rt_error err;
+	return settings_find("pixels", &err);
+}
 
 const char *pixels_mode_name(pixels_mode m)
 {
-	return m >= PIXELS_OFF && m <= PIXELS_AUTO ? mode_names[m] : "off";
+	const setting_def *d = pixels_setting();
+	return d && (int)m >= 0 && (int)m < settings_choices(d) ? d->choices[m] : "off";
 }
 
 bool pixels_mode_parse(const char *s, pixels_mode *m)
 {
-	for (int i = PIXELS_OFF; i <= PIXELS_AUTO; i++)
-		if (strcmp(s, mode_names[i]) == 0) {
+	const setting_def *d = pixels_setting();
+	for (int i = 0; d && i < settings_choices(d); i++)
+		if (strcmp(s, d->choices[i]) == 0) {
 			*m = (pixels_mode)i;
 			return true;
 		}

@@ -489,10 +489,7 @@ bool screen_set_pixels(screen *s, int mode)
 		s->cell_h = c->cell_h;
 		cell = true;
 	}
-	const encoder_ops *ops = mode == PIXELS_KITTY   ? &encoder_kitty
-	                         : mode == PIXELS_SIXEL ? &encoder_sixel
-	                         : mode == PIXELS_ITERM ? &encoder_iterm
-	                                                : NULL;
+	const encoder_ops *ops = encoder_pixels((pixels_mode)mode); /* by name, encoder.c's table */
 	if (s->cell_w <= 0 || s->cell_h <= 0)
 		ops = NULL;
 	if (ops == s->pix_ops && !(ops && cell))

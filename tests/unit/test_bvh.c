@@ -69,7 +69,7 @@ static scene *random_scene(uint64_t seed, size_t n, double region, double size, 
 {
 	test_rng g = {seed};
 	scene *s = scene_new();
-	camera cam = {v3(0, 0, -3 * region), v3(0, 0, 1), 60, false, 0};
+	camera cam = {v3(0, 0, -3 * region), v3(0, 0, 1), 60, false, 0, 0};
 	assert_true(scene_add_camera(s, &cam, NULL));
 	for (size_t i = 0; i < n; i++) {
 		obj_kind k = (obj_kind)(i % OBJ_KIND_COUNT);
@@ -202,7 +202,7 @@ static void test_rays_in_box_planes(void **state)
 {
 	(void)state;
 	scene *s = scene_new();
-	camera cam = {v3(0, 0, -10), v3(0, 0, 1), 60, false, 0};
+	camera cam = {v3(0, 0, -10), v3(0, 0, 1), 60, false, 0, 0};
 	assert_true(scene_add_camera(s, &cam, NULL));
 	for (int x = 0; x < 6; x++)
 		for (int y = 0; y < 6; y++) {

@@ -59,7 +59,7 @@ static void test_undo_redo_restore_every_state(void **state)
 	STEP(editor_insert_object(ed, 1, &o, &err));
 	STEP(editor_delete_object(ed, 0, &err));
 	STEP(editor_delete_light(ed, 1, &err));
-	STEP(editor_add_camera(ed, &(camera){v3(1, 2, 3), v3(0, 0, 1), 40, false, 0}, &err));
+	STEP(editor_add_camera(ed, &(camera){v3(1, 2, 3), v3(0, 0, 1), 40, false, 0, 0}, &err));
 	STEP(editor_select_camera(ed, 1, &err));
 	STEP(editor_delete_camera(ed, 0, &err));
 	STEP(editor_add_line(ed, "sp 1,1,1 0.5 0,255,0", "add", 0, NULL, &err));
@@ -222,7 +222,7 @@ static void test_big_scene_edits_are_cheap(void **state)
 	(void)state;
 	scene *s = scene_new();
 	rt_error err;
-	assert_true(scene_add_camera(s, &(camera){v3(0, 0, -5), v3(0, 0, 1), 70, false, 0}, &err));
+	assert_true(scene_add_camera(s, &(camera){v3(0, 0, -5), v3(0, 0, 1), 70, false, 0, 0}, &err));
 	object o = object_make(OBJ_SPHERE, v3(255, 0, 0));
 	for (int i = 0; i < 200000; i++) {
 		o.pos = v3(i, 0, 0);

@@ -583,6 +583,406 @@ static void test_camera_frustum(void **state)
 	scene_free(s);
 }
 
+/* A camera turned 90 degrees about its own axis (the node's rotation about
+ * Z: the camera's up +Y goes to -X in the file, +X once the reader mirrors
+ * X; its right +X goes to +Y). rtsh's upright camera looking along -Z has
+ * right = (0,1,0) x (0,0,-1) = (-1,0,0) and up (0,1,0): the file's up is
+ * minus the upright right, a roll of -90 degrees (the up turned towards the
+ * left). The view's up is then (1,0,0) and its right (0,1,0), and the save
+ * keeps the roll. */
+static void test_camera_roll(void **state)
+{
+	(void)state;
+	double h = sqrt(0.5);
+	char rest[1024];
+	snprintf(rest, sizeof rest,
+	         "\"nodes\":[{\"mesh\":0},{\"camera\":0,\"translation\":[0,0,5],\"rotation\":[0,0,%.17g,%.17g]}],"
+	         "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":1,\"aspectRatio\":2,\"znear\":0.1}}],",
+	         h, h);
+	char *text = tri_gltf(unit_tri, rest);
+	rt_error err = {0};
+	const char *path = tmp_text("roll.gltf", text);
+	free(text);
+	scene *s = rt_load_file(path, NULL, &err);
+	if (!s)
+		fail_msg("%s", err.msg);
+	assert_int_equal(s->ncams, 1);
+	assert_near(s->cams[0].roll, -90, 1e-9);
+	cam_view v = cam_view_make(&s->cams[0]);
+	assert_vec_near(v.fwd, v3(0, 0, -1), 1e-12);
+	assert_vec_near(v.up, v3(1, 0, 0), 1e-12);
+	assert_vec_near(v.right, v3(0, 1, 0), 1e-12);
+	/* the middle of the top row: up by tan(yfov / 2) */
+	ray top = cam_ray(&v, 100, 0, 200, 100);
+	assert_vec_near(top.d, v3_norm(v3(tan(0.5), 0, -1)), 1e-12);
+	char rt[256];
+	snprintf(rt, sizeof rt, "%s/roll.rt", tmpdir);
+	assert_true(rt_save(s, rt, &err));
+	scene *t = rt_load_file(rt, NULL, &err);
+	if (!t)
+		fail_msg("%s", err.msg);
+	assert_true(scene_equal(s, t));
+	scene_free(t);
+	scene_free(s);
+}
+
+/* Nodes as objects: two nodes place the unit triangle, the second moved by
+ * (5,0,0). Each becomes a mesh object of its own (node=0, node=1). Node 1's
+ * triangle, mirrored in X, is (-6,0,0) (-5,1,0) (-5,0,1): its plane is
+ * (x + 6) - y - z = 0, so the ray along +Z through x = -5.5, y = 0.2 meets
+ * it at z = 0.3 (barycentric 0.2 and 0.3, inside), from z = -10 at
+ * t = 10.3. Moved up by 1 as any object is moved, the ray through y = 1.2
+ * meets it at the same z. save keeps node=. */
+static void test_nodes_as_objects(void **state)
+{
+	(void)state;
+	char *text = tri_gltf(unit_tri, "\"nodes\":[{\"mesh\":0},{\"mesh\":0,\"translation\":[5,0,0]},"
+	                                "{\"camera\":0,\"translation\":[0,0,9]}],"
+	                                "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":1}}],");
+	rt_error err = {0};
+	const char *path = tmp_text("nodes.gltf", text);
+	free(text);
+	scene *s = rt_load_file(path, NULL, &err);
+	if (!s)
+		fail_msg("%s", err.msg);
+	assert_int_equal(s->nobjs, 3); /* and the stage's floor (no lights): y = 0, under the rays */
+	assert_int_equal(s->objs[0].node, 0);
+	assert_int_equal(s->objs[1].node, 1);
+	world *w = world_build(s, &err);
+	if (!w)
+		fail_msg("%s", err.msg);
+	hit h;
+	ray r = {v3(-5.5, 0.2, -10), v3(0, 0, 1)};
+	assert_true(world_intersect(w, &r, 0, INFINITY, &h));
+	assert_int_equal(h.object, 1);
+	assert_near(h.t, 10.3, 1e-6);
+	world_free(w);
+	s->objs[1].pos = v3_add(s->objs[1].pos, v3(0, 1, 0));
+	w = world_build(s, &err);
+	if (!w)
+		fail_msg("%s", err.msg);
+	r.o = v3(-5.5, 1.2, -10);
+	assert_true(world_intersect(w, &r, 0, INFINITY, &h));
+	assert_int_equal(h.object, 1);
+	assert_near(h.t, 10.3, 1e-6);
+	r.o = v3(-5.5, 0.2, -10); /* where it was: nothing now */
+	assert_false(world_intersect(w, &r, 0, INFINITY, &h));
+	world_free(w);
+	char rt[256];
+	snprintf(rt, sizeof rt, "%s/nodes.rt", tmpdir);
+	assert_true(rt_save(s, rt, &err));
+	scene *t = rt_load_file(rt, NULL, &err);
+	if (!t)
+		fail_msg("%s", err.msg);
+	assert_true(scene_equal(s, t));
+	assert_int_equal(t->objs[1].node, 1);
+	scene_free(t);
+	scene_free(s);
+	/* a node the scene does not place, and node= on another format */
+	mesh *m = mesh_read_gltf_node(path, 7, &err);
+	assert_null(m);
+	assert_non_null(strstr(err.msg, "node 7: not a node the scene places"));
+}
+
+/* --- a PNG of one texel, for textures the tests embed --- */
+
+static uint32_t crc32_of(const unsigned char *p, size_t n)
+{
+	uint32_t c = 0xffffffffu;
+	for (size_t i = 0; i < n; i++) {
+		c ^= p[i];
+		for (int k = 0; k < 8; k++)
+			c = c & 1 ? 0xedb88320u ^ (c >> 1) : c >> 1;
+	}
+	return c ^ 0xffffffffu;
+}
+
+static void put32(unsigned char *p, uint32_t v)
+{
+	p[0] = (unsigned char)(v >> 24);
+	p[1] = (unsigned char)(v >> 16);
+	p[2] = (unsigned char)(v >> 8);
+	p[3] = (unsigned char)v;
+}
+
+/* A 1x1 8-bit RGB PNG of (r, g, b): the IDAT a zlib stream of one stored
+ * block (filter byte 0 and the texel); 69 bytes into out. */
+static size_t png_1x1(unsigned char r, unsigned char g, unsigned char b, unsigned char *out)
+{
+	static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+	size_t n = 0;
+	memcpy(out, sig, 8);
+	n = 8;
+	unsigned char ihdr[17] = {'I', 'H', 'D', 'R', 0, 0, 0, 1, 0, 0, 0, 1, 8, 2, 0, 0, 0};
+	put32(out + n, 13);
+	memcpy(out + n + 4, ihdr, 17);
+	put32(out + n + 21, crc32_of(ihdr, 17));
+	n += 25;
+	unsigned char raw[4] = {0, r, g, b};
+	uint32_t a = 1, b2 = 0; /* adler32 */
+	for (int i = 0; i < 4; i++) {
+		a = (a + raw[i]) % 65521;
+		b2 = (b2 + a) % 65521;
+	}
+	unsigned char idat[4 + 2 + 5 + 4 + 4] = {'I', 'D', 'A', 'T', 0x78, 0x01, 0x01, 4, 0, 0xfb, 0xff};
+	memcpy(idat + 11, raw, 4);
+	put32(idat + 15, b2 << 16 | a);
+	put32(out + n, sizeof idat - 4);
+	memcpy(out + n + 4, idat, sizeof idat);
+	put32(out + n + 4 + sizeof idat, crc32_of(idat, sizeof idat));
+	n += 4 + sizeof idat + 4;
+	unsigned char iend[4] = {'I', 'E', 'N', 'D'};
+	put32(out + n, 0);
+	memcpy(out + n + 4, iend, 4);
+	put32(out + n + 8, crc32_of(iend, 4));
+	return n + 12;
+}
+
+/* The metallic-roughness texture in shading: a triangle with uv, metallic
+ * 0.5 and roughness 0.8, and a texture of one texel (R, G, B) = (0, 128,
+ * 255), read linear (glTF: G scales roughness, B metallic). At any point:
+ * roughness 0.8 x 128/255 = 0.40157, metallic 0.5 x 255/255 = 0.5. */
+static void test_metallic_roughness_texture(void **state)
+{
+	(void)state;
+	unsigned char bin[68];
+	const float pos[9] = {-1, -1, 0, 1, -1, 0, 0, 1, 0}, uv[6] = {0, 0, 1, 0, 0.5f, 1};
+	const uint16_t idx[4] = {0, 1, 2, 0};
+	memcpy(bin, pos, 36);
+	memcpy(bin + 36, uv, 24);
+	memcpy(bin + 60, idx, 8);
+	char data[128], png64[128];
+	b64(bin, sizeof bin, data);
+	unsigned char png[80];
+	size_t npng = png_1x1(0, 128, 255, png);
+	b64(png, npng, png64);
+	char text[4096];
+	snprintf(text, sizeof text,
+	         "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0},{\"camera\":0,\"translation\":[0,0,5]}],"
+	         "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":1}}],"
+	         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"indices\":2,"
+	         "\"material\":0}]}],"
+	         "\"materials\":[{\"pbrMetallicRoughness\":{\"metallicFactor\":0.5,\"roughnessFactor\":0.8,"
+	         "\"metallicRoughnessTexture\":{\"index\":0}}}],"
+	         "\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],"
+	         "\"buffers\":[{\"byteLength\":68,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
+	         "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":24},"
+	         "{\"buffer\":0,\"byteOffset\":60,\"byteLength\":6}],"
+	         "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+	         "{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"},"
+	         "{\"bufferView\":2,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}",
+	         png64, data);
+	rt_error err = {0};
+	scene *s = rt_load_file(tmp_text("mr.gltf", text), NULL, &err);
+	if (!s)
+		fail_msg("%s", err.msg);
+	world *w = world_build(s, &err);
+	if (!w)
+		fail_msg("%s", err.msg);
+	hit h;
+	ray r = {v3(0, -0.2, 5), v3(0, 0, -1)};
+	assert_true(world_intersect(w, &r, 0, INFINITY, &h));
+	assert_true(h.has_uv);
+	const mat_lin *m = &w->mats[h.mat];
+	assert_int_equal(m->family, MAT_PBR);
+	assert_near(m->pbr.roughness, 0.8, 1e-6);
+	assert_near(m->pbr.metallic, 0.5, 1e-6);
+	mat_lin tmp;
+	const mat_lin *t = hit_material(m, &h, &tmp);
+	assert_near(t->pbr.roughness, 0.8 * 128.0 / 255.0, 1e-6);
+	assert_near(t->pbr.metallic, 0.5, 1e-6);
+	world_free(w);
+	scene_free(s);
+}
+
+/* KHR_texture_transform with a rotation. The triangle of the test above,
+ * hit at (0, -0.2): barycentrics 0.3 and 0.4 for the second and third
+ * corners, so the file's uv there is 0.3 (1,0) + 0.4 (0.5,1) = (0.5, 0.4).
+ * Offset (0.1, 0.2), rotation pi/2, scale (2, 0.5), by the extension's
+ * formula (u' = o_u + cos s_u u - sin s_v v, v' = o_v + sin s_u u + cos s_v v):
+ * u' = 0.1 - 0.5 x 0.4 = -0.1 and v' = 0.2 + 2 x 0.5 = 1.2, which rtsh's v
+ * (up) makes 1 - 1.2 = -0.2. The tangents follow: dp/du' and dp/dv' map back
+ * to the moves of the hit point that change u' or v' alone. */
+static void test_texture_rotation(void **state)
+{
+	(void)state;
+	unsigned char bin[68];
+	const float pos[9] = {-1, -1, 0, 1, -1, 0, 0, 1, 0}, uv[6] = {0, 0, 1, 0, 0.5f, 1};
+	const uint16_t idx[4] = {0, 1, 2, 0};
+	memcpy(bin, pos, 36);
+	memcpy(bin + 36, uv, 24);
+	memcpy(bin + 60, idx, 8);
+	char data[128], png64[128];
+	b64(bin, sizeof bin, data);
+	unsigned char png[80];
+	b64(png, png_1x1(200, 100, 50, png), png64);
+	char text[4096];
+	snprintf(text, sizeof text,
+	         "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0},{\"camera\":0,\"translation\":[0,0,5]}],"
+	         "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":1}}],"
+	         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"indices\":2,"
+	         "\"material\":0}]}],"
+	         "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0,\"extensions\":"
+	         "{\"KHR_texture_transform\":{\"offset\":[0.1,0.2],\"rotation\":%.17g,\"scale\":[2,0.5]}}}}}],"
+	         "\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],"
+	         "\"buffers\":[{\"byteLength\":68,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
+	         "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":24},"
+	         "{\"buffer\":0,\"byteOffset\":60,\"byteLength\":6}],"
+	         "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+	         "{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"},"
+	         "{\"bufferView\":2,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}",
+	         M_PI / 2, png64, data);
+	rt_error err = {0};
+	scene *s = rt_load_file(tmp_text("rot.gltf", text), NULL, &err);
+	if (!s)
+		fail_msg("%s", err.msg);
+	world *w = world_build(s, &err);
+	if (!w)
+		fail_msg("%s", err.msg);
+	hit h;
+	ray r = {v3(0, -0.2, 5), v3(0, 0, -1)};
+	assert_true(world_intersect(w, &r, 0, INFINITY, &h));
+	assert_true(h.has_uv);
+	assert_near(h.u, -0.1, 1e-6);
+	assert_near(h.v, -0.2, 1e-6);
+	/* a step along dp/du' changes u' by its length and v' not at all: seen
+	 * through a second hit a little along it */
+	vec3 step = v3_scale(h.dpdu, 1e-3);
+	hit h2;
+	ray r2 = {v3_add(r.o, step), r.d};
+	assert_true(world_intersect(w, &r2, 0, INFINITY, &h2));
+	assert_near(h2.u - h.u, 1e-3, 1e-7);
+	assert_near(h2.v - h.v, 0, 1e-7);
+	world_free(w);
+	scene_free(s);
+}
+
+/* The emissive texture: the triangle above with emissiveFactor (1,1,1),
+ * KHR_materials_emissive_strength 2 and an emissive texture of one sRGB
+ * texel (255, 128, 0), seen straight on in path mode on black: the pixel is
+ * the emission, 2 x (1, ((128/255 + 0.055) / 1.055)^2.4, 0) =
+ * (2, 0.431722, 0). Such a material is left to the paths (no emitters). */
+static void test_emissive_texture(void **state)
+{
+	(void)state;
+	unsigned char bin[68];
+	const float pos[9] = {-1, -1, 0, 1, -1, 0, 0, 1, 0}, uv[6] = {0, 0, 1, 0, 0.5f, 1};
+	const uint16_t idx[4] = {0, 1, 2, 0};
+	memcpy(bin, pos, 36);
+	memcpy(bin + 36, uv, 24);
+	memcpy(bin + 60, idx, 8);
+	char data[128], png64[128];
+	b64(bin, sizeof bin, data);
+	unsigned char png[80];
+	b64(png, png_1x1(255, 128, 0, png), png64);
+	char text[4096];
+	snprintf(text, sizeof text,
+	         "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0},{\"camera\":0,\"translation\":[0,-0.2,5]}],"
+	         "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.01}}],"
+	         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"indices\":2,"
+	         "\"material\":0}]}],"
+	         "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1]},\"emissiveFactor\":[1,1,1],"
+	         "\"emissiveTexture\":{\"index\":0},"
+	         "\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":2}}}],"
+	         "\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],"
+	         "\"buffers\":[{\"byteLength\":68,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
+	         "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":24},"
+	         "{\"buffer\":0,\"byteOffset\":60,\"byteLength\":6}],"
+	         "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+	         "{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"},"
+	         "{\"bufferView\":2,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}",
+	         png64, data);
+	rt_error err = {0};
+	scene *s = rt_load_file(tmp_text("emit.gltf", text), NULL, &err);
+	if (!s)
+		fail_msg("%s", err.msg);
+	world *w = world_build(s, &err);
+	if (!w)
+		fail_msg("%s", err.msg);
+	assert_int_equal(w->nemitters, 0);
+	render_settings set = render_settings_default();
+	set.width = set.height = 1;
+	set.samples = 4;
+	set.depth = 1;
+	set.threads = 1;
+	set.mode = MODE_PATH;
+	framebuffer *fb = render_image(w, &set, NULL, NULL, NULL, &err);
+	assert_non_null(fb);
+	double g = pow((128.0 / 255 + 0.055) / 1.055, 2.4);
+	assert_near(fb->rgb[0], 2.0, 1e-5);
+	assert_near(fb->rgb[1], 2 * g, 1e-5);
+	assert_near(fb->rgb[2], 0.0, 1e-6);
+	fb_free(fb);
+	world_free(w);
+	scene_free(s);
+}
+
+/* A lamp made of a glTF mesh is sampled directly, as the .rt emitters are:
+ * a 2 x 2 square of two triangles, emissiveFactor 1 x
+ * KHR_materials_emissive_strength 2 (Le = 2), 1 above a Lambert floor of
+ * albedo 0.8 at the origin, seen by a narrow camera at depth 1. By hand,
+ * the form factor from the origin to a parallel rectangle whose corner is
+ * straight above it, sides a and b at height h, X = a/h, Y = b/h, is
+ *   F = (X / sqrt(1+X^2) atan(Y / sqrt(1+X^2)) + Y / sqrt(1+Y^2) atan(X / sqrt(1+Y^2))) / (2 pi);
+ * the square is four such (X = Y = 1): F = 4 (2 / sqrt 2) atan(1 / sqrt 2) / (2 pi)
+ * = 0.554128, and the floor sends back 0.8 Le F. The two triangles are the
+ * world's emitters; the paths alone give the same. */
+static void test_mesh_lamp(void **state)
+{
+	(void)state;
+	unsigned char bin[60];
+	const float pos[12] = {-1, 0, -1, 1, 0, -1, 1, 0, 1, -1, 0, 1};
+	const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+	memcpy(bin, pos, 48);
+	memcpy(bin + 48, idx, 12);
+	char data[128];
+	b64(bin, sizeof bin, data);
+	char text[2048];
+	snprintf(text, sizeof text,
+	         "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0}],"
+	         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":0}]}],"
+	         "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1]},\"emissiveFactor\":[1,1,1],"
+	         "\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":2}}}],"
+	         "\"buffers\":[{\"byteLength\":60,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
+	         "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":12}],"
+	         "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
+	         "{\"bufferView\":1,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}]}",
+	         data);
+	tmp_text("lamp.gltf", text);
+	const char *rt = tmp_text("lamp.rt", "C 0,0.5,-4 0,-0.5,4 0.2\npl 0,0,0 0,1,0 1,1,1 255,255,255 0.8 0 1 0\n"
+	                                     "mesh lamp.gltf 0,1,0 0,1,0 2\n");
+	rt_error err = {0};
+	scene *s = rt_load_file(rt, NULL, &err);
+	if (!s)
+		fail_msg("%s", err.msg);
+	double f = 4 * (2 / sqrt(2)) * atan(1 / sqrt(2)) / (2 * M_PI), want = 0.8 * 2 * f;
+	double got[2];
+	for (int k = 0; k < 2; k++) {
+		world *w = world_build(s, &err);
+		if (!w)
+			fail_msg("%s", err.msg);
+		assert_int_equal(w->nemitters, 2);
+		if (k)
+			w->nemitters = 0;
+		render_settings set = render_settings_default();
+		set.width = set.height = 1;
+		set.samples = k ? 400000 : 20000;
+		set.depth = 1;
+		set.threads = 2;
+		set.mode = MODE_PATH;
+		set.seed = 5;
+		framebuffer *fb = render_image(w, &set, NULL, NULL, NULL, &err);
+		assert_non_null(fb);
+		got[k] = fb->rgb[1];
+		fb_free(fb);
+		world_free(w);
+	}
+	print_message("expected %.5f, sampled %.5f, paths only %.5f\n", want, got[0], got[1]);
+	assert_near(got[0], want, 0.005 * want);
+	assert_near(got[1], want, 0.01 * want);
+	scene_free(s);
+}
+
 /* A file with neither lights nor emissive materials gets the model
  * viewer's stage lighting (ambient, a lamp, the sky, a floor) and a note
  * for the status line; with no camera it is framed as the viewer frames a
@@ -622,6 +1022,12 @@ int main(void)
 	    cmocka_unit_test(test_point_light_candela),
 	    cmocka_unit_test(test_spot_cone),
 	    cmocka_unit_test(test_camera_frustum),
+	    cmocka_unit_test(test_camera_roll),
+	    cmocka_unit_test(test_nodes_as_objects),
+	    cmocka_unit_test(test_metallic_roughness_texture),
+	    cmocka_unit_test(test_mesh_lamp),
+	    cmocka_unit_test(test_texture_rotation),
+	    cmocka_unit_test(test_emissive_texture),
 	    cmocka_unit_test(test_stage_lighting),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);

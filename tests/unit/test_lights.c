@@ -45,7 +45,7 @@ static world *one_emitter(object o, const emitter **e)
 {
 	scene *s = scene_new();
 	assert_non_null(s);
-	camera c = {v3(0, 0, -10), v3(0, 0, 1), 60, false, 0};
+	camera c = {v3(0, 0, -10), v3(0, 0, 1), 60, false, 0, 0};
 	assert_true(scene_add_camera(s, &c, NULL));
 	o.mat.emission = 1;
 	assert_true(scene_add_object(s, &o, NULL));

@@ -252,6 +252,16 @@ static void test_scan_matches_strtod(void **state)
 	assert_int_equal(num_scan_str("1e99999999999", 1e300, &v), NUM_BIG);
 	assert_int_equal(num_scan_str("0e99999999999", 1, &v), NUM_OK);
 	assert_true(v == 0);
+	/* the grammar (num.h): what is refused */
+	static const char *const bad[] = {"", ".", "+", "-.", "1e", "1e+", "e5", "1.2.3", "1,5", " 1", "1 ",
+	                                  "0x10", "inf", "nan", "1e5x", "--1", "1.5e-", "12345678901234567890x"};
+	for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++)
+		assert_int_not_equal(num_scan_str(bad[i], 1e300, &v), NUM_OK);
+	static const char *const good[] = {"1.", ".5", "+.5e-1", "-0.", "00012", "1E3", "12345678901234567890"};
+	for (size_t i = 0; i < sizeof good / sizeof good[0]; i++) {
+		assert_int_equal(num_scan_str(good[i], 1e300, &v), NUM_OK);
+		assert_true(v == strtod(good[i], NULL));
+	}
 	uint64_t x = 88172645463325252ull; /* xorshift64 (Marsaglia 2003) */
 	for (int i = 0; i < 200000; i++) {
 		char t[64];

@@ -28,7 +28,7 @@ static job_config sample(test_rng *r)
 	c.set.seed = (uint64_t)(trand(r) * 4294967296.0) << 32 | (uint64_t)(trand(r) * 4294967296.0);
 	c.set.exposure = trange(r, -10, 10);
 	c.set.denoise = (int)trange(r, DENOISE_AUTO, DENOISE_OFF + 0.999);
-	c.set.pixels = (int)trange(r, 0, 4.999);
+	c.set.pixels = (int)trange(r, 0, 4.999); /* sent by no one (assert_same) */
 	c.set.symbols = (int)trange(r, 0, 4.999);
 	c.files = (uint64_t)(trand(r) * 1e15);
 	return c;
@@ -52,8 +52,10 @@ static void assert_same(const job_config *a, const job_config *b)
 	assert_true(a->set.seed == b->set.seed);
 	assert_memory_equal(&a->set.exposure, &b->set.exposure, sizeof(double));
 	assert_int_equal(a->set.denoise, b->set.denoise);
-	assert_int_equal(a->set.pixels, b->set.pixels);
-	assert_int_equal(a->set.symbols, b->set.symbols);
+	/* the terminal's choices do not travel: the receiver has the defaults */
+	render_settings def = render_settings_default();
+	assert_int_equal(b->set.pixels, def.pixels);
+	assert_int_equal(b->set.symbols, def.symbols);
 	assert_true(a->files == b->files);
 }
 
@@ -89,7 +91,8 @@ static void test_round_trip(void **state)
 /* The bytes, from the layout in wire.h: header 16 bytes, seven i32 (28),
  * then the settings in the settings table's order: width at 44, height 48,
  * samples 52, depth 56, mode 60, threads 64, seed 68, exposure 76,
- * denoise 84, pixels 88, symbols 92; files 96; little-endian. */
+ * denoise 84 (not the terminal's pixels and symbols); files 88;
+ * little-endian. */
 static void test_layout(void **state)
 {
 	(void)state;
@@ -107,7 +110,7 @@ static void test_layout(void **state)
 	unsigned char buf[WIRE_CONFIG_SIZE];
 	memset(buf, 0xee, sizeof buf);
 	wire_put_config(&a, buf);
-	static const unsigned char head[16] = {'R', 'T', 'S', 'H', 'M', 'P', 'I', 0, 3, 0, 0, 0, 88, 0, 0, 0};
+	static const unsigned char head[16] = {'R', 'T', 'S', 'H', 'M', 'P', 'I', 0, 4, 0, 0, 0, 80, 0, 0, 0};
 	assert_memory_equal(buf, head, 16);
 	static const unsigned char status[4] = {0xff, 0xff, 0xff, 0xff}, tile[4] = {0x0d, 0x0c, 0x0b, 0x0a},
 	                           prefetch[4] = {0xfe, 0xff, 0xff, 0xff}, width[4] = {0x34, 0x12, 0, 0},
@@ -122,8 +125,8 @@ static void test_layout(void **state)
 	assert_memory_equal(buf + 60, mode, 4);
 	assert_memory_equal(buf + 68, seed, 8);
 	assert_memory_equal(buf + 76, exposure, 8);
-	assert_memory_equal(buf + 96, files, 8);
-	for (int i = 104; i < WIRE_CONFIG_SIZE; i++)
+	assert_memory_equal(buf + 88, files, 8);
+	for (int i = 96; i < WIRE_CONFIG_SIZE; i++)
 		assert_int_equal(buf[i], 0);
 }
 
@@ -158,6 +161,9 @@ static void test_refused(void **state)
 	memcpy(buf, good, sizeof buf);
 	buf[8] = 2; /* version 2 (mode after threads) */
 	expect_refused(buf, "version 2");
+	memcpy(buf, good, sizeof buf);
+	buf[8] = 3; /* version 3 (with the terminal's pixels and symbols) */
+	expect_refused(buf, "version 3");
 	memcpy(buf, good, sizeof buf);
 	buf[60] = 7; /* mode */
 	expect_refused(buf, "mode = 7");

@@ -9,7 +9,7 @@
 
 static camera cam(vec3 pos, vec3 dir)
 {
-	camera c = {pos, dir, 60, false, 0};
+	camera c = {pos, dir, 60, false, 0, 0};
 	return c;
 }
 

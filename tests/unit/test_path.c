@@ -27,7 +27,7 @@ static scene *cam_scene(vec3 pos, vec3 dir, double fov)
 {
 	scene *s = scene_new();
 	assert_non_null(s);
-	camera c = {pos, dir, fov, false, 0};
+	camera c = {pos, dir, fov, false, 0, 0};
 	assert_true(scene_add_camera(s, &c, NULL));
 	return s;
 }

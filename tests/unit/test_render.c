@@ -25,7 +25,7 @@ static double srgb_decode(double code)
 static scene *base_scene(vec3 cam_pos, vec3 cam_dir, double fov)
 {
 	scene *s = scene_new();
-	camera c = {cam_pos, cam_dir, fov, false, 0};
+	camera c = {cam_pos, cam_dir, fov, false, 0, 0};
 	assert_true(scene_add_camera(s, &c, NULL));
 	return s;
 }

@@ -1143,7 +1143,7 @@ static scene *rand_scene(test_rng *r)
 	}
 	int ncams = 1 + (int)trange(r, 0, 3);
 	for (int i = 0; i < ncams; i++) {
-		camera c = {rand_vec(r, -50, 50), rand_dir(r), trange(r, 1, 179), false, 0};
+		camera c = {rand_vec(r, -50, 50), rand_dir(r), trange(r, 1, 179), false, 0, 0};
 		assert_true(scene_add_camera(s, &c, &err));
 	}
 	int nlights = (int)trange(r, 0, 4);

@@ -190,7 +190,7 @@ static double rendered_edges(uint32_t n, int edges)
 	edge_stats e = {0, 0, 0};
 	scene *s = scene_new();
 	assert_non_null(s);
-	camera c = {v3(0, 0, 0), v3(0, 0, 1), 60, false, 0};
+	camera c = {v3(0, 0, 0), v3(0, 0, 1), 60, false, 0, 0};
 	assert_true(scene_add_camera(s, &c, NULL));
 	object tri = object_make(OBJ_TRIANGLE, v3(255, 255, 255));
 	tri.mat.emission = 1;

@@ -14,7 +14,7 @@ static world *world_of(const object *objs, size_t n)
 	assert_non_null(s);
 	for (size_t i = 0; i < n; i++)
 		assert_true(scene_add_object(s, &objs[i], NULL));
-	camera c = {v3(0, 0, -10), v3(0, 0, 1), 60, false, 0};
+	camera c = {v3(0, 0, -10), v3(0, 0, 1), 60, false, 0, 0};
 	assert_true(scene_add_camera(s, &c, NULL));
 	world *w = world_build(s, NULL);
 	assert_non_null(w);

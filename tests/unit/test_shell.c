@@ -181,7 +181,7 @@ static void test_completion(void **state)
 	assert_candidates(complete_at_end(sh, "object 1 set ", &files),
 	                  "twist= fuzz= metal= ior= emit= checker= tube= texture= normalmap= bump= bumpscale= "
 	                  "uvscale= uvoffset= roughness= metallic= transmission= thin= att_color= att_dist= clearcoat= "
-	                  "clearcoat_roughness= specular_factor= specular_color= emit_color= multiscatter= smooth= crease=");
+	                  "clearcoat_roughness= specular_factor= specular_color= emit_color= multiscatter= smooth= crease= node=");
 	assert_candidates(complete_at_end(sh, "object 1 move ", &files), "");
 	assert_candidates(complete_at_end(sh, "obj 2 r", &files), "rotate");
 	assert_candidates(complete_at_end(sh, "light ", &files), "1 2 3");

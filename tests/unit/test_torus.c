@@ -32,7 +32,7 @@ static world *world_of(const object *o)
 	scene *s = scene_new();
 	assert_non_null(s);
 	assert_true(scene_add_object(s, o, NULL));
-	camera c = {v3(0, 0, -10), v3(0, 0, 1), 60, false, 0};
+	camera c = {v3(0, 0, -10), v3(0, 0, 1), 60, false, 0, 0};
 	assert_true(scene_add_camera(s, &c, NULL));
 	world *w = world_build(s, NULL);
 	assert_non_null(w);

@@ -72,6 +72,7 @@ typedef struct gl {
 	unsigned char *seen; /* per node: 1 visited */
 	int32_t *order;   /* the nodes the scene places, in walk order */
 	size_t norder;
+	long only;        /* build only this node's mesh (a node object); -1: all */
 } gl;
 
 static bool fail(gl *g, const char *where, const char *fmt, ...)
@@ -1133,19 +1134,30 @@ static bool material(gl *g, mesh_builder *b, texture **cache, size_t i, mesh_mat
 		return false;
 	const cJSON *tt = key(key(bt, "extensions"), "KHR_texture_transform");
 	if (tt) {
-		/* glTF: uv' = T(offset) R(rotation) S(scale) uv, with v down; in
-		 * rtsh's v (up, 1 - v): v' = (1 - offset_v - scale_v) + scale_v v.
-		 * A rotation is not carried (mat_tex has none) */
+		/* glTF: uv' = T(offset) R(rotation) S(scale) uv, v down, R's
+		 * columns (cos r, sin r) and (-sin r, cos r) (the extension's GLSL):
+		 *   u' = o_u + c s_u u - s s_v v,  v' = o_v + s s_u u + c s_v v;
+		 * in rtsh's v (up: 1 - v on both sides)
+		 *   u' = (o_u - s s_v) + c s_u u + s s_v v
+		 *   v' = (1 - o_v - c s_v) - s s_u u + c s_v v */
 		static const double o0[2] = {0, 0}, s0[2] = {1, 1};
-		double off[2], sc[2];
+		double off[2], sc[2], rot;
 		snprintf(w2, sizeof w2, "%s.pbrMetallicRoughness.baseColorTexture.extensions.KHR_texture_transform", where);
 		if (!get_nums(g, tt, "offset", w2, 2, -1e300, 1e300, o0, off) ||
-		    !get_nums(g, tt, "scale", w2, 2, -1e300, 1e300, s0, sc))
+		    !get_nums(g, tt, "scale", w2, 2, -1e300, 1e300, s0, sc) ||
+		    !get_num(g, tt, "rotation", w2, -1e300, 1e300, 0, &rot))
 			return false;
-		m->uvs[0] = (float)sc[0];
-		m->uvs[1] = (float)sc[1];
-		m->uvo[0] = (float)off[0];
-		m->uvo[1] = (float)(1 - off[1] - sc[1]);
+		double cr = cos(rot), sn = sin(rot);
+		if (rot == 0) {
+			cr = 1;
+			sn = 0;
+		}
+		m->uvs[0] = (float)(cr * sc[0]);
+		m->uvs[1] = (float)(cr * sc[1]);
+		m->uvx[0] = (float)(sn * sc[1]);
+		m->uvx[1] = (float)(-sn * sc[0]);
+		m->uvo[0] = (float)(off[0] - sn * sc[1]);
+		m->uvo[1] = (float)(1 - off[1] - cr * sc[1]);
 	}
 	snprintf(w2, sizeof w2, "%s.pbrMetallicRoughness.metallicRoughnessTexture", where);
 	if (!tex_info(g, b, cache, key(pbr, "metallicRoughnessTexture"), w2, false, &m->map_mr, &m->tex_mr))
@@ -1193,9 +1205,20 @@ static mesh *build(gl *g)
 	double ntri = 0, nvert = 0;
 	bool any_uv = false, need_default = false;
 	char where[WHERE_MAX];
+	if (g->only >= 0) {
+		bool placed = false;
+		for (size_t o = 0; o < g->norder; o++)
+			placed |= g->order[o] == g->only;
+		if (!placed)
+			return fail(g, NULL, "node %ld: not a node the scene places; expected one of its %zu nodes", g->only,
+			            g->nodes.n),
+			       NULL;
+	}
 	for (size_t o = 0; o < g->norder; o++) {
 		size_t i = (size_t)g->order[o];
 		long mi;
+		if (g->only >= 0 && (long)i != g->only)
+			continue;
 		snprintf(where, sizeof where, "nodes[%zu]", i);
 		if (!get_index(g, g->nodes.v[i], "mesh", where, g->meshes.n, "meshes", false, &mi))
 			return NULL;
@@ -1220,6 +1243,8 @@ static mesh *build(gl *g)
 	snprintf(what, sizeof what, "the model %s (%.0f triangles)", g->name, ntri);
 	if (!mem_check(ntri * MESH_PREPARE_BYTES + nvert * 64, what, g->err))
 		return NULL;
+	if (ntri == 0 && g->only >= 0)
+		return fail(g, NULL, "node %ld: no triangles; expected a node with a mesh of triangles", g->only), NULL;
 	if (ntri == 0)
 		return fail(g, NULL, "no triangles in the scene; expected a node with a mesh of triangles"), NULL;
 	/* the materials, and glTF's default after them when a primitive has none */
@@ -1251,6 +1276,8 @@ static mesh *build(gl *g)
 	for (size_t o = 0; o < g->norder; o++) {
 		size_t i = (size_t)g->order[o];
 		long mi;
+		if (g->only >= 0 && (long)i != g->only)
+			continue;
 		get_index(g, g->nodes.v[i], "mesh", "", g->meshes.n, "meshes", false, &mi); /* checked above */
 		if (mi < 0)
 			continue;
@@ -1273,9 +1300,9 @@ static mesh *build(gl *g)
 	return mb_finish(&b, g->err);
 }
 
-mesh *mesh_parse_gltf(const char *name, const char *dir, const char *buf, size_t len, rt_error *err)
+mesh *mesh_parse_gltf_node(const char *name, const char *dir, const char *buf, size_t len, long node, rt_error *err)
 {
-	gl g = {.name = name, .dir = dir, .err = err};
+	gl g = {.name = name, .dir = dir, .err = err, .only = node < 0 ? -1 : node};
 	mesh *m = NULL;
 	if (gl_open(&g, buf, len))
 		m = build(&g);
@@ -1283,7 +1310,17 @@ mesh *mesh_parse_gltf(const char *name, const char *dir, const char *buf, size_t
 	return m;
 }
 
+mesh *mesh_parse_gltf(const char *name, const char *dir, const char *buf, size_t len, rt_error *err)
+{
+	return mesh_parse_gltf_node(name, dir, buf, len, -1, err);
+}
+
 mesh *mesh_read_gltf(const char *path, rt_error *err)
+{
+	return mesh_read_gltf_node(path, -1, err);
+}
+
+mesh *mesh_read_gltf_node(const char *path, long node, rt_error *err)
 {
 	size_t len;
 	char *buf = rt_file_read(path, "model", &len, err);
@@ -1294,7 +1331,7 @@ mesh *mesh_read_gltf(const char *path, rt_error *err)
 	if (!dir)
 		rt_error_set(err, "%s: out of memory", path);
 	else
-		m = mesh_parse_gltf(path, dir, buf, len, err);
+		m = mesh_parse_gltf_node(path, dir, buf, len, node, err);
 	free(dir);
 	free(buf);
 	return m;
@@ -1319,7 +1356,8 @@ static bool info(gl *g, gltf_info *out)
 		nc += key(n, "camera") != NULL;
 		nl += key(key(n, "extensions"), "KHR_lights_punctual") != NULL;
 	}
-	if ((nc && !(out->cams = calloc(nc, sizeof *out->cams))) || (nl && !(out->lights = calloc(nl, sizeof *out->lights))))
+	if ((nc && !(out->cams = calloc(nc, sizeof *out->cams))) || (nl && !(out->lights = calloc(nl, sizeof *out->lights))) ||
+	    (g->norder && !(out->mesh_nodes = calloc(g->norder, sizeof *out->mesh_nodes))))
 		return fail(g, NULL, "out of memory");
 	for (size_t o = 0; o < g->norder; o++) {
 		size_t i = (size_t)g->order[o];
@@ -1407,6 +1445,8 @@ static bool info(gl *g, gltf_info *out)
 		/* emissive materials of the meshes placed */
 		if (!get_index(g, n, "mesh", where, g->meshes.n, "meshes", false, &mi))
 			return false;
+		if (mi >= 0)
+			out->mesh_nodes[out->nmesh_nodes++] = (long)i;
 		const cJSON *prs = mi >= 0 ? key(g->meshes.v[mi], "primitives") : NULL;
 		for (const cJSON *pr = cJSON_IsArray(prs) ? prs->child : NULL; pr; pr = pr->next) {
 			const cJSON *mat = key(pr, "material");
@@ -1424,12 +1464,13 @@ void gltf_info_free(gltf_info *g)
 {
 	free(g->cams);
 	free(g->lights);
+	free(g->mesh_nodes);
 	memset(g, 0, sizeof *g);
 }
 
 bool gltf_parse_info(const char *name, const char *buf, size_t len, gltf_info *out, rt_error *err)
 {
-	gl g = {.name = name, .err = err};
+	gl g = {.name = name, .err = err, .only = -1};
 	memset(out, 0, sizeof *out);
 	bool ok = gl_open(&g, buf, len) && info(&g, out);
 	gl_free(&g);

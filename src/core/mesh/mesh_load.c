@@ -59,7 +59,7 @@ void mesh_format_list(char *buf, size_t size)
 	}
 }
 
-mesh *mesh_load(const char *path, rt_error *err)
+static mesh *load_node(const char *path, long node, rt_error *err)
 {
 	const struct model_format *f = format_of(path);
 	if (!f) {
@@ -68,7 +68,11 @@ mesh *mesh_load(const char *path, rt_error *err)
 		rt_error_set(err, "%s: unknown model format \".%s\"; expected %s", path, ext_of(path), list);
 		return NULL;
 	}
-	mesh *m = f->read(path, err);
+	if (node >= 0 && f->read != mesh_read_gltf) {
+		rt_error_set(err, "%s: node=%ld: only glTF files (.gltf, .glb) have nodes", path, node);
+		return NULL;
+	}
+	mesh *m = node >= 0 ? mesh_read_gltf_node(path, node, err) : f->read(path, err);
 	if (m && !m->path) {
 		m->path = strdup(path);
 		if (!m->path) {
@@ -80,9 +84,15 @@ mesh *mesh_load(const char *path, rt_error *err)
 	return m;
 }
 
+mesh *mesh_load(const char *path, rt_error *err)
+{
+	return load_node(path, -1, err);
+}
+
 typedef struct cache_entry {
 	mesh *m;
 	char *path;
+	long node;
 	bool smooth;
 	double crease;
 	off_t size;
@@ -95,6 +105,14 @@ static size_t ncache, ccache;
 
 mesh *mesh_cache_get(const char *path, bool smooth, double crease_deg, const atomic_bool *cancel, rt_error *err)
 {
+	return mesh_cache_get_node(path, -1, smooth, crease_deg, cancel, err);
+}
+
+mesh *mesh_cache_get_node(const char *path, long node, bool smooth, double crease_deg, const atomic_bool *cancel,
+                          rt_error *err)
+{
+	if (node < 0)
+		node = -1;
 	struct stat st;
 	if (rt_file_stat(path, &st) != 0) {
 		rt_error_set(err, "%s: cannot read the model: %s", path, strerror(errno));
@@ -105,7 +123,7 @@ mesh *mesh_cache_get(const char *path, bool smooth, double crease_deg, const ato
 	pthread_mutex_lock(&cache_lock);
 	for (size_t i = 0; i < ncache; i++) {
 		cache_entry *c = &cache[i];
-		if (strcmp(c->path, path) == 0 && c->smooth == smooth && c->crease == crease_deg &&
+		if (strcmp(c->path, path) == 0 && c->node == node && c->smooth == smooth && c->crease == crease_deg &&
 		    c->size == st.st_size && c->mtime.tv_sec == st.st_mtim.tv_sec &&
 		    c->mtime.tv_nsec == st.st_mtim.tv_nsec) {
 			c->m->refs++;
@@ -117,7 +135,7 @@ mesh *mesh_cache_get(const char *path, bool smooth, double crease_deg, const ato
 	/* the readers poll the flag every few thousand elements (the builder,
 	 * mesh.c); assimp's own parse (STL) runs to its end */
 	const atomic_bool *outer = read_cancel_set(cancel);
-	mesh *m = mesh_load(path, err);
+	mesh *m = load_node(path, node, err);
 	read_cancel_set(outer);
 	if (!m && cancel && atomic_load(cancel))
 		rt_error_set(err, "stopped");
@@ -143,7 +161,7 @@ mesh *mesh_cache_get(const char *path, bool smooth, double crease_deg, const ato
 		return NULL;
 	}
 	m->refs = 1;
-	cache[ncache++] = (cache_entry){m, p, smooth, crease_deg, st.st_size, st.st_mtim};
+	cache[ncache++] = (cache_entry){m, p, node, smooth, crease_deg, st.st_size, st.st_mtim};
 	pthread_mutex_unlock(&cache_lock);
 	return m;
 }
