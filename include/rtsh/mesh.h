@@ -160,10 +160,6 @@ bool mesh_prepare(mesh *m, bool smooth, double crease_deg, rt_error *err);
 /* mesh_prepare that stops, false with err "stopped", soon after *cancel is
  * set (NULL: never): Ctrl-C in the shell. */
 bool mesh_prepare_cancel(mesh *m, bool smooth, double crease_deg, const atomic_bool *cancel, rt_error *err);
-/* The first step of mesh_prepare alone: smooth normals for a mesh read
- * without them (mesh_prepare then keeps them); true at once when it has
- * some. test_load_growth times it apart from the tree. */
-bool mesh_smooth_normals(mesh *m, double crease_deg, const atomic_bool *cancel, rt_error *err);
 void mesh_free(mesh *m);
 /* Bytes held by a prepared mesh (benchmark: bytes per triangle). */
 size_t mesh_memory(const mesh *m);

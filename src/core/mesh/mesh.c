@@ -497,11 +497,6 @@ oom:
 	return rt_error_set(err, "%s: out of memory computing normals", m->path ? m->path : "mesh");
 }
 
-bool mesh_smooth_normals(mesh *m, double crease_deg, const atomic_bool *cancel, rt_error *err)
-{
-	return m->n || smooth_normals(m, crease_deg, cancel, err);
-}
-
 bool mesh_prepare(mesh *m, bool smooth, double crease_deg, rt_error *err)
 {
 	return mesh_prepare_cancel(m, smooth, crease_deg, NULL, err);
