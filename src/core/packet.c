@@ -199,12 +199,13 @@ static void leaf_spheres(pk_state *s, const prim *p, const ray *r, double tmin)
 #endif
 }
 
-static inline float packet_far(const pk_state *s)
+/* The farthest of the rays' nearest hits so far. */
+static inline double packet_far(const pk_state *s)
 {
 	double m = s->tmax[0];
 	for (int i = 1; i < s->n; i++)
 		m = s->tmax[i] > m ? s->tmax[i] : m;
-	return to_float_up(m);
+	return m;
 }
 
 typedef struct pk_entry {
@@ -217,7 +218,8 @@ static void packet_walk(const world *w, pk_state *s, const ray *r, const pk_ray 
 {
 	const bvh *tree = w->tree;
 	const bvh_node *nodes = tree->nodes;
-	float ftmin = to_float_down(tmin), ftmax = packet_far(s);
+	double far = packet_far(s);
+	float ftmin = to_float_down(tmin), ftmax = to_float_up(far);
 	pk_entry stack[BVH_STACK];
 	int sp = 0;
 	uint32_t child = tree->root, meta = tree->root_meta;
@@ -237,7 +239,8 @@ static void packet_walk(const world *w, pk_state *s, const ray *r, const pk_ray 
 						offer(s, i, &p[k], t, nl);
 				}
 			}
-			ftmax = packet_far(s);
+			far = packet_far(s);
+			ftmax = to_float_up(far);
 		} else {
 			const bvh_node *n = &nodes[child];
 			float tn[BVH_WIDTH];
@@ -259,7 +262,8 @@ static void packet_walk(const world *w, pk_state *s, const ray *r, const pk_ray 
 				continue;
 			}
 		}
-		while (sp > 0 && stack[sp - 1].t > ftmax * BVH_SLAB_SLACK)
+		/* the single walk's own test, in double, against the farthest ray */
+		while (sp > 0 && (double)stack[sp - 1].t > (double)BVH_SLAB_SLACK * far)
 			sp--;
 		if (sp == 0)
 			break;
