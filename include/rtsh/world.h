@@ -63,6 +63,7 @@ mat_lin mat_lin_make(const material *m);
 typedef struct mat_tex {
 	const struct texture *tex, *nmap, *bump;
 	const struct texture *mr; /* PBR: glTF's metallic-roughness texture (linear; G x roughness, B x metallic) */
+	const struct texture *emit; /* glTF's emissive texture (sRGB), x the emission; such a material is not sampled as a light */
 	bool tint;         /* tex x albedo (texture= with a colour); else tex alone */
 	double bumpscale;
 	double uvs[2], uvo[2]; /* uv x uvs + uvo */

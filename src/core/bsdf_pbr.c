@@ -473,7 +473,7 @@ static vec3 pbr_whitted(const world *w, const mat_lin *m, const hit *h, ray r, i
 	pbr_make(&b, m, hit_albedo(m, h));
 	const struct bsdf_pbr *p = &b.pb;
 	vec3 pt = offset_point(w, h->p, b.n);
-	vec3 c = v3_add(v3_mul(w->ambient, p->base), m->emission);
+	vec3 c = v3_add(v3_mul(w->ambient, p->base), hit_emission(m, h));
 	/* the point lights through the BRDF, Whitted's convention: pi L cos */
 	for (size_t i = 0; i < w->nlights; i++) {
 		vec3 ld;

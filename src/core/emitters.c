@@ -37,8 +37,8 @@ static size_t mesh_walk(world *w, const scene *s, bool put)
 		uint32_t nm = in->mat_base == UINT32_MAX ? 1 : (m->nmats ? m->nmats : 1);
 		for (uint32_t mi = 0; mi < nm; mi++) {
 			uint32_t wm = in->mat_base == UINT32_MAX ? (uint32_t)i : in->mat_base + mi;
-			if (wm >= w->nmats || !(max3(w->mats[wm].emission) > 0.0))
-				continue;
+			if (wm >= w->nmats || !(max3(w->mats[wm].emission) > 0.0) || (w->mats[wm].tx && w->mats[wm].tx->emit))
+				continue; /* an emissive texture: found by the paths */
 			size_t first = w->nemitters, run = 0;
 			uint32_t last = UINT32_MAX;
 			/* each triangle once: a leaf's last block repeats its last */

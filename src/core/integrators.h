@@ -191,6 +191,9 @@ vec3 hit_albedo(const mat_lin *m, const hit *h);
  * parameters applied (glTF's metallic-roughness texture: roughness x G,
  * metallic x B). */
 const mat_lin *hit_material(const mat_lin *m, const hit *h, mat_lin *tmp);
+/* The emitted radiance at a hit: the emission, times glTF's emissive
+ * texture there when the material has one. */
+vec3 hit_emission(const mat_lin *m, const hit *h);
 
 /* A point just off the surface on the side of n, for spawning rays. */
 static inline vec3 offset_point(const world *w, vec3 p, vec3 n)

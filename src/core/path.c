@@ -196,10 +196,10 @@ vec3 path_radiance_first(const world *w, const render_settings *s, ray r, sample
 		if (m->light >= 0 && from_pdf > 0.0) {
 			double pdf_l = emitter_pdf(emitter_at(w, m->light, h.p), from, r.d, h.t) /
 			               (double)w->nemitters;
-			radiance = v3_add(radiance, v3_mul(thr, v3_scale(m->emission,
+			radiance = v3_add(radiance, v3_mul(thr, v3_scale(hit_emission(m, &h),
 			                                                 power_weight(from_pdf, pdf_l))));
 		} else {
-			radiance = v3_add(radiance, v3_mul(thr, m->emission));
+			radiance = v3_add(radiance, v3_mul(thr, hit_emission(m, &h)));
 		}
 		if (bounce >= s->depth)
 			break;

@@ -30,6 +30,15 @@ const mat_lin *hit_material(const mat_lin *m, const hit *h, mat_lin *tmp)
 	return tmp;
 }
 
+vec3 hit_emission(const mat_lin *m, const hit *h)
+{
+	if (!m->tx || !m->tx->emit || !h->has_uv)
+		return m->emission;
+	double du = v3_len(h->dpdu);
+	double width = du > 0 ? h->t * texture_pixel_angle() / du : 0;
+	return v3_mul(m->emission, texture_lookup(m->tx->emit, h->u, h->v, width));
+}
+
 vec3 hit_albedo(const mat_lin *m, const hit *h)
 {
 	if (m->tx && m->tx->tex && h->has_uv) {

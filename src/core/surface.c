@@ -179,6 +179,10 @@ bool surf_material(world *w, const object *o, uint32_t i, rt_error *err)
 			return false;
 		if (mm->gltf && !mm->map_mr && mm->tex_mr)
 			t.mr = mm->tex_mr;
+		if (mm->gltf && mm->map_emit && !hold_texture(w, mm->map_emit, true, &t.emit, err))
+			return false;
+		if (mm->gltf && !mm->map_emit && mm->tex_emit)
+			t.emit = mm->tex_emit;
 		if (mm->map_bump) {
 			if (!hold_texture(w, mm->map_bump, false, &t.bump, err))
 				return false;
@@ -186,7 +190,7 @@ bool surf_material(world *w, const object *o, uint32_t i, rt_error *err)
 			t.bumpscale = mm->bump_scale * 0.01;
 		}
 		l.tx = NULL;
-		if (t.tex || t.nmap || t.bump || t.mr) {
+		if (t.tex || t.nmap || t.bump || t.mr || t.emit) {
 			w->mtex[w->nmtex] = t;
 			l.tx = &w->mtex[w->nmtex++];
 		}

@@ -47,46 +47,6 @@ static const file_entry *find(const fileset *fs, const char *path)
 	return NULL;
 }
 
-char *fileset_record(void *ctx, const char *path, size_t *len, rt_error *err)
-{
-	fileset *fs = ctx;
-	const file_entry *e = find(fs, path);
-	if (e) {
-		*len = e->len;
-		return mem_dupz(e->data, e->len);
-	}
-	char *data = rt_read_file(path, NULL, len, err);
-	if (!data)
-		return NULL;
-	char *copy = mem_dupz(data, *len), *name = mem_dupz(path, strlen(path));
-	if (!copy || !name || !add(fs, name, copy, *len)) {
-		if (!copy || !name) {
-			free(copy);
-			free(name);
-		}
-		free(data);
-		rt_error_at(err, path, 0, 0, "out of memory keeping the file for the other ranks");
-		return NULL;
-	}
-	return data;
-}
-
-char *fileset_serve(void *ctx, const char *path, size_t *len, rt_error *err)
-{
-	const file_entry *e = find(ctx, path);
-	if (!e) {
-		rt_error_at(err, path, 0, 0, "not among the files rank 0 sent; expected a file rank 0 read");
-		return NULL;
-	}
-	char *c = mem_dupz(e->data, e->len);
-	if (!c) {
-		rt_error_at(err, path, 0, 0, "out of memory");
-		return NULL;
-	}
-	*len = e->len;
-	return c;
-}
-
 /* Keeps a copy of data under path (when it is not kept yet). */
 static bool keep(fileset *fs, const char *path, const char *data, size_t len)
 {
@@ -101,21 +61,69 @@ static bool keep(fileset *fs, const char *path, const char *data, size_t len)
 	return add(fs, name, copy, len);
 }
 
-static char *src_record(void *ctx, const char *path, const char *what, size_t *len, rt_error *err)
+/* Rank 0's reads: a kept file again, else the bytes `data` the caller read
+ * (NULL: it failed, err set), kept for the other ranks. */
+static char *recorded(fileset *fs, const char *path, char *data, size_t *len, rt_error *err, const char *what)
 {
-	fileset *fs = ctx;
-	const file_entry *e = find(fs, path);
-	if (e) {
-		*len = e->len;
-		return mem_dupz(e->data, e->len);
-	}
-	char *data = rt_file_read_disk(path, what, len, err);
 	if (data && !keep(fs, path, data, *len)) {
 		free(data);
 		rt_error_set(err, "%s: out of memory keeping the %s for the other ranks", path, what);
 		return NULL;
 	}
 	return data;
+}
+
+/* True when path is kept: *copy its copy (NULL when memory ran out). */
+static bool kept(const fileset *fs, const char *path, size_t *len, char **copy)
+{
+	const file_entry *e = find(fs, path);
+	if (e) {
+		*len = e->len;
+		*copy = mem_dupz(e->data, e->len);
+	}
+	return e != NULL;
+}
+
+/* The other ranks' reads: a copy of the kept file, or NULL with err
+ * set (in the words of the core's file source, or with what NULL the
+ * scene loader's). */
+static char *served(const fileset *fs, const char *path, size_t *len, rt_error *err, const char *what)
+{
+	char *c = NULL;
+	bool there = kept(fs, path, len, &c);
+	if (c)
+		return c;
+	if (what)
+		rt_error_set(err, there ? "%s: out of memory reading the %s"
+		                        : "%s: cannot read the %s: not among the files rank 0 sent",
+		             path, what);
+	else
+		rt_error_at(err, path, 0, 0,
+		            there ? "out of memory" : "not among the files rank 0 sent; expected a file rank 0 read");
+	return NULL;
+}
+
+char *fileset_record(void *ctx, const char *path, size_t *len, rt_error *err)
+{
+	fileset *fs = ctx;
+	char *copy;
+	if (kept(fs, path, len, &copy))
+		return copy;
+	return recorded(fs, path, rt_read_file(path, NULL, len, err), len, err, "file");
+}
+
+char *fileset_serve(void *ctx, const char *path, size_t *len, rt_error *err)
+{
+	return served(ctx, path, len, err, NULL);
+}
+
+static char *src_record(void *ctx, const char *path, const char *what, size_t *len, rt_error *err)
+{
+	fileset *fs = ctx;
+	char *copy;
+	if (kept(fs, path, len, &copy))
+		return copy;
+	return recorded(fs, path, rt_file_read_disk(path, what, len, err), len, err, what);
 }
 
 static int src_stat_disk(void *ctx, const char *path, struct stat *st)
@@ -126,18 +134,7 @@ static int src_stat_disk(void *ctx, const char *path, struct stat *st)
 
 static char *src_serve(void *ctx, const char *path, const char *what, size_t *len, rt_error *err)
 {
-	const file_entry *e = find(ctx, path);
-	if (!e) {
-		rt_error_set(err, "%s: cannot read the %s: not among the files rank 0 sent", path, what);
-		return NULL;
-	}
-	char *c = mem_dupz(e->data, e->len);
-	if (!c) {
-		rt_error_set(err, "%s: out of memory reading the %s", path, what);
-		return NULL;
-	}
-	*len = e->len;
-	return c;
+	return served(ctx, path, len, err, what);
 }
 
 static int src_stat_kept(void *ctx, const char *path, struct stat *st)

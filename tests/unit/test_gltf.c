@@ -857,6 +857,66 @@ static void test_texture_rotation(void **state)
 	scene_free(s);
 }
 
+/* The emissive texture: the triangle above with emissiveFactor (1,1,1),
+ * KHR_materials_emissive_strength 2 and an emissive texture of one sRGB
+ * texel (255, 128, 0), seen straight on in path mode on black: the pixel is
+ * the emission, 2 x (1, ((128/255 + 0.055) / 1.055)^2.4, 0) =
+ * (2, 0.431722, 0). Such a material is left to the paths (no emitters). */
+static void test_emissive_texture(void **state)
+{
+	(void)state;
+	unsigned char bin[68];
+	const float pos[9] = {-1, -1, 0, 1, -1, 0, 0, 1, 0}, uv[6] = {0, 0, 1, 0, 0.5f, 1};
+	const uint16_t idx[4] = {0, 1, 2, 0};
+	memcpy(bin, pos, 36);
+	memcpy(bin + 36, uv, 24);
+	memcpy(bin + 60, idx, 8);
+	char data[128], png64[128];
+	b64(bin, sizeof bin, data);
+	unsigned char png[80];
+	b64(png, png_1x1(255, 128, 0, png), png64);
+	char text[4096];
+	snprintf(text, sizeof text,
+	         "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0},{\"camera\":0,\"translation\":[0,-0.2,5]}],"
+	         "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.01}}],"
+	         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"indices\":2,"
+	         "\"material\":0}]}],"
+	         "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1]},\"emissiveFactor\":[1,1,1],"
+	         "\"emissiveTexture\":{\"index\":0},"
+	         "\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":2}}}],"
+	         "\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],"
+	         "\"buffers\":[{\"byteLength\":68,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
+	         "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":24},"
+	         "{\"buffer\":0,\"byteOffset\":60,\"byteLength\":6}],"
+	         "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+	         "{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"},"
+	         "{\"bufferView\":2,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}",
+	         png64, data);
+	rt_error err = {0};
+	scene *s = rt_load_file(tmp_text("emit.gltf", text), NULL, &err);
+	if (!s)
+		fail_msg("%s", err.msg);
+	world *w = world_build(s, &err);
+	if (!w)
+		fail_msg("%s", err.msg);
+	assert_int_equal(w->nemitters, 0);
+	render_settings set = render_settings_default();
+	set.width = set.height = 1;
+	set.samples = 4;
+	set.depth = 1;
+	set.threads = 1;
+	set.mode = MODE_PATH;
+	framebuffer *fb = render_image(w, &set, NULL, NULL, NULL, &err);
+	assert_non_null(fb);
+	double g = pow((128.0 / 255 + 0.055) / 1.055, 2.4);
+	assert_near(fb->rgb[0], 2.0, 1e-5);
+	assert_near(fb->rgb[1], 2 * g, 1e-5);
+	assert_near(fb->rgb[2], 0.0, 1e-6);
+	fb_free(fb);
+	world_free(w);
+	scene_free(s);
+}
+
 /* A lamp made of a glTF mesh is sampled directly, as the .rt emitters are:
  * a 2 x 2 square of two triangles, emissiveFactor 1 x
  * KHR_materials_emissive_strength 2 (Le = 2), 1 above a Lambert floor of
@@ -967,6 +1027,7 @@ int main(void)
 	    cmocka_unit_test(test_metallic_roughness_texture),
 	    cmocka_unit_test(test_mesh_lamp),
 	    cmocka_unit_test(test_texture_rotation),
+	    cmocka_unit_test(test_emissive_texture),
 	    cmocka_unit_test(test_stage_lighting),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
