@@ -130,30 +130,47 @@ static inline void fbox_add_point(fbox *a, const float p[4])
 }
 #endif
 
+/* Inline in the bins' sweeps, which call it some 90 times a node. */
+static inline double fbox_half_area(const fbox *b)
+{
+	double e0 = (double)b->hi[0] - (double)b->lo[0], e1 = (double)b->hi[1] - (double)b->lo[1],
+	       e2 = (double)b->hi[2] - (double)b->lo[2];
+	if (!(e0 >= 0.0 && e1 >= 0.0 && e2 >= 0.0))
+		return 0.0;
+	return e0 * e1 + e1 * e2 + e2 * e0;
+}
+
 double bvh_fbox_half_area(const fbox *b)
 {
-	double e[3];
-	for (int i = 0; i < 3; i++) {
-		e[i] = (double)b->hi[i] - (double)b->lo[i];
-		if (!(e[i] >= 0.0))
-			return 0.0;
-	}
-	return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
+	return fbox_half_area(b);
 }
 
-#define fbox_half_area bvh_fbox_half_area
+/* The float next to finite f towards -inf (down) or +inf: one step of
+ * its bit pattern away from zero or towards it (what nextafterf does, in
+ * line: the root pass calls it for most bounds). Zero and infinities are
+ * left to nextafterf. */
+static inline float float_step(float f, bool down)
+{
+	if (!(f != 0.0f && f > -INFINITY && f < INFINITY))
+		return nextafterf(f, down ? -INFINITY : INFINITY);
+	uint32_t u;
+	memcpy(&u, &f, sizeof u);
+	u = (f > 0.0f) != down ? u + 1 : u - 1;
+	memcpy(&f, &u, sizeof f);
+	return f;
+}
 
 /* The nearest floats below and above a double. */
-static float float_down(double v)
+static inline float float_down(double v)
 {
 	float f = (float)v;
-	return (double)f > v ? nextafterf(f, -INFINITY) : f;
+	return (double)f > v ? float_step(f, true) : f;
 }
 
-static float float_up(double v)
+static inline float float_up(double v)
 {
 	float f = (float)v;
-	return (double)f < v ? nextafterf(f, INFINITY) : f;
+	return (double)f < v ? float_step(f, false) : f;
 }
 
 /* Fewer bins for small nodes: most nodes are small, and 16 bins on three
@@ -221,9 +238,12 @@ static split find_split(const builder *b, size_t begin, size_t end, const fbox *
 	split best = {.axis = -1, .cost = INFINITY};
 	binning bn;
 	best.total = 0.0;
-	for (size_t i = begin; i < end; i++)
-		best.total += b->refs[i].lo[3];
-	best.total = leaf_cost(b, best.total);
+	/* only a node that may be a leaf weighs itself whole (build) */
+	if (end - begin <= b->leaf_max) {
+		for (size_t i = begin; i < end; i++)
+			best.total += b->refs[i].lo[3];
+		best.total = leaf_cost(b, best.total);
+	}
 	if (!binning_make(cb, end - begin, &bn))
 		return best;
 	int nbins = bn.nbins;
