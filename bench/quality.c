@@ -1,13 +1,15 @@
 /* rtsh — equal-quality benchmarks (`make bench` runs them after the speed
  * table; bench/README.md explains the rows):
  *
- *   quality [--only cycles|preview] [--scene cornell|glass-sky|pbr] [--out FILE.tsv]
+ *   quality [--only cycles|preview] [--scene cornell|glass-sky|pbr|gltf] [--out FILE.tsv]
  *           [--no-cycles]
  *
  * cycles   rtsh's path mode against Blender's Cycles on the same scenes
  *          (scenes/cornell.rt at 256x256, bench/glass-sky.rt at 128x128 and
  *          bench/pbr-spheres.rt at 192x108, rebuilt in Cycles by
- *          bench/cycles_scene.py): CPU, one thread, a
+ *          bench/cycles_scene.py; and `gltf`, issue 26's scene built in
+ *          Blender by bench/gltf_scene.py, rtsh on its glTF export and
+ *          Cycles on the .blend, 192x108): CPU, one thread, a
  *          1-pixel box filter, no adaptive sampling, no denoising, the
  *          scene's bounces.
  *          Each renderer is judged against its own 4096-sample reference

@@ -62,6 +62,14 @@ char *path_dir(const char *path)
 static const double pow10_pos[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9, 1e10,
                                    1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
 
+/* Steps over a leading + or - at *s; true for -. */
+static inline bool take_sign(const char **s, const char *end)
+{
+	if (*s < end && (**s == '-' || **s == '+'))
+		return *(*s)++ == '-';
+	return false;
+}
+
 static bool word_at(const char *s, const char *end, const char *w)
 {
 	size_t n = strlen(w);
@@ -76,9 +84,7 @@ static bool word_at(const char *s, const char *end, const char *w)
 bool scan_double(const char **sp, const char *end, double *out)
 {
 	const char *s = *sp;
-	bool neg = false;
-	if (s < end && (*s == '-' || *s == '+'))
-		neg = *s++ == '-';
+	bool neg = take_sign(&s, end);
 	if (word_at(s, end, "nan")) {
 		*out = NAN;
 		*sp = s + 3;
@@ -154,9 +160,7 @@ bool scan_double(const char **sp, const char *end, double *out)
 bool scan_long(const char **sp, const char *end, long *out)
 {
 	const char *s = *sp;
-	bool neg = false;
-	if (s < end && (*s == '-' || *s == '+'))
-		neg = *s++ == '-';
+	bool neg = take_sign(&s, end);
 	if (!(s < end && *s >= '0' && *s <= '9'))
 		return false;
 	long v = 0;

@@ -1085,7 +1085,7 @@ static bool parse_mesh(parser *p, const elem_def *e)
 	 * is reported with this line */
 	rt_error merr;
 	rt_error_clear(&merr);
-	mesh *m = mesh_cache_get(o.file, o.smooth != 0, o.crease, p->cancel, &merr);
+	mesh *m = mesh_cache_get_node(o.file, o.node, o.smooth != 0, o.crease, p->cancel, &merr);
 	if (!m) {
 		char msg[RT_ERROR_MSG_MAX];
 		rt_error_format(&merr, msg, sizeof msg);

@@ -140,6 +140,19 @@ static void sb_file(sbuf *b, const char *file)
 	sb_put(b, name);
 }
 
+/* " NAME=A,B[,C]": a key whose value is a list of numbers. */
+static void sb_key_list(sbuf *b, const char *name, const double *v, int n)
+{
+	sb_put(b, " ");
+	sb_put(b, name);
+	sb_put(b, "=");
+	for (int i = 0; i < n; i++) {
+		if (i)
+			sb_put(b, ",");
+		sb_num(b, v[i]);
+	}
+}
+
 static void fmt_keys(sbuf *b, const object *o, bool short_form)
 {
 	for (size_t i = 0; i < rt_nkeys; i++) {
@@ -161,26 +174,14 @@ static void fmt_keys(sbuf *b, const object *o, bool short_form)
 			rt_key_get_n(k, o, c, 3);
 			if (c[0] == k->def && c[1] == k->def && c[2] == k->def)
 				continue;
-			sb_put(b, " ");
-			sb_put(b, k->name);
-			sb_put(b, "=");
-			sb_num(b, c[0]);
-			sb_put(b, ",");
-			sb_num(b, c[1]);
-			sb_put(b, ",");
-			sb_num(b, c[2]);
+			sb_key_list(b, k->name, c, 3);
 			continue;
 		}
 		if (k->type == RT_KEY_PAIR) {
 			const double *uv = (const double *)(const void *)((const char *)o + k->offset);
 			if (uv[0] == k->def && uv[1] == k->def)
 				continue;
-			sb_put(b, " ");
-			sb_put(b, k->name);
-			sb_put(b, "=");
-			sb_num(b, uv[0]);
-			sb_put(b, ",");
-			sb_num(b, uv[1]);
+			sb_key_list(b, k->name, uv, 2);
 			continue;
 		}
 		double v = rt_key_get(k, o);

@@ -682,6 +682,13 @@ static void test_nodes_as_objects(void **state)
 	mesh *m = mesh_read_gltf_node(path, 7, &err);
 	assert_null(m);
 	assert_non_null(strstr(err.msg, "node 7: not a node the scene places"));
+	/* in a .rt file, with its line */
+	const char *bad = tmp_text("badnode.rt", "C 0,0,-5 0,0,1 60\nmesh nodes.gltf 0,0,0 0,1,0 1 node=7\n");
+	assert_null(rt_load_file(bad, NULL, &err));
+	char msg[RT_ERROR_MSG_MAX];
+	rt_error_format(&err, msg, sizeof msg);
+	assert_non_null(strstr(msg, "badnode.rt:2:"));
+	assert_non_null(strstr(msg, "node 7: not a node the scene places"));
 }
 
 /* --- a PNG of one texel, for textures the tests embed --- */
