@@ -29,6 +29,9 @@ typedef enum render_mode {
 const char *render_mode_name(render_mode m);
 /* The names, NULL-terminated (the `mode` setting's values). */
 extern const char *const render_mode_names[MODE_COUNT + 1];
+/* The integrator of mode m gives the denoiser its features: the `denoise`
+ * setting applies to its pictures (path mode). */
+bool render_mode_denoises(render_mode m);
 
 /* When path-mode images are denoised (denoise.h). */
 typedef enum denoise_mode {

@@ -27,6 +27,11 @@ const integrator *integrator_of(render_mode m)
 	return integrators[(unsigned)m < MODE_COUNT ? m : 0];
 }
 
+bool render_mode_denoises(render_mode m)
+{
+	return integrator_of(m)->features;
+}
+
 ray render_sample_ray(const world *w, const render_settings *s, int px, int py, int fw, int fh, int sample)
 {
 	sampler sp;

@@ -56,7 +56,7 @@ static tiling tiling_of(const render_settings *s, int side)
 
 bool farm_denoises(const render_settings *s)
 {
-	return s->mode == MODE_PATH && s->denoise == DENOISE_ON;
+	return render_mode_denoises(s->mode) && s->denoise == DENOISE_ON;
 }
 
 static void tile_rect(const tiling *t, long i, int r[4])

@@ -112,10 +112,11 @@ bool cmd_save(shell *sh, int argc, char **argv, const char *rest)
 			 * auto, the saved image is not: say so, with the way to. */
 			shell_info(sh, "saved %s (%dx%d, %d sample%s, %s%s)\n", path, fb->w, fb->h, fb->spp,
 			           fb->spp == 1 ? "" : "s", render_mode_name(sh->full_set.mode),
-			           sh->full_set.mode == MODE_PATH && sh->full_set.denoise == DENOISE_AUTO
+			           render_mode_denoises(sh->full_set.mode) && sh->full_set.denoise == DENOISE_AUTO
 			               ? "; the raw samples: the preview is denoised, set denoise on denoises saves too"
-			               : sh->full_set.mode == MODE_PATH && sh->full_set.denoise == DENOISE_ON ? ", denoised"
-			                                                                                      : "");
+			           : render_mode_denoises(sh->full_set.mode) && sh->full_set.denoise == DENOISE_ON
+			               ? ", denoised"
+			               : "");
 	} else {
 		char exts[256] = "";
 		const char *const *x = output_extensions();

@@ -240,7 +240,7 @@ static void km_start(keymode *km, bool refine)
 		r.accumulate = true;
 		r.pass_seconds = KEYMODE_PASS_SECONDS;
 		/* Path passes denoised, as the shell's previews (set denoise). */
-		r.denoise = sh->set.mode == MODE_PATH && sh->set.denoise != DENOISE_OFF;
+		r.denoise = render_mode_denoises(sh->set.mode) && sh->set.denoise != DENOISE_OFF;
 	} else {
 		km->ratio_i = km_pick_ratio(km);
 		r.kind = RSVC_FRAME;

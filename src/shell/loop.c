@@ -150,8 +150,12 @@ static void show_output(shell *sh, const abuf *out)
 	screen *scr = sh->scr;
 	int area = scr->rows - scr->region_top; /* the command area, prompt included */
 	if (pager_rows(out->b, out->len, scr->cols) < area) {
-		fwrite(out->b, 1, out->len, stdout);
-		screen_log(scr, out->b, out->len);
+		/* wrapped as the pager wraps (words whole, hanging indent) */
+		size_t n;
+		char *w = pager_wrap(out->b, out->len, scr->cols, &n);
+		fwrite(w ? w : out->b, 1, w ? n : out->len, stdout);
+		screen_log(scr, w ? w : out->b, w ? n : out->len);
+		free(w);
 		return;
 	}
 	fflush(stdout);

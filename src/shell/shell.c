@@ -284,7 +284,7 @@ void shell_refresh(shell *sh)
 		.h = sh->scr->img_h,
 		.kind = RSVC_REFINE,
 		.quick = true,
-		.denoise = sh->set.mode == MODE_PATH && sh->set.denoise != DENOISE_OFF,
+		.denoise = render_mode_denoises(sh->set.mode) && sh->set.denoise != DENOISE_OFF,
 		.pass_seconds = PREVIEW_PASS_SECONDS,
 	};
 	rsvc_start(sh->rs, &req);
@@ -396,7 +396,7 @@ static bool same_image_settings(const render_settings *a, const render_settings 
 {
 	return a->width == b->width && a->height == b->height && a->samples == b->samples &&
 	       a->depth == b->depth && a->mode == b->mode && a->seed == b->seed &&
-	       (a->mode != MODE_PATH || (a->denoise == DENOISE_ON) == (b->denoise == DENOISE_ON));
+	       (!render_mode_denoises(a->mode) || (a->denoise == DENOISE_ON) == (b->denoise == DENOISE_ON));
 }
 
 const framebuffer *shell_full_image(shell *sh, bool force)

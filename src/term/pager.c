@@ -19,6 +19,7 @@
 typedef struct slice {
 	const char *p;
 	size_t n;
+	int indent; /* blanks before it: a wrapped line's hanging indent */
 } slice;
 
 /* Length of the escape sequence at p (CSI ... final byte), or 0. */
@@ -32,18 +33,54 @@ static size_t escape_len(const char *p, const char *end)
 	return q < end ? (size_t)(q - p) + 1 : (size_t)(end - p);
 }
 
+/* The hanging indent of the line at p: the column where its last column
+ * of text starts (after a run of two blanks: a table's description), else
+ * its own leading blanks; 0 when that leaves fewer than 20 columns. */
+static int hang_of(const char *p, const char *end, int cols)
+{
+	int width = 0, lead = 0, hang = 0, blanks = 0;
+	bool text = false;
+	for (; p < end && *p != '\n'; p++) {
+		size_t e = escape_len(p, end);
+		if (e) {
+			p += e - 1;
+			continue;
+		}
+		if (((unsigned char)*p & 0xc0) == 0x80)
+			continue;
+		if (*p == ' ') {
+			blanks++;
+			lead += !text;
+		} else {
+			if (text && blanks >= 2)
+				hang = width;
+			text = true;
+			blanks = 0;
+		}
+		width++;
+	}
+	if (!hang)
+		hang = lead;
+	return hang <= cols - 20 ? hang : 0;
+}
+
 /* Splits text into display rows of at most cols columns, a long line
  * broken after the last blank that fits (a word wider than the row is cut
- * at the width); returns the count and, when out is not NULL, fills it. */
+ * at the width), its further rows indented by hang_of; returns the count
+ * and, when out is not NULL, fills it. */
 static int split(const char *text, size_t len, int cols, slice *out)
 {
 	int n = 0;
 	const char *p = text, *end = text + len;
 	if (cols < 1)
 		cols = 1;
+	bool more = false; /* the row goes on the line of the row before */
+	int hang = 0;
 	while (p < end) {
 		const char *start = p, *blank = NULL;
-		int width = 0;
+		if (!more)
+			hang = hang_of(p, end, cols);
+		int indent = more ? hang : 0, width = indent;
 		while (p < end && *p != '\n') {
 			size_t e = escape_len(p, end);
 			if (e) {
@@ -62,14 +99,47 @@ static int split(const char *text, size_t len, int cols, slice *out)
 			p++;
 		}
 		if (out)
-			out[n] = (slice){start, (size_t)(p - start)};
+			out[n] = (slice){start, (size_t)(p - start), indent};
 		n++;
+		more = p < end && *p != '\n';
 		if (p < end && *p == '\n')
 			p++;
 		else if (p < end && *p == ' ')
 			p++; /* the blank the row broke at */
 	}
 	return n;
+}
+
+char *pager_wrap(const char *text, size_t len, int cols, size_t *out_len)
+{
+	int rows = split(text, len, cols, NULL);
+	slice *sl = malloc((size_t)(rows ? rows : 1) * sizeof *sl);
+	abuf a;
+	abuf_init(&a);
+	if (!sl)
+		return NULL;
+	split(text, len, cols, sl);
+	for (int i = 0; i < rows; i++) {
+		for (int k = 0; k < sl[i].indent; k++)
+			abuf_char(&a, ' ');
+		abuf_add(&a, sl[i].p, sl[i].n);
+		abuf_char(&a, '\n');
+	}
+	free(sl);
+	/* a text that did not end its last line: nor does the wrapped one */
+	if (rows && len && text[len - 1] != '\n' && a.len)
+		a.len--;
+	if (a.failed) {
+		abuf_free(&a);
+		return NULL;
+	}
+	abuf_char(&a, '\0');
+	if (a.failed) {
+		abuf_free(&a);
+		return NULL;
+	}
+	*out_len = a.len - 1;
+	return a.b;
 }
 
 int pager_split(const char *text, size_t len, int cols, size_t *off, size_t *n, int max)
@@ -99,8 +169,11 @@ static void draw(evloop *l, int fd, const slice *rows, int nrows, int top, int p
 	abuf_str(&a, "\x1b[?25l\x1b[m");
 	for (int r = 0; r < page; r++) {
 		abuf_printf(&a, "\x1b[%d;1H\x1b[m\x1b[K", r + 1);
-		if (top + r < nrows)
+		if (top + r < nrows) {
+			for (int k = 0; k < rows[top + r].indent; k++)
+				abuf_char(&a, ' ');
 			abuf_add(&a, rows[top + r].p, rows[top + r].n);
+		}
 	}
 	int last = top + page < nrows ? top + page : nrows;
 	char keys[160];

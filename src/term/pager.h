@@ -21,6 +21,12 @@ int pager_rows(const char *text, size_t len, int cols);
  * of them. A long line breaks after its last blank that fits, a word wider
  * than the row at the width. Returns the count, -1 when out of memory. */
 int pager_split(const char *text, size_t len, int cols, size_t *off, size_t *n, int max);
+/* The further rows of a wrapped line are indented: under the line's last
+ * column of text (after two blanks, as in `help set`'s table) or by its own
+ * leading blanks, when 20 columns are left. pager_wrap gives the text as
+ * those rows, one a line (malloc'ed, NUL-ended, its length in *out_len;
+ * NULL when out of memory): for output short enough not to be paged. */
+char *pager_wrap(const char *text, size_t len, int cols, size_t *out_len);
 
 /* Shows text on the terminal fd_out (through the loop's output scheduler
  * when it has one), reading keys from the event loop l (its input, a

@@ -65,11 +65,37 @@ static void test_word_wrap(void **state)
 	assert_int_equal(rows("aaaa bbbb", 4), 2);
 }
 
+/* A wrapped table line goes on under its last column (issue 31, defect 10:
+ * `help set` continuation lines started at column 0), prose under its own
+ * indent; by hand at 40 columns: "random" starts at column 18, and the
+ * line is 44 wide. */
+static void test_hanging_indent(void **state)
+{
+	(void)state;
+	const char *t = "  seed    N       random seed of the sampler\n  an indented line of prose that wraps here\n";
+	size_t len;
+	char *w = pager_wrap(t, strlen(t), 40, &len);
+	assert_non_null(w);
+	assert_string_equal(w, "  seed    N       random seed of the\n"
+	                       "                  sampler\n"
+	                       "  an indented line of prose that wraps\n"
+	                       "  here\n");
+	assert_int_equal(len, strlen(w));
+	free(w);
+	/* too little room left for a hanging indent (fewer than 20 columns) */
+	w = pager_wrap(t, strlen(t), 30, &len);
+	assert_non_null(w);
+	assert_string_equal(w, "  seed    N       random seed\nof the sampler\n"
+	                       "  an indented line of prose\n  that wraps here\n");
+	free(w);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_rows),
 		cmocka_unit_test(test_word_wrap),
+		cmocka_unit_test(test_hanging_indent),
 	};
 	return cmocka_run_group_tests_name("pager", tests, NULL, NULL);
 }
