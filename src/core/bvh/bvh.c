@@ -231,6 +231,48 @@ static bool binning_make(const fbox *cb, size_t n, binning *bn)
 	return any;
 }
 
+/* Adds refs[0, n) to the bins of binning bn on each axis: the box and
+ * the summed cost. */
+static void bin_refs(const fbox *refs, size_t n, const binning *bn, fbox bbox[3][BINS], float bcost[3][BINS])
+{
+#if defined(__SSE2__)
+	/* the same operations as the loop below, the reference and its bins
+	 * in registers */
+	__m128 blo = _mm_loadu_ps(bn->lo), bsc = _mm_loadu_ps(bn->scale), zero = _mm_setzero_ps(),
+	       top = _mm_set1_ps((float)(bn->nbins - 1));
+	for (size_t i = 0; i < n; i++) {
+		__m128 lo = _mm_loadu_ps(refs[i].lo), hi = _mm_loadu_ps(refs[i].hi);
+		float cost = _mm_cvtss_f32(_mm_shuffle_ps(lo, lo, _MM_SHUFFLE(3, 3, 3, 3)));
+		__m128 v = _mm_mul_ps(_mm_sub_ps(_mm_add_ps(lo, hi), blo), bsc);
+		__m128i k = _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(v, zero), top));
+		int k0 = _mm_cvtsi128_si32(k), k1 = _mm_cvtsi128_si32(_mm_shuffle_epi32(k, 1)),
+		    k2 = _mm_cvtsi128_si32(_mm_shuffle_epi32(k, 2));
+		bcost[0][k0] += cost;
+		bcost[1][k1] += cost;
+		bcost[2][k2] += cost;
+		fbox *x = &bbox[0][k0], *y = &bbox[1][k1], *z = &bbox[2][k2];
+		_mm_storeu_ps(x->lo, _mm_min_ps(_mm_loadu_ps(x->lo), lo));
+		_mm_storeu_ps(x->hi, _mm_max_ps(_mm_loadu_ps(x->hi), hi));
+		_mm_storeu_ps(y->lo, _mm_min_ps(_mm_loadu_ps(y->lo), lo));
+		_mm_storeu_ps(y->hi, _mm_max_ps(_mm_loadu_ps(y->hi), hi));
+		_mm_storeu_ps(z->lo, _mm_min_ps(_mm_loadu_ps(z->lo), lo));
+		_mm_storeu_ps(z->hi, _mm_max_ps(_mm_loadu_ps(z->hi), hi));
+	}
+#else
+	for (size_t i = 0; i < n; i++) {
+		const fbox *r = &refs[i];
+		float c[4];
+		int k[4];
+		centroid2(r, c);
+		bin_index(c, bn->lo, bn->scale, bn->nbins, k);
+		for (int a = 0; a < 3; a++) {
+			bcost[a][k[a]] += r->lo[3];
+			fbox_union(&bbox[a][k[a]], r);
+		}
+	}
+#endif
+}
+
 /* The cheapest binned split of refs[begin, end) with centroid bounds cb;
  * axis -1 when every centroid is the same point. */
 static split find_split(const builder *b, size_t begin, size_t end, const fbox *cb)
@@ -256,17 +298,7 @@ static split find_split(const builder *b, size_t begin, size_t end, const fbox *
 			bbox[a][k] = fbox_empty();
 			bcost[a][k] = 0.0f;
 		}
-	for (size_t i = begin; i < end; i++) {
-		const fbox *r = &b->refs[i];
-		float c[4];
-		int k[4];
-		centroid2(r, c);
-		bin_index(c, bn.lo, bn.scale, nbins, k);
-		for (int a = 0; a < 3; a++) {
-			bcost[a][k[a]] += r->lo[3];
-			fbox_union(&bbox[a][k[a]], r);
-		}
-	}
+	bin_refs(b->refs + begin, end - begin, &bn, bbox, bcost);
 	for (int a = 0; a < 3; a++) {
 		if (!bn.usable[a])
 			continue;
@@ -444,6 +476,31 @@ static size_t partition(builder *b, size_t begin, size_t end, const fbox *cb, co
 	int a = s->axis;
 	*lcb = *rcb = fbox_empty();
 	size_t i = begin, j = end;
+#if defined(__SSE2__)
+	/* the loop below with the bounds in registers */
+	__m128 blo = _mm_loadu_ps(bn.lo), bsc = _mm_loadu_ps(bn.scale), zero = _mm_setzero_ps(),
+	       top = _mm_set1_ps((float)(bn.nbins - 1));
+	__m128 llo = _mm_loadu_ps(lcb->lo), lhi = _mm_loadu_ps(lcb->hi), rlo = llo, rhi = lhi;
+	while (i < j) {
+		__m128 c = _mm_add_ps(_mm_loadu_ps(b->refs[i].lo), _mm_loadu_ps(b->refs[i].hi));
+		__m128 v = _mm_mul_ps(_mm_sub_ps(c, blo), bsc);
+		int k[4];
+		_mm_storeu_si128((__m128i *)k, _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(v, zero), top)));
+		if (k[a] < s->at) {
+			llo = _mm_min_ps(llo, c);
+			lhi = _mm_max_ps(lhi, c);
+			i++;
+		} else {
+			rlo = _mm_min_ps(rlo, c);
+			rhi = _mm_max_ps(rhi, c);
+			swap_refs(b, i, --j);
+		}
+	}
+	_mm_storeu_ps(lcb->lo, llo);
+	_mm_storeu_ps(lcb->hi, lhi);
+	_mm_storeu_ps(rcb->lo, rlo);
+	_mm_storeu_ps(rcb->hi, rhi);
+#else
 	while (i < j) {
 		float c[4];
 		int k[4];
@@ -457,6 +514,7 @@ static size_t partition(builder *b, size_t begin, size_t end, const fbox *cb, co
 			swap_refs(b, i, --j);
 		}
 	}
+#endif
 	return i;
 }
 
