@@ -73,7 +73,7 @@ static inline double next_up(double t)
  * for the interval test: a direction component of another sign than the
  * first ray's, a zero or NaN component, an inverse or origin that is not
  * finite. Each ray's origin and inverse direction are rounded as world.c's
- * ray_prepare rounds them (on and of bracket the origin so that the near
+ * bvh_ray_prepare rounds them (on and of bracket the origin so that the near
  * plane's distance can only come down and the far plane's go up), three
  * axes in one register, and the packet keeps their lowest and highest. */
 static bool packet_prepare(const ray *r, int n, pk_ray *q)
@@ -418,6 +418,18 @@ void world_occluded_packet(const world *w, int n, const ray *r, double tmin, con
 		for (int i = 0; i < n; i++)
 			far = tmax[i] > far ? tmax[i] : far;
 		float ftmax = to_float_up(far);
+		/* each ray's own slab test, as the single walk does it: a node the
+		 * packet's interval lets through is entered only when a ray still
+		 * live enters it too (shadow rays from points far apart make a
+		 * wide interval: with 1M small spheres it let through most of the
+		 * tree). The rays are tried in turn until they cover what the
+		 * interval let through, and a packet whose first 32 nodes culled
+		 * nothing stops trying (the grid's packets are that tight). */
+		bvh_ray one[PACKET_MAX];
+		float ftmax1[PACKET_MAX];
+		unsigned ready = 0; /* the rays whose one[] is filled */
+		bool refine = true;
+		int tried = 0, culled = 0;
 		pk_entry stack[BVH_STACK];
 		int sp = 0;
 		uint32_t child = w->tree->root, meta = w->tree->root_meta;
@@ -432,6 +444,25 @@ void world_occluded_packet(const world *w, int n, const ray *r, double tmin, con
 			} else {
 				float tn[BVH_WIDTH];
 				unsigned m = packet_slab4(&nodes[child], &q, ftmin, ftmax, tn);
+				if (m && refine) {
+					unsigned got = 0;
+					float t1[BVH_WIDTH];
+					for (unsigned lv = live; lv && (got & m) != m; lv &= lv - 1) {
+						int i = __builtin_ctz(lv);
+						if (!(ready >> i & 1u)) {
+							bvh_ray_prepare(&r[i], &one[i]);
+							ftmax1[i] = to_float_up(tmax[i]);
+							ready |= 1u << i;
+						}
+						got |= bvh_slab4(&nodes[child], &one[i], ftmin, ftmax1[i], t1);
+					}
+					tried++;
+					culled += (m & ~got) != 0;
+					m &= got;
+					/* a packet whose interval is tight wastes the rays'
+					 * tests: after 32 nodes with nothing culled, stop */
+					refine = culled > 0 || tried < 32;
+				}
 				if (m) {
 					const bvh_node *nd = &nodes[child];
 					int k = __builtin_ctz(m);
