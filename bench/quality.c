@@ -584,7 +584,7 @@ static unsigned char *lamp_mask(const world *w, int fw, int fh, long *count)
 			ray r = cam_ray(&w->cam, x + 0.5, y + 0.5, fw, fh);
 			hit h;
 			if (world_intersect(w, &r, 0.0, INFINITY, &h)) {
-				vec3 e = w->mats[h.object].emission;
+				vec3 e = w->mats[h.mat].emission;
 				em[y * fw + x] = e.x > 0 || e.y > 0 || e.z > 0;
 			}
 		}

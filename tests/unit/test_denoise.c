@@ -69,7 +69,7 @@ static bool sees_lamp(const world *w, int x, int y, int fw, int fh)
 			ray r = cam_ray(&w->cam, x + (i + 0.5) / 4, y + (j + 0.5) / 4, fw, fh);
 			hit h;
 			if (world_intersect(w, &r, 0.0, INFINITY, &h)) {
-				vec3 e = w->mats[h.object].emission;
+				vec3 e = w->mats[h.mat].emission;
 				if (e.x + e.y + e.z > 0.0)
 					return true;
 			}
