@@ -180,22 +180,18 @@ static int bins_for(size_t n)
 	return n >= BINS ? BINS : n < 4 ? 4 : (int)n;
 }
 
+#if !defined(__SSE2__)
 /* The bin of each lane of a (doubled) centroid: (c - lo) * scale, clamped to
- * [0, nbins - 1]; NaN (an infinite box) goes to bin 0. */
+ * [0, nbins - 1]; NaN (an infinite box) goes to bin 0. The SSE2 passes do
+ * the same in their registers. */
 static inline void bin_index(const float c[4], const float lo[4], const float scale[4], int nbins, int k[4])
 {
-#if defined(__SSE2__)
-	__m128 v = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(c), _mm_loadu_ps(lo)), _mm_loadu_ps(scale));
-	/* max(v, 0) is 0 when v is NaN */
-	v = _mm_min_ps(_mm_max_ps(v, _mm_setzero_ps()), _mm_set1_ps((float)(nbins - 1)));
-	_mm_storeu_si128((__m128i *)k, _mm_cvttps_epi32(v));
-#else
 	for (int i = 0; i < 4; i++) {
 		float v = (c[i] - lo[i]) * scale[i];
 		k[i] = !(v > 0.0f) ? 0 : v >= (float)(nbins - 1) ? nbins - 1 : (int)v;
 	}
-#endif
 }
+#endif
 
 typedef struct split {
 	int axis, at; /* object split: bins [0, at) go left */
