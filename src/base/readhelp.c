@@ -101,28 +101,26 @@ bool scan_double(const char **sp, const char *end, double *out)
 	uint64_t mant = 0;
 	int digits = 0, scale = 0;
 	bool any = false;
-	while (s < end && *s >= '0' && *s <= '9') {
+	/* The digits before and after one point: the first 19 significant ones
+	 * make mant; a later one before the point scales it up, after the point
+	 * it is dropped. */
+	bool frac = false;
+	for (; s < end; s++) {
+		if (*s == '.' && !frac) {
+			frac = true;
+			continue;
+		}
+		if (*s < '0' || *s > '9')
+			break;
 		any = true;
 		if (digits < 19) {
 			mant = mant * 10 + (uint64_t)(*s - '0');
 			if (mant)
 				digits++;
-		} else {
-			scale++;
-		}
-		s++;
-	}
-	if (s < end && *s == '.') {
-		s++;
-		while (s < end && *s >= '0' && *s <= '9') {
-			any = true;
-			if (digits < 19) {
-				mant = mant * 10 + (uint64_t)(*s - '0');
-				if (mant)
-					digits++;
+			if (frac)
 				scale--;
-			}
-			s++;
+		} else if (!frac) {
+			scale++;
 		}
 	}
 	if (!any)

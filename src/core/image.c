@@ -48,19 +48,34 @@ static uint8_t *encode_rows(const image_ctx *c, bool *owned)
 	return px;
 }
 
-static bool write_ppm(FILE *f, void *vctx, rt_error *err)
+/* An 8-bit format's encoder, given the image's sRGB codes px (rows top to
+ * bottom, R,G,B). */
+typedef bool (*write8_fn)(FILE *f, const image_ctx *c, uint8_t *px, rt_error *err);
+
+/* Runs an 8-bit encoder on the image's codes (encode_rows) and frees them
+ * when they were made for it. */
+static bool write_8bit(FILE *f, const image_ctx *c, write8_fn put, rt_error *err)
 {
-	image_ctx *c = vctx;
 	bool owned;
 	uint8_t *px = encode_rows(c, &owned);
 	if (!px)
 		return rt_error_at(err, c->path, 0, 0, "out of memory");
-	fprintf(f, "P6\n%d %d\n255\n", c->fb->w, c->fb->h);
-	size_t n = (size_t)c->fb->w * (size_t)c->fb->h * 3;
-	bool ok = fwrite(px, 1, n, f) == n;
+	bool ok = put(f, c, px, err);
 	if (owned)
 		free(px);
-	return ok || rt_error_at(err, c->path, 0, 0, "write failed");
+	return ok;
+}
+
+static bool ppm_put(FILE *f, const image_ctx *c, uint8_t *px, rt_error *err)
+{
+	fprintf(f, "P6\n%d %d\n255\n", c->fb->w, c->fb->h);
+	size_t n = (size_t)c->fb->w * (size_t)c->fb->h * 3;
+	return fwrite(px, 1, n, f) == n || rt_error_at(err, c->path, 0, 0, "write failed");
+}
+
+static bool write_ppm(FILE *f, void *vctx, rt_error *err)
+{
+	return write_8bit(f, vctx, ppm_put, err);
 }
 
 static bool write_pfm(FILE *f, void *vctx, rt_error *err)
@@ -104,18 +119,11 @@ static void png_warning_dropped(png_structp png, png_const_charp msg)
 	(void)msg;
 }
 
-static bool write_png(FILE *f, void *vctx, rt_error *err)
+static bool png_put(FILE *f, const image_ctx *c, uint8_t *px, rt_error *err)
 {
-	image_ctx *c = vctx;
-	bool owned;
-	uint8_t *px = encode_rows(c, &owned);
 	png_bytep *rows = malloc((size_t)c->fb->h * sizeof *rows);
-	if (!px || !rows) {
-		if (owned)
-			free(px);
-		free(rows);
+	if (!rows)
 		return rt_error_at(err, c->path, 0, 0, "out of memory");
-	}
 	char why[160] = "";
 	png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, why, png_error_kept, png_warning_dropped);
 	png_infop info = png ? png_create_info_struct(png) : NULL;
@@ -134,13 +142,16 @@ static bool write_png(FILE *f, void *vctx, rt_error *err)
 	}
 	png_destroy_write_struct(&png, &info);
 	free(rows);
-	if (owned)
-		free(px);
 	/* a failed write is named by the writer's errno (the caller checks
 	 * the file); libpng's own words otherwise */
 	if (!ok && ferror(f))
 		return rt_error_at(err, c->path, 0, 0, "write failed");
 	return ok || rt_error_at(err, c->path, 0, 0, "PNG encoding failed%s%s", why[0] ? ": " : "", why);
+}
+
+static bool write_png(FILE *f, void *vctx, rt_error *err)
+{
+	return write_8bit(f, vctx, png_put, err);
 }
 
 /* stb_image_write's output goes to the file; a failed write is kept. */
@@ -151,20 +162,17 @@ static void jpeg_out(void *ctx, void *data, int size)
 		fwrite(data, 1, (size_t)size, f);
 }
 
-static bool write_jpeg(FILE *f, void *vctx, rt_error *err)
+static bool jpeg_put(FILE *f, const image_ctx *c, uint8_t *px, rt_error *err)
 {
-	image_ctx *c = vctx;
-	bool owned;
-	uint8_t *px = encode_rows(c, &owned);
-	if (!px)
-		return rt_error_at(err, c->path, 0, 0, "out of memory");
 	/* Quality 92: no blocks a person sees on a rendered picture. */
-	int ok = stbi_write_jpg_to_func(jpeg_out, f, c->fb->w, c->fb->h, 3, px, 92);
-	if (owned)
-		free(px);
-	if (!ok)
+	if (!stbi_write_jpg_to_func(jpeg_out, f, c->fb->w, c->fb->h, 3, px, 92))
 		return rt_error_at(err, c->path, 0, 0, "JPEG encoding failed");
 	return !ferror(f) || rt_error_at(err, c->path, 0, 0, "write failed");
+}
+
+static bool write_jpeg(FILE *f, void *vctx, rt_error *err)
+{
+	return write_8bit(f, vctx, jpeg_put, err);
 }
 
 /* The formats, by extension: a new one is a line here (and its encoder

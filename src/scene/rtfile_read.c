@@ -841,29 +841,21 @@ static bool parse_keys(parser *p, const elem_def *e, object *o)
 				return false;
 			continue;
 		}
-		if (key->type == RT_KEY_RGB) {
+		if (key->type == RT_KEY_RGB || key->type == RT_KEY_PAIR) {
+			/* R,G,B or U,V, each in the key's range */
+			bool rgb = key->type == RT_KEY_RGB;
+			int n = rgb ? 3 : 2;
 			tok pt = *t;
 			pt.s = val;
 			pt.len = t->len - nlen - 1;
 			double c[3];
 			range r = {key->min, key->max, false, false, key->expect};
-			if (!get_tuple(p, &pt, e->name, key->name, 3, "R,G,B", &r, c))
+			if (!get_tuple(p, &pt, e->name, key->name, n, rgb ? "R,G,B" : "U,V", &r, c))
 				return false;
-			if (!rt_key_set_n(key, o, c, 3))
-				return fail_tok(p, t, e->name, "key", "could not be kept: out of memory", key->expect);
-			continue;
-		}
-		if (key->type == RT_KEY_PAIR) {
-			tok pt = *t;
-			pt.s = val;
-			pt.len = t->len - nlen - 1;
-			double uv[2];
-			range r = {key->min, key->max, false, false, key->expect};
-			if (!get_tuple(p, &pt, e->name, key->name, 2, "U,V", &r, uv))
-				return false;
-			if (strcmp(key->name, "uvscale") == 0 && (uv[0] == 0 || uv[1] == 0))
+			if (strcmp(key->name, "uvscale") == 0 && (c[0] == 0 || c[1] == 0))
 				return fail_tok(p, t, e->name, "key", "has a zero component", key->expect);
-			memcpy((char *)o + key->offset, uv, sizeof uv);
+			if (!rt_key_set_n(key, o, c, n))
+				return fail_tok(p, t, e->name, "key", "could not be kept: out of memory", key->expect);
 			continue;
 		}
 		num_status st = num_parse(val, t->len - nlen - 1, &v);
