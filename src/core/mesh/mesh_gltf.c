@@ -217,6 +217,17 @@ static bool get_num(gl *g, const cJSON *o, const char *k, const char *where, dou
 	return true;
 }
 
+/* get_num into a float field (left as it was on an error). */
+static bool get_float(gl *g, const cJSON *o, const char *k, const char *where, double lo, double hi, double def,
+                      float *out)
+{
+	double v;
+	if (!get_num(g, o, k, where, lo, hi, def, &v))
+		return false;
+	*out = (float)v;
+	return true;
+}
+
 /* n numbers at o[k] in [lo, hi] (def when absent). */
 static bool get_nums(gl *g, const cJSON *o, const char *k, const char *where, int n, double lo, double hi,
                      const double *def, double *out)
@@ -1040,12 +1051,9 @@ static bool material(gl *g, mesh_builder *b, texture **cache, size_t i, mesh_mat
 		m->ke[k] = (float)e[k];
 	}
 	m->alpha = (float)c[3];
-	if (!get_num(g, pbr, "metallicFactor", w2, 0, 1, 1, &v))
+	if (!get_float(g, pbr, "metallicFactor", w2, 0, 1, 1, &m->metallic) ||
+	    !get_float(g, pbr, "roughnessFactor", w2, 0, 1, 1, &m->roughness))
 		return false;
-	m->metallic = (float)v;
-	if (!get_num(g, pbr, "roughnessFactor", w2, 0, 1, 1, &v))
-		return false;
-	m->roughness = (float)v;
 	const cJSON *am = key(o, "alphaMode");
 	if (am) {
 		const char *s = cJSON_IsString(am) ? am->valuestring : "";
@@ -1053,14 +1061,12 @@ static bool material(gl *g, mesh_builder *b, texture **cache, size_t i, mesh_mat
 		if (!m->alpha_mode && strcmp(s, "OPAQUE") != 0)
 			return fail(g, where, "alphaMode: not \"OPAQUE\", \"MASK\" or \"BLEND\"; expected one of them");
 	}
-	if (!get_num(g, o, "alphaCutoff", where, 0, 1e300, 0.5, &v))
+	if (!get_float(g, o, "alphaCutoff", where, 0, 1e300, 0.5, &m->alpha_cutoff))
 		return false;
-	m->alpha_cutoff = (float)v;
 	const cJSON *nt = key(o, "normalTexture");
 	snprintf(w2, sizeof w2, "%s.normalTexture", where);
-	if (!get_num(g, nt, "scale", w2, -1e300, 1e300, 1, &v))
+	if (!get_float(g, nt, "scale", w2, -1e300, 1e300, 1, &m->normal_scale))
 		return false;
-	m->normal_scale = (float)v;
 	/* the extensions */
 	const cJSON *x;
 	m->ior = 1.5f;
@@ -1076,9 +1082,8 @@ static bool material(gl *g, mesh_builder *b, texture **cache, size_t i, mesh_mat
 	}
 	if ((x = key(ext, "KHR_materials_transmission"))) {
 		snprintf(w2, sizeof w2, "%s.extensions.KHR_materials_transmission", where);
-		if (!get_num(g, x, "transmissionFactor", w2, 0, 1, 0, &v))
+		if (!get_float(g, x, "transmissionFactor", w2, 0, 1, 0, &m->transmission))
 			return false;
-		m->transmission = (float)v;
 	}
 	if ((x = key(ext, "KHR_materials_ior"))) {
 		snprintf(w2, sizeof w2, "%s.extensions.KHR_materials_ior", where);
@@ -1091,32 +1096,25 @@ static bool material(gl *g, mesh_builder *b, texture **cache, size_t i, mesh_mat
 	if ((x = key(ext, "KHR_materials_volume"))) {
 		snprintf(w2, sizeof w2, "%s.extensions.KHR_materials_volume", where);
 		double ac[3];
-		if (!get_num(g, x, "thicknessFactor", w2, 0, 1e300, 0, &v))
-			return false;
-		m->thickness = (float)v;
-		if (!get_num(g, x, "attenuationDistance", w2, 0, 1e300, 0, &v) ||
+		if (!get_float(g, x, "thicknessFactor", w2, 0, 1e300, 0, &m->thickness) ||
+		    !get_float(g, x, "attenuationDistance", w2, 0, 1e300, 0, &m->att_dist) ||
 		    !get_nums(g, x, "attenuationColor", w2, 3, 0, 1, one3, ac))
 			return false;
-		m->att_dist = (float)v;
 		for (int k = 0; k < 3; k++)
 			m->att_color[k] = (float)ac[k];
 	}
 	if ((x = key(ext, "KHR_materials_clearcoat"))) {
 		snprintf(w2, sizeof w2, "%s.extensions.KHR_materials_clearcoat", where);
-		if (!get_num(g, x, "clearcoatFactor", w2, 0, 1, 0, &v))
+		if (!get_float(g, x, "clearcoatFactor", w2, 0, 1, 0, &m->clearcoat) ||
+		    !get_float(g, x, "clearcoatRoughnessFactor", w2, 0, 1, 0, &m->clearcoat_roughness))
 			return false;
-		m->clearcoat = (float)v;
-		if (!get_num(g, x, "clearcoatRoughnessFactor", w2, 0, 1, 0, &v))
-			return false;
-		m->clearcoat_roughness = (float)v;
 	}
 	if ((x = key(ext, "KHR_materials_specular"))) {
 		snprintf(w2, sizeof w2, "%s.extensions.KHR_materials_specular", where);
 		double sc[3];
-		if (!get_num(g, x, "specularFactor", w2, 0, 1, 1, &v) ||
+		if (!get_float(g, x, "specularFactor", w2, 0, 1, 1, &m->specular) ||
 		    !get_nums(g, x, "specularColorFactor", w2, 3, 0, 1e300, one3, sc))
 			return false;
-		m->specular = (float)v;
 		for (int k = 0; k < 3; k++)
 			m->specular_color[k] = (float)sc[k];
 	}
