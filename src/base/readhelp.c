@@ -81,6 +81,20 @@ static bool word_at(const char *s, const char *end, const char *w)
 	return true;
 }
 
+const unsigned char *skip_space(const unsigned char *s, const unsigned char *end, bool comments, int *lines)
+{
+	for (; s < end; s++) {
+		if (*s == '\n' && lines)
+			++*lines;
+		else if (comments && *s == '#')
+			while (s + 1 < end && s[1] != '\n')
+				s++;
+		else if (*s != ' ' && *s != '\t' && *s != '\r' && *s != '\n')
+			break;
+	}
+	return s;
+}
+
 bool scan_double(const char **sp, const char *end, double *out)
 {
 	const char *s = *sp;
