@@ -57,6 +57,31 @@ static const struct {
 };
 #define N_OCTANT_OTHER (sizeof octant_other / sizeof octant_other[0])
 
+/* The sextant set's glyphs beyond the 64 sextant patterns (ids 64 on):
+ * Block Elements (Unicode 1.1: the quadrants, the halves, the lower
+ * eighths and U+2594 UPPER ONE EIGHTH BLOCK) and the upper eighth blocks
+ * of Symbols for Legacy Computing (Unicode 13, the sextants' own block:
+ * U+1FB82..U+1FB86). On the 2x4 canvas a quadrant, a half and a quarter
+ * are exact where a sextant row is not (it covers 4/3 sample rows), and
+ * an odd eighth shows a mix of the two colours in one row of samples.
+ * (The left and right eighths were tried too and gained nothing on the
+ * bench's three scenes.) A shape is a quadrant pattern (bit 0 upper
+ * left, 1 upper right, 2 lower left, 3 lower right) or one rectangle in
+ * eighths of the cell (x0, y0, x1, y1, y down). */
+static const struct {
+	uint32_t cp;
+	uint8_t quad;
+	uint8_t x0, y0, x1, y1;
+} sextant_extra[] = {
+	{0x2598, 1, 0, 0, 0, 0},   {0x259d, 2, 0, 0, 0, 0},   {0x2580, 3, 0, 0, 0, 0},   {0x2596, 4, 0, 0, 0, 0},
+	{0x259e, 6, 0, 0, 0, 0},   {0x259b, 7, 0, 0, 0, 0},   {0x2597, 8, 0, 0, 0, 0},   {0x259a, 9, 0, 0, 0, 0},
+	{0x259c, 11, 0, 0, 0, 0},  {0x2584, 12, 0, 0, 0, 0},  {0x2599, 13, 0, 0, 0, 0},  {0x259f, 14, 0, 0, 0, 0},
+	{0x2581, 0, 0, 7, 8, 8},   {0x2582, 0, 0, 6, 8, 8},   {0x2583, 0, 0, 5, 8, 8},   {0x2585, 0, 0, 3, 8, 8},
+	{0x2586, 0, 0, 2, 8, 8},   {0x2587, 0, 0, 1, 8, 8},   {0x2594, 0, 0, 0, 8, 1},   {0x1fb82, 0, 0, 0, 8, 2},
+	{0x1fb83, 0, 0, 0, 8, 3},  {0x1fb84, 0, 0, 0, 8, 5},  {0x1fb85, 0, 0, 0, 8, 6},  {0x1fb86, 0, 0, 0, 8, 7},
+};
+#define N_SEXTANT_EXTRA (sizeof sextant_extra / sizeof sextant_extra[0])
+
 /* The quadrant an octant mask is, or -1: each pair of octant rows equal. */
 static int octant_as_quadrant(unsigned m)
 {
@@ -85,6 +110,8 @@ uint32_t symbols_codepoint(symbols_kind k, unsigned mask)
 	case SYMBOLS_QUADRANT:
 		return quadrant_cp[mask & 15];
 	case SYMBOLS_SEXTANT:
+		if (mask >= 64 && mask < 64 + N_SEXTANT_EXTRA)
+			return sextant_extra[mask - 64].cp;
 		mask &= 63;
 		/* U+1FB00.. run through masks 1..62 but the two columns. */
 		if (mask == 0 || mask == 63)
@@ -133,11 +160,63 @@ int symbols_utf8(symbols_kind k, unsigned mask, char out[4])
 	return 4;
 }
 
+
+int symbols_count(symbols_kind k)
+{
+	if (k < SYMBOLS_HALF || k >= SYMBOLS_AUTO)
+		return 0;
+	int n = 1 << (symbols_table[k].w * symbols_table[k].h);
+	return k == SYMBOLS_SEXTANT ? n + (int)N_SEXTANT_EXTRA : n;
+}
+
+/* The share of sample (sx, sy) of the 2x4 grid that rectangle r (in
+ * units of the cell, y down) covers. */
+static double rect_share(double x0, double y0, double x1, double y1, int sx, int sy)
+{
+	double ax = (double)sx / SYMBOLS_SAMPLE_W, bx = (double)(sx + 1) / SYMBOLS_SAMPLE_W;
+	double ay = (double)sy / SYMBOLS_SAMPLE_H, by = (double)(sy + 1) / SYMBOLS_SAMPLE_H;
+	double w = fmin(bx, x1) - fmax(ax, x0), h = fmin(by, y1) - fmax(ay, y0);
+	return w > 0 && h > 0 ? w * h * SYMBOLS_SAMPLE_W * SYMBOLS_SAMPLE_H : 0;
+}
+
+void symbols_cover(symbols_kind k, unsigned id, float cov[8])
+{
+	for (int i = 0; i < 8; i++)
+		cov[i] = 0;
+	if (k < SYMBOLS_HALF || k >= SYMBOLS_AUTO || (int)id >= symbols_count(k))
+		return;
+	const symbol_set *set = &symbols_table[k];
+	unsigned n = 1u << (set->w * set->h);
+	for (int sy = 0; sy < SYMBOLS_SAMPLE_H; sy++)
+		for (int sx = 0; sx < SYMBOLS_SAMPLE_W; sx++) {
+			double c = 0;
+			if (id < n) {
+				for (int j = 0; j < set->h; j++)
+					for (int i = 0; i < set->w; i++)
+						if (id >> (j * set->w + i) & 1)
+							c += rect_share((double)i / set->w, (double)j / set->h,
+							                (double)(i + 1) / set->w, (double)(j + 1) / set->h, sx, sy);
+			} else {
+				unsigned e = id - n;
+				if (sextant_extra[e].quad) {
+					for (int q = 0; q < 4; q++)
+						if (sextant_extra[e].quad >> q & 1)
+							c += rect_share((q & 1) * 0.5, (q >> 1) * 0.5, (q & 1) * 0.5 + 0.5,
+							                (q >> 1) * 0.5 + 0.5, sx, sy);
+				} else {
+					c = rect_share(sextant_extra[e].x0 / 8.0, sextant_extra[e].y0 / 8.0,
+					               sextant_extra[e].x1 / 8.0, sextant_extra[e].y1 / 8.0, sx, sy);
+				}
+			}
+			cov[sy * SYMBOLS_SAMPLE_W + sx] = (float)c;
+		}
+}
+
 int symbols_mask_of(symbols_kind k, uint32_t cp)
 {
 	if (k < SYMBOLS_HALF || k >= SYMBOLS_AUTO)
 		return -1;
-	unsigned n = 1u << (symbols_table[k].w * symbols_table[k].h);
+	unsigned n = (unsigned)symbols_count(k);
 	if (k == SYMBOLS_OCTANT && cp >= 0x1cd00 && cp <= 0x1cde5) {
 		unsigned rank = 0;
 		for (unsigned m = 0; m < n; m++)
@@ -259,4 +338,105 @@ symbols_kind symbols_choose(const char *term_program, const char *xtversion, con
 	if (vte_version && atol(vte_version) >= 6400)
 		return SYMBOLS_SEXTANT;
 	return SYMBOLS_HALF;
+}
+
+void symbols_shapes_init(symbols_shapes *s, symbols_kind k)
+{
+	s->n = symbols_count(k);
+	for (int g = 0; g < s->n; g++) {
+		symbols_cover(k, (unsigned)g, s->cov[g]);
+		double uu = 0, uv = 0, vv = 0;
+		for (int i = 0; i < 8; i++) {
+			double u = s->cov[g][i], v = 1 - u;
+			uu += u * u;
+			uv += u * v;
+			vv += v * v;
+		}
+		s->uu[g] = uu;
+		s->uv[g] = uv;
+		s->vv[g] = vv;
+	}
+	/* the complement: inked where g is not (the colours swapped) */
+	for (int g = 0; g < s->n; g++) {
+		s->comp[g] = -1;
+		for (int h = 0; h < s->n && s->comp[g] < 0; h++) {
+			bool same = true;
+			for (int i = 0; i < 8 && same; i++)
+				same = fabsf(s->cov[g][i] + s->cov[h][i] - 1) < 1e-5f;
+			if (same)
+				s->comp[g] = (short)h;
+		}
+	}
+}
+
+static double clamp255(double v)
+{
+	return v < 0 ? 0 : v > 255 ? 255 : v;
+}
+
+double symbols_fit_cover(const symbols_shapes *s, const float x[8][3], double flat, unsigned *id, uint8_t a[3],
+                         uint8_t b[3])
+{
+	/* Glyph g shows sample i as c_i a + (1 - c_i) b (c its ink's share of
+	 * the sample): a and b by least squares, per channel the 2x2 normal
+	 * equations [uu uv; uv vv] [a b] = [sum c x, sum (1-c) x]; the error
+	 * at the optimum is sum x^2 - a sum c x - b sum (1-c) x. */
+	double tot[3] = {0, 0, 0}, sq = 0;
+	for (int i = 0; i < 8; i++)
+		for (int c = 0; c < 3; c++) {
+			tot[c] += x[i][c];
+			sq += (double)x[i][c] * x[i][c];
+		}
+	double flat_err = sq - (tot[0] * tot[0] + tot[1] * tot[1] + tot[2] * tot[2]) / 8;
+	double best = flat_err, best_a[3] = {0, 0, 0}, best_b[3] = {0, 0, 0};
+	int best_g = -1;
+	for (int g = 1; g < s->n; g++) {
+		if (s->comp[g] >= 0 && s->comp[g] < g)
+			continue; /* the same fit as its complement's */
+		double det = s->uu[g] * s->vv[g] - s->uv[g] * s->uv[g];
+		if (det < 1e-6)
+			continue; /* a space or the full block */
+		double fa[3], fb[3], e = sq;
+		bool clamped = false;
+		for (int c = 0; c < 3; c++) {
+			double ru = 0;
+			for (int i = 0; i < 8; i++)
+				ru += (double)s->cov[g][i] * x[i][c];
+			double rv = tot[c] - ru;
+			fa[c] = (s->vv[g] * ru - s->uv[g] * rv) / det;
+			fb[c] = (s->uu[g] * rv - s->uv[g] * ru) / det;
+			e -= fa[c] * ru + fb[c] * rv;
+			clamped |= fa[c] < 0 || fa[c] > 255 || fb[c] < 0 || fb[c] > 255;
+		}
+		if (clamped) {
+			/* a mix past the ends: the error of the colours clamped */
+			e = 0;
+			for (int c = 0; c < 3; c++) {
+				fa[c] = clamp255(fa[c]);
+				fb[c] = clamp255(fb[c]);
+				for (int i = 0; i < 8; i++) {
+					double d = x[i][c] - (s->cov[g][i] * fa[c] + (1 - s->cov[g][i]) * fb[c]);
+					e += d * d;
+				}
+			}
+		}
+		if (e < best) {
+			best = e;
+			best_g = g;
+			memcpy(best_a, fa, sizeof fa);
+			memcpy(best_b, fb, sizeof fb);
+		}
+	}
+	if (best_g < 0 || flat_err - best <= flat) {
+		for (int c = 0; c < 3; c++)
+			a[c] = b[c] = to_byte(tot[c] / 8);
+		*id = 0;
+		return flat_err;
+	}
+	for (int c = 0; c < 3; c++) {
+		a[c] = to_byte(best_a[c]);
+		b[c] = to_byte(best_b[c]);
+	}
+	*id = (unsigned)best_g;
+	return best;
 }
