@@ -424,12 +424,16 @@ static void rd_row(frame *f, int cy)
 static double cover_error(const frame *f, const float x[8][3], unsigned g, uint32_t a, uint32_t b)
 {
 	const float *cov = f->shapes.cov[g];
+	float va[3], vb[3];
+	for (int c = 0; c < 3; c++) {
+		va[c] = (float)(a >> (16 - 8 * c) & 255);
+		vb[c] = (float)(b >> (16 - 8 * c) & 255) - va[c];
+	}
 	double e = 0;
 	for (int i = 0; i < 8; i++)
 		for (int c = 0; c < 3; c++) {
-			double va = (double)(a >> (16 - 8 * c) & 255), vb = (double)(b >> (16 - 8 * c) & 255);
-			double d = x[i][c] - (cov[i] * va + (1 - cov[i]) * vb);
-			e += d * d;
+			float d = x[i][c] - va[c] - (1 - cov[i]) * vb[c];
+			e += (double)(d * d);
 		}
 	return e;
 }
@@ -489,12 +493,16 @@ static void rd_row_cover(frame *f, int cy)
 				for (int ch = 0; ch < 3; ch++)
 					p[i] += (x[i][ch] - (double)(bg >> (16 - 8 * ch) & 255)) * d[ch];
 			}
+			float es[SYMBOLS_COVER_MAX]; /* sum c_i p_i, every glyph at once */
+			for (int g = 0; g < SYMBOLS_COVER_MAX; g++)
+				es[g] = 0;
+			for (int i = 0; i < 8; i++)
+				for (int g = 0; g < SYMBOLS_COVER_MAX; g++)
+					es[g] += sh->covt[i][g] * (float)p[i];
 			unsigned bg_id = 0;
 			double be = 0; /* glyph 0, all paper */
-			for (int g = 1; g < sh->n; g++) {
-				double e = sh->uu[g] * dd;
-				for (int i = 0; i < 8; i++)
-					e -= 2 * sh->cov[g][i] * p[i];
+			for (int g = 1; g < sh->n && g < SYMBOLS_COVER_MAX; g++) {
+				double e = sh->uu[g] * dd - 2 * (double)es[g];
 				if (e < be) {
 					be = e;
 					bg_id = (unsigned)g;

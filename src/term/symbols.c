@@ -343,8 +343,11 @@ symbols_kind symbols_choose(const char *term_program, const char *xtversion, con
 void symbols_shapes_init(symbols_shapes *s, symbols_kind k)
 {
 	s->n = symbols_count(k);
+	memset(s->covt, 0, sizeof s->covt);
 	for (int g = 0; g < s->n; g++) {
 		symbols_cover(k, (unsigned)g, s->cov[g]);
+		for (int i = 0; g < SYMBOLS_COVER_MAX && i < 8; i++)
+			s->covt[i][g] = s->cov[g][i];
 		double uu = 0, uv = 0, vv = 0;
 		for (int i = 0; i < 8; i++) {
 			double u = s->cov[g][i], v = 1 - u;
@@ -367,6 +370,22 @@ void symbols_shapes_init(symbols_shapes *s, symbols_kind k)
 				s->comp[g] = (short)h;
 		}
 	}
+	/* the inverse of each glyph's normal equations, for the glyphs of two
+	 * colours that are not the complement of one before */
+	memset(s->scovt, 0, sizeof s->scovt);
+	s->nsolve = 0;
+	for (int g = 0; g < s->n && s->nsolve < SYMBOLS_COVER_MAX; g++) {
+		double det = s->uu[g] * s->vv[g] - s->uv[g] * s->uv[g];
+		if (det <= 1e-6 || (s->comp[g] >= 0 && s->comp[g] < g))
+			continue;
+		int j = s->nsolve++;
+		s->solve[j] = (short)g;
+		for (int i = 0; i < 8; i++)
+			s->scovt[i][j] = s->cov[g][i];
+		s->ia[j] = s->vv[g] / det;
+		s->ib[j] = s->uv[g] / det;
+		s->ic[j] = s->uu[g] / det;
+	}
 }
 
 static double clamp255(double v)
@@ -381,33 +400,44 @@ double symbols_fit_cover(const symbols_shapes *s, const float x[8][3], double fl
 	 * the sample): a and b by least squares, per channel the 2x2 normal
 	 * equations [uu uv; uv vv] [a b] = [sum c x, sum (1-c) x]; the error
 	 * at the optimum is sum x^2 - a sum c x - b sum (1-c) x. */
+	float xt[3][8]; /* the channels apart: each sum c x one dot product */
 	double tot[3] = {0, 0, 0}, sq = 0;
 	for (int i = 0; i < 8; i++)
 		for (int c = 0; c < 3; c++) {
+			xt[c][i] = x[i][c];
 			tot[c] += x[i][c];
 			sq += (double)x[i][c] * x[i][c];
 		}
 	double flat_err = sq - (tot[0] * tot[0] + tot[1] * tot[1] + tot[2] * tot[2]) / 8;
 	double best = flat_err, best_a[3] = {0, 0, 0}, best_b[3] = {0, 0, 0};
 	int best_g = -1;
-	for (int g = 1; g < s->n; g++) {
-		if (s->comp[g] >= 0 && s->comp[g] < g)
-			continue; /* the same fit as its complement's */
-		double det = s->uu[g] * s->vv[g] - s->uv[g] * s->uv[g];
-		if (det < 1e-6)
-			continue; /* a space or the full block */
+	/* sum c x for every glyph tried at once (a loop the compiler
+	 * vectorises) */
+	enum { NS = 48 }; /* enough for the sextant set's 43 */
+	float rus[3][NS];
+	int ns = s->nsolve < NS ? s->nsolve : NS;
+	for (int c = 0; c < 3; c++) {
+		for (int k = 0; k < NS; k++)
+			rus[c][k] = 0;
+		for (int i = 0; i < 8; i++)
+			for (int k = 0; k < NS; k++)
+				rus[c][k] += s->scovt[i][k] * xt[c][i];
+	}
+	for (int k = 0; k < ns; k++) {
+		int g = s->solve[k];
+		const float *cv = s->cov[g];
+		float ru[3] = {rus[0][k], rus[1][k], rus[2][k]};
 		double fa[3], fb[3], e = sq;
 		bool clamped = false;
 		for (int c = 0; c < 3; c++) {
-			double ru = 0;
-			for (int i = 0; i < 8; i++)
-				ru += (double)s->cov[g][i] * x[i][c];
-			double rv = tot[c] - ru;
-			fa[c] = (s->vv[g] * ru - s->uv[g] * rv) / det;
-			fb[c] = (s->uu[g] * rv - s->uv[g] * ru) / det;
-			e -= fa[c] * ru + fb[c] * rv;
+			double rv = tot[c] - ru[c];
+			fa[c] = s->ia[k] * ru[c] - s->ib[k] * rv;
+			fb[c] = s->ic[k] * rv - s->ib[k] * ru[c];
+			e -= fa[c] * ru[c] + fb[c] * rv;
 			clamped |= fa[c] < 0 || fa[c] > 255 || fb[c] < 0 || fb[c] > 255;
 		}
+		if (e >= best)
+			continue; /* clamping only adds error */
 		if (clamped) {
 			/* a mix past the ends: the error of the colours clamped */
 			e = 0;
@@ -415,17 +445,17 @@ double symbols_fit_cover(const symbols_shapes *s, const float x[8][3], double fl
 				fa[c] = clamp255(fa[c]);
 				fb[c] = clamp255(fb[c]);
 				for (int i = 0; i < 8; i++) {
-					double d = x[i][c] - (s->cov[g][i] * fa[c] + (1 - s->cov[g][i]) * fb[c]);
+					double d = x[i][c] - (cv[i] * fa[c] + (1 - cv[i]) * fb[c]);
 					e += d * d;
 				}
 			}
+			if (e >= best)
+				continue;
 		}
-		if (e < best) {
-			best = e;
-			best_g = g;
-			memcpy(best_a, fa, sizeof fa);
-			memcpy(best_b, fb, sizeof fb);
-		}
+		best = e;
+		best_g = g;
+		memcpy(best_a, fa, sizeof fa);
+		memcpy(best_b, fb, sizeof fb);
 	}
 	if (best_g < 0 || flat_err - best <= flat) {
 		for (int c = 0; c < 3; c++)

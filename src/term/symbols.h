@@ -85,16 +85,26 @@ int symbols_count(symbols_kind k);
 void symbols_cover(symbols_kind k, unsigned id, float cov[8]);
 
 #define SYMBOLS_MAX_GLYPHS 256
+#define SYMBOLS_COVER_MAX 88 /* the most glyphs symbols_fit_cover takes */
 /* A set's glyph shapes on the sample grid, for symbols_fit_cover. */
 typedef struct symbols_shapes {
 	int n;                               /* glyphs */
 	float cov[SYMBOLS_MAX_GLYPHS][8];    /* symbols_cover */
 	double uu[SYMBOLS_MAX_GLYPHS], uv[SYMBOLS_MAX_GLYPHS], vv[SYMBOLS_MAX_GLYPHS];
 	short comp[SYMBOLS_MAX_GLYPHS];      /* the glyph inked where this one is not, or -1 */
+	float covt[8][SYMBOLS_COVER_MAX];    /* cov by sample, for sums over all glyphs at once
+	                                        (sets of at most SYMBOLS_COVER_MAX glyphs; 0 past n) */
+	/* The glyphs the fit tries: two colours, and not the complement of
+	 * one tried (the same fit, colours swapped); their shapes by sample
+	 * and the inverse of their normal equations, [ia -ib; -ib ic]. */
+	int nsolve;
+	short solve[SYMBOLS_COVER_MAX];
+	float scovt[8][SYMBOLS_COVER_MAX];
+	double ia[SYMBOLS_COVER_MAX], ib[SYMBOLS_COVER_MAX], ic[SYMBOLS_COVER_MAX];
 } symbols_shapes;
 void symbols_shapes_init(symbols_shapes *s, symbols_kind k);
 /* The best two-colour fit of a cell's 8 samples x (sRGB levels) over every
- * glyph of s: each sample shown as its ink's share of colour a and the
+ * glyph of s (a set of at most SYMBOLS_COVER_MAX glyphs: the sextant set): each sample shown as its ink's share of colour a and the
  * rest of b, a and b by least squares (clamped to 0..255, rounded). A
  * cell whose best glyph gains at most `flat` over one colour is flat
  * (id 0, a == b == the mean). Returns the squared error of the fit. */
