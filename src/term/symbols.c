@@ -2,6 +2,7 @@
 #include "term/symbols.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -320,20 +321,35 @@ double symbols_fit(const float sub[][3], int n, double flat, unsigned *mask, uin
 	return sq - best;
 }
 
+/* A version "A.B.C" at s as A*1000000 + B*1000 + C; -1 when s holds none. */
+static long version_of(const char *s)
+{
+	int a = 0, b = 0, c = 0;
+	if (sscanf(s, "%d.%d.%d", &a, &b, &c) < 2 || a < 0 || b < 0 || c < 0 || b > 999 || c > 999)
+		return -1;
+	return (long)a * 1000000 + (long)b * 1000 + c;
+}
+
 symbols_kind symbols_choose(const char *term_program, const char *xtversion, const char *vte_version, bool tmux)
 {
 	(void)tmux; /* inside tmux, TERM_PROGRAM and XTVERSION name tmux itself */
-	/* Terminals that draw the block elements and "Symbols for Legacy
-	 * Computing" themselves, not from a font that may lack them: kitty,
-	 * WezTerm, foot, Ghostty and VTE (GNOME Terminal and its kin, 0.64
-	 * on). Octants (Unicode 16, 2024) are left to `set symbols octant`:
-	 * which releases draw them is not known here. */
+	/* Terminals that draw the block elements and the glyphs of the
+	 * sextant set (sextants, U+1FB82..U+1FB86) themselves, not from a font
+	 * that may lack them: kitty (0.19.0 on), WezTerm (20210814 on), foot,
+	 * Ghostty and VTE (GNOME Terminal and its kin, 0.64 on). Octants
+	 * (Unicode 16) where a release's notes say the terminal draws them:
+	 * kitty 0.40.0 ("Add support for the octant box-drawing characters"),
+	 * known from its XTVERSION answer, kitty(0.40.0). */
+	if (xtversion && strncmp(xtversion, "kitty(", 6) == 0) {
+		long v = version_of(xtversion + 6);
+		return v >= 40000 ? SYMBOLS_OCTANT : v >= 19000 || v < 0 ? SYMBOLS_SEXTANT : SYMBOLS_HALF;
+	}
 	static const char *const programs[] = {"WezTerm", "ghostty", "kitty"};
 	for (size_t i = 0; term_program && i < sizeof programs / sizeof programs[0]; i++)
 		if (strcmp(term_program, programs[i]) == 0)
 			return SYMBOLS_SEXTANT;
-	if (xtversion && (strncmp(xtversion, "kitty(", 6) == 0 || strncmp(xtversion, "foot(", 5) == 0 ||
-	                  strncmp(xtversion, "WezTerm ", 8) == 0 || strncmp(xtversion, "ghostty ", 8) == 0))
+	if (xtversion && (strncmp(xtversion, "foot(", 5) == 0 || strncmp(xtversion, "WezTerm ", 8) == 0 ||
+	                  strncmp(xtversion, "ghostty ", 8) == 0))
 		return SYMBOLS_SEXTANT;
 	if (vte_version && atol(vte_version) >= 6400)
 		return SYMBOLS_SEXTANT;

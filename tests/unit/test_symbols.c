@@ -496,6 +496,14 @@ static void test_choose(void **state)
 	assert_int_equal(symbols_choose(NULL, "XTerm(379)", NULL, false), SYMBOLS_HALF);
 	assert_int_equal(symbols_choose("tmux", "tmux 3.3a", NULL, true), SYMBOLS_HALF);
 	assert_int_equal(symbols_choose(NULL, NULL, "7200", false), SYMBOLS_SEXTANT);
+	/* kitty's octants came with 0.40.0 (its changelog), its sextants and
+	 * eighth blocks with 0.19.0; without a version, sextants. */
+	assert_int_equal(symbols_choose(NULL, "kitty(0.40.0)", NULL, false), SYMBOLS_OCTANT);
+	assert_int_equal(symbols_choose("kitty", "kitty(0.42.1)", NULL, false), SYMBOLS_OCTANT);
+	assert_int_equal(symbols_choose(NULL, "kitty(0.39.1)", NULL, false), SYMBOLS_SEXTANT);
+	assert_int_equal(symbols_choose(NULL, "kitty(0.18.3)", NULL, false), SYMBOLS_HALF);
+	assert_int_equal(symbols_choose("kitty", NULL, NULL, false), SYMBOLS_SEXTANT);
+	assert_int_equal(symbols_choose(NULL, "kitty(x)", NULL, false), SYMBOLS_SEXTANT);
 	symbols_kind k;
 	assert_true(symbols_parse("octant", &k));
 	assert_int_equal(k, SYMBOLS_OCTANT);
