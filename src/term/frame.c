@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "rtsh/image.h"
+#include "rtsh/memory.h"
 
 #define UNKNOWN 0xffffffffu /* SGR state not known */
 #define GAP_FILL 3
@@ -67,12 +68,8 @@ void frame_free(frame *f)
 {
 	if (!f)
 		return;
-	free(f->cur);
-	free(f->shown);
-	free(f->px);
-	free(f->def);
 	abuf_free(&f->out);
-	free(f);
+	mem_free_all(f->cur, f->shown, f->px, f->def, f);
 }
 
 void frame_invalidate(frame *f)
