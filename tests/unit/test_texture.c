@@ -151,7 +151,7 @@ static void test_mipmap_average(void **state)
 			for (int c = 0; c < 3; c++)
 				rgb[3 * (y * n + x) + c] = (float)((x + y) & 1);
 	rt_error err = {0};
-	texture *t = texture_make(rgb, n, n, &err);
+	texture *t = texture_make(rgb, n, n, NULL, false, &err);
 	assert_non_null(t);
 	assert_int_equal(t->nlevels, 7); /* 64, 32, ..., 1 */
 	test_rng r = {3};

@@ -1022,14 +1022,9 @@ static bool tex_info(gl *g, mesh_builder *b, texture **cache, const cJSON *ti, c
 	free(own);
 	if (!rgb)
 		return false;
-	texture *x = texture_make(rgb, w, h, g->err);
+	texture *x = texture_make(rgb, w, h, name, srgb, g->err);
 	if (!x)
 		return false;
-	x->srgb = srgb;
-	if (!(x->path = strdup(name))) {
-		texture_free(x);
-		return fail(g, iw, "out of memory");
-	}
 	if (!mb_texture(b, x))
 		return fail(g, iw, "out of memory");
 	*slot = *tex = x;
