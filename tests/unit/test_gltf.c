@@ -745,13 +745,13 @@ static size_t png_1x1(unsigned char r, unsigned char g, unsigned char b, unsigne
 	return n + 12;
 }
 
-/* The metallic-roughness texture in shading: a triangle with uv, metallic
- * 0.5 and roughness 0.8, and a texture of one texel (R, G, B) = (0, 128,
- * 255), read linear (glTF: G scales roughness, B metallic). At any point:
- * roughness 0.8 x 128/255 = 0.40157, metallic 0.5 x 255/255 = 0.5. */
-static void test_metallic_roughness_texture(void **state)
+/* The triangle (-1,-1,0) (1,-1,0) (0,1,0) with uv (0,0) (1,0) (0.5,1), of
+ * material 0, whose texture 0 is one PNG texel (r, g, b); a camera of
+ * vertical field yfov at `at` ("[0,0,5]") looks at it. `materials` is the
+ * file's materials array. Written to tmpdir/name and loaded as a scene. */
+static scene *textured_tri(const char *name, unsigned char r, unsigned char g, unsigned char b, const char *at,
+                           double yfov, const char *materials)
 {
-	(void)state;
 	unsigned char bin[68];
 	const float pos[9] = {-1, -1, 0, 1, -1, 0, 0, 1, 0}, uv[6] = {0, 0, 1, 0, 0.5f, 1};
 	const uint16_t idx[4] = {0, 1, 2, 0};
@@ -761,16 +761,14 @@ static void test_metallic_roughness_texture(void **state)
 	char data[128], png64[128];
 	b64(bin, sizeof bin, data);
 	unsigned char png[80];
-	size_t npng = png_1x1(0, 128, 255, png);
-	b64(png, npng, png64);
+	b64(png, png_1x1(r, g, b, png), png64);
 	char text[4096];
 	snprintf(text, sizeof text,
-	         "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0},{\"camera\":0,\"translation\":[0,0,5]}],"
-	         "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":1}}],"
+	         "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0},{\"camera\":0,\"translation\":%s}],"
+	         "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":%.17g}}],"
 	         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"indices\":2,"
 	         "\"material\":0}]}],"
-	         "\"materials\":[{\"pbrMetallicRoughness\":{\"metallicFactor\":0.5,\"roughnessFactor\":0.8,"
-	         "\"metallicRoughnessTexture\":{\"index\":0}}}],"
+	         "\"materials\":%s,"
 	         "\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],"
 	         "\"buffers\":[{\"byteLength\":68,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
 	         "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":24},"
@@ -778,11 +776,25 @@ static void test_metallic_roughness_texture(void **state)
 	         "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
 	         "{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"},"
 	         "{\"bufferView\":2,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}",
-	         png64, data);
+	         at, yfov, materials, png64, data);
 	rt_error err = {0};
-	scene *s = rt_load_file(tmp_text("mr.gltf", text), NULL, &err);
-	if (!s)
+	scene *sc = rt_load_file(tmp_text(name, text), NULL, &err);
+	if (!sc)
 		fail_msg("%s", err.msg);
+	return sc;
+}
+
+/* The metallic-roughness texture in shading: a triangle with uv, metallic
+ * 0.5 and roughness 0.8, and a texture of one texel (R, G, B) = (0, 128,
+ * 255), read linear (glTF: G scales roughness, B metallic). At any point:
+ * roughness 0.8 x 128/255 = 0.40157, metallic 0.5 x 255/255 = 0.5. */
+static void test_metallic_roughness_texture(void **state)
+{
+	(void)state;
+	scene *s = textured_tri("mr.gltf", 0, 128, 255, "[0,0,5]", 1,
+	                        "[{\"pbrMetallicRoughness\":{\"metallicFactor\":0.5,\"roughnessFactor\":0.8,"
+	                        "\"metallicRoughnessTexture\":{\"index\":0}}}]");
+	rt_error err = {0};
 	world *w = world_build(s, &err);
 	if (!w)
 		fail_msg("%s", err.msg);
@@ -813,36 +825,13 @@ static void test_metallic_roughness_texture(void **state)
 static void test_texture_rotation(void **state)
 {
 	(void)state;
-	unsigned char bin[68];
-	const float pos[9] = {-1, -1, 0, 1, -1, 0, 0, 1, 0}, uv[6] = {0, 0, 1, 0, 0.5f, 1};
-	const uint16_t idx[4] = {0, 1, 2, 0};
-	memcpy(bin, pos, 36);
-	memcpy(bin + 36, uv, 24);
-	memcpy(bin + 60, idx, 8);
-	char data[128], png64[128];
-	b64(bin, sizeof bin, data);
-	unsigned char png[80];
-	b64(png, png_1x1(200, 100, 50, png), png64);
-	char text[4096];
-	snprintf(text, sizeof text,
-	         "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0},{\"camera\":0,\"translation\":[0,0,5]}],"
-	         "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":1}}],"
-	         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"indices\":2,"
-	         "\"material\":0}]}],"
-	         "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0,\"extensions\":"
-	         "{\"KHR_texture_transform\":{\"offset\":[0.1,0.2],\"rotation\":%.17g,\"scale\":[2,0.5]}}}}}],"
-	         "\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],"
-	         "\"buffers\":[{\"byteLength\":68,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
-	         "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":24},"
-	         "{\"buffer\":0,\"byteOffset\":60,\"byteLength\":6}],"
-	         "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
-	         "{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"},"
-	         "{\"bufferView\":2,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}",
-	         M_PI / 2, png64, data);
+	char mat[256];
+	snprintf(mat, sizeof mat,
+	         "[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0,\"extensions\":"
+	         "{\"KHR_texture_transform\":{\"offset\":[0.1,0.2],\"rotation\":%.17g,\"scale\":[2,0.5]}}}}}]",
+	         M_PI / 2);
+	scene *s = textured_tri("rot.gltf", 200, 100, 50, "[0,0,5]", 1, mat);
 	rt_error err = {0};
-	scene *s = rt_load_file(tmp_text("rot.gltf", text), NULL, &err);
-	if (!s)
-		fail_msg("%s", err.msg);
 	world *w = world_build(s, &err);
 	if (!w)
 		fail_msg("%s", err.msg);
@@ -872,37 +861,11 @@ static void test_texture_rotation(void **state)
 static void test_emissive_texture(void **state)
 {
 	(void)state;
-	unsigned char bin[68];
-	const float pos[9] = {-1, -1, 0, 1, -1, 0, 0, 1, 0}, uv[6] = {0, 0, 1, 0, 0.5f, 1};
-	const uint16_t idx[4] = {0, 1, 2, 0};
-	memcpy(bin, pos, 36);
-	memcpy(bin + 36, uv, 24);
-	memcpy(bin + 60, idx, 8);
-	char data[128], png64[128];
-	b64(bin, sizeof bin, data);
-	unsigned char png[80];
-	b64(png, png_1x1(255, 128, 0, png), png64);
-	char text[4096];
-	snprintf(text, sizeof text,
-	         "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0},{\"camera\":0,\"translation\":[0,-0.2,5]}],"
-	         "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.01}}],"
-	         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"indices\":2,"
-	         "\"material\":0}]}],"
-	         "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1]},\"emissiveFactor\":[1,1,1],"
-	         "\"emissiveTexture\":{\"index\":0},"
-	         "\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":2}}}],"
-	         "\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],"
-	         "\"buffers\":[{\"byteLength\":68,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
-	         "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":24},"
-	         "{\"buffer\":0,\"byteOffset\":60,\"byteLength\":6}],"
-	         "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
-	         "{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"},"
-	         "{\"bufferView\":2,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}",
-	         png64, data);
+	scene *s = textured_tri("emit.gltf", 255, 128, 0, "[0,-0.2,5]", 0.01,
+	                        "[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1]},\"emissiveFactor\":[1,1,1],"
+	                        "\"emissiveTexture\":{\"index\":0},"
+	                        "\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":2}}}]");
 	rt_error err = {0};
-	scene *s = rt_load_file(tmp_text("emit.gltf", text), NULL, &err);
-	if (!s)
-		fail_msg("%s", err.msg);
 	world *w = world_build(s, &err);
 	if (!w)
 		fail_msg("%s", err.msg);
