@@ -48,6 +48,21 @@ static const char *tmp_text(const char *name, const char *text)
 	return p;
 }
 
+/* s saved as tmpdir/name reads back as s; the copy read back (the caller
+ * frees it). */
+static scene *saved_again(const scene *s, const char *name)
+{
+	char rt[256];
+	snprintf(rt, sizeof rt, "%s/%s", tmpdir, name);
+	rt_error err = {0};
+	assert_true(rt_save(s, rt, &err));
+	scene *t = rt_load_file(rt, NULL, &err);
+	if (!t)
+		fail_msg("%s", err.msg);
+	assert_true(scene_equal(s, t));
+	return t;
+}
+
 /* --- writing glTF --- */
 
 static void b64(const unsigned char *in, size_t n, char *out)
@@ -572,13 +587,7 @@ static void test_camera_frustum(void **state)
 	assert_vec_near(top.o, v3(-1, 4, 3), 1e-12);
 	assert_vec_near(v3_sub(right.o, v3(-1, 2, 3)), v3_scale(v.right, 4), 1e-12);
 	/* save and load again: the same scene */
-	char rt[256];
-	snprintf(rt, sizeof rt, "%s/cams.rt", tmpdir);
-	assert_true(rt_save(s, rt, &err));
-	scene *t = rt_load_file(rt, NULL, &err);
-	if (!t)
-		fail_msg("%s", err.msg);
-	assert_true(scene_equal(s, t));
+	scene *t = saved_again(s, "cams.rt");
 	scene_free(t);
 	scene_free(s);
 }
@@ -615,13 +624,7 @@ static void test_camera_roll(void **state)
 	/* the middle of the top row: up by tan(yfov / 2) */
 	ray top = cam_ray(&v, 100, 0, 200, 100);
 	assert_vec_near(top.d, v3_norm(v3(tan(0.5), 0, -1)), 1e-12);
-	char rt[256];
-	snprintf(rt, sizeof rt, "%s/roll.rt", tmpdir);
-	assert_true(rt_save(s, rt, &err));
-	scene *t = rt_load_file(rt, NULL, &err);
-	if (!t)
-		fail_msg("%s", err.msg);
-	assert_true(scene_equal(s, t));
+	scene *t = saved_again(s, "roll.rt");
 	scene_free(t);
 	scene_free(s);
 }
@@ -668,13 +671,7 @@ static void test_nodes_as_objects(void **state)
 	r.o = v3(-5.5, 0.2, -10); /* where it was: nothing now */
 	assert_false(world_intersect(w, &r, 0, INFINITY, &h));
 	world_free(w);
-	char rt[256];
-	snprintf(rt, sizeof rt, "%s/nodes.rt", tmpdir);
-	assert_true(rt_save(s, rt, &err));
-	scene *t = rt_load_file(rt, NULL, &err);
-	if (!t)
-		fail_msg("%s", err.msg);
-	assert_true(scene_equal(s, t));
+	scene *t = saved_again(s, "nodes.rt");
 	assert_int_equal(t->objs[1].node, 1);
 	scene_free(t);
 	scene_free(s);
