@@ -44,6 +44,13 @@ typedef struct mesh_mat {
 	float alpha;      /* baseColorFactor's alpha */
 	uint8_t alpha_mode; /* MESH_ALPHA_* */
 	float alpha_cutoff; /* MASK: texels of alpha below it are holes (0.5) */
+	/* MASK with a base colour texture that has an alpha channel: that
+	 * channel (bytes, linear, top row first; only these materials keep it),
+	 * its size and its sampler's wrapS, wrapT (MESH_WRAP_*); NULL: alpha is
+	 * the factor's alone */
+	unsigned char *alpha_map;
+	int alpha_w, alpha_h;
+	uint8_t alpha_wrap[2];
 	float normal_scale; /* normalTexture.scale (1) */
 	float transmission; /* KHR_materials_transmission (0) */
 	float ior;          /* KHR_materials_ior (1.5) */
@@ -61,6 +68,7 @@ typedef struct mesh_mat {
 } mesh_mat;
 
 enum { MESH_ALPHA_OPAQUE, MESH_ALPHA_MASK, MESH_ALPHA_BLEND };
+enum { MESH_WRAP_REPEAT, MESH_WRAP_CLAMP, MESH_WRAP_MIRROR };
 
 /* Four triangles of a leaf laid out for the leaf test (mesh_trace.c):
  * v[3 * corner + axis][lane] is a vertex coordinate, the same float as the
@@ -119,6 +127,10 @@ typedef struct mesh {
 	float eps;         /* self-hit guard in object units */
 	size_t refs;       /* users in the cache (mesh_cache_get) */
 	char *warning;     /* the reader's first warning ("FILE:LINE: ..."), NULL: none (owned) */
+	/* Some material is an alphaMode MASK cut-out (glTF): the walk asks
+	 * mesh_cut_hole of each triangle hit it would accept. False: the walk
+	 * never asks (one test where a block finds a hit, nothing else). */
+	bool cuts;
 } mesh;
 
 /* --- loading --- */
@@ -299,5 +311,18 @@ typedef struct mesh_surf {
 	vec3 shift;
 } mesh_surf;
 void mesh_surface(const mesh *m, uint32_t slot, const float b[3], mesh_surf *s);
+
+/* glTF alpha coverage (alphaMode MASK): true when the hit on the triangle in
+ * `slot` at barycentrics b falls in a hole of its material, where alpha =
+ * baseColorFactor's alpha x the base colour texture's alpha at the hit's
+ * uv (KHR_texture_transform, the sampler's wrap, bilinear on the finest
+ * level) is below alphaCutoff. False for every other material. The walk
+ * (mesh_trace.c) skips such hits, for every kind of ray. */
+bool mesh_cut_hole(const mesh *m, uint32_t slot, const float b[3]);
+/* The same for the lanes in `lanes` (a bit each) of block `blk` hit with
+ * edge functions u, v, w and 1 / det inv (the walk's floats; b = u inv, v
+ * inv, w inv): `lanes` less those in holes. */
+unsigned mesh_cut_lanes(const mesh *m, uint32_t blk, unsigned lanes, const float u[4], const float v[4],
+                        const float w[4], const float inv[4]);
 
 #endif

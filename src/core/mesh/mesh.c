@@ -98,6 +98,7 @@ static void mat_free(mesh_mat *m)
 	free(m->map_norm);
 	free(m->map_mr);
 	free(m->map_emit);
+	free(m->alpha_map);
 }
 
 /* The materials and embedded textures a builder, then its mesh, holds. */
@@ -323,6 +324,9 @@ size_t mesh_memory(const mesh *m)
 	n += (size_t)m->nblk * (sizeof *m->blk + sizeof *m->btri);
 	for (uint32_t i = 0; i < m->ntexs; i++)
 		n += tex_bytes(m->texs[i]);
+	for (uint32_t i = 0; i < m->nmats; i++)
+		if (m->mats[i].alpha_map)
+			n += (size_t)m->mats[i].alpha_w * (size_t)m->mats[i].alpha_h;
 	return n;
 }
 
@@ -626,4 +630,86 @@ void mesh_surface(const mesh *m, uint32_t slot, const float b[3], mesh_surf *s)
 			s->dpdv = v3_scale(v3_sub(v3_scale(e2, du1), v3_scale(e1, du2)), 1.0 / det);
 		}
 	}
+}
+
+/* --- alpha coverage (glTF alphaMode MASK) --- */
+
+/* Texel index i of n along an axis, by the sampler's wrap mode. */
+static long wrap_texel(long i, long n, int mode)
+{
+	if (mode == MESH_WRAP_CLAMP)
+		return i < 0 ? 0 : i >= n ? n - 1 : i;
+	if (mode == MESH_WRAP_MIRROR) {
+		long k = i % (2 * n);
+		k = k < 0 ? k + 2 * n : k;
+		return k < n ? k : 2 * n - 1 - k;
+	}
+	long k = i % n;
+	return k < 0 ? k + n : k;
+}
+
+/* A texel coordinate (texel centres at integers) brought near the image,
+ * where floor() and the wrap are exact: by the wrap's period, or clamped. */
+static double wrap_coord(double x, long n, int mode)
+{
+	if (mode == MESH_WRAP_CLAMP)
+		return x < -1.0 ? -1.0 : x > (double)n ? (double)n : x;
+	return fmod(x, mode == MESH_WRAP_MIRROR ? 2.0 * (double)n : (double)n);
+}
+
+/* The bilinear alpha of the map at (u, v), v up (texture.c's texel
+ * centres: x = u w - 1/2, y = (1 - v) h - 1/2). */
+static double alpha_at(const mesh_mat *mm, double u, double v)
+{
+	long w = mm->alpha_w, h = mm->alpha_h;
+	double x = u * (double)w - 0.5, y = (1.0 - v) * (double)h - 0.5;
+	if (!isfinite(x) || !isfinite(y))
+		return 0.0;
+	x = wrap_coord(x, w, mm->alpha_wrap[0]);
+	y = wrap_coord(y, h, mm->alpha_wrap[1]);
+	double fx = floor(x), fy = floor(y), ax = x - fx, ay = y - fy;
+	long x0 = wrap_texel((long)fx, w, mm->alpha_wrap[0]), x1 = wrap_texel((long)fx + 1, w, mm->alpha_wrap[0]);
+	long y0 = wrap_texel((long)fy, h, mm->alpha_wrap[1]), y1 = wrap_texel((long)fy + 1, h, mm->alpha_wrap[1]);
+	const unsigned char *a = mm->alpha_map;
+	double a00 = a[(size_t)y0 * (size_t)w + (size_t)x0], a10 = a[(size_t)y0 * (size_t)w + (size_t)x1];
+	double a01 = a[(size_t)y1 * (size_t)w + (size_t)x0], a11 = a[(size_t)y1 * (size_t)w + (size_t)x1];
+	return ((1 - ay) * ((1 - ax) * a00 + ax * a10) + ay * ((1 - ax) * a01 + ax * a11)) / 255.0;
+}
+
+bool mesh_cut_hole(const mesh *m, uint32_t slot, const float b[3])
+{
+	if (m->nmats == 0)
+		return false;
+	uint32_t t = mesh_slot_tri(m, slot);
+	const mesh_mat *mm = &m->mats[m->tmat ? m->tmat[t] : 0];
+	if (mm->alpha_mode != MESH_ALPHA_MASK)
+		return false;
+	double a = mm->alpha;
+	if (mm->alpha_map) {
+		/* the hit's uv as mesh_surface interpolates it (none: 0, 0), then
+		 * the base colour texture's KHR_texture_transform (surface.c) */
+		double u = 0, v = 0;
+		if (m->tri && m->uv) {
+			const uint32_t *i = m->tri[t];
+			const float *pa = m->uv[i[0]], *pb = m->uv[i[1]], *pc = m->uv[i[2]];
+			u = b[0] * pa[0] + b[1] * pb[0] + b[2] * pc[0];
+			v = b[0] * pa[1] + b[1] * pb[1] + b[2] * pc[1];
+		}
+		double tu = u * mm->uvs[0] + mm->uvo[0] + v * mm->uvx[0];
+		double tv = v * mm->uvs[1] + mm->uvo[1] + u * mm->uvx[1];
+		a *= alpha_at(mm, tu, tv);
+	}
+	return a < mm->alpha_cutoff;
+}
+
+unsigned mesh_cut_lanes(const mesh *m, uint32_t blk, unsigned lanes, const float u[4], const float v[4],
+                        const float w[4], const float inv[4])
+{
+	for (unsigned rest = lanes; rest; rest &= rest - 1) {
+		int l = __builtin_ctz(rest);
+		float b[3] = {u[l] * inv[l], v[l] * inv[l], w[l] * inv[l]};
+		if (mesh_cut_hole(m, 4 * blk + (uint32_t)l, b))
+			lanes &= ~(1u << l);
+	}
+	return lanes;
 }
