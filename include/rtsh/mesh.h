@@ -127,9 +127,9 @@ typedef struct mesh {
 	float eps;         /* self-hit guard in object units */
 	size_t refs;       /* users in the cache (mesh_cache_get) */
 	char *warning;     /* the reader's first warning ("FILE:LINE: ..."), NULL: none (owned) */
-	/* Some material is an alphaMode MASK cut-out (glTF): the walk asks
-	 * mesh_cut_hole of each triangle hit it would accept. False: the walk
-	 * never asks (one test where a block finds a hit, nothing else). */
+	/* Some material is an alphaMode MASK cut-out or BLEND (glTF): the walk
+	 * asks mesh_cut_hole of each triangle hit it would accept. False: the
+	 * walk never asks (one test where a block finds a hit, nothing else). */
 	bool cuts;
 } mesh;
 
@@ -312,13 +312,20 @@ typedef struct mesh_surf {
 } mesh_surf;
 void mesh_surface(const mesh *m, uint32_t slot, const float b[3], mesh_surf *s);
 
-/* glTF alpha coverage (alphaMode MASK): true when the hit on the triangle in
- * `slot` at barycentrics b falls in a hole of its material, where alpha =
- * baseColorFactor's alpha x the base colour texture's alpha at the hit's
- * uv (KHR_texture_transform, the sampler's wrap, bilinear on the finest
- * level) is below alphaCutoff. False for every other material. The walk
- * (mesh_trace.c) skips such hits, for every kind of ray. */
+/* glTF alpha coverage: true when the hit on the triangle in `slot` at
+ * barycentrics b falls in a hole of its material. alpha = baseColorFactor's
+ * alpha x the base colour texture's alpha at the hit's uv
+ * (KHR_texture_transform, the sampler's wrap, bilinear on the finest
+ * level). alphaMode MASK: a hole where alpha < alphaCutoff. BLEND: with
+ * mesh_alpha_hashed on, where alpha < a number in [0, 1) hashed from the
+ * hit (so a ray passes with probability 1 - alpha: stochastic
+ * transparency, right on average over a pixel's samples), else as MASK at
+ * 0.5. OPAQUE: never. The walk (mesh_trace.c) skips such hits, for every
+ * kind of ray. */
 bool mesh_cut_hole(const mesh *m, uint32_t slot, const float b[3]);
+/* BLEND's hashed alpha on or off in the calling thread (off at first): the
+ * renderer turns it on for the integrators that sample (path mode). */
+void mesh_alpha_hashed(bool on);
 /* The same for the lanes in `lanes` (a bit each) of block `blk` hit with
  * edge functions u, v, w and 1 / det inv (the walk's floats; b = u inv, v
  * inv, w inv): `lanes` less those in holes. */

@@ -1183,7 +1183,7 @@ static void expect_centre(const world *w, double want)
  * between it and the camera, its MASK texture left opaque, right clear.
  * Through the opaque texel the camera sees the quad (black: 0); through
  * the clear one it sees the plane, lit through the same hole: 0.5 / pi.
- * OPAQUE (the default) and BLEND (opaque in rtsh) ignore alpha: 0. */
+ * OPAQUE (the default) ignores alpha: 0. */
 static void test_cutout_camera_rays(void **state)
 {
 	(void)state;
@@ -1379,6 +1379,45 @@ static void test_cutout_lamp(void **state)
 	}
 }
 
+/* BLEND: in Whitted mode a MASK at 0.5, so baseColorFactor alpha 0.3 is
+ * gone (the plane: 0.5 / pi) and 0.7 stays (0), on every path of
+ * expect_centre but path mode. In path mode it is seen through by its
+ * alpha: a ray passes with probability 1 - alpha, so with alpha 0.3 the
+ * camera ray passes 0.7 of the time and the lit plane's shadow ray 0.7 of
+ * the time: 0.49 x 0.5 / pi on average; alpha 0.7, 0.09 x 0.5 / pi. With
+ * 160000 samples the mean's standard deviation is sqrt(p (1 - p) / 160000)
+ * / p of it: 0.26% (p = 0.49) and 0.8% (p = 0.09); 3% allowed. */
+static void test_blend(void **state)
+{
+	(void)state;
+	double lit = 0.5 / M_PI;
+	for (int k = 0; k < 2; k++) {
+		scene *s;
+		world *w = cut_world(k ? CUT_MAT("0.7", "},\"alphaMode\":\"BLEND\"") : CUT_MAT("0.3", "},\"alphaMode\":\"BLEND\""),
+		                     false, 0, 1, &s);
+		render_settings set = render_settings_default();
+		set.width = set.height = 1001;
+		set.samples = 1;
+		set.depth = 1;
+		set.threads = 1;
+		set.mode = MODE_WHITTED;
+		vec3 c = whitted_radiance(w, &set, render_sample_ray(w, &set, 500, 500, 1001, 1001, 0));
+		assert_vec_near(c, v3_splat(k ? 0 : lit), 1e-5);
+		float px[16 * 3];
+		render_rect(w, &set, 498, 498, 502, 502, px);
+		for (int i = 0; i < 16 * 3; i++)
+			assert_near(px[i], k ? 0 : lit, 1e-5);
+		set.mode = MODE_PATH;
+		set.samples = 160000;
+		render_rect(w, &set, 500, 500, 501, 501, px);
+		double want = (k ? 0.3 * 0.3 : 0.7 * 0.7) * lit;
+		print_message("BLEND alpha %s in path mode: expected %.5f, got %.5f\n", k ? "0.7" : "0.3", want, px[1]);
+		assert_near(px[1], want, 0.03 * want);
+		world_free(w);
+		scene_free(s);
+	}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -1403,6 +1442,7 @@ int main(void)
 	    cmocka_unit_test(test_cutout_shadow_rays),
 	    cmocka_unit_test(test_cutout_factor),
 	    cmocka_unit_test(test_cutout_lamp),
+	    cmocka_unit_test(test_blend),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
 }

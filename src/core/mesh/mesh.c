@@ -676,13 +676,37 @@ static double alpha_at(const mesh_mat *mm, double u, double v)
 	return ((1 - ay) * ((1 - ax) * a00 + ax * a10) + ay * ((1 - ax) * a01 + ax * a11)) / 255.0;
 }
 
+static _Thread_local bool alpha_hashed;
+
+void mesh_alpha_hashed(bool on)
+{
+	alpha_hashed = on;
+}
+
+/* A number in [0, 1) of the hit (its triangle, not its slot: a leaf's
+ * lanes that repeat a triangle must draw the same, and the bits of its
+ * barycentrics): as good as random from one ray to the next, the same for
+ * the same point (splitmix64's finaliser). */
+static double hit_hash(uint32_t tri, const float b[3])
+{
+	uint32_t x, y, z;
+	memcpy(&x, &b[0], 4);
+	memcpy(&y, &b[1], 4);
+	memcpy(&z, &b[2], 4);
+	uint64_t h = ((uint64_t)x << 32 | y) ^ ((uint64_t)z << 32 | tri) * 0x9E3779B97F4A7C15ull;
+	h = (h ^ (h >> 30)) * 0xBF58476D1CE4E5B9ull;
+	h = (h ^ (h >> 27)) * 0x94D049BB133111EBull;
+	h ^= h >> 31;
+	return (double)(h >> 11) * 0x1p-53;
+}
+
 bool mesh_cut_hole(const mesh *m, uint32_t slot, const float b[3])
 {
 	if (m->nmats == 0)
 		return false;
 	uint32_t t = mesh_slot_tri(m, slot);
 	const mesh_mat *mm = &m->mats[m->tmat ? m->tmat[t] : 0];
-	if (mm->alpha_mode != MESH_ALPHA_MASK)
+	if (mm->alpha_mode == MESH_ALPHA_OPAQUE)
 		return false;
 	double a = mm->alpha;
 	if (mm->alpha_map) {
@@ -699,6 +723,8 @@ bool mesh_cut_hole(const mesh *m, uint32_t slot, const float b[3])
 		double tv = v * mm->uvs[1] + mm->uvo[1] + u * mm->uvx[1];
 		a *= alpha_at(mm, tu, tv);
 	}
+	if (mm->alpha_mode == MESH_ALPHA_BLEND) /* see through by alpha, or MASK at 0.5 */
+		return a < (alpha_hashed ? hit_hash(t, b) : 0.5);
 	return a < mm->alpha_cutoff;
 }
 

@@ -1240,7 +1240,7 @@ static bool material(gl *g, mesh_builder *b, texture **cache, size_t i, mesh_mat
 		m->uvo[1] = (float)(1 - off[1] - cr * sc[1]);
 	}
 	snprintf(w2, sizeof w2, "%s.pbrMetallicRoughness.baseColorTexture", where);
-	if (m->alpha_mode == MESH_ALPHA_MASK && !alpha_info(g, bt, w2, m))
+	if (m->alpha_mode != MESH_ALPHA_OPAQUE && !alpha_info(g, bt, w2, m))
 		return false;
 	snprintf(w2, sizeof w2, "%s.pbrMetallicRoughness.metallicRoughnessTexture", where);
 	if (!tex_info(g, b, cache, key(pbr, "metallicRoughnessTexture"), w2, false, &m->map_mr, &m->tex_mr))
@@ -1382,7 +1382,7 @@ static mesh *build(gl *g)
 	}
 	mesh *m = mb_finish(&b, g->err);
 	for (uint32_t i = 0; m && i < m->nmats; i++)
-		m->cuts |= m->mats[i].alpha_mode == MESH_ALPHA_MASK;
+		m->cuts |= m->mats[i].alpha_mode != MESH_ALPHA_OPAQUE;
 	return m;
 }
 
