@@ -11,6 +11,7 @@
 #include "integrators.h"
 #include "rtsh/denoise.h"
 #include "rtsh/memory.h"
+#include "rtsh/mesh.h"
 #include "rtsh/packet.h"
 #include "rtsh/srgb.h"
 #include "rtsh/texture.h"
@@ -76,8 +77,10 @@ vec3 render_sample(const world *w, const render_settings *s, int px, int py, int
 {
 	sampler sp;
 	const integrator *in = integrator_of(s->mode);
+	mesh_alpha_hashed(in->sampled); /* glTF BLEND: see-through by alpha when sampled (until the end) */
 	ray r = camera_sample_ray(w, s, in->sampled, px, py, fw, fh, sample, &sp);
 	vec3 c = in->radiance(w, s, r, &sp);
+	mesh_alpha_hashed(false);
 	/* A NaN or infinity from a degenerate case must not poison the pixel. */
 	if (!v3_finite(c))
 		c = v3(0, 0, 0);
@@ -115,6 +118,7 @@ static void block_add(const world *w, const render_settings *s, int x0, int y0, 
 	bool any_feat = false;
 	for (int i = 0; i < n; i++)
 		any_feat |= feat[i] != NULL;
+	mesh_alpha_hashed(in->sampled); /* glTF BLEND: see-through by alpha when sampled */
 	if (any_feat) {
 		memset(fa, 0, sizeof fa);
 		memset(ra, 0, sizeof ra);
@@ -154,6 +158,7 @@ static void block_add(const world *w, const render_settings *s, int x0, int y0, 
 		for (int x = x0; x < x1; x++, i++)
 			if (feat[i])
 				denoise_features(w, s, x, y, fw, fh, s0, s1, ra[i], fa[i], feat[i]);
+	mesh_alpha_hashed(false);
 }
 
 /* The blocks of PACKET_MAX pixels, 4 x 4, that render_tile and render_rect
