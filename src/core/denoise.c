@@ -8,6 +8,7 @@
 
 #include "emitters.h"
 #include "integrators.h"
+#include "rtsh/memory.h"
 #include "warp.h"
 
 /* --- features -------------------------------------------------------------- */
@@ -937,14 +938,6 @@ bool denoise_image(const framebuffer *fb, float *out, int threads)
 		pthread_mutex_destroy(&j.lock);
 		pthread_cond_destroy(&j.go_cond);
 	}
-	free(j.g);
-	free(j.am);
-	free(j.mixed);
-	free(j.t);
-	free(j.data);
-	free(j.fit);
-	free(j.err);
-	free(tid);
-	free(args);
+	mem_free_all(j.g, j.am, j.mixed, j.t, j.data, j.fit, j.err, tid, args);
 	return ok;
 }

@@ -10,6 +10,7 @@
 
 #include "integrators.h"
 #include "rtsh/denoise.h"
+#include "rtsh/memory.h"
 #include "rtsh/packet.h"
 #include "rtsh/srgb.h"
 #include "rtsh/texture.h"
@@ -43,13 +44,8 @@ framebuffer *fb_new(int w, int h)
 
 void fb_free(framebuffer *fb)
 {
-	if (!fb)
-		return;
-	free(fb->rgb);
-	free(fb->sum);
-	free(fb->feat);
-	free(fb->srgb8);
-	free(fb);
+	if (fb)
+		mem_free_all(fb->rgb, fb->sum, fb->feat, fb->srgb8, fb);
 }
 
 void fb_clear(framebuffer *fb)

@@ -2,16 +2,44 @@
  * through the scene's file source (rt_file_read, rtsh/filesrc.h). */
 #include "core/mesh/mesh_io.h"
 
+#include <pthread.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
 
-#include <assimp/cfileio.h>
-#include <assimp/cimport.h>
-#include <assimp/scene.h>
-
+#include "base/dynlib.h"
+#include "core/mesh/ai_lib.h"
 #include "rtsh/filesrc.h"
+
+static ai_lib ai;
+static bool ai_ok;
+static char ai_why[256];
+static pthread_once_t ai_once = PTHREAD_ONCE_INIT;
+
+static void ai_open_lib(void)
+{
+	const dynlib_fn fns[] = {
+	    {"aiImportFileEx", &ai.import_file_ex},
+	    {"aiReleaseImport", &ai.release_import},
+	    {"aiGetErrorString", &ai.get_error_string},
+	    {"aiGetMaterialColor", &ai.get_material_color},
+	    {"aiGetMaterialFloatArray", &ai.get_material_float_array},
+	    {"aiGetMaterialTexture", &ai.get_material_texture},
+	};
+	ai_ok = dynlib_open(RTSH_ASSIMP_SONAME, fns, sizeof fns / sizeof fns[0], ai_why, sizeof ai_why);
+}
+
+const ai_lib *ai_lib_get(const char *path, rt_error *err)
+{
+	pthread_once(&ai_once, ai_open_lib);
+	if (!ai_ok) {
+		rt_error_set(err, "%s: cannot read the model: assimp cannot be loaded (%s); expected %s installed", path,
+		             ai_why, RTSH_ASSIMP_SONAME);
+		return NULL;
+	}
+	return &ai;
+}
 
 /* One import: the model's bytes, read once before assimp starts. */
 typedef struct ai_job {
@@ -207,11 +235,16 @@ const struct aiScene *rt_file_ai_import(const char *path, unsigned flags, rt_err
 		free(bytes);
 		return NULL;
 	}
+	const ai_lib *lib = ai_lib_get(path, err);
+	if (!lib) {
+		free(bytes);
+		return NULL;
+	}
 	ai_job job = {path, bytes, len};
 	struct aiFileIO io = {ai_open_file, ai_close_file, (aiUserData)(void *)&job};
-	const struct aiScene *sc = aiImportFileEx(path, flags, &io);
+	const struct aiScene *sc = lib->import_file_ex(path, flags, &io);
 	free(bytes);
 	if (!sc)
-		rt_error_set(err, "%s: cannot read the model: %s", path, aiGetErrorString());
+		rt_error_set(err, "%s: cannot read the model: %s", path, lib->get_error_string());
 	return sc;
 }

@@ -92,12 +92,7 @@ bool mb_texture(mesh_builder *b, texture *t)
 /* The embedded textures are the mesh's (texs), not the material's. */
 static void mat_free(mesh_mat *m)
 {
-	free(m->name);
-	free(m->map_kd);
-	free(m->map_bump);
-	free(m->map_norm);
-	free(m->map_mr);
-	free(m->map_emit);
+	mem_free_all(m->name, m->map_kd, m->map_bump, m->map_norm, m->map_mr, m->map_emit);
 }
 
 /* The materials and embedded textures a builder, then its mesh, holds. */
@@ -113,13 +108,8 @@ static void mats_texs_free(mesh_mat *mats, size_t nmats, texture **texs, size_t 
 
 void mb_free(mesh_builder *b)
 {
-	free(b->v);
-	free(b->vt);
-	free(b->vn);
-	free(b->c);
-	free(b->fm);
 	mats_texs_free(b->mats, b->nmats, b->texs, b->ntexs);
-	free(b->warning);
+	mem_free_all(b->v, b->vt, b->vn, b->c, b->fm, b->warning);
 	memset(b, 0, sizeof *b);
 }
 
@@ -284,18 +274,8 @@ void mesh_free(mesh *m)
 {
 	if (!m)
 		return;
-	free(m->path);
-	free(m->p);
-	free(m->n);
-	free(m->uv);
-	free(m->tri);
-	free(m->tmat);
 	mats_texs_free(m->mats, m->nmats, m->texs, m->ntexs);
-	free(m->warning);
-	free(m->nodes);
-	free(m->blk);
-	free(m->btri);
-	free(m);
+	mem_free_all(m->path, m->p, m->n, m->uv, m->tri, m->tmat, m->warning, m->nodes, m->blk, m->btri, m);
 }
 
 static size_t tex_bytes(const texture *t)
@@ -375,8 +355,9 @@ static bool smooth_normals(mesh *m, double crease_deg, const atomic_bool *cancel
 	double *ang = malloc((size_t)nt * 3 * sizeof *ang);
 	uint32_t *slot = malloc(cap * sizeof *slot);
 	float(*nn)[3] = malloc((size_t)nt * 3 * sizeof *nn);
+	bool stopped = false;
 	if (!fn || !start || !list || !newid || !ang || !slot || !nn)
-		goto oom;
+		goto fail;
 	memset(slot, 0xff, cap * sizeof *slot);
 	for (uint32_t t = 0; t < nt; t++) {
 		vec3 a = vtx(m, m->tri[t][0]), b = vtx(m, m->tri[t][1]), c = vtx(m, m->tri[t][2]);
@@ -398,7 +379,7 @@ static bool smooth_normals(mesh *m, double crease_deg, const atomic_bool *cancel
 	{
 		uint32_t *fill = malloc((size_t)nv * sizeof *fill);
 		if (!fill)
-			goto oom;
+			goto fail;
 		memcpy(fill, start, (size_t)nv * sizeof *fill);
 		for (uint32_t t = 0; t < nt; t++)
 			for (uint32_t k = 0; k < 3; k++)
@@ -410,14 +391,8 @@ static bool smooth_normals(mesh *m, double crease_deg, const atomic_bool *cancel
 	for (uint32_t v = 0; v < nv; v++) {
 		uint32_t s = start[v], e = start[v + 1], deg = e - s;
 		if ((v & 0xffff) == 0 && cancel && atomic_load_explicit(cancel, memory_order_relaxed)) {
-			free(fn);
-			free(start);
-			free(list);
-			free(newid);
-			free(ang);
-			free(slot);
-			free(nn);
-			return rt_error_set(err, "stopped");
+			stopped = true;
+			goto fail;
 		}
 		vec3 all = v3(0, 0, 0); /* the sum of every face, when the crease is ignored */
 		if (deg > CREASE_DEG_MAX)
@@ -458,7 +433,7 @@ static bool smooth_normals(mesh *m, double crease_deg, const atomic_bool *cancel
 		free(p);
 		free(n);
 		free(uv);
-		goto oom;
+		goto fail;
 	}
 	for (uint32_t v = 0; v < nv; v++) {
 		memcpy(p[v], m->p[v], sizeof *p);
@@ -480,20 +455,12 @@ static bool smooth_normals(mesh *m, double crease_deg, const atomic_bool *cancel
 	m->n = n;
 	m->uv = uv;
 	m->nverts = next;
-	free(fn);
-	free(start);
-	free(list);
-	free(newid);
-	free(nn);
+	mem_free_all(fn, start, list, newid, nn);
 	return true;
-oom:
-	free(fn);
-	free(start);
-	free(list);
-	free(newid);
-	free(ang);
-	free(slot);
-	free(nn);
+fail:
+	mem_free_all(fn, start, list, newid, ang, slot, nn);
+	if (stopped)
+		return rt_error_set(err, "stopped");
 	return rt_error_set(err, "%s: out of memory computing normals", m->path ? m->path : "mesh");
 }
 

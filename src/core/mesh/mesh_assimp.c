@@ -17,11 +17,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <assimp/cimport.h>
-#include <assimp/material.h>
 #include <assimp/postprocess.h>
-#include <assimp/scene.h>
 
+#include "core/mesh/ai_lib.h"
 #include "core/mesh/mesh_io.h"
 #include "rtsh/filesrc.h"
 #include "rtsh/mesh.h"
@@ -119,14 +117,14 @@ static texture *embedded_texture(const struct aiTexture *tx, unsigned index, con
 /* A material's texture of `type`: a file beside the model (*file) or an
  * image embedded in it (*tex). False (err set) when an embedded image
  * cannot be read. */
-static bool material_texture(mesh_builder *b, const struct aiScene *sc, const struct aiMaterial *m,
+static bool material_texture(const ai_lib *ai, mesh_builder *b, const struct aiScene *sc, const struct aiMaterial *m,
                              enum aiTextureType type, const char *path, const char *dir, bool srgb, char **file,
                              texture **tex, rt_error *err)
 {
 	struct aiString s;
 	*file = NULL;
 	*tex = NULL;
-	if (aiGetMaterialTexture(m, type, 0, &s, NULL, NULL, NULL, NULL, NULL, NULL) != AI_SUCCESS || s.length == 0)
+	if (ai->get_material_texture(m, type, 0, &s, NULL, NULL, NULL, NULL, NULL, NULL) != AI_SUCCESS || s.length == 0)
 		return true;
 	unsigned index = 0;
 	const struct aiTexture *tx = embedded_image(sc, s.data, &index);
@@ -151,6 +149,7 @@ mesh *mesh_read_assimp(const char *path, rt_error *err)
 	    path, aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType, err);
 	if (!sc)
 		return NULL;
+	const ai_lib *ai = ai_lib_get(path, err); /* loaded: the import above used it */
 	mesh_builder b = {.name = path};
 	char *dir = path_dir(path);
 	bool ok = dir != NULL;
@@ -165,29 +164,29 @@ mesh *mesh_read_assimp(const char *path, rt_error *err)
 			m->kd[0] = m->kd[1] = m->kd[2] = 0.64f;
 			m->roughness = 1.0f;
 			m->bump_scale = 1.0f;
-			if (aiGetMaterialColor(am, AI_MATKEY_BASE_COLOR, &c) == AI_SUCCESS ||
-			    aiGetMaterialColor(am, AI_MATKEY_COLOR_DIFFUSE, &c) == AI_SUCCESS) {
+			if (ai->get_material_color(am, AI_MATKEY_BASE_COLOR, &c) == AI_SUCCESS ||
+			    ai->get_material_color(am, AI_MATKEY_COLOR_DIFFUSE, &c) == AI_SUCCESS) {
 				/* glTF factors are linear */
 				m->kd[0] = (float)lin(c.r);
 				m->kd[1] = (float)lin(c.g);
 				m->kd[2] = (float)lin(c.b);
 			}
-			if (aiGetMaterialColor(am, AI_MATKEY_COLOR_EMISSIVE, &c) == AI_SUCCESS) {
+			if (ai->get_material_color(am, AI_MATKEY_COLOR_EMISSIVE, &c) == AI_SUCCESS) {
 				m->ke[0] = c.r;
 				m->ke[1] = c.g;
 				m->ke[2] = c.b;
 			}
 			ai_real v;
-			if (aiGetMaterialFloatArray(am, AI_MATKEY_METALLIC_FACTOR, &v, NULL) == AI_SUCCESS)
+			if (ai->get_material_float_array(am, AI_MATKEY_METALLIC_FACTOR, &v, NULL) == AI_SUCCESS)
 				m->metallic = (float)v;
-			if (aiGetMaterialFloatArray(am, AI_MATKEY_ROUGHNESS_FACTOR, &v, NULL) == AI_SUCCESS)
+			if (ai->get_material_float_array(am, AI_MATKEY_ROUGHNESS_FACTOR, &v, NULL) == AI_SUCCESS)
 				m->roughness = (float)v;
-			ok = material_texture(&b, sc, am, aiTextureType_BASE_COLOR, path, dir, true, &m->map_kd, &m->tex_kd, err);
+			ok = material_texture(ai, &b, sc, am, aiTextureType_BASE_COLOR, path, dir, true, &m->map_kd, &m->tex_kd, err);
 			if (ok && !m->map_kd && !m->tex_kd)
-				ok = material_texture(&b, sc, am, aiTextureType_DIFFUSE, path, dir, true, &m->map_kd, &m->tex_kd,
+				ok = material_texture(ai, &b, sc, am, aiTextureType_DIFFUSE, path, dir, true, &m->map_kd, &m->tex_kd,
 				                      err);
 			ok = ok &&
-			     material_texture(&b, sc, am, aiTextureType_NORMALS, path, dir, false, &m->map_norm, &m->tex_norm, err);
+			     material_texture(ai, &b, sc, am, aiTextureType_NORMALS, path, dir, false, &m->map_norm, &m->tex_norm, err);
 		}
 	}
 	bool has_uv = true, has_n = true;
@@ -241,7 +240,7 @@ mesh *mesh_read_assimp(const char *path, rt_error *err)
 			ok = ok && mb_triangle(&b, t);
 		}
 	}
-	aiReleaseImport(sc);
+	ai->release_import(sc);
 	free(dir);
 	if (!ok) {
 		if (err && !err->msg[0])

@@ -275,12 +275,7 @@ static void gl_free(gl *g)
 	for (size_t i = 0; g->buf && i < g->buffers.n; i++)
 		if (g->bufown[i])
 			free(g->buf[i]);
-	free(g->buf);
-	free(g->buflen);
-	free(g->bufown);
-	free(g->world);
-	free(g->seen);
-	free(g->order);
+	mem_free_all(g->buf, g->buflen, g->bufown, g->world, g->seen, g->order);
 }
 
 /* The JSON and the tables; the asset must say glTF 2.x and every required

@@ -12,7 +12,7 @@
 /* assimp's aiImportFile, with every file assimp opens (the model, and a
  * .gltf's buffers) read through rt_file_read (rtsh/filesrc.h). NULL with
  * err set ("PATH: cannot read the model: reason") on failure; free with
- * aiReleaseImport. */
+ * ai_lib_get()->release_import (core/mesh/ai_lib.h). */
 struct aiScene;
 const struct aiScene *rt_file_ai_import(const char *path, unsigned flags, rt_error *err);
 

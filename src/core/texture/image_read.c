@@ -8,6 +8,7 @@
  * into colours and fail on anything else.
  */
 #include <errno.h>
+#include <pthread.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,6 +18,7 @@
 #include <X11/xpm.h>
 #include <stb/stb_image.h>
 
+#include "base/dynlib.h"
 #include "base/readhelp.h"
 #include "rtsh/filesrc.h"
 #include "rtsh/memory.h"
@@ -368,6 +370,31 @@ static bool xpm_color(const char *s, float rgb[3], bool srgb)
 	return true;
 }
 
+/* libXpm, opened on the first XPM image (base/dynlib.h): it brings five X11
+ * libraries that no other start-up needs. */
+#ifndef RTSH_XPM_SONAME
+#define RTSH_XPM_SONAME "libXpm.so.4"
+#endif
+
+static struct {
+	int (*create_from_buffer)(char *buffer, XpmImage *image, XpmInfo *info);
+	void (*free_image)(XpmImage *image);
+	char *(*error_string)(int errcode);
+} xpm;
+static bool xpm_ok;
+static char xpm_why[256];
+static pthread_once_t xpm_once = PTHREAD_ONCE_INIT;
+
+static void xpm_open(void)
+{
+	const dynlib_fn fns[] = {
+	    {"XpmCreateXpmImageFromBuffer", &xpm.create_from_buffer},
+	    {"XpmFreeXpmImage", &xpm.free_image},
+	    {"XpmGetErrorString", &xpm.error_string},
+	};
+	xpm_ok = dynlib_open(RTSH_XPM_SONAME, fns, sizeof fns / sizeof fns[0], xpm_why, sizeof xpm_why);
+}
+
 static float *read_xpm(const char *path, const unsigned char *buf, size_t len, bool srgb, int *w, int *h,
                        rt_error *err)
 {
@@ -394,6 +421,12 @@ static float *read_xpm(const char *path, const unsigned char *buf, size_t len, b
 		             "per pixel: more than the file holds", path, v[0], v[1], v[2], v[3]);
 		return NULL;
 	}
+	pthread_once(&xpm_once, xpm_open);
+	if (!xpm_ok) {
+		rt_error_set(err, "%s: cannot read the XPM image: libXpm cannot be loaded (%s); expected %s installed",
+		             path, xpm_why, RTSH_XPM_SONAME);
+		return NULL;
+	}
 	char *text = malloc(len + 1);
 	if (!text) {
 		rt_error_set(err, "%s: out of memory", path);
@@ -403,11 +436,11 @@ static float *read_xpm(const char *path, const unsigned char *buf, size_t len, b
 	text[len] = '\0';
 	XpmImage img;
 	memset(&img, 0, sizeof img);
-	int rc = XpmCreateXpmImageFromBuffer(text, &img, NULL);
+	int rc = xpm.create_from_buffer(text, &img, NULL);
 	free(text);
 	if (rc != XpmSuccess) {
-		XpmFreeXpmImage(&img); /* what libXpm left allocated (it may leave some) */
-		rt_error_set(err, "%s: cannot read the XPM image: %s", path, XpmGetErrorString(rc));
+		xpm.free_image(&img); /* what libXpm left allocated (it may leave some) */
+		rt_error_set(err, "%s: cannot read the XPM image: %s", path, xpm.error_string(rc));
 		return NULL;
 	}
 	float *out = NULL;
@@ -452,7 +485,7 @@ static float *read_xpm(const char *path, const unsigned char *buf, size_t len, b
 	*h = (int)img.height;
 done:
 	free(table);
-	XpmFreeXpmImage(&img);
+	xpm.free_image(&img);
 	return out;
 }
 
