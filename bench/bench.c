@@ -1292,11 +1292,12 @@ static void bench_keymode_at(int cols, int cell_rows, int sym)
 }
 
 /* The row of issue 6 (160x48 cells, half blocks), and issue 29's at 200x60
- * cells with half blocks and with octants (2x4 samples a cell). */
+ * cells with half blocks, the sextant set and octants (2x4 samples a cell). */
 static void bench_keymode(void)
 {
 	bench_keymode_at(160, 48, -1);
 	bench_keymode_at(200, 60, SYMBOLS_HALF);
+	bench_keymode_at(200, 60, SYMBOLS_SEXTANT);
 	bench_keymode_at(200, 60, SYMBOLS_OCTANT);
 }
 
