@@ -8,9 +8,12 @@
  * video, defaults), and draws each glyph from its shape in the Unicode
  * charts as rectangles inked in the foreground colour: the block elements
  * (U+2580..U+259F: halves, eighths, quadrants, shades as a uniform mix),
- * the sextants (U+1FB00..U+1FB3B), the octants (U+1CD00..U+1CDE5) and the
- * quarter blocks that octants borrow (U+1FB82 U+1FB85 U+1FBE6 U+1FBE7
- * U+1CEA0 U+1CEA3 U+1CEA8 U+1CEAB). The picture it gives is sampled on a
+ * the sextants (U+1FB00..U+1FB3B), the octants (U+1CD00..U+1CDE5), the
+ * upper and right eighth blocks of Symbols for Legacy Computing
+ * (U+1FB82..U+1FB8B: UPPER ONE QUARTER, THREE EIGHTHS, FIVE EIGHTHS, THREE
+ * QUARTERS, SEVEN EIGHTHS BLOCK, then RIGHT the same) and the quarter
+ * blocks that octants borrow (U+1FBE6 U+1FBE7 U+1CEA0 U+1CEA3 U+1CEA8
+ * U+1CEAB). The picture it gives is sampled on a
  * grid of 2x4 pixels a cell: each pixel the area-weighted mix of ink and
  * paper over it. Any other character counts as unknown (drawn as paper).
  *
@@ -61,7 +64,15 @@ static int sq_glyph(uint32_t cp, sq_rect r[8], float *shade)
 	case 0x2592: *shade = 0.5f; return 0;
 	case 0x2593: *shade = 0.75f; return 0;
 	case 0x1fb82: r[n++] = (sq_rect){0, 0, 1, 0.25f}; return n;     /* upper one quarter */
+	case 0x1fb83: r[n++] = (sq_rect){0, 0, 1, 0.375f}; return n;    /* upper three eighths */
+	case 0x1fb84: r[n++] = (sq_rect){0, 0, 1, 0.625f}; return n;    /* upper five eighths */
 	case 0x1fb85: r[n++] = (sq_rect){0, 0, 1, 0.75f}; return n;     /* upper three quarters */
+	case 0x1fb86: r[n++] = (sq_rect){0, 0, 1, 0.875f}; return n;    /* upper seven eighths */
+	case 0x1fb87: r[n++] = (sq_rect){0.75f, 0, 1, 1}; return n;     /* right one quarter */
+	case 0x1fb88: r[n++] = (sq_rect){0.625f, 0, 1, 1}; return n;    /* right three eighths */
+	case 0x1fb89: r[n++] = (sq_rect){0.375f, 0, 1, 1}; return n;    /* right five eighths */
+	case 0x1fb8a: r[n++] = (sq_rect){0.25f, 0, 1, 1}; return n;     /* right three quarters */
+	case 0x1fb8b: r[n++] = (sq_rect){0.125f, 0, 1, 1}; return n;    /* right seven eighths */
 	case 0x1fbe6: r[n++] = (sq_rect){0, 0.25f, 0.5f, 0.75f}; return n; /* middle left one quarter */
 	case 0x1fbe7: r[n++] = (sq_rect){0.5f, 0.25f, 1, 0.75f}; return n; /* middle right one quarter */
 	case 0x1cea8: r[n++] = (sq_rect){0, 0, 0.5f, 0.25f}; return n;  /* left half upper one quarter */

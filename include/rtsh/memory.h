@@ -60,4 +60,12 @@ bool mem_grow(void **a, size_t *cap, size_t need, size_t size);
  * file contents), or NULL when out of memory. */
 char *mem_dupz(const void *p, size_t n);
 
+/* Frees each pointer named, in order (NULLs are skipped, as free does): a
+ * destructor still names every field its struct owns, in one line,
+ * mem_free_all(fb->rgb, fb->sum, fb). Only for plain heap blocks; a field
+ * with its own destructor is freed by that. */
+#define mem_free_all(...) \
+	mem_free_list((void *[]){__VA_ARGS__}, sizeof((void *[]){__VA_ARGS__}) / sizeof(void *))
+void mem_free_list(void *const *p, size_t n);
+
 #endif

@@ -140,3 +140,9 @@ char *mem_dupz(const void *p, size_t n)
 	}
 	return d;
 }
+
+void mem_free_list(void *const *p, size_t n)
+{
+	for (size_t i = 0; i < n; i++)
+		free(p[i]);
+}

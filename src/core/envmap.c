@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rtsh/memory.h"
 #include "rtsh/texture.h"
 
 struct envmap {
@@ -112,11 +113,7 @@ void envmap_free(envmap *e)
 	if (!e)
 		return;
 	texture_cache_put(e->tex);
-	free(e->marg);
-	free(e->cond);
-	free(e->rowsum);
-	free(e->texw);
-	free(e);
+	mem_free_all(e->marg, e->cond, e->rowsum, e->texw, e);
 }
 
 size_t envmap_memory(const envmap *e)

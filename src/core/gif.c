@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "rtsh/atomic.h"
+#include "rtsh/memory.h"
 #include "rtsh/srgb.h"
 
 struct gif_anim {
@@ -86,11 +87,8 @@ gif_anim *gif_new(int w, int h, int delay_cs)
 
 void gif_free(gif_anim *g)
 {
-	if (!g)
-		return;
-	free(g->buf);
-	free(g->idx);
-	free(g);
+	if (g)
+		mem_free_all(g->buf, g->idx, g);
 }
 
 /* --- median cut --- */

@@ -10,6 +10,8 @@
 
 #include "integrators.h"
 #include "rtsh/denoise.h"
+#include "rtsh/memory.h"
+#include "rtsh/mesh.h"
 #include "rtsh/packet.h"
 #include "rtsh/srgb.h"
 #include "rtsh/texture.h"
@@ -43,13 +45,8 @@ framebuffer *fb_new(int w, int h)
 
 void fb_free(framebuffer *fb)
 {
-	if (!fb)
-		return;
-	free(fb->rgb);
-	free(fb->sum);
-	free(fb->feat);
-	free(fb->srgb8);
-	free(fb);
+	if (fb)
+		mem_free_all(fb->rgb, fb->sum, fb->feat, fb->srgb8, fb);
 }
 
 void fb_clear(framebuffer *fb)
@@ -80,8 +77,10 @@ vec3 render_sample(const world *w, const render_settings *s, int px, int py, int
 {
 	sampler sp;
 	const integrator *in = integrator_of(s->mode);
+	mesh_alpha_hashed(in->sampled); /* glTF BLEND: see-through by alpha when sampled (until the end) */
 	ray r = camera_sample_ray(w, s, in->sampled, px, py, fw, fh, sample, &sp);
 	vec3 c = in->radiance(w, s, r, &sp);
+	mesh_alpha_hashed(false);
 	/* A NaN or infinity from a degenerate case must not poison the pixel. */
 	if (!v3_finite(c))
 		c = v3(0, 0, 0);
@@ -124,6 +123,7 @@ static void block_add(const world *w, const render_settings *s, int x0, int y0, 
 	bool any_feat = false;
 	for (int i = 0; i < n; i++)
 		any_feat |= feat[i] != NULL;
+	mesh_alpha_hashed(in->sampled); /* glTF BLEND: see-through by alpha when sampled */
 	if (any_feat) {
 		memset(fa, 0, sizeof fa);
 		memset(ra, 0, sizeof ra);
@@ -163,6 +163,7 @@ static void block_add(const world *w, const render_settings *s, int x0, int y0, 
 		for (int x = x0; x < x1; x++, i++)
 			if (feat[i])
 				denoise_features(w, s, x, y, fw, fh, s0, s1, ra[i], fa[i], feat[i]);
+	mesh_alpha_hashed(false);
 }
 
 /* The blocks of PACKET_MAX pixels, 4 x 4, that render_tile and render_rect

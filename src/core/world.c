@@ -333,17 +333,10 @@ void world_release(const world *cw)
 	world *w = (world *)cw;
 	if (!w || atomic_fetch_sub_explicit(&w->refs, 1, memory_order_acq_rel) != 1)
 		return;
-	free(w->lights);
-	free(w->mats);
-	free(w->prims);
-	free(w->planes);
-	free(w->shapes);
-	free(w->tris);
-	free(w->emitters);
 	surf_free(w);
 	envmap_free((envmap *)w->env);
 	bvh_free(w->tree);
-	free(w);
+	mem_free_all(w->lights, w->mats, w->prims, w->planes, w->shapes, w->tris, w->emitters, w);
 }
 
 void world_free(world *w)

@@ -77,12 +77,8 @@ scene *scene_new(void)
 
 void scene_free(scene *s)
 {
-	if (!s)
-		return;
-	free(s->cams);
-	free(s->lights);
-	free(s->objs);
-	free(s);
+	if (s)
+		mem_free_all(s->cams, s->lights, s->objs, s);
 }
 
 size_t scene_bytes(const scene *s)

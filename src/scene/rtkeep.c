@@ -19,6 +19,7 @@
 
 #include "base/abuf.h"
 #include "rtsh/image.h"
+#include "rtsh/memory.h"
 #include "rtsh/rtfile.h"
 #include "scene/rtfile_priv.h"
 
@@ -177,11 +178,8 @@ static bool push_index(size_t **arr, size_t n, size_t v)
 
 static void base_free(base *b)
 {
-	free(b->lines);
 	scene_free(b->s);
-	free(b->obj_line);
-	free(b->light_line);
-	free(b->cam_line);
+	mem_free_all(b->lines, b->obj_line, b->light_line, b->cam_line);
 }
 
 /* Reads the source line by line; false when a line does not parse (the

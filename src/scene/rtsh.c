@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "rtsh/edit.h"
+#include "rtsh/memory.h"
 #include "rtsh/rtfile.h"
 #include "rtsh/settings.h"
 #include "rtsh/srgb.h"
@@ -192,10 +193,8 @@ rtsh_image *rtsh_render(rtsh_scene *sc, int x0, int y0, int x1, int y1)
 
 void rtsh_image_free(rtsh_image *im)
 {
-	if (!im)
-		return;
-	free(im->rgb);
-	free(im);
+	if (im)
+		mem_free_all(im->rgb, im);
 }
 
 int rtsh_image_width(const rtsh_image *im)

@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rtsh/memory.h"
 #include "term/encoder.h"
 #include "term/pixels.h"
 
@@ -126,12 +127,7 @@ static encoder *pix_open_mode(const encoder_geom *g, const encoder_ops *ops, pix
 static void pix_close(encoder *b)
 {
 	pix_enc *e = (pix_enc *)b;
-	free(e->rgb);
-	free(e->tmp);
-	free(e->want);
-	free(e->shown);
-	free(e->stale);
-	free(e);
+	mem_free_all(e->rgb, e->tmp, e->want, e->shown, e->stale, e);
 }
 
 static void pix_put(encoder *b, const uint8_t *rgb, int w, int h, int ox, int oy)

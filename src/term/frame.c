@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "rtsh/image.h"
+#include "rtsh/memory.h"
 
 #define UNKNOWN 0xffffffffu /* SGR state not known */
 #define GAP_FILL 3
@@ -45,8 +46,10 @@ frame *frame_new_symbols(int cols, int rows, frame_palette pal, symbols_kind sym
 	f->sym = sym;
 	f->nsub = symbols_table[sym].w * symbols_table[sym].h;
 	f->lambda = FRAME_LAMBDA;
-	for (unsigned m = 0; m < 1u << f->nsub; m++)
+	for (unsigned m = 0; m < (unsigned)symbols_count(sym); m++)
 		f->glyph_len[m] = (uint8_t)symbols_utf8(sym, m, f->glyph[m]);
+	symbols_shapes_init(&f->shapes, sym);
+	f->cover = sym == SYMBOLS_SEXTANT;
 	f->cur = calloc(n, sizeof *f->cur);
 	f->shown = calloc(n, sizeof *f->shown);
 	size_t ns = n * (sym == SYMBOLS_HALF ? 2 : SYMBOLS_SAMPLE_W * SYMBOLS_SAMPLE_H);
@@ -65,12 +68,8 @@ void frame_free(frame *f)
 {
 	if (!f)
 		return;
-	free(f->cur);
-	free(f->shown);
-	free(f->px);
-	free(f->def);
 	abuf_free(&f->out);
-	free(f);
+	mem_free_all(f->cur, f->shown, f->px, f->def, f);
 }
 
 void frame_invalidate(frame *f)
@@ -235,8 +234,15 @@ static void fit_cell(frame *f, int cx, int cy)
 			*c = (frame_cell){c->top, c->top, 0};
 		return;
 	}
-	symbols_subpixels(f->sym, px, cw * 3, sub);
-	symbols_fit((const float(*)[3])sub, f->nsub, f->flat, &mask, a, b);
+	if (f->cover) {
+		for (int i = 0; i < SW * SH; i++)
+			for (int ch = 0; ch < 3; ch++)
+				sub[i][ch] = px[((size_t)(i / SW) * cw + (size_t)(i % SW)) * 3 + ch];
+		symbols_fit_cover(&f->shapes, (const float(*)[3])sub, f->flat, &mask, a, b);
+	} else {
+		symbols_subpixels(f->sym, px, cw * 3, sub);
+		symbols_fit((const float(*)[3])sub, f->nsub, f->flat, &mask, a, b);
+	}
 	uint32_t qa = palette_quantize(f->pal, a[0], a[1], a[2]);
 	uint32_t qb = palette_quantize(f->pal, b[0], b[1], b[2]);
 	if (mask == 0 || qa == qb)
@@ -410,6 +416,144 @@ static void rd_row(frame *f, int cy)
 	}
 }
 
+/* The squared error (sRGB levels) of showing samples x[8] as glyph g of
+ * f's shapes in colours a (ink) and b. */
+static double cover_error(const frame *f, const float x[8][3], unsigned g, uint32_t a, uint32_t b)
+{
+	const float *cov = f->shapes.cov[g];
+	float va[3], vb[3];
+	for (int c = 0; c < 3; c++) {
+		va[c] = (float)(a >> (16 - 8 * c) & 255);
+		vb[c] = (float)(b >> (16 - 8 * c) & 255) - va[c];
+	}
+	double e = 0;
+	for (int i = 0; i < 8; i++)
+		for (int c = 0; c < 3; c++) {
+			float d = x[i][c] - va[c] - (1 - cov[i]) * vb[c];
+			e += (double)(d * d);
+		}
+	return e;
+}
+
+/* rd_row for frames fitted over the glyphs' shapes (f->cover): the same
+ * candidates, each glyph's colours by least squares on its samples. */
+static void rd_row_cover(frame *f, int cy)
+{
+	enum { SW = SYMBOLS_SAMPLE_W, SH = SYMBOLS_SAMPLE_H };
+	size_t cw = (size_t)f->cols * SW;
+	uint32_t fg = UINT32_MAX, bg = UINT32_MAX; /* not known */
+	const symbols_shapes *sh = &f->shapes;
+	for (int cx = 0; cx < f->cols; cx++) {
+		frame_cell *c = &f->cur[(size_t)cy * f->cols + cx];
+		float x[8][3];
+		bool whole = true;
+		size_t at = (size_t)cy * SH * cw + (size_t)cx * SW;
+		for (int i = 0; i < SW * SH; i++) {
+			size_t k = at + (size_t)(i / SW) * cw + (size_t)(i % SW);
+			whole &= f->def[k] != 0;
+			for (int ch = 0; ch < 3; ch++)
+				x[i][ch] = f->px[k * 3 + ch];
+		}
+		if (!whole || c->top == FRAME_DEFAULT || c->bot == FRAME_DEFAULT) {
+			fg = c->top;
+			bg = c->bot;
+			continue;
+		}
+		frame_cell best = *c;
+		bool two = c->mask != 0 && c->top != c->bot;
+		double best_j = cover_error(f, (const float(*)[3])x, c->mask, c->top, c->bot) +
+		                f->lambda * cell_bytes(f, c->top, c->bot, two, fg, bg);
+		frame_cell cand[7];
+		int nc = 0;
+		float mean[3] = {0, 0, 0};
+		for (int i = 0; i < 8; i++)
+			for (int ch = 0; ch < 3; ch++)
+				mean[ch] += x[i][ch] / 8;
+		uint32_t m = rgb_of(mean);
+		cand[nc++] = (frame_cell){m, m, 0};
+		if (fg != UINT32_MAX && fg != FRAME_DEFAULT)
+			cand[nc++] = (frame_cell){fg, fg, 0};
+		if (bg != UINT32_MAX && bg != FRAME_DEFAULT && bg != fg)
+			cand[nc++] = (frame_cell){bg, bg, 0};
+		if (fg != UINT32_MAX && bg != UINT32_MAX && fg != FRAME_DEFAULT && bg != FRAME_DEFAULT && fg != bg) {
+			/* both colours of the state: the glyph that shows them best.
+			 * With d = fg - bg, sample i shows bg + c_i d, off by
+			 * |x_i - bg|^2 - 2 c_i (x_i - bg).d + c_i^2 |d|^2: only the
+			 * last two terms differ from glyph to glyph. */
+			double p[8], dd = 0, d[3];
+			for (int ch = 0; ch < 3; ch++) {
+				d[ch] = (double)(fg >> (16 - 8 * ch) & 255) - (double)(bg >> (16 - 8 * ch) & 255);
+				dd += d[ch] * d[ch];
+			}
+			for (int i = 0; i < 8; i++) {
+				p[i] = 0;
+				for (int ch = 0; ch < 3; ch++)
+					p[i] += (x[i][ch] - (double)(bg >> (16 - 8 * ch) & 255)) * d[ch];
+			}
+			float es[SYMBOLS_COVER_MAX]; /* sum c_i p_i, every glyph at once */
+			for (int g = 0; g < SYMBOLS_COVER_MAX; g++)
+				es[g] = 0;
+			for (int i = 0; i < 8; i++)
+				for (int g = 0; g < SYMBOLS_COVER_MAX; g++)
+					es[g] += sh->covt[i][g] * (float)p[i];
+			unsigned bg_id = 0;
+			double be = 0; /* glyph 0, all paper */
+			for (int g = 1; g < sh->n && g < SYMBOLS_COVER_MAX; g++) {
+				double e = sh->uu[g] * dd - 2 * (double)es[g];
+				if (e < be) {
+					be = e;
+					bg_id = (unsigned)g;
+				}
+			}
+			cand[nc++] = (frame_cell){fg, bg, bg_id};
+		}
+		/* one colour of the state for the fit's nearer colour, the other
+		 * by least squares with the fit's glyph */
+		for (int k = 0; k < 2 && two; k++) {
+			uint32_t xs = k ? bg : fg;
+			if (xs == UINT32_MAX || xs == FRAME_DEFAULT)
+				continue;
+			/* xs takes the ink when nearer to c->top, else the paper */
+			bool ink = colour_dist2(xs, c->top) < colour_dist2(xs, c->bot);
+			const float *cov = sh->cov[c->mask];
+			double ww = 0, r[3] = {0, 0, 0};
+			for (int i = 0; i < 8; i++) {
+				double wf = ink ? cov[i] : 1 - cov[i], wo = 1 - wf; /* xs's share, the other's */
+				ww += wo * wo;
+				for (int ch = 0; ch < 3; ch++)
+					r[ch] += wo * (x[i][ch] - wf * (double)(xs >> (16 - 8 * ch) & 255));
+			}
+			if (ww <= 0)
+				continue;
+			float o[3];
+			for (int ch = 0; ch < 3; ch++)
+				o[ch] = (float)(r[ch] / ww);
+			uint32_t ov = rgb_of(o);
+			if (ov == xs)
+				cand[nc++] = (frame_cell){xs, xs, 0};
+			else
+				cand[nc++] = ink ? (frame_cell){xs, ov, c->mask} : (frame_cell){ov, xs, c->mask};
+		}
+		for (int k = 0; k < nc; k++) {
+			bool t = cand[k].mask != 0 && cand[k].top != cand[k].bot;
+			double j = cover_error(f, (const float(*)[3])x, cand[k].mask, cand[k].top, cand[k].bot) +
+			           f->lambda * cell_bytes(f, cand[k].top, cand[k].bot, t, fg, bg);
+			if (j < best_j) {
+				best_j = j;
+				best = cand[k];
+			}
+		}
+		*c = best;
+		if (best.mask == 0 || best.top == best.bot) {
+			if (best.top != fg && best.top != bg)
+				bg = best.top;
+		} else {
+			fg = best.top;
+			bg = best.bot;
+		}
+	}
+}
+
 /* frame_put_image for the symbol sets: the samples, then every cell they
  * touch fitted again. */
 static void put_symbols(frame *f, const uint8_t *rgb, int w, int h, int ox, int oy)
@@ -427,8 +571,12 @@ static void put_symbols(frame *f, const uint8_t *rgb, int w, int h, int ox, int 
 	for (int cy = y0 / SYMBOLS_SAMPLE_H; cy <= (y1 - 1) / SYMBOLS_SAMPLE_H; cy++) {
 		for (int cx = x0 / SYMBOLS_SAMPLE_W; cx <= (x1 - 1) / SYMBOLS_SAMPLE_W; cx++)
 			fit_cell(f, cx, cy);
-		if (f->lambda > 0 && f->pal == PALETTE_TRUECOLOR)
-			rd_row(f, cy);
+		if (f->lambda > 0 && f->pal == PALETTE_TRUECOLOR) {
+			if (f->cover)
+				rd_row_cover(f, cy);
+			else
+				rd_row(f, cy);
+		}
 	}
 }
 
@@ -548,6 +696,7 @@ typedef struct way {
 static int ways_of(const frame *f, frame_cell c, way w[2])
 {
 	uint32_t full = (1u << f->nsub) - 1;
+	short comp = f->shapes.comp[c.mask];
 	if (c.top == c.bot || c.mask == 0 || c.mask == full) {
 		uint32_t v = c.mask == 0 ? c.bot : c.top;
 		int n = 0;
@@ -559,8 +708,8 @@ static int ways_of(const frame *f, frame_cell c, way w[2])
 	int n = 0;
 	if (c.top != FRAME_DEFAULT)
 		w[n++] = (way){c.mask, c.top, c.bot};
-	if (c.bot != FRAME_DEFAULT)
-		w[n++] = (way){full ^ c.mask, c.bot, c.top};
+	if (c.bot != FRAME_DEFAULT && comp >= 0)
+		w[n++] = (way){(uint32_t)comp, c.bot, c.top};
 	return n;
 }
 
@@ -712,6 +861,30 @@ static void update_begin(const frame *f, update_state *u, abuf *out)
 	(void)f;
 }
 
+/* cell_close for frames fitted over the glyphs' shapes: each sample's
+ * mix of the two colours within f->tol, the default background only where
+ * both show it alike. */
+static bool cover_close(const frame *f, frame_cell a, frame_cell b)
+{
+	const float *ca = f->shapes.cov[a.mask], *cb = f->shapes.cov[b.mask];
+	for (int i = 0; i < SYMBOLS_SAMPLE_W * SYMBOLS_SAMPLE_H; i++) {
+		bool da = (ca[i] > 0 && a.top == FRAME_DEFAULT) || (ca[i] < 1 && a.bot == FRAME_DEFAULT);
+		bool db = (cb[i] > 0 && b.top == FRAME_DEFAULT) || (cb[i] < 1 && b.bot == FRAME_DEFAULT);
+		if (da || db) {
+			if (da != db || a.top != b.top || a.bot != b.bot || ca[i] != cb[i])
+				return false;
+			continue;
+		}
+		for (int sh = 0; sh < 24; sh += 8) {
+			float va = ca[i] * (float)(a.top >> sh & 255) + (1 - ca[i]) * (float)(a.bot >> sh & 255);
+			float vb = cb[i] * (float)(b.top >> sh & 255) + (1 - cb[i]) * (float)(b.bot >> sh & 255);
+			if (fabsf(va - vb) > (float)f->tol)
+				return false;
+		}
+	}
+	return true;
+}
+
 /* True when the terminal's cell b may stay for a: equal, or in truecolor
  * within f->tol in every channel of every subpixel. */
 static bool cell_close(const frame *f, frame_cell a, frame_cell b)
@@ -720,6 +893,8 @@ static bool cell_close(const frame *f, frame_cell a, frame_cell b)
 		return true;
 	if (f->tol <= 0 || f->pal != PALETTE_TRUECOLOR || b.top == unknown_cell.top)
 		return false;
+	if (f->cover)
+		return cover_close(f, a, b);
 	for (int i = 0; i < f->nsub; i++) {
 		uint32_t ca = a.mask >> i & 1 ? a.top : a.bot, cb = b.mask >> i & 1 ? b.top : b.bot;
 		if (ca == cb)

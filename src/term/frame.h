@@ -76,6 +76,10 @@ typedef struct frame {
 	                      rows*4 samples), sRGB */
 	uint8_t *def;      /* 1 where the canvas holds a picture's sample, 0 where
 	                      it shows the default background */
+	bool cover;        /* cells fitted over the glyphs' shapes on the 2x4 samples
+	                      (symbols_fit_cover: the sextant set, whose glyphs
+	                      beyond the masks mix samples), else over subpixels */
+	symbols_shapes shapes; /* the set's glyphs on the samples, their complements */
 	char glyph[256][4]; /* the UTF-8 of each mask's glyph ... */
 	uint8_t glyph_len[256]; /* ... and its length */
 	abuf out;

@@ -74,6 +74,43 @@ void symbols_subpixels(symbols_kind k, const uint8_t *samples, size_t stride, fl
  * mask 0 and a == b == the mean. Returns the fit's squared error. */
 double symbols_fit(const float sub[][3], int n, double flat, unsigned *mask, uint8_t a[3], uint8_t b[3]);
 
+/* The glyphs of set k: ids 0 .. symbols_count(k)-1. Below 1 << (w*h) an
+ * id is a mask of the set's grid; the sextant set has more glyphs beyond
+ * its 64 patterns (ids 64 on: the Block Elements' quadrants, halves and
+ * eighths, and the eighth blocks of Unicode 13's Symbols for Legacy
+ * Computing), each drawn from its shape. */
+int symbols_count(symbols_kind k);
+/* The share (0..1) of each of a cell's SYMBOLS_SAMPLE_W x SYMBOLS_SAMPLE_H
+ * samples (rows top down) that glyph id of set k inks. */
+void symbols_cover(symbols_kind k, unsigned id, float cov[8]);
+
+#define SYMBOLS_MAX_GLYPHS 256
+#define SYMBOLS_COVER_MAX 88 /* the most glyphs symbols_fit_cover takes */
+/* A set's glyph shapes on the sample grid, for symbols_fit_cover. */
+typedef struct symbols_shapes {
+	int n;                               /* glyphs */
+	float cov[SYMBOLS_MAX_GLYPHS][8];    /* symbols_cover */
+	double uu[SYMBOLS_MAX_GLYPHS], uv[SYMBOLS_MAX_GLYPHS], vv[SYMBOLS_MAX_GLYPHS];
+	short comp[SYMBOLS_MAX_GLYPHS];      /* the glyph inked where this one is not, or -1 */
+	float covt[8][SYMBOLS_COVER_MAX];    /* cov by sample, for sums over all glyphs at once
+	                                        (sets of at most SYMBOLS_COVER_MAX glyphs; 0 past n) */
+	/* The glyphs the fit tries: two colours, and not the complement of
+	 * one tried (the same fit, colours swapped); their shapes by sample
+	 * and the inverse of their normal equations, [ia -ib; -ib ic]. */
+	int nsolve;
+	short solve[SYMBOLS_COVER_MAX];
+	float scovt[8][SYMBOLS_COVER_MAX];
+	double ia[SYMBOLS_COVER_MAX], ib[SYMBOLS_COVER_MAX], ic[SYMBOLS_COVER_MAX];
+} symbols_shapes;
+void symbols_shapes_init(symbols_shapes *s, symbols_kind k);
+/* The best two-colour fit of a cell's 8 samples x (sRGB levels) over every
+ * glyph of s (a set of at most SYMBOLS_COVER_MAX glyphs: the sextant set): each sample shown as its ink's share of colour a and the
+ * rest of b, a and b by least squares (clamped to 0..255, rounded). A
+ * cell whose best glyph gains at most `flat` over one colour is flat
+ * (id 0, a == b == the mean). Returns the squared error of the fit. */
+double symbols_fit_cover(const symbols_shapes *s, const float x[8][3], double flat, unsigned *id, uint8_t a[3],
+                         uint8_t b[3]);
+
 /* The set `auto` picks from what is known of the terminal: the names it
  * gives (TERM_PROGRAM, its XTVERSION answer, VTE_VERSION; NULL: not
  * known) and whether it runs inside tmux (which passes the glyphs on to

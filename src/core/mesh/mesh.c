@@ -92,12 +92,7 @@ bool mb_texture(mesh_builder *b, texture *t)
 /* The embedded textures are the mesh's (texs), not the material's. */
 static void mat_free(mesh_mat *m)
 {
-	free(m->name);
-	free(m->map_kd);
-	free(m->map_bump);
-	free(m->map_norm);
-	free(m->map_mr);
-	free(m->map_emit);
+	mem_free_all(m->name, m->map_kd, m->map_bump, m->map_norm, m->map_mr, m->map_emit, m->alpha_map);
 }
 
 /* The materials and embedded textures a builder, then its mesh, holds. */
@@ -113,13 +108,8 @@ static void mats_texs_free(mesh_mat *mats, size_t nmats, texture **texs, size_t 
 
 void mb_free(mesh_builder *b)
 {
-	free(b->v);
-	free(b->vt);
-	free(b->vn);
-	free(b->c);
-	free(b->fm);
 	mats_texs_free(b->mats, b->nmats, b->texs, b->ntexs);
-	free(b->warning);
+	mem_free_all(b->v, b->vt, b->vn, b->c, b->fm, b->warning);
 	memset(b, 0, sizeof *b);
 }
 
@@ -284,18 +274,8 @@ void mesh_free(mesh *m)
 {
 	if (!m)
 		return;
-	free(m->path);
-	free(m->p);
-	free(m->n);
-	free(m->uv);
-	free(m->tri);
-	free(m->tmat);
 	mats_texs_free(m->mats, m->nmats, m->texs, m->ntexs);
-	free(m->warning);
-	free(m->nodes);
-	free(m->blk);
-	free(m->btri);
-	free(m);
+	mem_free_all(m->path, m->p, m->n, m->uv, m->tri, m->tmat, m->warning, m->nodes, m->blk, m->btri, m);
 }
 
 static size_t tex_bytes(const texture *t)
@@ -323,6 +303,9 @@ size_t mesh_memory(const mesh *m)
 	n += (size_t)m->nblk * (sizeof *m->blk + sizeof *m->btri);
 	for (uint32_t i = 0; i < m->ntexs; i++)
 		n += tex_bytes(m->texs[i]);
+	for (uint32_t i = 0; i < m->nmats; i++)
+		if (m->mats[i].alpha_map)
+			n += (size_t)m->mats[i].alpha_w * (size_t)m->mats[i].alpha_h;
 	return n;
 }
 
@@ -375,8 +358,9 @@ static bool smooth_normals(mesh *m, double crease_deg, const atomic_bool *cancel
 	double *ang = malloc((size_t)nt * 3 * sizeof *ang);
 	uint32_t *slot = malloc(cap * sizeof *slot);
 	float(*nn)[3] = malloc((size_t)nt * 3 * sizeof *nn);
+	bool stopped = false;
 	if (!fn || !start || !list || !newid || !ang || !slot || !nn)
-		goto oom;
+		goto fail;
 	memset(slot, 0xff, cap * sizeof *slot);
 	for (uint32_t t = 0; t < nt; t++) {
 		vec3 a = vtx(m, m->tri[t][0]), b = vtx(m, m->tri[t][1]), c = vtx(m, m->tri[t][2]);
@@ -398,7 +382,7 @@ static bool smooth_normals(mesh *m, double crease_deg, const atomic_bool *cancel
 	{
 		uint32_t *fill = malloc((size_t)nv * sizeof *fill);
 		if (!fill)
-			goto oom;
+			goto fail;
 		memcpy(fill, start, (size_t)nv * sizeof *fill);
 		for (uint32_t t = 0; t < nt; t++)
 			for (uint32_t k = 0; k < 3; k++)
@@ -410,14 +394,8 @@ static bool smooth_normals(mesh *m, double crease_deg, const atomic_bool *cancel
 	for (uint32_t v = 0; v < nv; v++) {
 		uint32_t s = start[v], e = start[v + 1], deg = e - s;
 		if ((v & 0xffff) == 0 && cancel && atomic_load_explicit(cancel, memory_order_relaxed)) {
-			free(fn);
-			free(start);
-			free(list);
-			free(newid);
-			free(ang);
-			free(slot);
-			free(nn);
-			return rt_error_set(err, "stopped");
+			stopped = true;
+			goto fail;
 		}
 		vec3 all = v3(0, 0, 0); /* the sum of every face, when the crease is ignored */
 		if (deg > CREASE_DEG_MAX)
@@ -458,7 +436,7 @@ static bool smooth_normals(mesh *m, double crease_deg, const atomic_bool *cancel
 		free(p);
 		free(n);
 		free(uv);
-		goto oom;
+		goto fail;
 	}
 	for (uint32_t v = 0; v < nv; v++) {
 		memcpy(p[v], m->p[v], sizeof *p);
@@ -480,20 +458,12 @@ static bool smooth_normals(mesh *m, double crease_deg, const atomic_bool *cancel
 	m->n = n;
 	m->uv = uv;
 	m->nverts = next;
-	free(fn);
-	free(start);
-	free(list);
-	free(newid);
-	free(nn);
+	mem_free_all(fn, start, list, newid, nn);
 	return true;
-oom:
-	free(fn);
-	free(start);
-	free(list);
-	free(newid);
-	free(ang);
-	free(slot);
-	free(nn);
+fail:
+	mem_free_all(fn, start, list, newid, ang, slot, nn);
+	if (stopped)
+		return rt_error_set(err, "stopped");
 	return rt_error_set(err, "%s: out of memory computing normals", m->path ? m->path : "mesh");
 }
 
@@ -626,4 +596,112 @@ void mesh_surface(const mesh *m, uint32_t slot, const float b[3], mesh_surf *s)
 			s->dpdv = v3_scale(v3_sub(v3_scale(e2, du1), v3_scale(e1, du2)), 1.0 / det);
 		}
 	}
+}
+
+/* --- alpha coverage (glTF alphaMode MASK) --- */
+
+/* Texel index i of n along an axis, by the sampler's wrap mode. */
+static long wrap_texel(long i, long n, int mode)
+{
+	if (mode == MESH_WRAP_CLAMP)
+		return i < 0 ? 0 : i >= n ? n - 1 : i;
+	if (mode == MESH_WRAP_MIRROR) {
+		long k = i % (2 * n);
+		k = k < 0 ? k + 2 * n : k;
+		return k < n ? k : 2 * n - 1 - k;
+	}
+	long k = i % n;
+	return k < 0 ? k + n : k;
+}
+
+/* A texel coordinate (texel centres at integers) brought near the image,
+ * where floor() and the wrap are exact: by the wrap's period, or clamped. */
+static double wrap_coord(double x, long n, int mode)
+{
+	if (mode == MESH_WRAP_CLAMP)
+		return x < -1.0 ? -1.0 : x > (double)n ? (double)n : x;
+	return fmod(x, mode == MESH_WRAP_MIRROR ? 2.0 * (double)n : (double)n);
+}
+
+/* The bilinear alpha of the map at (u, v), v up (texture.c's texel
+ * centres: x = u w - 1/2, y = (1 - v) h - 1/2). */
+static double alpha_at(const mesh_mat *mm, double u, double v)
+{
+	long w = mm->alpha_w, h = mm->alpha_h;
+	double x = u * (double)w - 0.5, y = (1.0 - v) * (double)h - 0.5;
+	if (!isfinite(x) || !isfinite(y))
+		return 0.0;
+	x = wrap_coord(x, w, mm->alpha_wrap[0]);
+	y = wrap_coord(y, h, mm->alpha_wrap[1]);
+	double fx = floor(x), fy = floor(y), ax = x - fx, ay = y - fy;
+	long x0 = wrap_texel((long)fx, w, mm->alpha_wrap[0]), x1 = wrap_texel((long)fx + 1, w, mm->alpha_wrap[0]);
+	long y0 = wrap_texel((long)fy, h, mm->alpha_wrap[1]), y1 = wrap_texel((long)fy + 1, h, mm->alpha_wrap[1]);
+	const unsigned char *a = mm->alpha_map;
+	double a00 = a[(size_t)y0 * (size_t)w + (size_t)x0], a10 = a[(size_t)y0 * (size_t)w + (size_t)x1];
+	double a01 = a[(size_t)y1 * (size_t)w + (size_t)x0], a11 = a[(size_t)y1 * (size_t)w + (size_t)x1];
+	return ((1 - ay) * ((1 - ax) * a00 + ax * a10) + ay * ((1 - ax) * a01 + ax * a11)) / 255.0;
+}
+
+static _Thread_local bool alpha_hashed;
+
+void mesh_alpha_hashed(bool on)
+{
+	alpha_hashed = on;
+}
+
+/* A number in [0, 1) of the hit (its triangle, not its slot: a leaf's
+ * lanes that repeat a triangle must draw the same, and the bits of its
+ * barycentrics): as good as random from one ray to the next, the same for
+ * the same point (splitmix64's finaliser). */
+static double hit_hash(uint32_t tri, const float b[3])
+{
+	uint32_t x, y, z;
+	memcpy(&x, &b[0], 4);
+	memcpy(&y, &b[1], 4);
+	memcpy(&z, &b[2], 4);
+	uint64_t h = ((uint64_t)x << 32 | y) ^ ((uint64_t)z << 32 | tri) * 0x9E3779B97F4A7C15ull;
+	h = (h ^ (h >> 30)) * 0xBF58476D1CE4E5B9ull;
+	h = (h ^ (h >> 27)) * 0x94D049BB133111EBull;
+	h ^= h >> 31;
+	return (double)(h >> 11) * 0x1p-53;
+}
+
+bool mesh_cut_hole(const mesh *m, uint32_t slot, const float b[3])
+{
+	if (m->nmats == 0)
+		return false;
+	uint32_t t = mesh_slot_tri(m, slot);
+	const mesh_mat *mm = &m->mats[m->tmat ? m->tmat[t] : 0];
+	if (mm->alpha_mode == MESH_ALPHA_OPAQUE)
+		return false;
+	double a = mm->alpha;
+	if (mm->alpha_map) {
+		/* the hit's uv as mesh_surface interpolates it (none: 0, 0), then
+		 * the base colour texture's KHR_texture_transform (surface.c) */
+		double u = 0, v = 0;
+		if (m->tri && m->uv) {
+			const uint32_t *i = m->tri[t];
+			const float *pa = m->uv[i[0]], *pb = m->uv[i[1]], *pc = m->uv[i[2]];
+			u = b[0] * pa[0] + b[1] * pb[0] + b[2] * pc[0];
+			v = b[0] * pa[1] + b[1] * pb[1] + b[2] * pc[1];
+		}
+		double tu = u * mm->uvs[0] + mm->uvo[0] + v * mm->uvx[0];
+		double tv = v * mm->uvs[1] + mm->uvo[1] + u * mm->uvx[1];
+		a *= alpha_at(mm, tu, tv);
+	}
+	if (mm->alpha_mode == MESH_ALPHA_BLEND) /* see through by alpha, or MASK at 0.5 */
+		return a < (alpha_hashed ? hit_hash(t, b) : 0.5);
+	return a < mm->alpha_cutoff;
+}
+
+unsigned mesh_cut_lanes(const mesh *m, uint32_t blk, unsigned lanes, const float u[4], const float v[4],
+                        const float w[4], const float inv[4])
+{
+	for (unsigned rest = lanes; rest; rest &= rest - 1) {
+		int l = __builtin_ctz(rest);
+		float b[3] = {u[l] * inv[l], v[l] * inv[l], w[l] * inv[l]};
+		if (mesh_cut_hole(m, 4 * blk + (uint32_t)l, b))
+			lanes &= ~(1u << l);
+	}
+	return lanes;
 }
