@@ -235,12 +235,19 @@ static bool stream_make(stream *st, render_rows_fn rows, rt_error *err)
 	return true;
 }
 
-static bool write_ppm_rendered(FILE *f, void *vctx, rt_error *err)
+/* Points the stream at the file the atomic save opened (image_write_rendered). */
+static void stream_open(stream *st, FILE *f)
 {
-	stream *st = vctx;
 	st->f = f;
 	st->fd = fileno(f);
 	st->synced = 0;
+	st->why[0] = '\0';
+}
+
+static bool write_ppm_rendered(FILE *f, void *vctx, rt_error *err)
+{
+	stream *st = vctx;
+	stream_open(st, f);
 	if (fprintf(f, "P6\n%d %d\n255\n", st->w, st->h) < 0)
 		return rt_error_at(err, st->path, 0, 0, "write failed");
 	return stream_make(st, ppm_rows, err);
@@ -270,10 +277,7 @@ static bool png_rows(void *vctx, const framebuffer *fb, int y0, int y1)
 static bool write_png_rendered(FILE *f, void *vctx, rt_error *err)
 {
 	stream *st = vctx;
-	st->f = f;
-	st->fd = fileno(f);
-	st->synced = 0;
-	st->why[0] = '\0';
+	stream_open(st, f);
 	png_infop info = NULL;
 	st->png = png_create_write_struct(PNG_LIBPNG_VER_STRING, st->why, png_error_kept, png_warning_dropped);
 	if (st->png)
