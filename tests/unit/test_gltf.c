@@ -1319,6 +1319,23 @@ static void test_cutout_factor(void **state)
 		}
 		mesh_free(m);
 	}
+	/* bad values, by their JSON path */
+	static const char *const bad[][3] = {
+	    {"{\"alphaMode\":\"MASK\",\"alphaCutoff\":-1}", "materials[0]: alphaCutoff: not a number from 0", ""},
+	    {"{\"alphaMode\":\"CUTOUT\"}", "materials[0]: alphaMode: not \"OPAQUE\", \"MASK\" or \"BLEND\"", "expected"},
+	    {"{\"alphaMode\":\"MASK\",\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}}}",
+	     "samplers[0]: wrapS: 5; expected 33071 (clamp), 33648 (mirrored repeat) or 10497 (repeat)", ""},
+	};
+	for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+		char rest[1024];
+		snprintf(rest, sizeof rest,
+		         "\"nodes\":[{\"mesh\":0}],\"materials\":[%s],\"textures\":[{\"source\":0,\"sampler\":0}],"
+		         "\"samplers\":[{\"wrapS\":5}],\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],",
+		         bad[k][0], png64);
+		char *text = tri_gltf(unit_tri, rest);
+		expect_fail(text, bad[k][1], bad[k][2]);
+		free(text);
+	}
 }
 
 /* An emissive cut-out is not sampled as a lamp (its holes would light
