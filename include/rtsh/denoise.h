@@ -12,11 +12,16 @@
  * well antialiased as that many samples would make its colour.
  *
  * A lamp's albedo feature is its emission, far from any surface's, so that
- * no filter mixes a lamp with what lies next to it. A further feature is
- * the direct light the surface sends to the eye (the point lights exactly,
- * each lamp from 2x2 stratified points, shadowed; through a glossy metal
- * that is looked through, its own highlight too): it explains shadows and
- * highlights that albedo and normal do not. The job also keeps the mean
+ * no filter mixes a lamp with what lies next to it; but a lamp seen through
+ * a glossy metal (not a perfect mirror) is blurred by it, and there the
+ * metal's own features are taken. A further feature is the direct light
+ * the surface sends to the eye (the point lights exactly, each lamp from 4
+ * points a sample and the sky from 4 cosine-distributed directions a
+ * sample, shadowed: over the first DENOISE_FEATURE_SAMPLES samples one
+ * fixed set of 32 of each, the same for every pixel, so that the feature is
+ * smooth; through a glossy metal that is looked through, its own highlight
+ * too): it explains shadows, highlights and the sky's contact shadows that
+ * albedo and normal do not. The job also keeps the mean
  * radiance and squared brightness of the even-numbered samples: with
  * those of all of them they split the samples into two independent halves,
  * and the albedo at the even samples' and all the samples' own positions.

@@ -9,6 +9,7 @@
 #include "emitters.h"
 #include "integrators.h"
 #include "rtsh/memory.h"
+#include "warp.h"
 
 /* --- features -------------------------------------------------------------- */
 
@@ -41,16 +42,35 @@ static double lum_d(vec3 c)
 	return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
 }
 
+/* Point idx of a Hammersley set of n points (n a power of two) of the
+ * unit square, at its strata's centres: (idx + 1/2) / n and idx's bits
+ * reversed. Sample k of the first DENOISE_FEATURE_SAMPLES takes the points
+ * k, k + DENOISE_FEATURE_SAMPLES, ...: each sample's share is spread over
+ * the square, and all of them make the whole set. */
+static void hammersley(unsigned idx, unsigned n, double *u, double *v)
+{
+	unsigned rev = 0;
+	for (unsigned bit = 1, r = n / 2; bit < n; bit <<= 1, r >>= 1)
+		if (idx & bit)
+			rev |= r;
+	*u = (idx + 0.5) / n;
+	*v = (rev + 0.5) / n;
+}
+
 /* Emitters sampled for the direct-light feature at most (more: these many
  * picked, their light scaled up). */
 #define DIRECT_EMITTERS 4
 
 /* The direct light that the point lights and the lamps send through b at p
  * (on object self) toward the eye, as brightness: the point lights
- * exactly, each lamp from 2x2 stratified points of the solid angle (or
- * area) emitter_sample maps them to, shifted by the numbers r1, r2. No
+ * exactly, each lamp from 4 points of the solid angle (or area)
+ * emitter_sample maps them to, sample ks taking its share of one fixed
+ * Hammersley set of 4 DENOISE_FEATURE_SAMPLES (hammersley): the same
+ * points for every pixel, so that the feature is a smooth function of the
+ * position (random points made it noisy where a glossy lobe sees the lamp,
+ * its highlight). With more than DIRECT_EMITTERS lamps, r1 picks them. No
  * weight of multiple importance sampling: the full direct light. */
-static double direct_feature(const world *w, const bsdf *b, vec3 p, uint32_t self, double r1, double r2)
+static double direct_feature(const world *w, const bsdf *b, vec3 p, uint32_t self, int ks, double r1)
 {
 	double sum = 0.0;
 	if (!b->smooth)
@@ -76,7 +96,8 @@ static double direct_feature(const world *w, const bsdf *b, vec3 p, uint32_t sel
 			continue;
 		double part = 0.0;
 		for (int q = 0; q < 4; q++) {
-			double u1 = (q & 1) * 0.5 + 0.5 * r1, u2 = (q >> 1) * 0.5 + 0.5 * r2;
+			double u1, u2;
+			hammersley((unsigned)(q * DENOISE_FEATURE_SAMPLES + ks % DENOISE_FEATURE_SAMPLES), 4 * DENOISE_FEATURE_SAMPLES, &u1, &u2);
 			vec3 wi;
 			double pdf, t;
 			if (!emitter_sample(e, p, u1, u2, &wi, &pdf, &t) || !(pdf > 0.0))
@@ -95,20 +116,62 @@ static double direct_feature(const world *w, const bsdf *b, vec3 p, uint32_t sel
 	return sum;
 }
 
+/* Directions of the sky's part of the direct-light feature, per sample:
+ * the first DENOISE_FEATURE_SAMPLES samples take ENV_DIRS each of one
+ * fixed set of ENV_DIRS * DENOISE_FEATURE_SAMPLES. */
+#define ENV_DIRS 4
+#define ENV_SET (ENV_DIRS * DENOISE_FEATURE_SAMPLES)
+
+/* Whether the world has light from its background (a sky, an HDR sky or
+ * path mode's ambient). */
+static bool env_lit(const world *w)
+{
+	return w->env || w->has_sky || w->ambient.x > 0.0 || w->ambient.y > 0.0 || w->ambient.z > 0.0;
+}
+
+/* The light of the background (the sky) that b at p sends toward the eye,
+ * as brightness: ENV_DIRS of a fixed set of ENV_SET cosine-distributed
+ * directions about the normal (a Hammersley set through the concentric
+ * disc, the same about every normal), sample k taking the directions
+ * k, k + DENOISE_FEATURE_SAMPLES, ...; shadowed. The same set for every
+ * pixel: a function of the position and normal, smooth wherever what
+ * blocks the sky changes slowly, and no noise between neighbours. */
+static double env_feature(const world *w, const bsdf *b, vec3 p, int k)
+{
+	if (!b->smooth || !env_lit(w))
+		return 0.0;
+	double sum = 0.0;
+	for (int q = 0; q < ENV_DIRS; q++) {
+		double u1, u2;
+		hammersley((unsigned)(q * DENOISE_FEATURE_SAMPLES + k % DENOISE_FEATURE_SAMPLES), ENV_SET, &u1, &u2);
+		vec3 wi = warp_cosine(b->n, u1, u2);
+		vec3 f = bsdf_eval(b, wi);
+		ray sr = {p, wi};
+		if (lum_d(f) <= 0.0 || world_occluded(w, &sr, 0.0, INFINITY))
+			continue;
+		sum += lum_d(v3_mul(f, world_background(w, wi, MODE_PATH))) * RT_PI;
+	}
+	return sum / ENV_DIRS;
+}
+
 /* What the camera ray r shows first, in f (albedo, normal, depth). A
  * surface that is mostly a perfect mirror, a metal of little fuzz or glass
  * is looked through (up to four times): its features are those of the
  * surface seen in it, the albedo tinted by the mirror's or the glass's
  * colour, the depth the length of the whole path. Glass is followed along the refracted ray unless the
  * reflection is total. */
-static void first_surface(const world *w, ray r, bool direct, double f[8])
+static void first_surface(const world *w, ray r, int ks, double f[8])
 {
 	vec3 tint = v3(1, 1, 1);
 	uint64_t bits[2];
 	memcpy(&bits[0], &r.d.x, sizeof bits[0]);
 	memcpy(&bits[1], &r.d.y, sizeof bits[1]);
-	double r1 = hash_unit(bits[0] ^ (bits[1] << 1)), r2 = hash_unit(bits[1] ^ 0x9e3779b97f4a7c15u ^ bits[0] >> 3);
+	double r1 = hash_unit(bits[0] ^ (bits[1] << 1));
 	double dist = 0.0;
+	/* the first glossy surface looked through (its features) */
+	bool gl = false;
+	vec3 gl_a = v3(0, 0, 0), gl_n = v3(0, 0, 0);
+	double gl_d = 0.0;
 	for (int k = 0;; k++) {
 		hit h;
 		if (!(k == 0 ? world_intersect_coherent : world_intersect)(w, &r, 0.0, INFINITY, &h)) {
@@ -126,6 +189,19 @@ static void first_surface(const world *w, ray r, bool direct, double f[8])
 		int follow = bsdf_features(&b, &a, &tt, &dir);
 		if (follow == 0 || k == 3 || m->emission.x + m->emission.y + m->emission.z > 0.0) {
 			vec3 e = m->emission;
+			if (e.x + e.y + e.z > 0.0 && gl) {
+				/* A lamp seen through a glossy lobe is blurred by it: the
+				 * features are the glossy surface's own, and its direct
+				 * light (added there) explains the highlight. */
+				f[0] += gl_a.x;
+				f[1] += gl_a.y;
+				f[2] += gl_a.z;
+				f[3] += gl_n.x;
+				f[4] += gl_n.y;
+				f[5] += gl_n.z;
+				f[6] += gl_d;
+				return;
+			}
 			if (e.x + e.y + e.z > 0.0) {
 				/* A lamp's "albedo" is its emission, unclamped: far from any
 				 * surface's, so that no filter mixes the two. */
@@ -141,12 +217,21 @@ static void first_surface(const world *w, ray r, bool direct, double f[8])
 			f[4] += b.n.y;
 			f[5] += b.n.z;
 			f[6] += dist;
-			if (direct && !(e.x + e.y + e.z > 0.0))
-				f[7] += direct_feature(w, &b, offset_point(w, h.p, b.n), h.object, r1, r2) * lum_d(tint);
+			if (ks >= 0 && !(e.x + e.y + e.z > 0.0)) {
+				vec3 p = offset_point(w, h.p, b.n);
+				f[7] += (direct_feature(w, &b, p, h.object, ks, r1) + env_feature(w, &b, p, ks)) * lum_d(tint);
+			}
 			return;
 		}
-		if (direct && b.smooth) /* a glossy lobe looked through: its own highlights */
-			f[7] += direct_feature(w, &b, offset_point(w, h.p, b.n), h.object, r1, r2) * lum_d(tint);
+		if (ks >= 0 && b.smooth) /* a glossy lobe looked through: its own highlights */
+			f[7] += direct_feature(w, &b, offset_point(w, h.p, b.n), h.object, ks, r1) * lum_d(tint);
+		if (b.smooth && !gl) {
+			gl = true;
+			gl_a = v3_mul(a, tint);
+			gl_a = v3(clamp01(gl_a.x), clamp01(gl_a.y), clamp01(gl_a.z));
+			gl_n = b.n;
+			gl_d = dist;
+		}
 		tint = v3_mul(tint, tt);
 		if (follow == 1)
 			r = (ray){offset_point(w, h.p, b.n), v3_sub(v3_scale(b.n, 2.0 * b.cos_o), b.wo)};
@@ -167,7 +252,7 @@ static inline double albedo_divisor(double a)
 void denoise_sample(const world *w, ray r, int k, double *acc)
 {
 	double f[8] = {0};
-	first_surface(w, r, true, f);
+	first_surface(w, r, k, f);
 	for (int q = 0; q < 8; q++)
 		acc[q] += f[q];
 	acc[8] += f[0] * f[0] + f[1] * f[1] + f[2] * f[2];
@@ -225,7 +310,7 @@ void denoise_features(const world *w, const render_settings *s, int px, int py, 
 		sum[k] = (double)f[k] * n1;
 	for (int k = n1; k < DENOISE_EDGE_SAMPLES; k++) {
 		double one[8] = {0};
-		first_surface(w, render_sample_ray(w, s, px, py, fw, fh, k), false, one);
+		first_surface(w, render_sample_ray(w, s, px, py, fw, fh, k), -1, one);
 		for (int q = 0; q < 8; q++)
 			sum[q] += one[q];
 		sum[8] += one[0] * one[0] + one[1] * one[1] + one[2] * one[2];

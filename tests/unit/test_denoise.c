@@ -608,6 +608,80 @@ static void test_direct_feature(void **state)
 	}
 }
 
+/* The sky's part of the direct-light feature: the first
+ * DENOISE_FEATURE_SAMPLES samples of a pixel take ENV_DIRS each of one set
+ * of 32 cosine-distributed directions, so their mean is that set's
+ * estimate of the light the sky sends through the surface. A white
+ * Lambertian wall at z = 2 faces the camera at the origin, no lamp:
+ * - a uniform sky of radiance 0.5: every direction sees 0.5, and a white
+ *   Lambertian surface sends back albedo / pi x pi x 0.5 = 0.5, exactly;
+ * - a sky black at the horizon and white at the zenith, radiance
+ *   max(0, d.y): the cosine-weighted mean of max(0, y) over the hemisphere
+ *   about -z is half the mean of |y| over the unit disc (Malley's method:
+ *   the tangent coordinates are uniform on the disc), 1/2 x 4 / (3 pi) =
+ *   2 / (3 pi), to the set's quadrature error (32 points: 0.01);
+ * - the uniform sky with an infinite floor at y = -0.5: the directions
+ *   below the horizon are blocked, half of them, 0.25 to 0.01;
+ * - no sky and no ambient: 0, and no shadow ray is traced. */
+static void test_env_feature(void **state)
+{
+	(void)state;
+	const char *wall = "C 0,0,0 0,0,1 10\npl 0,0,2 0,0,-1 1,1,1 255,255,255 1 0 1 0\n";
+	const char *extra[4] = {
+		"sky 255,255,255 255,255,255 0.5\n",
+		"sky 255,255,255 0,0,0 1\n",
+		"sky 255,255,255 255,255,255 0.5\npl 0,-0.5,0 0,1,0 1,1,1 255,255,255 1 0 1 0\n",
+		"A 0 255,255,255\n",
+	};
+	const double want[4] = {0.5, 2.0 / (3.0 * M_PI), 0.25, 0.0}, tol[4] = {1e-9, 0.01, 0.01, 0.0};
+	for (int c = 0; c < 4; c++) {
+		char text[512];
+		snprintf(text, sizeof text, "%s%s", wall, extra[c]);
+		scene *s = load_text(text);
+		world *w = world_build(s, NULL);
+		assert_non_null(w);
+		double f[DENOISE_ACC] = {0};
+		for (int k = 0; k < DENOISE_FEATURE_SAMPLES; k++)
+			denoise_sample(w, cam_ray(&w->cam, 4.5, 4.5, 9, 9), k, f);
+		assert_near(f[7] / DENOISE_FEATURE_SAMPLES, want[c], tol[c]);
+		assert_near(f[6] / DENOISE_FEATURE_SAMPLES, 2.0, 1e-9);
+		world_free(w);
+		scene_free(s);
+	}
+}
+
+/* A lamp seen through a glossy lobe: a white metal of fuzz 0.1 (looked
+ * through, test_features_through_mirror) at z = 2 facing the camera at the
+ * origin, a lamp of radiance 5 (a sphere of radius 1 at z = -3, behind the
+ * camera): the reflected centre ray meets the lamp at z = -2. Through the
+ * fuzz the lamp is blurred, so the features are the metal's own: albedo
+ * white, normal -z, depth 2. Through a perfect mirror the lamp is sharp:
+ * its emission is the albedo (far from any surface's), depth 2 + 4 = 6. */
+static void test_lamp_through_glossy(void **state)
+{
+	(void)state;
+	const char *texts[2] = {
+		"C 0,0,0 0,0,1 10\npl 0,0,2 0,0,-1 1,1,1 255,255,255 0 0 1 1 metal=1 fuzz=0.1\n"
+		"sp 0,0,-3 0,1,0 2,2,2 255,255,255 0 0 1 0 emit=5\n",
+		"C 0,0,0 0,0,1 10\npl 0,0,2 0,0,-1 1,1,1 255,255,255 0 0 1 1\n"
+		"sp 0,0,-3 0,1,0 2,2,2 255,255,255 0 0 1 0 emit=5\n",
+	};
+	const double albedo[2] = {1, 5}, normal_z[2] = {-1, 1}, depth[2] = {2, 6};
+	for (int c = 0; c < 2; c++) {
+		scene *s = load_text(texts[c]);
+		world *w = world_build(s, NULL);
+		assert_non_null(w);
+		double f[DENOISE_ACC] = {0};
+		denoise_sample(w, cam_ray(&w->cam, 4.5, 4.5, 9, 9), 0, f);
+		for (int k = 0; k < 3; k++)
+			assert_near(f[k], albedo[c], 1e-5);
+		assert_near(f[5], normal_z[c], 1e-3);
+		assert_near(f[6], depth[c], 1e-3);
+		world_free(w);
+		scene_free(s);
+	}
+}
+
 /* Features recorded in passes equal those of one pass, and mean the first
  * DENOISE_FEATURE_SAMPLES samples; the mean square covers every sample. */
 static void test_features_in_passes(void **state)
@@ -698,6 +772,8 @@ int main(void)
 		cmocka_unit_test(test_threads),
 		cmocka_unit_test(test_features_through_mirror),
 		cmocka_unit_test(test_direct_feature),
+		cmocka_unit_test(test_env_feature),
+		cmocka_unit_test(test_lamp_through_glossy),
 		cmocka_unit_test(test_features_in_passes),
 		cmocka_unit_test(test_modes),
 		cmocka_unit_test(test_setting),
