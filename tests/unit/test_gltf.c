@@ -1092,6 +1092,8 @@ static void png_half(char *uri64)
  * 0.25, the centre of the opaque texel, and tx = -0.5 gives u = 0.75, the
  * centre of the transparent one (bilinear, repeat: alpha 1.5 - 2u on
  * [0.25, 0.75]). */
+static const char *cut_sampler; /* the texture's sampler (its JSON), NULL: none */
+
 static world *cut_world(const char *mat, bool tex, double tx, double qy, scene **out)
 {
 	unsigned char bin[92];
@@ -1104,8 +1106,9 @@ static world *cut_world(const char *mat, bool tex, double tx, double qy, scene *
 	b64(bin, sizeof bin, data);
 	if (tex) {
 		png_half(png64);
-		snprintf(images, sizeof images, "\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],",
-		         png64);
+		snprintf(images, sizeof images, "\"textures\":[{\"source\":0%s}],%s%s%s\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],",
+		         cut_sampler ? ",\"sampler\":0" : "", cut_sampler ? "\"samplers\":[" : "", cut_sampler ? cut_sampler : "",
+		         cut_sampler ? "]," : "", png64);
 	}
 	double h = sqrt(0.5);
 	char text[4096];
@@ -1145,6 +1148,7 @@ static world *cut_world(const char *mat, bool tex, double tx, double qy, scene *
  * seen and lit along its normal it sends back nothing), with alpha a. */
 #define CUT_MAT(a, rest) "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0," a "]" rest "}"
 #define CUT_TEX ",\"baseColorTexture\":{\"index\":0}}"
+#define CUT_TEX_T(t) ",\"baseColorTexture\":{\"index\":0,\"extensions\":{\"KHR_texture_transform\":{" t "}}}}"
 
 /* The radiance around the centre of the picture is `want`, found every way
  * the renderer finds it, on every vector unit of the walk: the single
@@ -1183,7 +1187,8 @@ static void expect_centre(const world *w, double want)
  * between it and the camera, its MASK texture left opaque, right clear.
  * Through the opaque texel the camera sees the quad (black: 0); through
  * the clear one it sees the plane, lit through the same hole: 0.5 / pi.
- * OPAQUE (the default) ignores alpha: 0. */
+ * OPAQUE (the default) ignores alpha: 0. Then the texture moved by
+ * KHR_texture_transform, and the sampler's wrap. */
 static void test_cutout_camera_rays(void **state)
 {
 	(void)state;
@@ -1191,16 +1196,29 @@ static void test_cutout_camera_rays(void **state)
 	struct {
 		const char *mat;
 		double tx, want;
+		const char *sampler;
 	} c[] = {
-	    {CUT_MAT("1", CUT_TEX ",\"alphaMode\":\"MASK\""), 0.5, 0},
-	    {CUT_MAT("1", CUT_TEX ",\"alphaMode\":\"MASK\""), -0.5, lit},
-	    {CUT_MAT("1", CUT_TEX ",\"alphaMode\":\"MASK\",\"alphaCutoff\":0.5"), -0.5, lit},
-	    {CUT_MAT("1", CUT_TEX), -0.5, 0},
-	    {CUT_MAT("1", CUT_TEX ",\"alphaMode\":\"OPAQUE\""), -0.5, 0},
+	    {CUT_MAT("1", CUT_TEX ",\"alphaMode\":\"MASK\""), 0.5, 0, NULL},
+	    {CUT_MAT("1", CUT_TEX ",\"alphaMode\":\"MASK\""), -0.5, lit, NULL},
+	    {CUT_MAT("1", CUT_TEX ",\"alphaMode\":\"MASK\",\"alphaCutoff\":0.5"), -0.5, lit, NULL},
+	    {CUT_MAT("1", CUT_TEX), -0.5, 0, NULL},
+	    {CUT_MAT("1", CUT_TEX ",\"alphaMode\":\"OPAQUE\""), -0.5, 0, NULL},
+	    /* KHR_texture_transform offset (0.5, 0): u 0.25 + 0.5, the clear texel */
+	    {CUT_MAT("1", CUT_TEX_T("\"offset\":[0.5,0]") ",\"alphaMode\":\"MASK\""), 0.5, lit, NULL},
+	    /* offset (1, 0): u 1.25, the opaque texel again by the default
+	     * repeat, and by an explicit one; past the right edge, so the clear
+	     * texel, with wrapS clamp (33071); mirrored (33648): 2 - 1.25 =
+	     * 0.75, clear */
+	    {CUT_MAT("1", CUT_TEX_T("\"offset\":[1,0]") ",\"alphaMode\":\"MASK\""), 0.5, 0, NULL},
+	    {CUT_MAT("1", CUT_TEX_T("\"offset\":[1,0]") ",\"alphaMode\":\"MASK\""), 0.5, 0, "{\"wrapS\":10497}"},
+	    {CUT_MAT("1", CUT_TEX_T("\"offset\":[1,0]") ",\"alphaMode\":\"MASK\""), 0.5, lit, "{\"wrapS\":33071}"},
+	    {CUT_MAT("1", CUT_TEX_T("\"offset\":[1,0]") ",\"alphaMode\":\"MASK\""), 0.5, lit, "{\"wrapS\":33648}"},
 	};
 	for (size_t k = 0; k < sizeof c / sizeof c[0]; k++) {
 		scene *s;
+		cut_sampler = c[k].sampler;
 		world *w = cut_world(c[k].mat, true, c[k].tx, 1, &s);
+		cut_sampler = NULL;
 		hit h;
 		ray r = {v3(0, 5, 0), v3(0, -1, 0)};
 		assert_true(world_intersect(w, &r, 0, INFINITY, &h));
