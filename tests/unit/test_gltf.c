@@ -1453,6 +1453,49 @@ static void test_blend(void **state)
 	}
 }
 
+/* The alpha of an image file beside the model (not inside it): read by the
+ * reader from the file, as the colour is by the world; a missing file is
+ * an error naming it. */
+static void test_cutout_image_file(void **state)
+{
+	(void)state;
+	static const unsigned char t[8] = {255, 255, 255, 255, 255, 255, 255, 0};
+	unsigned char png[128];
+	size_t n = png_rgba(2, 1, t, png);
+	char path[256];
+	snprintf(path, sizeof path, "%s/half.png", tmpdir);
+	FILE *f = fopen(path, "wb");
+	assert_non_null(f);
+	assert_int_equal(fwrite(png, 1, n, f), n);
+	assert_int_equal(fclose(f), 0);
+	for (int k = 0; k < 2; k++) {
+		char rest[512];
+		snprintf(rest, sizeof rest,
+		         "\"nodes\":[{\"mesh\":0}],\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":"
+		         "{\"index\":0}},\"alphaMode\":\"MASK\"}],\"textures\":[{\"source\":0}],"
+		         "\"images\":[{\"uri\":\"%s\"}],",
+		         k ? "nothere.png" : "half.png");
+		char *text = tri_gltf(unit_tri, rest);
+		const char *model = tmp_text("file.gltf", text);
+		free(text);
+		rt_error err = {0};
+		mesh *m = mesh_read_gltf(model, &err);
+		if (k) {
+			assert_null(m);
+			assert_non_null(strstr(err.msg, "nothere.png"));
+			continue;
+		}
+		if (!m)
+			fail_msg("%s", err.msg);
+		assert_true(m->cuts);
+		assert_non_null(m->mats[0].alpha_map);
+		assert_int_equal(m->mats[0].alpha_w, 2);
+		assert_int_equal(m->mats[0].alpha_map[0], 255);
+		assert_int_equal(m->mats[0].alpha_map[1], 0);
+		mesh_free(m);
+	}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -1478,6 +1521,7 @@ int main(void)
 	    cmocka_unit_test(test_cutout_factor),
 	    cmocka_unit_test(test_cutout_lamp),
 	    cmocka_unit_test(test_blend),
+	    cmocka_unit_test(test_cutout_image_file),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
 }
