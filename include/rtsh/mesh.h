@@ -251,7 +251,9 @@ typedef struct mesh_ray {
 
 void mesh_ray_make(mesh_ray *r, vec3 o, vec3 d);
 /* The nearest triangle with tmin < t < *tmax: sets *tmax, *tri (its slot)
- * and the barycentric weights b[3] of its corners. */
+ * and the barycentric weights b[3] of its corners. A hit in a cut-out's
+ * hole (mesh.cuts, mesh_cut_hole) is no hit, here and in every query
+ * below but mesh_intersect_brute. */
 bool mesh_intersect(const mesh *m, const mesh_ray *r, float tmin, float *tmax, uint32_t *tri, float b[3]);
 bool mesh_occluded(const mesh *m, const mesh_ray *r, float tmin, float tmax);
 /* The same for a world-space ray r on an instance of m, `inv` taking world

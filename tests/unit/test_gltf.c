@@ -1052,6 +1052,9 @@ static void png_half(char *uri64)
  * 0.25, the centre of the opaque texel, and tx = -0.5 gives u = 0.75, the
  * centre of the transparent one (bilinear, repeat: alpha 1.5 - 2u on
  * [0.25, 0.75]). */
+static const char *cut_sampler; /* the texture's sampler (its JSON), NULL: none */
+static bool cut_mirror;          /* the plane a perfect mirror, not Lambertian */
+
 static world *cut_world(const char *mat, bool tex, double tx, double qy, scene **out)
 {
 	unsigned char bin[92];
@@ -1064,8 +1067,9 @@ static world *cut_world(const char *mat, bool tex, double tx, double qy, scene *
 	b64(bin, sizeof bin, data);
 	if (tex) {
 		png_half(png64);
-		snprintf(images, sizeof images, "\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],",
-		         png64);
+		snprintf(images, sizeof images, "\"textures\":[{\"source\":0%s}],%s%s%s\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],",
+		         cut_sampler ? ",\"sampler\":0" : "", cut_sampler ? "\"samplers\":[" : "", cut_sampler ? cut_sampler : "",
+		         cut_sampler ? "]," : "", png64);
 	}
 	double h = sqrt(0.5);
 	char text[4096];
@@ -1091,8 +1095,9 @@ static world *cut_world(const char *mat, bool tex, double tx, double qy, scene *
 		fail_msg("%s", err.msg);
 	object pl = object_make(OBJ_PLANE, linear_to_srgb255(v3(0.5, 0.5, 0.5)));
 	pl.dir = v3(0, 1, 0);
-	pl.mat.diffuse = 1;
+	pl.mat.diffuse = cut_mirror ? 0 : 1;
 	pl.mat.specular = 0;
+	pl.mat.reflective = cut_mirror ? 1 : 0;
 	assert_true(scene_add_object(s, &pl, &err));
 	world *w = world_build(s, &err);
 	if (!w)
@@ -1105,6 +1110,7 @@ static world *cut_world(const char *mat, bool tex, double tx, double qy, scene *
  * seen and lit along its normal it sends back nothing), with alpha a. */
 #define CUT_MAT(a, rest) "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0," a "]" rest "}"
 #define CUT_TEX ",\"baseColorTexture\":{\"index\":0}}"
+#define CUT_TEX_T(t) ",\"baseColorTexture\":{\"index\":0,\"extensions\":{\"KHR_texture_transform\":{" t "}}}}"
 
 /* The radiance around the centre of the picture is `want`, found every way
  * the renderer finds it, on every vector unit of the walk: the single
@@ -1143,7 +1149,8 @@ static void expect_centre(const world *w, double want)
  * between it and the camera, its MASK texture left opaque, right clear.
  * Through the opaque texel the camera sees the quad (black: 0); through
  * the clear one it sees the plane, lit through the same hole: 0.5 / pi.
- * OPAQUE (the default) ignores alpha: 0. */
+ * OPAQUE (the default) ignores alpha: 0. Then the texture moved by
+ * KHR_texture_transform, and the sampler's wrap. */
 static void test_cutout_camera_rays(void **state)
 {
 	(void)state;
@@ -1151,16 +1158,29 @@ static void test_cutout_camera_rays(void **state)
 	struct {
 		const char *mat;
 		double tx, want;
+		const char *sampler;
 	} c[] = {
-	    {CUT_MAT("1", CUT_TEX ",\"alphaMode\":\"MASK\""), 0.5, 0},
-	    {CUT_MAT("1", CUT_TEX ",\"alphaMode\":\"MASK\""), -0.5, lit},
-	    {CUT_MAT("1", CUT_TEX ",\"alphaMode\":\"MASK\",\"alphaCutoff\":0.5"), -0.5, lit},
-	    {CUT_MAT("1", CUT_TEX), -0.5, 0},
-	    {CUT_MAT("1", CUT_TEX ",\"alphaMode\":\"OPAQUE\""), -0.5, 0},
+	    {CUT_MAT("1", CUT_TEX ",\"alphaMode\":\"MASK\""), 0.5, 0, NULL},
+	    {CUT_MAT("1", CUT_TEX ",\"alphaMode\":\"MASK\""), -0.5, lit, NULL},
+	    {CUT_MAT("1", CUT_TEX ",\"alphaMode\":\"MASK\",\"alphaCutoff\":0.5"), -0.5, lit, NULL},
+	    {CUT_MAT("1", CUT_TEX), -0.5, 0, NULL},
+	    {CUT_MAT("1", CUT_TEX ",\"alphaMode\":\"OPAQUE\""), -0.5, 0, NULL},
+	    /* KHR_texture_transform offset (0.5, 0): u 0.25 + 0.5, the clear texel */
+	    {CUT_MAT("1", CUT_TEX_T("\"offset\":[0.5,0]") ",\"alphaMode\":\"MASK\""), 0.5, lit, NULL},
+	    /* offset (1, 0): u 1.25, the opaque texel again by the default
+	     * repeat, and by an explicit one; past the right edge, so the clear
+	     * texel, with wrapS clamp (33071); mirrored (33648): 2 - 1.25 =
+	     * 0.75, clear */
+	    {CUT_MAT("1", CUT_TEX_T("\"offset\":[1,0]") ",\"alphaMode\":\"MASK\""), 0.5, 0, NULL},
+	    {CUT_MAT("1", CUT_TEX_T("\"offset\":[1,0]") ",\"alphaMode\":\"MASK\""), 0.5, 0, "{\"wrapS\":10497}"},
+	    {CUT_MAT("1", CUT_TEX_T("\"offset\":[1,0]") ",\"alphaMode\":\"MASK\""), 0.5, lit, "{\"wrapS\":33071}"},
+	    {CUT_MAT("1", CUT_TEX_T("\"offset\":[1,0]") ",\"alphaMode\":\"MASK\""), 0.5, lit, "{\"wrapS\":33648}"},
 	};
 	for (size_t k = 0; k < sizeof c / sizeof c[0]; k++) {
 		scene *s;
+		cut_sampler = c[k].sampler;
 		world *w = cut_world(c[k].mat, true, c[k].tx, 1, &s);
+		cut_sampler = NULL;
 		hit h;
 		ray r = {v3(0, 5, 0), v3(0, -1, 0)};
 		assert_true(world_intersect(w, &r, 0, INFINITY, &h));
@@ -1279,6 +1299,23 @@ static void test_cutout_factor(void **state)
 		}
 		mesh_free(m);
 	}
+	/* bad values, by their JSON path */
+	static const char *const bad[][3] = {
+	    {"{\"alphaMode\":\"MASK\",\"alphaCutoff\":-1}", "materials[0]: alphaCutoff: not a number from 0", ""},
+	    {"{\"alphaMode\":\"CUTOUT\"}", "materials[0]: alphaMode: not \"OPAQUE\", \"MASK\" or \"BLEND\"", "expected"},
+	    {"{\"alphaMode\":\"MASK\",\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}}}",
+	     "samplers[0]: wrapS: 5; expected 33071 (clamp), 33648 (mirrored repeat) or 10497 (repeat)", ""},
+	};
+	for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+		char rest[1024];
+		snprintf(rest, sizeof rest,
+		         "\"nodes\":[{\"mesh\":0}],\"materials\":[%s],\"textures\":[{\"source\":0,\"sampler\":0}],"
+		         "\"samplers\":[{\"wrapS\":5}],\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],",
+		         bad[k][0], png64);
+		char *text = tri_gltf(unit_tri, rest);
+		expect_fail(text, bad[k][1], bad[k][2]);
+		free(text);
+	}
 }
 
 /* An emissive cut-out is not sampled as a lamp (its holes would light
@@ -1378,6 +1415,84 @@ static void test_blend(void **state)
 	}
 }
 
+/* The alpha of an image file beside the model (not inside it): read by the
+ * reader from the file, as the colour is by the world; a missing file is
+ * an error naming it. */
+static void test_cutout_image_file(void **state)
+{
+	(void)state;
+	static const unsigned char t[8] = {255, 255, 255, 255, 255, 255, 255, 0};
+	unsigned char png[128];
+	size_t n = png_rgba(2, 1, t, png);
+	char path[256];
+	snprintf(path, sizeof path, "%s/half.png", tmpdir);
+	FILE *f = fopen(path, "wb");
+	assert_non_null(f);
+	assert_int_equal(fwrite(png, 1, n, f), n);
+	assert_int_equal(fclose(f), 0);
+	for (int k = 0; k < 2; k++) {
+		char rest[512];
+		snprintf(rest, sizeof rest,
+		         "\"nodes\":[{\"mesh\":0}],\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":"
+		         "{\"index\":0}},\"alphaMode\":\"MASK\"}],\"textures\":[{\"source\":0}],"
+		         "\"images\":[{\"uri\":\"%s\"}],",
+		         k ? "nothere.png" : "half.png");
+		char *text = tri_gltf(unit_tri, rest);
+		const char *model = tmp_text("file.gltf", text);
+		free(text);
+		rt_error err = {0};
+		mesh *m = mesh_read_gltf(model, &err);
+		if (k) {
+			assert_null(m);
+			assert_non_null(strstr(err.msg, "nothere.png"));
+			continue;
+		}
+		if (!m)
+			fail_msg("%s", err.msg);
+		assert_true(m->cuts);
+		assert_non_null(m->mats[0].alpha_map);
+		assert_int_equal(m->mats[0].alpha_w, 2);
+		assert_int_equal(m->mats[0].alpha_map[0], 255);
+		assert_int_equal(m->mats[0].alpha_map[1], 0);
+		mesh_free(m);
+	}
+}
+
+/* Reflection rays: the plane a perfect mirror (no diffuse part), the quad
+ * 10 above it, above the camera, glowing (emissiveFactor 0.5, black
+ * metal). The camera's centre ray meets the mirror at the origin and goes
+ * back up the y axis: through the opaque texel it meets the quad and
+ * brings back its emission, 0.5 (Whitted: the mirror's weight 1 times
+ * what the reflection sees); through the clear texel it leaves into the
+ * black: 0. Single ray and packets. */
+static void test_cutout_reflection(void **state)
+{
+	(void)state;
+	const char *mat = "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1],\"baseColorTexture\":{\"index\":0}},"
+	                  "\"emissiveFactor\":[0.5,0.5,0.5],\"alphaMode\":\"MASK\"}";
+	for (int k = 0; k < 2; k++) {
+		scene *s;
+		cut_mirror = true;
+		world *w = cut_world(mat, true, k ? -0.5 : 0.5, 10, &s);
+		cut_mirror = false;
+		double want = k ? 0 : 0.5;
+		render_settings set = render_settings_default();
+		set.width = set.height = 1001;
+		set.samples = 1;
+		set.depth = 4;
+		set.threads = 1;
+		set.mode = MODE_WHITTED;
+		vec3 c = whitted_radiance(w, &set, render_sample_ray(w, &set, 500, 500, 1001, 1001, 0));
+		assert_vec_near(c, v3_splat(want), 1e-5);
+		float px[16 * 3];
+		render_rect(w, &set, 498, 498, 502, 502, px);
+		for (int i = 0; i < 16 * 3; i++)
+			assert_near(px[i], want, 1e-5);
+		world_free(w);
+		scene_free(s);
+	}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -1403,6 +1518,8 @@ int main(void)
 	    cmocka_unit_test(test_cutout_factor),
 	    cmocka_unit_test(test_cutout_lamp),
 	    cmocka_unit_test(test_blend),
+	    cmocka_unit_test(test_cutout_image_file),
+	    cmocka_unit_test(test_cutout_reflection),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -26,6 +26,12 @@
  * best the processor has (mesh_isa_active), through a table of entries.
  * The triangle test's set-up is made at the walk's first leaf: most rays
  * that miss a model never reach one.
+ *
+ * glTF cut-outs (alphaMode MASK and BLEND, mesh.cuts): where a block finds
+ * hits, the lanes in a hole (mesh_cut_hole) are dropped before the nearest
+ * is taken, so no ray of any kind stops there; a mesh without them pays one
+ * test of the flag where a block finds a hit (callgrind on the bunny: no
+ * instruction more).
  */
 #include <float.h>
 #include <stdatomic.h>
