@@ -1008,9 +1008,11 @@ static void bench_symbols(void)
 	const int cols = 160, crows = 45;
 	const int W = cols * SQ_W, H = crows * SQ_H;
 	uint8_t *ref = malloc((size_t)W * H * 3), *shown = malloc((size_t)W * H * 3),
-	        *half = malloc((size_t)cols * crows * 2 * 3);
+	        *half = malloc((size_t)cols * crows * 2 * 3), *adapt = malloc((size_t)W * H * 3),
+	        *ref4 = malloc((size_t)W * H * 3);
+	int64_t *ids = malloc(sizeof *ids * (size_t)W * H);
 	framebuffer *fb = fb_new(W, H);
-	if (!ref || !shown || !half || !fb)
+	if (!ref || !shown || !half || !adapt || !ref4 || !ids || !fb)
 		fail("memory", NULL);
 	char ppm[64];
 	snprintf(ppm, sizeof ppm, "/tmp/rtsh-bench-sym-%ld.ppm", (long)getpid());
@@ -1025,6 +1027,22 @@ static void bench_symbols(void)
 		set.samples = scenes[si].spp;
 		render_once(wd, &set, fb);
 		frame_srgb_from_linear(fb->rgb, (size_t)W * H, set.exposure, ref);
+		/* what each sample's first ray hits (object and material; -1: none),
+		 * for the adaptive rows below */
+		for (int y = 0; y < H; y++)
+			for (int x = 0; x < W; x++) {
+				ray r = render_sample_ray(wd, &set, x, y, W, H, 0);
+				hit h;
+				ids[(size_t)y * W + x] = world_intersect(wd, &r, 1e-9, INFINITY, &h)
+				                             ? (int64_t)h.object << 32 | h.mat
+				                             : -1;
+			}
+		/* a render of 4x the samples, to tell the adaptive rows' error from
+		 * the reference's own noise */
+		set.samples = 4 * scenes[si].spp;
+		render_once(wd, &set, fb);
+		frame_srgb_from_linear(fb->rgb, (size_t)W * H, set.exposure, ref4);
+		set.samples = scenes[si].spp;
 		world_free(wd);
 		scene_free(s);
 		/* the half blocks' input: each half block's 2x2 samples */
@@ -1036,8 +1054,8 @@ static void bench_symbols(void)
 						v += ref[((size_t)(2 * y + k / 2) * W + 2 * x + k % 2) * 3 + c];
 					half[((size_t)y * cols + x) * 3 + c] = (uint8_t)((v + 2) / 4);
 				}
-		size_t half_bytes = 0;
-		double half_psnr = 0;
+		size_t half_bytes = 0, full_bytes[SYMBOLS_AUTO] = {0};
+		double half_psnr = 0, full_psnr[SYMBOLS_AUTO] = {0};
 		for (int k = SYMBOLS_HALF; k <= SYMBOLS_OCTANT; k++) {
 			double t[MAX_RUNS];
 			size_t bytes = 0;
@@ -1063,12 +1081,93 @@ static void bench_symbols(void)
 				half_bytes = bytes;
 				half_psnr = psnr;
 			}
+			full_psnr[k] = psnr;
+			full_bytes[k] = bytes;
 			char mode[24];
 			snprintf(mode, sizeof mode, "sym-%s", symbols_name((symbols_kind)k));
 			row *r = add_row(scenes[si].name, mode, cols, crows, set.samples, 1, nr, median(t, nr), -1);
 			snprintf(r->note, sizeof r->note,
 			         "PSNR %.2f dB (%+.2f vs half), SSIM %.4f, %zu bytes (%.2fx half); put+update time",
 			         psnr, psnr - half_psnr, ssim, bytes, (double)bytes / (double)half_bytes);
+		}
+		/* Adaptive tracing, simulated on the same render: a first pass
+		 * traces each cell's four corner samples and its inner sample
+		 * (1,1); a cell whose five samples hit the same object and
+		 * material and lie within ADAPT_TOL sRGB levels of each other in
+		 * every channel is flat, and its three other inner samples are not
+		 * traced: each takes the line between its column's two corners. The note gives the rays saved, the PSNR
+		 * and bytes against the full trace (the rows above), and the PSNR
+		 * of both against a render of 4x the samples (the reference's own
+		 * noise set apart). Not in the render loop: see bench/README.md. */
+		for (int k = SYMBOLS_SEXTANT; k <= SYMBOLS_OCTANT; k++) {
+			enum { ADAPT_TOL = 2 };
+			memcpy(adapt, ref, (size_t)W * H * 3);
+			long flat = 0;
+			for (int cy = 0; cy < crows; cy++)
+				for (int cx = 0; cx < cols; cx++) {
+					/* the first pass: the corners, then one inner sample */
+					static const int first[5][2] = {{0, 0}, {1, 0}, {0, 3}, {1, 3}, {1, 1}};
+					size_t at[5];
+					bool same = true;
+					int lo[3] = {255, 255, 255}, hi[3] = {0, 0, 0};
+					for (int i = 0; i < 5; i++) {
+						at[i] = (size_t)(cy * SQ_H + first[i][1]) * W + (size_t)(cx * SQ_W + first[i][0]);
+						same &= ids[at[i]] == ids[at[0]];
+						for (int c = 0; c < 3; c++) {
+							int v = ref[at[i] * 3 + c];
+							lo[c] = v < lo[c] ? v : lo[c];
+							hi[c] = v > hi[c] ? v : hi[c];
+						}
+					}
+					for (int c = 0; c < 3; c++)
+						same &= hi[c] - lo[c] <= ADAPT_TOL;
+					if (!same)
+						continue;
+					flat++;
+					/* each column's inner samples: the line between its
+					 * corners (rows 1 and 2 at a third and two thirds) */
+					for (int y = 1; y < 3; y++)
+						for (int x = 0; x < 2 && !(x == 1 && y == 1); x++)
+							for (int c = 0; c < 3; c++) {
+								int top = ref[at[x] * 3 + c], bot = ref[at[2 + x] * 3 + c];
+								adapt[((size_t)(cy * SQ_H + y) * W + (size_t)(cx * SQ_W + x)) * 3 + c] =
+								    (uint8_t)(((3 - y) * top + y * bot + 1) / 3);
+							}
+				}
+			/* both pictures against the render of 4x the samples */
+			double hi_psnr[2];
+			for (int a = 0; a < 2; a++) {
+				frame *f = frame_new_symbols(cols, crows, PALETTE_TRUECOLOR, (symbols_kind)k);
+				if (!f)
+					fail("memory", NULL);
+				frame_put_image(f, a ? adapt : ref, W, H, 0, 0);
+				const abuf *out = frame_update(f);
+				if (sq_decode(out->b, out->len, cols, crows, shown) != 0)
+					fail("symbols: the decoder met a glyph it does not know", NULL);
+				hi_psnr[a] = sq_psnr(ref4, shown, (size_t)W * H);
+				frame_free(f);
+			}
+			frame *f = frame_new_symbols(cols, crows, PALETTE_TRUECOLOR, (symbols_kind)k);
+			if (!f)
+				fail("memory", NULL);
+			double t0 = now();
+			frame_put_image(f, adapt, W, H, 0, 0);
+			const abuf *out = frame_update(f);
+			double t = now() - t0;
+			size_t bytes = out->len;
+			if (sq_decode(out->b, out->len, cols, crows, shown) != 0)
+				fail("symbols: the decoder met a glyph it does not know", NULL);
+			frame_free(f);
+			double psnr = sq_psnr(ref, shown, (size_t)W * H), ssim = sq_ssim(ref, shown, W, H);
+			long cells = (long)cols * crows;
+			char mode[24];
+			snprintf(mode, sizeof mode, "sym-%s-adapt", symbols_name((symbols_kind)k));
+			row *r = add_row(scenes[si].name, mode, cols, crows, set.samples, 1, 1, t, -1);
+			snprintf(r->note, sizeof r->note,
+			         "%.1f%% rays saved; PSNR %.2f dB (%+.2f vs all rays), SSIM %.4f, %zu bytes (%.3fx); vs 4x spp "
+			         "%.2f dB (%+.2f)",
+			         100.0 * (double)flat * 3 / ((double)cells * 8), psnr, psnr - full_psnr[k], ssim, bytes,
+			         (double)bytes / (double)full_bytes[k], hi_psnr[1], hi_psnr[1] - hi_psnr[0]);
 		}
 		/* chafa on the same render */
 		FILE *f = fopen(ppm, "wb");
@@ -1101,6 +1200,9 @@ static void bench_symbols(void)
 	}
 	unlink(ppm);
 	fb_free(fb);
+	free(adapt);
+	free(ref4);
+	free(ids);
 	free(half);
 	free(shown);
 	free(ref);
@@ -1191,11 +1293,12 @@ static void bench_keymode_at(int cols, int cell_rows, int sym)
 }
 
 /* The row of issue 6 (160x48 cells, half blocks), and issue 29's at 200x60
- * cells with half blocks and with octants (2x4 samples a cell). */
+ * cells with half blocks, the sextant set and octants (2x4 samples a cell). */
 static void bench_keymode(void)
 {
 	bench_keymode_at(160, 48, -1);
 	bench_keymode_at(200, 60, SYMBOLS_HALF);
+	bench_keymode_at(200, 60, SYMBOLS_SEXTANT);
 	bench_keymode_at(200, 60, SYMBOLS_OCTANT);
 }
 

@@ -54,6 +54,50 @@ static void print_warning(void *ctx, const rt_error *w)
 	fprintf(stderr, "%s (warning)\n", buf);
 }
 
+/* What image_write_rendered's make needs: the render of batch mode. */
+typedef struct batch_make {
+	const world *w;
+	const render_settings *set;
+	bool eight;       /* an 8-bit format: the codes made as tiles finish */
+	bool bar;
+	batch_progress *ps;
+	render_rows_fn rows; /* the file's, which batch_rows calls */
+	void *rows_ctx;
+	bool write_stopped; /* the file's write stopped the render */
+	bool failed;      /* the render failed by itself: err is its */
+	rt_error err;
+} batch_make;
+
+static bool batch_rows(void *ctx, const framebuffer *fb, int y0, int y1)
+{
+	batch_make *b = ctx;
+	if (b->rows(b->rows_ctx, fb, y0, y1))
+		return true;
+	b->write_stopped = true;
+	return false;
+}
+
+static framebuffer *batch_make_fn(void *ctx, render_rows_fn rows, void *rows_ctx, rt_error *err)
+{
+	batch_make *b = ctx;
+	clock_gettime(CLOCK_MONOTONIC, &b->ps->start);
+	render_progress_fn progress = b->bar ? show_progress : NULL;
+	b->rows = rows;
+	b->rows_ctx = rows_ctx;
+	framebuffer *fb = rows ? render_image_rows(b->w, b->set, NULL, progress, b->ps, batch_rows, b, &b->err)
+	                  : b->eight ? render_image_srgb8(b->w, b->set, NULL, progress, b->ps, &b->err)
+	                             : render_image(b->w, b->set, NULL, progress, b->ps, &b->err);
+	if (b->ps->shown) {
+		fputc('\n', stderr);
+		b->ps->shown = false;
+	}
+	if (!fb) {
+		b->failed = !b->write_stopped;
+		*err = b->err;
+	}
+	return fb;
+}
+
 static int batch_render(const rtsh_options *o)
 {
 	rt_error err;
@@ -91,21 +135,17 @@ static int batch_render(const rtsh_options *o)
 	}
 	batch_progress ps = {.w = set.width, .h = set.height, .samples = set.samples, .shown = false};
 	clock_gettime(CLOCK_MONOTONIC, &ps.start);
-	bool bar = !o->quiet && isatty(STDERR_FILENO);
-	/* the 8-bit codes are made by the render's threads as tiles finish */
-	bool eight = !image_type_of(o->output)->linear;
-	framebuffer *fb = (eight ? render_image_srgb8 : render_image)(w, &set, NULL, bar ? show_progress : NULL,
-	                                                               &ps, &err);
+	/* The file is written as the render's rows finish (PPM, PNG), then
+	 * synced and renamed over the old one (image.h). */
+	batch_make bm = {.w = w, .set = &set, .eight = !image_type_of(o->output)->linear,
+	                 .bar = !o->quiet && isatty(STDERR_FILENO), .ps = &ps};
+	bool ok = image_write_rendered(o->output, set.width, set.height, set.exposure, batch_make_fn, &bm, &err);
 	world_free(w);
-	if (ps.shown)
-		fputc('\n', stderr);
-	if (!fb) {
-		rt_error_format(&err, msg, sizeof msg);
+	if (!ok && bm.failed) {
+		rt_error_format(&bm.err, msg, sizeof msg);
 		fprintf(stderr, "%s: %s\n", o->scene, msg);
 		return 1;
 	}
-	bool ok = image_write(o->output, fb, set.exposure, &err);
-	fb_free(fb);
 	if (!ok) {
 		rt_error_format(&err, msg, sizeof msg);
 		fprintf(stderr, "%s\n", msg);

@@ -27,6 +27,9 @@ typedef struct image_type {
 	framebuffer *(*read)(const char *path, rt_error *err); /* NULL: not read */
 	const char *help;   /* one line */
 	bool linear;        /* keeps linear radiance (PFM); else 8-bit sRGB codes */
+	/* image_write_rendered's encoder, that writes the rows as the render
+	 * finishes them; NULL: the format needs the whole picture first */
+	bool (*write_rendered)(FILE *f, void *ctx, rt_error *err);
 } image_type;
 
 /* The i-th format, NULL past the last; the format of path by its
@@ -46,6 +49,23 @@ framebuffer *image_read(const char *path, rt_error *err);
 /* Writes the framebuffer. `exposure` (stops: radiance x 2^exposure) applies
  * to the 8-bit formats; a PFM keeps the linear radiance as rendered. */
 bool image_write(const char *path, const framebuffer *fb, double exposure, rt_error *err);
+
+/* Makes the picture while its file is written (batch mode): the file is
+ * created first; make(make_ctx, rows, rows_ctx, err) renders the w x h
+ * picture with render_image_rows(..., rows, rows_ctx, ...) and returns its
+ * framebuffer, or NULL with err set; a PPM or PNG then takes each band of
+ * rows as the render finishes it (the main thread writes and starts the
+ * disk's write-back while the workers render), so that only the last band,
+ * the sync and the rename are left after the render. A format that needs
+ * the whole picture (image_type.write_rendered NULL: PFM, JPEG) gets make
+ * called with rows NULL (make renders as render_image or
+ * render_image_srgb8 do) and is written after it, as image_write does. The
+ * file is replaced atomically either way: a render that fails or is
+ * interrupted leaves the old file as it was. `exposure` as image_write's;
+ * the framebuffer is freed here. */
+typedef framebuffer *(*image_make_fn)(void *make_ctx, render_rows_fn rows, void *rows_ctx, rt_error *err);
+bool image_write_rendered(const char *path, int w, int h, double exposure, image_make_fn make, void *make_ctx,
+                          rt_error *err);
 
 /* Readers for tests and tools: a new framebuffer with linear values (PPM
  * codes are sRGB-decoded), through the textures' one netpbm/PFM reader

@@ -44,6 +44,13 @@ typedef struct mesh_mat {
 	float alpha;      /* baseColorFactor's alpha */
 	uint8_t alpha_mode; /* MESH_ALPHA_* */
 	float alpha_cutoff; /* MASK: texels of alpha below it are holes (0.5) */
+	/* MASK with a base colour texture that has an alpha channel: that
+	 * channel (bytes, linear, top row first; only these materials keep it),
+	 * its size and its sampler's wrapS, wrapT (MESH_WRAP_*); NULL: alpha is
+	 * the factor's alone */
+	unsigned char *alpha_map;
+	int alpha_w, alpha_h;
+	uint8_t alpha_wrap[2];
 	float normal_scale; /* normalTexture.scale (1) */
 	float transmission; /* KHR_materials_transmission (0) */
 	float ior;          /* KHR_materials_ior (1.5) */
@@ -61,6 +68,7 @@ typedef struct mesh_mat {
 } mesh_mat;
 
 enum { MESH_ALPHA_OPAQUE, MESH_ALPHA_MASK, MESH_ALPHA_BLEND };
+enum { MESH_WRAP_REPEAT, MESH_WRAP_CLAMP, MESH_WRAP_MIRROR };
 
 /* Four triangles of a leaf laid out for the leaf test (mesh_trace.c):
  * v[3 * corner + axis][lane] is a vertex coordinate, the same float as the
@@ -119,6 +127,10 @@ typedef struct mesh {
 	float eps;         /* self-hit guard in object units */
 	size_t refs;       /* users in the cache (mesh_cache_get) */
 	char *warning;     /* the reader's first warning ("FILE:LINE: ..."), NULL: none (owned) */
+	/* Some material is an alphaMode MASK cut-out or BLEND (glTF): the walk
+	 * asks mesh_cut_hole of each triangle hit it would accept. False: the
+	 * walk never asks (one test where a block finds a hit, nothing else). */
+	bool cuts;
 } mesh;
 
 /* --- loading --- */
@@ -239,7 +251,9 @@ typedef struct mesh_ray {
 
 void mesh_ray_make(mesh_ray *r, vec3 o, vec3 d);
 /* The nearest triangle with tmin < t < *tmax: sets *tmax, *tri (its slot)
- * and the barycentric weights b[3] of its corners. */
+ * and the barycentric weights b[3] of its corners. A hit in a cut-out's
+ * hole (mesh.cuts, mesh_cut_hole) is no hit, here and in every query
+ * below but mesh_intersect_brute. */
 bool mesh_intersect(const mesh *m, const mesh_ray *r, float tmin, float *tmax, uint32_t *tri, float b[3]);
 bool mesh_occluded(const mesh *m, const mesh_ray *r, float tmin, float tmax);
 /* The same for a world-space ray r on an instance of m, `inv` taking world
@@ -299,5 +313,25 @@ typedef struct mesh_surf {
 	vec3 shift;
 } mesh_surf;
 void mesh_surface(const mesh *m, uint32_t slot, const float b[3], mesh_surf *s);
+
+/* glTF alpha coverage: true when the hit on the triangle in `slot` at
+ * barycentrics b falls in a hole of its material. alpha = baseColorFactor's
+ * alpha x the base colour texture's alpha at the hit's uv
+ * (KHR_texture_transform, the sampler's wrap, bilinear on the finest
+ * level). alphaMode MASK: a hole where alpha < alphaCutoff. BLEND: with
+ * mesh_alpha_hashed on, where alpha < a number in [0, 1) hashed from the
+ * hit (so a ray passes with probability 1 - alpha: stochastic
+ * transparency, right on average over a pixel's samples), else as MASK at
+ * 0.5. OPAQUE: never. The walk (mesh_trace.c) skips such hits, for every
+ * kind of ray. */
+bool mesh_cut_hole(const mesh *m, uint32_t slot, const float b[3]);
+/* BLEND's hashed alpha on or off in the calling thread (off at first): the
+ * renderer turns it on for the integrators that sample (path mode). */
+void mesh_alpha_hashed(bool on);
+/* The same for the lanes in `lanes` (a bit each) of block `blk` hit with
+ * edge functions u, v, w and 1 / det inv (the walk's floats; b = u inv, v
+ * inv, w inv): `lanes` less those in holes. */
+unsigned mesh_cut_lanes(const mesh *m, uint32_t blk, unsigned lanes, const float u[4], const float v[4],
+                        const float w[4], const float inv[4]);
 
 #endif

@@ -114,6 +114,14 @@ typedef enum render_status {
  * the end, with the tiles done so far. */
 typedef void (*render_progress_fn)(void *ctx, long done, long total);
 
+/* Called with the rows y0 <= y < y1 of the image once every tile of them is
+ * finished, their fb->srgb8 codes final: in order from the top, every row
+ * once, always on the thread that runs render_run, while the other tiles
+ * still render (a file is written as the picture is made: image.h's
+ * image_write_rendered). False stops the render (RENDER_FAILED); the
+ * callback keeps its own error. */
+typedef bool (*render_rows_fn)(void *ctx, const framebuffer *fb, int y0, int y1);
+
 typedef struct render_job {
 	const world *w;
 	render_settings set;   /* mode, depth, seed, threads, samples (= total target) */
@@ -123,6 +131,8 @@ typedef struct render_job {
 	atomic_bool *cancel;   /* optional: set to stop; checked per tile */
 	render_progress_fn progress; /* optional */
 	void *progress_ctx;
+	render_rows_fn rows;   /* optional: needs fb->srgb8 */
+	void *rows_ctx;
 } render_job;
 
 /* Runs the job to the end or until cancelled. On RENDER_DONE the fb holds
@@ -141,6 +151,15 @@ framebuffer *render_image(const world *w, const render_settings *s, atomic_bool 
  * an 8-bit file written next (batch mode). */
 framebuffer *render_image_srgb8(const world *w, const render_settings *s, atomic_bool *cancel,
                                 render_progress_fn progress, void *ctx, rt_error *err);
+/* The codes alone, handed to rows (render_rows_fn) as bands of tiles finish:
+ * the framebuffer returned holds fb->srgb8 (the same codes as
+ * render_image_srgb8's) and no float image (rgb NULL: the tiles keep their
+ * floats to themselves), unless the image is denoised after its render: then
+ * rgb too, and every row is handed over at the end. NULL on failure (err set;
+ * when rows returned false, err says the write stopped the render). */
+framebuffer *render_image_rows(const world *w, const render_settings *s, atomic_bool *cancel,
+                               render_progress_fn progress, void *ctx, render_rows_fn rows, void *rows_ctx,
+                               rt_error *err);
 
 /* Renders the pixels x0 <= x < x1, y0 <= y < y1 of the s->width x s->height
  * image, all s->samples samples, on the calling thread, into out: (x1-x0) x

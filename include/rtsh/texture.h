@@ -45,6 +45,13 @@ float *image_load_rgb(const char *path, bool srgb, int *w, int *h, rt_error *err
 /* The same from memory; the format from `path`'s extension (fuzzing). */
 float *image_decode_rgb(const char *path, const unsigned char *buf, size_t len, bool srgb, int *w, int *h,
                         rt_error *err);
+/* The alpha channel of an image in memory (glTF MASK cut-outs): *alpha
+ * w x h bytes, top row first, codes / 255 the linear alpha (never
+ * sRGB-decoded). PNG, TGA and BMP with an alpha channel (grey+alpha or
+ * RGBA); *alpha NULL for an image without one (opaque). False (err set)
+ * when the image cannot be decoded. */
+bool image_decode_alpha(const char *path, const unsigned char *buf, size_t len, unsigned char **alpha, int *w, int *h,
+                        rt_error *err);
 /* The one netpbm and PFM reader, for a file on disk whatever its name:
  * pfm false, PPM/PGM (P2 P3 P5 P6, 8 or 16 bits, sRGB-decoded); pfm true,
  * PFM (PF colour, Pf grey, linear; non-finite values read as 0). image.c's

@@ -39,6 +39,12 @@ static size_t mesh_walk(world *w, const scene *s, bool put)
 			uint32_t wm = in->mat_base == UINT32_MAX ? (uint32_t)i : in->mat_base + mi;
 			if (wm >= w->nmats || !(max3(w->mats[wm].emission) > 0.0) || (w->mats[wm].tx && w->mats[wm].tx->emit))
 				continue; /* an emissive texture: found by the paths */
+			/* a glTF cut-out (alphaMode MASK or BLEND): an emitter with holes is
+			 * found by the paths too, which pass through its holes
+			 * (mesh_cut_hole); a point sampled on the whole triangle could
+			 * light through one */
+			if (in->mat_base != UINT32_MAX && mi < m->nmats && m->mats[mi].alpha_mode != MESH_ALPHA_OPAQUE)
+				continue;
 			size_t first = w->nemitters, run = 0;
 			uint32_t last = UINT32_MAX;
 			/* each triangle once: a leaf's last block repeats its last */

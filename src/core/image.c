@@ -1,4 +1,5 @@
 /* rtsh — image files (image.h); atomic.c writes them. */
+#define _GNU_SOURCE /* sync_file_range */
 #include "rtsh/image.h"
 
 #include <errno.h>
@@ -167,14 +168,162 @@ static bool write_jpeg(FILE *f, void *vctx, rt_error *err)
 	return !ferror(f) || rt_error_at(err, c->path, 0, 0, "write failed");
 }
 
+/* --- writing the rows as the render finishes them (image_write_rendered) --- */
+
+typedef struct stream {
+	const char *path;
+	int w, h;
+	image_make_fn make;
+	void *make_ctx;
+	FILE *f;
+	int fd;           /* the file's descriptor; -1: in memory (written in place later) */
+	off_t synced;     /* write-back started up to here */
+	png_structp png;
+	char why[160];    /* libpng's words */
+	int write_errno;  /* why a write of rows failed; 0: none did */
+} stream;
+
+/* Starts the disk's write-back of what was written since the last call,
+ * every megabyte, so that the sync after the render has little left to
+ * wait for (sync_file_range does not wait; on a FIFO or device, or a file
+ * system without it, it does nothing). */
+static void stream_writeback(stream *st)
+{
+	if (st->fd < 0)
+		return;
+	off_t end = ftello(st->f);
+	if (end < 0 || end - st->synced < ((off_t)1 << 20))
+		return;
+	if (fflush(st->f) == 0) {
+		(void)sync_file_range(st->fd, st->synced, end - st->synced, SYNC_FILE_RANGE_WRITE);
+		st->synced = end;
+	}
+}
+
+static bool ppm_rows(void *vctx, const framebuffer *fb, int y0, int y1)
+{
+	stream *st = vctx;
+	size_t n = (size_t)(y1 - y0) * (size_t)fb->w * 3;
+	if (fwrite(fb->srgb8 + (size_t)y0 * (size_t)fb->w * 3, 1, n, st->f) != n) {
+		st->write_errno = errno ? errno : EIO;
+		return false;
+	}
+	stream_writeback(st);
+	return true;
+}
+
+/* Runs the render; false (err set) when it failed or a write stopped it. */
+static bool stream_make(stream *st, render_rows_fn rows, rt_error *err)
+{
+	framebuffer *fb = st->make(st->make_ctx, rows, st, err);
+	if (!fb) {
+		if (st->write_errno) /* the render stopped for it */
+			rt_error_at(err, st->path, 0, 0, "write failed (%s)", strerror(st->write_errno));
+		else if (st->why[0])
+			rt_error_at(err, st->path, 0, 0, "PNG encoding failed: %s", st->why);
+		return false;
+	}
+	fb_free(fb);
+	return true;
+}
+
+static bool write_ppm_rendered(FILE *f, void *vctx, rt_error *err)
+{
+	stream *st = vctx;
+	st->f = f;
+	st->fd = fileno(f);
+	st->synced = 0;
+	if (fprintf(f, "P6\n%d %d\n255\n", st->w, st->h) < 0)
+		return rt_error_at(err, st->path, 0, 0, "write failed");
+	return stream_make(st, ppm_rows, err);
+}
+
+/* libpng's errors come back here, not through write_png_rendered's frame: a
+ * longjmp across the render would leave its threads running. */
+static bool png_rows(void *vctx, const framebuffer *fb, int y0, int y1)
+{
+	stream *st = vctx;
+	if (setjmp(png_jmpbuf(st->png))) {
+		st->write_errno = ferror(st->f) ? (errno ? errno : EIO) : 0;
+		if (!st->write_errno && !st->why[0])
+			snprintf(st->why, sizeof st->why, "libpng stopped");
+		return false;
+	}
+	for (int y = y0; y < y1; y++)
+		png_write_row(st->png, fb->srgb8 + (size_t)y * (size_t)fb->w * 3);
+	if (ferror(st->f)) {
+		st->write_errno = errno ? errno : EIO;
+		return false;
+	}
+	stream_writeback(st);
+	return true;
+}
+
+static bool write_png_rendered(FILE *f, void *vctx, rt_error *err)
+{
+	stream *st = vctx;
+	st->f = f;
+	st->fd = fileno(f);
+	st->synced = 0;
+	st->why[0] = '\0';
+	png_infop info = NULL;
+	st->png = png_create_write_struct(PNG_LIBPNG_VER_STRING, st->why, png_error_kept, png_warning_dropped);
+	if (st->png)
+		info = png_create_info_struct(st->png);
+	volatile bool started = false, ended = false;
+	if (st->png && info && !setjmp(png_jmpbuf(st->png))) {
+		png_init_io(st->png, f);
+		png_set_IHDR(st->png, info, (png_uint_32)st->w, (png_uint_32)st->h, 8, PNG_COLOR_TYPE_RGB,
+		             PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+		png_set_sRGB_gAMA_and_cHRM(st->png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+		png_write_info(st->png, info);
+		started = true;
+	}
+	if (started && !stream_make(st, png_rows, err)) {
+		png_destroy_write_struct(&st->png, &info);
+		return false; /* err says why */
+	}
+	if (started && !setjmp(png_jmpbuf(st->png))) {
+		png_write_end(st->png, NULL);
+		ended = true;
+	}
+	png_destroy_write_struct(&st->png, &info);
+	if (ended)
+		return true;
+	if (ferror(f))
+		return rt_error_at(err, st->path, 0, 0, "write failed");
+	return rt_error_at(err, st->path, 0, 0, "PNG encoding failed%s%s", st->why[0] ? ": " : "", st->why);
+}
+
+bool image_write_rendered(const char *path, int w, int h, double exposure, image_make_fn make, void *make_ctx,
+                          rt_error *err)
+{
+	const image_type *t = image_type_of(path);
+	if (!t) {
+		char exts[128];
+		image_extensions(exts, sizeof exts, false);
+		return rt_error_at(err, path, 0, 0, "unknown image type; expected %s", exts);
+	}
+	if (!t->write_rendered) {
+		framebuffer *fb = make(make_ctx, NULL, NULL, err);
+		if (!fb)
+			return false;
+		bool ok = image_write(path, fb, exposure, err);
+		fb_free(fb);
+		return ok;
+	}
+	stream st = {.path = path, .w = w, .h = h, .make = make, .make_ctx = make_ctx, .fd = -1};
+	return file_write_atomic(path, t->write_rendered, &st, err);
+}
+
 /* The formats, by extension: a new one is a line here (and its encoder
  * above, its decoder below). */
 static const image_type types[] = {
-	{".ppm", "PPM", write_ppm, image_read_ppm, "8-bit sRGB, binary netpbm (P6)", false},
-	{".pfm", "PFM", write_pfm, image_read_pfm, "linear 32-bit float, as rendered", true},
-	{".png", "PNG", write_png, NULL, "8-bit sRGB, libpng", false},
-	{".jpg", "JPEG", write_jpeg, NULL, "8-bit sRGB, baseline, quality 92 (stb_image_write)", false},
-	{".jpeg", "JPEG", write_jpeg, NULL, "8-bit sRGB, as .jpg", false},
+	{".ppm", "PPM", write_ppm, image_read_ppm, "8-bit sRGB, binary netpbm (P6)", false, write_ppm_rendered},
+	{".pfm", "PFM", write_pfm, image_read_pfm, "linear 32-bit float, as rendered", true, NULL},
+	{".png", "PNG", write_png, NULL, "8-bit sRGB, libpng", false, write_png_rendered},
+	{".jpg", "JPEG", write_jpeg, NULL, "8-bit sRGB, baseline, quality 92 (stb_image_write)", false, NULL},
+	{".jpeg", "JPEG", write_jpeg, NULL, "8-bit sRGB, as .jpg", false, NULL},
 };
 #define NTYPES (sizeof types / sizeof types[0])
 

@@ -11,6 +11,7 @@
 #include "integrators.h"
 #include "rtsh/denoise.h"
 #include "rtsh/memory.h"
+#include "rtsh/mesh.h"
 #include "rtsh/packet.h"
 #include "rtsh/srgb.h"
 #include "rtsh/texture.h"
@@ -76,8 +77,10 @@ vec3 render_sample(const world *w, const render_settings *s, int px, int py, int
 {
 	sampler sp;
 	const integrator *in = integrator_of(s->mode);
+	mesh_alpha_hashed(in->sampled); /* glTF BLEND: see-through by alpha when sampled (until the end) */
 	ray r = camera_sample_ray(w, s, in->sampled, px, py, fw, fh, sample, &sp);
 	vec3 c = in->radiance(w, s, r, &sp);
+	mesh_alpha_hashed(false);
 	/* A NaN or infinity from a degenerate case must not poison the pixel. */
 	if (!v3_finite(c))
 		c = v3(0, 0, 0);
@@ -95,7 +98,12 @@ typedef struct shared {
 	_Alignas(64) atomic_long done;
 	_Alignas(64) atomic_int running;
 	pthread_mutex_t lock;
-	pthread_cond_t finished;
+	pthread_cond_t finished; /* also signalled when a band of tiles is finished (job->rows) */
+	/* job->rows: the tiles left in each band (row of tiles), the first
+	 * band not yet handed over, and whether a handover failed */
+	atomic_int *band_left;
+	int bands, band_next;
+	atomic_bool stop;
 } shared;
 
 /* Adds samples [s0, s1) of the pixels of block [x0, x1) x [y0, y1) (at
@@ -115,6 +123,7 @@ static void block_add(const world *w, const render_settings *s, int x0, int y0, 
 	bool any_feat = false;
 	for (int i = 0; i < n; i++)
 		any_feat |= feat[i] != NULL;
+	mesh_alpha_hashed(in->sampled); /* glTF BLEND: see-through by alpha when sampled */
 	if (any_feat) {
 		memset(fa, 0, sizeof fa);
 		memset(ra, 0, sizeof ra);
@@ -154,6 +163,7 @@ static void block_add(const world *w, const render_settings *s, int x0, int y0, 
 		for (int x = x0; x < x1; x++, i++)
 			if (feat[i])
 				denoise_features(w, s, x, y, fw, fh, s0, s1, ra[i], fa[i], feat[i]);
+	mesh_alpha_hashed(false);
 }
 
 /* The blocks of PACKET_MAX pixels, 4 x 4, that render_tile and render_rect
@@ -174,6 +184,8 @@ static void render_tile(shared *sh, long t)
 {
 	render_job *job = sh->job;
 	framebuffer *fb = job->fb;
+	/* no float image (render_image_rows): the tile's floats, for its codes */
+	float own[RENDER_TILE * RENDER_TILE * 3];
 	int x0 = (int)(t % sh->tiles_x) * RENDER_TILE, y0 = (int)(t / sh->tiles_x) * RENDER_TILE;
 	int x1 = x0 + RENDER_TILE < fb->w ? x0 + RENDER_TILE : fb->w;
 	int y1 = y0 + RENDER_TILE < fb->h ? y0 + RENDER_TILE : fb->h;
@@ -207,13 +219,52 @@ static void render_tile(shared *sh, long t)
 						fb->sum[i + 1] = acc[k][1];
 						fb->sum[i + 2] = acc[k][2];
 					}
-					fb->rgb[i] = (float)(acc[k][0] * inv);
-					fb->rgb[i + 1] = (float)(acc[k][1] * inv);
-					fb->rgb[i + 2] = (float)(acc[k][2] * inv);
+					float *o = fb->rgb ? fb->rgb + i : own + ((size_t)(y - y0) * RENDER_TILE + (size_t)(x - x0)) * 3;
+					o[0] = (float)(acc[k][0] * inv);
+					o[1] = (float)(acc[k][1] * inv);
+					o[2] = (float)(acc[k][2] * inv);
 				}
 		}
-	if (fb->srgb8)
+	if (fb->rgb && fb->srgb8)
 		tile_srgb8(fb, x0, y0, x1, y1);
+	else if (fb->srgb8)
+		for (int y = y0; y < y1; y++) /* the same expression on the same floats */
+			linear_to_srgb8_n(own + (size_t)(y - y0) * RENDER_TILE * 3, fb->srgb8_gain,
+			                  fb->srgb8 + ((size_t)y * (size_t)fb->w + (size_t)x0) * 3, (size_t)(x1 - x0) * 3);
+}
+
+/* A tile is finished: the last of its band wakes the thread that hands the
+ * bands to job->rows. */
+static void tile_finished(shared *sh, long t)
+{
+	if (sh->band_left && atomic_fetch_sub(&sh->band_left[t / sh->tiles_x], 1) == 1) {
+		pthread_mutex_lock(&sh->lock);
+		pthread_cond_signal(&sh->finished);
+		pthread_mutex_unlock(&sh->lock);
+	}
+}
+
+/* Hands the finished bands at the top, in one call, to job->rows; false
+ * when it failed (the workers are then told to stop). */
+static bool hand_rows(shared *sh)
+{
+	int b = sh->band_next;
+	while (b < sh->bands && atomic_load(&sh->band_left[b]) == 0)
+		b++;
+	if (b == sh->band_next)
+		return true;
+	const framebuffer *fb = sh->job->fb;
+	int y0 = sh->band_next * RENDER_TILE, y1 = b * RENDER_TILE < fb->h ? b * RENDER_TILE : fb->h;
+	sh->band_next = b;
+	if (sh->job->rows(sh->job->rows_ctx, fb, y0, y1))
+		return true;
+	atomic_store(&sh->stop, true);
+	return false;
+}
+
+static bool band_ready(const shared *sh)
+{
+	return sh->band_left && sh->band_next < sh->bands && atomic_load(&sh->band_left[sh->band_next]) == 0;
 }
 
 void render_rect(const world *w, const render_settings *s, int x0, int y0, int x1, int y1,
@@ -258,13 +309,15 @@ static void *worker(void *arg)
 {
 	shared *sh = arg;
 	for (;;) {
-		if (sh->job->cancel && atomic_load_explicit(sh->job->cancel, memory_order_relaxed))
+		if ((sh->job->cancel && atomic_load_explicit(sh->job->cancel, memory_order_relaxed)) ||
+		    atomic_load_explicit(&sh->stop, memory_order_relaxed))
 			break;
 		long t = atomic_fetch_add(&sh->next, 1);
 		if (t >= sh->tiles)
 			break;
 		render_tile(sh, t);
 		atomic_fetch_add(&sh->done, 1);
+		tile_finished(sh, t);
 	}
 	pthread_mutex_lock(&sh->lock);
 	if (atomic_fetch_sub(&sh->running, 1) == 1)
@@ -278,6 +331,17 @@ static double now_seconds(void)
 	struct timespec ts;
 	clock_gettime(CLOCK_MONOTONIC, &ts);
 	return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+/* The time 100 ms from now, for pthread_cond_timedwait. */
+static void in_100ms(struct timespec *ts)
+{
+	clock_gettime(CLOCK_REALTIME, ts);
+	ts->tv_nsec += 100 * 1000 * 1000;
+	if (ts->tv_nsec >= 1000000000L) {
+		ts->tv_sec++;
+		ts->tv_nsec -= 1000000000L;
+	}
 }
 
 static void report(render_job *job, shared *sh)
@@ -295,10 +359,27 @@ render_status render_run(render_job *job, rt_error *err)
 		             job->sample_begin, job->sample_end, fb->spp);
 		return RENDER_FAILED;
 	}
+	if (job->rows && !fb->srgb8) {
+		rt_error_set(err, "a render job handing over rows needs the framebuffer's 8-bit codes");
+		return RENDER_FAILED;
+	}
 	shared sh;
 	sh.job = job;
 	sh.tiles_x = (fb->w + RENDER_TILE - 1) / RENDER_TILE;
-	sh.tiles = (long)sh.tiles_x * ((fb->h + RENDER_TILE - 1) / RENDER_TILE);
+	sh.bands = (fb->h + RENDER_TILE - 1) / RENDER_TILE;
+	sh.tiles = (long)sh.tiles_x * sh.bands;
+	sh.band_next = 0;
+	sh.band_left = NULL;
+	atomic_init(&sh.stop, false);
+	if (job->rows) {
+		sh.band_left = malloc((size_t)sh.bands * sizeof *sh.band_left);
+		if (!sh.band_left) {
+			rt_error_set(err, "out of memory");
+			return RENDER_FAILED;
+		}
+		for (int b = 0; b < sh.bands; b++)
+			atomic_init(&sh.band_left[b], sh.tiles_x);
+	}
 	atomic_init(&sh.next, 0);
 	atomic_init(&sh.done, 0);
 	int n = render_threads(&job->set);
@@ -319,13 +400,17 @@ render_status render_run(render_job *job, rt_error *err)
 		 * every 100 ms. */
 		double last = now_seconds();
 		for (;;) {
-			if (job->cancel && atomic_load(job->cancel))
+			if ((job->cancel && atomic_load(job->cancel)) || atomic_load(&sh.stop))
 				break;
 			long t = atomic_fetch_add(&sh.next, 1);
 			if (t >= sh.tiles)
 				break;
 			render_tile(&sh, t);
 			atomic_fetch_add(&sh.done, 1);
+			if (sh.band_left) {
+				atomic_fetch_sub(&sh.band_left[t / sh.tiles_x], 1);
+				hand_rows(&sh);
+			}
 			if (job->progress && now_seconds() - last >= 0.1) {
 				last = now_seconds();
 				report(job, &sh);
@@ -339,15 +424,21 @@ render_status render_run(render_job *job, rt_error *err)
 			pthread_mutex_unlock(&sh.lock);
 		}
 		pthread_mutex_lock(&sh.lock);
+		/* progress every 100 ms: a band that wakes this thread early
+		 * does not move the deadline */
+		struct timespec deadline;
+		in_100ms(&deadline);
 		while (atomic_load(&sh.running) > 0) {
-			struct timespec ts;
-			clock_gettime(CLOCK_REALTIME, &ts);
-			ts.tv_nsec += 100 * 1000 * 1000;
-			if (ts.tv_nsec >= 1000000000L) {
-				ts.tv_sec++;
-				ts.tv_nsec -= 1000000000L;
+			if (!atomic_load(&sh.stop) && band_ready(&sh)) {
+				/* the file is written while the workers render */
+				pthread_mutex_unlock(&sh.lock);
+				hand_rows(&sh);
+				pthread_mutex_lock(&sh.lock);
+				continue;
 			}
-			pthread_cond_timedwait(&sh.finished, &sh.lock, &ts);
+			if (pthread_cond_timedwait(&sh.finished, &sh.lock, &deadline) == 0)
+				continue;
+			in_100ms(&deadline);
 			if (atomic_load(&sh.running) > 0 && job->progress) {
 				pthread_mutex_unlock(&sh.lock);
 				report(job, &sh);
@@ -361,7 +452,15 @@ render_status render_run(render_job *job, rt_error *err)
 	free(tid);
 	pthread_mutex_destroy(&sh.lock);
 	pthread_cond_destroy(&sh.finished);
+	if (sh.band_left && !atomic_load(&sh.stop))
+		hand_rows(&sh); /* the last bands */
+	free(sh.band_left);
 	report(job, &sh);
+	if (atomic_load(&sh.stop)) {
+		fb->spp = 0;
+		rt_error_set(err, "writing the image stopped the render");
+		return RENDER_FAILED;
+	}
 	if (atomic_load(&sh.done) < sh.tiles) {
 		fb->spp = 0; /* the sums now mix passes: the next pass must start over */
 		return RENDER_CANCELLED;
@@ -370,19 +469,40 @@ render_status render_run(render_job *job, rt_error *err)
 	return RENDER_DONE;
 }
 
-static framebuffer *render_image_with(const world *w, const render_settings *s, atomic_bool *cancel,
-                                      render_progress_fn progress, void *ctx, bool srgb8, rt_error *err)
+/* A framebuffer for one pass: no running sums; no float image either when
+ * only the 8-bit codes are wanted (codes_only: render_image_rows). */
+static framebuffer *fb_one_pass(int w, int h, bool codes_only)
 {
-	framebuffer *fb = fb_new(s->width, s->height);
+	if (w < 1 || h < 1 || w > RENDER_MAX_DIM || h > RENDER_MAX_DIM)
+		return NULL;
+	framebuffer *fb = calloc(1, sizeof *fb);
+	if (!fb)
+		return NULL;
+	fb->w = w;
+	fb->h = h;
+	if (!codes_only) {
+		fb->rgb = calloc((size_t)w * (size_t)h * 3, sizeof *fb->rgb);
+		if (!fb->rgb) {
+			free(fb);
+			return NULL;
+		}
+	}
+	return fb;
+}
+
+static framebuffer *render_image_with(const world *w, const render_settings *s, atomic_bool *cancel,
+                                      render_progress_fn progress, void *ctx, bool srgb8,
+                                      render_rows_fn rows, void *rows_ctx, rt_error *err)
+{
+	bool denoise = integrator_of(s->mode)->features && s->denoise == DENOISE_ON;
+	/* One pass makes the whole image: no running sums are needed (nor,
+	 * handing rows over, the floats: the tiles keep theirs). */
+	framebuffer *fb = fb_one_pass(s->width, s->height, rows && !denoise);
 	if (!fb) {
 		rt_error_set(err, "cannot make a %dx%d image; expected 1..%d pixels a side, and memory",
 		             s->width, s->height, RENDER_MAX_DIM);
 		return NULL;
 	}
-	/* One pass makes the whole image: no running sums are needed. */
-	free(fb->sum);
-	fb->sum = NULL;
-	bool denoise = integrator_of(s->mode)->features && s->denoise == DENOISE_ON;
 	if (denoise && !denoise_prepare(fb)) {
 		rt_error_set(err, "out of memory for the denoiser's features of a %dx%d image",
 		             s->width, s->height);
@@ -393,6 +513,11 @@ static framebuffer *render_image_with(const world *w, const render_settings *s, 
 		/* no zeroing: every tile writes its codes (a failed render frees them) */
 		fb->srgb8 = malloc((size_t)fb->w * (size_t)fb->h * 3);
 		fb->srgb8_gain = exp2(s->exposure);
+		if (!fb->srgb8) {
+			rt_error_set(err, "out of memory for a %dx%d image", s->width, s->height);
+			fb_free(fb);
+			return NULL;
+		}
 	}
 	render_job job = {
 		.w = w,
@@ -403,6 +528,8 @@ static framebuffer *render_image_with(const world *w, const render_settings *s, 
 		.cancel = cancel,
 		.progress = progress,
 		.progress_ctx = ctx,
+		.rows = denoise ? NULL : rows,
+		.rows_ctx = rows_ctx,
 	};
 	render_status st = render_run(&job, err);
 	if (st != RENDER_DONE) {
@@ -416,17 +543,41 @@ static framebuffer *render_image_with(const world *w, const render_settings *s, 
 		fb_free(fb);
 		return NULL;
 	}
+	if (denoise && rows) {
+		/* the codes of the denoised image, every row at once */
+		size_t n = (size_t)fb->w * (size_t)fb->h * 3;
+		fb->srgb8 = malloc(n);
+		fb->srgb8_gain = exp2(s->exposure);
+		if (!fb->srgb8) {
+			rt_error_set(err, "out of memory for a %dx%d image", s->width, s->height);
+			fb_free(fb);
+			return NULL;
+		}
+		linear_to_srgb8_n(fb->rgb, fb->srgb8_gain, fb->srgb8, n);
+		if (!rows(rows_ctx, fb, 0, fb->h)) {
+			rt_error_set(err, "writing the image stopped the render");
+			fb_free(fb);
+			return NULL;
+		}
+	}
 	return fb;
 }
 
 framebuffer *render_image(const world *w, const render_settings *s, atomic_bool *cancel,
                           render_progress_fn progress, void *ctx, rt_error *err)
 {
-	return render_image_with(w, s, cancel, progress, ctx, false, err);
+	return render_image_with(w, s, cancel, progress, ctx, false, NULL, NULL, err);
 }
 
 framebuffer *render_image_srgb8(const world *w, const render_settings *s, atomic_bool *cancel,
                                 render_progress_fn progress, void *ctx, rt_error *err)
 {
-	return render_image_with(w, s, cancel, progress, ctx, true, err);
+	return render_image_with(w, s, cancel, progress, ctx, true, NULL, NULL, err);
+}
+
+framebuffer *render_image_rows(const world *w, const render_settings *s, atomic_bool *cancel,
+                               render_progress_fn progress, void *ctx, render_rows_fn rows, void *rows_ctx,
+                               rt_error *err)
+{
+	return render_image_with(w, s, cancel, progress, ctx, true, rows, rows_ctx, err);
 }

@@ -7,7 +7,8 @@
  * symbol set (term/symbols.h: quadrants, sextants, octants) shows a grid of
  * subpixels a cell instead, each cell in two colours: its canvas holds 2x4
  * samples a cell, and each cell takes the glyph and colours of least error
- * (symbols_fit), or the complement glyph with the colours swapped when
+ * (symbols_fit; the sextant set: symbols_fit_cover on the samples), or the
+ * complement glyph with the colours swapped when
  * that costs fewer bytes. The encoder keeps the cells the terminal shows
  * and sends only the cells that changed.
  *
@@ -45,8 +46,9 @@ typedef enum frame_palette {
 
 /* Two stacked pixels, quantised for the frame's palette. In PALETTE_NONE a
  * cell is one character: top == bot == its code. In a frame of another
- * symbol set, top is the colour of the subpixels in mask (symbols.h) and
- * bot the colour of the others; a cell of one colour has mask 0 and
+ * symbol set, top is the colour of the subpixels in mask (symbols.h; in
+ * the sextant set mask is a glyph id, 64 and up a glyph beyond the
+ * sextants, top its ink) and bot the colour of the others; a cell of one colour has mask 0 and
  * top == bot (half blocks: mask is always 1, the upper pixel). */
 typedef struct frame_cell {
 	uint32_t top, bot;

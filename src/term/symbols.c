@@ -439,21 +439,29 @@ double symbols_fit_cover(const symbols_shapes *s, const float x[8][3], double fl
 			for (int k = 0; k < NS; k++)
 				rus[c][k] += s->scovt[i][k] * xt[c][i];
 	}
+	/* each glyph's error at its optimum, all at once as well */
+	double es[NS];
+	for (int k = 0; k < NS; k++)
+		es[k] = sq;
+	for (int c = 0; c < 3; c++)
+		for (int k = 0; k < NS; k++) {
+			double ru = rus[c][k], rv = tot[c] - ru;
+			double fa = s->ia[k] * ru - s->ib[k] * rv, fb = s->ic[k] * rv - s->ib[k] * ru;
+			es[k] -= fa * ru + fb * rv;
+		}
 	for (int k = 0; k < ns; k++) {
+		if (es[k] >= best)
+			continue; /* clamping the colours below only adds error */
 		int g = s->solve[k];
 		const float *cv = s->cov[g];
-		float ru[3] = {rus[0][k], rus[1][k], rus[2][k]};
-		double fa[3], fb[3], e = sq;
+		double fa[3], fb[3], e = es[k];
 		bool clamped = false;
 		for (int c = 0; c < 3; c++) {
-			double rv = tot[c] - ru[c];
-			fa[c] = s->ia[k] * ru[c] - s->ib[k] * rv;
-			fb[c] = s->ic[k] * rv - s->ib[k] * ru[c];
-			e -= fa[c] * ru[c] + fb[c] * rv;
+			double ru = rus[c][k], rv = tot[c] - ru;
+			fa[c] = s->ia[k] * ru - s->ib[k] * rv;
+			fb[c] = s->ic[k] * rv - s->ib[k] * ru;
 			clamped |= fa[c] < 0 || fa[c] > 255 || fb[c] < 0 || fb[c] > 255;
 		}
-		if (e >= best)
-			continue; /* clamping only adds error */
 		if (clamped) {
 			/* a mix past the ends: the error of the colours clamped */
 			e = 0;

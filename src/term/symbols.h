@@ -5,7 +5,10 @@
  *   half      1x2  U+2580 U+2584 (Unicode 1.1)
  *   quadrant  2x2  U+2596..U+259F with the halves (Unicode 1.1)
  *   sextant   2x3  U+1FB00..U+1FB3B, "Symbols for Legacy Computing"
- *                  (Unicode 13), with U+258C U+2590 for the two columns
+ *                  (Unicode 13), with U+258C U+2590 for the two columns;
+ *                  and beyond the 64 patterns (ids 64..87) the quadrants,
+ *                  halves and eighth rows of U+2580..U+259F and U+1FB82..
+ *                  U+1FB86, which follow the 2x4 samples' rows
  *   octant    2x4  U+1CD00..U+1CDE5 (Unicode 16), with the 26 patterns
  *                  that other blocks already hold (the quadrants, U+2582
  *                  U+2586 U+1FB82 U+1FB85 U+1FBE6 U+1FBE7 U+1CEA0 U+1CEA3
@@ -19,7 +22,9 @@
  * canvas assumes), and a subpixel's colour is the mean of the samples it
  * covers, weighted by area (a sextant row covers 4/3 sample rows). Each
  * cell then gets the mask and two colours of least squared error
- * (symbols_fit), found by trying every split of its subpixels in two.
+ * (symbols_fit), found by trying every split of its subpixels in two. A
+ * cell of the sextant set is fitted on its 8 samples instead, over every
+ * glyph's shape (symbols_fit_cover).
  */
 #ifndef RTSH_SYMBOLS_H
 #define RTSH_SYMBOLS_H

@@ -15,6 +15,7 @@
 #include "rtsh/gltf.h"
 #include "rtsh/memory.h"
 #include "rtsh/mesh.h"
+#include "rtsh/packet.h"
 #include "rtsh/render.h"
 #include "rtsh/rtfile.h"
 #include "rtsh/world.h"
@@ -1016,6 +1017,442 @@ static void test_stage_lighting(void **state)
 	scene_free(s);
 }
 
+/* --- alphaMode MASK cut-outs --- */
+
+/* A w x h 8-bit RGBA PNG (colour type 6) of the texels rgba, top row first:
+ * the IDAT a zlib stream of one stored block (each row its filter byte 0
+ * and its texels). At most 64 x 64 texels; the bytes into out. */
+static size_t png_rgba(int w, int h, const unsigned char *rgba, unsigned char *out)
+{
+	static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+	memcpy(out, sig, 8);
+	size_t n = 8;
+	unsigned char ihdr[17] = {'I', 'H', 'D', 'R', 0, 0, 0, 0, 0, 0, 0, 0, 8, 6, 0, 0, 0};
+	put32(ihdr + 4, (uint32_t)w);
+	put32(ihdr + 8, (uint32_t)h);
+	put32(out + n, 13);
+	memcpy(out + n + 4, ihdr, 17);
+	put32(out + n + 21, crc32_of(ihdr, 17));
+	n += 25;
+	unsigned char raw[64 * (1 + 4 * 64)];
+	size_t nr = 0;
+	for (int y = 0; y < h; y++) {
+		raw[nr++] = 0;
+		memcpy(raw + nr, rgba + (size_t)y * 4 * (size_t)w, 4 * (size_t)w);
+		nr += 4 * (size_t)w;
+	}
+	uint32_t a = 1, b2 = 0; /* adler32 */
+	for (size_t i = 0; i < nr; i++) {
+		a = (a + raw[i]) % 65521;
+		b2 = (b2 + a) % 65521;
+	}
+	unsigned char *idat = out + n + 4;
+	memcpy(idat, "IDAT", 4);
+	idat[4] = 0x78;
+	idat[5] = 0x01;
+	idat[6] = 0x01; /* the last block, stored */
+	idat[7] = (unsigned char)(nr & 255);
+	idat[8] = (unsigned char)(nr >> 8);
+	idat[9] = (unsigned char)(~nr & 255);
+	idat[10] = (unsigned char)(~nr >> 8 & 255);
+	memcpy(idat + 11, raw, nr);
+	put32(idat + 11 + nr, b2 << 16 | a);
+	size_t nidat = 11 + nr + 4;
+	put32(out + n, (uint32_t)(nidat - 4));
+	put32(out + n + 4 + nidat, crc32_of(idat, nidat));
+	n += 4 + nidat + 4;
+	put32(out + n, 0);
+	memcpy(out + n + 4, "IEND", 4);
+	put32(out + n + 8, crc32_of(out + n + 4, 4));
+	return n + 12;
+}
+
+/* The 2 x 1 texture of the cut-out tests: the left texel white and opaque
+ * (alpha 255), the right one white and transparent (alpha 0), as a data:
+ * URI. */
+static void png_half(char *uri64)
+{
+	static const unsigned char t[8] = {255, 255, 255, 255, 255, 255, 255, 0};
+	unsigned char png[128];
+	b64(png, png_rgba(2, 1, t, png), uri64);
+}
+
+/* A glTF scene for the cut-out tests: a camera at (0, 5, 0) looking
+ * straight down (yfov 0.5), a point light of 400 cd at (0, 20, 0), and a
+ * 2 x 2 quad in its node's y = 0 plane, facing up, corners (+-1, 0, +-1),
+ * uv = ((x + 1) / 2, (z + 1) / 2), of material `mat` (its JSON), moved by
+ * (tx, qy, 0). tex: the file has the 2 x 1 texture above as textures[0].
+ * Under it, added to the scene, a Lambertian plane y = 0 of albedo 1/2.
+ *
+ * By hand: the camera's centre ray runs down the y axis. The plane's point
+ * at the origin, lit from 20 units straight above, has irradiance
+ * 400 / 20^2 = 1 and radiance 0.5 / pi. The quad's point on the y axis
+ * has x = -tx in the quad's own frame (glTF's x; the reader mirrors x for
+ * both the node and the camera), so u = (1 - tx) / 2: tx = 0.5 gives u =
+ * 0.25, the centre of the opaque texel, and tx = -0.5 gives u = 0.75, the
+ * centre of the transparent one (bilinear, repeat: alpha 1.5 - 2u on
+ * [0.25, 0.75]). */
+static const char *cut_sampler; /* the texture's sampler (its JSON), NULL: none */
+
+static world *cut_world(const char *mat, bool tex, double tx, double qy, scene **out)
+{
+	unsigned char bin[92];
+	const float pos[12] = {-1, 0, -1, 1, 0, -1, 1, 0, 1, -1, 0, 1}, uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+	const uint16_t idx[6] = {0, 2, 1, 0, 3, 2};
+	memcpy(bin, pos, 48);
+	memcpy(bin + 48, uv, 32);
+	memcpy(bin + 80, idx, 12);
+	char data[160], png64[256] = "", images[400] = "";
+	b64(bin, sizeof bin, data);
+	if (tex) {
+		png_half(png64);
+		snprintf(images, sizeof images, "\"textures\":[{\"source\":0%s}],%s%s%s\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],",
+		         cut_sampler ? ",\"sampler\":0" : "", cut_sampler ? "\"samplers\":[" : "", cut_sampler ? cut_sampler : "",
+		         cut_sampler ? "]," : "", png64);
+	}
+	double h = sqrt(0.5);
+	char text[4096];
+	snprintf(text, sizeof text,
+	         "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0,1,2]}],"
+	         "\"nodes\":[{\"camera\":0,\"translation\":[0,5,0],\"rotation\":[%.17g,0,0,%.17g]},"
+	         "{\"mesh\":0,\"translation\":[%.17g,%.17g,0]},"
+	         "{\"translation\":[0,20,0],\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}}],"
+	         "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.5,\"znear\":0.1}}],"
+	         "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[{\"type\":\"point\",\"intensity\":400}]}},"
+	         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"indices\":2,"
+	         "\"material\":0}]}],\"materials\":[%s],%s"
+	         "\"buffers\":[{\"byteLength\":92,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
+	         "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":32},"
+	         "{\"buffer\":0,\"byteOffset\":80,\"byteLength\":12}],"
+	         "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
+	         "{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"},"
+	         "{\"bufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}]}",
+	         -h, h, tx, qy, mat, images, data);
+	rt_error err = {0};
+	scene *s = rt_load_file(tmp_text("cut.gltf", text), NULL, &err);
+	if (!s)
+		fail_msg("%s", err.msg);
+	object pl = object_make(OBJ_PLANE, linear_to_srgb255(v3(0.5, 0.5, 0.5)));
+	pl.dir = v3(0, 1, 0);
+	pl.mat.diffuse = 1;
+	pl.mat.specular = 0;
+	assert_true(scene_add_object(s, &pl, &err));
+	world *w = world_build(s, &err);
+	if (!w)
+		fail_msg("%s", err.msg);
+	*out = s;
+	return w;
+}
+
+/* The black metal of the quads (base colour 0: no diffuse part, F0 = 0, so
+ * seen and lit along its normal it sends back nothing), with alpha a. */
+#define CUT_MAT(a, rest) "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0," a "]" rest "}"
+#define CUT_TEX ",\"baseColorTexture\":{\"index\":0}}"
+#define CUT_TEX_T(t) ",\"baseColorTexture\":{\"index\":0,\"extensions\":{\"KHR_texture_transform\":{" t "}}}}"
+
+/* The radiance around the centre of the picture is `want`, found every way
+ * the renderer finds it, on every vector unit of the walk: the single
+ * Whitted ray (world_intersect, world_occluded), the camera packets and
+ * shadow packets of a 4 x 4 block, and path mode (depth 1: the light
+ * sampled at the first hit; its camera rays in packets too). The block's
+ * points lie within 0.01 of the axis, where nothing changes but the light's
+ * distance, by 1e-7. */
+static void expect_centre(const world *w, double want)
+{
+	for (int isa = MESH_ISA_SCALAR; isa < MESH_ISA_BEST; isa++) {
+		if (!mesh_isa_force((mesh_isa)isa))
+			continue;
+		render_settings set = render_settings_default();
+		set.width = set.height = 1001;
+		set.samples = 1;
+		set.depth = 1;
+		set.threads = 1;
+		set.mode = MODE_WHITTED;
+		vec3 c = whitted_radiance(w, &set, render_sample_ray(w, &set, 500, 500, 1001, 1001, 0));
+		assert_vec_near(c, v3_splat(want), 1e-5);
+		float px[16 * 3];
+		render_rect(w, &set, 498, 498, 502, 502, px);
+		for (int i = 0; i < 16 * 3; i++)
+			assert_near(px[i], want, 1e-5);
+		set.mode = MODE_PATH;
+		set.samples = 2;
+		render_rect(w, &set, 498, 498, 502, 502, px);
+		for (int i = 0; i < 16 * 3; i++)
+			assert_near(px[i], want, 1e-5);
+	}
+	mesh_isa_force(MESH_ISA_BEST);
+}
+
+/* Camera rays (and the reflection of nothing): the quad 1 above the plane,
+ * between it and the camera, its MASK texture left opaque, right clear.
+ * Through the opaque texel the camera sees the quad (black: 0); through
+ * the clear one it sees the plane, lit through the same hole: 0.5 / pi.
+ * OPAQUE (the default) ignores alpha: 0. Then the texture moved by
+ * KHR_texture_transform, and the sampler's wrap. */
+static void test_cutout_camera_rays(void **state)
+{
+	(void)state;
+	double lit = 0.5 / M_PI;
+	struct {
+		const char *mat;
+		double tx, want;
+		const char *sampler;
+	} c[] = {
+	    {CUT_MAT("1", CUT_TEX ",\"alphaMode\":\"MASK\""), 0.5, 0, NULL},
+	    {CUT_MAT("1", CUT_TEX ",\"alphaMode\":\"MASK\""), -0.5, lit, NULL},
+	    {CUT_MAT("1", CUT_TEX ",\"alphaMode\":\"MASK\",\"alphaCutoff\":0.5"), -0.5, lit, NULL},
+	    {CUT_MAT("1", CUT_TEX), -0.5, 0, NULL},
+	    {CUT_MAT("1", CUT_TEX ",\"alphaMode\":\"OPAQUE\""), -0.5, 0, NULL},
+	    /* KHR_texture_transform offset (0.5, 0): u 0.25 + 0.5, the clear texel */
+	    {CUT_MAT("1", CUT_TEX_T("\"offset\":[0.5,0]") ",\"alphaMode\":\"MASK\""), 0.5, lit, NULL},
+	    /* offset (1, 0): u 1.25, the opaque texel again by the default
+	     * repeat, and by an explicit one; past the right edge, so the clear
+	     * texel, with wrapS clamp (33071); mirrored (33648): 2 - 1.25 =
+	     * 0.75, clear */
+	    {CUT_MAT("1", CUT_TEX_T("\"offset\":[1,0]") ",\"alphaMode\":\"MASK\""), 0.5, 0, NULL},
+	    {CUT_MAT("1", CUT_TEX_T("\"offset\":[1,0]") ",\"alphaMode\":\"MASK\""), 0.5, 0, "{\"wrapS\":10497}"},
+	    {CUT_MAT("1", CUT_TEX_T("\"offset\":[1,0]") ",\"alphaMode\":\"MASK\""), 0.5, lit, "{\"wrapS\":33071}"},
+	    {CUT_MAT("1", CUT_TEX_T("\"offset\":[1,0]") ",\"alphaMode\":\"MASK\""), 0.5, lit, "{\"wrapS\":33648}"},
+	};
+	for (size_t k = 0; k < sizeof c / sizeof c[0]; k++) {
+		scene *s;
+		cut_sampler = c[k].sampler;
+		world *w = cut_world(c[k].mat, true, c[k].tx, 1, &s);
+		cut_sampler = NULL;
+		hit h;
+		ray r = {v3(0, 5, 0), v3(0, -1, 0)};
+		assert_true(world_intersect(w, &r, 0, INFINITY, &h));
+		/* the quad at t = 4, or the plane at t = 5 */
+		assert_near(h.t, c[k].want > 0 ? 5 : 4, 1e-6);
+		expect_centre(w, c[k].want);
+		world_free(w);
+		scene_free(s);
+	}
+}
+
+/* Shadow rays: the same quad 10 above the plane, above the camera (which
+ * does not see it), between the plane and the light. The plane's point
+ * under the light is lit exactly when its shadow ray passes the clear
+ * texel. Then, with the quad centred (tx = 0), points (x, 0, 0) of the
+ * plane: the shadow ray to (0, 20, 0) crosses the quad at x / 2, where the
+ * quad's own x is -x / 2 and u = (1 - x / 2) / 2. x = -1.5 and -0.5: u =
+ * 0.875 and 0.625, alpha 0.25 (the clear texel's and, by the repeat, the
+ * opaque one's) and 0.25 again: lit. x = 0.5 and 1.5: u = 0.375 and 0.125,
+ * alpha 0.75 both: in shadow. x = 2.5 crosses y = 10 at 1.25, past the
+ * quad: lit. Single rays and one packet of all five. */
+static void test_cutout_shadow_rays(void **state)
+{
+	(void)state;
+	const char *mat = CUT_MAT("1", CUT_TEX ",\"alphaMode\":\"MASK\"");
+	for (int k = 0; k < 2; k++) {
+		scene *s;
+		world *w = cut_world(mat, true, k ? -0.5 : 0.5, 10, &s);
+		expect_centre(w, k ? 0.5 / M_PI : 0);
+		world_free(w);
+		scene_free(s);
+	}
+	scene *s;
+	world *w = cut_world(mat, true, 0, 10, &s);
+	const double xs[5] = {-1.5, -0.5, 0.5, 1.5, 2.5};
+	const bool shade[5] = {false, false, true, true, false};
+	ray r[5];
+	double tmax[5];
+	bool occ[5];
+	for (int isa = MESH_ISA_SCALAR; isa < MESH_ISA_BEST; isa++) {
+		if (!mesh_isa_force((mesh_isa)isa))
+			continue;
+		for (int i = 0; i < 5; i++) {
+			vec3 p = v3(xs[i], 0, 0), to = v3_sub(v3(0, 20, 0), p);
+			tmax[i] = v3_len(to);
+			r[i] = (ray){p, v3_scale(to, 1 / tmax[i])};
+			assert_int_equal(world_occluded(w, &r[i], 1e-6, tmax[i]), shade[i]);
+		}
+		world_occluded_packet(w, 5, r, 1e-6, tmax, occ);
+		for (int i = 0; i < 5; i++)
+			assert_int_equal(occ[i], shade[i]);
+	}
+	mesh_isa_force(MESH_ISA_BEST);
+	world_free(w);
+	scene_free(s);
+}
+
+/* baseColorFactor's alpha alone (no texture): 0.3 under the default cutoff
+ * 0.5 removes the whole quad (the plane is seen and lit: 0.5 / pi); under a
+ * cutoff of 0.2 the quad stays (0). The reader keeps no alpha channel for
+ * such materials, nor for an OPAQUE one with an RGBA texture, and marks
+ * only meshes with a MASK material (mesh.cuts). */
+static void test_cutout_factor(void **state)
+{
+	(void)state;
+	struct {
+		const char *mat;
+		double want;
+	} c[] = {
+	    {CUT_MAT("0.3", ",\"metallicFactor\":1},\"alphaMode\":\"MASK\""), 0.5 / M_PI},
+	    {CUT_MAT("0.3", ",\"metallicFactor\":1},\"alphaMode\":\"MASK\",\"alphaCutoff\":0.2"), 0},
+	    {CUT_MAT("0.3", ",\"metallicFactor\":1}"), 0},
+	};
+	for (size_t k = 0; k < sizeof c / sizeof c[0]; k++) {
+		scene *s;
+		world *w = cut_world(c[k].mat, false, 0, 1, &s);
+		expect_centre(w, c[k].want);
+		world_free(w);
+		scene_free(s);
+	}
+	/* what the reader keeps */
+	char png64[256];
+	png_half(png64);
+	for (int k = 0; k < 2; k++) {
+		char *text = malloc(8192), rest[1024];
+		assert_non_null(text);
+		snprintf(rest, sizeof rest,
+		         "\"nodes\":[{\"mesh\":0}],\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":"
+		         "{\"index\":0}},\"alphaMode\":\"%s\"}],\"textures\":[{\"source\":0,\"sampler\":0}],"
+		         "\"samplers\":[{\"wrapS\":33071,\"wrapT\":33648}],"
+		         "\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],",
+		         k ? "MASK" : "OPAQUE", png64);
+		char *base = tri_gltf(unit_tri, rest);
+		/* tri_gltf's primitive has no material: give it material 0 */
+		char *at = strstr(base, "\"indices\":1}");
+		assert_non_null(at);
+		snprintf(text, 8192, "%.*s\"indices\":1,\"material\":0}%s", (int)(at - base), base,
+		         at + strlen("\"indices\":1}"));
+		free(base);
+		rt_error err = {0};
+		mesh *m = mesh_parse_gltf("t.gltf", NULL, text, strlen(text), &err);
+		free(text);
+		if (!m)
+			fail_msg("%s", err.msg);
+		assert_int_equal(m->cuts, k == 1);
+		if (k) {
+			assert_non_null(m->mats[0].alpha_map);
+			assert_int_equal(m->mats[0].alpha_w, 2);
+			assert_int_equal(m->mats[0].alpha_h, 1);
+			assert_int_equal(m->mats[0].alpha_map[0], 255);
+			assert_int_equal(m->mats[0].alpha_map[1], 0);
+			assert_int_equal(m->mats[0].alpha_wrap[0], MESH_WRAP_CLAMP);
+			assert_int_equal(m->mats[0].alpha_wrap[1], MESH_WRAP_MIRROR);
+		} else {
+			assert_null(m->mats[0].alpha_map);
+		}
+		mesh_free(m);
+	}
+	/* bad values, by their JSON path */
+	static const char *const bad[][3] = {
+	    {"{\"alphaMode\":\"MASK\",\"alphaCutoff\":-1}", "materials[0]: alphaCutoff: not a number from 0", ""},
+	    {"{\"alphaMode\":\"CUTOUT\"}", "materials[0]: alphaMode: not \"OPAQUE\", \"MASK\" or \"BLEND\"", "expected"},
+	    {"{\"alphaMode\":\"MASK\",\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}}}",
+	     "samplers[0]: wrapS: 5; expected 33071 (clamp), 33648 (mirrored repeat) or 10497 (repeat)", ""},
+	};
+	for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+		char rest[1024];
+		snprintf(rest, sizeof rest,
+		         "\"nodes\":[{\"mesh\":0}],\"materials\":[%s],\"textures\":[{\"source\":0,\"sampler\":0}],"
+		         "\"samplers\":[{\"wrapS\":5}],\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],",
+		         bad[k][0], png64);
+		char *text = tri_gltf(unit_tri, rest);
+		expect_fail(text, bad[k][1], bad[k][2]);
+		free(text);
+	}
+}
+
+/* An emissive cut-out is not sampled as a lamp (its holes would light
+ * through): the paths find it, through its holes too. The lamp of
+ * test_mesh_lamp (Le = 2, 2 x 2, 1 above a floor of albedo 0.8) as a MASK
+ * with baseColorFactor alpha 0.3: all hole, the floor gets nothing (0);
+ * with alpha 1 it is whole, found by the paths alone: 0.8 Le F. */
+static void test_cutout_lamp(void **state)
+{
+	(void)state;
+	unsigned char bin[60];
+	const float pos[12] = {-1, 0, -1, 1, 0, -1, 1, 0, 1, -1, 0, 1};
+	const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+	memcpy(bin, pos, 48);
+	memcpy(bin + 48, idx, 12);
+	char data[128];
+	b64(bin, sizeof bin, data);
+	double f = 4 * (2 / sqrt(2)) * atan(1 / sqrt(2)) / (2 * M_PI), want = 0.8 * 2 * f;
+	for (int k = 0; k < 2; k++) {
+		char text[2048];
+		snprintf(text, sizeof text,
+		         "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0}],"
+		         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":0}]}],"
+		         "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,%s]},\"emissiveFactor\":[1,1,1],"
+		         "\"alphaMode\":\"MASK\",\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":2}}}],"
+		         "\"buffers\":[{\"byteLength\":60,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
+		         "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":12}],"
+		         "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
+		         "{\"bufferView\":1,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}]}",
+		         k ? "1" : "0.3", data);
+		tmp_text("cutlamp.gltf", text);
+		const char *rt = tmp_text("cutlamp.rt", "C 0,0.5,-4 0,-0.5,4 0.2\npl 0,0,0 0,1,0 1,1,1 255,255,255 0.8 0 1 0\n"
+		                                        "mesh cutlamp.gltf 0,1,0 0,1,0 2\n");
+		rt_error err = {0};
+		scene *s = rt_load_file(rt, NULL, &err);
+		if (!s)
+			fail_msg("%s", err.msg);
+		world *w = world_build(s, &err);
+		if (!w)
+			fail_msg("%s", err.msg);
+		assert_int_equal(w->nemitters, 0);
+		render_settings set = render_settings_default();
+		set.width = set.height = 1;
+		set.samples = k ? 100000 : 64;
+		set.depth = 1;
+		set.threads = 2;
+		set.mode = MODE_PATH;
+		set.seed = 5;
+		framebuffer *fb = render_image(w, &set, NULL, NULL, NULL, &err);
+		assert_non_null(fb);
+		if (k)
+			assert_near(fb->rgb[1], want, 0.02 * want);
+		else
+			assert_near(fb->rgb[1], 0, 1e-9);
+		fb_free(fb);
+		world_free(w);
+		scene_free(s);
+	}
+}
+
+/* BLEND: in Whitted mode a MASK at 0.5, so baseColorFactor alpha 0.3 is
+ * gone (the plane: 0.5 / pi) and 0.7 stays (0), on every path of
+ * expect_centre but path mode. In path mode it is seen through by its
+ * alpha: a ray passes with probability 1 - alpha, so with alpha 0.3 the
+ * camera ray passes 0.7 of the time and the lit plane's shadow ray 0.7 of
+ * the time: 0.49 x 0.5 / pi on average; alpha 0.7, 0.09 x 0.5 / pi. With
+ * 160000 samples the mean's standard deviation is sqrt(p (1 - p) / 160000)
+ * / p of it: 0.26% (p = 0.49) and 0.8% (p = 0.09); 3% allowed. */
+static void test_blend(void **state)
+{
+	(void)state;
+	double lit = 0.5 / M_PI;
+	for (int k = 0; k < 2; k++) {
+		scene *s;
+		world *w = cut_world(k ? CUT_MAT("0.7", "},\"alphaMode\":\"BLEND\"") : CUT_MAT("0.3", "},\"alphaMode\":\"BLEND\""),
+		                     false, 0, 1, &s);
+		render_settings set = render_settings_default();
+		set.width = set.height = 1001;
+		set.samples = 1;
+		set.depth = 1;
+		set.threads = 1;
+		set.mode = MODE_WHITTED;
+		vec3 c = whitted_radiance(w, &set, render_sample_ray(w, &set, 500, 500, 1001, 1001, 0));
+		assert_vec_near(c, v3_splat(k ? 0 : lit), 1e-5);
+		float px[16 * 3];
+		render_rect(w, &set, 498, 498, 502, 502, px);
+		for (int i = 0; i < 16 * 3; i++)
+			assert_near(px[i], k ? 0 : lit, 1e-5);
+		set.mode = MODE_PATH;
+		set.samples = 160000;
+		render_rect(w, &set, 500, 500, 501, 501, px);
+		double want = (k ? 0.3 * 0.3 : 0.7 * 0.7) * lit;
+		print_message("BLEND alpha %s in path mode: expected %.5f, got %.5f\n", k ? "0.7" : "0.3", want, px[1]);
+		assert_near(px[1], want, 0.03 * want);
+		world_free(w);
+		scene_free(s);
+	}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -1036,6 +1473,11 @@ int main(void)
 	    cmocka_unit_test(test_texture_rotation),
 	    cmocka_unit_test(test_emissive_texture),
 	    cmocka_unit_test(test_stage_lighting),
+	    cmocka_unit_test(test_cutout_camera_rays),
+	    cmocka_unit_test(test_cutout_shadow_rays),
+	    cmocka_unit_test(test_cutout_factor),
+	    cmocka_unit_test(test_cutout_lamp),
+	    cmocka_unit_test(test_blend),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
 }

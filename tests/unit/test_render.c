@@ -4,8 +4,12 @@
  * binary checked against the projection formula. */
 #include "testutil.h"
 
+#include <dirent.h>
+#include <signal.h>
 #include <stdatomic.h>
+#include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -501,6 +505,228 @@ static void test_basic_silhouette(void **state)
 	fb_free(fb);
 }
 
+/* --- rows handed over as the render finishes them (render_image_rows) --- */
+
+static world *rows_world(void)
+{
+	scene *s = base_scene(v3(0, 0, -5), v3(0, 0, 1), 60);
+	add_light(s, v3(3, 2, -5), 0.7);
+	object o = sphere(v3(0, 0, 0), 2.0, v3(200, 120, 40));
+	assert_true(scene_add_object(s, &o, NULL));
+	world *wd = world_build(s, NULL);
+	assert_non_null(wd);
+	scene_free(s);
+	return wd;
+}
+
+typedef struct rows_seen {
+	const uint8_t *expect; /* the codes by their definition */
+	int next;              /* the row the next call must start at */
+	int calls, stop_at;    /* stop_at: the call that returns false (0: none) */
+} rows_seen;
+
+static bool rows_check(void *ctx, const framebuffer *fb, int y0, int y1)
+{
+	rows_seen *r = ctx;
+	r->calls++;
+	assert_int_equal(y0, r->next); /* in order, each row once */
+	assert_true(y1 > y0 && y1 <= fb->h);
+	r->next = y1;
+	/* final when handed over */
+	size_t row = (size_t)fb->w * 3;
+	assert_memory_equal(fb->srgb8 + (size_t)y0 * row, r->expect + (size_t)y0 * row, (size_t)(y1 - y0) * row);
+	return r->calls != r->stop_at;
+}
+
+/* Every row once, in order, its codes final when handed over and those of
+ * linear_to_srgb8 on render_image's floats x 2^exposure; no float image
+ * kept; with 1, 2 and 3 threads. A callback that fails stops the render. */
+static void test_rows_while_rendering(void **state)
+{
+	(void)state;
+	world *wd = rows_world();
+	render_settings set = render_settings_default();
+	set.width = 37; /* not a multiple of the tile either way: 4 bands, the last of 5 rows */
+	set.height = 53;
+	set.exposure = 0.5;
+	size_t n = 37 * 53 * 3;
+	framebuffer *ref = render_image(wd, &set, NULL, NULL, NULL, NULL);
+	assert_non_null(ref);
+	uint8_t *expect = malloc(n);
+	assert_non_null(expect);
+	double gain = pow(2.0, 0.5);
+	for (size_t i = 0; i < n; i++)
+		expect[i] = linear_to_srgb8(ref->rgb[i] * gain);
+	for (int threads = 1; threads <= 3; threads++) {
+		set.threads = threads;
+		rows_seen r = {expect, 0, 0, 0};
+		framebuffer *fb = render_image_rows(wd, &set, NULL, NULL, NULL, rows_check, &r, NULL);
+		assert_non_null(fb);
+		assert_int_equal(r.next, 53);
+		assert_true(r.calls >= 1 && r.calls <= 4);
+		assert_null(fb->rgb);
+		assert_memory_equal(fb->srgb8, expect, n);
+		fb_free(fb);
+		/* a failed handover stops the render */
+		rows_seen stop = {expect, 0, 0, 1};
+		rt_error err = {0};
+		assert_null(render_image_rows(wd, &set, NULL, NULL, NULL, rows_check, &stop, &err));
+		assert_int_equal(stop.calls, 1);
+		assert_non_null(strstr(err.msg, "writing the image stopped the render"));
+	}
+	free(expect);
+	fb_free(ref);
+	world_free(wd);
+}
+
+/* image_write_rendered's make: renders with the rows it is given, counting
+ * them; fails by itself when `fail` is set. */
+typedef struct make_ctx {
+	const world *w;
+	const render_settings *set;
+	bool fail;
+	int rows_calls;
+	render_rows_fn rows;
+	void *rows_ctx;
+} make_ctx;
+
+static bool count_rows(void *ctx, const framebuffer *fb, int y0, int y1)
+{
+	make_ctx *m = ctx;
+	m->rows_calls++;
+	return m->rows(m->rows_ctx, fb, y0, y1);
+}
+
+static framebuffer *make_render(void *ctx, render_rows_fn rows, void *rows_ctx, rt_error *err)
+{
+	make_ctx *m = ctx;
+	if (m->fail) {
+		rt_error_set(err, "the render failed");
+		return NULL;
+	}
+	if (!rows)
+		return render_image_srgb8(m->w, m->set, NULL, NULL, NULL, err);
+	m->rows = rows;
+	m->rows_ctx = rows_ctx;
+	return render_image_rows(m->w, m->set, NULL, NULL, NULL, count_rows, m, err);
+}
+
+static unsigned char *slurp(const char *path, size_t *len)
+{
+	FILE *f = fopen(path, "rb");
+	assert_non_null(f);
+	fseek(f, 0, SEEK_END);
+	long n = ftell(f);
+	fseek(f, 0, SEEK_SET);
+	unsigned char *b = malloc((size_t)n + 1);
+	assert_non_null(b);
+	assert_int_equal(fread(b, 1, (size_t)n, f), (size_t)n);
+	fclose(f);
+	*len = (size_t)n;
+	return b;
+}
+
+static int temp_files(const char *dir)
+{
+	DIR *d = opendir(dir);
+	assert_non_null(d);
+	int k = 0;
+	struct dirent *e;
+	while ((e = readdir(d)))
+		k += strstr(e->d_name, ".tmp.") != NULL;
+	closedir(d);
+	return k;
+}
+
+/* A file written while the picture renders is whole and the same bytes as
+ * one written after the render (PPM, PNG, JPEG; 2 threads); the PPM's
+ * pixels are linear_to_srgb8 of render_image's floats. A render that fails,
+ * or a write that fails half way (the file size limit), leaves the old file
+ * as it was and no temporary file. */
+static void test_write_rendered(void **state)
+{
+	(void)state;
+	world *wd = rows_world();
+	render_settings set = render_settings_default();
+	set.width = 320;
+	set.height = 180;
+	set.exposure = 0.5;
+	set.threads = 2;
+	char dir[] = "/tmp/rtsh-test-XXXXXX", a[256], b[256];
+	assert_non_null(mkdtemp(dir));
+	static const char *const ext[] = {"ppm", "png", "jpg"};
+	framebuffer *ref = render_image_srgb8(wd, &set, NULL, NULL, NULL, NULL);
+	assert_non_null(ref);
+	for (int k = 0; k < 3; k++) {
+		snprintf(a, sizeof a, "%s/a.%s", dir, ext[k]);
+		snprintf(b, sizeof b, "%s/b.%s", dir, ext[k]);
+		make_ctx m = {wd, &set, false, 0, NULL, NULL};
+		rt_error err = {0};
+		assert_true(image_write_rendered(a, 320, 180, 0.5, make_render, &m, &err));
+		assert_true(k == 2 ? m.rows_calls == 0 : m.rows_calls >= 1); /* JPEG: after the render */
+		assert_true(image_write(b, ref, 0.5, NULL));
+		size_t la, lb;
+		unsigned char *fa = slurp(a, &la), *fb = slurp(b, &lb);
+		assert_int_equal(la, lb);
+		assert_memory_equal(fa, fb, la);
+		if (k == 0) {
+			const char *head = "P6\n320 180\n255\n";
+			size_t hn = strlen(head);
+			assert_int_equal(la, hn + 320 * 180 * 3);
+			assert_memory_equal(fa, head, hn);
+			double gain = pow(2.0, 0.5);
+			for (size_t i = 0; i < 320 * 180 * 3; i++)
+				assert_int_equal(fa[hn + i], linear_to_srgb8(ref->rgb[i] * gain));
+		}
+		free(fa);
+		free(fb);
+	}
+	/* the old file stays when the render fails */
+	snprintf(a, sizeof a, "%s/a.ppm", dir);
+	size_t lold;
+	unsigned char *old = slurp(a, &lold);
+	make_ctx bad = {wd, &set, true, 0, NULL, NULL};
+	rt_error err = {0};
+	assert_false(image_write_rendered(a, 320, 180, 0.5, make_render, &bad, &err));
+	assert_non_null(strstr(err.msg, "the render failed"));
+	size_t l2;
+	unsigned char *now = slurp(a, &l2);
+	assert_int_equal(l2, lold);
+	assert_memory_equal(now, old, lold);
+	free(now);
+	assert_int_equal(temp_files(dir), 0);
+	/* and when the disk refuses the rows half way: the render stops early */
+	struct rlimit lim, small;
+	assert_int_equal(getrlimit(RLIMIT_FSIZE, &lim), 0);
+	small = lim;
+	small.rlim_cur = 100000; /* the header and six bands of 16 rows (15360 bytes each) */
+	void (*was)(int) = signal(SIGXFSZ, SIG_IGN);
+	assert_int_equal(setrlimit(RLIMIT_FSIZE, &small), 0);
+	make_ctx cut = {wd, &set, false, 0, NULL, NULL};
+	memset(&err, 0, sizeof err);
+	bool ok = image_write_rendered(a, 320, 180, 0.5, make_render, &cut, &err);
+	assert_int_equal(setrlimit(RLIMIT_FSIZE, &lim), 0);
+	signal(SIGXFSZ, was);
+	assert_false(ok);
+	assert_non_null(strstr(err.msg, "write failed"));
+	assert_true(cut.rows_calls >= 1 && cut.rows_calls <= 7);
+	now = slurp(a, &l2);
+	assert_int_equal(l2, lold);
+	assert_memory_equal(now, old, lold);
+	free(now);
+	free(old);
+	assert_int_equal(temp_files(dir), 0);
+	for (int k = 0; k < 3; k++) {
+		snprintf(a, sizeof a, "%s/a.%s", dir, ext[k]);
+		snprintf(b, sizeof b, "%s/b.%s", dir, ext[k]);
+		unlink(a);
+		unlink(b);
+	}
+	assert_int_equal(rmdir(dir), 0);
+	fb_free(ref);
+	world_free(wd);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -514,6 +740,8 @@ int main(void)
 		cmocka_unit_test(test_srgb),
 		cmocka_unit_test(test_image_files),
 		cmocka_unit_test(test_srgb8_in_tiles),
+		cmocka_unit_test(test_rows_while_rendering),
+		cmocka_unit_test(test_write_rendered),
 		cmocka_unit_test(test_basic_silhouette),
 	};
 	return cmocka_run_group_tests_name("render", tests, NULL, NULL);

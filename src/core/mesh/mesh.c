@@ -92,7 +92,7 @@ bool mb_texture(mesh_builder *b, texture *t)
 /* The embedded textures are the mesh's (texs), not the material's. */
 static void mat_free(mesh_mat *m)
 {
-	mem_free_all(m->name, m->map_kd, m->map_bump, m->map_norm, m->map_mr, m->map_emit);
+	mem_free_all(m->name, m->map_kd, m->map_bump, m->map_norm, m->map_mr, m->map_emit, m->alpha_map);
 }
 
 /* The materials and embedded textures a builder, then its mesh, holds. */
@@ -303,6 +303,9 @@ size_t mesh_memory(const mesh *m)
 	n += (size_t)m->nblk * (sizeof *m->blk + sizeof *m->btri);
 	for (uint32_t i = 0; i < m->ntexs; i++)
 		n += tex_bytes(m->texs[i]);
+	for (uint32_t i = 0; i < m->nmats; i++)
+		if (m->mats[i].alpha_map)
+			n += (size_t)m->mats[i].alpha_w * (size_t)m->mats[i].alpha_h;
 	return n;
 }
 
@@ -593,4 +596,112 @@ void mesh_surface(const mesh *m, uint32_t slot, const float b[3], mesh_surf *s)
 			s->dpdv = v3_scale(v3_sub(v3_scale(e2, du1), v3_scale(e1, du2)), 1.0 / det);
 		}
 	}
+}
+
+/* --- alpha coverage (glTF alphaMode MASK) --- */
+
+/* Texel index i of n along an axis, by the sampler's wrap mode. */
+static long wrap_texel(long i, long n, int mode)
+{
+	if (mode == MESH_WRAP_CLAMP)
+		return i < 0 ? 0 : i >= n ? n - 1 : i;
+	if (mode == MESH_WRAP_MIRROR) {
+		long k = i % (2 * n);
+		k = k < 0 ? k + 2 * n : k;
+		return k < n ? k : 2 * n - 1 - k;
+	}
+	long k = i % n;
+	return k < 0 ? k + n : k;
+}
+
+/* A texel coordinate (texel centres at integers) brought near the image,
+ * where floor() and the wrap are exact: by the wrap's period, or clamped. */
+static double wrap_coord(double x, long n, int mode)
+{
+	if (mode == MESH_WRAP_CLAMP)
+		return x < -1.0 ? -1.0 : x > (double)n ? (double)n : x;
+	return fmod(x, mode == MESH_WRAP_MIRROR ? 2.0 * (double)n : (double)n);
+}
+
+/* The bilinear alpha of the map at (u, v), v up (texture.c's texel
+ * centres: x = u w - 1/2, y = (1 - v) h - 1/2). */
+static double alpha_at(const mesh_mat *mm, double u, double v)
+{
+	long w = mm->alpha_w, h = mm->alpha_h;
+	double x = u * (double)w - 0.5, y = (1.0 - v) * (double)h - 0.5;
+	if (!isfinite(x) || !isfinite(y))
+		return 0.0;
+	x = wrap_coord(x, w, mm->alpha_wrap[0]);
+	y = wrap_coord(y, h, mm->alpha_wrap[1]);
+	double fx = floor(x), fy = floor(y), ax = x - fx, ay = y - fy;
+	long x0 = wrap_texel((long)fx, w, mm->alpha_wrap[0]), x1 = wrap_texel((long)fx + 1, w, mm->alpha_wrap[0]);
+	long y0 = wrap_texel((long)fy, h, mm->alpha_wrap[1]), y1 = wrap_texel((long)fy + 1, h, mm->alpha_wrap[1]);
+	const unsigned char *a = mm->alpha_map;
+	double a00 = a[(size_t)y0 * (size_t)w + (size_t)x0], a10 = a[(size_t)y0 * (size_t)w + (size_t)x1];
+	double a01 = a[(size_t)y1 * (size_t)w + (size_t)x0], a11 = a[(size_t)y1 * (size_t)w + (size_t)x1];
+	return ((1 - ay) * ((1 - ax) * a00 + ax * a10) + ay * ((1 - ax) * a01 + ax * a11)) / 255.0;
+}
+
+static _Thread_local bool alpha_hashed;
+
+void mesh_alpha_hashed(bool on)
+{
+	alpha_hashed = on;
+}
+
+/* A number in [0, 1) of the hit (its triangle, not its slot: a leaf's
+ * lanes that repeat a triangle must draw the same, and the bits of its
+ * barycentrics): as good as random from one ray to the next, the same for
+ * the same point (splitmix64's finaliser). */
+static double hit_hash(uint32_t tri, const float b[3])
+{
+	uint32_t x, y, z;
+	memcpy(&x, &b[0], 4);
+	memcpy(&y, &b[1], 4);
+	memcpy(&z, &b[2], 4);
+	uint64_t h = ((uint64_t)x << 32 | y) ^ ((uint64_t)z << 32 | tri) * 0x9E3779B97F4A7C15ull;
+	h = (h ^ (h >> 30)) * 0xBF58476D1CE4E5B9ull;
+	h = (h ^ (h >> 27)) * 0x94D049BB133111EBull;
+	h ^= h >> 31;
+	return (double)(h >> 11) * 0x1p-53;
+}
+
+bool mesh_cut_hole(const mesh *m, uint32_t slot, const float b[3])
+{
+	if (m->nmats == 0)
+		return false;
+	uint32_t t = mesh_slot_tri(m, slot);
+	const mesh_mat *mm = &m->mats[m->tmat ? m->tmat[t] : 0];
+	if (mm->alpha_mode == MESH_ALPHA_OPAQUE)
+		return false;
+	double a = mm->alpha;
+	if (mm->alpha_map) {
+		/* the hit's uv as mesh_surface interpolates it (none: 0, 0), then
+		 * the base colour texture's KHR_texture_transform (surface.c) */
+		double u = 0, v = 0;
+		if (m->tri && m->uv) {
+			const uint32_t *i = m->tri[t];
+			const float *pa = m->uv[i[0]], *pb = m->uv[i[1]], *pc = m->uv[i[2]];
+			u = b[0] * pa[0] + b[1] * pb[0] + b[2] * pc[0];
+			v = b[0] * pa[1] + b[1] * pb[1] + b[2] * pc[1];
+		}
+		double tu = u * mm->uvs[0] + mm->uvo[0] + v * mm->uvx[0];
+		double tv = v * mm->uvs[1] + mm->uvo[1] + u * mm->uvx[1];
+		a *= alpha_at(mm, tu, tv);
+	}
+	if (mm->alpha_mode == MESH_ALPHA_BLEND) /* see through by alpha, or MASK at 0.5 */
+		return a < (alpha_hashed ? hit_hash(t, b) : 0.5);
+	return a < mm->alpha_cutoff;
+}
+
+unsigned mesh_cut_lanes(const mesh *m, uint32_t blk, unsigned lanes, const float u[4], const float v[4],
+                        const float w[4], const float inv[4])
+{
+	for (unsigned rest = lanes; rest; rest &= rest - 1) {
+		int l = __builtin_ctz(rest);
+		float b[3] = {u[l] * inv[l], v[l] * inv[l], w[l] * inv[l]};
+		if (mesh_cut_hole(m, 4 * blk + (uint32_t)l, b))
+			lanes &= ~(1u << l);
+	}
+	return lanes;
 }

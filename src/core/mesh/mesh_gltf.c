@@ -64,7 +64,7 @@ typedef struct gl {
 	const unsigned char *bin; /* the GLB's BIN chunk */
 	size_t nbin;
 	bool has_bin;
-	table nodes, meshes, accessors, views, buffers, materials, textures, images, cameras, lights;
+	table nodes, meshes, accessors, views, buffers, materials, textures, images, samplers, cameras, lights;
 	unsigned char **buf; /* decoded buffers, NULL until used */
 	size_t *buflen;
 	bool *bufown;
@@ -269,7 +269,7 @@ static void gl_free(gl *g)
 {
 	cJSON_Delete(g->root);
 	table *ts[] = {&g->nodes, &g->meshes, &g->accessors, &g->views, &g->buffers, &g->materials,
-	               &g->textures, &g->images, &g->cameras, &g->lights};
+	               &g->textures, &g->images, &g->samplers, &g->cameras, &g->lights};
 	for (size_t i = 0; i < sizeof ts / sizeof ts[0]; i++)
 		free(ts[i]->v);
 	for (size_t i = 0; g->buf && i < g->buffers.n; i++)
@@ -307,7 +307,7 @@ static bool gl_open(gl *g, const char *buf, size_t len)
 	    !get_table(g, "accessors", &g->accessors) || !get_table(g, "bufferViews", &g->views) ||
 	    !get_table(g, "buffers", &g->buffers) || !get_table(g, "materials", &g->materials) ||
 	    !get_table(g, "textures", &g->textures) || !get_table(g, "images", &g->images) ||
-	    !get_table(g, "cameras", &g->cameras))
+	    !get_table(g, "samplers", &g->samplers) || !get_table(g, "cameras", &g->cameras))
 		return false;
 	/* KHR_lights_punctual's lights sit in the root's extensions */
 	const cJSON *la = key(key(key(g->root, "extensions"), "KHR_lights_punctual"), "lights");
@@ -952,6 +952,104 @@ full:
 
 /* --- materials --- */
 
+/* The bytes of image im (where: "images[im]"): in a buffer view or a data
+ * URI (*data, len; *own when they need freeing, *ext the format's
+ * extension), or a file beside the model (*file, owned; nothing read). */
+static bool image_bytes(gl *g, long im, const char *iw, const unsigned char **data, size_t *len, unsigned char **own,
+                        char **file, const char **ext)
+{
+	const cJSON *img = g->images.v[im], *uri = key(img, "uri"), *mime = key(img, "mimeType");
+	long bv;
+	*file = NULL;
+	*own = NULL;
+	if (!get_index(g, img, "bufferView", iw, g->views.n, "bufferViews", false, &bv))
+		return false;
+	*ext = "png";
+	if (cJSON_IsString(mime) && strcmp(mime->valuestring, "image/jpeg") == 0)
+		*ext = "jpg";
+	if (bv >= 0) {
+		size_t stride;
+		return view(g, (size_t)bv, data, len, &stride);
+	} else if (cJSON_IsString(uri) && strncmp(uri->valuestring, "data:", 5) == 0) {
+		if (strncmp(uri->valuestring, "data:image/jpeg", 15) == 0)
+			*ext = "jpg";
+		if (!(*own = data_uri(g, uri->valuestring, iw, len)))
+			return false;
+		*data = *own;
+		return true;
+	} else if (cJSON_IsString(uri)) {
+		*file = uri_file(g->dir ? g->dir : "", uri->valuestring);
+		return *file ? true : fail(g, iw, "out of memory");
+	}
+	return fail(g, iw, "neither \"uri\" nor \"bufferView\"; expected one");
+}
+
+/* An alphaMode MASK material's coverage: the alpha channel of its base
+ * colour texture (textureInfo ti; mesh_mat.alpha_map, NULL for an image
+ * without one) and its sampler's wrap modes. Read from the model's own
+ * bytes, or from the image file beside it (not from a buffer: dir NULL). */
+static bool alpha_info(gl *g, const cJSON *ti, const char *where, mesh_mat *m)
+{
+	if (!ti)
+		return true;
+	long t, im, sm;
+	if (!get_index(g, ti, "index", where, g->textures.n, "textures", true, &t))
+		return false;
+	char tw[WHERE_MAX];
+	snprintf(tw, sizeof tw, "textures[%ld]", t);
+	if (!get_index(g, g->textures.v[t], "source", tw, g->images.n, "images", false, &im) ||
+	    !get_index(g, g->textures.v[t], "sampler", tw, g->samplers.n, "samplers", false, &sm))
+		return false;
+	if (sm >= 0) {
+		static const char *const axis[2] = {"wrapS", "wrapT"};
+		char sw[WHERE_MAX];
+		snprintf(sw, sizeof sw, "samplers[%ld]", sm);
+		for (int a = 0; a < 2; a++) {
+			double v;
+			if (!get_num(g, g->samplers.v[sm], axis[a], sw, 0, 1e9, 10497, &v))
+				return false;
+			if (v != 10497 && v != 33071 && v != 33648)
+				return fail(g, sw, "%s: %g; expected 33071 (clamp), 33648 (mirrored repeat) or 10497 (repeat)",
+				            axis[a], v);
+			m->alpha_wrap[a] = v == 33071 ? MESH_WRAP_CLAMP : v == 33648 ? MESH_WRAP_MIRROR : MESH_WRAP_REPEAT;
+		}
+	}
+	if (im < 0)
+		return true;
+	char iw[WHERE_MAX];
+	snprintf(iw, sizeof iw, "images[%ld]", im);
+	const unsigned char *data = NULL;
+	size_t len = 0;
+	unsigned char *own = NULL;
+	char *file = NULL;
+	const char *ext;
+	if (!image_bytes(g, im, iw, &data, &len, &own, &file, &ext))
+		return false;
+	char name[RT_ERROR_FILE_MAX + 64];
+	char *disk = NULL;
+	if (file) {
+		if (!g->dir) { /* a buffer: no file is read */
+			free(file);
+			return true;
+		}
+		disk = rt_file_read(file, "image", &len, g->err);
+		snprintf(name, sizeof name, "%s", file);
+		free(file);
+		if (!disk)
+			return false;
+		data = (const unsigned char *)disk;
+	} else {
+		snprintf(name, sizeof name, "%s: images[%ld].%s", g->name, im, ext);
+	}
+	int w = 0, h = 0;
+	bool ok = image_decode_alpha(name, data, len, &m->alpha_map, &w, &h, g->err);
+	free(own);
+	free(disk);
+	m->alpha_w = w;
+	m->alpha_h = h;
+	return ok;
+}
+
 /* The texture a textureInfo names: a file beside the model (*file), or an
  * embedded image decoded once per image and colour space (*tex, held by
  * the builder). Neither when the texture has no image rtsh reads. */
@@ -978,32 +1076,14 @@ static bool tex_info(gl *g, mesh_builder *b, texture **cache, const cJSON *ti, c
 	}
 	char iw[WHERE_MAX];
 	snprintf(iw, sizeof iw, "images[%ld]", im);
-	const cJSON *img = g->images.v[im], *uri = key(img, "uri"), *mime = key(img, "mimeType");
-	long bv;
-	if (!get_index(g, img, "bufferView", iw, g->views.n, "bufferViews", false, &bv))
-		return false;
-	const char *ext = "png";
-	if (cJSON_IsString(mime) && strcmp(mime->valuestring, "image/jpeg") == 0)
-		ext = "jpg";
 	const unsigned char *data = NULL;
 	size_t len = 0;
 	unsigned char *own = NULL;
-	if (bv >= 0) {
-		size_t stride;
-		if (!view(g, (size_t)bv, &data, &len, &stride))
-			return false;
-	} else if (cJSON_IsString(uri) && strncmp(uri->valuestring, "data:", 5) == 0) {
-		if (strncmp(uri->valuestring, "data:image/jpeg", 15) == 0)
-			ext = "jpg";
-		if (!(own = data_uri(g, uri->valuestring, iw, &len)))
-			return false;
-		data = own;
-	} else if (cJSON_IsString(uri)) {
-		*file = uri_file(g->dir ? g->dir : "", uri->valuestring);
-		return *file ? true : fail(g, iw, "out of memory");
-	} else {
-		return fail(g, iw, "neither \"uri\" nor \"bufferView\"; expected one");
-	}
+	const char *ext;
+	if (!image_bytes(g, im, iw, &data, &len, &own, file, &ext))
+		return false;
+	if (*file)
+		return true;
 	char name[RT_ERROR_FILE_MAX + 64];
 	snprintf(name, sizeof name, "%s: images[%ld].%s", g->name, im, ext);
 	int w = 0, h = 0;
@@ -1154,6 +1234,9 @@ static bool material(gl *g, mesh_builder *b, texture **cache, size_t i, mesh_mat
 		m->uvo[0] = (float)(off[0] - sn * sc[1]);
 		m->uvo[1] = (float)(1 - off[1] - cr * sc[1]);
 	}
+	snprintf(w2, sizeof w2, "%s.pbrMetallicRoughness.baseColorTexture", where);
+	if (m->alpha_mode != MESH_ALPHA_OPAQUE && !alpha_info(g, bt, w2, m))
+		return false;
 	snprintf(w2, sizeof w2, "%s.pbrMetallicRoughness.metallicRoughnessTexture", where);
 	if (!tex_info(g, b, cache, key(pbr, "metallicRoughnessTexture"), w2, false, &m->map_mr, &m->tex_mr))
 		return false;
@@ -1292,7 +1375,10 @@ static mesh *build(gl *g)
 			}
 		}
 	}
-	return mb_finish(&b, g->err);
+	mesh *m = mb_finish(&b, g->err);
+	for (uint32_t i = 0; m && i < m->nmats; i++)
+		m->cuts |= m->mats[i].alpha_mode != MESH_ALPHA_OPAQUE;
+	return m;
 }
 
 mesh *mesh_parse_gltf_node(const char *name, const char *dir, const char *buf, size_t len, long node, rt_error *err)

@@ -153,9 +153,9 @@ static inline __attribute__((always_inline)) WALK_TARGET bool WALK(const mesh *m
 				mesh_stat_blocks++;
 #endif
 #if WALK_ISA >= 1
-				int l = block_sse(blk, r, &rq, tmin, &best, b);
+				int l = block_sse(m, first + k, blk, r, &rq, tmin, &best, b);
 #else
-				int l = block_scalar(blk, r, tmin, &best, b);
+				int l = block_scalar(m, first + k, blk, r, tmin, &best, b);
 #endif
 				if (l >= 0) {
 					*tri = 4 * (first + k) + (uint32_t)l;

@@ -148,6 +148,39 @@ static float *read_stb(const char *path, const unsigned char *buf, size_t len, b
 	return out;
 }
 
+/* The alpha channel of a PNG, TGA or BMP (stb_image): codes / 255, linear
+ * (never sRGB-decoded), bytes top row first. */
+static bool read_stb_alpha(const char *path, const unsigned char *buf, size_t len, unsigned char **alpha, int *w,
+                           int *h, rt_error *err)
+{
+	int x = 0, y = 0, comp = 0;
+	if (len > INT32_MAX || !stbi_info_from_memory(buf, (int)len, &x, &y, &comp))
+		return rt_error_set(err, "%s: cannot decode the image: %s", path,
+		                    len > INT32_MAX ? "too large" : stbi_failure_reason());
+	if (comp != 2 && comp != 4)
+		return true; /* grey or RGB: opaque */
+	if (!size_ok(path, x, y, err))
+		return false;
+	if ((double)x * (double)y * comp > IMAGE_MAX_RATIO * (double)len + 65536.0)
+		return rt_error_set(err, "%s: the header says %dx%d pixels, more than its %zu bytes can hold; expected a "
+		                    "complete image", path, x, y, len);
+	unsigned char *c = stbi_load_from_memory(buf, (int)len, &x, &y, &comp, comp);
+	if (!c)
+		return rt_error_set(err, "%s: cannot decode the image: %s", path, stbi_failure_reason());
+	size_t n = (size_t)x * (size_t)y;
+	unsigned char *a = malloc(n);
+	if (a)
+		for (size_t i = 0; i < n; i++)
+			a[i] = c[i * (size_t)comp + (size_t)comp - 1];
+	stbi_image_free(c);
+	if (!a)
+		return rt_error_set(err, "%s: out of memory (%dx%d image)", path, x, y);
+	*alpha = a;
+	*w = x;
+	*h = y;
+	return true;
+}
+
 /* --- netpbm --- */
 
 typedef struct pnm {
@@ -540,4 +573,17 @@ float *image_load_rgb(const char *path, bool srgb, int *w, int *h, rt_error *err
 	float *out = image_decode_rgb(path, (const unsigned char *)buf, len, srgb, w, h, err);
 	free(buf);
 	return out;
+}
+
+bool image_decode_alpha(const char *path, const unsigned char *buf, size_t len, unsigned char **alpha, int *w, int *h,
+                        rt_error *err)
+{
+	*alpha = NULL;
+	*w = *h = 0;
+	int f = format_of(path);
+	if (f == F_STB && len >= 2 && buf[0] == 'P' && (buf[1] == '5' || buf[1] == '6'))
+		f = F_PPM;
+	if (f != F_STB || stbi_is_hdr_from_memory(buf, len > INT32_MAX ? 0 : (int)len))
+		return true; /* PPM, PFM, XPM, HDR, JPEG (stb says 3): no alpha */
+	return read_stb_alpha(path, buf, len, alpha, w, h, err);
 }
