@@ -20,8 +20,9 @@
  * sample, shadowed: over the first DENOISE_FEATURE_SAMPLES samples one
  * fixed set of 32 of each, the same for every pixel, so that the feature is
  * smooth; through a glossy metal that is looked through, its own highlight
- * too): it explains shadows, highlights and the sky's contact shadows that
- * albedo and normal do not. The job also keeps the mean
+ * too, the lamps from 8 directions a sample of its own lobe, 64 fixed ones
+ * in all): it explains shadows, highlights and the sky's contact shadows
+ * that albedo and normal do not. The job also keeps the mean
  * radiance and squared brightness of the even-numbered samples: with
  * those of all of them they split the samples into two independent halves,
  * and the albedo at the even samples' and all the samples' own positions.

@@ -68,9 +68,10 @@ static void hammersley(unsigned idx, unsigned n, double *u, double *v)
  * Hammersley set of 4 DENOISE_FEATURE_SAMPLES (hammersley): the same
  * points for every pixel, so that the feature is a smooth function of the
  * position (random points made it noisy where a glossy lobe sees the lamp,
- * its highlight). With more than DIRECT_EMITTERS lamps, r1 picks them. No
+ * its highlight). With more than DIRECT_EMITTERS lamps, r1 picks them;
+ * without lamps (false: lobe_feature takes them), the point lights alone. No
  * weight of multiple importance sampling: the full direct light. */
-static double direct_feature(const world *w, const bsdf *b, vec3 p, uint32_t self, int ks, double r1)
+static double direct_feature(const world *w, const bsdf *b, vec3 p, uint32_t self, int ks, double r1, bool lamps)
 {
 	double sum = 0.0;
 	if (!b->smooth)
@@ -88,7 +89,7 @@ static double direct_feature(const world *w, const bsdf *b, vec3 p, uint32_t sel
 			continue;
 		sum += lum_d(v3_mul(f, v3_scale(lr, RT_PI * c)));
 	}
-	size_t ne = w->nemitters, pick = ne < DIRECT_EMITTERS ? ne : DIRECT_EMITTERS;
+	size_t ne = lamps ? w->nemitters : 0, pick = ne < DIRECT_EMITTERS ? ne : DIRECT_EMITTERS;
 	for (size_t k = 0; k < pick; k++) {
 		size_t ei = ne <= DIRECT_EMITTERS ? k : (size_t)((k + r1) * (double)ne / DIRECT_EMITTERS);
 		const emitter *e = &w->emitters[ei < ne ? ei : ne - 1];
@@ -152,6 +153,45 @@ static double env_feature(const world *w, const bsdf *b, vec3 p, int k)
 		sum += lum_d(v3_mul(f, world_background(w, wi, MODE_PATH))) * RT_PI;
 	}
 	return sum / ENV_DIRS;
+}
+
+/* Directions of a glossy lobe's lamp feature per sample (LOBE_DIRS x
+ * DENOISE_FEATURE_SAMPLES in the whole set). */
+#define LOBE_DIRS 8
+
+/* The lamps' light that a glossy lobe looked through (a metal of little
+ * fuzz: narrower than a lamp, so that a few points on the lamp would make
+ * spikes) sends toward the eye, as brightness: LOBE_DIRS directions a
+ * sample drawn from the lobe itself (bsdf_sample_u) with sample ks's share
+ * of one fixed Hammersley set, each one's emission where it meets a lamp
+ * first (what the direction meets first: shadows included). The same
+ * directions about every mirror direction: the lamp's image blurred by the
+ * lobe, smooth from pixel to pixel. */
+static double lobe_feature(const world *w, const bsdf *b, vec3 p, int ks)
+{
+	if (!b->smooth || w->nemitters == 0)
+		return 0.0;
+	double sum = 0.0;
+	for (int q = 0; q < LOBE_DIRS; q++) {
+		unsigned idx = (unsigned)(q * DENOISE_FEATURE_SAMPLES + ks % DENOISE_FEATURE_SAMPLES);
+		double u[3];
+		hammersley(idx, LOBE_DIRS * DENOISE_FEATURE_SAMPLES, &u[1], &u[2]);
+		/* the lobe's pick (where there are more): a golden-ratio sequence,
+		 * apart from the two coordinates */
+		double g = (idx + 0.5) * 0.6180339887498949;
+		u[0] = g - (double)(long)g;
+		bsdf_sample sm;
+		if (!bsdf_sample_u(b, u, &sm) || sm.transmit)
+			continue;
+		ray r = {p, sm.wi};
+		hit h;
+		if (!world_intersect(w, &r, 0.0, INFINITY, &h))
+			continue;
+		vec3 e = hit_emission(&w->mats[h.mat], &h);
+		if (e.x + e.y + e.z > 0.0)
+			sum += lum_d(v3_mul(sm.weight, e));
+	}
+	return sum / LOBE_DIRS;
 }
 
 /* What the camera ray r shows first, in f (albedo, normal, depth). A
@@ -219,12 +259,14 @@ static void first_surface(const world *w, ray r, int ks, double f[8])
 			f[6] += dist;
 			if (ks >= 0 && !(e.x + e.y + e.z > 0.0)) {
 				vec3 p = offset_point(w, h.p, b.n);
-				f[7] += (direct_feature(w, &b, p, h.object, ks, r1) + env_feature(w, &b, p, ks)) * lum_d(tint);
+				f[7] += (direct_feature(w, &b, p, h.object, ks, r1, true) + env_feature(w, &b, p, ks)) * lum_d(tint);
 			}
 			return;
 		}
-		if (ks >= 0 && b.smooth) /* a glossy lobe looked through: its own highlights */
-			f[7] += direct_feature(w, &b, offset_point(w, h.p, b.n), h.object, ks, r1) * lum_d(tint);
+		if (ks >= 0 && b.smooth) { /* a glossy lobe looked through: its own highlights */
+			vec3 p = offset_point(w, h.p, b.n);
+			f[7] += (direct_feature(w, &b, p, h.object, ks, r1, false) + lobe_feature(w, &b, p, ks)) * lum_d(tint);
+		}
 		if (b.smooth && !gl) {
 			gl = true;
 			gl_a = v3_mul(a, tint);

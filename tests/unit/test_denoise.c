@@ -650,23 +650,31 @@ static void test_env_feature(void **state)
 	}
 }
 
-/* A lamp seen through a glossy lobe: a white metal of fuzz 0.1 (looked
- * through, test_features_through_mirror) at z = 2 facing the camera at the
- * origin, a lamp of radiance 5 (a sphere of radius 1 at z = -3, behind the
- * camera): the reflected centre ray meets the lamp at z = -2. Through the
- * fuzz the lamp is blurred, so the features are the metal's own: albedo
- * white, normal -z, depth 2. Through a perfect mirror the lamp is sharp:
- * its emission is the albedo (far from any surface's), depth 2 + 4 = 6. */
+/* A lamp seen through a glossy lobe: a white metal of fuzz 0.05 (Phong
+ * exponent 5 / 0.05^2 - 2 = 1998, looked through as a mirror is,
+ * test_features_through_mirror) at z = 2 facing the camera at the origin, a
+ * lamp of radiance 5 (a sphere of radius 2.5 at z = -5, behind the camera):
+ * the reflected centre ray meets the lamp at z = -2.5. Through the fuzz the
+ * lamp is blurred, so the features are the metal's own: albedo white,
+ * normal -z, depth 2. Through a perfect mirror the lamp is sharp: its
+ * emission is the albedo (far from any surface's), depth 2 + 4.5 = 6.5.
+ * The glossy metal's direct light then holds the lamp as its lobe sees it:
+ * the lamp covers 20.9 degrees about the mirror direction (sin = 2.5 / 7);
+ * the lobe sends all but cos(20.9 deg)^1999 (nothing) of its directions
+ * there, each with the weight f cos / pdf of a white metal, between 1 and
+ * (n + 2) / (n + 1) = 1.0005 times the tint 1 (the cosine within a degree
+ * or two of the normal): 5, to 1 %. 32 points on the lamp weighed by the
+ * lobe instead are too far apart for a lobe a degree or two wide. */
 static void test_lamp_through_glossy(void **state)
 {
 	(void)state;
 	const char *texts[2] = {
-		"C 0,0,0 0,0,1 10\npl 0,0,2 0,0,-1 1,1,1 255,255,255 0 0 1 1 metal=1 fuzz=0.1\n"
-		"sp 0,0,-3 0,1,0 2,2,2 255,255,255 0 0 1 0 emit=5\n",
+		"C 0,0,0 0,0,1 10\npl 0,0,2 0,0,-1 1,1,1 255,255,255 0 0 1 1 metal=1 fuzz=0.05\n"
+		"sp 0,0,-5 0,1,0 5,5,5 255,255,255 0 0 1 0 emit=5\n",
 		"C 0,0,0 0,0,1 10\npl 0,0,2 0,0,-1 1,1,1 255,255,255 0 0 1 1\n"
-		"sp 0,0,-3 0,1,0 2,2,2 255,255,255 0 0 1 0 emit=5\n",
+		"sp 0,0,-5 0,1,0 5,5,5 255,255,255 0 0 1 0 emit=5\n",
 	};
-	const double albedo[2] = {1, 5}, normal_z[2] = {-1, 1}, depth[2] = {2, 6};
+	const double albedo[2] = {1, 5}, normal_z[2] = {-1, 1}, depth[2] = {2, 6.5};
 	for (int c = 0; c < 2; c++) {
 		scene *s = load_text(texts[c]);
 		world *w = world_build(s, NULL);
@@ -677,6 +685,11 @@ static void test_lamp_through_glossy(void **state)
 			assert_near(f[k], albedo[c], 1e-5);
 		assert_near(f[5], normal_z[c], 1e-3);
 		assert_near(f[6], depth[c], 1e-3);
+		if (c == 0) {
+			for (int k = 1; k < DENOISE_FEATURE_SAMPLES; k++)
+				denoise_sample(w, cam_ray(&w->cam, 4.5, 4.5, 9, 9), k, f);
+			assert_near(f[7] / DENOISE_FEATURE_SAMPLES, 5.0, 0.05);
+		}
 		world_free(w);
 		scene_free(s);
 	}

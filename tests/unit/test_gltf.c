@@ -1093,6 +1093,7 @@ static void png_half(char *uri64)
  * centre of the transparent one (bilinear, repeat: alpha 1.5 - 2u on
  * [0.25, 0.75]). */
 static const char *cut_sampler; /* the texture's sampler (its JSON), NULL: none */
+static bool cut_mirror;          /* the plane a perfect mirror, not Lambertian */
 
 static world *cut_world(const char *mat, bool tex, double tx, double qy, scene **out)
 {
@@ -1134,8 +1135,9 @@ static world *cut_world(const char *mat, bool tex, double tx, double qy, scene *
 		fail_msg("%s", err.msg);
 	object pl = object_make(OBJ_PLANE, linear_to_srgb255(v3(0.5, 0.5, 0.5)));
 	pl.dir = v3(0, 1, 0);
-	pl.mat.diffuse = 1;
+	pl.mat.diffuse = cut_mirror ? 0 : 1;
 	pl.mat.specular = 0;
+	pl.mat.reflective = cut_mirror ? 1 : 0;
 	assert_true(scene_add_object(s, &pl, &err));
 	world *w = world_build(s, &err);
 	if (!w)
@@ -1496,6 +1498,41 @@ static void test_cutout_image_file(void **state)
 	}
 }
 
+/* Reflection rays: the plane a perfect mirror (no diffuse part), the quad
+ * 10 above it, above the camera, glowing (emissiveFactor 0.5, black
+ * metal). The camera's centre ray meets the mirror at the origin and goes
+ * back up the y axis: through the opaque texel it meets the quad and
+ * brings back its emission, 0.5 (Whitted: the mirror's weight 1 times
+ * what the reflection sees); through the clear texel it leaves into the
+ * black: 0. Single ray and packets. */
+static void test_cutout_reflection(void **state)
+{
+	(void)state;
+	const char *mat = "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1],\"baseColorTexture\":{\"index\":0}},"
+	                  "\"emissiveFactor\":[0.5,0.5,0.5],\"alphaMode\":\"MASK\"}";
+	for (int k = 0; k < 2; k++) {
+		scene *s;
+		cut_mirror = true;
+		world *w = cut_world(mat, true, k ? -0.5 : 0.5, 10, &s);
+		cut_mirror = false;
+		double want = k ? 0 : 0.5;
+		render_settings set = render_settings_default();
+		set.width = set.height = 1001;
+		set.samples = 1;
+		set.depth = 4;
+		set.threads = 1;
+		set.mode = MODE_WHITTED;
+		vec3 c = whitted_radiance(w, &set, render_sample_ray(w, &set, 500, 500, 1001, 1001, 0));
+		assert_vec_near(c, v3_splat(want), 1e-5);
+		float px[16 * 3];
+		render_rect(w, &set, 498, 498, 502, 502, px);
+		for (int i = 0; i < 16 * 3; i++)
+			assert_near(px[i], want, 1e-5);
+		world_free(w);
+		scene_free(s);
+	}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -1522,6 +1559,7 @@ int main(void)
 	    cmocka_unit_test(test_cutout_lamp),
 	    cmocka_unit_test(test_blend),
 	    cmocka_unit_test(test_cutout_image_file),
+	    cmocka_unit_test(test_cutout_reflection),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
 }
