@@ -20,34 +20,7 @@
 #include "rtsh/rtfile.h"
 #include "rtsh/world.h"
 #include "testutil.h"
-
-static char tmpdir[64];
-
-static int setup(void **state)
-{
-	(void)state;
-	snprintf(tmpdir, sizeof tmpdir, "/tmp/rtsh-gltf-XXXXXX");
-	return mkdtemp(tmpdir) ? 0 : -1;
-}
-
-static int teardown(void **state)
-{
-	(void)state;
-	char cmd[128];
-	snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
-	return system(cmd) == 0 ? 0 : -1;
-}
-
-static const char *tmp_text(const char *name, const char *text)
-{
-	static char p[256];
-	snprintf(p, sizeof p, "%s/%s", tmpdir, name);
-	FILE *f = fopen(p, "w");
-	assert_non_null(f);
-	assert_true(fputs(text, f) >= 0);
-	assert_int_equal(fclose(f), 0);
-	return p;
-}
+#include "tmpdir.h"
 
 /* s saved as tmpdir/name reads back as s; the copy read back (the caller
  * frees it). */
@@ -1521,5 +1494,5 @@ int main(void)
 	    cmocka_unit_test(test_cutout_image_file),
 	    cmocka_unit_test(test_cutout_reflection),
 	};
-	return cmocka_run_group_tests(tests, setup, teardown);
+	return cmocka_run_group_tests(tests, tmpdir_setup, tmpdir_teardown);
 }
