@@ -257,6 +257,11 @@ install: all
 	install -m 644 man/rtsh.1 $(DESTDIR)$(PREFIX)/share/man/man1/rtsh.1
 	install -m 644 man/rtsh.5 $(DESTDIR)$(PREFIX)/share/man/man5/rtsh.5
 	install -m 644 scenes/*.rt $(DESTDIR)$(PREFIX)/share/rtsh/scenes/
+	# the models and textures the scenes name by relative path (spot.rt, earth.rt, fence.rt)
+	for d in $$(cd scenes && find models textures -type d); do \
+		install -d $(DESTDIR)$(PREFIX)/share/rtsh/scenes/$$d; done
+	for f in $$(cd scenes && find models textures -type f ! -name '*.py'); do \
+		install -m 644 scenes/$$f $(DESTDIR)$(PREFIX)/share/rtsh/scenes/$$f; done
 
 uninstall:
 	rm -f $(DESTDIR)$(PREFIX)/bin/rtsh $(DESTDIR)$(PREFIX)/share/man/man1/rtsh.1 \

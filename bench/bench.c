@@ -326,7 +326,7 @@ static void bench_grid(void)
 	for (int k = 0; k < 2 && cli; k++) {
 		mc[k] = median(c[k], nc[k]);
 		row *r = add_row("grid.rt", "rtsh-process", w, h, 1, k + 1, nc[k], mc[k], -1);
-		snprintf(r->note, sizeof r->note, "rtsh grid.rt -o x.ppm: read, prepare, render, write");
+		snprintf(r->note, sizeof r->note, "rtsh grid.rt -o x.ppm: start, read, prepare, render + write, sync");
 	}
 	for (int k = 0; k < 2 && pov && np[0] && np[1]; k++) {
 		double mw = median(pw[k], np[k]), mt = median(pt[k], np[k]);

@@ -60,8 +60,10 @@ float *image_load_netpbm(const char *path, bool pfm, int *w, int *h, rt_error *e
 /* True when the extension is one image_load_rgb reads. */
 bool image_format_known(const char *path);
 
-/* A texture with its mip chain; takes the pixels. */
-texture *texture_make(float *rgb, int w, int h, rt_error *err);
+/* A texture with its mip chain; takes the pixels (freed on failure). Its
+ * path is a copy of name (NULL: none) and srgb says how its pixels were
+ * decoded (the caches' key). */
+texture *texture_make(float *rgb, int w, int h, const char *name, bool srgb, rt_error *err);
 texture *texture_load(const char *path, bool srgb, rt_error *err);
 void texture_free(texture *t);
 

@@ -133,55 +133,33 @@ bool m4_invert(mat4 a, mat4 *out)
 	return true;
 }
 
+/* The makers below write their matrix out row by row. */
 mat4 m4_translate(vec3 t)
 {
-	mat4 r = m4_identity();
-	r.m[0][3] = t.x;
-	r.m[1][3] = t.y;
-	r.m[2][3] = t.z;
-	return r;
+	return (mat4){{{1, 0, 0, t.x}, {0, 1, 0, t.y}, {0, 0, 1, t.z}, {0, 0, 0, 1}}};
 }
 
 mat4 m4_scale(vec3 s)
 {
-	mat4 r = m4_identity();
-	r.m[0][0] = s.x;
-	r.m[1][1] = s.y;
-	r.m[2][2] = s.z;
-	return r;
+	return (mat4){{{s.x, 0, 0, 0}, {0, s.y, 0, 0}, {0, 0, s.z, 0}, {0, 0, 0, 1}}};
 }
 
 mat4 m4_rotate_x(double a)
 {
-	mat4 r = m4_identity();
 	double c = cos(a), s = sin(a);
-	r.m[1][1] = c;
-	r.m[1][2] = -s;
-	r.m[2][1] = s;
-	r.m[2][2] = c;
-	return r;
+	return (mat4){{{1, 0, 0, 0}, {0, c, -s, 0}, {0, s, c, 0}, {0, 0, 0, 1}}};
 }
 
 mat4 m4_rotate_y(double a)
 {
-	mat4 r = m4_identity();
 	double c = cos(a), s = sin(a);
-	r.m[0][0] = c;
-	r.m[0][2] = s;
-	r.m[2][0] = -s;
-	r.m[2][2] = c;
-	return r;
+	return (mat4){{{c, 0, s, 0}, {0, 1, 0, 0}, {-s, 0, c, 0}, {0, 0, 0, 1}}};
 }
 
 mat4 m4_rotate_z(double a)
 {
-	mat4 r = m4_identity();
 	double c = cos(a), s = sin(a);
-	r.m[0][0] = c;
-	r.m[0][1] = -s;
-	r.m[1][0] = s;
-	r.m[1][1] = c;
-	return r;
+	return (mat4){{{c, -s, 0, 0}, {s, c, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}}};
 }
 
 mat4 m4_rotate_axis(vec3 k, double a)

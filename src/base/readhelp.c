@@ -81,6 +81,20 @@ static bool word_at(const char *s, const char *end, const char *w)
 	return true;
 }
 
+const unsigned char *skip_space(const unsigned char *s, const unsigned char *end, bool comments, int *lines)
+{
+	for (; s < end; s++) {
+		if (*s == '\n' && lines)
+			++*lines;
+		else if (comments && *s == '#')
+			while (s + 1 < end && s[1] != '\n')
+				s++;
+		else if (*s != ' ' && *s != '\t' && *s != '\r' && *s != '\n')
+			break;
+	}
+	return s;
+}
+
 bool scan_double(const char **sp, const char *end, double *out)
 {
 	const char *s = *sp;
@@ -101,28 +115,26 @@ bool scan_double(const char **sp, const char *end, double *out)
 	uint64_t mant = 0;
 	int digits = 0, scale = 0;
 	bool any = false;
-	while (s < end && *s >= '0' && *s <= '9') {
+	/* The digits before and after one point: the first 19 significant ones
+	 * make mant; a later one before the point scales it up, after the point
+	 * it is dropped. */
+	bool frac = false;
+	for (; s < end; s++) {
+		if (*s == '.' && !frac) {
+			frac = true;
+			continue;
+		}
+		if (*s < '0' || *s > '9')
+			break;
 		any = true;
 		if (digits < 19) {
 			mant = mant * 10 + (uint64_t)(*s - '0');
 			if (mant)
 				digits++;
-		} else {
-			scale++;
-		}
-		s++;
-	}
-	if (s < end && *s == '.') {
-		s++;
-		while (s < end && *s >= '0' && *s <= '9') {
-			any = true;
-			if (digits < 19) {
-				mant = mant * 10 + (uint64_t)(*s - '0');
-				if (mant)
-					digits++;
+			if (frac)
 				scale--;
-			}
-			s++;
+		} else if (!frac) {
+			scale++;
 		}
 	}
 	if (!any)

@@ -17,6 +17,11 @@ bool scan_double(const char **s, const char *end, double *out);
 /* A decimal integer (optionally signed). */
 bool scan_long(const char **s, const char *end, long *out);
 
+/* The first byte from s on (not past end) that is no blank (' ', '\t',
+ * '\r') or line end, each '\n' counted in *lines (when not NULL), and with
+ * `comments` not in a '#' comment, which runs to its line's end. */
+const unsigned char *skip_space(const unsigned char *s, const unsigned char *end, bool comments, int *lines);
+
 /* Ctrl-C during a read (issue 31, defect 3): the flag the readers on this
  * thread poll, set around a read by the caches (mesh_cache_get,
  * texture_cache_get); NULL: none. Returns the one it replaces. */

@@ -49,19 +49,34 @@ static uint8_t *encode_rows(const image_ctx *c, bool *owned)
 	return px;
 }
 
-static bool write_ppm(FILE *f, void *vctx, rt_error *err)
+/* An 8-bit format's encoder, given the image's sRGB codes px (rows top to
+ * bottom, R,G,B). */
+typedef bool (*write8_fn)(FILE *f, const image_ctx *c, uint8_t *px, rt_error *err);
+
+/* Runs an 8-bit encoder on the image's codes (encode_rows) and frees them
+ * when they were made for it. */
+static bool write_8bit(FILE *f, const image_ctx *c, write8_fn put, rt_error *err)
 {
-	image_ctx *c = vctx;
 	bool owned;
 	uint8_t *px = encode_rows(c, &owned);
 	if (!px)
 		return rt_error_at(err, c->path, 0, 0, "out of memory");
-	fprintf(f, "P6\n%d %d\n255\n", c->fb->w, c->fb->h);
-	size_t n = (size_t)c->fb->w * (size_t)c->fb->h * 3;
-	bool ok = fwrite(px, 1, n, f) == n;
+	bool ok = put(f, c, px, err);
 	if (owned)
 		free(px);
-	return ok || rt_error_at(err, c->path, 0, 0, "write failed");
+	return ok;
+}
+
+static bool ppm_put(FILE *f, const image_ctx *c, uint8_t *px, rt_error *err)
+{
+	fprintf(f, "P6\n%d %d\n255\n", c->fb->w, c->fb->h);
+	size_t n = (size_t)c->fb->w * (size_t)c->fb->h * 3;
+	return fwrite(px, 1, n, f) == n || rt_error_at(err, c->path, 0, 0, "write failed");
+}
+
+static bool write_ppm(FILE *f, void *vctx, rt_error *err)
+{
+	return write_8bit(f, vctx, ppm_put, err);
 }
 
 static bool write_pfm(FILE *f, void *vctx, rt_error *err)
@@ -105,18 +120,11 @@ static void png_warning_dropped(png_structp png, png_const_charp msg)
 	(void)msg;
 }
 
-static bool write_png(FILE *f, void *vctx, rt_error *err)
+static bool png_put(FILE *f, const image_ctx *c, uint8_t *px, rt_error *err)
 {
-	image_ctx *c = vctx;
-	bool owned;
-	uint8_t *px = encode_rows(c, &owned);
 	png_bytep *rows = malloc((size_t)c->fb->h * sizeof *rows);
-	if (!px || !rows) {
-		if (owned)
-			free(px);
-		free(rows);
+	if (!rows)
 		return rt_error_at(err, c->path, 0, 0, "out of memory");
-	}
 	char why[160] = "";
 	png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, why, png_error_kept, png_warning_dropped);
 	png_infop info = png ? png_create_info_struct(png) : NULL;
@@ -135,13 +143,16 @@ static bool write_png(FILE *f, void *vctx, rt_error *err)
 	}
 	png_destroy_write_struct(&png, &info);
 	free(rows);
-	if (owned)
-		free(px);
 	/* a failed write is named by the writer's errno (the caller checks
 	 * the file); libpng's own words otherwise */
 	if (!ok && ferror(f))
 		return rt_error_at(err, c->path, 0, 0, "write failed");
 	return ok || rt_error_at(err, c->path, 0, 0, "PNG encoding failed%s%s", why[0] ? ": " : "", why);
+}
+
+static bool write_png(FILE *f, void *vctx, rt_error *err)
+{
+	return write_8bit(f, vctx, png_put, err);
 }
 
 /* stb_image_write's output goes to the file; a failed write is kept. */
@@ -152,20 +163,17 @@ static void jpeg_out(void *ctx, void *data, int size)
 		fwrite(data, 1, (size_t)size, f);
 }
 
-static bool write_jpeg(FILE *f, void *vctx, rt_error *err)
+static bool jpeg_put(FILE *f, const image_ctx *c, uint8_t *px, rt_error *err)
 {
-	image_ctx *c = vctx;
-	bool owned;
-	uint8_t *px = encode_rows(c, &owned);
-	if (!px)
-		return rt_error_at(err, c->path, 0, 0, "out of memory");
 	/* Quality 92: no blocks a person sees on a rendered picture. */
-	int ok = stbi_write_jpg_to_func(jpeg_out, f, c->fb->w, c->fb->h, 3, px, 92);
-	if (owned)
-		free(px);
-	if (!ok)
+	if (!stbi_write_jpg_to_func(jpeg_out, f, c->fb->w, c->fb->h, 3, px, 92))
 		return rt_error_at(err, c->path, 0, 0, "JPEG encoding failed");
 	return !ferror(f) || rt_error_at(err, c->path, 0, 0, "write failed");
+}
+
+static bool write_jpeg(FILE *f, void *vctx, rt_error *err)
+{
+	return write_8bit(f, vctx, jpeg_put, err);
 }
 
 /* --- writing the rows as the render finishes them (image_write_rendered) --- */
@@ -227,12 +235,19 @@ static bool stream_make(stream *st, render_rows_fn rows, rt_error *err)
 	return true;
 }
 
-static bool write_ppm_rendered(FILE *f, void *vctx, rt_error *err)
+/* Points the stream at the file the atomic save opened (image_write_rendered). */
+static void stream_open(stream *st, FILE *f)
 {
-	stream *st = vctx;
 	st->f = f;
 	st->fd = fileno(f);
 	st->synced = 0;
+	st->why[0] = '\0';
+}
+
+static bool write_ppm_rendered(FILE *f, void *vctx, rt_error *err)
+{
+	stream *st = vctx;
+	stream_open(st, f);
 	if (fprintf(f, "P6\n%d %d\n255\n", st->w, st->h) < 0)
 		return rt_error_at(err, st->path, 0, 0, "write failed");
 	return stream_make(st, ppm_rows, err);
@@ -262,10 +277,7 @@ static bool png_rows(void *vctx, const framebuffer *fb, int y0, int y1)
 static bool write_png_rendered(FILE *f, void *vctx, rt_error *err)
 {
 	stream *st = vctx;
-	st->f = f;
-	st->fd = fileno(f);
-	st->synced = 0;
-	st->why[0] = '\0';
+	stream_open(st, f);
 	png_infop info = NULL;
 	st->png = png_create_write_struct(PNG_LIBPNG_VER_STRING, st->why, png_error_kept, png_warning_dropped);
 	if (st->png)

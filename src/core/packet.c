@@ -48,6 +48,18 @@ typedef struct pk_state {
 	bool tie[PACKET_MAX];
 } pk_state;
 
+/* Ray i by component, and d . d as sphere_hit computes it. */
+static inline void pk_load_ray(pk_state *s, int i, const ray *r)
+{
+	s->ox[i] = r->o.x;
+	s->oy[i] = r->o.y;
+	s->oz[i] = r->o.z;
+	s->dx[i] = r->d.x;
+	s->dy[i] = r->d.y;
+	s->dz[i] = r->d.z;
+	s->dd[i] = v3_dot(r->d, r->d);
+}
+
 /* The interval form of bvh_ray: per axis, the near- and far-plane origins
  * that give the lowest near and highest far distances of any ray, the
  * inverse directions' range, and the rows of the node's boxes to read. */
@@ -166,23 +178,42 @@ static inline void offer(pk_state *s, int i, const prim *p, double t, vec3 nl)
 	}
 }
 
+#if defined(__SSE2__)
+/* A sphere in SSE2 registers, both lanes: its centre and squared radius. */
+typedef struct pk_sphere {
+	__m128d cx, cy, cz, rr;
+} pk_sphere;
+
+static inline pk_sphere pk_sphere_of(const prim *p)
+{
+	return (pk_sphere){_mm_set1_pd(p->u.sph.c.x), _mm_set1_pd(p->u.sph.c.y), _mm_set1_pd(p->u.sph.c.z),
+	                   _mm_set1_pd(p->u.sph.r * p->u.sph.r)};
+}
+
+/* Rays i and i + 1 (bits 0 and 1) whose discriminant against the sphere is
+ * not negative: sphere_hit's, term by term; NaN passes on to sphere_hit,
+ * as there (leaf_spheres and leaf_occluded). */
+static inline unsigned sphere_disc2(const pk_state *s, int i, const pk_sphere *sp)
+{
+	__m128d ocx = _mm_sub_pd(_mm_load_pd(&s->ox[i]), sp->cx);
+	__m128d ocy = _mm_sub_pd(_mm_load_pd(&s->oy[i]), sp->cy);
+	__m128d ocz = _mm_sub_pd(_mm_load_pd(&s->oz[i]), sp->cz);
+	__m128d dx = _mm_load_pd(&s->dx[i]), dy = _mm_load_pd(&s->dy[i]), dz = _mm_load_pd(&s->dz[i]);
+	__m128d b = _mm_add_pd(_mm_add_pd(_mm_mul_pd(ocx, dx), _mm_mul_pd(ocy, dy)), _mm_mul_pd(ocz, dz));
+	__m128d c = _mm_sub_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(ocx, ocx), _mm_mul_pd(ocy, ocy)), _mm_mul_pd(ocz, ocz)),
+	                       sp->rr);
+	__m128d disc = _mm_sub_pd(_mm_mul_pd(b, b), _mm_mul_pd(_mm_load_pd(&s->dd[i]), c));
+	return (unsigned)_mm_movemask_pd(_mm_cmpnlt_pd(disc, _mm_setzero_pd()));
+}
+#endif
+
 static void leaf_spheres(pk_state *s, const prim *p, const ray *r, double tmin)
 {
 	vec3 zero = {0, 0, 0};
 #if defined(__SSE2__)
-	const __m128d cx = _mm_set1_pd(p->u.sph.c.x), cy = _mm_set1_pd(p->u.sph.c.y), cz = _mm_set1_pd(p->u.sph.c.z);
-	const __m128d rr = _mm_set1_pd(p->u.sph.r * p->u.sph.r), zd = _mm_setzero_pd();
+	const pk_sphere sph = pk_sphere_of(p);
 	for (int i = 0; i < s->n; i += 2) {
-		/* sphere_hit's discriminant, term by term */
-		__m128d ocx = _mm_sub_pd(_mm_load_pd(&s->ox[i]), cx);
-		__m128d ocy = _mm_sub_pd(_mm_load_pd(&s->oy[i]), cy);
-		__m128d ocz = _mm_sub_pd(_mm_load_pd(&s->oz[i]), cz);
-		__m128d dx = _mm_load_pd(&s->dx[i]), dy = _mm_load_pd(&s->dy[i]), dz = _mm_load_pd(&s->dz[i]);
-		__m128d b = _mm_add_pd(_mm_add_pd(_mm_mul_pd(ocx, dx), _mm_mul_pd(ocy, dy)), _mm_mul_pd(ocz, dz));
-		__m128d c = _mm_sub_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(ocx, ocx), _mm_mul_pd(ocy, ocy)), _mm_mul_pd(ocz, ocz)), rr);
-		__m128d disc = _mm_sub_pd(_mm_mul_pd(b, b), _mm_mul_pd(_mm_load_pd(&s->dd[i]), c));
-		/* !(disc < 0): NaN goes on to sphere_hit, as there */
-		unsigned m = (unsigned)_mm_movemask_pd(_mm_cmpnlt_pd(disc, zd));
+		unsigned m = sphere_disc2(s, i, &sph);
 		for (; m; m &= m - 1) {
 			int j = i + __builtin_ctz(m);
 			double t;
@@ -208,19 +239,13 @@ static inline double packet_far(const pk_state *s)
 	return m;
 }
 
-typedef struct pk_entry {
-	uint32_t child, meta;
-	float t;
-	uint32_t pad;
-} pk_entry;
-
 static void packet_walk(const world *w, pk_state *s, const ray *r, const pk_ray *q, double tmin)
 {
 	const bvh *tree = w->tree;
 	const bvh_node *nodes = tree->nodes;
 	double far = packet_far(s);
 	float ftmin = to_float_down(tmin), ftmax = to_float_up(far);
-	pk_entry stack[BVH_STACK];
+	bvh_entry stack[BVH_STACK];
 	int sp = 0;
 	uint32_t child = tree->root, meta = tree->root_meta;
 	for (;;) {
@@ -246,19 +271,8 @@ static void packet_walk(const world *w, pk_state *s, const ray *r, const pk_ray 
 			float tn[BVH_WIDTH];
 			unsigned m = packet_slab4(n, q, ftmin, ftmax, tn);
 			if (m) {
-				int idx[BVH_WIDTH], c = 0;
-				for (unsigned b = m; b; b &= b - 1) { /* farthest first, nearest on top */
-					int k = __builtin_ctz(b), j = c++;
-					while (j > 0 && tn[idx[j - 1]] < tn[k]) {
-						idx[j] = idx[j - 1];
-						j--;
-					}
-					idx[j] = k;
-				}
-				for (int i = 0; i < c - 1; i++)
-					stack[sp++] = (pk_entry){n->child[idx[i]], n->meta[idx[i]], tn[idx[i]], 0};
-				child = n->child[idx[c - 1]];
-				meta = n->meta[idx[c - 1]];
+				/* the nearest now, the others later */
+				sp = bvh_enter_sorted(n, m, tn, stack, sp, &child, &meta);
 				continue;
 			}
 		}
@@ -297,23 +311,10 @@ void world_trace_packet(const world *w, int n, const ray *r, double tmin, double
 		s.tmax[i] = t;
 		s.best[i] = NULL;
 		s.tie[i] = false;
-		s.ox[i] = r[i].o.x;
-		s.oy[i] = r[i].o.y;
-		s.oz[i] = r[i].o.z;
-		s.dx[i] = r[i].d.x;
-		s.dy[i] = r[i].d.y;
-		s.dz[i] = r[i].d.z;
-		s.dd[i] = v3_dot(r[i].d, r[i].d);
+		pk_load_ray(&s, i, &r[i]);
 	}
-	if (n & 1) { /* the vector pre-test reads an even count; the pad is never offered */
-		s.ox[n] = s.ox[0];
-		s.oy[n] = s.oy[0];
-		s.oz[n] = s.oz[0];
-		s.dx[n] = s.dx[0];
-		s.dy[n] = s.dy[0];
-		s.dz[n] = s.dz[0];
-		s.dd[n] = s.dd[0];
-	}
+	if (n & 1) /* the vector pre-test reads an even count; the pad is never offered */
+		pk_load_ray(&s, n, &r[0]);
 	packet_walk(w, &s, r, &q, tmin);
 	for (int i = 0; i < n; i++) {
 		if (s.tie[i]) {
@@ -351,19 +352,11 @@ static void leaf_occluded(const world *w, pk_state *s, unsigned *live, const pri
 		}
 		return;
 	}
-	const __m128d cx = _mm_set1_pd(p->u.sph.c.x), cy = _mm_set1_pd(p->u.sph.c.y), cz = _mm_set1_pd(p->u.sph.c.z);
-	const __m128d rr = _mm_set1_pd(p->u.sph.r * p->u.sph.r), zd = _mm_setzero_pd();
+	const pk_sphere sph = pk_sphere_of(p);
 	for (int i = 0; i < s->n; i += 2) {
 		if (!(*live >> i & 3u))
 			continue;
-		__m128d ocx = _mm_sub_pd(_mm_load_pd(&s->ox[i]), cx);
-		__m128d ocy = _mm_sub_pd(_mm_load_pd(&s->oy[i]), cy);
-		__m128d ocz = _mm_sub_pd(_mm_load_pd(&s->oz[i]), cz);
-		__m128d dx = _mm_load_pd(&s->dx[i]), dy = _mm_load_pd(&s->dy[i]), dz = _mm_load_pd(&s->dz[i]);
-		__m128d b = _mm_add_pd(_mm_add_pd(_mm_mul_pd(ocx, dx), _mm_mul_pd(ocy, dy)), _mm_mul_pd(ocz, dz));
-		__m128d c = _mm_sub_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(ocx, ocx), _mm_mul_pd(ocy, ocy)), _mm_mul_pd(ocz, ocz)), rr);
-		__m128d disc = _mm_sub_pd(_mm_mul_pd(b, b), _mm_mul_pd(_mm_load_pd(&s->dd[i]), c));
-		unsigned m = (unsigned)_mm_movemask_pd(_mm_cmpnlt_pd(disc, zd)) & (*live >> i);
+		unsigned m = sphere_disc2(s, i, &sph) & (*live >> i);
 		for (; m; m &= m - 1) {
 			int j = i + __builtin_ctz(m);
 			double t;
@@ -394,23 +387,10 @@ void world_occluded_packet(const world *w, int n, const ray *r, double tmin, con
 		occ[i] = blocked;
 		live |= (unsigned)!blocked << i;
 		s.tmax[i] = tmax[i];
-		s.ox[i] = r[i].o.x;
-		s.oy[i] = r[i].o.y;
-		s.oz[i] = r[i].o.z;
-		s.dx[i] = r[i].d.x;
-		s.dy[i] = r[i].d.y;
-		s.dz[i] = r[i].d.z;
-		s.dd[i] = v3_dot(r[i].d, r[i].d);
+		pk_load_ray(&s, i, &r[i]);
 	}
-	if (n & 1) {
-		s.ox[n] = s.ox[0];
-		s.oy[n] = s.oy[0];
-		s.oz[n] = s.oz[0];
-		s.dx[n] = s.dx[0];
-		s.dy[n] = s.dy[0];
-		s.dz[n] = s.dz[0];
-		s.dd[n] = s.dd[0];
-	}
+	if (n & 1) /* the vector pre-test reads an even count; the pad is never offered */
+		pk_load_ray(&s, n, &r[0]);
 	if (w->nprims && live) {
 		const bvh_node *nodes = w->tree->nodes;
 		float ftmin = to_float_down(tmin);
@@ -430,7 +410,7 @@ void world_occluded_packet(const world *w, int n, const ray *r, double tmin, con
 		unsigned ready = 0; /* the rays whose one[] is filled */
 		bool refine = true;
 		int tried = 0, culled = 0;
-		pk_entry stack[BVH_STACK];
+		bvh_entry stack[BVH_STACK];
 		int sp = 0;
 		uint32_t child = w->tree->root, meta = w->tree->root_meta;
 		for (;;) {
@@ -464,14 +444,7 @@ void world_occluded_packet(const world *w, int n, const ray *r, double tmin, con
 					refine = culled > 0 || tried < 32;
 				}
 				if (m) {
-					const bvh_node *nd = &nodes[child];
-					int k = __builtin_ctz(m);
-					for (unsigned rest = m & (m - 1); rest; rest &= rest - 1) {
-						int j = __builtin_ctz(rest);
-						stack[sp++] = (pk_entry){nd->child[j], nd->meta[j], tn[j], 0};
-					}
-					child = nd->child[k];
-					meta = nd->meta[k];
+					sp = bvh_enter_any(&nodes[child], m, tn, stack, sp, &child, &meta);
 					continue;
 				}
 			}

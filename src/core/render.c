@@ -24,7 +24,9 @@ int render_threads(const render_settings *s)
 	return n < 1 ? 1 : n > 256 ? 256 : (int)n;
 }
 
-framebuffer *fb_new(int w, int h)
+/* A w x h framebuffer with its float image (rgb) and its running sums
+ * (sum) when asked; NULL when a side is out of range or out of memory. */
+static framebuffer *fb_alloc(int w, int h, bool rgb, bool sum)
 {
 	if (w < 1 || h < 1 || w > RENDER_MAX_DIM || h > RENDER_MAX_DIM)
 		return NULL;
@@ -34,13 +36,16 @@ framebuffer *fb_new(int w, int h)
 	size_t n = (size_t)w * (size_t)h * 3;
 	fb->w = w;
 	fb->h = h;
-	fb->rgb = calloc(n, sizeof *fb->rgb);
-	fb->sum = calloc(n, sizeof *fb->sum);
-	if (!fb->rgb || !fb->sum) {
+	if ((rgb && !(fb->rgb = calloc(n, sizeof *fb->rgb))) || (sum && !(fb->sum = calloc(n, sizeof *fb->sum)))) {
 		fb_free(fb);
 		return NULL;
 	}
 	return fb;
+}
+
+framebuffer *fb_new(int w, int h)
+{
+	return fb_alloc(w, h, true, true);
 }
 
 void fb_free(framebuffer *fb)
@@ -473,21 +478,7 @@ render_status render_run(render_job *job, rt_error *err)
  * only the 8-bit codes are wanted (codes_only: render_image_rows). */
 static framebuffer *fb_one_pass(int w, int h, bool codes_only)
 {
-	if (w < 1 || h < 1 || w > RENDER_MAX_DIM || h > RENDER_MAX_DIM)
-		return NULL;
-	framebuffer *fb = calloc(1, sizeof *fb);
-	if (!fb)
-		return NULL;
-	fb->w = w;
-	fb->h = h;
-	if (!codes_only) {
-		fb->rgb = calloc((size_t)w * (size_t)h * 3, sizeof *fb->rgb);
-		if (!fb->rgb) {
-			free(fb);
-			return NULL;
-		}
-	}
-	return fb;
+	return fb_alloc(w, h, !codes_only, false);
 }
 
 static framebuffer *render_image_with(const world *w, const render_settings *s, atomic_bool *cancel,

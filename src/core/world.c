@@ -516,33 +516,6 @@ size_t world_memory(const world *w)
 	return n + surf_memory(w) + (w->env ? envmap_memory(w->env) : 0);
 }
 
-typedef struct walk_entry {
-	uint32_t child, meta; /* a node or a leaf, as in bvh_node */
-	float t;              /* where the ray enters its box */
-	uint32_t pad;
-} walk_entry;
-
-/* The children of node n that mask m says are hit, pushed farthest first so
- * that the nearest is on top (an insertion sort of at most four); returns
- * the new stack height. */
-static inline int push_hits(const bvh_node *n, unsigned m, const float tn[4], walk_entry *stack, int sp)
-{
-	int idx[BVH_WIDTH], c = 0;
-	for (int k = 0; k < BVH_WIDTH; k++) {
-		if (!(m >> k & 1))
-			continue;
-		int j = c++;
-		while (j > 0 && tn[idx[j - 1]] < tn[k]) {
-			idx[j] = idx[j - 1];
-			j--;
-		}
-		idx[j] = k;
-	}
-	for (int i = 0; i < c; i++)
-		stack[sp++] = (walk_entry){n->child[idx[i]], n->meta[idx[i]], tn[idx[i]], 0};
-	return sp;
-}
-
 /* The one walk of the scene's BVH, below the planes. any: an occlusion
  * test, true at the first primitive hit (children in mask order, nothing
  * pruned); otherwise the nearest hit: *tmax, *best and *best_n follow it,
@@ -558,7 +531,7 @@ static inline __attribute__((always_inline)) bool walk(const world *w, const ray
 	bvh_ray q;
 	bvh_ray_prepare(r, &q);
 	float ftmin = to_float_down(tmin), ftmax = to_float_up(tmax);
-	walk_entry stack[BVH_STACK];
+	bvh_entry stack[BVH_STACK];
 	int sp = 0;
 	uint32_t child = tree->root, meta = tree->root_meta;
 	for (;;) {
@@ -582,24 +555,17 @@ static inline __attribute__((always_inline)) bool walk(const world *w, const ray
 			if (m) {
 				if (any) {
 					/* any hit will do: no sorting, the first child now */
-					int k = __builtin_ctz(m);
-					for (unsigned rest = m & (m - 1); rest; rest &= rest - 1) {
-						int j = __builtin_ctz(rest);
-						stack[sp++] = (walk_entry){n->child[j], n->meta[j], tn[j], 0};
-					}
-					child = n->child[k];
-					meta = n->meta[k];
+					sp = bvh_enter_any(n, m, tn, stack, sp, &child, &meta);
 					continue;
 				}
 				if (m & (m - 1)) {
 					/* several: the nearest now, the others later */
-					sp = push_hits(n, m, tn, stack, sp) - 1;
+					sp = bvh_enter_sorted(n, m, tn, stack, sp, &child, &meta);
 				} else {
 					int k = __builtin_ctz(m);
-					stack[sp] = (walk_entry){n->child[k], n->meta[k], 0, 0};
+					child = n->child[k];
+					meta = n->meta[k];
 				}
-				child = stack[sp].child;
-				meta = stack[sp].meta;
 				continue;
 			}
 		}

@@ -206,6 +206,32 @@ static bool grow(void **arr, size_t *cap, size_t n, size_t size, rt_error *err)
 	return true;
 }
 
+/* Inserts the element of `size` bytes at index i (past the end: at the end)
+ * of the array *arr of *n elements, moving those from i up one place. */
+static bool insert_at(void **arr, size_t *cap, size_t *n, size_t i, const void *elem, size_t size, rt_error *err)
+{
+	if (!grow(arr, cap, *n, size, err))
+		return false;
+	if (i > *n)
+		i = *n;
+	char *a = *arr;
+	memmove(a + (i + 1) * size, a + i * size, (*n - i) * size);
+	memcpy(a + i * size, elem, size);
+	(*n)++;
+	return true;
+}
+
+/* Removes the element at index i (none past the end), moving those after
+ * it down one place. */
+static void remove_at(void *arr, size_t *n, size_t i, size_t size)
+{
+	if (i >= *n)
+		return;
+	char *a = arr;
+	memmove(a + i * size, a + (i + 1) * size, (*n - i - 1) * size);
+	(*n)--;
+}
+
 bool scene_insert_object(scene *s, size_t i, const object *o, rt_error *err)
 {
 	/* Before the array doubles: what a scene of this size will need. */
@@ -214,26 +240,12 @@ bool scene_insert_object(scene *s, size_t i, const object *o, rt_error *err)
 	    (snprintf(what, sizeof what, "a scene of more than %zu objects", s->nobjs),
 	     !mem_check((double)s->nobjs * 2 * MEM_PER_OBJECT, what, err)))
 		return false;
-	if (!grow((void **)&s->objs, &s->cap_objs, s->nobjs, sizeof *o, err))
-		return false;
-	if (i > s->nobjs)
-		i = s->nobjs;
-	memmove(&s->objs[i + 1], &s->objs[i], (s->nobjs - i) * sizeof *o);
-	s->objs[i] = *o;
-	s->nobjs++;
-	return true;
+	return insert_at((void **)&s->objs, &s->cap_objs, &s->nobjs, i, o, sizeof *o, err);
 }
 
 bool scene_insert_light(scene *s, size_t i, const light *l, rt_error *err)
 {
-	if (!grow((void **)&s->lights, &s->cap_lights, s->nlights, sizeof *l, err))
-		return false;
-	if (i > s->nlights)
-		i = s->nlights;
-	memmove(&s->lights[i + 1], &s->lights[i], (s->nlights - i) * sizeof *l);
-	s->lights[i] = *l;
-	s->nlights++;
-	return true;
+	return insert_at((void **)&s->lights, &s->cap_lights, &s->nlights, i, l, sizeof *l, err);
 }
 
 bool scene_add_object(scene *s, const object *o, rt_error *err)
@@ -248,26 +260,17 @@ bool scene_add_light(scene *s, const light *l, rt_error *err)
 
 bool scene_add_camera(scene *s, const camera *c, rt_error *err)
 {
-	if (!grow((void **)&s->cams, &s->cap_cams, s->ncams, sizeof *c, err))
-		return false;
-	s->cams[s->ncams++] = *c;
-	return true;
+	return insert_at((void **)&s->cams, &s->cap_cams, &s->ncams, s->ncams, c, sizeof *c, err);
 }
 
 void scene_remove_object(scene *s, size_t i)
 {
-	if (i >= s->nobjs)
-		return;
-	memmove(&s->objs[i], &s->objs[i + 1], (s->nobjs - i - 1) * sizeof *s->objs);
-	s->nobjs--;
+	remove_at(s->objs, &s->nobjs, i, sizeof *s->objs);
 }
 
 void scene_remove_light(scene *s, size_t i)
 {
-	if (i >= s->nlights)
-		return;
-	memmove(&s->lights[i], &s->lights[i + 1], (s->nlights - i - 1) * sizeof *s->lights);
-	s->nlights--;
+	remove_at(s->lights, &s->nlights, i, sizeof *s->lights);
 }
 
 camera scene_camera(const scene *s)

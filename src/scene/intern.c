@@ -11,9 +11,16 @@
 #include "rtsh/memory.h"
 #include "rtsh/scene.h"
 
-static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
-static char **set;
-static size_t nset, cap; /* cap a power of two, at most half full */
+/* A set of byte strings kept for ever: open addressing, its capacity a
+ * power of two at most half full, guarded by its mutex. Each kept copy has
+ * a NUL after its bytes; `fixed` is the size of every entry (records), or 0
+ * for NUL-free strings, whose length is strlen's. */
+typedef struct intern_set {
+	pthread_mutex_t lock;
+	char **tab;
+	size_t n, cap;
+	size_t fixed;
+} intern_set;
 
 static uint64_t hash(const char *s, size_t n)
 {
@@ -23,73 +30,71 @@ static uint64_t hash(const char *s, size_t n)
 	return h;
 }
 
-static bool insert(char **tab, size_t c, char *s)
+static size_t entry_len(const intern_set *set, const char *e)
 {
-	size_t i = (size_t)hash(s, strlen(s)) & (c - 1);
+	return set->fixed ? set->fixed : strlen(e);
+}
+
+static void insert(const intern_set *set, char **tab, size_t c, char *e)
+{
+	size_t i = (size_t)hash(e, entry_len(set, e)) & (c - 1);
 	while (tab[i])
 		i = (i + 1) & (c - 1);
-	tab[i] = s;
-	return true;
+	tab[i] = e;
 }
+
+/* The kept copy of the n bytes at p (kept now when new), or NULL when out
+ * of memory. */
+static const char *set_intern(intern_set *set, const char *p, size_t n)
+{
+	pthread_mutex_lock(&set->lock);
+	const char *out = NULL;
+	if (set->cap) {
+		size_t i = (size_t)hash(p, n) & (set->cap - 1);
+		while (set->tab[i]) {
+			if (entry_len(set, set->tab[i]) == n && memcmp(set->tab[i], p, n) == 0) {
+				out = set->tab[i];
+				break;
+			}
+			i = (i + 1) & (set->cap - 1);
+		}
+	}
+	if (!out && 2 * (set->n + 1) > set->cap) {
+		size_t c = set->cap ? 2 * set->cap : 64;
+		char **t = calloc(c, sizeof *t);
+		if (t) {
+			for (size_t i = 0; i < set->cap; i++)
+				if (set->tab[i])
+					insert(set, t, c, set->tab[i]);
+			free(set->tab);
+			set->tab = t;
+			set->cap = c;
+		}
+	}
+	if (!out && 2 * (set->n + 1) <= set->cap) {
+		char *d = mem_dupz(p, n);
+		if (d) {
+			insert(set, set->tab, set->cap, d);
+			set->n++;
+			out = d;
+		}
+	}
+	pthread_mutex_unlock(&set->lock);
+	return out;
+}
+
+static intern_set names = {PTHREAD_MUTEX_INITIALIZER, NULL, 0, 0, 0};
 
 const char *rt_intern(const char *s, size_t n)
 {
 	if (memchr(s, '\0', n))
 		n = strlen(s);
-	pthread_mutex_lock(&lock);
-	const char *out = NULL;
-	if (cap) {
-		size_t i = (size_t)hash(s, n) & (cap - 1);
-		while (set[i]) {
-			if (strlen(set[i]) == n && memcmp(set[i], s, n) == 0) {
-				out = set[i];
-				break;
-			}
-			i = (i + 1) & (cap - 1);
-		}
-	}
-	if (!out && 2 * (nset + 1) > cap) {
-		size_t c = cap ? 2 * cap : 64;
-		char **t = calloc(c, sizeof *t);
-		if (t) {
-			for (size_t i = 0; i < cap; i++)
-				if (set[i])
-					insert(t, c, set[i]);
-			free(set);
-			set = t;
-			cap = c;
-		}
-	}
-	if (!out && 2 * (nset + 1) <= cap) {
-		char *d = mem_dupz(s, n);
-		if (d) {
-			insert(set, cap, d);
-			nset++;
-			out = d;
-		}
-	}
-	pthread_mutex_unlock(&lock);
-	return out;
+	return set_intern(&names, s, n);
 }
 
 /* The PBR blocks of materials (scene.h): the same idea for a fixed-size
  * record, compared by its bytes (every -0 made +0 first). */
-static pthread_mutex_t pbr_lock = PTHREAD_MUTEX_INITIALIZER;
-static material_pbr **pbr_set;
-static size_t pbr_n, pbr_cap;
-
-static uint64_t pbr_hash(const material_pbr *p)
-{
-	return hash((const char *)p, sizeof *p);
-}
-
-static void pbr_insert(material_pbr **tab, size_t c, material_pbr *p)
-{
-	size_t i = (size_t)pbr_hash(p) & (c - 1);
-	while (tab[i])
-		i = (i + 1) & (c - 1);
-	tab[i] = p;
-}
+static intern_set pbrs = {PTHREAD_MUTEX_INITIALIZER, NULL, 0, 0, sizeof(material_pbr)};
 
 const material_pbr *material_pbr_intern(const material_pbr *in, bool *oom)
 {
@@ -119,40 +124,7 @@ const material_pbr *material_pbr_intern(const material_pbr *in, bool *oom)
 	absent.multiscatter = a.multiscatter;
 	if (memcmp(&p, &absent, sizeof p) == 0)
 		return NULL;
-	pthread_mutex_lock(&pbr_lock);
-	const material_pbr *out = NULL;
-	if (pbr_cap) {
-		size_t i = (size_t)pbr_hash(&p) & (pbr_cap - 1);
-		while (pbr_set[i]) {
-			if (memcmp(pbr_set[i], &p, sizeof p) == 0) {
-				out = pbr_set[i];
-				break;
-			}
-			i = (i + 1) & (pbr_cap - 1);
-		}
-	}
-	if (!out && 2 * (pbr_n + 1) > pbr_cap) {
-		size_t c = pbr_cap ? 2 * pbr_cap : 64;
-		material_pbr **t = calloc(c, sizeof *t);
-		if (t) {
-			for (size_t i = 0; i < pbr_cap; i++)
-				if (pbr_set[i])
-					pbr_insert(t, c, pbr_set[i]);
-			free(pbr_set);
-			pbr_set = t;
-			pbr_cap = c;
-		}
-	}
-	if (!out && 2 * (pbr_n + 1) <= pbr_cap) {
-		material_pbr *d = malloc(sizeof *d);
-		if (d) {
-			*d = p;
-			pbr_insert(pbr_set, pbr_cap, d);
-			pbr_n++;
-			out = d;
-		}
-	}
-	pthread_mutex_unlock(&pbr_lock);
+	const material_pbr *out = (const material_pbr *)(const void *)set_intern(&pbrs, (const char *)&p, sizeof p);
 	if (!out && oom)
 		*oom = true;
 	return out;

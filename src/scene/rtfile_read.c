@@ -150,6 +150,21 @@ static bool push_tok(parser *p, tok t)
 }
 
 /* Cuts the line s[0..len) into p->toks. */
+/* Copies the quoted text whose opening quote is s[*i] to *out and moves *i
+ * past its closing quote; a quote that is not closed is an error (the form
+ * `expect` named). Blanks, '#' and ',' inside are the text's own. */
+static bool copy_quoted(parser *p, const char *s, size_t len, size_t *i, char **out, const char *expect)
+{
+	const char *q = memchr(s + *i + 1, '"', len - *i - 1);
+	if (!q)
+		return fail(p, (int)*i + 1, "a quote that is not closed; expected %s", expect);
+	size_t n = (size_t)(q - (s + *i + 1));
+	memcpy(*out, s + *i + 1, n);
+	*out += n;
+	*i = (size_t)(q - s) + 1;
+	return true;
+}
+
 static bool lex_line(parser *p, const char *s, size_t len)
 {
 	p->ntoks = 0;
@@ -184,17 +199,12 @@ static bool lex_line(parser *p, const char *s, size_t len)
 			break;
 		tok t = {.s = out, .col = (int)i + 1};
 		if (s[i] == '"') {
-			/* a quoted file name: blanks, '#' and ',' are its own */
-			const char *q = memchr(s + i + 1, '"', len - i - 1);
-			if (!q)
-				return fail(p, (int)i + 1, "a quote that is not closed; expected \"NAME\"");
-			size_t n = (size_t)(q - (s + i + 1));
-			memcpy(out, s + i + 1, n);
-			out += n;
+			/* a quoted file name */
+			if (!copy_quoted(p, s, len, &i, &out, "\"NAME\""))
+				return false;
 			t.quoted = true;
-			i = (size_t)(q - s) + 1;
 			t.endcol = (int)i + 1;
-			t.len = n;
+			t.len = (size_t)(out - t.s);
 			*out++ = '\0';
 			p->endcol = t.endcol;
 			if (!push_tok(p, t))
@@ -204,14 +214,9 @@ static bool lex_line(parser *p, const char *s, size_t len)
 		for (;;) {
 			while (i < len && !is_blank(s[i]) && !comment_at(s, i, len)) {
 				if (s[i] == '"' && out > t.s && out[-1] == '=') {
-					/* KEY="a file name": blanks, '#' and ',' are its own */
-					const char *q = memchr(s + i + 1, '"', len - i - 1);
-					if (!q)
-						return fail(p, (int)i + 1, "a quote that is not closed; expected KEY=\"NAME\"");
-					size_t n = (size_t)(q - (s + i + 1));
-					memcpy(out, s + i + 1, n);
-					out += n;
-					i = (size_t)(q - s) + 1;
+					/* KEY="a file name" */
+					if (!copy_quoted(p, s, len, &i, &out, "KEY=\"NAME\""))
+						return false;
 					continue;
 				}
 				*out++ = s[i++];
@@ -709,19 +714,18 @@ static bool parse_set(parser *p, const elem_def *e)
 	int r;
 	switch (i) {
 	case 0:
-		if (!get_num(p, v, "set", "samples", &r_samples, &d))
+	case 1: {
+		/* the whole numbers: samples, depth */
+		int *field = i == 0 ? &hn->samples : &hn->depth;
+		if (!get_num(p, v, "set", keys[i], i == 0 ? &r_samples : &r_depth, &d))
 			return false;
-		r = once(p, e, "set samples", &p->line_set[0], hn->samples == (int)d);
+		char what[32];
+		snprintf(what, sizeof what, "set %s", keys[i]);
+		r = once(p, e, what, &p->line_set[i], *field == (int)d);
 		if (r > 0)
-			hn->samples = (int)d;
+			*field = (int)d;
 		break;
-	case 1:
-		if (!get_num(p, v, "set", "depth", &r_depth, &d))
-			return false;
-		r = once(p, e, "set depth", &p->line_set[1], hn->depth == (int)d);
-		if (r > 0)
-			hn->depth = (int)d;
-		break;
+	}
 	case 2: {
 		int m = 0; /* the integrators' names (integrators.def) */
 		while (m < MODE_COUNT && strcmp(v->s, render_mode_names[m]) != 0)
@@ -841,29 +845,21 @@ static bool parse_keys(parser *p, const elem_def *e, object *o)
 				return false;
 			continue;
 		}
-		if (key->type == RT_KEY_RGB) {
+		if (key->type == RT_KEY_RGB || key->type == RT_KEY_PAIR) {
+			/* R,G,B or U,V, each in the key's range */
+			bool rgb = key->type == RT_KEY_RGB;
+			int n = rgb ? 3 : 2;
 			tok pt = *t;
 			pt.s = val;
 			pt.len = t->len - nlen - 1;
 			double c[3];
 			range r = {key->min, key->max, false, false, key->expect};
-			if (!get_tuple(p, &pt, e->name, key->name, 3, "R,G,B", &r, c))
+			if (!get_tuple(p, &pt, e->name, key->name, n, rgb ? "R,G,B" : "U,V", &r, c))
 				return false;
-			if (!rt_key_set_n(key, o, c, 3))
-				return fail_tok(p, t, e->name, "key", "could not be kept: out of memory", key->expect);
-			continue;
-		}
-		if (key->type == RT_KEY_PAIR) {
-			tok pt = *t;
-			pt.s = val;
-			pt.len = t->len - nlen - 1;
-			double uv[2];
-			range r = {key->min, key->max, false, false, key->expect};
-			if (!get_tuple(p, &pt, e->name, key->name, 2, "U,V", &r, uv))
-				return false;
-			if (strcmp(key->name, "uvscale") == 0 && (uv[0] == 0 || uv[1] == 0))
+			if (strcmp(key->name, "uvscale") == 0 && (c[0] == 0 || c[1] == 0))
 				return fail_tok(p, t, e->name, "key", "has a zero component", key->expect);
-			memcpy((char *)o + key->offset, uv, sizeof uv);
+			if (!rt_key_set_n(key, o, c, n))
+				return fail_tok(p, t, e->name, "key", "could not be kept: out of memory", key->expect);
 			continue;
 		}
 		num_status st = num_parse(val, t->len - nlen - 1, &v);

@@ -2,6 +2,7 @@
 #include "shell/args.h"
 
 #include <getopt.h>
+#include <stddef.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
@@ -26,27 +27,52 @@ static const struct {
 };
 #define NSHORT (sizeof short_settings / sizeof short_settings[0])
 
-/* The options that are not settings; `shell` ones only for ARGS_RTSH. */
+/* The options that are not settings; `shell` ones only for ARGS_RTSH. A
+ * plain option names its field of rtsh_options (`field`, an offsetof; 0:
+ * the option is handled in args_parse): its value there, or true for an
+ * option with no value. */
 static const struct {
 	struct option opt;
 	bool shell;
 	const char *arg, *help;
+	size_t field;
 } fixed[] = {
-	{{"output", required_argument, NULL, 'o'}, false, "OUT", "render at full resolution to OUT (@images), exit"},
-	{{"command", required_argument, NULL, 'c'}, true, "'CMD; CMD'", "run shell commands, then exit"},
-	{{"file", required_argument, NULL, 'f'}, true, "FILE", "run a command file (- = standard input), then exit"},
-	{{"interactive", no_argument, NULL, 'i'}, true, NULL, "with -c or -f: stay in the interactive shell afterwards"},
-	{{"quiet", no_argument, NULL, 'q'}, false, NULL, "no progress output"},
-	{{"strict", no_argument, NULL, OPT_STRICT}, false, NULL, "validate scenes by the 42 subject's rules"},
-	{{"color", required_argument, NULL, OPT_COLOR}, false, "WHEN", "auto|truecolor|256|16|none: colour output (default auto)"},
+	{{"output", required_argument, NULL, 'o'}, false, "OUT", "render at full resolution to OUT (@images), exit",
+	 offsetof(rtsh_options, output)},
+	{{"command", required_argument, NULL, 'c'}, true, "'CMD; CMD'", "run shell commands, then exit",
+	 offsetof(rtsh_options, commands)},
+	{{"file", required_argument, NULL, 'f'}, true, "FILE", "run a command file (- = standard input), then exit",
+	 offsetof(rtsh_options, file)},
+	{{"interactive", no_argument, NULL, 'i'}, true, NULL, "with -c or -f: stay in the interactive shell afterwards",
+	 offsetof(rtsh_options, interactive)},
+	{{"quiet", no_argument, NULL, 'q'}, false, NULL, "no progress output", offsetof(rtsh_options, quiet)},
+	{{"strict", no_argument, NULL, OPT_STRICT}, false, NULL, "validate scenes by the 42 subject's rules",
+	 offsetof(rtsh_options, strict)},
+	{{"color", required_argument, NULL, OPT_COLOR}, false, "WHEN", "auto|truecolor|256|16|none: colour output (default auto)",
+	 0},
 	{{"preview", required_argument, NULL, OPT_PREVIEW}, true, "COLSxROWS",
-	 "print a still picture of the scene or model, COLS x ROWS cells, and exit (file managers)"},
+	 "print a still picture of the scene or model, COLS x ROWS cells, and exit (file managers)", 0},
 	{{"turntable", optional_argument, NULL, OPT_TURNTABLE}, false, "[FRAMES]",
-	 "a full turn of the camera about the scene: in the terminal, or FRAMES frames with -o (.gif, frame%03d.png)"},
-	{{"help", no_argument, NULL, 'h'}, false, NULL, "this help"},
-	{{"version", no_argument, NULL, 'V'}, false, NULL, "the version"},
+	 "a full turn of the camera about the scene: in the terminal, or FRAMES frames with -o (.gif, frame%03d.png)", 0},
+	{{"help", no_argument, NULL, 'h'}, false, NULL, "this help", 0},
+	{{"version", no_argument, NULL, 'V'}, false, NULL, "the version", 0},
 };
 #define NFIXED (sizeof fixed / sizeof fixed[0])
+
+/* Keeps a plain option's value (fixed[].field); false when c is not one. */
+static bool keep_plain(int c, rtsh_options *o)
+{
+	for (size_t i = 0; i < NFIXED; i++)
+		if (fixed[i].opt.val == c && fixed[i].field) {
+			char *at = (char *)o + fixed[i].field;
+			if (fixed[i].opt.has_arg == required_argument)
+				*(const char **)(void *)at = optarg;
+			else
+				*(bool *)(void *)at = true;
+			return true;
+		}
+	return false;
+}
 
 static int usage_error(const char *prog, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 static int usage_error(const char *prog, const char *fmt, ...)
@@ -227,6 +253,8 @@ int args_parse(int argc, char **argv, args_kind kind, const char *prog, rtsh_opt
 	while (rc < 0 && (c = getopt_long(argc, argv, shorts, longs, NULL)) != -1) {
 		char name[64];
 		const setting_def *def = NULL;
+		if (keep_plain(c, o))
+			continue;
 		switch (c) {
 		case 1: /* an operand: the scene */
 			if (o->scene)
@@ -242,24 +270,6 @@ int args_parse(int argc, char **argv, args_kind kind, const char *prog, rtsh_opt
 		case 'V':
 			printf("%s %s\n", prog, RTSH_VERSION);
 			rc = 0;
-			break;
-		case 'o':
-			o->output = optarg;
-			break;
-		case 'c':
-			o->commands = optarg;
-			break;
-		case 'f':
-			o->file = optarg;
-			break;
-		case 'i':
-			o->interactive = true;
-			break;
-		case 'q':
-			o->quiet = true;
-			break;
-		case OPT_STRICT:
-			o->strict = true;
 			break;
 		case OPT_COLOR:
 			rc = parse_color(prog, optarg, &o->color);

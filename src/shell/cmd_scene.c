@@ -194,43 +194,33 @@ bool cmd_set(shell *sh, int argc, char **argv, const char *rest)
 	return true;
 }
 
-static void list_cameras(shell *sh, const scene *s)
+/* The `list` of the cameras (which 0), lights (1) or objects (2): a line
+ * an item, "camera 2 (active): C ...", or a line that says there are none. */
+static void list_items(shell *sh, const scene *s, int which)
 {
-	char line[512];
-	if (s->ncams == 0)
-		shell_out(sh, "no camera (the default one is used)\n");
-	for (size_t i = 0; i < s->ncams; i++) {
-		rt_format_camera(&s->cams[i], line, sizeof line);
-		shell_out(sh, "camera %zu%s: %s\n", i + 1, i == s->cam ? " (active)" : "", line);
-	}
-}
-
-static void list_lights(shell *sh, const scene *s)
-{
-	char line[512];
-	if (s->nlights == 0)
-		shell_out(sh, "no lights\n");
-	for (size_t i = 0; i < s->nlights; i++) {
-		rt_format_light(&s->lights[i], line, sizeof line);
-		shell_out(sh, "light %zu: %s\n", i + 1, line);
-	}
-}
-
-static void list_objects(shell *sh, const scene *s)
-{
-	char line[1024];
-	if (s->nobjs == 0)
-		shell_out(sh, "no objects\n");
-	for (size_t i = 0; i < s->nobjs; i++) {
-		const object *o = &s->objs[i];
-		rt_format_object(o, line, sizeof line);
-		/* a mesh: its triangle count (the model is cached, so this is cheap) */
-		mesh *m = o->kind == OBJ_MESH && o->file ? mesh_cache_get(o->file, o->smooth != 0, o->crease, NULL, NULL) : NULL;
-		if (m)
-			shell_out(sh, "object %zu: %s  # %u triangles\n", i + 1, line, m->ntris);
-		else
-			shell_out(sh, "object %zu: %s\n", i + 1, line);
-		mesh_cache_put(m);
+	static const char *const name[] = {"camera", "light", "object"};
+	static const char *const none[] = {"no camera (the default one is used)", "no lights", "no objects"};
+	size_t n = which == 0 ? s->ncams : which == 1 ? s->nlights : s->nobjs;
+	if (n == 0)
+		shell_out(sh, "%s\n", none[which]);
+	for (size_t i = 0; i < n; i++) {
+		char line[1024], note[48] = "";
+		if (which == 0) {
+			rt_format_camera(&s->cams[i], line, sizeof line);
+		} else if (which == 1) {
+			rt_format_light(&s->lights[i], line, sizeof line);
+		} else {
+			const object *o = &s->objs[i];
+			rt_format_object(o, line, sizeof line);
+			/* a mesh: its triangle count (the model is cached, so this is cheap) */
+			mesh *m = o->kind == OBJ_MESH && o->file ? mesh_cache_get(o->file, o->smooth != 0, o->crease, NULL, NULL)
+			                                         : NULL;
+			if (m)
+				snprintf(note, sizeof note, "  # %u triangles", m->ntris);
+			mesh_cache_put(m);
+		}
+		shell_out(sh, "%s %zu%s: %s%s\n", name[which], i + 1, which == 0 && i == s->cam ? " (active)" : "", line,
+		          note);
 	}
 }
 
@@ -249,7 +239,7 @@ bool cmd_list(shell *sh, int argc, char **argv, const char *rest)
 			                  argv[0]);
 	}
 	if (which < 0 || which == 0)
-		list_cameras(sh, s);
+		list_items(sh, s, 0);
 	if (which < 0) {
 		if (s->has_ambient)
 			shell_out(sh, "ambient: A %g %g,%g,%g\n", s->amb.ratio, s->amb.color.x, s->amb.color.y,
@@ -262,9 +252,9 @@ bool cmd_list(shell *sh, int argc, char **argv, const char *rest)
 			          s->sky.strength);
 	}
 	if (which < 0 || which == 1)
-		list_lights(sh, s);
+		list_items(sh, s, 1);
 	if (which < 0 || which == 2)
-		list_objects(sh, s);
+		list_items(sh, s, 2);
 	return true;
 }
 

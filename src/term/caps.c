@@ -148,3 +148,15 @@ frame_palette caps_palette(color_mode mode, int fd)
 		return PALETTE_TRUECOLOR;
 	return terminfo_palette(fd);
 }
+
+bool caps_raw_modes(int fd, cc_t vmin, int when, struct termios *saved)
+{
+	if (tcgetattr(fd, saved) != 0)
+		return false;
+	struct termios raw = *saved;
+	raw.c_lflag &= ~(tcflag_t)(ICANON | ECHO);
+	raw.c_cc[VMIN] = vmin;
+	raw.c_cc[VTIME] = 0;
+	tcsetattr(fd, when, &raw);
+	return true;
+}

@@ -3,6 +3,7 @@
 #define RTSH_CAPS_H
 
 #include <stdbool.h>
+#include <termios.h>
 
 #include "term/frame.h"
 
@@ -32,5 +33,12 @@ bool caps_features_rgb(const char *features);
 /* True when fd is a terminal that can show the full-screen shell: TERM is
  * set and not "dumb". */
 bool caps_screen_ok(int fd);
+
+/* Sets the terminal on fd to pass keys one at a time with no echo (ICANON
+ * and ECHO off; Ctrl-C and Ctrl-Z still signal), a read returning once vmin
+ * bytes are in (0: at once), applied `when` (TCSANOW, TCSADRAIN). *saved
+ * gets the modes to restore; false, nothing changed, when fd is not a
+ * terminal. */
+bool caps_raw_modes(int fd, cc_t vmin, int when, struct termios *saved);
 
 #endif

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "base/abuf.h"
+#include "term/caps.h"
 #include "term/out.h"
 
 /* Seconds the rest of an escape sequence may take over a slow link. */
@@ -199,15 +200,8 @@ bool pager_show(evloop *l, int fd_out, const char *text, size_t len, int cols, i
 {
 	bool left = true;
 	int fd_in = evloop_in_fd(l);
-	struct termios saved, raw;
-	bool have_tty = tcgetattr(fd_in, &saved) == 0;
-	if (have_tty) {
-		raw = saved;
-		raw.c_lflag &= ~(tcflag_t)(ICANON | ECHO);
-		raw.c_cc[VMIN] = 1;
-		raw.c_cc[VTIME] = 0;
-		tcsetattr(fd_in, TCSADRAIN, &raw);
-	}
+	struct termios saved;
+	bool have_tty = caps_raw_modes(fd_in, 1, TCSADRAIN, &saved);
 	int nrows = split(text, len, cols, NULL);
 	slice *sl = malloc((size_t)(nrows ? nrows : 1) * sizeof *sl);
 	if (sl) {

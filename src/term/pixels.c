@@ -16,6 +16,7 @@
 #include <png.h>
 
 #include "rtsh/settings.h"
+#include "term/caps.h"
 
 /* The names are the `pixels` setting's choices (settings.c): off, kitty,
  * sixel, iterm, auto, then any other pixel encoder's (encoder.c). */
@@ -336,15 +337,8 @@ void pixels_probe(int in_fd, int out_fd, double timeout, pixels_caps *c, abuf *k
 		c->cell_w = ws.ws_xpixel / ws.ws_col;
 		c->cell_h = ws.ws_ypixel / ws.ws_row;
 	}
-	struct termios saved, raw;
-	bool restore = tcgetattr(in_fd, &saved) == 0;
-	if (restore) {
-		raw = saved;
-		raw.c_lflag &= ~(tcflag_t)(ICANON | ECHO);
-		raw.c_cc[VMIN] = 0;
-		raw.c_cc[VTIME] = 0;
-		tcsetattr(in_fd, TCSANOW, &raw);
-	}
+	struct termios saved;
+	bool restore = caps_raw_modes(in_fd, 0, TCSANOW, &saved);
 	abuf q;
 	abuf_init(&q);
 	pixels_queries(&q);

@@ -37,7 +37,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	int w, h;
 	float *rgb = image_decode_rgb(names[data[0] % 8], data + 1, size - 1, true, &w, &h, &err);
 	if (rgb && (size_t)w * (size_t)h <= ((size_t)1 << 22)) {
-		texture *t = texture_make(rgb, w, h, &err);
+		texture *t = texture_make(rgb, w, h, NULL, true, &err);
 		if (t)
 			texture_lookup(t, 0.3, 0.7, 0.01);
 		texture_free(t);

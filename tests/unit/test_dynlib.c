@@ -3,6 +3,7 @@
  * them; dynlib_open's answers for a library or a function that is missing.
  * This test binary is linked as rtsh is (LDLIBS_FRONT). */
 #include "testutil.h"
+#include "tmpdir.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -25,34 +26,6 @@ static bool mapped(const char *name)
 		found = strstr(line, name) != NULL;
 	fclose(f);
 	return found;
-}
-
-static char tmpdir[64];
-
-static int setup(void **state)
-{
-	(void)state;
-	snprintf(tmpdir, sizeof tmpdir, "/tmp/rtsh-dynlib-XXXXXX");
-	return mkdtemp(tmpdir) ? 0 : -1;
-}
-
-static int teardown(void **state)
-{
-	(void)state;
-	char cmd[128];
-	snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
-	return system(cmd) == 0 ? 0 : -1;
-}
-
-static const char *tmp_text(const char *name, const char *text)
-{
-	static char path[256];
-	snprintf(path, sizeof path, "%s/%s", tmpdir, name);
-	FILE *f = fopen(path, "wb");
-	assert_non_null(f);
-	assert_int_equal(fwrite(text, 1, strlen(text), f), strlen(text));
-	fclose(f);
-	return path;
 }
 
 /* Runs first: nothing has read a model or an XPM image yet. */
@@ -142,5 +115,5 @@ int main(void)
 	    cmocka_unit_test(test_missing_function),
 	    cmocka_unit_test(test_functions_called),
 	};
-	return cmocka_run_group_tests(tests, setup, teardown);
+	return cmocka_run_group_tests(tests, tmpdir_setup, tmpdir_teardown);
 }

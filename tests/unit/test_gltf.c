@@ -20,33 +20,21 @@
 #include "rtsh/rtfile.h"
 #include "rtsh/world.h"
 #include "testutil.h"
+#include "tmpdir.h"
 
-static char tmpdir[64];
-
-static int setup(void **state)
+/* s saved as tmpdir/name reads back as s; the copy read back (the caller
+ * frees it). */
+static scene *saved_again(const scene *s, const char *name)
 {
-	(void)state;
-	snprintf(tmpdir, sizeof tmpdir, "/tmp/rtsh-gltf-XXXXXX");
-	return mkdtemp(tmpdir) ? 0 : -1;
-}
-
-static int teardown(void **state)
-{
-	(void)state;
-	char cmd[128];
-	snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
-	return system(cmd) == 0 ? 0 : -1;
-}
-
-static const char *tmp_text(const char *name, const char *text)
-{
-	static char p[256];
-	snprintf(p, sizeof p, "%s/%s", tmpdir, name);
-	FILE *f = fopen(p, "w");
-	assert_non_null(f);
-	assert_true(fputs(text, f) >= 0);
-	assert_int_equal(fclose(f), 0);
-	return p;
+	char rt[256];
+	snprintf(rt, sizeof rt, "%s/%s", tmpdir, name);
+	rt_error err = {0};
+	assert_true(rt_save(s, rt, &err));
+	scene *t = rt_load_file(rt, NULL, &err);
+	if (!t)
+		fail_msg("%s", err.msg);
+	assert_true(scene_equal(s, t));
+	return t;
 }
 
 /* --- writing glTF --- */
@@ -573,13 +561,7 @@ static void test_camera_frustum(void **state)
 	assert_vec_near(top.o, v3(-1, 4, 3), 1e-12);
 	assert_vec_near(v3_sub(right.o, v3(-1, 2, 3)), v3_scale(v.right, 4), 1e-12);
 	/* save and load again: the same scene */
-	char rt[256];
-	snprintf(rt, sizeof rt, "%s/cams.rt", tmpdir);
-	assert_true(rt_save(s, rt, &err));
-	scene *t = rt_load_file(rt, NULL, &err);
-	if (!t)
-		fail_msg("%s", err.msg);
-	assert_true(scene_equal(s, t));
+	scene *t = saved_again(s, "cams.rt");
 	scene_free(t);
 	scene_free(s);
 }
@@ -616,13 +598,7 @@ static void test_camera_roll(void **state)
 	/* the middle of the top row: up by tan(yfov / 2) */
 	ray top = cam_ray(&v, 100, 0, 200, 100);
 	assert_vec_near(top.d, v3_norm(v3(tan(0.5), 0, -1)), 1e-12);
-	char rt[256];
-	snprintf(rt, sizeof rt, "%s/roll.rt", tmpdir);
-	assert_true(rt_save(s, rt, &err));
-	scene *t = rt_load_file(rt, NULL, &err);
-	if (!t)
-		fail_msg("%s", err.msg);
-	assert_true(scene_equal(s, t));
+	scene *t = saved_again(s, "roll.rt");
 	scene_free(t);
 	scene_free(s);
 }
@@ -669,13 +645,7 @@ static void test_nodes_as_objects(void **state)
 	r.o = v3(-5.5, 0.2, -10); /* where it was: nothing now */
 	assert_false(world_intersect(w, &r, 0, INFINITY, &h));
 	world_free(w);
-	char rt[256];
-	snprintf(rt, sizeof rt, "%s/nodes.rt", tmpdir);
-	assert_true(rt_save(s, rt, &err));
-	scene *t = rt_load_file(rt, NULL, &err);
-	if (!t)
-		fail_msg("%s", err.msg);
-	assert_true(scene_equal(s, t));
+	scene *t = saved_again(s, "nodes.rt");
 	assert_int_equal(t->objs[1].node, 1);
 	scene_free(t);
 	scene_free(s);
@@ -746,13 +716,13 @@ static size_t png_1x1(unsigned char r, unsigned char g, unsigned char b, unsigne
 	return n + 12;
 }
 
-/* The metallic-roughness texture in shading: a triangle with uv, metallic
- * 0.5 and roughness 0.8, and a texture of one texel (R, G, B) = (0, 128,
- * 255), read linear (glTF: G scales roughness, B metallic). At any point:
- * roughness 0.8 x 128/255 = 0.40157, metallic 0.5 x 255/255 = 0.5. */
-static void test_metallic_roughness_texture(void **state)
+/* The triangle (-1,-1,0) (1,-1,0) (0,1,0) with uv (0,0) (1,0) (0.5,1), of
+ * material 0, whose texture 0 is one PNG texel (r, g, b); a camera of
+ * vertical field yfov at `at` ("[0,0,5]") looks at it. `materials` is the
+ * file's materials array. Written to tmpdir/name and loaded as a scene. */
+static scene *textured_tri(const char *name, unsigned char r, unsigned char g, unsigned char b, const char *at,
+                           double yfov, const char *materials)
 {
-	(void)state;
 	unsigned char bin[68];
 	const float pos[9] = {-1, -1, 0, 1, -1, 0, 0, 1, 0}, uv[6] = {0, 0, 1, 0, 0.5f, 1};
 	const uint16_t idx[4] = {0, 1, 2, 0};
@@ -762,16 +732,14 @@ static void test_metallic_roughness_texture(void **state)
 	char data[128], png64[128];
 	b64(bin, sizeof bin, data);
 	unsigned char png[80];
-	size_t npng = png_1x1(0, 128, 255, png);
-	b64(png, npng, png64);
+	b64(png, png_1x1(r, g, b, png), png64);
 	char text[4096];
 	snprintf(text, sizeof text,
-	         "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0},{\"camera\":0,\"translation\":[0,0,5]}],"
-	         "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":1}}],"
+	         "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0},{\"camera\":0,\"translation\":%s}],"
+	         "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":%.17g}}],"
 	         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"indices\":2,"
 	         "\"material\":0}]}],"
-	         "\"materials\":[{\"pbrMetallicRoughness\":{\"metallicFactor\":0.5,\"roughnessFactor\":0.8,"
-	         "\"metallicRoughnessTexture\":{\"index\":0}}}],"
+	         "\"materials\":%s,"
 	         "\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],"
 	         "\"buffers\":[{\"byteLength\":68,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
 	         "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":24},"
@@ -779,11 +747,25 @@ static void test_metallic_roughness_texture(void **state)
 	         "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
 	         "{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"},"
 	         "{\"bufferView\":2,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}",
-	         png64, data);
+	         at, yfov, materials, png64, data);
 	rt_error err = {0};
-	scene *s = rt_load_file(tmp_text("mr.gltf", text), NULL, &err);
-	if (!s)
+	scene *sc = rt_load_file(tmp_text(name, text), NULL, &err);
+	if (!sc)
 		fail_msg("%s", err.msg);
+	return sc;
+}
+
+/* The metallic-roughness texture in shading: a triangle with uv, metallic
+ * 0.5 and roughness 0.8, and a texture of one texel (R, G, B) = (0, 128,
+ * 255), read linear (glTF: G scales roughness, B metallic). At any point:
+ * roughness 0.8 x 128/255 = 0.40157, metallic 0.5 x 255/255 = 0.5. */
+static void test_metallic_roughness_texture(void **state)
+{
+	(void)state;
+	scene *s = textured_tri("mr.gltf", 0, 128, 255, "[0,0,5]", 1,
+	                        "[{\"pbrMetallicRoughness\":{\"metallicFactor\":0.5,\"roughnessFactor\":0.8,"
+	                        "\"metallicRoughnessTexture\":{\"index\":0}}}]");
+	rt_error err = {0};
 	world *w = world_build(s, &err);
 	if (!w)
 		fail_msg("%s", err.msg);
@@ -814,36 +796,13 @@ static void test_metallic_roughness_texture(void **state)
 static void test_texture_rotation(void **state)
 {
 	(void)state;
-	unsigned char bin[68];
-	const float pos[9] = {-1, -1, 0, 1, -1, 0, 0, 1, 0}, uv[6] = {0, 0, 1, 0, 0.5f, 1};
-	const uint16_t idx[4] = {0, 1, 2, 0};
-	memcpy(bin, pos, 36);
-	memcpy(bin + 36, uv, 24);
-	memcpy(bin + 60, idx, 8);
-	char data[128], png64[128];
-	b64(bin, sizeof bin, data);
-	unsigned char png[80];
-	b64(png, png_1x1(200, 100, 50, png), png64);
-	char text[4096];
-	snprintf(text, sizeof text,
-	         "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0},{\"camera\":0,\"translation\":[0,0,5]}],"
-	         "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":1}}],"
-	         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"indices\":2,"
-	         "\"material\":0}]}],"
-	         "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0,\"extensions\":"
-	         "{\"KHR_texture_transform\":{\"offset\":[0.1,0.2],\"rotation\":%.17g,\"scale\":[2,0.5]}}}}}],"
-	         "\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],"
-	         "\"buffers\":[{\"byteLength\":68,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
-	         "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":24},"
-	         "{\"buffer\":0,\"byteOffset\":60,\"byteLength\":6}],"
-	         "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
-	         "{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"},"
-	         "{\"bufferView\":2,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}",
-	         M_PI / 2, png64, data);
+	char mat[256];
+	snprintf(mat, sizeof mat,
+	         "[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0,\"extensions\":"
+	         "{\"KHR_texture_transform\":{\"offset\":[0.1,0.2],\"rotation\":%.17g,\"scale\":[2,0.5]}}}}}]",
+	         M_PI / 2);
+	scene *s = textured_tri("rot.gltf", 200, 100, 50, "[0,0,5]", 1, mat);
 	rt_error err = {0};
-	scene *s = rt_load_file(tmp_text("rot.gltf", text), NULL, &err);
-	if (!s)
-		fail_msg("%s", err.msg);
 	world *w = world_build(s, &err);
 	if (!w)
 		fail_msg("%s", err.msg);
@@ -873,37 +832,11 @@ static void test_texture_rotation(void **state)
 static void test_emissive_texture(void **state)
 {
 	(void)state;
-	unsigned char bin[68];
-	const float pos[9] = {-1, -1, 0, 1, -1, 0, 0, 1, 0}, uv[6] = {0, 0, 1, 0, 0.5f, 1};
-	const uint16_t idx[4] = {0, 1, 2, 0};
-	memcpy(bin, pos, 36);
-	memcpy(bin + 36, uv, 24);
-	memcpy(bin + 60, idx, 8);
-	char data[128], png64[128];
-	b64(bin, sizeof bin, data);
-	unsigned char png[80];
-	b64(png, png_1x1(255, 128, 0, png), png64);
-	char text[4096];
-	snprintf(text, sizeof text,
-	         "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0},{\"camera\":0,\"translation\":[0,-0.2,5]}],"
-	         "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.01}}],"
-	         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"indices\":2,"
-	         "\"material\":0}]}],"
-	         "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1]},\"emissiveFactor\":[1,1,1],"
-	         "\"emissiveTexture\":{\"index\":0},"
-	         "\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":2}}}],"
-	         "\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],"
-	         "\"buffers\":[{\"byteLength\":68,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
-	         "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":24},"
-	         "{\"buffer\":0,\"byteOffset\":60,\"byteLength\":6}],"
-	         "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
-	         "{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"},"
-	         "{\"bufferView\":2,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}]}",
-	         png64, data);
+	scene *s = textured_tri("emit.gltf", 255, 128, 0, "[0,-0.2,5]", 0.01,
+	                        "[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1]},\"emissiveFactor\":[1,1,1],"
+	                        "\"emissiveTexture\":{\"index\":0},"
+	                        "\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":2}}}]");
 	rt_error err = {0};
-	scene *s = rt_load_file(tmp_text("emit.gltf", text), NULL, &err);
-	if (!s)
-		fail_msg("%s", err.msg);
 	world *w = world_build(s, &err);
 	if (!w)
 		fail_msg("%s", err.msg);
@@ -1093,6 +1026,7 @@ static void png_half(char *uri64)
  * centre of the transparent one (bilinear, repeat: alpha 1.5 - 2u on
  * [0.25, 0.75]). */
 static const char *cut_sampler; /* the texture's sampler (its JSON), NULL: none */
+static bool cut_mirror;          /* the plane a perfect mirror, not Lambertian */
 
 static world *cut_world(const char *mat, bool tex, double tx, double qy, scene **out)
 {
@@ -1134,8 +1068,9 @@ static world *cut_world(const char *mat, bool tex, double tx, double qy, scene *
 		fail_msg("%s", err.msg);
 	object pl = object_make(OBJ_PLANE, linear_to_srgb255(v3(0.5, 0.5, 0.5)));
 	pl.dir = v3(0, 1, 0);
-	pl.mat.diffuse = 1;
+	pl.mat.diffuse = cut_mirror ? 0 : 1;
 	pl.mat.specular = 0;
+	pl.mat.reflective = cut_mirror ? 1 : 0;
 	assert_true(scene_add_object(s, &pl, &err));
 	world *w = world_build(s, &err);
 	if (!w)
@@ -1453,6 +1388,84 @@ static void test_blend(void **state)
 	}
 }
 
+/* The alpha of an image file beside the model (not inside it): read by the
+ * reader from the file, as the colour is by the world; a missing file is
+ * an error naming it. */
+static void test_cutout_image_file(void **state)
+{
+	(void)state;
+	static const unsigned char t[8] = {255, 255, 255, 255, 255, 255, 255, 0};
+	unsigned char png[128];
+	size_t n = png_rgba(2, 1, t, png);
+	char path[256];
+	snprintf(path, sizeof path, "%s/half.png", tmpdir);
+	FILE *f = fopen(path, "wb");
+	assert_non_null(f);
+	assert_int_equal(fwrite(png, 1, n, f), n);
+	assert_int_equal(fclose(f), 0);
+	for (int k = 0; k < 2; k++) {
+		char rest[512];
+		snprintf(rest, sizeof rest,
+		         "\"nodes\":[{\"mesh\":0}],\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":"
+		         "{\"index\":0}},\"alphaMode\":\"MASK\"}],\"textures\":[{\"source\":0}],"
+		         "\"images\":[{\"uri\":\"%s\"}],",
+		         k ? "nothere.png" : "half.png");
+		char *text = tri_gltf(unit_tri, rest);
+		const char *model = tmp_text("file.gltf", text);
+		free(text);
+		rt_error err = {0};
+		mesh *m = mesh_read_gltf(model, &err);
+		if (k) {
+			assert_null(m);
+			assert_non_null(strstr(err.msg, "nothere.png"));
+			continue;
+		}
+		if (!m)
+			fail_msg("%s", err.msg);
+		assert_true(m->cuts);
+		assert_non_null(m->mats[0].alpha_map);
+		assert_int_equal(m->mats[0].alpha_w, 2);
+		assert_int_equal(m->mats[0].alpha_map[0], 255);
+		assert_int_equal(m->mats[0].alpha_map[1], 0);
+		mesh_free(m);
+	}
+}
+
+/* Reflection rays: the plane a perfect mirror (no diffuse part), the quad
+ * 10 above it, above the camera, glowing (emissiveFactor 0.5, black
+ * metal). The camera's centre ray meets the mirror at the origin and goes
+ * back up the y axis: through the opaque texel it meets the quad and
+ * brings back its emission, 0.5 (Whitted: the mirror's weight 1 times
+ * what the reflection sees); through the clear texel it leaves into the
+ * black: 0. Single ray and packets. */
+static void test_cutout_reflection(void **state)
+{
+	(void)state;
+	const char *mat = "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1],\"baseColorTexture\":{\"index\":0}},"
+	                  "\"emissiveFactor\":[0.5,0.5,0.5],\"alphaMode\":\"MASK\"}";
+	for (int k = 0; k < 2; k++) {
+		scene *s;
+		cut_mirror = true;
+		world *w = cut_world(mat, true, k ? -0.5 : 0.5, 10, &s);
+		cut_mirror = false;
+		double want = k ? 0 : 0.5;
+		render_settings set = render_settings_default();
+		set.width = set.height = 1001;
+		set.samples = 1;
+		set.depth = 4;
+		set.threads = 1;
+		set.mode = MODE_WHITTED;
+		vec3 c = whitted_radiance(w, &set, render_sample_ray(w, &set, 500, 500, 1001, 1001, 0));
+		assert_vec_near(c, v3_splat(want), 1e-5);
+		float px[16 * 3];
+		render_rect(w, &set, 498, 498, 502, 502, px);
+		for (int i = 0; i < 16 * 3; i++)
+			assert_near(px[i], want, 1e-5);
+		world_free(w);
+		scene_free(s);
+	}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -1478,6 +1491,8 @@ int main(void)
 	    cmocka_unit_test(test_cutout_factor),
 	    cmocka_unit_test(test_cutout_lamp),
 	    cmocka_unit_test(test_blend),
+	    cmocka_unit_test(test_cutout_image_file),
+	    cmocka_unit_test(test_cutout_reflection),
 	};
-	return cmocka_run_group_tests(tests, setup, teardown);
+	return cmocka_run_group_tests(tests, tmpdir_setup, tmpdir_teardown);
 }

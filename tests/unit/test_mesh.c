@@ -2,6 +2,7 @@
  * mesh element (mesh.h, surface.c, rtfile). Expected values come from the
  * files' own descriptions, from formulas or from an independent count. */
 #include "testutil.h"
+#include "tmpdir.h"
 
 #include <unistd.h>
 
@@ -17,41 +18,6 @@
 #include "../fuzz/mesh_check.h"
 
 #define MODELS "../shared/models"
-
-static char tmpdir[64];
-
-static int setup(void **state)
-{
-	(void)state;
-	snprintf(tmpdir, sizeof tmpdir, "/tmp/rtsh-mesh-XXXXXX");
-	return mkdtemp(tmpdir) ? 0 : -1;
-}
-
-static int teardown(void **state)
-{
-	(void)state;
-	char cmd[128];
-	snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
-	return system(cmd) == 0 ? 0 : -1;
-}
-
-static const char *tmp_write(const char *name, const void *data, size_t len)
-{
-	static char path[8][256];
-	static int k;
-	char *p = path[k++ % 8];
-	snprintf(p, 256, "%s/%s", tmpdir, name);
-	FILE *f = fopen(p, "wb");
-	assert_non_null(f);
-	assert_int_equal(fwrite(data, 1, len, f), len);
-	fclose(f);
-	return p;
-}
-
-static const char *tmp_text(const char *name, const char *text)
-{
-	return tmp_write(name, text, strlen(text));
-}
 
 static bool have_models(void)
 {
@@ -1246,5 +1212,5 @@ int main(void)
 		cmocka_unit_test(test_memory_limit),
 		cmocka_unit_test(test_shadow_terminator),
 	};
-	return cmocka_run_group_tests(tests, setup, teardown);
+	return cmocka_run_group_tests(tests, tmpdir_setup, tmpdir_teardown);
 }

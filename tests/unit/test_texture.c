@@ -3,6 +3,7 @@
  * bytes written here, from the layout rtsh(5) documents, or from physics
  * (the furnace). */
 #include "testutil.h"
+#include "tmpdir.h"
 
 #include <unistd.h>
 
@@ -12,36 +13,6 @@
 #include "rtsh/rtfile.h"
 #include "rtsh/texture.h"
 #include "rtsh/world.h"
-
-static char tmpdir[64];
-
-static int setup(void **state)
-{
-	(void)state;
-	snprintf(tmpdir, sizeof tmpdir, "/tmp/rtsh-tex-XXXXXX");
-	return mkdtemp(tmpdir) ? 0 : -1;
-}
-
-static int teardown(void **state)
-{
-	(void)state;
-	char cmd[128];
-	snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
-	return system(cmd) == 0 ? 0 : -1;
-}
-
-static const char *tmp_write(const char *name, const void *data, size_t len)
-{
-	static char path[8][256];
-	static int k;
-	char *p = path[k++ % 8];
-	snprintf(p, 256, "%s/%s", tmpdir, name);
-	FILE *f = fopen(p, "wb");
-	assert_non_null(f);
-	assert_int_equal(fwrite(data, 1, len, f), len);
-	fclose(f);
-	return p;
-}
 
 static double srgb(int code)
 {
@@ -151,7 +122,7 @@ static void test_mipmap_average(void **state)
 			for (int c = 0; c < 3; c++)
 				rgb[3 * (y * n + x) + c] = (float)((x + y) & 1);
 	rt_error err = {0};
-	texture *t = texture_make(rgb, n, n, &err);
+	texture *t = texture_make(rgb, n, n, NULL, false, &err);
 	assert_non_null(t);
 	assert_int_equal(t->nlevels, 7); /* 64, 32, ..., 1 */
 	test_rng r = {3};
@@ -375,5 +346,5 @@ int main(void)
 		cmocka_unit_test(test_sky_pdf),
 		cmocka_unit_test(test_threads_same_picture),
 	};
-	return cmocka_run_group_tests(tests, setup, teardown);
+	return cmocka_run_group_tests(tests, tmpdir_setup, tmpdir_teardown);
 }

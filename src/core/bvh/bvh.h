@@ -166,6 +166,55 @@ static inline unsigned bvh_slab4(const bvh_node *n, const bvh_ray *q, float tmin
 #endif
 }
 
+/* An entry of a walk's stack (world.c's single rays, packet.c's packets): a
+ * node or a leaf, as in bvh_node, and where the ray or packet enters its
+ * box. */
+typedef struct bvh_entry {
+	uint32_t child, meta;
+	float t;
+	uint32_t pad;
+} bvh_entry;
+
+/* A nearest-hit walk's step into the children of n that mask m (not 0)
+ * says are hit: the nearest is entered now (*child, *meta), the others
+ * pushed farthest first, so that the next nearest is on top (an insertion
+ * sort of at most BVH_WIDTH; of two at the same distance, the lower index
+ * comes first); returns the new stack height. */
+static inline int bvh_enter_sorted(const bvh_node *n, unsigned m, const float tn[BVH_WIDTH], bvh_entry *stack,
+                                   int sp, uint32_t *child, uint32_t *meta)
+{
+	int idx[BVH_WIDTH], c = 0;
+	for (unsigned b = m; b; b &= b - 1) {
+		int k = __builtin_ctz(b), j = c++;
+		while (j > 0 && tn[idx[j - 1]] < tn[k]) {
+			idx[j] = idx[j - 1];
+			j--;
+		}
+		idx[j] = k;
+	}
+	for (int i = 0; i < c - 1; i++)
+		stack[sp++] = (bvh_entry){n->child[idx[i]], n->meta[idx[i]], tn[idx[i]], 0};
+	*child = n->child[idx[c - 1]];
+	*meta = n->meta[idx[c - 1]];
+	return sp;
+}
+
+/* An any-hit walk's step into the children of n that mask m (not 0) says
+ * are hit, in index order: the first is entered now (*child, *meta), the
+ * others pushed; returns the new stack height. */
+static inline int bvh_enter_any(const bvh_node *n, unsigned m, const float tn[BVH_WIDTH], bvh_entry *stack, int sp,
+                                uint32_t *child, uint32_t *meta)
+{
+	int k = __builtin_ctz(m);
+	for (unsigned rest = m & (m - 1); rest; rest &= rest - 1) {
+		int j = __builtin_ctz(rest);
+		stack[sp++] = (bvh_entry){n->child[j], n->meta[j], tn[j], 0};
+	}
+	*child = n->child[k];
+	*meta = n->meta[k];
+	return sp;
+}
+
 struct bvh {
 	bvh_node *nodes;    /* 64-byte aligned; none when there are no primitives */
 	size_t nnodes;

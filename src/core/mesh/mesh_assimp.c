@@ -101,17 +101,7 @@ static texture *embedded_texture(const struct aiTexture *tx, unsigned index, con
 				rgb[3 * i + (size_t)k] = srgb ? (float)srgb8_to_linear(c[k]) : c[k] / 255.0f;
 		}
 	}
-	texture *t = texture_make(rgb, w, h, err);
-	if (!t)
-		return NULL;
-	t->srgb = srgb;
-	t->path = strdup(name);
-	if (!t->path) {
-		texture_free(t);
-		rt_error_set(err, "%s: out of memory", name);
-		return NULL;
-	}
-	return t;
+	return texture_make(rgb, w, h, name, srgb, err);
 }
 
 /* A material's texture of `type`: a file beside the model (*file) or an

@@ -217,6 +217,17 @@ static bool get_num(gl *g, const cJSON *o, const char *k, const char *where, dou
 	return true;
 }
 
+/* get_num into a float field (left as it was on an error). */
+static bool get_float(gl *g, const cJSON *o, const char *k, const char *where, double lo, double hi, double def,
+                      float *out)
+{
+	double v;
+	if (!get_num(g, o, k, where, lo, hi, def, &v))
+		return false;
+	*out = (float)v;
+	return true;
+}
+
 /* n numbers at o[k] in [lo, hi] (def when absent). */
 static bool get_nums(gl *g, const cJSON *o, const char *k, const char *where, int n, double lo, double hi,
                      const double *def, double *out)
@@ -952,34 +963,44 @@ full:
 
 /* --- materials --- */
 
-/* The bytes of image im (where: "images[im]"): in a buffer view or a data
- * URI (*data, len; *own when they need freeing, *ext the format's
- * extension), or a file beside the model (*file, owned; nothing read). */
-static bool image_bytes(gl *g, long im, const char *iw, const unsigned char **data, size_t *len, unsigned char **own,
-                        char **file, const char **ext)
+/* Where image im's bytes are (image_bytes): in a buffer view or a data URI
+ * (data, len; own when they need freeing), or in a file beside the model
+ * (file, owned; nothing read). */
+typedef struct img_bytes {
+	char where[WHERE_MAX];                /* "images[im]", for messages */
+	char name[RT_ERROR_FILE_MAX + 64];    /* the decoder's: "MODEL: images[im].png" */
+	const unsigned char *data;
+	size_t len;
+	unsigned char *own;
+	char *file;
+} img_bytes;
+
+static bool image_bytes(gl *g, long im, img_bytes *ib)
 {
 	const cJSON *img = g->images.v[im], *uri = key(img, "uri"), *mime = key(img, "mimeType");
+	memset(ib, 0, sizeof *ib);
+	snprintf(ib->where, sizeof ib->where, "images[%ld]", im);
+	const char *iw = ib->where;
 	long bv;
-	*file = NULL;
-	*own = NULL;
 	if (!get_index(g, img, "bufferView", iw, g->views.n, "bufferViews", false, &bv))
 		return false;
-	*ext = "png";
-	if (cJSON_IsString(mime) && strcmp(mime->valuestring, "image/jpeg") == 0)
-		*ext = "jpg";
+	bool in_uri = bv < 0 && cJSON_IsString(uri) && strncmp(uri->valuestring, "data:", 5) == 0;
+	const char *ext = "png";
+	if ((cJSON_IsString(mime) && strcmp(mime->valuestring, "image/jpeg") == 0) ||
+	    (in_uri && strncmp(uri->valuestring, "data:image/jpeg", 15) == 0))
+		ext = "jpg";
+	snprintf(ib->name, sizeof ib->name, "%s: images[%ld].%s", g->name, im, ext);
 	if (bv >= 0) {
 		size_t stride;
-		return view(g, (size_t)bv, data, len, &stride);
-	} else if (cJSON_IsString(uri) && strncmp(uri->valuestring, "data:", 5) == 0) {
-		if (strncmp(uri->valuestring, "data:image/jpeg", 15) == 0)
-			*ext = "jpg";
-		if (!(*own = data_uri(g, uri->valuestring, iw, len)))
+		return view(g, (size_t)bv, &ib->data, &ib->len, &stride);
+	} else if (in_uri) {
+		if (!(ib->own = data_uri(g, uri->valuestring, iw, &ib->len)))
 			return false;
-		*data = *own;
+		ib->data = ib->own;
 		return true;
 	} else if (cJSON_IsString(uri)) {
-		*file = uri_file(g->dir ? g->dir : "", uri->valuestring);
-		return *file ? true : fail(g, iw, "out of memory");
+		ib->file = uri_file(g->dir ? g->dir : "", uri->valuestring);
+		return ib->file ? true : fail(g, iw, "out of memory");
 	}
 	return fail(g, iw, "neither \"uri\" nor \"bufferView\"; expected one");
 }
@@ -1016,34 +1037,25 @@ static bool alpha_info(gl *g, const cJSON *ti, const char *where, mesh_mat *m)
 	}
 	if (im < 0)
 		return true;
-	char iw[WHERE_MAX];
-	snprintf(iw, sizeof iw, "images[%ld]", im);
-	const unsigned char *data = NULL;
-	size_t len = 0;
-	unsigned char *own = NULL;
-	char *file = NULL;
-	const char *ext;
-	if (!image_bytes(g, im, iw, &data, &len, &own, &file, &ext))
+	img_bytes ib;
+	if (!image_bytes(g, im, &ib))
 		return false;
-	char name[RT_ERROR_FILE_MAX + 64];
 	char *disk = NULL;
-	if (file) {
+	if (ib.file) {
 		if (!g->dir) { /* a buffer: no file is read */
-			free(file);
+			free(ib.file);
 			return true;
 		}
-		disk = rt_file_read(file, "image", &len, g->err);
-		snprintf(name, sizeof name, "%s", file);
-		free(file);
+		disk = rt_file_read(ib.file, "image", &ib.len, g->err);
+		snprintf(ib.name, sizeof ib.name, "%s", ib.file);
+		free(ib.file);
 		if (!disk)
 			return false;
-		data = (const unsigned char *)disk;
-	} else {
-		snprintf(name, sizeof name, "%s: images[%ld].%s", g->name, im, ext);
+		ib.data = (const unsigned char *)disk;
 	}
 	int w = 0, h = 0;
-	bool ok = image_decode_alpha(name, data, len, &m->alpha_map, &w, &h, g->err);
-	free(own);
+	bool ok = image_decode_alpha(ib.name, ib.data, ib.len, &m->alpha_map, &w, &h, g->err);
+	free(ib.own);
 	free(disk);
 	m->alpha_w = w;
 	m->alpha_h = h;
@@ -1074,33 +1086,21 @@ static bool tex_info(gl *g, mesh_builder *b, texture **cache, const cJSON *ti, c
 		*tex = *slot;
 		return true;
 	}
-	char iw[WHERE_MAX];
-	snprintf(iw, sizeof iw, "images[%ld]", im);
-	const unsigned char *data = NULL;
-	size_t len = 0;
-	unsigned char *own = NULL;
-	const char *ext;
-	if (!image_bytes(g, im, iw, &data, &len, &own, file, &ext))
+	img_bytes ib;
+	if (!image_bytes(g, im, &ib))
 		return false;
-	if (*file)
+	if ((*file = ib.file))
 		return true;
-	char name[RT_ERROR_FILE_MAX + 64];
-	snprintf(name, sizeof name, "%s: images[%ld].%s", g->name, im, ext);
 	int w = 0, h = 0;
-	float *rgb = image_decode_rgb(name, data, len, srgb, &w, &h, g->err);
-	free(own);
+	float *rgb = image_decode_rgb(ib.name, ib.data, ib.len, srgb, &w, &h, g->err);
+	free(ib.own);
 	if (!rgb)
 		return false;
-	texture *x = texture_make(rgb, w, h, g->err);
+	texture *x = texture_make(rgb, w, h, ib.name, srgb, g->err);
 	if (!x)
 		return false;
-	x->srgb = srgb;
-	if (!(x->path = strdup(name))) {
-		texture_free(x);
-		return fail(g, iw, "out of memory");
-	}
 	if (!mb_texture(b, x))
-		return fail(g, iw, "out of memory");
+		return fail(g, ib.where, "out of memory");
 	*slot = *tex = x;
 	return true;
 }
@@ -1120,12 +1120,9 @@ static bool material(gl *g, mesh_builder *b, texture **cache, size_t i, mesh_mat
 		m->ke[k] = (float)e[k];
 	}
 	m->alpha = (float)c[3];
-	if (!get_num(g, pbr, "metallicFactor", w2, 0, 1, 1, &v))
+	if (!get_float(g, pbr, "metallicFactor", w2, 0, 1, 1, &m->metallic) ||
+	    !get_float(g, pbr, "roughnessFactor", w2, 0, 1, 1, &m->roughness))
 		return false;
-	m->metallic = (float)v;
-	if (!get_num(g, pbr, "roughnessFactor", w2, 0, 1, 1, &v))
-		return false;
-	m->roughness = (float)v;
 	const cJSON *am = key(o, "alphaMode");
 	if (am) {
 		const char *s = cJSON_IsString(am) ? am->valuestring : "";
@@ -1133,14 +1130,12 @@ static bool material(gl *g, mesh_builder *b, texture **cache, size_t i, mesh_mat
 		if (!m->alpha_mode && strcmp(s, "OPAQUE") != 0)
 			return fail(g, where, "alphaMode: not \"OPAQUE\", \"MASK\" or \"BLEND\"; expected one of them");
 	}
-	if (!get_num(g, o, "alphaCutoff", where, 0, 1e300, 0.5, &v))
+	if (!get_float(g, o, "alphaCutoff", where, 0, 1e300, 0.5, &m->alpha_cutoff))
 		return false;
-	m->alpha_cutoff = (float)v;
 	const cJSON *nt = key(o, "normalTexture");
 	snprintf(w2, sizeof w2, "%s.normalTexture", where);
-	if (!get_num(g, nt, "scale", w2, -1e300, 1e300, 1, &v))
+	if (!get_float(g, nt, "scale", w2, -1e300, 1e300, 1, &m->normal_scale))
 		return false;
-	m->normal_scale = (float)v;
 	/* the extensions */
 	const cJSON *x;
 	m->ior = 1.5f;
@@ -1156,9 +1151,8 @@ static bool material(gl *g, mesh_builder *b, texture **cache, size_t i, mesh_mat
 	}
 	if ((x = key(ext, "KHR_materials_transmission"))) {
 		snprintf(w2, sizeof w2, "%s.extensions.KHR_materials_transmission", where);
-		if (!get_num(g, x, "transmissionFactor", w2, 0, 1, 0, &v))
+		if (!get_float(g, x, "transmissionFactor", w2, 0, 1, 0, &m->transmission))
 			return false;
-		m->transmission = (float)v;
 	}
 	if ((x = key(ext, "KHR_materials_ior"))) {
 		snprintf(w2, sizeof w2, "%s.extensions.KHR_materials_ior", where);
@@ -1171,32 +1165,25 @@ static bool material(gl *g, mesh_builder *b, texture **cache, size_t i, mesh_mat
 	if ((x = key(ext, "KHR_materials_volume"))) {
 		snprintf(w2, sizeof w2, "%s.extensions.KHR_materials_volume", where);
 		double ac[3];
-		if (!get_num(g, x, "thicknessFactor", w2, 0, 1e300, 0, &v))
-			return false;
-		m->thickness = (float)v;
-		if (!get_num(g, x, "attenuationDistance", w2, 0, 1e300, 0, &v) ||
+		if (!get_float(g, x, "thicknessFactor", w2, 0, 1e300, 0, &m->thickness) ||
+		    !get_float(g, x, "attenuationDistance", w2, 0, 1e300, 0, &m->att_dist) ||
 		    !get_nums(g, x, "attenuationColor", w2, 3, 0, 1, one3, ac))
 			return false;
-		m->att_dist = (float)v;
 		for (int k = 0; k < 3; k++)
 			m->att_color[k] = (float)ac[k];
 	}
 	if ((x = key(ext, "KHR_materials_clearcoat"))) {
 		snprintf(w2, sizeof w2, "%s.extensions.KHR_materials_clearcoat", where);
-		if (!get_num(g, x, "clearcoatFactor", w2, 0, 1, 0, &v))
+		if (!get_float(g, x, "clearcoatFactor", w2, 0, 1, 0, &m->clearcoat) ||
+		    !get_float(g, x, "clearcoatRoughnessFactor", w2, 0, 1, 0, &m->clearcoat_roughness))
 			return false;
-		m->clearcoat = (float)v;
-		if (!get_num(g, x, "clearcoatRoughnessFactor", w2, 0, 1, 0, &v))
-			return false;
-		m->clearcoat_roughness = (float)v;
 	}
 	if ((x = key(ext, "KHR_materials_specular"))) {
 		snprintf(w2, sizeof w2, "%s.extensions.KHR_materials_specular", where);
 		double sc[3];
-		if (!get_num(g, x, "specularFactor", w2, 0, 1, 1, &v) ||
+		if (!get_float(g, x, "specularFactor", w2, 0, 1, 1, &m->specular) ||
 		    !get_nums(g, x, "specularColorFactor", w2, 3, 0, 1e300, one3, sc))
 			return false;
-		m->specular = (float)v;
 		for (int k = 0; k < 3; k++)
 			m->specular_color[k] = (float)sc[k];
 	}

@@ -82,16 +82,7 @@ static bool fail(ply_reader *r, const char *fmt, ...)
 
 static bool ascii_value(ply_reader *r, double *v)
 {
-	for (;;) {
-		while (r->s < r->end && (*r->s == ' ' || *r->s == '\t' || *r->s == '\r'))
-			r->s++;
-		if (r->s < r->end && *r->s == '\n') {
-			r->s++;
-			r->line++;
-			continue;
-		}
-		break;
-	}
+	r->s = skip_space(r->s, r->end, false, &r->line);
 	const char *p = (const char *)r->s;
 	if (!scan_double(&p, (const char *)r->end, v))
 		return false;

@@ -2,14 +2,6 @@
  * Its side is x^2 + z^2 = k^2 (y - 1)^2 with k = 1/2, for -1 <= y <= 1. */
 #include "shapes.h"
 
-static void keep(double tt, vec3 nn, double tmin, double *best, vec3 *n)
-{
-	if (tt > tmin && tt < *best) {
-		*best = tt;
-		*n = nn;
-	}
-}
-
 static void side(vec3 o, vec3 d, double tt, double tmin, double *best, vec3 *n)
 {
 	double y = o.y + d.y * tt;
@@ -21,7 +13,7 @@ static void side(vec3 o, vec3 d, double tt, double tmin, double *best, vec3 *n)
 	vec3 g = v3(x, -0.25 * (y - 1.0), z);
 	if (v3_len2(g) == 0.0)
 		g = v3(0, 1, 0);
-	keep(tt, g, tmin, best, n);
+	shape_keep(tt, g, tmin, best, n);
 }
 
 static bool cone_intersect(vec3 o, vec3 d, double tube, double tmin, double tmax, double *t, vec3 *n)
@@ -43,12 +35,8 @@ static bool cone_intersect(vec3 o, vec3 d, double tube, double tmin, double tmax
 		/* The ray runs parallel to a generatrix: one root of 2bt + c = 0. */
 		side(o, d, -c / (2.0 * b), tmin, &best, n);
 	}
-	if (d.y != 0.0) {
-		double tc = (-1.0 - o.y) / d.y;
-		double x = o.x + d.x * tc, z = o.z + d.z * tc;
-		if (x * x + z * z <= 1.0)
-			keep(tc, v3(0, -1, 0), tmin, &best, n);
-	}
+	if (d.y != 0.0)
+		shape_cap(o, d, -1.0, tmin, &best, n);
 	if (best >= tmax)
 		return false;
 	*t = best;
@@ -64,12 +52,11 @@ static bool cone_occluded(vec3 o, vec3 d, double tube, double tmin, double tmax)
 }
 
 const shape_kind cone_kind = {
-	.form = {"co", "cone", false, true, false, 4, "CENTER AXIS DIAMETER HEIGHT",
-	         {"center", "axis", "diameter", "height"}, "pdss", read_tube, write_tube},
+	.form = TUBE_FORM("co", "cone", false),
 	.intersect = cone_intersect,
 	.occluded = cone_occluded,
 	.bounds = unit_cube_bounds,
 	.uv = uv_capped_side,
 	.cost = 8,
-	.recipe = {true, {40, 60, 0}, {100, 140, 0}, 0, 0},
+	.recipe = TUBE_RECIPE,
 };

@@ -1,5 +1,6 @@
 /* rtsh — the flat bounded shapes in the plane y = 0: the disc x^2 + z^2 <= 1
- * and the rectangle |x| <= 1, |z| <= 1, both with normal +Y. */
+ * and the rectangle |x| <= 1, |z| <= 1, both with normal +Y. Their texture coordinates are the planar
+ * default (no uv). */
 #include "shapes.h"
 
 #include "core/warp.h"
@@ -119,7 +120,6 @@ const shape_kind disc_kind = {
 	.intersect = disc_intersect,
 	.occluded = disc_occluded,
 	.bounds = unit_flat_bounds,
-	.uv = uv_planar,
 	.light = {disc_light, disc_light_sample, flat_light_pdf},
 	.cost = 8,
 	.recipe = {true, {50, -1, 0}, {100, 0, 0}, 0, 0},
@@ -132,7 +132,6 @@ const shape_kind rect_kind = {
 	.intersect = rect_intersect,
 	.occluded = rect_occluded,
 	.bounds = unit_flat_bounds,
-	.uv = uv_planar,
 	.light = {rect_light, rect_light_sample, flat_light_pdf},
 	.cost = 8,
 	.recipe = {true, {50, -1, 50}, {120, 0, 120}, 0, 0},

@@ -8,6 +8,26 @@
  * no real root. t0 <= t1. */
 bool solve_quadratic_half(double a, double b, double c, double *t0, double *t1);
 
+/* Keeps the candidate hit (tt, nn) when it lies beyond tmin and nearer than
+ * the best so far (cone, cylinder). */
+static inline void shape_keep(double tt, vec3 nn, double tmin, double *best, vec3 *n)
+{
+	if (tt > tmin && tt < *best) {
+		*best = tt;
+		*n = nn;
+	}
+}
+
+/* The cap of radius 1 in the plane y = yc, its normal (0, yc, 0) (yc = 1 or
+ * -1): kept when the ray crosses it inside the disc (d.y != 0). */
+static inline void shape_cap(vec3 o, vec3 d, double yc, double tmin, double *best, vec3 *n)
+{
+	double tc = (yc - o.y) / d.y;
+	double x = o.x + d.x * tc, z = o.z + d.z * tc;
+	if (x * x + z * z <= 1.0)
+		shape_keep(tc, v3(0, yc, 0), tmin, best, n);
+}
+
 /* The cube [-1,1]^3 (the bounds of most unit shapes). */
 box unit_cube_bounds(double tube);
 /* The square [-1,1] x {0} x [-1,1] (flat shapes). */
@@ -56,5 +76,11 @@ bool write_uniform(const object *o, double *sizes);
 /* DIAMETER HEIGHT: scale (d, h, d) (cylinder, cone). */
 void read_tube(object *o, const double *sizes);
 bool write_tube(const object *o, double *sizes);
+/* Their short form (its id, name and whether --strict allows it) and their
+ * generator recipe. */
+#define TUBE_FORM(id, name, strict)                                                                               \
+	{id, name, strict, true, false, 4, "CENTER AXIS DIAMETER HEIGHT", {"center", "axis", "diameter", "height"}, \
+	 "pdss", read_tube, write_tube}
+#define TUBE_RECIPE {true, {40, 60, 0}, {100, 140, 0}, 0, 0}
 
 #endif

@@ -184,7 +184,7 @@ const shape_kind torus_kind = {
 	.intersect = torus_intersect,
 	.occluded = torus_occluded,
 	.bounds = torus_bounds,
-	.uv = uv_planar, /* planar, seen along its axis (rtsh(5)) */
+	/* no uv: the planar default, seen along its axis (rtsh(5)) */
 	.cost = 40,
 	.recipe = {true, {50, 0, 0}, {100, 0, 0}, 20, 60},
 };

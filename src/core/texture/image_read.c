@@ -190,16 +190,7 @@ typedef struct pnm {
 
 static bool pnm_int(pnm *p, long *v)
 {
-	for (;;) {
-		while (p->s < p->end && (*p->s == ' ' || *p->s == '\t' || *p->s == '\r' || *p->s == '\n'))
-			p->s++;
-		if (p->s < p->end && *p->s == '#') {
-			while (p->s < p->end && *p->s != '\n')
-				p->s++;
-			continue;
-		}
-		break;
-	}
+	p->s = skip_space(p->s, p->end, true, NULL);
 	const char *c = (const char *)p->s;
 	if (!scan_long(&c, (const char *)p->end, v))
 		return false;

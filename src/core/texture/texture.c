@@ -32,16 +32,22 @@ void texture_free(texture *t)
 	free(t);
 }
 
-texture *texture_make(float *rgb, int w, int h, rt_error *err)
+texture *texture_make(float *rgb, int w, int h, const char *name, bool srgb, rt_error *err)
 {
 	texture *t = calloc(1, sizeof *t);
 	if (!t) {
 		free(rgb);
-		rt_error_set(err, "out of memory");
+		rt_error_set(err, "%s: out of memory", name ? name : "texture");
 		return NULL;
 	}
 	t->level[0] = (tex_level){w, h, rgb};
 	t->nlevels = 1;
+	t->srgb = srgb;
+	if (name && !(t->path = strdup(name))) {
+		texture_free(t);
+		rt_error_set(err, "%s: out of memory", name);
+		return NULL;
+	}
 	/* each level the 2x2 box average of the one above (an odd row or
 	 * column is folded into its neighbour by clamping) */
 	while (t->nlevels < TEX_MAX_LEVELS) {
@@ -75,12 +81,7 @@ texture *texture_load(const char *path, bool srgb, rt_error *err)
 	float *rgb = image_load_rgb(path, srgb, &w, &h, err);
 	if (!rgb)
 		return NULL;
-	texture *t = texture_make(rgb, w, h, err);
-	if (t) {
-		t->path = strdup(path);
-		t->srgb = srgb;
-	}
-	return t;
+	return texture_make(rgb, w, h, path, srgb, err);
 }
 
 static inline int wrap(int i, int n)
