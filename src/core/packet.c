@@ -46,6 +46,7 @@ typedef struct pk_state {
 	const prim *best[PACKET_MAX];
 	vec3 nl[PACKET_MAX];
 	bool tie[PACKET_MAX];
+	bool one_o; /* every ray's origin is ray 0's, bit for bit (camera rays) */
 } pk_state;
 
 /* Ray i by component, and d . d as sphere_hit computes it. */
@@ -66,6 +67,7 @@ static inline void pk_load_ray(pk_state *s, int i, const ray *r)
 typedef struct pk_ray {
 	__m128 on[3], of[3], ilo[3], ihi[3];
 	int near[3], far[3];
+	bool one_o; /* every ray's origin equals ray 0's (as doubles: a zero of either sign) */
 } pk_ray;
 
 /* The smallest double above t >= 0 (+inf stays): a primitive at exactly
@@ -112,7 +114,7 @@ static bool packet_prepare(const ray *r, int n, pk_ray *q)
 	__m128d nan = _mm_setzero_pd();
 	__m128 on_lo = _mm_set1_ps(INFINITY), on_hi = _mm_set1_ps(-INFINITY), of_lo = on_lo, of_hi = on_hi;
 	__m128 bad = _mm_setzero_ps();
-	int neg_and = 7, neg_or = 0;
+	int neg_and = 7, neg_or = 0, same_o = 0;
 	for (int i = 0; i < n; i++) {
 		__m128d d = _mm_loadu_pd(&r[i].d.x), dz = _mm_load_sd(&r[i].d.z);
 		__m128d o = _mm_loadu_pd(&r[i].o.x), oz = _mm_load_sd(&r[i].o.z);
@@ -128,8 +130,10 @@ static bool packet_prepare(const ray *r, int n, pk_ray *q)
 		/* the origin's bracket, unless it is the first ray's (camera
 		 * rays: equal doubles, a zero of either sign giving the same
 		 * floats here) */
-		if (i > 0 && _mm_movemask_pd(_mm_and_pd(_mm_cmpeq_pd(o, o0), _mm_cmpeq_pd(oz, o0z))) == 3)
+		if (i > 0 && _mm_movemask_pd(_mm_and_pd(_mm_cmpeq_pd(o, o0), _mm_cmpeq_pd(oz, o0z))) == 3) {
+			same_o++;
 			continue;
+		}
 		__m128 f = _mm_movelh_ps(_mm_cvtpd_ps(o), _mm_cvtpd_ps(oz));
 		__m128 e = _mm_add_ps(_mm_mul_ps(_mm_andnot_ps(sign, f), ulp), tiny);
 		__m128 es = _mm_xor_ps(e, isign);
@@ -155,6 +159,7 @@ static bool packet_prepare(const ray *r, int n, pk_ray *q)
 	bad = _mm_or_ps(bad, _mm_cmpeq_ps(_mm_andnot_ps(sign, ihi), _mm_setzero_ps()));
 	if (_mm_movemask_ps(bad) & 7)
 		return false;
+	q->one_o = same_o == n - 1;
 	float a_on_lo[4], a_on_hi[4], a_of_lo[4], a_of_hi[4], a_ilo[4], a_ihi[4];
 	_mm_storeu_ps(a_on_lo, on_lo);
 	_mm_storeu_ps(a_on_hi, on_hi);
@@ -237,6 +242,19 @@ static inline unsigned sphere_disc2(const pk_state *s, int i, const pk_sphere *s
 	__m128d disc = _mm_sub_pd(_mm_mul_pd(b, b), _mm_mul_pd(_mm_load_pd(&s->dd[i]), c));
 	return (unsigned)_mm_movemask_pd(_mm_cmpnlt_pd(disc, _mm_setzero_pd()));
 }
+
+/* sphere_disc2 for rays of one origin: oc and c, computed once by
+ * sphere_disc2's own operations on that origin, are every ray's, and so
+ * is the discriminant. (Origins equal as doubles may differ in the sign
+ * of a zero; that can change the sign of a zero in oc and b but not b * b
+ * or oc . oc, so not the discriminant.) */
+static inline unsigned sphere_disc2_o(const pk_state *s, int i, __m128d ocx, __m128d ocy, __m128d ocz, __m128d c)
+{
+	__m128d dx = _mm_load_pd(&s->dx[i]), dy = _mm_load_pd(&s->dy[i]), dz = _mm_load_pd(&s->dz[i]);
+	__m128d b = _mm_add_pd(_mm_add_pd(_mm_mul_pd(ocx, dx), _mm_mul_pd(ocy, dy)), _mm_mul_pd(ocz, dz));
+	__m128d disc = _mm_sub_pd(_mm_mul_pd(b, b), _mm_mul_pd(_mm_load_pd(&s->dd[i]), c));
+	return (unsigned)_mm_movemask_pd(_mm_cmpnlt_pd(disc, _mm_setzero_pd()));
+}
 #endif
 
 static void leaf_spheres(pk_state *s, const prim *p, const ray *r, double tmin)
@@ -244,6 +262,22 @@ static void leaf_spheres(pk_state *s, const prim *p, const ray *r, double tmin)
 	vec3 zero = {0, 0, 0};
 #if defined(__SSE2__)
 	const pk_sphere sph = pk_sphere_of(p);
+	if (s->one_o) {
+		__m128d ocx = _mm_sub_pd(_mm_load_pd(&s->ox[0]), sph.cx), ocy = _mm_sub_pd(_mm_load_pd(&s->oy[0]), sph.cy);
+		__m128d ocz = _mm_sub_pd(_mm_load_pd(&s->oz[0]), sph.cz);
+		__m128d c = _mm_sub_pd(
+			_mm_add_pd(_mm_add_pd(_mm_mul_pd(ocx, ocx), _mm_mul_pd(ocy, ocy)), _mm_mul_pd(ocz, ocz)), sph.rr);
+		for (int i = 0; i < s->n; i += 2) {
+			unsigned m = sphere_disc2_o(s, i, ocx, ocy, ocz, c);
+			for (; m; m &= m - 1) {
+				int j = i + __builtin_ctz(m);
+				double t;
+				if (j < s->n && sphere_hit(p, &r[j], tmin, next_up(s->tmax[j]), &t))
+					offer(s, j, p, t, zero);
+			}
+		}
+		return;
+	}
 	for (int i = 0; i < s->n; i += 2) {
 		unsigned m = sphere_disc2(s, i, &sph);
 		for (; m; m &= m - 1) {
@@ -260,6 +294,27 @@ static void leaf_spheres(pk_state *s, const prim *p, const ray *r, double tmin)
 			offer(s, i, p, t, zero);
 	}
 #endif
+}
+
+/* plane_hit in two steps for rays of one origin o: its height over the
+ * plane, then each ray's test, with plane_hit's own operations. */
+static inline double plane_oy(const prim_plane *pl, vec3 o)
+{
+	const double *h = pl->h;
+	return h[0] * o.x + h[1] * o.y + h[2] * o.z + h[3];
+}
+
+static inline bool plane_hit_o(const prim_plane *pl, double oy, const ray *r, double tmin, double tmax, double *t)
+{
+	const double *h = pl->h;
+	double dy = h[0] * r->d.x + h[1] * r->d.y + h[2] * r->d.z;
+	if (dy == 0.0)
+		return false;
+	double tt = -oy / dy;
+	if (!(tt > tmin && tt < tmax))
+		return false;
+	*t = tt;
+	return true;
 }
 
 /* The farthest of the rays' nearest hits so far. */
@@ -332,11 +387,21 @@ void world_trace_packet(const world *w, int n, const ray *r, double tmin, double
 	pk_state s;
 	s.n = n;
 	const prim_plane *best_plane[PACKET_MAX];
+	s.one_o = q.one_o;
+	/* rays of one origin: its height over each of the first planes once
+	 * (plane_oy). Origins equal as doubles may differ in the sign of a
+	 * zero, and so may oy, only when it is zero: then -oy / dy is a zero
+	 * (or NaN) that no tmin >= 0 lets through either way. */
+	double oy[4];
+	size_t noy = s.one_o && tmin >= 0.0 ? (w->nplanes < 4 ? w->nplanes : 4) : 0;
+	for (size_t k = 0; k < noy; k++)
+		oy[k] = plane_oy(&w->planes[k], r[0].o);
 	for (int i = 0; i < n; i++) {
 		double t = tmax, tp;
 		best_plane[i] = NULL;
 		for (size_t k = 0; k < w->nplanes; k++)
-			if (plane_hit(&w->planes[k], &r[i], tmin, t, &tp)) {
+			if (k < noy ? plane_hit_o(&w->planes[k], oy[k], &r[i], tmin, t, &tp)
+			            : plane_hit(&w->planes[k], &r[i], tmin, t, &tp)) {
 				t = tp;
 				best_plane[i] = &w->planes[k];
 			}
@@ -410,6 +475,7 @@ void world_occluded_packet(const world *w, int n, const ray *r, double tmin, con
 	world_rays_count(n);
 	pk_state s;
 	s.n = n;
+	s.one_o = false;
 	unsigned live = 0;
 	for (int i = 0; i < n; i++) {
 		double t;
