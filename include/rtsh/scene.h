@@ -188,9 +188,12 @@ typedef struct sky {
 } sky;
 
 /* The most rows of the settings table (settings.h; checked there), and the
- * longest text of a kept setting's value with its terminating zero. */
+ * longest text of a kept setting's value with its terminating zero (a
+ * 64-bit whole number, a double in the fewest digits: "-0.00012345678901234567").
+ * 16 x 24 keeps scene_hints no larger than an object, the largest member of
+ * the editor's undo records. */
 #define SCENE_KEPT_MAX 16
-#define SCENE_KEPT_LEN 32
+#define SCENE_KEPT_LEN 24
 
 /* Per-scene render hints from the file (`R`, `set` lines). scene_new sets
  * them all to "unset": width, height and samples 0, depth and mode -1, the

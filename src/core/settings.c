@@ -264,8 +264,13 @@ bool settings_scene_value(const setting_def *def, const char *value, char *out, 
 	render_settings s = render_settings_default();
 	if (!set_value(&s, def, value, false, err))
 		return false;
+	char text[64];
+	settings_format(&s, def, text, sizeof text);
+	if (strlen(text) >= size)
+		return rt_error_set(err, "%s \"%s\" is not valid; expected at most %zu characters", def->name, value,
+		                    size - 1);
 	memset(out, 0, size);
-	settings_format(&s, def, out, size);
+	memcpy(out, text, strlen(text));
 	return true;
 }
 

@@ -408,6 +408,11 @@ static void test_kept_settings(void **state)
 	free(out);
 	assert_round_trip(s, "a long seed and exposure");
 	scene_free(s);
+	/* The longest text a kept value takes (scene.h's SCENE_KEPT_LEN). */
+	s = load_ok(KCAM "set exposure -0.00012345678901234567\n");
+	assert_true(applied(s).exposure == -0.00012345678901234567);
+	assert_round_trip(s, "the longest exposure");
+	scene_free(s);
 	/* A repeat with the same value is ignored (lenient); another fails. */
 	s = load_ok(KCAM "set seed 5\nset seed 5\n");
 	assert_int_equal(applied(s).seed, 5);
