@@ -16,8 +16,8 @@
  * a glossy metal (not a perfect mirror) is blurred by it, and there the
  * metal's own features are taken. A further feature is the direct light
  * the surface sends to the eye (the point lights exactly, each lamp from 4
- * points a sample and the sky from 4 cosine-distributed directions a
- * sample, shadowed: over the first DENOISE_FEATURE_SAMPLES samples one
+ * points a sample and the sky from 4 directions a sample drawn from the
+ * surface's bsdf, shadowed: over the first DENOISE_FEATURE_SAMPLES samples one
  * fixed set of 32 of each, the same for every pixel, so that the feature is
  * smooth; through a glossy metal that is looked through, its own highlight
  * too, the lamps from 8 directions a sample of its own lobe, 64 fixed ones

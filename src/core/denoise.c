@@ -9,7 +9,6 @@
 #include "emitters.h"
 #include "integrators.h"
 #include "rtsh/memory.h"
-#include "warp.h"
 
 /* --- features -------------------------------------------------------------- */
 
@@ -131,26 +130,34 @@ static bool env_lit(const world *w)
 }
 
 /* The light of the background (the sky) that b at p sends toward the eye,
- * as brightness: ENV_DIRS of a fixed set of ENV_SET cosine-distributed
- * directions about the normal (a Hammersley set through the concentric
- * disc, the same about every normal), sample k taking the directions
- * k, k + DENOISE_FEATURE_SAMPLES, ...; shadowed. The same set for every
- * pixel: a function of the position and normal, smooth wherever what
- * blocks the sky changes slowly, and no noise between neighbours. */
+ * as brightness: ENV_DIRS directions drawn from the bsdf itself
+ * (bsdf_sample_u: about the normal, cosine-distributed, for a Lambertian
+ * surface; a glossy lobe's own directions for a rough metal) with the
+ * numbers of one fixed Hammersley set of ENV_SET, sample k taking the
+ * points k, k + DENOISE_FEATURE_SAMPLES, ...; each weighed by f cos / pdf
+ * and shadowed. The same numbers for every pixel: a function of the
+ * position and normal, smooth wherever what blocks the sky changes slowly,
+ * and no noise between neighbours. */
 static double env_feature(const world *w, const bsdf *b, vec3 p, int k)
 {
 	if (!b->smooth || !env_lit(w))
 		return 0.0;
 	double sum = 0.0;
 	for (int q = 0; q < ENV_DIRS; q++) {
-		double u1, u2;
-		hammersley((unsigned)(q * DENOISE_FEATURE_SAMPLES + k % DENOISE_FEATURE_SAMPLES), ENV_SET, &u1, &u2);
-		vec3 wi = warp_cosine(b->n, u1, u2);
-		vec3 f = bsdf_eval(b, wi);
-		ray sr = {p, wi};
-		if (lum_d(f) <= 0.0 || world_occluded(w, &sr, 0.0, INFINITY))
+		unsigned idx = (unsigned)(q * DENOISE_FEATURE_SAMPLES + k % DENOISE_FEATURE_SAMPLES);
+		double u[3];
+		hammersley(idx, ENV_SET, &u[1], &u[2]);
+		/* the lobe's pick (where there are more): a golden-ratio sequence,
+		 * apart from the two coordinates */
+		double g = (idx + 0.5) * 0.6180339887498949;
+		u[0] = g - (double)(long)g;
+		bsdf_sample sm;
+		if (!bsdf_sample_u(b, u, &sm) || sm.transmit)
 			continue;
-		sum += lum_d(v3_mul(f, world_background(w, wi, MODE_PATH))) * RT_PI;
+		ray sr = {p, sm.wi};
+		if (world_occluded(w, &sr, 0.0, INFINITY))
+			continue;
+		sum += lum_d(v3_mul(sm.weight, world_background(w, sm.wi, MODE_PATH)));
 	}
 	return sum / ENV_DIRS;
 }

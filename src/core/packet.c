@@ -87,41 +87,73 @@ static inline double next_up(double t)
  * finite. Each ray's origin and inverse direction are rounded as world.c's
  * bvh_ray_prepare rounds them (on and of bracket the origin so that the near
  * plane's distance can only come down and the far plane's go up), three
- * axes in one register, and the packet keeps their lowest and highest. */
+ * axes in one register, and the packet keeps their lowest and highest.
+ *
+ * The inverses are not computed ray by ray: for directions of one sign,
+ * 1/d falls as d rises, and both the double division and the rounding to
+ * float are monotonic, so the lowest rounded inverse is that of the highest
+ * direction component and the highest that of the lowest: the same floats
+ * from two divisions a packet instead of one a ray. Every ray's inverse
+ * lies between those two (of one sign), so they are finite and not zero
+ * exactly when all the rays' are. An origin equal to the first ray's
+ * (camera rays) brackets the same floats and is not rounded again. */
 static bool packet_prepare(const ray *r, int n, pk_ray *q)
 {
 	const __m128d one = _mm_set1_pd(1.0);
 	const __m128 sign = _mm_set1_ps(-0.0f), ulp = _mm_set1_ps(0x1p-23f), tiny = _mm_set1_ps(0x1p-149f);
 	const __m128 big = _mm_set1_ps(FLT_MAX);
+	/* the directions' lowest and highest, x and y in one register, z in
+	 * the low lane of another; any NaN among them or the origins */
+	__m128d dlo = _mm_loadu_pd(&r[0].d.x), dhi = dlo, dlo_z = _mm_load_sd(&r[0].d.z), dhi_z = dlo_z;
+	const __m128d o0 = _mm_loadu_pd(&r[0].o.x), o0z = _mm_load_sd(&r[0].o.z);
+	/* the inverses' signs are the directions' (when the packet is used:
+	 * no NaN, every ray's signs the first ray's) */
+	const __m128 isign = _mm_and_ps(_mm_movelh_ps(_mm_cvtpd_ps(dlo), _mm_cvtpd_ps(dlo_z)), sign);
+	__m128d nan = _mm_setzero_pd();
 	__m128 on_lo = _mm_set1_ps(INFINITY), on_hi = _mm_set1_ps(-INFINITY), of_lo = on_lo, of_hi = on_hi;
-	__m128 ilo = on_lo, ihi = on_hi;
 	__m128 bad = _mm_setzero_ps();
 	int neg_and = 7, neg_or = 0;
 	for (int i = 0; i < n; i++) {
-		__m128 inv = _mm_movelh_ps(_mm_cvtpd_ps(_mm_div_pd(one, _mm_loadu_pd(&r[i].d.x))),
-		                           _mm_cvtpd_ps(_mm_div_sd(one, _mm_load_sd(&r[i].d.z))));
-		__m128 f = _mm_movelh_ps(_mm_cvtpd_ps(_mm_loadu_pd(&r[i].o.x)), _mm_cvtpd_ps(_mm_load_sd(&r[i].o.z)));
-		__m128 e = _mm_add_ps(_mm_mul_ps(_mm_andnot_ps(sign, f), ulp), tiny);
-		__m128 es = _mm_xor_ps(e, _mm_and_ps(inv, sign));
-		__m128 on = _mm_add_ps(f, es), of = _mm_sub_ps(f, es);
-		/* |x| <= FLT_MAX fails for infinities and NaN; the inverse must
-		 * also not be zero */
-		__m128 ai = _mm_andnot_ps(sign, inv);
-		bad = _mm_or_ps(bad, _mm_cmpnle_ps(ai, big));
-		bad = _mm_or_ps(bad, _mm_cmpeq_ps(ai, _mm_setzero_ps()));
-		bad = _mm_or_ps(bad, _mm_cmpnle_ps(_mm_andnot_ps(sign, on), big));
-		bad = _mm_or_ps(bad, _mm_cmpnle_ps(_mm_andnot_ps(sign, of), big));
-		int neg = _mm_movemask_ps(inv) & 7;
+		__m128d d = _mm_loadu_pd(&r[i].d.x), dz = _mm_load_sd(&r[i].d.z);
+		__m128d o = _mm_loadu_pd(&r[i].o.x), oz = _mm_load_sd(&r[i].o.z);
+		/* (lane 0: x or z is NaN, lane 1: y; dz's high lane is 0) */
+		nan = _mm_or_pd(nan, _mm_or_pd(_mm_cmpunord_pd(d, dz), _mm_cmpunord_pd(o, oz)));
+		int neg = _mm_movemask_pd(d) | (_mm_movemask_pd(dz) & 1) << 2;
 		neg_and &= neg;
 		neg_or |= neg;
+		dlo = _mm_min_pd(dlo, d);
+		dhi = _mm_max_pd(dhi, d);
+		dlo_z = _mm_min_sd(dlo_z, dz);
+		dhi_z = _mm_max_sd(dhi_z, dz);
+		/* the origin's bracket, unless it is the first ray's (camera
+		 * rays: equal doubles, a zero of either sign giving the same
+		 * floats here) */
+		if (i > 0 && _mm_movemask_pd(_mm_and_pd(_mm_cmpeq_pd(o, o0), _mm_cmpeq_pd(oz, o0z))) == 3)
+			continue;
+		__m128 f = _mm_movelh_ps(_mm_cvtpd_ps(o), _mm_cvtpd_ps(oz));
+		__m128 e = _mm_add_ps(_mm_mul_ps(_mm_andnot_ps(sign, f), ulp), tiny);
+		__m128 es = _mm_xor_ps(e, isign);
+		__m128 on = _mm_add_ps(f, es), of = _mm_sub_ps(f, es);
+		/* |x| <= FLT_MAX fails for infinities and NaN */
+		bad = _mm_or_ps(bad, _mm_cmpnle_ps(_mm_andnot_ps(sign, on), big));
+		bad = _mm_or_ps(bad, _mm_cmpnle_ps(_mm_andnot_ps(sign, of), big));
 		on_lo = _mm_min_ps(on_lo, on);
 		on_hi = _mm_max_ps(on_hi, on);
 		of_lo = _mm_min_ps(of_lo, of);
 		of_hi = _mm_max_ps(of_hi, of);
-		ilo = _mm_min_ps(ilo, inv);
-		ihi = _mm_max_ps(ihi, inv);
 	}
-	if ((_mm_movemask_ps(bad) & 7) || neg_and != neg_or)
+	if (_mm_movemask_pd(nan) || neg_and != neg_or)
+		return false;
+	__m128 ilo = _mm_movelh_ps(_mm_cvtpd_ps(_mm_div_pd(one, dhi)), _mm_cvtpd_ps(_mm_div_sd(one, dhi_z)));
+	__m128 ihi = _mm_movelh_ps(_mm_cvtpd_ps(_mm_div_pd(one, dlo)), _mm_cvtpd_ps(_mm_div_sd(one, dlo_z)));
+	/* the inverses must be finite and not zero (a zero direction
+	 * component, of either sign, is the lowest in magnitude of its axis:
+	 * its infinite inverse is ilo's or ihi's) */
+	bad = _mm_or_ps(bad, _mm_cmpnle_ps(_mm_andnot_ps(sign, ilo), big));
+	bad = _mm_or_ps(bad, _mm_cmpnle_ps(_mm_andnot_ps(sign, ihi), big));
+	bad = _mm_or_ps(bad, _mm_cmpeq_ps(_mm_andnot_ps(sign, ilo), _mm_setzero_ps()));
+	bad = _mm_or_ps(bad, _mm_cmpeq_ps(_mm_andnot_ps(sign, ihi), _mm_setzero_ps()));
+	if (_mm_movemask_ps(bad) & 7)
 		return false;
 	float a_on_lo[4], a_on_hi[4], a_of_lo[4], a_of_hi[4], a_ilo[4], a_ihi[4];
 	_mm_storeu_ps(a_on_lo, on_lo);

@@ -622,21 +622,33 @@ static void test_direct_feature(void **state)
  *   2 / (3 pi), to the set's quadrature error (32 points: 0.01);
  * - the uniform sky with an infinite floor at y = -0.5: the directions
  *   below the horizon are blocked, half of them, 0.25 to 0.01;
- * - no sky and no ambient: 0, and no shadow ray is traced. */
+ * - no sky and no ambient: 0, and no shadow ray is traced;
+ * - a white metal of fuzz 0.3 instead of the wall (Phong exponent
+ *   5 / 0.3^2 - 2 = 53.6: not looked through) under the uniform sky: the
+ *   directions are drawn from its lobe about the mirror direction, here
+ *   the normal, each weighed by f cos / pdf = (n + 2) / (n + 1) cos, whose
+ *   mean over the lobe is 1 (the lobe's mean cosine is (n + 1) / (n + 2)),
+ *   times the tint 1 (white): 0.5, to the set's quadrature (0.01). Fixed
+ *   cosine-distributed directions would put one or two of the 32 in a lobe
+ *   some 10 degrees wide. */
 static void test_env_feature(void **state)
 {
 	(void)state;
-	const char *wall = "C 0,0,0 0,0,1 10\npl 0,0,2 0,0,-1 1,1,1 255,255,255 1 0 1 0\n";
-	const char *extra[4] = {
+	const char *cam = "C 0,0,0 0,0,1 10\n", *lambert = "pl 0,0,2 0,0,-1 1,1,1 255,255,255 1 0 1 0\n";
+	const char *surface[5] = {lambert, lambert, lambert, lambert,
+	                          "pl 0,0,2 0,0,-1 1,1,1 255,255,255 0 0 1 1 metal=1 fuzz=0.3\n"};
+	const char *extra[5] = {
 		"sky 255,255,255 255,255,255 0.5\n",
 		"sky 255,255,255 0,0,0 1\n",
 		"sky 255,255,255 255,255,255 0.5\npl 0,-0.5,0 0,1,0 1,1,1 255,255,255 1 0 1 0\n",
 		"A 0 255,255,255\n",
+		"sky 255,255,255 255,255,255 0.5\n",
 	};
-	const double want[4] = {0.5, 2.0 / (3.0 * M_PI), 0.25, 0.0}, tol[4] = {1e-9, 0.01, 0.01, 0.0};
-	for (int c = 0; c < 4; c++) {
+	const double want[5] = {0.5, 2.0 / (3.0 * M_PI), 0.25, 0.0, 0.5};
+	const double tol[5] = {1e-9, 0.01, 0.01, 0.0, 0.01};
+	for (int c = 0; c < 5; c++) {
 		char text[512];
-		snprintf(text, sizeof text, "%s%s", wall, extra[c]);
+		snprintf(text, sizeof text, "%s%s%s", cam, surface[c], extra[c]);
 		scene *s = load_text(text);
 		world *w = world_build(s, NULL);
 		assert_non_null(w);

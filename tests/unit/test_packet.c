@@ -247,10 +247,74 @@ static void test_ties(void **state)
 	scene_free(s);
 }
 
+/* Packets at the edges of the interval set-up (packet_prepare): origins
+ * equal to the first ray's (a zero of either sign among them) and one
+ * ulp off it; a direction component that is 0, -0, of the other sign, or
+ * so small or large that its inverse is not a finite non-zero float, in one
+ * ray of an otherwise coherent packet; components of one sign spread over
+ * many magnitudes. Each packet must give the single rays' answers. */
+static void test_prepare_edges(void **state)
+{
+	(void)state;
+	rt_error err;
+	scene *s = rt_load_file("scenes/grid.rt", NULL, &err);
+	if (!s)
+		fail_msg("grid: %s", err.msg);
+	world *w = world_build(s, &err);
+	if (!w)
+		fail_msg("grid: %s", err.msg);
+	vec3 lamp = w->lights[0].pos;
+	static const double odd[] = {0.0, -0.0, 1e-300, -1e-300, 1e-40, -1e-40, 1e300, 1e-30};
+	const int nodd = (int)(sizeof odd / sizeof *odd);
+	test_rng g = {29};
+	long before = rays_hit;
+	for (int k = 0; k < 400; k++) {
+		/* from above the grid (y = 0 is the ground), origins with zeros */
+		vec3 o = v3(k % 3 == 0 ? 0.0 : -0.0, 3 + trand(&g), k % 2 ? 0.0 : -6 + trand(&g));
+		vec3 at = v3(-4 + 8 * trand(&g), 0.4, -4 + 8 * trand(&g));
+		vec3 d0 = v3_norm(v3_sub(at, o));
+		ray r[PACKET_MAX];
+		for (int i = 0; i < PACKET_MAX; i++) {
+			vec3 d = v3_add(d0, v3((trand(&g) - 0.5) * 0.02, (trand(&g) - 0.5) * 0.02, (trand(&g) - 0.5) * 0.02));
+			r[i] = (ray){o, d};
+			if (i % 4 == 1) /* the same origin with the other zero */
+				r[i].o.x = -r[i].o.x;
+			if (k % 4 == 1 && i == 7) /* one ulp off */
+				r[i].o.y = nextafter(r[i].o.y, INFINITY);
+		}
+		int j = 1 + (int)(trand(&g) * (PACKET_MAX - 1));
+		switch (k % 5) {
+		case 0: /* one odd component in one ray */
+			r[j].d.x = odd[k / 5 % nodd];
+			break;
+		case 1: /* one ray's component of the other sign */
+			r[j].d.z = -r[j].d.z;
+			break;
+		case 2: /* magnitudes spread over the packet, one sign */
+			for (int i = 0; i < PACKET_MAX; i++)
+				r[i].d.x = copysign(pow(10.0, -30.0 * trand(&g)), d0.x);
+			break;
+		case 3: /* the same direction throughout */
+			for (int i = 0; i < PACKET_MAX; i++)
+				r[i].d = d0;
+			break;
+		default: /* the same odd component in every ray */
+			for (int i = 0; i < PACKET_MAX; i++)
+				r[i].d.y = -odd[k / 5 % nodd];
+		}
+		check_packet(w, r, 1 + k % PACKET_MAX, lamp);
+		check_packet(w, r, PACKET_MAX, lamp);
+	}
+	assert_true(rays_hit - before > 5000);
+	world_free(w);
+	scene_free(s);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_ties),
+		cmocka_unit_test(test_prepare_edges),
 		cmocka_unit_test(test_scenes),
 		cmocka_unit_test(test_bunny),
 	};
