@@ -187,13 +187,28 @@ typedef struct sky {
 	double rotation;  /* degrees about +Y */
 } sky;
 
+/* The most rows of the settings table (settings.h; checked there), and the
+ * longest text of a kept setting's value with its terminating zero (a
+ * 64-bit whole number, a double in the fewest digits: "-0.00012345678901234567").
+ * 16 x 24 keeps scene_hints no larger than an object, the largest member of
+ * the editor's undo records. */
+#define SCENE_KEPT_MAX 16
+#define SCENE_KEPT_LEN 24
+
 /* Per-scene render hints from the file (`R`, `set` lines). scene_new sets
- * them all to "unset": width, height and samples 0, depth and mode -1. */
+ * them all to "unset": width, height and samples 0, depth and mode -1, the
+ * kept values "". */
 typedef struct scene_hints {
 	int width, height; /* R w h, or set resolution WxH */
 	int samples;       /* set samples N */
 	int depth;         /* set depth N (0 is a valid depth) */
 	int mode;          /* set mode whitted|path: -1 unset, else render_mode */
+	/* Every other setting kept with the scene (a SETTING_SCENE row of the
+	 * settings table: seed, exposure, denoise, ...), by its row number:
+	 * `set NAME VALUE`'s value as the row formats it (settings_scene_value),
+	 * zero-padded; "" = unset. The four above keep their own fields (the R
+	 * line and their long-standing messages), and their slots stay "". */
+	char kept[SCENE_KEPT_MAX][SCENE_KEPT_LEN];
 } scene_hints;
 
 typedef struct scene {

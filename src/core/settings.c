@@ -24,16 +24,16 @@ _Static_assert(sizeof(render_mode) == sizeof(int), "an enum setting is stored as
 
 const setting_def settings_table[] = {
 #define AT(field) offsetof(render_settings, field)
-	{"resolution", SETTING_RESOLUTION, 1, RENDER_MAX_DIM, AT(width), "full-resolution image size, WxH", "1280x720", NULL, 0},
-	{"samples", SETTING_INT, 1, 1000000, AT(samples), "samples (rays or paths) per pixel", "1", NULL, 0},
-	{"depth", SETTING_INT, 0, 1000, AT(depth), "reflection depth (whitted) or bounces (path)", "5", NULL, 0},
-	{"mode", SETTING_ENUM, 0, 0, AT(mode), "render mode: whitted or path", "whitted", render_mode_names, 0},
+	{"resolution", SETTING_RESOLUTION, 1, RENDER_MAX_DIM, AT(width), "full-resolution image size, WxH", "1280x720", NULL, SETTING_SCENE},
+	{"samples", SETTING_INT, 1, 1000000, AT(samples), "samples (rays or paths) per pixel", "1", NULL, SETTING_SCENE},
+	{"depth", SETTING_INT, 0, 1000, AT(depth), "reflection depth (whitted) or bounces (path)", "5", NULL, SETTING_SCENE},
+	{"mode", SETTING_ENUM, 0, 0, AT(mode), "render mode: whitted or path", "whitted", render_mode_names, SETTING_SCENE},
 	{"threads", SETTING_INT, 0, 256, AT(threads), "render threads; 0 = one per online CPU", "0", NULL, 0},
-	{"seed", SETTING_U64, 0, 0, AT(seed), "random seed of the sampler", "1", NULL, 0},
-	{"exposure", SETTING_DOUBLE, -20, 20, AT(exposure), "exposure in stops: output = radiance x 2^exposure", "0", NULL, 0},
+	{"seed", SETTING_U64, 0, 0, AT(seed), "random seed of the sampler", "1", NULL, SETTING_SCENE},
+	{"exposure", SETTING_DOUBLE, -20, 20, AT(exposure), "exposure in stops: output = radiance x 2^exposure", "0", NULL, SETTING_SCENE},
 	{"denoise", SETTING_ENUM, 0, 0, AT(denoise),
 	 "path mode: denoise auto (previews only), on (saved images too) or off", "auto", denoise_names,
-	 SETTING_BARE_ON},
+	 SETTING_BARE_ON | SETTING_SCENE},
 	{"pixels", SETTING_ENUM, 0, 0, AT(pixels),
 	 "the picture in real pixels: off (half blocks), kitty, sixel, iterm, or auto (ask the terminal)", "off",
 	 pixels_names, SETTING_TERMINAL},
@@ -43,6 +43,8 @@ const setting_def settings_table[] = {
 #undef AT
 };
 const size_t settings_count = sizeof settings_table / sizeof settings_table[0];
+_Static_assert(sizeof settings_table / sizeof settings_table[0] <= SCENE_KEPT_MAX,
+               "scene_hints.kept has a slot per row: raise SCENE_KEPT_MAX (scene.h)");
 
 static bool set_value(render_settings *s, const setting_def *def, const char *value, bool check_memory,
                       rt_error *err);
@@ -76,6 +78,10 @@ bool render_settings_apply_hints(render_settings *s, const scene_hints *h)
 		s->depth = h->depth;
 	if (h->mode >= 0)
 		s->mode = (render_mode)h->mode;
+	rt_error err;
+	for (size_t i = 0; i < settings_count; i++)
+		if (settings_kept_slot(&settings_table[i]) && h->kept[i][0])
+			set_value(s, &settings_table[i], h->kept[i], false, &err);
 	return clamped;
 }
 
@@ -232,9 +238,16 @@ void settings_format(const render_settings *s, const setting_def *def, char *buf
 	case SETTING_U64:
 		snprintf(buf, size, "%" PRIu64, *(const uint64_t *)cfield(s, def));
 		return;
-	case SETTING_DOUBLE:
-		snprintf(buf, size, "%g", *(const double *)cfield(s, def));
+	case SETTING_DOUBLE: {
+		/* %g, or the fewest digits beyond it that read back the same */
+		double v = *(const double *)cfield(s, def);
+		for (int digits = 6; digits <= 17; digits++) {
+			snprintf(buf, size, "%.*g", digits, v);
+			if (strtod(buf, NULL) == v)
+				break;
+		}
 		return;
+	}
 	case SETTING_RESOLUTION:
 		snprintf(buf, size, "%dx%d", s->width, s->height);
 		return;
@@ -244,4 +257,26 @@ void settings_format(const render_settings *s, const setting_def *def, char *buf
 		return;
 	}
 	}
+}
+
+bool settings_scene_value(const setting_def *def, const char *value, char *out, size_t size, rt_error *err)
+{
+	render_settings s = render_settings_default();
+	if (!set_value(&s, def, value, false, err))
+		return false;
+	char text[64];
+	settings_format(&s, def, text, sizeof text);
+	if (strlen(text) >= size)
+		return rt_error_set(err, "%s \"%s\" is not valid; expected at most %zu characters", def->name, value,
+		                    size - 1);
+	memset(out, 0, size);
+	memcpy(out, text, strlen(text));
+	return true;
+}
+
+bool settings_kept_slot(const setting_def *def)
+{
+	return (def->flags & SETTING_SCENE) && def->offset != offsetof(render_settings, width) &&
+	       def->offset != offsetof(render_settings, samples) && def->offset != offsetof(render_settings, depth) &&
+	       def->offset != offsetof(render_settings, mode);
 }

@@ -627,6 +627,9 @@ bool editor_add_line(editor *ed, const char *line, const char *name, int lineno,
 		h.depth = n.depth;
 	if (n.mode >= 0)
 		h.mode = n.mode;
+	for (size_t i = 0; i < SCENE_KEPT_MAX; i++)
+		if (n.kept[i][0])
+			memcpy(h.kept[i], n.kept[i], sizeof h.kept[i]);
 	if (ok && memcmp(&h, &ed->s->hints, sizeof h) != 0) {
 		record r = {.kind = REC_HINTS, .u.hints = h};
 		ok = commit(ed, &r, err);

@@ -17,12 +17,14 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "base/nearest.h"
 #include "rtsh/filesrc.h"
 #include "rtsh/mesh.h"
 #include "rtsh/num.h"
 #include "rtsh/render.h"
 #include "rtsh/texture.h"
 #include "rtsh/rtfile.h"
+#include "rtsh/settings.h"
 #include "rtsh/shape.h"
 #include "scene/rtfile_priv.h"
 
@@ -64,8 +66,9 @@ typedef struct parser {
 	rt_error *err;
 	int line;
 	/* The line of the first A, C, L, R (or set resolution), sky and set
-	 * samples/depth/mode seen; 0 = none yet. */
-	int line_a, line_c, line_l, line_r, line_sky, line_set[3];
+	 * samples/depth/mode seen, and of each other kept setting's `set` line
+	 * (by its row of settings_table); 0 = none yet. */
+	int line_a, line_c, line_l, line_r, line_sky, line_set[3], line_kept[SCENE_KEPT_MAX];
 	size_t cam_c;     /* index of the C camera */
 	size_t nelems;    /* elements read */
 	tok *toks;
@@ -695,6 +698,59 @@ static bool get_resolution(parser *p, const tok *t, int *w, int *h)
 	return true;
 }
 
+/* `set NAME VALUE` for a kept setting other than the four of parse_set:
+ * the settings table's row reads and checks the value. */
+static bool parse_set_kept(parser *p, const elem_def *e, const tok *k, const tok *v)
+{
+	size_t row = 0;
+	while (row < settings_count &&
+	       !(settings_kept_slot(&settings_table[row]) && strcmp(k->s, settings_table[row].name) == 0))
+		row++;
+	if (row == settings_count) {
+		char names[256] = "";
+		nearest near = nearest_start(k->s);
+		bool known = false;
+		for (size_t j = 0; j < settings_count; j++) {
+			known |= strcmp(k->s, settings_table[j].name) == 0;
+			if (!(settings_table[j].flags & SETTING_SCENE))
+				continue;
+			snprintf(names + strlen(names), sizeof names - strlen(names), " %s", settings_table[j].name);
+			nearest_try(&near, settings_table[j].name, strlen(settings_table[j].name));
+		}
+		if (known)
+			return fail(p, k->col, "set key \"%s\" is not kept with a scene (it is the machine's or "
+			                       "the terminal's: give it to the shell or the command line); expected one of%s",
+			            quoted(p, k), names);
+		if (nearest_ok(&near))
+			return fail(p, k->col, "set key \"%s\" is unknown; did you mean \"%s\"? (expected one of%s)",
+			            quoted(p, k), near.best, names);
+		char expect[300];
+		snprintf(expect, sizeof expect, "one of%s", names);
+		return fail_tok(p, k, "set", "key", "is unknown", expect);
+	}
+	const setting_def *def = &settings_table[row];
+	char val[SCENE_KEPT_LEN];
+	rt_error err;
+	if (!settings_scene_value(def, v->s, val, sizeof val, &err)) {
+		nearest near = nearest_start(v->s);
+		for (int j = 0; j < settings_choices(def); j++)
+			nearest_try(&near, def->choices[j], strlen(def->choices[j]));
+		char expect[256];
+		settings_choices_text(def, ", ", " or ", expect, sizeof expect);
+		if (nearest_ok(&near))
+			return fail(p, v->col, "set %s \"%s\" is not valid; did you mean \"%s\"? (expected %s)",
+			            def->name, quoted(p, v), near.best, expect);
+		return fail(p, v->col, "set %s", err.msg);
+	}
+	scene_hints *hn = &p->s->hints;
+	char what[64];
+	snprintf(what, sizeof what, "set %s", def->name);
+	int r = once(p, e, what, &p->line_kept[row], strcmp(hn->kept[row], val) == 0);
+	if (r > 0)
+		memcpy(hn->kept[row], val, sizeof val);
+	return r >= 0;
+}
+
 static bool parse_set(parser *p, const elem_def *e)
 {
 	static const char *const keys[] = {"samples", "depth", "mode", "resolution"};
@@ -707,8 +763,7 @@ static bool parse_set(parser *p, const elem_def *e)
 	while (i < 4 && strcmp(k->s, keys[i]) != 0)
 		i++;
 	if (i == 4)
-		return fail_tok(p, k, "set", "key", "is unknown",
-		                "one of samples depth mode resolution");
+		return parse_set_kept(p, e, k, v);
 	scene_hints *hn = &p->s->hints;
 	double d = 0;
 	int r;
@@ -1111,7 +1166,7 @@ static const elem_def elements_tail[] = {
 	 "mesh FILE POSITION DIRECTION SIZE [R,G,B [DIFFUSE SPECULAR SHININESS REFLECTIVE]]", NULL, NULL},
 	{"sky", "sky", -1, false, parse_sky,
 	 "sky ZENITH_R,G,B HORIZON_R,G,B [STRENGTH] or sky FILE.hdr [STRENGTH [ROTATION]]", NULL, NULL},
-	{"set", "set", -1, false, parse_set, "set samples|depth|mode|resolution VALUE", NULL, NULL},
+	{"set", "set", -1, false, parse_set, "set NAME VALUE", NULL, NULL},
 };
 #define NHEAD (sizeof elements_head / sizeof elements_head[0])
 #define NTAIL (sizeof elements_tail / sizeof elements_tail[0])

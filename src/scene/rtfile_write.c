@@ -16,6 +16,7 @@
 #include "rtsh/image.h"
 #include "rtsh/render.h"
 #include "rtsh/rtfile.h"
+#include "rtsh/settings.h"
 #include "rtsh/shape.h"
 #include "scene/rtfile_priv.h"
 
@@ -365,6 +366,9 @@ static void write_scene(const scene *s, FILE *f)
 		fprintf(f, "set depth %d\n", h->depth);
 	if (h->mode >= 0 && h->mode < MODE_COUNT)
 		fprintf(f, "set mode %s\n", render_mode_name((render_mode)h->mode));
+	for (size_t i = 0; i < settings_count; i++) /* the other kept settings, in the table's order */
+		if (settings_kept_slot(&settings_table[i]) && h->kept[i][0])
+			fprintf(f, "set %s %s\n", settings_table[i].name, h->kept[i]);
 	if (s->has_ambient) {
 		sb_put(&b, "A");
 		sb_field(&b, s->amb.ratio);

@@ -21,6 +21,7 @@
 #include "rtsh/image.h"
 #include "rtsh/memory.h"
 #include "rtsh/rtfile.h"
+#include "rtsh/settings.h"
 #include "scene/rtfile_priv.h"
 
 #define NONE SIZE_MAX
@@ -131,7 +132,9 @@ typedef enum line_kind {
 } line_kind;
 
 typedef enum once_kind {
-	ONCE_AMB, ONCE_SKY, ONCE_RES, ONCE_SAMPLES, ONCE_DEPTH, ONCE_MODE, ONCE_CAM, ONCE_N,
+	ONCE_AMB, ONCE_SKY, ONCE_RES, ONCE_SAMPLES, ONCE_DEPTH, ONCE_MODE, ONCE_CAM,
+	ONCE_KEPT, /* ONCE_KEPT + i: the `set` line of scene_hints.kept[i] */
+	ONCE_N = ONCE_KEPT + SCENE_KEPT_MAX,
 } once_kind;
 
 typedef struct src_line {
@@ -260,6 +263,10 @@ static bool base_read(base *b, const char *src, size_t len)
 				once = ONCE_DEPTH;
 			} else if (t->hints.mode >= 0) {
 				once = ONCE_MODE;
+			} else {
+				for (int k = 0; k < SCENE_KEPT_MAX && once < 0; k++)
+					if (t->hints.kept[k][0])
+						once = ONCE_KEPT + k;
 			}
 			/* Else an object of size 0, which the reader leaves out: a
 			 * line of text like a comment. */
@@ -286,6 +293,9 @@ static bool base_read(base *b, const char *src, size_t len)
 					b->s->hints.depth = t->hints.depth;
 				} else if (once == ONCE_MODE) {
 					b->s->hints.mode = t->hints.mode;
+				} else if (once >= ONCE_KEPT) {
+					memcpy(b->s->hints.kept[once - ONCE_KEPT], t->hints.kept[once - ONCE_KEPT],
+					       sizeof t->hints.kept[0]);
 				}
 			}
 		}
@@ -566,6 +576,12 @@ static void put_once(abuf *o, const scene *s, once_kind k, bool as_r, bool stren
 		abuf_str(o, mode_name(h->mode));
 		break;
 	default:
+		if (k >= ONCE_KEPT && (size_t)(k - ONCE_KEPT) < settings_count) {
+			abuf_str(o, "set ");
+			abuf_str(o, settings_table[k - ONCE_KEPT].name);
+			abuf_str(o, " ");
+			abuf_str(o, h->kept[k - ONCE_KEPT]);
+		}
 		break;
 	}
 }
@@ -588,7 +604,7 @@ static bool once_present(const scene *s, once_kind k)
 	case ONCE_MODE:
 		return s->hints.mode >= 0;
 	default:
-		return true;
+		return k >= ONCE_KEPT ? s->hints.kept[k - ONCE_KEPT][0] != '\0' : true;
 	}
 }
 
@@ -613,7 +629,7 @@ static bool once_same(const scene *a, const scene *b, once_kind k)
 	case ONCE_MODE:
 		return a->hints.mode == b->hints.mode;
 	default:
-		return true;
+		return k >= ONCE_KEPT ? strcmp(a->hints.kept[k - ONCE_KEPT], b->hints.kept[k - ONCE_KEPT]) == 0 : true;
 	}
 }
 
@@ -940,10 +956,14 @@ static char *keep_text(const scene *s, const char *src, size_t len, size_t *out_
 	for (size_t i = 0; ok && i < b.nlines; i++)
 		write_line(&w, &b.lines[i]);
 	if (ok) {
-		/* What is left goes at the end: settings, A, sky, then the lists. */
+		/* What is left goes at the end: settings (R, samples, depth, mode,
+		 * then the other kept ones in the table's order), A, sky, then the
+		 * lists. */
 		static const once_kind order[] = {ONCE_RES, ONCE_SAMPLES, ONCE_DEPTH, ONCE_MODE, ONCE_AMB, ONCE_SKY};
-		for (size_t k = 0; k < sizeof order / sizeof order[0]; k++) {
-			once_kind ok_ = order[k];
+		size_t norder = sizeof order / sizeof order[0];
+		for (size_t k = 0; k < norder + SCENE_KEPT_MAX; k++) {
+			once_kind ok_ = k < 4 ? order[k] : k < 4 + SCENE_KEPT_MAX ? (once_kind)(ONCE_KEPT + (k - 4))
+			                                                        : order[k - SCENE_KEPT_MAX];
 			if (b.once_line[ok_] != NONE || !once_present(s, ok_))
 				continue;
 			new_line(&w);

@@ -36,6 +36,14 @@ static const char *settings_help(void)
 		used += (size_t)snprintf(text + used, sizeof text - used, "  %-10s %-34s %s\n", d->name, values,
 		                         d->help);
 	}
+	/* The SETTING_SCENE rows: what a .rt file's set lines and save x.rt hold. */
+	if (used < sizeof text)
+		used += (size_t)snprintf(text + used, sizeof text - used, "kept with a scene (.rt set lines, save x.rt):");
+	for (size_t i = 0; i < settings_count && used < sizeof text; i++)
+		if (settings_table[i].flags & SETTING_SCENE)
+			used += (size_t)snprintf(text + used, sizeof text - used, " %s", settings_table[i].name);
+	if (used < sizeof text)
+		snprintf(text + used, sizeof text - used, "\n");
 	return text;
 }
 

@@ -10,6 +10,7 @@
 #include "rtsh/mesh.h"
 #include "rtsh/rtkeep.h"
 #include "rtsh/rtfile.h"
+#include "rtsh/settings.h"
 #include "shell/builtin_scene.h"
 
 /* Sources larger than this are not kept (the scene is written afresh). */
@@ -30,6 +31,18 @@ scene_hints save_rt_hints(const scene_hints *h, const render_settings *set)
 		out.depth = set->depth;
 	if (r.mode != set->mode)
 		out.mode = (int)set->mode;
+	for (size_t i = 0; i < settings_count; i++) {
+		const setting_def *def = &settings_table[i];
+		char was[SCENE_KEPT_LEN], now[SCENE_KEPT_LEN];
+		if (!settings_kept_slot(def))
+			continue;
+		settings_format(&r, def, was, sizeof was);
+		settings_format(set, def, now, sizeof now);
+		if (strcmp(was, now) != 0) {
+			memset(out.kept[i], 0, sizeof out.kept[i]);
+			snprintf(out.kept[i], sizeof out.kept[i], "%s", now);
+		}
+	}
 	return out;
 }
 

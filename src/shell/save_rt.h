@@ -9,9 +9,10 @@
 #include "rtsh/scene.h"
 #include "shell/shell.h"
 
-/* The scene's hints made to reopen with the shell's current resolution,
- * samples, depth and mode: a hint that already gives the current value (from
- * the defaults) stays as it is; any other is set to the current value. */
+/* The scene's hints made to reopen with the shell's current settings that
+ * are kept with a scene (resolution, samples, depth, mode and every other
+ * SETTING_SCENE row): a hint that already gives the current value (from the
+ * defaults) stays as it is; any other is set to the current value. */
 scene_hints save_rt_hints(const scene_hints *h, const render_settings *set);
 
 /* Writes the current scene to path. The text it was loaded from (its file,

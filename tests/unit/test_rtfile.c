@@ -12,6 +12,7 @@
 
 #include "rtsh/render.h"
 #include "rtsh/rtfile.h"
+#include "rtsh/settings.h"
 
 #define WILD_DIR "../shared/scenes-wild"
 
@@ -367,6 +368,126 @@ static void test_sky_and_set(void **state)
 	scene_free(s);
 }
 
+/* --- the other settings kept with the scene (SETTING_SCENE rows) --- */
+
+#define KCAM "C 0,0,0 0,0,1 70\n"
+
+/* The settings a scene's text gives over the defaults. */
+static render_settings applied(const scene *s)
+{
+	render_settings r = render_settings_default();
+	render_settings_apply_hints(&r, &s->hints);
+	return r;
+}
+
+static void test_kept_settings(void **state)
+{
+	(void)state;
+	/* Values read off the text; the four older ones beside them. */
+	const char text[] = KCAM "set samples 4\nset denoise off\nset seed 42\nset exposure -1.5\n";
+	scene *s = load_ok(text);
+	render_settings r = applied(s);
+	assert_int_equal(r.samples, 4);
+	assert_int_equal(r.seed, 42);
+	assert_true(r.exposure == -1.5);
+	assert_int_equal(r.denoise, DENOISE_OFF);
+	assert_int_equal(r.threads, 0); /* untouched: the default */
+	/* Written back after the older ones, in the table's order. */
+	char *out = write_text(s, NULL);
+	assert_non_null(strstr(out, "set samples 4\nset seed 42\nset exposure -1.5\nset denoise off\n"));
+	free(out);
+	assert_round_trip(s, "kept settings");
+	scene_free(s);
+	/* The largest seed, and an exposure that needs more than %g's digits. */
+	s = load_ok(KCAM "set seed 18446744073709551615\nset exposure 0.1234567891234\n");
+	r = applied(s);
+	assert_true(r.seed == UINT64_MAX);
+	assert_true(r.exposure == 0.1234567891234);
+	out = write_text(s, NULL);
+	assert_non_null(strstr(out, "set seed 18446744073709551615\nset exposure 0.1234567891234\n"));
+	free(out);
+	assert_round_trip(s, "a long seed and exposure");
+	scene_free(s);
+	/* The longest text a kept value takes (scene.h's SCENE_KEPT_LEN). */
+	s = load_ok(KCAM "set exposure -0.00012345678901234567\n");
+	assert_true(applied(s).exposure == -0.00012345678901234567);
+	assert_round_trip(s, "the longest exposure");
+	scene_free(s);
+	/* A repeat with the same value is ignored (lenient); another fails. */
+	s = load_ok(KCAM "set seed 5\nset seed 5\n");
+	assert_int_equal(applied(s).seed, 5);
+	scene_free(s);
+	expect_error(KCAM "set seed 5\nset seed 6\n", 3, 1, "set: a second set seed line; expected only one "
+	                                                    "(the first is on line 2)");
+}
+
+/* Each kept row of the table: a value other than its default (its maximum,
+ * its last choice) loads, writes back as it was written and reloads. */
+static void test_kept_settings_each_row(void **state)
+{
+	(void)state;
+	int rows = 0;
+	for (size_t i = 0; i < settings_count; i++) {
+		const setting_def *d = &settings_table[i];
+		if (!(d->flags & SETTING_SCENE))
+			continue;
+		char value[64], line[128], text[256], got[64];
+		switch (d->type) {
+		case SETTING_INT:
+		case SETTING_DOUBLE:
+			snprintf(value, sizeof value, "%.0f", d->max);
+			break;
+		case SETTING_U64:
+			snprintf(value, sizeof value, "123456789012345");
+			break;
+		case SETTING_RESOLUTION:
+			snprintf(value, sizeof value, "320x200");
+			break;
+		case SETTING_ENUM:
+			snprintf(value, sizeof value, "%s", d->choices[settings_choices(d) - 1]);
+			break;
+		}
+		snprintf(line, sizeof line, "set %s %s\n", d->name, value);
+		snprintf(text, sizeof text, KCAM "%s", line);
+		scene *s = load_ok(text);
+		render_settings r = applied(s);
+		settings_format(&r, d, got, sizeof got);
+		assert_string_equal(got, value);
+		/* (a resolution is written as the R line it has always been) */
+		const char *want = d->type == SETTING_RESOLUTION ? "R 320 200\n" : line;
+		char *out = write_text(s, NULL);
+		if (!strstr(out, want))
+			fail_msg("%s is not written back as \"%s\":\n%s", d->name, want, out);
+		free(out);
+		assert_round_trip(s, d->name);
+		scene_free(s);
+		rows++;
+	}
+	assert_true(rows >= 7); /* resolution samples depth mode seed exposure denoise */
+}
+
+static void test_kept_settings_errors(void **state)
+{
+	(void)state;
+	/* The row's own range and message, at the value's column. */
+	expect_error(KCAM "set exposure 30\n", 2, 14, "set exposure \"30\" is not valid; expected a number in -20..20");
+	expect_error(KCAM "set seed -1\n", 2, 10, "set seed \"-1\" is not valid; expected a whole number >= 0");
+	expect_error(KCAM "set denoise xyz\n", 2, 13, "set denoise \"xyz\" is not valid; expected auto, on or off");
+	expect_error(KCAM "set denoise onn\n", 2, 13,
+	             "set denoise \"onn\" is not valid; did you mean \"on\"? (expected auto, on or off)");
+	/* A typo of a name: the nearest kept one. */
+	expect_error(KCAM "set seeed 3\n", 2, 5, "set key \"seeed\" is unknown; did you mean \"seed\"?");
+	expect_error(KCAM "set exposur 1\n", 2, 5, "did you mean \"exposure\"?");
+	/* A setting of the machine or the terminal is not the scene's. */
+	expect_error(KCAM "set threads 2\n", 2, 5, "set key \"threads\" is not kept with a scene");
+	expect_error(KCAM "set pixels kitty\n", 2, 5, "set key \"pixels\" is not kept with a scene");
+	/* 42's strict mode allows no set line at all. */
+	expect_strict_error("A 0.2 255,255,255\nC 0,0,0 0,0,1 70\nL 0,0,0 0.5 255,255,255\nset seed 1\n", 4, 1,
+	                    "strict mode does not allow the element \"set\"");
+}
+
+#undef KCAM
+
 /* --- numbers --- */
 
 static void test_numbers_accepted(void **state)
@@ -694,8 +815,9 @@ static const err_case field_errors[] = {
 	{CAM "set resolution 10x\n", 2, 16, "set resolution \"10x\" is not WxH; expected WIDTHxHEIGHT"},
 	{CAM "set resolution 0x10\n", 2, 16, "set resolution \"0x10\" has a size that is out of range"},
 	{CAM "set resolution 10,10\n", 2, 16, "set resolution \"10,10\" is not WxH"},
-	{CAM "set foo 1\n", 2, 5, "set key \"foo\" is unknown; expected one of samples depth mode resolution"},
-	{CAM "set samples\n", 2, 12, "set: too few fields; expected set samples|depth|mode|resolution VALUE"},
+	{CAM "set foo 1\n", 2, 5,
+	 "set key \"foo\" is unknown; expected one of resolution samples depth mode seed exposure denoise"},
+	{CAM "set samples\n", 2, 12, "set: too few fields; expected set NAME VALUE"},
 	{CAM "set samples 4 8\n", 2, 15, "set: too many fields"},
 	{CAM "set samples 4\nset samples 8\n", 3, 1, "set: a second set samples line"},
 };
@@ -1347,6 +1469,9 @@ int main(void)
 		cmocka_unit_test(test_parse_line),
 		cmocka_unit_test(test_round_trip_examples),
 		cmocka_unit_test(test_round_trip_random),
+		cmocka_unit_test(test_kept_settings),
+		cmocka_unit_test(test_kept_settings_each_row),
+		cmocka_unit_test(test_kept_settings_errors),
 		cmocka_unit_test(test_wild_corpus),
 		cmocka_unit_test(test_c_locale_numbers),
 	};

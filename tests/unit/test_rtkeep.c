@@ -8,6 +8,7 @@
 
 #include "rtsh/rtfile.h"
 #include "rtsh/rtkeep.h"
+#include "rtsh/settings.h"
 #include "scene/rtfile_priv.h"
 
 static scene *load(const char *text)
@@ -255,6 +256,45 @@ static void test_delete_add_and_hints(void **state)
 	scene_free(s);
 }
 
+/* scene_hints.kept[] of the setting called name: the value text, "" unset. */
+static char *kept(scene *s, const char *name)
+{
+	rt_error err;
+	const setting_def *d = settings_find(name, &err);
+	assert_non_null(d);
+	return s->hints.kept[d - settings_table];
+}
+
+static void set_kept(scene *s, const char *name, const char *value)
+{
+	char *k = kept(s, name);
+	memset(k, 0, SCENE_KEPT_LEN);
+	snprintf(k, SCENE_KEPT_LEN, "%s", value);
+}
+
+/* The settings kept with the scene beyond the four: as the others. */
+static void test_kept_settings(void **state)
+{
+	(void)state;
+	const char src[] = "set seed 7\nC 0,0,-5 0,0,1 70\n# exposure\nset exposure 0.50\nsp 0,0,0 1 255,0,0\n";
+	scene *s = load(src);
+	assert_string_equal(kept(s, "seed"), "7");
+	assert_string_equal(kept(s, "exposure"), "0.5");
+	char *t = keep(s, src);
+	assert_string_equal(t, src); /* unedited: 0.50 as it was written */
+	free(t);
+	/* Changed in place, dropped, added after the other settings. */
+	set_kept(s, "seed", "9");
+	set_kept(s, "exposure", "");
+	set_kept(s, "denoise", "on");
+	s->hints.samples = 3;
+	t = keep(s, src);
+	assert_string_equal(t, "set seed 9\nC 0,0,-5 0,0,1 70\n# exposure\nsp 0,0,0 1 255,0,0\n"
+	                       "set samples 3\nset denoise on\n");
+	free(t);
+	scene_free(s);
+}
+
 static void test_default_camera(void **state)
 {
 	(void)state;
@@ -317,6 +357,7 @@ int main(void)
 		cmocka_unit_test(test_one_edit_one_line),
 		cmocka_unit_test(test_delete_add_and_hints),
 		cmocka_unit_test(test_default_camera),
+		cmocka_unit_test(test_kept_settings),
 		cmocka_unit_test(test_long_lists),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
