@@ -3,6 +3,7 @@
 #include "rtsh/denoise.h"
 
 #include <pthread.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -420,6 +421,15 @@ typedef struct texel {
 	chan h[NCH];
 } texel;
 
+/* What regression_rows reads, one plane a quantity (structure of arrays),
+ * so that four neighbouring pixels' values are one load: the guide's six
+ * scaled features, depth, direct light, depth gradient, and what the
+ * regression fits (all the samples' colour and each half's brightness).
+ * Each plane has PL_PAD floats of zeros before and after it, so that the
+ * loads of four pixels at a row's ends stay inside. */
+enum { PL_F0, PL_Z = 6, PL_D, PL_GX, PL_GY, PL_DATA, NPL = PL_DATA + 5 };
+#define PL_PAD 8
+
 /* The candidates for a pixel: itself, and the regression. */
 enum { CAND_RAW, CAND_FIT, NCAND };
 
@@ -429,7 +439,8 @@ typedef struct job {
 	float *am;              /* 3 a pixel: the albedo the radiance is divided by */
 	bool *mixed;            /* the pixel's features vary inside it */
 	texel *t;               /* the chains; CH_ALL later holds the result */
-	float *data;            /* 8 a pixel: what the regression fits (regression_rows) */
+	float *pl;              /* the regression's planes (plane), NPL of them */
+	size_t pstride;         /* floats from one plane to the next */
 	float *fit;             /* 3 a pixel: the regression's value */
 	float *err;             /* NCAND a pixel: their estimated squared errors */
 	float *out;
@@ -448,16 +459,10 @@ static inline float lum(const float *c)
 	return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
 }
 
-/* exp(-x) for x >= 0 as (1 - x/16)^16 (its limit definition), 0 from
- * x = 16 on: within 0.03 of it everywhere, four multiplications. */
-static inline float exp_fast(float x)
+/* Plane k's first pixel (regression_rows). */
+static inline float *plane(const job *j, int k)
 {
-	float t = 1.0f - x * (1.0f / 16);
-	t = t > 0.0f ? t : 0.0f;
-	t *= t;
-	t *= t;
-	t *= t;
-	return t * t;
+	return j->pl + (size_t)k * j->pstride + PL_PAD;
 }
 
 static float depth_slope(const float *z, int x, int w, int stride)
@@ -515,14 +520,17 @@ static void setup_rows(job *j, int y0, int y1)
 				t->h[CH_B].c[k] = isfinite(b) ? b / db : 0.0f;
 				t->h[CH_ALL].c[k] = isfinite(c) ? c / dc : 0.0f;
 			}
+			for (int k = 0; k < 6; k++)
+				plane(j, PL_F0 + k)[i] = g->f[k];
+			plane(j, PL_Z)[i] = g->z;
+			plane(j, PL_D)[i] = g->d;
+			plane(j, PL_GX)[i] = g->gx;
+			plane(j, PL_GY)[i] = g->gy;
 			/* all the samples' colour and each half's brightness */
-			float *d = j->data + i * 8;
-			d[0] = t->h[CH_ALL].c[0];
-			d[1] = t->h[CH_ALL].c[1];
-			d[2] = t->h[CH_ALL].c[2];
-			d[3] = lum(t->h[CH_A].c);
-			d[4] = lum(t->h[CH_B].c);
-			d[5] = d[6] = d[7] = 0.0f;
+			for (int k = 0; k < 3; k++)
+				plane(j, PL_DATA + k)[i] = t->h[CH_ALL].c[k];
+			plane(j, PL_DATA + 3)[i] = lum(t->h[CH_A].c);
+			plane(j, PL_DATA + 4)[i] = lum(t->h[CH_B].c);
 		}
 }
 
@@ -586,12 +594,15 @@ static void variance_rows(job *j, int y0, int y1)
 
 /* Cholesky solve of the n x n system a x = b with m right-hand sides (a
  * positive definite and overwritten; only its lower triangle is read).
- * False when it is not. */
-static bool solve(int n, float a[][MIX_NU], int m, float b[][NRHS], float x[][NRHS])
+ * False when it is not. Inlined and unrolled: its callers' n and m are
+ * constants. */
+static inline __attribute__((always_inline)) bool solve(int n, float a[][MIX_NU], int m, float b[][NRHS], float x[][NRHS])
 {
 	float inv[MIX_NU]; /* 1 / the factor's diagonal */
+#pragma GCC unroll 8
 	for (int c = 0; c < n; c++) {
 		float d = a[c][c];
+#pragma GCC unroll 8
 		for (int k = 0; k < c; k++)
 			d -= a[c][k] * a[c][k];
 		if (!(d > 1e-12f))
@@ -599,23 +610,30 @@ static bool solve(int n, float a[][MIX_NU], int m, float b[][NRHS], float x[][NR
 		d = sqrtf(d);
 		a[c][c] = d;
 		inv[c] = 1.0f / d;
+#pragma GCC unroll 8
 		for (int r = c + 1; r < n; r++) {
 			float v = a[r][c];
+#pragma GCC unroll 8
 			for (int k = 0; k < c; k++)
 				v -= a[r][k] * a[c][k];
 			a[r][c] = v * inv[c];
 		}
 	}
+#pragma GCC unroll 8
 	for (int ch = 0; ch < m; ch++) {
 		float z[MIX_NU];
+#pragma GCC unroll 8
 		for (int r = 0; r < n; r++) {
 			float v = b[r][ch];
+#pragma GCC unroll 8
 			for (int k = 0; k < r; k++)
 				v -= a[r][k] * z[k];
 			z[r] = v * inv[r];
 		}
+#pragma GCC unroll 8
 		for (int r = n - 1; r >= 0; r--) {
 			float v = z[r];
+#pragma GCC unroll 8
 			for (int k = r + 1; k < n; k++)
 				v -= a[k][r] * x[k][ch];
 			x[r][ch] = v * inv[r];
@@ -641,10 +659,17 @@ static float cross_error(const chan *r, float na, float nb, float la, float lb)
 /* Four floats in one SIMD register (a GCC and Clang extension), for the
  * regression's sums. */
 typedef float v4 __attribute__((vector_size(16)));
+/* Four ints: the lanes' masks (all bits set where true). */
+typedef int v4i __attribute__((vector_size(16)));
 
 static inline v4 v4_splat(float x)
 {
 	return (v4){x, x, x, x};
+}
+
+static inline v4i v4_isplat(int x)
+{
+	return (v4i){x, x, x, x};
 }
 
 static inline v4 v4_load(const float *p)
@@ -654,6 +679,35 @@ static inline v4 v4_load(const float *p)
 	return v;
 }
 
+
+static inline v4 v4_and(v4 x, v4i m)
+{
+	return (v4)((v4i)x & m);
+}
+
+static inline v4 v4_abs(v4 x)
+{
+	return (v4)((v4i)x & v4_isplat(0x7fffffff));
+}
+
+/* exp(-x) for x >= 0 as (1 - x/16)^16 (its limit definition), 0 from
+ * x = 16 on: within 0.03 of it everywhere, four multiplications; of four
+ * values. */
+static inline v4 v4_exp_fast(v4 x)
+{
+	v4 t = v4_splat(1.0f) - x * v4_splat(1.0f / 16);
+	t = v4_and(t, t > v4_splat(0.0f));
+	t *= t;
+	t *= t;
+	t *= t;
+	return t * t;
+}
+
+/* Where the sum of row r and column c (c <= r) of the normal equations is
+ * kept: their lower triangle, row by row. */
+#define TRI(r, c) ((r) * ((r) + 1) / 2 + (c))
+#define NTRI (NU * (NU + 1) / 2)
+
 /* Weighted first-order regression (NFOR, Bitterli et al. 2016, without its
  * colour weights) of the radiance over albedo on the screen position, the
  * normal and the depth, over the window around each pixel of rows
@@ -661,122 +715,141 @@ static inline v4 v4_load(const float *p)
  * their features are (albedo, normal, depth off the pixel's plane) and by
  * nothing else: no weight depends on the noise, so the fit of each half's
  * brightness depends on that half's samples only, and cross_error
- * estimates the fit's error honestly. */
+ * estimates the fit's error honestly.
+ *
+ * Four neighbouring pixels of a row at a time, one in each SIMD lane
+ * (their planes: one load for the four): each lane does the one pixel's
+ * operations in the one pixel's order, so the results are those of a
+ * pixel alone to the bit. A tap that is outside the image or has no
+ * weight for a lane adds +0 to that lane's sums (masked), which leaves
+ * them as they were, as if it had been skipped. */
 static void regression_rows(job *j, int y0, int y1)
 {
 	int w = j->fb->w, h = j->fb->h;
 	float na = j->n[CH_A], nb = j->n[CH_B];
+	const float *pf[6], *pdata[5];
+	for (int k = 0; k < 6; k++)
+		pf[k] = plane(j, PL_F0 + k);
+	for (int k = 0; k < 5; k++)
+		pdata[k] = plane(j, PL_DATA + k);
+	const float *pz = plane(j, PL_Z), *pd = plane(j, PL_D), *pgx = plane(j, PL_GX), *pgy = plane(j, PL_GY);
 	for (int y = y0; y < y1; y++)
-		for (int x = 0; x < w; x++) {
-			size_t i = (size_t)y * w + x;
-			const guide *gp = &j->g[i];
-			float inv_z = 1.0f / (SIGMA_Z * gp->z + 1e-6f);
+		for (int x = 0; x < w; x += 4) {
+			ptrdiff_t i = (ptrdiff_t)y * w + x;
+			v4 gf[6];
+			for (int k = 0; k < 6; k++)
+				gf[k] = v4_load(pf[k] + i);
+			v4 gz = v4_load(pz + i), gd = v4_load(pd + i), ggx = v4_load(pgx + i), ggy = v4_load(pgy + i);
+			v4 inv_z = v4_splat(1.0f) / (v4_splat(SIGMA_Z) * gz + v4_splat(1e-6f));
 			/* the direct light's slope, in shares of its value */
-			float dscale = 1.0f / (0.5f * fabsf(gp->d) + 0.05f);
-			/* The taps with a weight: each one's weight, regressors and
-			 * data (rows of 8 floats, SIMD-friendly). */
-			float tw[TAPS], tv[TAPS][8], td[TAPS][8];
+			v4 dscale = v4_splat(1.0f) / (v4_splat(0.5f) * v4_abs(gd) + v4_splat(0.05f));
+			v4i lane = {x, x + 1, x + 2, x + 3};
+			/* The taps with a weight in some lane: the weights (0 where
+			 * none), regressors, masks and where the tap's data are. */
+			v4 tw[TAPS], tv[TAPS][NU];
+			v4i tm[TAPS];
+			ptrdiff_t tq[TAPS];
+			/* The normal equations' lower triangle (what solve reads). */
+			v4 a[NTRI] = {{0}};
 			int nt = 0;
 			for (int dy = -WIN; dy <= WIN; dy++) {
 				int qy = y + dy;
 				if (qy < 0 || qy >= h)
 					continue;
 				for (int dx = -WIN; dx <= WIN; dx++) {
-					int qx = x + dx;
-					if (qx < 0 || qx >= w)
+					v4i qx = lane + v4_isplat(dx);
+					v4i in = (qx >= v4_isplat(0)) & (qx < v4_isplat(w));
+					if (!(in[0] | in[1] | in[2] | in[3]))
 						continue;
-					size_t q = (size_t)qy * w + qx;
-					const guide *gq = &j->g[q];
-					float e = 0;
-					for (int k = 0; k < 6; k++)
-						e += (gp->f[k] - gq->f[k]) * (gp->f[k] - gq->f[k]);
-					e += fabsf(gq->z - (gp->z + gp->gx * (float)dx + gp->gy * (float)dy)) * inv_z;
-					float wt = exp_fast(e);
-					if (wt <= 0)
+					ptrdiff_t q = (ptrdiff_t)qy * w + x + dx;
+					v4 e = v4_splat(0.0f);
+#pragma GCC unroll 6
+					for (int k = 0; k < 6; k++) {
+						v4 d = gf[k] - v4_load(pf[k] + q);
+						e += d * d;
+					}
+					v4 qz = v4_load(pz + q);
+					e += v4_abs(qz - (gz + ggx * v4_splat((float)dx) + ggy * v4_splat((float)dy))) * inv_z;
+					v4 wt = v4_exp_fast(e);
+					v4i m = in & (wt > v4_splat(0.0f));
+					if (!(m[0] | m[1] | m[2] | m[3]))
 						continue;
-					tw[nt] = wt;
-					float *v = tv[nt];
-					v[0] = 1.0f;
-					v[1] = (float)dx * (1.0f / WIN);
-					v[2] = (float)dy * (1.0f / WIN);
-					v[3] = gq->f[3] - gp->f[3];
-					v[4] = gq->f[4] - gp->f[4];
-					v[5] = gq->f[5] - gp->f[5];
-					v[6] = (gq->z - gp->z) * inv_z;
-					v[7] = (gq->d - gp->d) * dscale;
-					memcpy(td[nt], j->data + q * 8, sizeof td[nt]);
+					v4 tww = v4_and(wt, m);
+					v4 *v = tv[nt];
+					v[0] = v4_splat(1.0f);
+					v[1] = v4_splat((float)dx * (1.0f / WIN));
+					v[2] = v4_splat((float)dy * (1.0f / WIN));
+					for (int k = 3; k < 6; k++)
+						v[k] = v4_and(v4_load(pf[k] + q) - gf[k], m);
+					v[6] = v4_and((qz - gz) * inv_z, m);
+					v[7] = v4_and((v4_load(pd + q) - gd) * dscale, m);
+					tw[nt] = tww;
+					tm[nt] = m;
+					tq[nt] = q;
 					nt++;
+#pragma GCC unroll 8
+					for (int r = 0; r < NU; r++) {
+						v4 wv = tww * v[r];
+#pragma GCC unroll 8
+						for (int c = 0; c <= r; c++)
+							a[TRI(r, c)] += wv * v[c];
+					}
 				}
 			}
-			/* The normal equations in one pass over the taps, their lower
-			 * triangle (what solve reads) in twelve registers. */
-			v4 a[12] = {{0}};
+			/* Each lane's solve: the fit at the pixel is sum_t h_t y_t,
+			 * with h_t the tap's weight times z . (its regressors),
+			 * M z = (1, 0, ..., 0): one solve for all the right-hand
+			 * sides. */
+			bool ok[4] = {false, false, false, false};
+			v4 zv[NU] = {{0}};
+			int lanes = w - x < 4 ? w - x : 4;
+			for (int l = 0; l < lanes; l++) {
+				float m[NU][MIX_NU] = {{0}}, e0[NU][NRHS] = {{1.0f}}, z[NU][NRHS];
+				for (int r = 0; r < NU; r++)
+					for (int c = 0; c <= r; c++)
+						m[r][c] = a[TRI(r, c)][l];
+				float ridge = m[0][0] * RIDGE;
+				for (int r = 1; r < NU; r++)
+					m[r][r] += ridge;
+				ok[l] = solve(NU, m, 1, e0, z);
+				if (ok[l])
+					for (int r = 0; r < NU; r++)
+						zv[r][l] = z[r][0];
+			}
+			v4 fo[5] = {{0}};
 			for (int t = 0; t < nt; t++) {
-				v4 v0 = v4_load(tv[t]), v1 = v4_load(tv[t] + 4);
-				v4 w0 = v4_splat(tw[t]) * v0, w1 = v4_splat(tw[t]) * v1;
-				a[0] += v4_splat(w0[0]) * v0;
-				a[1] += v4_splat(w0[1]) * v0;
-				a[2] += v4_splat(w0[2]) * v0;
-				a[3] += v4_splat(w0[3]) * v0;
-				a[4] += v4_splat(w1[0]) * v0;
-				a[5] += v4_splat(w1[0]) * v1;
-				a[6] += v4_splat(w1[1]) * v0;
-				a[7] += v4_splat(w1[1]) * v1;
-				a[8] += v4_splat(w1[2]) * v0;
-				a[9] += v4_splat(w1[2]) * v1;
-				a[10] += v4_splat(w1[3]) * v0;
-				a[11] += v4_splat(w1[3]) * v1;
+				const v4 *v = tv[t];
+				v4 p0 = zv[0] * v[0] + zv[4] * v[4], p1 = zv[1] * v[1] + zv[5] * v[5];
+				v4 p2 = zv[2] * v[2] + zv[6] * v[6], p3 = zv[3] * v[3] + zv[7] * v[7];
+				v4 hv = tw[t] * (p0 + p1 + p2 + p3);
+#pragma GCC unroll 5
+				for (int c = 0; c < 5; c++)
+					fo[c] += v4_and(hv * v4_load(pdata[c] + tq[t]), tm[t]);
 			}
-			float m[NU][MIX_NU], e0[NU][NRHS] = {{1.0f}}, z[NU][NRHS];
-			for (int r = 0; r < 4; r++)
-				memcpy(m[r], &a[r], sizeof a[r]);
-			for (int r = 4; r < NU; r++) {
-				memcpy(m[r], &a[4 + 2 * (r - 4)], sizeof a[0]);
-				memcpy(m[r] + 4, &a[5 + 2 * (r - 4)], sizeof a[0]);
-			}
-			float ridge = m[0][0] * RIDGE;
-			for (int r = 1; r < NU; r++)
-				m[r][r] += ridge;
-			/* The fit at the pixel is sum_t h_t y_t, with h_t the tap's
-			 * weight times z . (its regressors), M z = (1, 0, ..., 0): one
-			 * solve for all the right-hand sides. */
-			bool ok = solve(NU, m, 1, e0, z);
-			float beta[1][NRHS];
-			if (ok) {
-				v4 z0 = {z[0][0], z[1][0], z[2][0], z[3][0]}, z1 = {z[4][0], z[5][0], z[6][0], z[7][0]};
-				v4 f0 = {0}, f1 = {0};
-				for (int t = 0; t < nt; t++) {
-					v4 p = z0 * v4_load(tv[t]) + z1 * v4_load(tv[t] + 4);
-					v4 hv = v4_splat(tw[t] * (p[0] + p[1] + p[2] + p[3]));
-					f0 += hv * v4_load(td[t]);
-					f1 += hv * v4_load(td[t] + 4);
+			for (int l = 0; l < lanes; l++) {
+				size_t pi = (size_t)i + (size_t)l;
+				const chan *r0 = j->t[pi].h;
+				float am = lum(j->am + pi * 3), am2 = am * am;
+				float *fit = j->fit + pi * 3, *err = j->err + pi * NCAND;
+				if (!ok[l]) {
+					memcpy(fit, r0[CH_ALL].c, sizeof r0[CH_ALL].c);
+					err[CAND_RAW] = 0.0f; /* the raw pixel */
+					err[CAND_FIT] = INFINITY;
+					continue;
 				}
-				float fs[8];
-				memcpy(fs, &f0, sizeof f0);
-				memcpy(fs + 4, &f1, sizeof f1);
-				memcpy(beta[0], fs, sizeof beta[0]);
+				for (int k = 0; k < 3; k++)
+					fit[k] = fo[k][l];
+				if (!j->halves) {
+					/* One sample: no halves, no error estimate; the fit. */
+					err[CAND_RAW] = INFINITY;
+					err[CAND_FIT] = 0.0f;
+					continue;
+				}
+				/* The raw pixel estimated the same way as the fit, so
+				 * that the two estimates share their noise. */
+				err[CAND_RAW] = cross_error(r0, na, nb, lum(r0[CH_A].c), lum(r0[CH_B].c)) * am2;
+				err[CAND_FIT] = cross_error(r0, na, nb, fo[3][l], fo[4][l]) * am2;
 			}
-			const chan *r0 = j->t[i].h;
-			float am = lum(j->am + i * 3), am2 = am * am;
-			float *fit = j->fit + i * 3, *err = j->err + i * NCAND;
-			if (!ok) {
-				memcpy(fit, r0[CH_ALL].c, sizeof r0[CH_ALL].c);
-				err[CAND_RAW] = 0.0f; /* the raw pixel */
-				err[CAND_FIT] = INFINITY;
-				continue;
-			}
-			for (int k = 0; k < 3; k++)
-				fit[k] = beta[0][k];
-			if (!j->halves) {
-				/* One sample: no halves, no error estimate; the fit. */
-				err[CAND_RAW] = INFINITY;
-				err[CAND_FIT] = 0.0f;
-				continue;
-			}
-			/* The raw pixel estimated the same way as the fit, so that
-			 * the two estimates share their noise. */
-			err[CAND_RAW] = cross_error(r0, na, nb, lum(r0[CH_A].c), lum(r0[CH_B].c)) * am2;
-			err[CAND_FIT] = cross_error(r0, na, nb, beta[0][3], beta[0][4]) * am2;
 		}
 }
 
@@ -953,12 +1026,13 @@ bool denoise_image(const framebuffer *fb, float *out, int threads)
 	j.am = malloc(n * 3 * sizeof *j.am);
 	j.mixed = malloc(n * sizeof *j.mixed);
 	j.t = malloc(n * sizeof *j.t);
-	j.data = malloc(n * 8 * sizeof *j.data);
+	j.pstride = n + 2 * PL_PAD;
+	j.pl = calloc(NPL * j.pstride, sizeof *j.pl); /* the pads zero */
 	j.fit = malloc(n * 3 * sizeof *j.fit);
 	j.err = malloc(n * NCAND * sizeof *j.err);
 	pthread_t *tid = malloc((size_t)threads * sizeof *tid);
 	worker_arg *args = malloc((size_t)threads * sizeof *args);
-	bool ok = j.g && j.am && j.mixed && j.t && j.data && j.fit && j.err && tid && args;
+	bool ok = j.g && j.am && j.mixed && j.t && j.pl && j.fit && j.err && tid && args;
 	if (ok) {
 		pthread_mutex_init(&j.lock, NULL);
 		pthread_cond_init(&j.go_cond, NULL);
@@ -987,6 +1061,6 @@ bool denoise_image(const framebuffer *fb, float *out, int threads)
 		pthread_mutex_destroy(&j.lock);
 		pthread_cond_destroy(&j.go_cond);
 	}
-	mem_free_all(j.g, j.am, j.mixed, j.t, j.data, j.fit, j.err, tid, args);
+	mem_free_all(j.g, j.am, j.mixed, j.t, j.pl, j.fit, j.err, tid, args);
 	return ok;
 }
