@@ -296,27 +296,6 @@ static void leaf_spheres(pk_state *s, const prim *p, const ray *r, double tmin)
 #endif
 }
 
-/* plane_hit in two steps for rays of one origin o: its height over the
- * plane, then each ray's test, with plane_hit's own operations. */
-static inline double plane_oy(const prim_plane *pl, vec3 o)
-{
-	const double *h = pl->h;
-	return h[0] * o.x + h[1] * o.y + h[2] * o.z + h[3];
-}
-
-static inline bool plane_hit_o(const prim_plane *pl, double oy, const ray *r, double tmin, double tmax, double *t)
-{
-	const double *h = pl->h;
-	double dy = h[0] * r->d.x + h[1] * r->d.y + h[2] * r->d.z;
-	if (dy == 0.0)
-		return false;
-	double tt = -oy / dy;
-	if (!(tt > tmin && tt < tmax))
-		return false;
-	*t = tt;
-	return true;
-}
-
 /* The farthest of the rays' nearest hits so far. */
 static inline double packet_far(const pk_state *s)
 {

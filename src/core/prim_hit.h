@@ -53,11 +53,19 @@ static inline bool sphere_hit(const prim *p, const ray *r, double tmin, double t
 }
 
 /* A plane: the unit plane's test (plane.c) with the ray's object-space
- * height and slope computed from row 1 of the matrix only. */
-static inline bool plane_hit(const prim_plane *pl, const ray *r, double tmin, double tmax, double *t)
+ * height and slope computed from row 1 of the matrix only, in two steps so
+ * that rays of one origin (packet.c's camera packets) share the first:
+ * plane_oy, the origin's height over the plane, then plane_hit_o, a ray's
+ * test from that height. */
+static inline double plane_oy(const prim_plane *pl, vec3 o)
 {
 	const double *h = pl->h;
-	double oy = h[0] * r->o.x + h[1] * r->o.y + h[2] * r->o.z + h[3];
+	return h[0] * o.x + h[1] * o.y + h[2] * o.z + h[3];
+}
+
+static inline bool plane_hit_o(const prim_plane *pl, double oy, const ray *r, double tmin, double tmax, double *t)
+{
+	const double *h = pl->h;
 	double dy = h[0] * r->d.x + h[1] * r->d.y + h[2] * r->d.z;
 	if (dy == 0.0)
 		return false;
@@ -66,6 +74,11 @@ static inline bool plane_hit(const prim_plane *pl, const ray *r, double tmin, do
 		return false;
 	*t = tt;
 	return true;
+}
+
+static inline bool plane_hit(const prim_plane *pl, const ray *r, double tmin, double tmax, double *t)
+{
+	return plane_hit_o(pl, plane_oy(pl, r->o), r, tmin, tmax, t);
 }
 
 /* The nearest hit of any bounded primitive in (tmin, tmax) (world.c's
