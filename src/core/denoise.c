@@ -421,17 +421,19 @@ typedef struct texel {
 	chan h[NCH];
 } texel;
 
+/* The candidates for a pixel: itself, and the regression. */
+enum { CAND_RAW, CAND_FIT, NCAND };
+
 /* What regression_rows reads, one plane a quantity (structure of arrays),
  * so that four neighbouring pixels' values are one load: the guide's six
  * scaled features, depth, direct light, depth gradient, and what the
- * regression fits (all the samples' colour and each half's brightness).
+ * regression fits (all the samples' colour and each half's brightness);
+ * and what it writes for pick_rows, the candidates' estimated squared
+ * errors.
  * Each plane has PL_PAD floats of zeros before and after it, so that the
  * loads of four pixels at a row's ends stay inside. */
-enum { PL_F0, PL_Z = 6, PL_D, PL_GX, PL_GY, PL_DATA, NPL = PL_DATA + 5 };
+enum { PL_F0, PL_Z = 6, PL_D, PL_GX, PL_GY, PL_DATA, PL_ERR = PL_DATA + 5, NPL = PL_ERR + NCAND };
 #define PL_PAD 8
-
-/* The candidates for a pixel: itself, and the regression. */
-enum { CAND_RAW, CAND_FIT, NCAND };
 
 typedef struct job {
 	const framebuffer *fb;
@@ -442,7 +444,6 @@ typedef struct job {
 	float *pl;              /* the regression's planes (plane), NPL of them */
 	size_t pstride;         /* floats from one plane to the next */
 	float *fit;             /* 3 a pixel: the regression's value */
-	float *err;             /* NCAND a pixel: their estimated squared errors */
 	float *out;
 	float n[NCH];           /* samples in each chain */
 	bool halves;            /* at least two samples: two independent halves */
@@ -708,6 +709,33 @@ static inline v4 v4_exp_fast(v4 x)
 #define TRI(r, c) ((r) * ((r) + 1) / 2 + (c))
 #define NTRI (NU * (NU + 1) / 2)
 
+/* Rows [r0, r1) of the normal equations' lower triangle in a: each sum
+ * over the taps in their order, a few rows at a time so that their sums
+ * stay in registers. */
+static inline __attribute__((always_inline)) void normal_rows(v4 *a, int nt, const v4 *tw, v4 (*tv)[NU],
+                                                              int r0, int r1)
+{
+	v4 s[NU * 2];
+	int n = TRI(r1, 0) - TRI(r0, 0);
+#pragma GCC unroll 16
+	for (int k = 0; k < n; k++)
+		s[k] = a[TRI(r0, 0) + k];
+	for (int t = 0; t < nt; t++) {
+#pragma GCC unroll 8
+		for (int r = r0; r < r1; r++) {
+			/* regressor 0 is 1: times it, a product is itself exactly */
+			v4 wv = r == 0 ? tw[t] : tw[t] * tv[t][r];
+			s[TRI(r, 0) - TRI(r0, 0)] += wv;
+#pragma GCC unroll 8
+			for (int c = 1; c <= r; c++)
+				s[TRI(r, c) - TRI(r0, 0)] += wv * tv[t][c];
+		}
+	}
+#pragma GCC unroll 16
+	for (int k = 0; k < n; k++)
+		a[TRI(r0, 0) + k] = s[k];
+}
+
 /* Weighted first-order regression (NFOR, Bitterli et al. 2016, without its
  * colour weights) of the radiance over albedo on the screen position, the
  * normal and the depth, over the window around each pixel of rows
@@ -733,6 +761,9 @@ static void regression_rows(job *j, int y0, int y1)
 	for (int k = 0; k < 5; k++)
 		pdata[k] = plane(j, PL_DATA + k);
 	const float *pz = plane(j, PL_Z), *pd = plane(j, PL_D), *pgx = plane(j, PL_GX), *pgy = plane(j, PL_GY);
+	float *perr[NCAND];
+	for (int c = 0; c < NCAND; c++)
+		perr[c] = plane(j, PL_ERR + c);
 	for (int y = y0; y < y1; y++)
 		for (int x = 0; x < w; x += 4) {
 			ptrdiff_t i = (ptrdiff_t)y * w + x;
@@ -787,15 +818,12 @@ static void regression_rows(job *j, int y0, int y1)
 					tm[nt] = m;
 					tq[nt] = q;
 					nt++;
-#pragma GCC unroll 8
-					for (int r = 0; r < NU; r++) {
-						v4 wv = tww * v[r];
-#pragma GCC unroll 8
-						for (int c = 0; c <= r; c++)
-							a[TRI(r, c)] += wv * v[c];
-					}
 				}
 			}
+			normal_rows(a, nt, tw, tv, 0, 4);
+			normal_rows(a, nt, tw, tv, 4, 6);
+			normal_rows(a, nt, tw, tv, 6, 7);
+			normal_rows(a, nt, tw, tv, 7, 8);
 			/* Each lane's solve: the fit at the pixel is sum_t h_t y_t,
 			 * with h_t the tap's weight times z . (its regressors),
 			 * M z = (1, 0, ..., 0): one solve for all the right-hand
@@ -830,25 +858,27 @@ static void regression_rows(job *j, int y0, int y1)
 				size_t pi = (size_t)i + (size_t)l;
 				const chan *r0 = j->t[pi].h;
 				float am = lum(j->am + pi * 3), am2 = am * am;
-				float *fit = j->fit + pi * 3, *err = j->err + pi * NCAND;
+				float *fit = j->fit + pi * 3, err[NCAND];
 				if (!ok[l]) {
 					memcpy(fit, r0[CH_ALL].c, sizeof r0[CH_ALL].c);
-					err[CAND_RAW] = 0.0f; /* the raw pixel */
-					err[CAND_FIT] = INFINITY;
+					perr[CAND_RAW][pi] = 0.0f; /* the raw pixel */
+					perr[CAND_FIT][pi] = INFINITY;
 					continue;
 				}
 				for (int k = 0; k < 3; k++)
 					fit[k] = fo[k][l];
 				if (!j->halves) {
 					/* One sample: no halves, no error estimate; the fit. */
-					err[CAND_RAW] = INFINITY;
-					err[CAND_FIT] = 0.0f;
+					perr[CAND_RAW][pi] = INFINITY;
+					perr[CAND_FIT][pi] = 0.0f;
 					continue;
 				}
 				/* The raw pixel estimated the same way as the fit, so
 				 * that the two estimates share their noise. */
 				err[CAND_RAW] = cross_error(r0, na, nb, lum(r0[CH_A].c), lum(r0[CH_B].c)) * am2;
 				err[CAND_FIT] = cross_error(r0, na, nb, fo[3][l], fo[4][l]) * am2;
+				for (int c = 0; c < NCAND; c++)
+					perr[c][pi] = err[c];
 			}
 		}
 }
@@ -861,33 +891,46 @@ static void regression_rows(job *j, int y0, int y1)
 static void pick_rows(job *j, int y0, int y1)
 {
 	int w = j->fb->w, h = j->fb->h;
+	const float *perr[NCAND];
+	for (int c = 0; c < NCAND; c++)
+		perr[c] = plane(j, PL_ERR + c);
 	for (int y = y0; y < y1; y++)
-		for (int x = 0; x < w; x++) {
-			size_t i = (size_t)y * w + x;
-			float s[NCAND] = {0};
+		for (int x0 = 0; x0 < w; x0 += 4) {
+			/* Four pixels' sums, one in each lane, each over its window
+			 * in the one pixel's order; a tap outside the image adds +0
+			 * (masked), as if skipped. */
+			v4i lane = {x0, x0 + 1, x0 + 2, x0 + 3};
+			v4 sv[NCAND] = {{0}};
 			for (int qy = y - PICK_R; qy <= y + PICK_R; qy++) {
 				if (qy < 0 || qy >= h)
 					continue;
-				for (int qx = x - PICK_R; qx <= x + PICK_R; qx++) {
-					if (qx < 0 || qx >= w)
-						continue;
-					const float *e = j->err + ((size_t)qy * w + qx) * NCAND;
+				for (int dx = -PICK_R; dx <= PICK_R; dx++) {
+					v4i qx = lane + v4_isplat(dx);
+					v4i in = (qx >= v4_isplat(0)) & (qx < v4_isplat(w));
+					ptrdiff_t q = (ptrdiff_t)qy * w + x0 + dx;
 					for (int c = 0; c < NCAND; c++)
-						s[c] += e[c];
+						sv[c] += v4_and(v4_load(perr[c] + q), in);
 				}
 			}
-			int best = CAND_RAW;
-			for (int c = 1; c < NCAND; c++)
-				if (s[c] < s[best])
-					best = c;
-			chan *o = &j->t[i].h[CH_ALL];
-			const float *am = j->am + i * 3, *c = best == CAND_RAW ? o->c : j->fit + i * 3;
-			float l = lum(am);
-			for (int k = 0; k < 3; k++) {
-				float v = c[k] * am[k];
-				o->c[k] = v > 0 ? v : 0;
+			int lanes = w - x0 < 4 ? w - x0 : 4;
+			for (int ln = 0; ln < lanes; ln++) {
+				size_t i = (size_t)y * w + (size_t)(x0 + ln);
+				float s[NCAND];
+				for (int c = 0; c < NCAND; c++)
+					s[c] = sv[c][ln];
+				int best = CAND_RAW;
+				for (int c = 1; c < NCAND; c++)
+					if (s[c] < s[best])
+						best = c;
+				chan *o = &j->t[i].h[CH_ALL];
+				const float *am = j->am + i * 3, *c = best == CAND_RAW ? o->c : j->fit + i * 3;
+				float l = lum(am);
+				for (int k = 0; k < 3; k++) {
+					float v = c[k] * am[k];
+					o->c[k] = v > 0 ? v : 0;
+				}
+				o->v = o->v / j->n[CH_ALL] * l * l;
 			}
-			o->v = o->v / j->n[CH_ALL] * l * l;
 		}
 }
 
@@ -1029,10 +1072,9 @@ bool denoise_image(const framebuffer *fb, float *out, int threads)
 	j.pstride = n + 2 * PL_PAD;
 	j.pl = calloc(NPL * j.pstride, sizeof *j.pl); /* the pads zero */
 	j.fit = malloc(n * 3 * sizeof *j.fit);
-	j.err = malloc(n * NCAND * sizeof *j.err);
 	pthread_t *tid = malloc((size_t)threads * sizeof *tid);
 	worker_arg *args = malloc((size_t)threads * sizeof *args);
-	bool ok = j.g && j.am && j.mixed && j.t && j.pl && j.fit && j.err && tid && args;
+	bool ok = j.g && j.am && j.mixed && j.t && j.pl && j.fit && tid && args;
 	if (ok) {
 		pthread_mutex_init(&j.lock, NULL);
 		pthread_cond_init(&j.go_cond, NULL);
@@ -1061,6 +1103,6 @@ bool denoise_image(const framebuffer *fb, float *out, int threads)
 		pthread_mutex_destroy(&j.lock);
 		pthread_cond_destroy(&j.go_cond);
 	}
-	mem_free_all(j.g, j.am, j.mixed, j.t, j.pl, j.fit, j.err, tid, args);
+	mem_free_all(j.g, j.am, j.mixed, j.t, j.pl, j.fit, tid, args);
 	return ok;
 }
