@@ -833,7 +833,9 @@ static void regression_rows(job *j, int y0, int y1)
 			int lanes = w - x < 4 ? w - x : 4;
 			for (int l = 0; l < lanes; l++) {
 				float m[NU][MIX_NU] = {{0}}, e0[NU][NRHS] = {{1.0f}}, z[NU][NRHS];
+#pragma GCC unroll 8
 				for (int r = 0; r < NU; r++)
+#pragma GCC unroll 8
 					for (int c = 0; c <= r; c++)
 						m[r][c] = a[TRI(r, c)][l];
 				float ridge = m[0][0] * RIDGE;
