@@ -57,6 +57,16 @@ static void hammersley(unsigned idx, unsigned n, double *u, double *v)
 	*v = (rev + 0.5) / n;
 }
 
+/* The three numbers bsdf_sample_u takes for point idx of a fixed set of
+ * n: the lobe's pick (where there are more) from a golden-ratio sequence,
+ * apart from the direction's two, point idx of the Hammersley set. */
+static void fixed_u(unsigned idx, unsigned n, double u[3])
+{
+	hammersley(idx, n, &u[1], &u[2]);
+	double g = (idx + 0.5) * 0.6180339887498949;
+	u[0] = g - (double)(long)g;
+}
+
 /* Emitters sampled for the direct-light feature at most (more: these many
  * picked, their light scaled up). */
 #define DIRECT_EMITTERS 4
@@ -147,11 +157,7 @@ static double env_feature(const world *w, const bsdf *b, vec3 p, int k)
 	for (int q = 0; q < ENV_DIRS; q++) {
 		unsigned idx = (unsigned)(q * DENOISE_FEATURE_SAMPLES + k % DENOISE_FEATURE_SAMPLES);
 		double u[3];
-		hammersley(idx, ENV_SET, &u[1], &u[2]);
-		/* the lobe's pick (where there are more): a golden-ratio sequence,
-		 * apart from the two coordinates */
-		double g = (idx + 0.5) * 0.6180339887498949;
-		u[0] = g - (double)(long)g;
+		fixed_u(idx, ENV_SET, u);
 		bsdf_sample sm;
 		if (!bsdf_sample_u(b, u, &sm) || sm.transmit)
 			continue;
@@ -183,11 +189,7 @@ static double lobe_feature(const world *w, const bsdf *b, vec3 p, int ks)
 	for (int q = 0; q < LOBE_DIRS; q++) {
 		unsigned idx = (unsigned)(q * DENOISE_FEATURE_SAMPLES + ks % DENOISE_FEATURE_SAMPLES);
 		double u[3];
-		hammersley(idx, LOBE_DIRS * DENOISE_FEATURE_SAMPLES, &u[1], &u[2]);
-		/* the lobe's pick (where there are more): a golden-ratio sequence,
-		 * apart from the two coordinates */
-		double g = (idx + 0.5) * 0.6180339887498949;
-		u[0] = g - (double)(long)g;
+		fixed_u(idx, LOBE_DIRS * DENOISE_FEATURE_SAMPLES, u);
 		bsdf_sample sm;
 		if (!bsdf_sample_u(b, u, &sm) || sm.transmit)
 			continue;
