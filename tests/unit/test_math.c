@@ -3,6 +3,7 @@
 
 #include "rtsh/num.h"
 #include "rtsh/scene.h"
+#include "rtsh/srgb.h"
 
 static void assert_identity(mat4 m, double tol)
 {
@@ -292,6 +293,86 @@ static void test_scan_matches_strtod(void **state)
 	}
 }
 
+/* The 8-bit code of linear v from the definition: the k whose interval
+ * [decode((k - 0.5) / 255), decode((k + 0.5) / 255)) holds v, clamped;
+ * found from 255 x the encoding and corrected by those bounds. */
+static int srgb8_reference(double v)
+{
+	if (!(v > 0.0))
+		return 0;
+	if (v >= 1.0)
+		return 255;
+	double e = v <= 0.0031308 ? v * 12.92 : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
+	int k = (int)floor(255.0 * e + 0.5);
+	k = k < 0 ? 0 : k > 255 ? 255 : k;
+	while (k < 255 && v >= srgb_to_linear((k + 0.5) / 255.0))
+		k++;
+	while (k > 0 && v < srgb_to_linear((k - 0.5) / 255.0))
+		k--;
+	return k;
+}
+
+static void check_srgb8_n(const float *in, size_t n, double gain)
+{
+	uint8_t out[64];
+	assert_true(n <= 64);
+	linear_to_srgb8_n(in, gain, out, n);
+	for (size_t i = 0; i < n; i++)
+		if (out[i] != srgb8_reference(in[i] * gain))
+			fail_msg("linear_to_srgb8_n(%.9g x %.17g) = %d; the definition gives %d", (double)in[i], gain,
+			         out[i], srgb8_reference(in[i] * gain));
+}
+
+/* linear_to_srgb8_n, whose buckets are cut by the bits of the value: every
+ * bucket's first and last float, the floats around every code's lower
+ * bound, the edges, and random values and gains, against the definition. */
+static void test_srgb8_codes(void **state)
+{
+	(void)state;
+	float in[64];
+	size_t n = 0;
+	/* floats from 2^-14 to 1: each 1/1024 of a binade's first and last */
+	for (uint32_t b = 0; b < 14u * 1024u; b++) {
+		uint32_t first = ((uint32_t)(127 - 14) << 23) + (b << 13), last = first + 0x1fff;
+		memcpy(&in[n++], &first, sizeof first);
+		memcpy(&in[n++], &last, sizeof last);
+		if (n == 64) {
+			check_srgb8_n(in, n, 1.0);
+			n = 0;
+		}
+	}
+	/* around each code's lower bound, in floats (gain 1) and in doubles
+	 * (the float 1 times a gain that is the bound's neighbour) */
+	for (int k = 1; k < 256; k++) {
+		double t = srgb_to_linear((k - 0.5) / 255.0);
+		float f = (float)t;
+		for (int d = 0; d < 4; d++) {
+			f = nextafterf(f, 0.0f);
+		}
+		for (int d = 0; d < 9; d++, f = nextafterf(f, 2.0f))
+			check_srgb8_n(&f, 1, 1.0);
+		float one = 1.0f;
+		double g = t;
+		for (int d = 0; d < 4; d++)
+			g = nextafter(g, 0.0);
+		for (int d = 0; d < 9; d++, g = nextafter(g, 2.0))
+			check_srgb8_n(&one, 1, g);
+	}
+	float edges[] = {0.0f, -0.0f, -1.0f, NAN, INFINITY, -INFINITY, 1.0f, nextafterf(1.0f, 0.0f), 0x1p-13f,
+	                 nextafterf(0x1p-13f, 0.0f), 0x1p-149f, 1e-30f, 2.0f, 1e30f};
+	size_t ne = sizeof edges / sizeof edges[0];
+	check_srgb8_n(edges, ne, 1.0);
+	check_srgb8_n(edges, ne, 0.5);
+	check_srgb8_n(edges, ne, 3.7);
+	test_rng r = {7};
+	for (int round = 0; round < 20000; round++) {
+		double gain = exp2(trange(&r, -4.0, 4.0));
+		for (int i = 0; i < 64; i++)
+			in[i] = (float)(round % 2 ? trange(&r, 0.0, 1.2) : exp2(trange(&r, -16.0, 0.5)));
+		check_srgb8_n(in, 64, round % 3 ? gain : 1.0);
+	}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -304,6 +385,7 @@ int main(void)
 		cmocka_unit_test(test_orient),
 		cmocka_unit_test(test_object_rotate),
 		cmocka_unit_test(test_object_xform_sizes),
+		cmocka_unit_test(test_srgb8_codes),
 	};
 	return cmocka_run_group_tests_name("math", tests, NULL, NULL);
 }
