@@ -452,30 +452,37 @@ _Thread_local unsigned long mesh_stat_nodes, mesh_stat_blocks, mesh_stat_leaves;
 		            near_row(r, 2));                                                                         \
 	}
 
-/* A world ray on an instance (M: world to model) for the walk `walk`. An
- * instance that is not turned (an upright model: M scales and moves only)
- * skips M's zeros, 24 of its 33 operations: the same floats but for the
- * sign of a zero coordinate, on every unit (camera rays +7%, diffuse +2%:
- * bench/README.md). */
+/* A world ray on an instance (M: world to model) in the model's floats,
+ * ready for the box tests: the single walks (WALK_WORLD) and the packets
+ * make it alike. An instance that is not turned (an upright model: M
+ * scales and moves only) skips M's zeros, 24 of its 33 operations: the same
+ * floats but for the sign of a zero coordinate, on every unit (camera rays
+ * +7%, diffuse +2%: bench/README.md). */
+static inline __attribute__((always_inline)) void world_ray_setup(const double (*M)[4], const ray *wr, mesh_ray *r)
+{
+	double px = wr->o.x, py = wr->o.y, pz = wr->o.z, vx = wr->d.x, vy = wr->d.y, vz = wr->d.z;
+	if (M[0][1] == 0 && M[0][2] == 0 && M[1][0] == 0 && M[1][2] == 0 && M[2][0] == 0 && M[2][1] == 0)
+		ray_node_setup(r, (float)(M[0][0] * px + M[0][3]), (float)(M[1][1] * py + M[1][3]),
+		               (float)(M[2][2] * pz + M[2][3]), (float)(M[0][0] * vx), (float)(M[1][1] * vy),
+		               (float)(M[2][2] * vz));
+	else
+		ray_node_setup(r, (float)(M[0][0] * px + M[0][1] * py + M[0][2] * pz + M[0][3]),
+		               (float)(M[1][0] * px + M[1][1] * py + M[1][2] * pz + M[1][3]),
+		               (float)(M[2][0] * px + M[2][1] * py + M[2][2] * pz + M[2][3]),
+		               (float)(M[0][0] * vx + M[0][1] * vy + M[0][2] * vz),
+		               (float)(M[1][0] * vx + M[1][1] * vy + M[1][2] * vz),
+		               (float)(M[2][0] * vx + M[2][1] * vy + M[2][2] * vz));
+}
+
+/* A world ray on an instance for the walk `walk` (world_ray_setup). */
 #define WALK_WORLD(name, walk, target)                                                                              \
 	static target inline __attribute__((always_inline)) bool name(const mesh *m, const double (*M)[4],          \
 	                                                                     const ray *wr, double tmin, double tmax, \
 	                                                                     double *t, uint32_t *slot, float b[3],   \
 	                                                                     bool any)                                \
 	{                                                                                                             \
-		double px = wr->o.x, py = wr->o.y, pz = wr->o.z, vx = wr->d.x, vy = wr->d.y, vz = wr->d.z;            \
 		mesh_ray r;                                                                                           \
-		if (M[0][1] == 0 && M[0][2] == 0 && M[1][0] == 0 && M[1][2] == 0 && M[2][0] == 0 && M[2][1] == 0)     \
-			ray_node_setup(&r, (float)(M[0][0] * px + M[0][3]), (float)(M[1][1] * py + M[1][3]),          \
-			               (float)(M[2][2] * pz + M[2][3]), (float)(M[0][0] * vx), (float)(M[1][1] * vy), \
-			               (float)(M[2][2] * vz));                                                        \
-		else                                                                                                  \
-			ray_node_setup(&r, (float)(M[0][0] * px + M[0][1] * py + M[0][2] * pz + M[0][3]),             \
-			               (float)(M[1][0] * px + M[1][1] * py + M[1][2] * pz + M[1][3]),                 \
-			               (float)(M[2][0] * px + M[2][1] * py + M[2][2] * pz + M[2][3]),                 \
-			               (float)(M[0][0] * vx + M[0][1] * vy + M[0][2] * vz),                           \
-			               (float)(M[1][0] * vx + M[1][1] * vy + M[1][2] * vz),                           \
-			               (float)(M[2][0] * vx + M[2][1] * vy + M[2][2] * vz));                          \
+		world_ray_setup(M, wr, &r);                                                                           \
 		float ft = tmax < 3e38 ? (float)tmax : INFINITY;                                                      \
 		if (!walk(m, &r, false, (float)tmin, m->eps, &ft, slot, b, any) || !((double)ft < tmax))              \
 			return false;                                                                                 \
@@ -535,6 +542,278 @@ _Thread_local unsigned long mesh_stat_nodes, mesh_stat_blocks, mesh_stat_leaves;
 	{                                                                                                             \
 		return isa##_world_o(m, M, wr, tmin, tmax, t, slot, b, false);                                        \
 	}
+
+#if defined(HAVE_AVX2_WALK)
+/* --- packets (mesh_intersect_world_packet) ---
+ *
+ * Up to MESH_PACKET_MAX rays whose directions share each axis's sign walk
+ * the tree once. A node's eight children are tested against the packet as
+ * intervals: per axis, the near distance (b - o) inv of any ray is no less
+ * than the lowest corner product of b less the rays' farthest origin and
+ * their lowest and highest inverse, and the far one (b - o) (inv S) no
+ * more than the highest corner product (rounding to nearest is monotonic,
+ * so the bounds hold for each ray's rounded floats). A child that no ray
+ * could enter by its own test is skipped for all; the others are visited
+ * nearest first for the packet. A leaf is entered by the rays whose own
+ * slab test (the single walk's floats) lets them into its box, and each of
+ * those meets its blocks with the single ray's block test (block_sse), so
+ * a hit is the single ray's floats: distance, slot, barycentrics.
+ *
+ * The nearest distance does not depend on the order of the walk; which of
+ * two triangles at the same distance wins does (the single ray keeps the
+ * first it meets, block_sse the first lane in a block). A ray therefore
+ * also takes a triangle at exactly its distance so far, from another
+ * block, as a tie; a ray with a tie at the end is reported (the caller
+ * traces it alone). */
+
+/* A child waiting on the packet's stack: its reference, the packet's entry
+ * distance, and where its box is (node `parent`'s column k). */
+typedef struct pk_entry {
+	uint32_t ref;
+	float t;
+	uint32_t parent, k;
+} pk_entry;
+
+typedef struct mesh_packet {
+	/* the rays by component for the leaves' slab tests (lanes past n hold
+	 * ray 0 again), and each ray's fl((next float above best) S) */
+	_Alignas(32) float ox[MESH_PACKET_MAX], oy[MESH_PACKET_MAX], oz[MESH_PACKET_MAX];
+	_Alignas(32) float ix[MESH_PACKET_MAX], iy[MESH_PACKET_MAX], iz[MESH_PACKET_MAX];
+	_Alignas(32) float fx[MESH_PACKET_MAX], fy[MESH_PACKET_MAX], fz[MESH_PACKET_MAX];
+	_Alignas(32) float bs[MESH_PACKET_MAX];
+	ray4 rq[MESH_PACKET_MAX];
+	mesh_ray r[MESH_PACKET_MAX];
+	float best[MESH_PACKET_MAX], tmin[MESH_PACKET_MAX];
+	uint32_t slot[MESH_PACKET_MAX];
+	float b[MESH_PACKET_MAX][3];
+	unsigned found, tie;
+} mesh_packet;
+
+/* The smallest float above t (+inf stays). */
+static inline float next_upf(float t)
+{
+	if (!(t < INFINITY))
+		return t;
+	if (t == 0.0f)
+		return 0x1p-149f;
+	uint32_t u;
+	memcpy(&u, &t, sizeof u);
+	u = u >> 31 ? u - 1 : u + 1; /* a negative one comes nearer zero */
+	memcpy(&t, &u, sizeof t);
+	return t;
+}
+
+/* The rays (a bit each) whose own slab test, the single walk's floats,
+ * lets them into column k of node p. */
+static AVX2 inline unsigned pk_rays_in(const mesh_packet *s, const mesh_node *p, uint32_t k, float box_tmin, size_t rn0,
+                                       size_t rn1, size_t rn2)
+{
+#define ROW(n, off) ((const float *)((const char *)(n)->b + (off)))
+	const __m256 nx = _mm256_set1_ps(ROW(p, rn0)[k]), ny = _mm256_set1_ps(ROW(p, rn1)[k]),
+		     nz = _mm256_set1_ps(ROW(p, rn2)[k]);
+	const __m256 gx = _mm256_set1_ps(ROW(p, rn0 ^ MESH_ROW)[k]), gy = _mm256_set1_ps(ROW(p, rn1 ^ MESH_ROW)[k]),
+		     gz = _mm256_set1_ps(ROW(p, rn2 ^ MESH_ROW)[k]);
+#undef ROW
+	unsigned m = 0;
+	for (int h = 0; h < MESH_PACKET_MAX; h += 8) {
+		__m256 ox = _mm256_load_ps(&s->ox[h]), oy = _mm256_load_ps(&s->oy[h]), oz = _mm256_load_ps(&s->oz[h]);
+		__m256 t0 = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(nx, ox), _mm256_load_ps(&s->ix[h])),
+					  _mm256_set1_ps(box_tmin));
+		__m256 t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(gx, ox), _mm256_load_ps(&s->fx[h])),
+					  _mm256_load_ps(&s->bs[h]));
+		t0 = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(ny, oy), _mm256_load_ps(&s->iy[h])), t0);
+		t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(gy, oy), _mm256_load_ps(&s->fy[h])), t1);
+		t0 = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(nz, oz), _mm256_load_ps(&s->iz[h])), t0);
+		t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(gz, oz), _mm256_load_ps(&s->fz[h])), t1);
+		m |= (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ)) << h;
+	}
+	return m;
+}
+
+/* Ray i meets the blocks of leaf `ref`. */
+static AVX2 inline void pk_leaf(const mesh *m, mesh_packet *s, int i, uint32_t ref)
+{
+	uint32_t first = ref & (MESH_MAX_BLOCKS - 1), nb = ((ref & ~MESH_LEAF) >> MESH_LEAF_SHIFT) + 1;
+	const mesh_ray *r = &s->r[i];
+	float old = s->best[i];
+	for (uint32_t k = 0; k < nb; k++) {
+		float bt = next_upf(s->best[i]), bb[3];
+		int l = block_sse(m, first + k, &m->blk[first + k], r, &s->rq[i], s->tmin[i], &bt, bb);
+		if (l < 0)
+			continue;
+		uint32_t slot = 4 * (first + k) + (uint32_t)l;
+		if (bt < s->best[i]) {
+			s->best[i] = bt;
+			s->slot[i] = slot;
+			s->b[i][0] = bb[0];
+			s->b[i][1] = bb[1];
+			s->b[i][2] = bb[2];
+			s->found |= 1u << i;
+			s->tie &= ~(1u << i);
+		} else if (s->found >> i & 1u) {
+			/* bt is the distance so far, from another block (or the
+			 * query's tmax: no hit, as for the single ray) */
+			s->tie |= 1u << i;
+		}
+	}
+	if (s->best[i] != old)
+		s->bs[i] = next_upf(s->best[i]) * BVH_SLAB_SLACK;
+}
+
+/* The highest of the rays' bs: where the packet prunes. */
+static AVX2 inline float pk_far(const mesh_packet *s)
+{
+	__m256 a = _mm256_max_ps(_mm256_load_ps(&s->bs[0]), _mm256_load_ps(&s->bs[8]));
+	__m128 b = _mm_max_ps(_mm256_castps256_ps128(a), _mm256_extractf128_ps(a, 1));
+	b = _mm_max_ps(b, _mm_movehl_ps(b, b));
+	b = _mm_max_ss(b, _mm_shuffle_ps(b, b, 1));
+	return _mm_cvtss_f32(b);
+}
+
+static AVX2 __attribute__((noinline)) bool packet_walk(const mesh *m, const double (*M)[4], int n, const ray *wr,
+                                                       double tmin, const double *tmax, double *t, uint32_t *slot,
+                                                       float (*b)[3], unsigned *found, unsigned *tie)
+{
+	_Alignas(32) mesh_packet s;
+	float box_tmin = (float)tmin;
+	for (int i = 0; i < n; i++) {
+		mesh_ray *r = &s.r[i];
+		world_ray_setup(M, &wr[i], r);
+		ray_leaf_setup(r);
+		ray4_make(r, &s.rq[i]);
+		/* the triangles' tmin, as the single walk raises it at its first leaf */
+		float tm = box_tmin;
+		if (m->eps > 0.0f) {
+			float g = m->eps / sqrtf(r->d[0] * r->d[0] + r->d[1] * r->d[1] + r->d[2] * r->d[2]);
+			tm = tm > g ? tm : g;
+		}
+		s.tmin[i] = tm;
+		s.best[i] = tmax[i] < 3e38 ? (float)tmax[i] : INFINITY;
+		s.bs[i] = next_upf(s.best[i]) * BVH_SLAB_SLACK;
+	}
+	/* the signs each axis shares, and the rays by component */
+	unsigned neg_and = 7, neg_or = 0;
+	bool finite = true;
+	for (int i = 0; i < MESH_PACKET_MAX; i++) {
+		const mesh_ray *r = &s.r[i < n ? i : 0];
+		s.ox[i] = r->o[0];
+		s.oy[i] = r->o[1];
+		s.oz[i] = r->o[2];
+		s.ix[i] = r->inv[0];
+		s.iy[i] = r->inv[1];
+		s.iz[i] = r->inv[2];
+		s.fx[i] = r->inv[0] * BVH_SLAB_SLACK;
+		s.fy[i] = r->inv[1] * BVH_SLAB_SLACK;
+		s.fz[i] = r->inv[2] * BVH_SLAB_SLACK;
+		if (i >= n)
+			s.bs[i] = -INFINITY; /* never enters a leaf, never raises pk_far */
+		unsigned neg = (unsigned)(signbit(r->inv[0]) != 0) | (unsigned)(signbit(r->inv[1]) != 0) << 1 |
+			       (unsigned)(signbit(r->inv[2]) != 0) << 2;
+		neg_and &= neg;
+		neg_or |= neg;
+		/* the interval bounds need finite origins and finite, non-zero
+		 * inverses (NaN fails too) */
+		for (int a = 0; a < 3; a++)
+			finite &= fabsf(r->o[a]) <= FLT_MAX && fabsf(r->inv[a]) <= FLT_MAX && r->inv[a] != 0.0f &&
+				  fabsf(r->inv[a] * BVH_SLAB_SLACK) <= FLT_MAX;
+	}
+	if (neg_and != neg_or || !finite)
+		return false;
+	/* the intervals: per axis the origin to subtract from the near planes
+	 * (the farthest along the direction) and from the far ones (the
+	 * farthest back), the inverses' and the far inverses' range */
+	__m256 on[3], of[3], ilo[3], ihi[3], flo[3], fhi[3];
+	const float *oa[3] = {s.ox, s.oy, s.oz}, *ia[3] = {s.ix, s.iy, s.iz}, *fa[3] = {s.fx, s.fy, s.fz};
+	size_t rn[3];
+	for (int a = 0; a < 3; a++) {
+		float olo = oa[a][0], ohi = olo, il = ia[a][0], ih = il, fl = fa[a][0], fh = fl;
+		for (int i = 1; i < n; i++) {
+			olo = oa[a][i] < olo ? oa[a][i] : olo;
+			ohi = oa[a][i] > ohi ? oa[a][i] : ohi;
+			il = ia[a][i] < il ? ia[a][i] : il;
+			ih = ia[a][i] > ih ? ia[a][i] : ih;
+			fl = fa[a][i] < fl ? fa[a][i] : fl;
+			fh = fa[a][i] > fh ? fa[a][i] : fh;
+		}
+		bool neg = neg_and >> a & 1u;
+		on[a] = _mm256_set1_ps(neg ? olo : ohi);
+		of[a] = _mm256_set1_ps(neg ? ohi : olo);
+		ilo[a] = _mm256_set1_ps(il);
+		ihi[a] = _mm256_set1_ps(ih);
+		flo[a] = _mm256_set1_ps(fl);
+		fhi[a] = _mm256_set1_ps(fh);
+		rn[a] = (size_t)(MESH_LO(a) + neg) * MESH_ROW;
+	}
+	const size_t rn0 = rn[0], rn1 = rn[1], rn2 = rn[2];
+	s.found = s.tie = 0;
+	const __m256 t0_8 = _mm256_set1_ps(box_tmin);
+	float far = pk_far(&s);
+	pk_entry stack[MESH_STACK];
+	int sp = 0;
+	uint32_t ref = 0; /* the root node */
+	const mesh_node *nodes = m->nodes;
+	for (;;) {
+		{
+			const mesh_node *nd = (const mesh_node *)((const char *)nodes + ref);
+			__m256 t0 = t0_8, t1 = _mm256_set1_ps(far);
+			for (int a = 0; a < 3; a++) {
+				size_t r0 = rn[a];
+				__m256 x = _mm256_sub_ps(_mm256_load_ps((const float *)((const char *)nd->b + r0)), on[a]);
+				__m256 y = _mm256_sub_ps(_mm256_load_ps((const float *)((const char *)nd->b + (r0 ^ MESH_ROW))),
+							 of[a]);
+				t0 = _mm256_max_ps(_mm256_min_ps(_mm256_mul_ps(x, ilo[a]), _mm256_mul_ps(x, ihi[a])), t0);
+				t1 = _mm256_min_ps(_mm256_max_ps(_mm256_mul_ps(y, flo[a]), _mm256_mul_ps(y, fhi[a])), t1);
+			}
+			_Alignas(32) float tn[MESH_WIDTH];
+			_mm256_store_ps(tn, t0);
+			unsigned hm = (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ));
+			/* the children, farthest first, so the nearest is on top */
+			int base = sp;
+			for (; hm; hm &= hm - 1) {
+				uint32_t k = (uint32_t)__builtin_ctz(hm);
+				pk_entry e = {nd->child[k], tn[k], ref, k};
+				int j = sp++;
+				while (j > base && stack[j - 1].t < e.t) {
+					stack[j] = stack[j - 1];
+					j--;
+				}
+				stack[j] = e;
+			}
+		}
+		/* the next entry the packet may still need */
+		for (;;) {
+			while (sp > 0 && stack[sp - 1].t > far)
+				sp--;
+			if (sp == 0)
+				goto done;
+			pk_entry e = stack[--sp];
+			if (!(e.ref & MESH_LEAF)) {
+				ref = e.ref;
+				break;
+			}
+			unsigned in = pk_rays_in(&s, (const mesh_node *)((const char *)nodes + e.parent), e.k, box_tmin, rn0,
+						 rn1, rn2);
+			for (; in; in &= in - 1)
+				pk_leaf(m, &s, __builtin_ctz(in), e.ref);
+			far = pk_far(&s);
+		}
+	}
+done:
+	for (int i = 0; i < n; i++) {
+		t[i] = s.best[i];
+		slot[i] = s.slot[i];
+		b[i][0] = s.b[i][0];
+		b[i][1] = s.b[i][1];
+		b[i][2] = s.b[i][2];
+		if ((s.found >> i & 1u) && !((double)s.best[i] < tmax[i]))
+			s.found &= ~(1u << i);
+	}
+	*found = s.found;
+	*tie = s.tie & s.found;
+	return true;
+}
+#endif
+
 
 typedef struct walker {
 	bool (*hit)(const mesh *m, const mesh_ray *r, float tmin, float *tmax, uint32_t *tri, float b[3]);
@@ -656,4 +935,17 @@ bool mesh_intersect_brute(const mesh *m, const mesh_ray *r, float tmin, float *t
 			found = true;
 		}
 	return found;
+}
+
+bool mesh_intersect_world_packet(const mesh *m, const double (*inv)[4], int n, const ray *r, double tmin,
+                                 const double *tmax, double *t, uint32_t *slot, float (*b)[3], unsigned *found,
+                                 unsigned *tie)
+{
+#if defined(HAVE_AVX2_WALK)
+	if (n >= 1 && n <= MESH_PACKET_MAX && mesh_isa_active() >= MESH_ISA_AVX2)
+		return packet_walk(m, inv, n, r, tmin, tmax, t, slot, b, found, tie);
+#else
+	(void)m, (void)inv, (void)n, (void)r, (void)tmin, (void)tmax, (void)t, (void)slot, (void)b, (void)found, (void)tie;
+#endif
+	return false;
 }
