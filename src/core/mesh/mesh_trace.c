@@ -458,20 +458,32 @@ _Thread_local unsigned long mesh_stat_nodes, mesh_stat_blocks, mesh_stat_leaves;
  * scales and moves only) skips M's zeros, 24 of its 33 operations: the same
  * floats but for the sign of a zero coordinate, on every unit (camera rays
  * +7%, diffuse +2%: bench/README.md). */
-static inline __attribute__((always_inline)) void world_ray_setup(const double (*M)[4], const ray *wr, mesh_ray *r)
+static inline __attribute__((always_inline)) void world_ray_floats(const double (*M)[4], const ray *wr, float o[3],
+                                                                   float d[3])
 {
 	double px = wr->o.x, py = wr->o.y, pz = wr->o.z, vx = wr->d.x, vy = wr->d.y, vz = wr->d.z;
-	if (M[0][1] == 0 && M[0][2] == 0 && M[1][0] == 0 && M[1][2] == 0 && M[2][0] == 0 && M[2][1] == 0)
-		ray_node_setup(r, (float)(M[0][0] * px + M[0][3]), (float)(M[1][1] * py + M[1][3]),
-		               (float)(M[2][2] * pz + M[2][3]), (float)(M[0][0] * vx), (float)(M[1][1] * vy),
-		               (float)(M[2][2] * vz));
-	else
-		ray_node_setup(r, (float)(M[0][0] * px + M[0][1] * py + M[0][2] * pz + M[0][3]),
-		               (float)(M[1][0] * px + M[1][1] * py + M[1][2] * pz + M[1][3]),
-		               (float)(M[2][0] * px + M[2][1] * py + M[2][2] * pz + M[2][3]),
-		               (float)(M[0][0] * vx + M[0][1] * vy + M[0][2] * vz),
-		               (float)(M[1][0] * vx + M[1][1] * vy + M[1][2] * vz),
-		               (float)(M[2][0] * vx + M[2][1] * vy + M[2][2] * vz));
+	if (M[0][1] == 0 && M[0][2] == 0 && M[1][0] == 0 && M[1][2] == 0 && M[2][0] == 0 && M[2][1] == 0) {
+		o[0] = (float)(M[0][0] * px + M[0][3]);
+		o[1] = (float)(M[1][1] * py + M[1][3]);
+		o[2] = (float)(M[2][2] * pz + M[2][3]);
+		d[0] = (float)(M[0][0] * vx);
+		d[1] = (float)(M[1][1] * vy);
+		d[2] = (float)(M[2][2] * vz);
+	} else {
+		o[0] = (float)(M[0][0] * px + M[0][1] * py + M[0][2] * pz + M[0][3]);
+		o[1] = (float)(M[1][0] * px + M[1][1] * py + M[1][2] * pz + M[1][3]);
+		o[2] = (float)(M[2][0] * px + M[2][1] * py + M[2][2] * pz + M[2][3]);
+		d[0] = (float)(M[0][0] * vx + M[0][1] * vy + M[0][2] * vz);
+		d[1] = (float)(M[1][0] * vx + M[1][1] * vy + M[1][2] * vz);
+		d[2] = (float)(M[2][0] * vx + M[2][1] * vy + M[2][2] * vz);
+	}
+}
+
+static inline __attribute__((always_inline)) void world_ray_setup(const double (*M)[4], const ray *wr, mesh_ray *r)
+{
+	float o[3], d[3];
+	world_ray_floats(M, wr, o, d);
+	ray_node_setup(r, o[0], o[1], o[2], d[0], d[1], d[2]);
 }
 
 /* A world ray on an instance for the walk `walk` (world_ray_setup). */
@@ -581,12 +593,16 @@ typedef struct mesh_packet {
 	_Alignas(32) float ix[MESH_PACKET_MAX], iy[MESH_PACKET_MAX], iz[MESH_PACKET_MAX];
 	_Alignas(32) float fx[MESH_PACKET_MAX], fy[MESH_PACKET_MAX], fz[MESH_PACKET_MAX];
 	_Alignas(32) float bs[MESH_PACKET_MAX];
+	_Alignas(32) float dx[MESH_PACKET_MAX], dy[MESH_PACKET_MAX], dz[MESH_PACKET_MAX];
 	ray4 rq[MESH_PACKET_MAX];
 	mesh_ray r[MESH_PACKET_MAX];
 	float best[MESH_PACKET_MAX], tmin[MESH_PACKET_MAX];
 	uint32_t slot[MESH_PACKET_MAX];
 	float b[MESH_PACKET_MAX][3];
 	unsigned found, tie;
+	unsigned ready; /* the rays whose r, rq and tmin are made (at their first leaf) */
+	float tmin0;    /* the query's tmin as a float */
+	float eps;      /* the mesh's self-hit guard */
 } mesh_packet;
 
 /* The smallest float above t (+inf stays). */
@@ -634,7 +650,29 @@ static AVX2 inline unsigned pk_rays_in(const mesh_packet *s, const mesh_node *p,
 static AVX2 inline void pk_leaf(const mesh *m, mesh_packet *s, int i, uint32_t ref)
 {
 	uint32_t first = ref & (MESH_MAX_BLOCKS - 1), nb = ((ref & ~MESH_LEAF) >> MESH_LEAF_SHIFT) + 1;
-	const mesh_ray *r = &s->r[i];
+	mesh_ray *r = &s->r[i];
+	if (!(s->ready >> i & 1u)) {
+		/* the triangle test's set-up and tmin, as the single walk makes
+		 * them at its first leaf */
+		r->o[0] = s->ox[i];
+		r->o[1] = s->oy[i];
+		r->o[2] = s->oz[i];
+		r->d[0] = s->dx[i];
+		r->d[1] = s->dy[i];
+		r->d[2] = s->dz[i];
+		r->inv[0] = s->ix[i];
+		r->inv[1] = s->iy[i];
+		r->inv[2] = s->iz[i];
+		ray_leaf_setup(r);
+		ray4_make(r, &s->rq[i]);
+		float tm = s->tmin0;
+		if (s->eps > 0.0f) {
+			float g = s->eps / sqrtf(r->d[0] * r->d[0] + r->d[1] * r->d[1] + r->d[2] * r->d[2]);
+			tm = tm > g ? tm : g;
+		}
+		s->tmin[i] = tm;
+		s->ready |= 1u << i;
+	}
 	float old = s->best[i];
 	for (uint32_t k = 0; k < nb; k++) {
 		float bt = next_upf(s->best[i]), bb[3];
@@ -670,80 +708,100 @@ static AVX2 inline float pk_far(const mesh_packet *s)
 	return _mm_cvtss_f32(b);
 }
 
+/* The lowest and highest of eight floats (no NaN among them). */
+static AVX2 inline float pk_hmin(__m256 a)
+{
+	__m128 b = _mm_min_ps(_mm256_castps256_ps128(a), _mm256_extractf128_ps(a, 1));
+	b = _mm_min_ps(b, _mm_movehl_ps(b, b));
+	return _mm_cvtss_f32(_mm_min_ss(b, _mm_shuffle_ps(b, b, 1)));
+}
+
+static AVX2 inline float pk_hmax(__m256 a)
+{
+	__m128 b = _mm_max_ps(_mm256_castps256_ps128(a), _mm256_extractf128_ps(a, 1));
+	b = _mm_max_ps(b, _mm_movehl_ps(b, b));
+	return _mm_cvtss_f32(_mm_max_ss(b, _mm_shuffle_ps(b, b, 1)));
+}
+
 static AVX2 __attribute__((noinline)) bool packet_walk(const mesh *m, const double (*M)[4], int n, const ray *wr,
                                                        double tmin, const double *tmax, double *t, uint32_t *slot,
                                                        float (*b)[3], unsigned *found, unsigned *tie)
 {
 	_Alignas(32) mesh_packet s;
 	float box_tmin = (float)tmin;
+	/* the rays in the model's floats by component (world_ray_floats, as
+	 * the single walk makes them), the lanes past n ray 0 again */
 	for (int i = 0; i < n; i++) {
-		mesh_ray *r = &s.r[i];
-		world_ray_setup(M, &wr[i], r);
-		ray_leaf_setup(r);
-		ray4_make(r, &s.rq[i]);
-		/* the triangles' tmin, as the single walk raises it at its first leaf */
-		float tm = box_tmin;
-		if (m->eps > 0.0f) {
-			float g = m->eps / sqrtf(r->d[0] * r->d[0] + r->d[1] * r->d[1] + r->d[2] * r->d[2]);
-			tm = tm > g ? tm : g;
-		}
-		s.tmin[i] = tm;
+		float o[3], d[3];
+		world_ray_floats(M, &wr[i], o, d);
+		s.ox[i] = o[0];
+		s.oy[i] = o[1];
+		s.oz[i] = o[2];
+		s.dx[i] = d[0];
+		s.dy[i] = d[1];
+		s.dz[i] = d[2];
 		s.best[i] = tmax[i] < 3e38 ? (float)tmax[i] : INFINITY;
 		s.bs[i] = next_upf(s.best[i]) * BVH_SLAB_SLACK;
 	}
-	/* the signs each axis shares, and the rays by component */
-	unsigned neg_and = 7, neg_or = 0;
-	bool finite = true;
-	for (int i = 0; i < MESH_PACKET_MAX; i++) {
-		const mesh_ray *r = &s.r[i < n ? i : 0];
-		s.ox[i] = r->o[0];
-		s.oy[i] = r->o[1];
-		s.oz[i] = r->o[2];
-		s.ix[i] = r->inv[0];
-		s.iy[i] = r->inv[1];
-		s.iz[i] = r->inv[2];
-		s.fx[i] = r->inv[0] * BVH_SLAB_SLACK;
-		s.fy[i] = r->inv[1] * BVH_SLAB_SLACK;
-		s.fz[i] = r->inv[2] * BVH_SLAB_SLACK;
-		if (i >= n)
-			s.bs[i] = -INFINITY; /* never enters a leaf, never raises pk_far */
-		unsigned neg = (unsigned)(signbit(r->inv[0]) != 0) | (unsigned)(signbit(r->inv[1]) != 0) << 1 |
-			       (unsigned)(signbit(r->inv[2]) != 0) << 2;
-		neg_and &= neg;
-		neg_or |= neg;
-		/* the interval bounds need finite origins and finite, non-zero
-		 * inverses (NaN fails too) */
-		for (int a = 0; a < 3; a++)
-			finite &= fabsf(r->o[a]) <= FLT_MAX && fabsf(r->inv[a]) <= FLT_MAX && r->inv[a] != 0.0f &&
-				  fabsf(r->inv[a] * BVH_SLAB_SLACK) <= FLT_MAX;
+	for (int i = n; i < MESH_PACKET_MAX; i++) {
+		s.ox[i] = s.ox[0];
+		s.oy[i] = s.oy[0];
+		s.oz[i] = s.oz[0];
+		s.dx[i] = s.dx[0];
+		s.dy[i] = s.dy[0];
+		s.dz[i] = s.dz[0];
+		s.bs[i] = -INFINITY; /* never enters a leaf, never raises pk_far */
 	}
-	if (neg_and != neg_or || !finite)
-		return false;
-	/* the intervals: per axis the origin to subtract from the near planes
-	 * (the farthest along the direction) and from the far ones (the
-	 * farthest back), the inverses' and the far inverses' range */
+	/* the inverses (1 / d, correctly rounded as ray_node_setup's), the far
+	 * ones inv S; the signs each axis shares; per axis the origin to
+	 * subtract from the near planes (the farthest along the direction) and
+	 * from the far ones (the farthest back), the inverses' and the far
+	 * inverses' ranges. The bounds need finite origins and finite, non-zero
+	 * inverses (a NaN fails too). */
+	const __m256 one = _mm256_set1_ps(1.0f), slack = _mm256_set1_ps(BVH_SLAB_SLACK), big = _mm256_set1_ps(FLT_MAX);
+	const __m256 mag = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff)), zero = _mm256_setzero_ps();
+	float *oa[3] = {s.ox, s.oy, s.oz}, *da[3] = {s.dx, s.dy, s.dz}, *ia[3] = {s.ix, s.iy, s.iz},
+	      *fa[3] = {s.fx, s.fy, s.fz};
 	__m256 on[3], of[3], ilo[3], ihi[3], flo[3], fhi[3];
-	const float *oa[3] = {s.ox, s.oy, s.oz}, *ia[3] = {s.ix, s.iy, s.iz}, *fa[3] = {s.fx, s.fy, s.fz};
 	size_t rn[3];
+	__m256 bad = zero;
 	for (int a = 0; a < 3; a++) {
-		float olo = oa[a][0], ohi = olo, il = ia[a][0], ih = il, fl = fa[a][0], fh = fl;
-		for (int i = 1; i < n; i++) {
-			olo = oa[a][i] < olo ? oa[a][i] : olo;
-			ohi = oa[a][i] > ohi ? oa[a][i] : ohi;
-			il = ia[a][i] < il ? ia[a][i] : il;
-			ih = ia[a][i] > ih ? ia[a][i] : ih;
-			fl = fa[a][i] < fl ? fa[a][i] : fl;
-			fh = fa[a][i] > fh ? fa[a][i] : fh;
+		__m256 olo = _mm256_load_ps(oa[a]), ohi = olo, il = _mm256_set1_ps(INFINITY), ih = _mm256_set1_ps(-INFINITY);
+		__m256 fl = il, fh = ih;
+		unsigned negs = 0;
+		for (int h = 0; h < MESH_PACKET_MAX; h += 8) {
+			__m256 o = _mm256_load_ps(oa[a] + h), inv = _mm256_div_ps(one, _mm256_load_ps(da[a] + h));
+			__m256 f = _mm256_mul_ps(inv, slack);
+			_mm256_store_ps(ia[a] + h, inv);
+			_mm256_store_ps(fa[a] + h, f);
+			bad = _mm256_or_ps(bad, _mm256_cmp_ps(_mm256_and_ps(o, mag), big, _CMP_NLE_UQ));
+			bad = _mm256_or_ps(bad, _mm256_cmp_ps(_mm256_and_ps(inv, mag), big, _CMP_NLE_UQ));
+			bad = _mm256_or_ps(bad, _mm256_cmp_ps(_mm256_and_ps(f, mag), big, _CMP_NLE_UQ));
+			bad = _mm256_or_ps(bad, _mm256_cmp_ps(inv, zero, _CMP_EQ_OQ));
+			negs |= (unsigned)_mm256_movemask_ps(inv) << h;
+			olo = _mm256_min_ps(olo, o);
+			ohi = _mm256_max_ps(ohi, o);
+			il = _mm256_min_ps(il, inv);
+			ih = _mm256_max_ps(ih, inv);
+			fl = _mm256_min_ps(fl, f);
+			fh = _mm256_max_ps(fh, f);
 		}
-		bool neg = neg_and >> a & 1u;
-		on[a] = _mm256_set1_ps(neg ? olo : ohi);
-		of[a] = _mm256_set1_ps(neg ? ohi : olo);
-		ilo[a] = _mm256_set1_ps(il);
-		ihi[a] = _mm256_set1_ps(ih);
-		flo[a] = _mm256_set1_ps(fl);
-		fhi[a] = _mm256_set1_ps(fh);
+		if (negs != 0 && negs != 0xffffu)
+			return false;
+		bool neg = negs != 0;
+		on[a] = _mm256_set1_ps(neg ? pk_hmin(olo) : pk_hmax(ohi));
+		of[a] = _mm256_set1_ps(neg ? pk_hmax(ohi) : pk_hmin(olo));
+		ilo[a] = _mm256_set1_ps(pk_hmin(il));
+		ihi[a] = _mm256_set1_ps(pk_hmax(ih));
+		flo[a] = _mm256_set1_ps(pk_hmin(fl));
+		fhi[a] = _mm256_set1_ps(pk_hmax(fh));
 		rn[a] = (size_t)(MESH_LO(a) + neg) * MESH_ROW;
 	}
+	if (_mm256_movemask_ps(bad))
+		return false;
+	s.ready = 0;
+	s.tmin0 = box_tmin;
+	s.eps = m->eps;
 	const size_t rn0 = rn[0], rn1 = rn[1], rn2 = rn[2];
 	s.found = s.tie = 0;
 	const __m256 t0_8 = _mm256_set1_ps(box_tmin);
