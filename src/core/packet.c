@@ -367,31 +367,34 @@ static bool model_packet(const world *w, int n, const ray *r, double tmin, doubl
 	uint32_t slot[PACKET_MAX];
 	float b[PACKET_MAX][3];
 	for (int i = 0; i < n; i++) {
-		double tp;
 		tm[i] = tmax;
 		best_plane[i] = NULL;
-		for (size_t k = 0; k < w->nplanes; k++)
+	}
+	for (size_t k = 0; k < w->nplanes; k++)
+		for (int i = 0; i < n; i++) {
+			double tp;
 			if (plane_hit(&w->planes[k], &r[i], tmin, tm[i], &tp)) {
 				tm[i] = tp;
 				best_plane[i] = &w->planes[k];
 			}
-	}
+		}
 	unsigned got, tie;
 	if (!mesh_intersect_world_packet(in->mesh, in->inv, n, r, tmin, tm, t, slot, b, &got, &tie))
 		return false;
 	world_rays_count(n);
 	for (int i = 0; i < n; i++) {
-		if (tie >> i & 1u) {
-			world_rays_count(-1);
-			found[i] = world_trace_coherent(w, &r[i], tmin, tmax, &th[i]);
-			continue;
+		if (got >> i & 1u) {
+			th[i] = (trace_hit){t[i], p, NULL, {(double)slot[i], b[i][1], b[i][2]}};
+			found[i] = true;
+		} else {
+			th[i] = (trace_hit){tm[i], NULL, best_plane[i], {0, 0, 0}};
+			found[i] = best_plane[i] != NULL;
 		}
-		bool on = got >> i & 1u;
-		th[i].t = on ? t[i] : tm[i];
-		th[i].prim = on ? p : NULL;
-		th[i].plane = on ? NULL : best_plane[i];
-		th[i].nl = on ? v3((double)slot[i], b[i][1], b[i][2]) : (vec3){0, 0, 0};
-		found[i] = on || best_plane[i];
+	}
+	for (; tie; tie &= tie - 1) {
+		int i = __builtin_ctz(tie);
+		world_rays_count(-1);
+		found[i] = world_trace_coherent(w, &r[i], tmin, tmax, &th[i]);
 	}
 	return true;
 }

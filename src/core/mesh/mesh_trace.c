@@ -34,6 +34,7 @@
  * instruction more).
  */
 #include <float.h>
+#include <stddef.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -458,11 +459,16 @@ _Thread_local unsigned long mesh_stat_nodes, mesh_stat_blocks, mesh_stat_leaves;
  * scales and moves only) skips M's zeros, 24 of its 33 operations: the same
  * floats but for the sign of a zero coordinate, on every unit (camera rays
  * +7%, diffuse +2%: bench/README.md). */
-static inline __attribute__((always_inline)) void world_ray_floats(const double (*M)[4], const ray *wr, float o[3],
-                                                                   float d[3])
+static inline __attribute__((always_inline)) bool upright(const double (*M)[4])
+{
+	return M[0][1] == 0 && M[0][2] == 0 && M[1][0] == 0 && M[1][2] == 0 && M[2][0] == 0 && M[2][1] == 0;
+}
+
+static inline __attribute__((always_inline)) void world_ray_floats(const double (*M)[4], bool up, const ray *wr,
+                                                                   float o[3], float d[3])
 {
 	double px = wr->o.x, py = wr->o.y, pz = wr->o.z, vx = wr->d.x, vy = wr->d.y, vz = wr->d.z;
-	if (M[0][1] == 0 && M[0][2] == 0 && M[1][0] == 0 && M[1][2] == 0 && M[2][0] == 0 && M[2][1] == 0) {
+	if (up) {
 		o[0] = (float)(M[0][0] * px + M[0][3]);
 		o[1] = (float)(M[1][1] * py + M[1][3]);
 		o[2] = (float)(M[2][2] * pz + M[2][3]);
@@ -482,7 +488,7 @@ static inline __attribute__((always_inline)) void world_ray_floats(const double 
 static inline __attribute__((always_inline)) void world_ray_setup(const double (*M)[4], const ray *wr, mesh_ray *r)
 {
 	float o[3], d[3];
-	world_ray_floats(M, wr, o, d);
+	world_ray_floats(M, upright(M), wr, o, d);
 	ray_node_setup(r, o[0], o[1], o[2], d[0], d[1], d[2]);
 }
 
@@ -729,11 +735,69 @@ static AVX2 __attribute__((noinline)) bool packet_walk(const mesh *m, const doub
 {
 	_Alignas(32) mesh_packet s;
 	float box_tmin = (float)tmin;
-	/* the rays in the model's floats by component (world_ray_floats, as
-	 * the single walk makes them), the lanes past n ray 0 again */
-	for (int i = 0; i < n; i++) {
+	/* the rays in the model's floats by component, as the single walk
+	 * makes them (world_ray_floats: its operations in its order, four rays
+	 * at a time), the lanes past n ray 0 again */
+	const bool up = upright(M);
+	int i = 0;
+	{
+		_Static_assert(sizeof(ray) == 6 * sizeof(double) && offsetof(ray, d) == 3 * sizeof(double),
+			       "ray: six doubles o, d");
+		const __m128i idx = _mm_setr_epi32(0, 6, 12, 18);
+		const __m256d m00 = _mm256_set1_pd(M[0][0]), m01 = _mm256_set1_pd(M[0][1]), m02 = _mm256_set1_pd(M[0][2]),
+			      m03 = _mm256_set1_pd(M[0][3]);
+		const __m256d m10 = _mm256_set1_pd(M[1][0]), m11 = _mm256_set1_pd(M[1][1]), m12 = _mm256_set1_pd(M[1][2]),
+			      m13 = _mm256_set1_pd(M[1][3]);
+		const __m256d m20 = _mm256_set1_pd(M[2][0]), m21 = _mm256_set1_pd(M[2][1]), m22 = _mm256_set1_pd(M[2][2]),
+			      m23 = _mm256_set1_pd(M[2][3]);
+		const __m256d huge = _mm256_set1_pd(3e38);
+		const __m256i pick = _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6);
+		for (; i + 4 <= n; i += 4) {
+			const double *base = &wr[i].o.x;
+			__m256d px = _mm256_i32gather_pd(base, idx, 8), py = _mm256_i32gather_pd(base + 1, idx, 8);
+			__m256d pz = _mm256_i32gather_pd(base + 2, idx, 8), vx = _mm256_i32gather_pd(base + 3, idx, 8);
+			__m256d vy = _mm256_i32gather_pd(base + 4, idx, 8), vz = _mm256_i32gather_pd(base + 5, idx, 8);
+			__m256d a, bq, c, e, f, g;
+			if (up) {
+				a = _mm256_add_pd(_mm256_mul_pd(m00, px), m03);
+				bq = _mm256_add_pd(_mm256_mul_pd(m11, py), m13);
+				c = _mm256_add_pd(_mm256_mul_pd(m22, pz), m23);
+				e = _mm256_mul_pd(m00, vx);
+				f = _mm256_mul_pd(m11, vy);
+				g = _mm256_mul_pd(m22, vz);
+			} else {
+				a = _mm256_add_pd(_mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(m00, px), _mm256_mul_pd(m01, py)),
+								_mm256_mul_pd(m02, pz)),
+						  m03);
+				bq = _mm256_add_pd(_mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(m10, px), _mm256_mul_pd(m11, py)),
+								 _mm256_mul_pd(m12, pz)),
+						   m13);
+				c = _mm256_add_pd(_mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(m20, px), _mm256_mul_pd(m21, py)),
+								_mm256_mul_pd(m22, pz)),
+						  m23);
+				e = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(m00, vx), _mm256_mul_pd(m01, vy)),
+						  _mm256_mul_pd(m02, vz));
+				f = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(m10, vx), _mm256_mul_pd(m11, vy)),
+						  _mm256_mul_pd(m12, vz));
+				g = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(m20, vx), _mm256_mul_pd(m21, vy)),
+						  _mm256_mul_pd(m22, vz));
+			}
+			_mm_store_ps(&s.ox[i], _mm256_cvtpd_ps(a));
+			_mm_store_ps(&s.oy[i], _mm256_cvtpd_ps(bq));
+			_mm_store_ps(&s.oz[i], _mm256_cvtpd_ps(c));
+			_mm_store_ps(&s.dx[i], _mm256_cvtpd_ps(e));
+			_mm_store_ps(&s.dy[i], _mm256_cvtpd_ps(f));
+			_mm_store_ps(&s.dz[i], _mm256_cvtpd_ps(g));
+			/* best: tmax < 3e38 ? (float)tmax : inf */
+			__m256d tm = _mm256_loadu_pd(&tmax[i]);
+			__m128 lt = _mm256_castps256_ps128(
+				_mm256_permutevar8x32_ps(_mm256_castpd_ps(_mm256_cmp_pd(tm, huge, _CMP_LT_OQ)), pick));
+			_mm_storeu_ps(&s.best[i], _mm_blendv_ps(_mm_set1_ps(INFINITY), _mm256_cvtpd_ps(tm), lt));
+		}
+	}
+	for (; i < n; i++) {
 		float o[3], d[3];
-		world_ray_floats(M, &wr[i], o, d);
+		world_ray_floats(M, up, &wr[i], o, d);
 		s.ox[i] = o[0];
 		s.oy[i] = o[1];
 		s.oz[i] = o[2];
@@ -741,9 +805,10 @@ static AVX2 __attribute__((noinline)) bool packet_walk(const mesh *m, const doub
 		s.dy[i] = d[1];
 		s.dz[i] = d[2];
 		s.best[i] = tmax[i] < 3e38 ? (float)tmax[i] : INFINITY;
-		s.bs[i] = next_upf(s.best[i]) * BVH_SLAB_SLACK;
 	}
-	for (int i = n; i < MESH_PACKET_MAX; i++) {
+	for (i = 0; i < n; i++)
+		s.bs[i] = next_upf(s.best[i]) * BVH_SLAB_SLACK;
+	for (i = n; i < MESH_PACKET_MAX; i++) {
 		s.ox[i] = s.ox[0];
 		s.oy[i] = s.oy[0];
 		s.oz[i] = s.oz[0];
@@ -857,14 +922,15 @@ static AVX2 __attribute__((noinline)) bool packet_walk(const mesh *m, const doub
 		}
 	}
 done:
-	for (int i = 0; i < n; i++) {
-		t[i] = s.best[i];
-		slot[i] = s.slot[i];
-		b[i][0] = s.b[i][0];
-		b[i][1] = s.b[i][1];
-		b[i][2] = s.b[i][2];
-		if ((s.found >> i & 1u) && !((double)s.best[i] < tmax[i]))
-			s.found &= ~(1u << i);
+	for (unsigned f = s.found; f; f &= f - 1) {
+		int j = __builtin_ctz(f);
+		t[j] = s.best[j];
+		slot[j] = s.slot[j];
+		b[j][0] = s.b[j][0];
+		b[j][1] = s.b[j][1];
+		b[j][2] = s.b[j][2];
+		if (!((double)s.best[j] < tmax[j]))
+			s.found &= ~(1u << j);
 	}
 	*found = s.found;
 	*tie = s.tie & s.found;
