@@ -373,6 +373,47 @@ static void test_srgb8_codes(void **state)
 	}
 }
 
+/* object_validate passes the common objects (no shear, direction and sizes
+ * within 1e-50..1e50) without building their transform: each one it passes
+ * must have a transform object_xform can make. Random kinds, directions
+ * (some within 1e-7..1e-20 of straight down, where the rotation is the
+ * least exact), twists, positions, and lengths and sizes from 1e-120 to
+ * 1e120 (beyond the bounds, where the transform can fail: those the
+ * shortcut must leave to the full check). */
+static void test_validate_without_transform(void **state)
+{
+	(void)state;
+	test_rng r = {11};
+	int passed = 0, shortcut_range = 0;
+	for (int k = 0; k < 200000; k++) {
+		obj_kind kind = (obj_kind)(k % OBJ_KIND_COUNT);
+		if (obj_kind_flags(kind) & (KIND_VERTICES | KIND_MODEL))
+			continue;
+		object o = object_make(kind, v3(1, 1, 1));
+		vec3 d = k % 5 == 0 ? v3(pow(10.0, trange(&r, -20, -7)) * trange(&r, -1, 1), -1,
+		                         pow(10.0, trange(&r, -20, -7)) * trange(&r, -1, 1))
+		                    : tdir(&r);
+		double wide = k % 2 ? 120 : 55;
+		o.dir = v3_scale(d, pow(10.0, trange(&r, -wide, wide)));
+		o.scale = v3(pow(10.0, trange(&r, -wide, wide)), pow(10.0, trange(&r, -wide, wide)),
+		             pow(10.0, trange(&r, -wide, wide)));
+		if (k % 3 == 0)
+			o.scale = v3(o.scale.x, o.scale.x, o.scale.x);
+		o.twist = k % 4 ? trange(&r, -1e6, 1e6) : 0;
+		o.pos = v3(trange(&r, -1e300, 1e300), trange(&r, -1, 1), pow(10.0, trange(&r, -300, 300)));
+		xform x;
+		if (object_validate(&o, NULL)) {
+			passed++;
+			if (!object_xform(&o, &x))
+				fail_msg("kind %d dir %g,%g,%g scale %g,%g,%g twist %g: validated, but no transform", kind,
+				         o.dir.x, o.dir.y, o.dir.z, o.scale.x, o.scale.y, o.scale.z, o.twist);
+		}
+		double len = v3_len(o.dir);
+		shortcut_range += len >= 1e-50 && len <= 1e50;
+	}
+	assert_true(passed > 50000 && shortcut_range > 50000);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -386,6 +427,7 @@ int main(void)
 		cmocka_unit_test(test_object_rotate),
 		cmocka_unit_test(test_object_xform_sizes),
 		cmocka_unit_test(test_srgb8_codes),
+		cmocka_unit_test(test_validate_without_transform),
 	};
 	return cmocka_run_group_tests_name("math", tests, NULL, NULL);
 }
