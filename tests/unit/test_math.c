@@ -414,12 +414,59 @@ static void test_validate_without_transform(void **state)
 	assert_true(passed > 50000 && shortcut_range > 50000);
 }
 
+/* The short decimals num_scan reads in one pass (at most 15 digits, no
+ * exponent) and those just beyond (16 digits, leading zeros counted):
+ * every length from 1 to 17 digits with the point at every place, signs,
+ * leading zeros, against strtod, bit for bit (-0 included). */
+static void test_scan_short_decimals(void **state)
+{
+	(void)state;
+	uint64_t r = 99;
+	for (int n = 1; n <= 17; n++)
+		for (int point = 0; point <= n; point++)
+			for (int k = 0; k < 40; k++) {
+				char t[40];
+				size_t len = 0;
+				if (k % 3)
+					t[len++] = k % 3 == 1 ? '-' : '+';
+				for (int i = 0; i < n; i++) {
+					if (i == point && point > 0)
+						t[len++] = '.';
+					r = r * 6364136223846793005ull + 1442695040888963407ull;
+					int digit = (int)((r >> 59) % 10);
+					if (k % 4 == 0 && i < n / 2)
+						digit = 0; /* leading zeros */
+					if (k == 39)
+						digit = 0; /* all zeros: 0 or -0 */
+					t[len++] = (char)('0' + digit);
+				}
+				if (point == n && k % 2)
+					t[len++] = '.'; /* "12." */
+				if (point == 0 && k % 5 == 1) {
+					memmove(t + (k % 3 ? 2 : 1), t + (k % 3 ? 1 : 0), len - (k % 3 ? 1 : 0));
+					t[k % 3 ? 1 : 0] = '.'; /* ".5", "-.5" */
+					len++;
+				}
+				t[len] = '\0';
+				double v, want = strtod(t, NULL);
+				assert_int_equal(num_scan_str(t, 1e300, &v), NUM_OK);
+				if (memcmp(&v, &want, sizeof v) != 0)
+					fail_msg("%s: num_scan %.17g, strtod %.17g", t, v, want);
+			}
+	double v;
+	const char *bad[] = {"-", "+", ".", "-.", "1.2.3", "1-", "--1", "1 ", "0x1"};
+	for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++)
+		assert_int_equal(num_scan_str(bad[i], 1e300, &v), NUM_BAD);
+	assert_int_equal(num_scan_str("123456789012345", 1e14, &v), NUM_BIG);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_inverse_product_is_identity),
 		cmocka_unit_test(test_add_decimal),
 		cmocka_unit_test(test_scan_matches_strtod),
+		cmocka_unit_test(test_scan_short_decimals),
 		cmocka_unit_test(test_singular_matrices_are_refused),
 		cmocka_unit_test(test_points_vectors_normals),
 		cmocka_unit_test(test_transform_composition),
