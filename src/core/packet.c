@@ -363,23 +363,24 @@ static bool model_packet(const world *w, int n, const ray *r, double tmin, doubl
 	const prim *p = &w->prims[0];
 	const prim_inst *in = &w->insts[p->u.index];
 	double tm[PACKET_MAX], t[PACKET_MAX];
-	const prim_plane *best_plane[PACKET_MAX];
+	const prim_plane *best_plane[PACKET_MAX] = {NULL};
 	uint32_t slot[PACKET_MAX];
 	float b[PACKET_MAX][3];
-	for (int i = 0; i < n; i++) {
-		tm[i] = tmax;
-		best_plane[i] = NULL;
-	}
-	for (size_t k = 0; k < w->nplanes; k++)
-		for (int i = 0; i < n; i++) {
-			double tp;
-			if (plane_hit(&w->planes[k], &r[i], tmin, tm[i], &tp)) {
-				tm[i] = tp;
-				best_plane[i] = &w->planes[k];
+	if (w->nplanes) {
+		for (int i = 0; i < n; i++)
+			tm[i] = tmax;
+		for (size_t k = 0; k < w->nplanes; k++)
+			for (int i = 0; i < n; i++) {
+				double tp;
+				if (plane_hit(&w->planes[k], &r[i], tmin, tm[i], &tp)) {
+					tm[i] = tp;
+					best_plane[i] = &w->planes[k];
+				}
 			}
-		}
+	}
 	unsigned got, tie;
-	if (!mesh_intersect_world_packet(in->mesh, in->inv, n, r, tmin, tm, t, slot, b, &got, &tie))
+	if (!mesh_intersect_world_packet(in->mesh, in->inv, n, r, tmin, tmax, w->nplanes ? tm : NULL, t, slot, b, &got,
+	                                 &tie))
 		return false;
 	world_rays_count(n);
 	for (int i = 0; i < n; i++) {
@@ -387,7 +388,7 @@ static bool model_packet(const world *w, int n, const ray *r, double tmin, doubl
 			th[i] = (trace_hit){t[i], p, NULL, {(double)slot[i], b[i][1], b[i][2]}};
 			found[i] = true;
 		} else {
-			th[i] = (trace_hit){tm[i], NULL, best_plane[i], {0, 0, 0}};
+			th[i] = (trace_hit){w->nplanes ? tm[i] : tmax, NULL, best_plane[i], {0, 0, 0}};
 			found[i] = best_plane[i] != NULL;
 		}
 	}

@@ -331,7 +331,7 @@ static long model_traced, model_ties;
 static void check_model(const world *w, const ray *r, int n, int turn)
 {
 	const prim_inst *in = &w->insts[w->prims[0].u.index];
-	double ts[PACKET_MAX], tm[PACKET_MAX], t[PACKET_MAX];
+	double ts[PACKET_MAX], tm[PACKET_MAX] = {0}, t[PACKET_MAX];
 	uint32_t ss[PACKET_MAX], slot[PACKET_MAX];
 	float bs[PACKET_MAX][3], b[PACKET_MAX][3];
 	bool fs[PACKET_MAX];
@@ -343,7 +343,12 @@ static void check_model(const world *w, const ray *r, int n, int turn)
 			fs[i] = mesh_intersect_world_coherent(in->mesh, in->inv, &r[i], 0.0, tm[i], &ts[i], &ss[i], bs[i]);
 	}
 	unsigned got, tie;
-	if (!mesh_intersect_world_packet(in->mesh, in->inv, n, r, 0.0, tm, t, slot, b, &got, &tie))
+	/* each its own tmax, or (every other turn, when they are all
+	 * the same) one for all */
+	bool one = turn % 2 == 0;
+	for (int i = 1; i < n && one; i++)
+		one = tm[i] == tm[0];
+	if (!mesh_intersect_world_packet(in->mesh, in->inv, n, r, 0.0, tm[0], one ? NULL : tm, t, slot, b, &got, &tie))
 		return;
 	model_traced++;
 	for (int i = 0; i < n; i++) {

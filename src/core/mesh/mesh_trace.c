@@ -902,8 +902,8 @@ static AVX2 inline float pk_hmax(__m256 a)
 }
 
 static AVX2 __attribute__((noinline)) bool packet_walk(const mesh *m, const double (*M)[4], int n, const ray *wr,
-                                                       double tmin, const double *tmax, double *t, uint32_t *slot,
-                                                       float (*b)[3], unsigned *found, unsigned *tie)
+                                                       double tmin, double tmax1, const double *tmax, double *t,
+                                                       uint32_t *slot, float (*b)[3], unsigned *found, unsigned *tie)
 {
 	_Alignas(32) mesh_packet s;
 	float box_tmin = (float)tmin;
@@ -960,11 +960,13 @@ static AVX2 __attribute__((noinline)) bool packet_walk(const mesh *m, const doub
 			_mm_store_ps(&s.dx[i], _mm256_cvtpd_ps(e));
 			_mm_store_ps(&s.dy[i], _mm256_cvtpd_ps(f));
 			_mm_store_ps(&s.dz[i], _mm256_cvtpd_ps(g));
-			/* best: tmax < 3e38 ? (float)tmax : inf */
-			__m256d tm = _mm256_loadu_pd(&tmax[i]);
-			__m128 lt = _mm256_castps256_ps128(
-				_mm256_permutevar8x32_ps(_mm256_castpd_ps(_mm256_cmp_pd(tm, huge, _CMP_LT_OQ)), pick));
-			_mm_storeu_ps(&s.best[i], _mm_blendv_ps(_mm_set1_ps(INFINITY), _mm256_cvtpd_ps(tm), lt));
+			if (tmax) {
+				/* best: tmax < 3e38 ? (float)tmax : inf */
+				__m256d tm = _mm256_loadu_pd(&tmax[i]);
+				__m128 lt = _mm256_castps256_ps128(_mm256_permutevar8x32_ps(
+					_mm256_castpd_ps(_mm256_cmp_pd(tm, huge, _CMP_LT_OQ)), pick));
+				_mm_storeu_ps(&s.best[i], _mm_blendv_ps(_mm_set1_ps(INFINITY), _mm256_cvtpd_ps(tm), lt));
+			}
 		}
 	}
 	for (; i < n; i++) {
@@ -976,11 +978,23 @@ static AVX2 __attribute__((noinline)) bool packet_walk(const mesh *m, const doub
 		s.dx[i] = d[0];
 		s.dy[i] = d[1];
 		s.dz[i] = d[2];
-		s.best[i] = tmax[i] < 3e38 ? (float)tmax[i] : INFINITY;
+		if (tmax)
+			s.best[i] = tmax[i] < 3e38 ? (float)tmax[i] : INFINITY;
 	}
-	for (i = 0; i < n; i++) {
-		s.bt[i] = next_upf(s.best[i]);
-		s.bs[i] = s.bt[i] * BVH_SLAB_SLACK;
+	if (tmax) {
+		for (i = 0; i < n; i++) {
+			s.bt[i] = next_upf(s.best[i]);
+			s.bs[i] = s.bt[i] * BVH_SLAB_SLACK;
+		}
+	} else {
+		/* one tmax for all */
+		float b1 = tmax1 < 3e38 ? (float)tmax1 : INFINITY, t1 = next_upf(b1);
+		const __m256 vb = _mm256_set1_ps(b1), vt = _mm256_set1_ps(t1), vs = _mm256_set1_ps(t1 * BVH_SLAB_SLACK);
+		for (i = 0; i < MESH_PACKET_MAX; i += 8) {
+			_mm256_store_ps(&s.best[i], vb);
+			_mm256_store_ps(&s.bt[i], vt);
+			_mm256_store_ps(&s.bs[i], vs);
+		}
 	}
 	for (i = n; i < MESH_PACKET_MAX; i++) {
 		s.ox[i] = s.ox[0];
@@ -1104,7 +1118,7 @@ done:
 		b[j][0] = s.b[j][0];
 		b[j][1] = s.b[j][1];
 		b[j][2] = s.b[j][2];
-		if (!((double)s.best[j] < tmax[j]))
+		if (!((double)s.best[j] < (tmax ? tmax[j] : tmax1)))
 			s.found &= ~(1u << j);
 	}
 	*found = s.found;
@@ -1237,14 +1251,15 @@ bool mesh_intersect_brute(const mesh *m, const mesh_ray *r, float tmin, float *t
 }
 
 bool mesh_intersect_world_packet(const mesh *m, const double (*inv)[4], int n, const ray *r, double tmin,
-                                 const double *tmax, double *t, uint32_t *slot, float (*b)[3], unsigned *found,
-                                 unsigned *tie)
+                                 double tmax, const double *tmax_each, double *t, uint32_t *slot, float (*b)[3],
+                                 unsigned *found, unsigned *tie)
 {
 #if defined(HAVE_AVX2_WALK)
 	if (n >= 1 && n <= MESH_PACKET_MAX && mesh_isa_active() >= MESH_ISA_AVX2)
-		return packet_walk(m, inv, n, r, tmin, tmax, t, slot, b, found, tie);
+		return packet_walk(m, inv, n, r, tmin, tmax, tmax_each, t, slot, b, found, tie);
 #else
-	(void)m, (void)inv, (void)n, (void)r, (void)tmin, (void)tmax, (void)t, (void)slot, (void)b, (void)found, (void)tie;
+	(void)m, (void)inv, (void)n, (void)r, (void)tmin, (void)tmax, (void)tmax_each, (void)t, (void)slot, (void)b,
+		(void)found, (void)tie;
 #endif
 	return false;
 }
