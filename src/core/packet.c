@@ -383,14 +383,19 @@ static bool model_packet(const world *w, int n, const ray *r, double tmin, doubl
 	                                 &tie))
 		return false;
 	world_rays_count(n);
-	for (int i = 0; i < n; i++) {
-		if (got >> i & 1u) {
-			th[i] = (trace_hit){t[i], p, NULL, {(double)slot[i], b[i][1], b[i][2]}};
-			found[i] = true;
-		} else {
-			th[i] = (trace_hit){w->nplanes ? tm[i] : tmax, NULL, best_plane[i], {0, 0, 0}};
+	if (w->nplanes) {
+		for (int i = 0; i < n; i++) {
 			found[i] = best_plane[i] != NULL;
+			if (found[i] && !(got >> i & 1u))
+				th[i] = (trace_hit){tm[i], NULL, best_plane[i], {0, 0, 0}};
 		}
+	} else {
+		memset(found, 0, (size_t)n * sizeof *found);
+	}
+	for (unsigned g = got; g; g &= g - 1) {
+		int i = __builtin_ctz(g);
+		th[i] = (trace_hit){t[i], p, NULL, {(double)slot[i], b[i][1], b[i][2]}};
+		found[i] = true;
 	}
 	for (; tie; tie &= tie - 1) {
 		int i = __builtin_ctz(tie);
