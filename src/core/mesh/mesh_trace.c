@@ -915,7 +915,6 @@ static AVX2 __attribute__((noinline)) bool packet_walk(const mesh *m, const doub
 	{
 		_Static_assert(sizeof(ray) == 6 * sizeof(double) && offsetof(ray, d) == 3 * sizeof(double),
 			       "ray: six doubles o, d");
-		const __m128i idx = _mm_setr_epi32(0, 6, 12, 18);
 		const __m256d m00 = _mm256_set1_pd(M[0][0]), m01 = _mm256_set1_pd(M[0][1]), m02 = _mm256_set1_pd(M[0][2]),
 			      m03 = _mm256_set1_pd(M[0][3]);
 		const __m256d m10 = _mm256_set1_pd(M[1][0]), m11 = _mm256_set1_pd(M[1][1]), m12 = _mm256_set1_pd(M[1][2]),
@@ -925,10 +924,23 @@ static AVX2 __attribute__((noinline)) bool packet_walk(const mesh *m, const doub
 		const __m256d huge = _mm256_set1_pd(3e38);
 		const __m256i pick = _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6);
 		for (; i + 4 <= n; i += 4) {
-			const double *base = &wr[i].o.x;
-			__m256d px = _mm256_i32gather_pd(base, idx, 8), py = _mm256_i32gather_pd(base + 1, idx, 8);
-			__m256d pz = _mm256_i32gather_pd(base + 2, idx, 8), vx = _mm256_i32gather_pd(base + 3, idx, 8);
-			__m256d vy = _mm256_i32gather_pd(base + 4, idx, 8), vz = _mm256_i32gather_pd(base + 5, idx, 8);
+			/* the four rays' 24 doubles turned into six registers of
+			 * one component each (loads and shuffles: gathers are slow) */
+			const ray *q4 = &wr[i];
+			__m256d a0 = _mm256_loadu_pd(&q4[0].o.x), a1 = _mm256_loadu_pd(&q4[1].o.x);
+			__m256d a2 = _mm256_loadu_pd(&q4[2].o.x), a3 = _mm256_loadu_pd(&q4[3].o.x);
+			/* a_k: o.x o.y o.z d.x of ray k; c_k: d.y d.z of ray k */
+			__m128d c0 = _mm_loadu_pd(&q4[0].d.y), c1 = _mm_loadu_pd(&q4[1].d.y);
+			__m128d c2 = _mm_loadu_pd(&q4[2].d.y), c3 = _mm_loadu_pd(&q4[3].d.y);
+			__m256d t0 = _mm256_unpacklo_pd(a0, a1); /* ox0 ox1 oz0 oz1 */
+			__m256d t1 = _mm256_unpackhi_pd(a0, a1); /* oy0 oy1 dx0 dx1 */
+			__m256d t2 = _mm256_unpacklo_pd(a2, a3); /* ox2 ox3 oz2 oz3 */
+			__m256d t3 = _mm256_unpackhi_pd(a2, a3); /* oy2 oy3 dx2 dx3 */
+			__m256d px = _mm256_permute2f128_pd(t0, t2, 0x20), pz = _mm256_permute2f128_pd(t0, t2, 0x31);
+			__m256d py = _mm256_permute2f128_pd(t1, t3, 0x20), vx = _mm256_permute2f128_pd(t1, t3, 0x31);
+			__m256d c01 = _mm256_set_m128d(c1, c0), c23 = _mm256_set_m128d(c3, c2); /* dy0 dz0 dy1 dz1 */
+			__m256d u0 = _mm256_unpacklo_pd(c01, c23), u1 = _mm256_unpackhi_pd(c01, c23); /* dy0 dy2 dy1 dy3 */
+			__m256d vy = _mm256_permute4x64_pd(u0, 0xd8), vz = _mm256_permute4x64_pd(u1, 0xd8);
 			__m256d a, bq, c, e, f, g;
 			if (up) {
 				a = _mm256_add_pd(_mm256_mul_pd(m00, px), m03);
