@@ -821,6 +821,11 @@ static AVX2 inline void pk_leaf_rays(const mesh *m, mesh_packet *s, unsigned in,
 					hi = _mm256_max_ps(_mm256_max_ps(u, v), w);
 				}
 				__m256 out = _mm256_and_ps(_mm256_cmp_ps(lo, zero, _CMP_LT_OQ), _mm256_cmp_ps(hi, zero, _CMP_GT_OQ));
+				/* no ray of the eight meets it: the next (coherent rays
+				 * mostly agree; a NaN lane goes on, to fail on its
+				 * distance) */
+				if (!_mm256_movemask_ps(_mm256_andnot_ps(out, act)))
+					continue;
 				__m256 det = _mm256_add_ps(_mm256_add_ps(u, v), w);
 				__m256 tt = _mm256_mul_ps(
 					_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(u, az), _mm256_mul_ps(v, bz)), _mm256_mul_ps(w, cz)), sz);
