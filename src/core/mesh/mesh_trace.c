@@ -868,12 +868,15 @@ static AVX2 inline void pk_leaf_all(const mesh *m, mesh_packet *s, unsigned in, 
 {
 	if (!s->ready)
 		pk_ready(s);
+	/* the rays whose axes are the first's, in vector registers (the
+	 * axes were just stored as vectors: a scalar load would wait) */
 	int i0 = __builtin_ctz(in);
-	int32_t ax = s->axes[i0];
-	bool same = !m->cuts && (in & (in - 1)) != 0;
-	for (unsigned rest = in & (in - 1); rest && same; rest &= rest - 1)
-		same = s->axes[__builtin_ctz(rest)] == ax;
-	if (same) {
+	__m256i a0 = _mm256_load_si256((const __m256i *)&s->axes[0]), a1 = _mm256_load_si256((const __m256i *)&s->axes[8]);
+	__m256i first = _mm256_permutevar8x32_epi32(i0 < 8 ? a0 : a1, _mm256_set1_epi32(i0 & 7));
+	unsigned same = (unsigned)_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(a0, first))) |
+			(unsigned)_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(a1, first))) << 8;
+	if (!m->cuts && (in & (in - 1)) && !(in & ~same)) {
+		int ax = _mm256_cvtsi256_si32(first);
 		pk_leaf_rays(m, s, in, ref, ax & 3, ax >> 2 & 3, ax >> 4);
 		return;
 	}
