@@ -493,6 +493,37 @@ static void test_model_ties(void **state)
 	snprintf(text, sizeof text, "C 0,0,-7 0,0,1 70\nL -2,3,-6 0.8 255,255,255\nmesh %s 0,0,1 0,1,0 6 200,200,200\n",
 	         path);
 	check_model_scene(text, 64, 64, 100);
+	/* rays exactly through the grid's corners and edges (the model's
+	 * coordinates are the world's here: placed at its own centre at its
+	 * own size; each ray 8 long in z, so that the shear is exact and the
+	 * edge functions there are zeros, recomputed in double) */
+	snprintf(text, sizeof text, "C 0,0,-7 0,0,1 70\nmesh %s 0,0,1 0,1,0 6 200,200,200\n", path);
+	rt_error err;
+	scene *sc = rt_load_string(text, strlen(text), "ties", NULL, &err);
+	if (!sc)
+		fail_msg("ties: %s", err.msg);
+	world *w = world_build(sc, &err);
+	if (!w)
+		fail_msg("ties: %s", err.msg);
+	for (int isa = MESH_ISA_SCALAR; isa <= MESH_ISA_BEST; isa++) {
+		if (!mesh_isa_force((mesh_isa)isa))
+			continue;
+		for (int q = 0; q < 8; q++) {
+			double sx = q & 1 ? -1 : 1, sy = q & 2 ? -1 : 1;
+			ray r[PACKET_MAX];
+			vec3 o = v3(0.25 * (q >> 2), 0.125 * (q >> 2), -6);
+			for (int i = 0; i < PACKET_MAX; i++) {
+				/* corners and edge midpoints of the grid's outer quads */
+				double tx = sx * (2.25 + 0.375 * (i % 3)), ty = sy * (0.75 + 0.375 * (i / 3));
+				r[i] = (ray){o, v3(tx - o.x, ty - o.y, 8)};
+			}
+			check_packet(w, r, PACKET_MAX, v3(0, 0, -10));
+			check_model(w, r, PACKET_MAX, q);
+		}
+	}
+	assert_true(mesh_isa_force(MESH_ISA_BEST));
+	world_free(w);
+	scene_free(sc);
 	unlink(path);
 	if (have_model_packets()) {
 		assert_true(model_traced - traced > 500);
