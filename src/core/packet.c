@@ -34,6 +34,7 @@
 
 #include "core/bvh/bvh.h"
 #include "core/prim_hit.h"
+#include "rtsh/mesh.h"
 
 /* The state of a packet's walk: the rays by component (for the vector
  * sphere pre-test, padded to an even count) and each ray's best hit. */
@@ -353,10 +354,57 @@ static void packet_walk(const world *w, pk_state *s, const ray *r, const pk_ray 
 	}
 }
 
+/* A lone model (the model viewer's world, trace's own case in world.c): the
+ * planes first for each ray, as there, then the packet through the model's
+ * triangle tree (mesh_intersect_world_packet). False when that packet is
+ * not traced: the caller traces each ray alone. */
+static bool model_packet(const world *w, int n, const ray *r, double tmin, double tmax, trace_hit *th, bool *found)
+{
+	const prim *p = &w->prims[0];
+	const prim_inst *in = &w->insts[p->u.index];
+	double tm[PACKET_MAX], t[PACKET_MAX];
+	const prim_plane *best_plane[PACKET_MAX];
+	uint32_t slot[PACKET_MAX];
+	float b[PACKET_MAX][3];
+	for (int i = 0; i < n; i++) {
+		tm[i] = tmax;
+		best_plane[i] = NULL;
+	}
+	for (size_t k = 0; k < w->nplanes; k++)
+		for (int i = 0; i < n; i++) {
+			double tp;
+			if (plane_hit(&w->planes[k], &r[i], tmin, tm[i], &tp)) {
+				tm[i] = tp;
+				best_plane[i] = &w->planes[k];
+			}
+		}
+	unsigned got, tie;
+	if (!mesh_intersect_world_packet(in->mesh, in->inv, n, r, tmin, tm, t, slot, b, &got, &tie))
+		return false;
+	world_rays_count(n);
+	for (int i = 0; i < n; i++) {
+		if (got >> i & 1u) {
+			th[i] = (trace_hit){t[i], p, NULL, {(double)slot[i], b[i][1], b[i][2]}};
+			found[i] = true;
+		} else {
+			th[i] = (trace_hit){tm[i], NULL, best_plane[i], {0, 0, 0}};
+			found[i] = best_plane[i] != NULL;
+		}
+	}
+	for (; tie; tie &= tie - 1) {
+		int i = __builtin_ctz(tie);
+		world_rays_count(-1);
+		found[i] = world_trace_coherent(w, &r[i], tmin, tmax, &th[i]);
+	}
+	return true;
+}
+
 void world_trace_packet(const world *w, int n, const ray *r, double tmin, double tmax, trace_hit *th, bool *found)
 {
 	pk_ray q;
 	bool lone_model = w->nprims == 1 && w->prims[0].tag == PRIM_MESH;
+	if (lone_model && n >= 2 && n <= PACKET_MAX && model_packet(w, n, r, tmin, tmax, th, found))
+		return;
 	if (n < 2 || n > PACKET_MAX || !w->nprims || lone_model || !packet_prepare(r, n, &q)) {
 		for (int i = 0; i < n; i++)
 			found[i] = world_trace_coherent(w, &r[i], tmin, tmax, &th[i]);

@@ -10,6 +10,13 @@
  *   - a scene of ties: two spheres in one place, cubes sharing a face, two
  *     triangles sharing an edge, a sphere resting on a plane, with rays aimed
  *     exactly at the shared edge, the corners and the point of contact;
+ *   - a lone model's own packets (mesh_intersect_world_packet) against
+ *     its single rays, the slot and barycentrics too, each ray to its own
+ *     tmax: the bunny, the fence's cut-outs, spot turned over two planes,
+ *     and a model of ties (copies of a triangle in different blocks, a
+ *     grid's shared edges and corners); camera packets, rays from the hits
+ *     toward the light (the self-hit guard), narrow and wide cones, zero
+ *     components, origins apart, short packets;
  * and every vector unit the triangle walk has (mesh_isa_force), as
  * test_world_ray_entry does for single rays. */
 #include "testutil.h"
@@ -310,6 +317,211 @@ static void test_prepare_edges(void **state)
 	scene_free(s);
 }
 
+/* --- a lone model: the triangle tree's own packets --- */
+
+/* The packets mesh_intersect_world_packet traced, and the ties it reported
+ * (check_model). */
+static long model_traced, model_ties;
+
+/* mesh_intersect_world_packet itself against mesh_intersect_world_coherent
+ * ray by ray, on the lone model of w, each ray to its own tmax: the beyond
+ * of the single ray's hit, exactly it, or half of it. A ray with a tie is
+ * the caller's to trace again: its answer is not compared, but whether it
+ * hit at all is (the distance of a tie is the nearest). */
+static void check_model(const world *w, const ray *r, int n, int turn)
+{
+	const prim_inst *in = &w->insts[w->prims[0].u.index];
+	double ts[PACKET_MAX], tm[PACKET_MAX], t[PACKET_MAX];
+	uint32_t ss[PACKET_MAX], slot[PACKET_MAX];
+	float bs[PACKET_MAX][3], b[PACKET_MAX][3];
+	bool fs[PACKET_MAX];
+	for (int i = 0; i < n; i++) {
+		fs[i] = mesh_intersect_world_coherent(in->mesh, in->inv, &r[i], 0.0, INFINITY, &ts[i], &ss[i], bs[i]);
+		int k = (turn + i) % 4;
+		tm[i] = !fs[i] || k == 0 ? INFINITY : k == 1 ? ts[i] : k == 2 ? 0.5 * ts[i] : 2.0 * ts[i];
+		if (tm[i] < INFINITY) /* again to that tmax */
+			fs[i] = mesh_intersect_world_coherent(in->mesh, in->inv, &r[i], 0.0, tm[i], &ts[i], &ss[i], bs[i]);
+	}
+	unsigned got, tie;
+	if (!mesh_intersect_world_packet(in->mesh, in->inv, n, r, 0.0, tm, t, slot, b, &got, &tie))
+		return;
+	model_traced++;
+	for (int i = 0; i < n; i++) {
+		assert_int_equal(got >> i & 1u, fs[i]);
+		if (!fs[i])
+			continue;
+		same_double(t[i], ts[i], "model t");
+		if (tie >> i & 1u) {
+			model_ties++;
+			continue;
+		}
+		assert_int_equal(slot[i], ss[i]);
+		for (int k = 0; k < 3; k++)
+			if (memcmp(&b[i][k], &bs[i][k], sizeof(float)) != 0)
+				fail_msg("model b[%d]: packet %.9g, single %.9g", k, (double)b[i][k], (double)bs[i][k]);
+	}
+}
+
+/* Packets on the lone model of w (and the planes beside it): camera
+ * packets, narrow cones, wide ones (directions of both signs: the single
+ * rays' way), and rays with odd components, through check_packet and
+ * check_model. */
+static void model_packets(const world *w, int W, int H, int cones, uint64_t seed)
+{
+	assert_true(w->nprims == 1 && w->prims[0].tag == PRIM_MESH);
+	vec3 lamp = w->nlights ? w->lights[0].pos : v3(0, 10, 0);
+	camera_packets(w, W, H, lamp);
+	int turn = 0;
+	for (int y0 = 0; y0 < H; y0 += 4)
+		for (int x0 = 0; x0 < W; x0 += 4) {
+			ray r[PACKET_MAX];
+			int n = 0;
+			for (int y = y0; y < y0 + 4 && y < H; y++)
+				for (int x = x0; x < x0 + 4 && x < W; x++)
+					r[n++] = cam_ray(&w->cam, x + 0.5, y + 0.5, W, H);
+			check_model(w, r, n, turn++);
+			/* from the hits toward the lamp: rays that start on the
+			 * model, where its self-hit guard raises tmin */
+			ray sr[PACKET_MAX];
+			int m = 0;
+			for (int i = 0; i < n; i++) {
+				hit h;
+				if (world_intersect(w, &r[i], 0.0, INFINITY, &h))
+					sr[m++] = (ray){h.p, v3_sub(lamp, h.p)};
+			}
+			if (m > 0) {
+				check_packet(w, sr, m, lamp);
+				check_model(w, sr, m, turn);
+			}
+		}
+	box b = w->bounds;
+	cone_packets(w, b.lo, b.hi, cones, seed, lamp);
+	test_rng g = {seed};
+	vec3 ext = v3_sub(b.hi, b.lo);
+	for (int k = 0; k < cones; k++) {
+		vec3 o = v3_add(b.lo, v3(ext.x * (3 * trand(&g) - 1), ext.y * (3 * trand(&g) - 1), ext.z * (3 * trand(&g) - 1)));
+		vec3 at = v3_add(b.lo, v3(ext.x * trand(&g), ext.y * trand(&g), ext.z * trand(&g)));
+		vec3 d0 = v3_norm(v3_sub(at, o));
+		double spread = k % 3 == 0 ? 2.0 : 0.002 + 0.05 * trand(&g);
+		ray r[PACKET_MAX];
+		for (int i = 0; i < PACKET_MAX; i++) {
+			vec3 j = v3((trand(&g) - 0.5) * spread, (trand(&g) - 0.5) * spread, (trand(&g) - 0.5) * spread);
+			r[i] = (ray){o, v3_add(d0, j)};
+			if (k % 7 == 1 && i == 3) /* a zero component */
+				r[i].d.y = k % 2 ? 0.0 : -0.0;
+			if (k % 7 == 2) /* all along one axis */
+				r[i].d = v3(0, 0, d0.z < 0 ? -1 : 1);
+			if (k % 7 == 3 && i > 0) /* origins apart */
+				r[i].o = v3_add(o, v3(0.01 * ext.x * trand(&g), 0.01 * ext.y * trand(&g), 0));
+		}
+		int n = k % 5 == 4 ? 1 + k % PACKET_MAX : PACKET_MAX;
+		check_packet(w, r, n, lamp);
+		check_model(w, r, n, k);
+	}
+}
+
+/* A lone model from text on every vector unit. */
+static void check_model_scene(const char *text, int W, int H, int cones)
+{
+	rt_error err;
+	scene *s = rt_load_string(text, strlen(text), "model", NULL, &err);
+	if (!s)
+		fail_msg("model: %s", err.msg);
+	world *w = world_build(s, &err);
+	if (!w)
+		fail_msg("model: %s", err.msg);
+	for (int isa = MESH_ISA_SCALAR; isa <= MESH_ISA_BEST; isa++)
+		if (mesh_isa_force((mesh_isa)isa))
+			model_packets(w, W, H, cones, 41 + (uint64_t)isa);
+	assert_true(mesh_isa_force(MESH_ISA_BEST));
+	world_free(w);
+	scene_free(s);
+}
+
+/* Whether the machine has a vector unit with the triangle packets. */
+static bool have_model_packets(void)
+{
+	bool yes = mesh_isa_force(MESH_ISA_AVX2);
+	assert_true(mesh_isa_force(MESH_ISA_BEST));
+	return yes;
+}
+
+/* Triangles at exactly the same distance in different blocks and leaves:
+ * twelve copies of one triangle, six of another with its corners turned,
+ * a grid of quads behind them whose rays meet shared edges and corners, a
+ * grid of thin slivers; where a single ray keeps the first it meets, the
+ * packet must keep the same one (by tracing the ray again alone). */
+static void test_model_ties(void **state)
+{
+	(void)state;
+	char path[] = "/tmp/rtsh-test-packet-XXXXXX.obj";
+	int fd = mkstemps(path, 4);
+	assert_true(fd >= 0);
+	FILE *f = fdopen(fd, "w");
+	assert_non_null(f);
+	int nv = 0;
+	for (int c = 0; c < 12; c++) { /* the same triangle twelve times */
+		fprintf(f, "v -2 -2 0\nv 2 -2 0\nv 0 2 0\nf %d %d %d\n", nv + 1, nv + 2, nv + 3);
+		nv += 3;
+	}
+	for (int c = 0; c < 6; c++) { /* another, its corners turned */
+		fprintf(f, "v -2.5 -1 1\nv 2.5 -1.5 1\nv 0 2.5 1\n");
+		fprintf(f, "f %d %d %d\n", nv + 1 + c % 3, nv + 1 + (c + 1) % 3, nv + 1 + (c + 2) % 3);
+		nv += 3;
+	}
+	for (int j = 0; j <= 8; j++) /* a grid of 8 x 8 quads at z = 2 */
+		for (int i = 0; i <= 8; i++)
+			fprintf(f, "v %g %g 2\n", -3 + 0.75 * i, -3 + 0.75 * j);
+	for (int j = 0; j < 8; j++)
+		for (int i = 0; i < 8; i++) {
+			int a = nv + j * 9 + i + 1, b = a + 1, c = a + 9, d = c + 1;
+			fprintf(f, "f %d %d %d\nf %d %d %d\n", a, b, d, a, d, c);
+		}
+	nv += 81;
+	assert_int_equal(fclose(f), 0);
+	char text[512];
+	snprintf(text, sizeof text, "C 0.1,0.05,-7 0,0,1 50\nL -2,3,-6 0.8 255,255,255\nmesh %s 0,0,1 0,1,0 6 200,200,200\n",
+	         path);
+	long traced = model_traced, ties = model_ties;
+	check_model_scene(text, 96, 64, 300);
+	/* the same seen through holes: only the grid and its edges */
+	snprintf(text, sizeof text, "C 0,0,-7 0,0,1 70\nL -2,3,-6 0.8 255,255,255\nmesh %s 0,0,1 0,1,0 6 200,200,200\n",
+	         path);
+	check_model_scene(text, 64, 64, 100);
+	unlink(path);
+	if (have_model_packets()) {
+		assert_true(model_traced - traced > 500);
+		assert_true(model_ties - ties > 100);
+	}
+}
+
+/* Models alone on every vector unit: the bunny (upright: the matrix's
+ * zeros skipped), the cow turned (the whole matrix), the fence's glTF
+ * cut-outs (alphaMode MASK), spot over a plane (the planes first). */
+static void test_model_packets(void **state)
+{
+	(void)state;
+	long traced = model_traced;
+	const char *bunny = "../shared/models/stanford-bunny.obj";
+	char text[512];
+	if (access(bunny, R_OK) == 0) {
+		snprintf(text, sizeof text, "C 0,0.1,-3.2 0,0,1 40\nL -2,3,-4 0.8 255,255,255\nmesh %s 0,0,0 0,1,0 1 200,200,200\n",
+		         bunny);
+		check_model_scene(text, 96, 72, 200);
+	} else {
+		print_message("(%s is absent: the bunny is left out)\n", bunny);
+	}
+	check_model_scene("C -0.5,0.9,-4.5 0.2,-0.1,1 60\nL -4,5,-3 0.8 255,245,225\n"
+	                  "mesh scenes/models/fence/fence.gltf 0,0.5,0 0,1,0 8\n",
+	                  128, 72, 200);
+	check_model_scene("C -3.4,1.5,-4.0 3.4,-0.8,4.0 40\nL -3,6,-2 0.6 255,250,240\n"
+	                  "pl 0,0,0 0,1,0 200,200,200\npl 0,0,3 0,0,-1 100,200,100\n"
+	                  "mesh scenes/models/spot/spot_triangulated.obj 0,0.74,0 0.3,1,0.1 1.5 255,255,255 twist=-40\n",
+	                  96, 54, 200);
+	if (have_model_packets())
+		assert_true(model_traced - traced > 1000);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -317,8 +529,11 @@ int main(void)
 		cmocka_unit_test(test_prepare_edges),
 		cmocka_unit_test(test_scenes),
 		cmocka_unit_test(test_bunny),
+		cmocka_unit_test(test_model_ties),
+		cmocka_unit_test(test_model_packets),
 	};
 	int rc = cmocka_run_group_tests(tests, NULL, NULL);
-	printf("packets: %ld, rays that hit: %ld\n", packets, rays_hit);
+	printf("packets: %ld, rays that hit: %ld; the model's own packets: %ld, ties among them: %ld\n", packets, rays_hit,
+	       model_traced, model_ties);
 	return rc;
 }

@@ -34,6 +34,7 @@
  * instruction more).
  */
 #include <float.h>
+#include <stddef.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -452,30 +453,54 @@ _Thread_local unsigned long mesh_stat_nodes, mesh_stat_blocks, mesh_stat_leaves;
 		            near_row(r, 2));                                                                         \
 	}
 
-/* A world ray on an instance (M: world to model) for the walk `walk`. An
- * instance that is not turned (an upright model: M scales and moves only)
- * skips M's zeros, 24 of its 33 operations: the same floats but for the
- * sign of a zero coordinate, on every unit (camera rays +7%, diffuse +2%:
- * bench/README.md). */
+/* A world ray on an instance (M: world to model) in the model's floats,
+ * ready for the box tests: the single walks (WALK_WORLD) and the packets
+ * make it alike. An instance that is not turned (an upright model: M
+ * scales and moves only) skips M's zeros, 24 of its 33 operations: the same
+ * floats but for the sign of a zero coordinate, on every unit (camera rays
+ * +7%, diffuse +2%: bench/README.md). */
+static inline __attribute__((always_inline)) bool upright(const double (*M)[4])
+{
+	return M[0][1] == 0 && M[0][2] == 0 && M[1][0] == 0 && M[1][2] == 0 && M[2][0] == 0 && M[2][1] == 0;
+}
+
+static inline __attribute__((always_inline)) void world_ray_floats(const double (*M)[4], bool up, const ray *wr,
+                                                                   float o[3], float d[3])
+{
+	double px = wr->o.x, py = wr->o.y, pz = wr->o.z, vx = wr->d.x, vy = wr->d.y, vz = wr->d.z;
+	if (up) {
+		o[0] = (float)(M[0][0] * px + M[0][3]);
+		o[1] = (float)(M[1][1] * py + M[1][3]);
+		o[2] = (float)(M[2][2] * pz + M[2][3]);
+		d[0] = (float)(M[0][0] * vx);
+		d[1] = (float)(M[1][1] * vy);
+		d[2] = (float)(M[2][2] * vz);
+	} else {
+		o[0] = (float)(M[0][0] * px + M[0][1] * py + M[0][2] * pz + M[0][3]);
+		o[1] = (float)(M[1][0] * px + M[1][1] * py + M[1][2] * pz + M[1][3]);
+		o[2] = (float)(M[2][0] * px + M[2][1] * py + M[2][2] * pz + M[2][3]);
+		d[0] = (float)(M[0][0] * vx + M[0][1] * vy + M[0][2] * vz);
+		d[1] = (float)(M[1][0] * vx + M[1][1] * vy + M[1][2] * vz);
+		d[2] = (float)(M[2][0] * vx + M[2][1] * vy + M[2][2] * vz);
+	}
+}
+
+static inline __attribute__((always_inline)) void world_ray_setup(const double (*M)[4], const ray *wr, mesh_ray *r)
+{
+	float o[3], d[3];
+	world_ray_floats(M, upright(M), wr, o, d);
+	ray_node_setup(r, o[0], o[1], o[2], d[0], d[1], d[2]);
+}
+
+/* A world ray on an instance for the walk `walk` (world_ray_setup). */
 #define WALK_WORLD(name, walk, target)                                                                              \
 	static target inline __attribute__((always_inline)) bool name(const mesh *m, const double (*M)[4],          \
 	                                                                     const ray *wr, double tmin, double tmax, \
 	                                                                     double *t, uint32_t *slot, float b[3],   \
 	                                                                     bool any)                                \
 	{                                                                                                             \
-		double px = wr->o.x, py = wr->o.y, pz = wr->o.z, vx = wr->d.x, vy = wr->d.y, vz = wr->d.z;            \
 		mesh_ray r;                                                                                           \
-		if (M[0][1] == 0 && M[0][2] == 0 && M[1][0] == 0 && M[1][2] == 0 && M[2][0] == 0 && M[2][1] == 0)     \
-			ray_node_setup(&r, (float)(M[0][0] * px + M[0][3]), (float)(M[1][1] * py + M[1][3]),          \
-			               (float)(M[2][2] * pz + M[2][3]), (float)(M[0][0] * vx), (float)(M[1][1] * vy), \
-			               (float)(M[2][2] * vz));                                                        \
-		else                                                                                                  \
-			ray_node_setup(&r, (float)(M[0][0] * px + M[0][1] * py + M[0][2] * pz + M[0][3]),             \
-			               (float)(M[1][0] * px + M[1][1] * py + M[1][2] * pz + M[1][3]),                 \
-			               (float)(M[2][0] * px + M[2][1] * py + M[2][2] * pz + M[2][3]),                 \
-			               (float)(M[0][0] * vx + M[0][1] * vy + M[0][2] * vz),                           \
-			               (float)(M[1][0] * vx + M[1][1] * vy + M[1][2] * vz),                           \
-			               (float)(M[2][0] * vx + M[2][1] * vy + M[2][2] * vz));                          \
+		world_ray_setup(M, wr, &r);                                                                           \
 		float ft = tmax < 3e38 ? (float)tmax : INFINITY;                                                      \
 		if (!walk(m, &r, false, (float)tmin, m->eps, &ft, slot, b, any) || !((double)ft < tmax))              \
 			return false;                                                                                 \
@@ -535,6 +560,384 @@ _Thread_local unsigned long mesh_stat_nodes, mesh_stat_blocks, mesh_stat_leaves;
 	{                                                                                                             \
 		return isa##_world_o(m, M, wr, tmin, tmax, t, slot, b, false);                                        \
 	}
+
+#if defined(HAVE_AVX2_WALK)
+/* --- packets (mesh_intersect_world_packet) ---
+ *
+ * Up to MESH_PACKET_MAX rays whose directions share each axis's sign walk
+ * the tree once. A node's eight children are tested against the packet as
+ * intervals: per axis, the near distance (b - o) inv of any ray is no less
+ * than the lowest corner product of b less the rays' farthest origin and
+ * their lowest and highest inverse, and the far one (b - o) (inv S) no
+ * more than the highest corner product (rounding to nearest is monotonic,
+ * so the bounds hold for each ray's rounded floats). A child that no ray
+ * could enter by its own test is skipped for all; the others are visited
+ * nearest first for the packet. A leaf is entered by the rays whose own
+ * slab test (the single walk's floats) lets them into its box, and each of
+ * those meets its blocks with the single ray's block test (block_sse), so
+ * a hit is the single ray's floats: distance, slot, barycentrics.
+ *
+ * The nearest distance does not depend on the order of the walk; which of
+ * two triangles at the same distance wins does (the single ray keeps the
+ * first it meets, block_sse the first lane in a block). A ray therefore
+ * also takes a triangle at exactly its distance so far, from another
+ * block, as a tie; a ray with a tie at the end is reported (the caller
+ * traces it alone). */
+
+/* A child waiting on the packet's stack: its reference, the packet's entry
+ * distance, and where its box is (node `parent`'s column k). */
+typedef struct pk_entry {
+	uint32_t ref;
+	float t;
+	uint32_t parent, k;
+} pk_entry;
+
+typedef struct mesh_packet {
+	/* the rays by component for the leaves' slab tests (lanes past n hold
+	 * ray 0 again), and each ray's fl((next float above best) S) */
+	_Alignas(32) float ox[MESH_PACKET_MAX], oy[MESH_PACKET_MAX], oz[MESH_PACKET_MAX];
+	_Alignas(32) float ix[MESH_PACKET_MAX], iy[MESH_PACKET_MAX], iz[MESH_PACKET_MAX];
+	_Alignas(32) float fx[MESH_PACKET_MAX], fy[MESH_PACKET_MAX], fz[MESH_PACKET_MAX];
+	_Alignas(32) float bs[MESH_PACKET_MAX];
+	_Alignas(32) float dx[MESH_PACKET_MAX], dy[MESH_PACKET_MAX], dz[MESH_PACKET_MAX];
+	ray4 rq[MESH_PACKET_MAX];
+	mesh_ray r[MESH_PACKET_MAX];
+	float best[MESH_PACKET_MAX], tmin[MESH_PACKET_MAX];
+	uint32_t slot[MESH_PACKET_MAX];
+	float b[MESH_PACKET_MAX][3];
+	unsigned found, tie;
+	unsigned ready; /* the rays whose r, rq and tmin are made (at their first leaf) */
+	float tmin0;    /* the query's tmin as a float */
+	float eps;      /* the mesh's self-hit guard */
+} mesh_packet;
+
+/* The smallest float above t (+inf stays). */
+static inline float next_upf(float t)
+{
+	if (!(t < INFINITY))
+		return t;
+	if (t == 0.0f)
+		return 0x1p-149f;
+	uint32_t u;
+	memcpy(&u, &t, sizeof u);
+	u = u >> 31 ? u - 1 : u + 1; /* a negative one comes nearer zero */
+	memcpy(&t, &u, sizeof t);
+	return t;
+}
+
+/* The rays (a bit each) whose own slab test, the single walk's floats,
+ * lets them into column k of node p. */
+static AVX2 inline unsigned pk_rays_in(const mesh_packet *s, const mesh_node *p, uint32_t k, float box_tmin, size_t rn0,
+                                       size_t rn1, size_t rn2)
+{
+#define ROW(n, off) ((const float *)((const char *)(n)->b + (off)))
+	const __m256 nx = _mm256_set1_ps(ROW(p, rn0)[k]), ny = _mm256_set1_ps(ROW(p, rn1)[k]),
+		     nz = _mm256_set1_ps(ROW(p, rn2)[k]);
+	const __m256 gx = _mm256_set1_ps(ROW(p, rn0 ^ MESH_ROW)[k]), gy = _mm256_set1_ps(ROW(p, rn1 ^ MESH_ROW)[k]),
+		     gz = _mm256_set1_ps(ROW(p, rn2 ^ MESH_ROW)[k]);
+#undef ROW
+	unsigned m = 0;
+	for (int h = 0; h < MESH_PACKET_MAX; h += 8) {
+		__m256 ox = _mm256_load_ps(&s->ox[h]), oy = _mm256_load_ps(&s->oy[h]), oz = _mm256_load_ps(&s->oz[h]);
+		__m256 t0 = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(nx, ox), _mm256_load_ps(&s->ix[h])),
+					  _mm256_set1_ps(box_tmin));
+		__m256 t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(gx, ox), _mm256_load_ps(&s->fx[h])),
+					  _mm256_load_ps(&s->bs[h]));
+		t0 = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(ny, oy), _mm256_load_ps(&s->iy[h])), t0);
+		t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(gy, oy), _mm256_load_ps(&s->fy[h])), t1);
+		t0 = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(nz, oz), _mm256_load_ps(&s->iz[h])), t0);
+		t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(gz, oz), _mm256_load_ps(&s->fz[h])), t1);
+		m |= (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ)) << h;
+	}
+	return m;
+}
+
+/* Ray i meets the blocks of leaf `ref`. */
+static AVX2 inline void pk_leaf(const mesh *m, mesh_packet *s, int i, uint32_t ref)
+{
+	uint32_t first = ref & (MESH_MAX_BLOCKS - 1), nb = ((ref & ~MESH_LEAF) >> MESH_LEAF_SHIFT) + 1;
+	mesh_ray *r = &s->r[i];
+	if (!(s->ready >> i & 1u)) {
+		/* the triangle test's set-up and tmin, as the single walk makes
+		 * them at its first leaf */
+		r->o[0] = s->ox[i];
+		r->o[1] = s->oy[i];
+		r->o[2] = s->oz[i];
+		r->d[0] = s->dx[i];
+		r->d[1] = s->dy[i];
+		r->d[2] = s->dz[i];
+		r->inv[0] = s->ix[i];
+		r->inv[1] = s->iy[i];
+		r->inv[2] = s->iz[i];
+		ray_leaf_setup(r);
+		ray4_make(r, &s->rq[i]);
+		float tm = s->tmin0;
+		if (s->eps > 0.0f) {
+			float g = s->eps / sqrtf(r->d[0] * r->d[0] + r->d[1] * r->d[1] + r->d[2] * r->d[2]);
+			tm = tm > g ? tm : g;
+		}
+		s->tmin[i] = tm;
+		s->ready |= 1u << i;
+	}
+	float old = s->best[i];
+	for (uint32_t k = 0; k < nb; k++) {
+		float bt = next_upf(s->best[i]), bb[3];
+		int l = block_sse(m, first + k, &m->blk[first + k], r, &s->rq[i], s->tmin[i], &bt, bb);
+		if (l < 0)
+			continue;
+		uint32_t slot = 4 * (first + k) + (uint32_t)l;
+		if (bt < s->best[i]) {
+			s->best[i] = bt;
+			s->slot[i] = slot;
+			s->b[i][0] = bb[0];
+			s->b[i][1] = bb[1];
+			s->b[i][2] = bb[2];
+			s->found |= 1u << i;
+			s->tie &= ~(1u << i);
+		} else if (s->found >> i & 1u) {
+			/* bt is the distance so far, from another block (or the
+			 * query's tmax: no hit, as for the single ray) */
+			s->tie |= 1u << i;
+		}
+	}
+	if (s->best[i] != old)
+		s->bs[i] = next_upf(s->best[i]) * BVH_SLAB_SLACK;
+}
+
+/* The highest of the rays' bs: where the packet prunes. */
+static AVX2 inline float pk_far(const mesh_packet *s)
+{
+	__m256 a = _mm256_max_ps(_mm256_load_ps(&s->bs[0]), _mm256_load_ps(&s->bs[8]));
+	__m128 b = _mm_max_ps(_mm256_castps256_ps128(a), _mm256_extractf128_ps(a, 1));
+	b = _mm_max_ps(b, _mm_movehl_ps(b, b));
+	b = _mm_max_ss(b, _mm_shuffle_ps(b, b, 1));
+	return _mm_cvtss_f32(b);
+}
+
+/* The lowest and highest of eight floats (no NaN among them). */
+static AVX2 inline float pk_hmin(__m256 a)
+{
+	__m128 b = _mm_min_ps(_mm256_castps256_ps128(a), _mm256_extractf128_ps(a, 1));
+	b = _mm_min_ps(b, _mm_movehl_ps(b, b));
+	return _mm_cvtss_f32(_mm_min_ss(b, _mm_shuffle_ps(b, b, 1)));
+}
+
+static AVX2 inline float pk_hmax(__m256 a)
+{
+	__m128 b = _mm_max_ps(_mm256_castps256_ps128(a), _mm256_extractf128_ps(a, 1));
+	b = _mm_max_ps(b, _mm_movehl_ps(b, b));
+	return _mm_cvtss_f32(_mm_max_ss(b, _mm_shuffle_ps(b, b, 1)));
+}
+
+static AVX2 __attribute__((noinline)) bool packet_walk(const mesh *m, const double (*M)[4], int n, const ray *wr,
+                                                       double tmin, const double *tmax, double *t, uint32_t *slot,
+                                                       float (*b)[3], unsigned *found, unsigned *tie)
+{
+	_Alignas(32) mesh_packet s;
+	float box_tmin = (float)tmin;
+	/* the rays in the model's floats by component, as the single walk
+	 * makes them (world_ray_floats: its operations in its order, four rays
+	 * at a time), the lanes past n ray 0 again */
+	const bool up = upright(M);
+	int i = 0;
+	{
+		_Static_assert(sizeof(ray) == 6 * sizeof(double) && offsetof(ray, d) == 3 * sizeof(double),
+			       "ray: six doubles o, d");
+		const __m128i idx = _mm_setr_epi32(0, 6, 12, 18);
+		const __m256d m00 = _mm256_set1_pd(M[0][0]), m01 = _mm256_set1_pd(M[0][1]), m02 = _mm256_set1_pd(M[0][2]),
+			      m03 = _mm256_set1_pd(M[0][3]);
+		const __m256d m10 = _mm256_set1_pd(M[1][0]), m11 = _mm256_set1_pd(M[1][1]), m12 = _mm256_set1_pd(M[1][2]),
+			      m13 = _mm256_set1_pd(M[1][3]);
+		const __m256d m20 = _mm256_set1_pd(M[2][0]), m21 = _mm256_set1_pd(M[2][1]), m22 = _mm256_set1_pd(M[2][2]),
+			      m23 = _mm256_set1_pd(M[2][3]);
+		const __m256d huge = _mm256_set1_pd(3e38);
+		const __m256i pick = _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6);
+		for (; i + 4 <= n; i += 4) {
+			const double *base = &wr[i].o.x;
+			__m256d px = _mm256_i32gather_pd(base, idx, 8), py = _mm256_i32gather_pd(base + 1, idx, 8);
+			__m256d pz = _mm256_i32gather_pd(base + 2, idx, 8), vx = _mm256_i32gather_pd(base + 3, idx, 8);
+			__m256d vy = _mm256_i32gather_pd(base + 4, idx, 8), vz = _mm256_i32gather_pd(base + 5, idx, 8);
+			__m256d a, bq, c, e, f, g;
+			if (up) {
+				a = _mm256_add_pd(_mm256_mul_pd(m00, px), m03);
+				bq = _mm256_add_pd(_mm256_mul_pd(m11, py), m13);
+				c = _mm256_add_pd(_mm256_mul_pd(m22, pz), m23);
+				e = _mm256_mul_pd(m00, vx);
+				f = _mm256_mul_pd(m11, vy);
+				g = _mm256_mul_pd(m22, vz);
+			} else {
+				a = _mm256_add_pd(_mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(m00, px), _mm256_mul_pd(m01, py)),
+								_mm256_mul_pd(m02, pz)),
+						  m03);
+				bq = _mm256_add_pd(_mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(m10, px), _mm256_mul_pd(m11, py)),
+								 _mm256_mul_pd(m12, pz)),
+						   m13);
+				c = _mm256_add_pd(_mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(m20, px), _mm256_mul_pd(m21, py)),
+								_mm256_mul_pd(m22, pz)),
+						  m23);
+				e = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(m00, vx), _mm256_mul_pd(m01, vy)),
+						  _mm256_mul_pd(m02, vz));
+				f = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(m10, vx), _mm256_mul_pd(m11, vy)),
+						  _mm256_mul_pd(m12, vz));
+				g = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(m20, vx), _mm256_mul_pd(m21, vy)),
+						  _mm256_mul_pd(m22, vz));
+			}
+			_mm_store_ps(&s.ox[i], _mm256_cvtpd_ps(a));
+			_mm_store_ps(&s.oy[i], _mm256_cvtpd_ps(bq));
+			_mm_store_ps(&s.oz[i], _mm256_cvtpd_ps(c));
+			_mm_store_ps(&s.dx[i], _mm256_cvtpd_ps(e));
+			_mm_store_ps(&s.dy[i], _mm256_cvtpd_ps(f));
+			_mm_store_ps(&s.dz[i], _mm256_cvtpd_ps(g));
+			/* best: tmax < 3e38 ? (float)tmax : inf */
+			__m256d tm = _mm256_loadu_pd(&tmax[i]);
+			__m128 lt = _mm256_castps256_ps128(
+				_mm256_permutevar8x32_ps(_mm256_castpd_ps(_mm256_cmp_pd(tm, huge, _CMP_LT_OQ)), pick));
+			_mm_storeu_ps(&s.best[i], _mm_blendv_ps(_mm_set1_ps(INFINITY), _mm256_cvtpd_ps(tm), lt));
+		}
+	}
+	for (; i < n; i++) {
+		float o[3], d[3];
+		world_ray_floats(M, up, &wr[i], o, d);
+		s.ox[i] = o[0];
+		s.oy[i] = o[1];
+		s.oz[i] = o[2];
+		s.dx[i] = d[0];
+		s.dy[i] = d[1];
+		s.dz[i] = d[2];
+		s.best[i] = tmax[i] < 3e38 ? (float)tmax[i] : INFINITY;
+	}
+	for (i = 0; i < n; i++)
+		s.bs[i] = next_upf(s.best[i]) * BVH_SLAB_SLACK;
+	for (i = n; i < MESH_PACKET_MAX; i++) {
+		s.ox[i] = s.ox[0];
+		s.oy[i] = s.oy[0];
+		s.oz[i] = s.oz[0];
+		s.dx[i] = s.dx[0];
+		s.dy[i] = s.dy[0];
+		s.dz[i] = s.dz[0];
+		s.bs[i] = -INFINITY; /* never enters a leaf, never raises pk_far */
+	}
+	/* the inverses (1 / d, correctly rounded as ray_node_setup's), the far
+	 * ones inv S; the signs each axis shares; per axis the origin to
+	 * subtract from the near planes (the farthest along the direction) and
+	 * from the far ones (the farthest back), the inverses' and the far
+	 * inverses' ranges. The bounds need finite origins and finite, non-zero
+	 * inverses (a NaN fails too). */
+	const __m256 one = _mm256_set1_ps(1.0f), slack = _mm256_set1_ps(BVH_SLAB_SLACK), big = _mm256_set1_ps(FLT_MAX);
+	const __m256 mag = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff)), zero = _mm256_setzero_ps();
+	float *oa[3] = {s.ox, s.oy, s.oz}, *da[3] = {s.dx, s.dy, s.dz}, *ia[3] = {s.ix, s.iy, s.iz},
+	      *fa[3] = {s.fx, s.fy, s.fz};
+	__m256 on[3], of[3], ilo[3], ihi[3], flo[3], fhi[3];
+	size_t rn[3];
+	__m256 bad = zero;
+	for (int a = 0; a < 3; a++) {
+		__m256 olo = _mm256_load_ps(oa[a]), ohi = olo, il = _mm256_set1_ps(INFINITY), ih = _mm256_set1_ps(-INFINITY);
+		__m256 fl = il, fh = ih;
+		unsigned negs = 0;
+		for (int h = 0; h < MESH_PACKET_MAX; h += 8) {
+			__m256 o = _mm256_load_ps(oa[a] + h), inv = _mm256_div_ps(one, _mm256_load_ps(da[a] + h));
+			__m256 f = _mm256_mul_ps(inv, slack);
+			_mm256_store_ps(ia[a] + h, inv);
+			_mm256_store_ps(fa[a] + h, f);
+			bad = _mm256_or_ps(bad, _mm256_cmp_ps(_mm256_and_ps(o, mag), big, _CMP_NLE_UQ));
+			bad = _mm256_or_ps(bad, _mm256_cmp_ps(_mm256_and_ps(inv, mag), big, _CMP_NLE_UQ));
+			bad = _mm256_or_ps(bad, _mm256_cmp_ps(_mm256_and_ps(f, mag), big, _CMP_NLE_UQ));
+			bad = _mm256_or_ps(bad, _mm256_cmp_ps(inv, zero, _CMP_EQ_OQ));
+			negs |= (unsigned)_mm256_movemask_ps(inv) << h;
+			olo = _mm256_min_ps(olo, o);
+			ohi = _mm256_max_ps(ohi, o);
+			il = _mm256_min_ps(il, inv);
+			ih = _mm256_max_ps(ih, inv);
+			fl = _mm256_min_ps(fl, f);
+			fh = _mm256_max_ps(fh, f);
+		}
+		if (negs != 0 && negs != 0xffffu)
+			return false;
+		bool neg = negs != 0;
+		on[a] = _mm256_set1_ps(neg ? pk_hmin(olo) : pk_hmax(ohi));
+		of[a] = _mm256_set1_ps(neg ? pk_hmax(ohi) : pk_hmin(olo));
+		ilo[a] = _mm256_set1_ps(pk_hmin(il));
+		ihi[a] = _mm256_set1_ps(pk_hmax(ih));
+		flo[a] = _mm256_set1_ps(pk_hmin(fl));
+		fhi[a] = _mm256_set1_ps(pk_hmax(fh));
+		rn[a] = (size_t)(MESH_LO(a) + neg) * MESH_ROW;
+	}
+	if (_mm256_movemask_ps(bad))
+		return false;
+	s.ready = 0;
+	s.tmin0 = box_tmin;
+	s.eps = m->eps;
+	const size_t rn0 = rn[0], rn1 = rn[1], rn2 = rn[2];
+	s.found = s.tie = 0;
+	const __m256 t0_8 = _mm256_set1_ps(box_tmin);
+	float far = pk_far(&s);
+	pk_entry stack[MESH_STACK];
+	int sp = 0;
+	uint32_t ref = 0; /* the root node */
+	const mesh_node *nodes = m->nodes;
+	for (;;) {
+		{
+			const mesh_node *nd = (const mesh_node *)((const char *)nodes + ref);
+			__m256 t0 = t0_8, t1 = _mm256_set1_ps(far);
+			for (int a = 0; a < 3; a++) {
+				size_t r0 = rn[a];
+				__m256 x = _mm256_sub_ps(_mm256_load_ps((const float *)((const char *)nd->b + r0)), on[a]);
+				__m256 y = _mm256_sub_ps(_mm256_load_ps((const float *)((const char *)nd->b + (r0 ^ MESH_ROW))),
+							 of[a]);
+				t0 = _mm256_max_ps(_mm256_min_ps(_mm256_mul_ps(x, ilo[a]), _mm256_mul_ps(x, ihi[a])), t0);
+				t1 = _mm256_min_ps(_mm256_max_ps(_mm256_mul_ps(y, flo[a]), _mm256_mul_ps(y, fhi[a])), t1);
+			}
+			_Alignas(32) float tn[MESH_WIDTH];
+			_mm256_store_ps(tn, t0);
+			unsigned hm = (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ));
+			/* the children, farthest first, so the nearest is on top */
+			int base = sp;
+			for (; hm; hm &= hm - 1) {
+				uint32_t k = (uint32_t)__builtin_ctz(hm);
+				pk_entry e = {nd->child[k], tn[k], ref, k};
+				int j = sp++;
+				while (j > base && stack[j - 1].t < e.t) {
+					stack[j] = stack[j - 1];
+					j--;
+				}
+				stack[j] = e;
+			}
+		}
+		/* the next entry the packet may still need */
+		for (;;) {
+			while (sp > 0 && stack[sp - 1].t > far)
+				sp--;
+			if (sp == 0)
+				goto done;
+			pk_entry e = stack[--sp];
+			if (!(e.ref & MESH_LEAF)) {
+				ref = e.ref;
+				break;
+			}
+			unsigned in = pk_rays_in(&s, (const mesh_node *)((const char *)nodes + e.parent), e.k, box_tmin, rn0,
+						 rn1, rn2);
+			for (; in; in &= in - 1)
+				pk_leaf(m, &s, __builtin_ctz(in), e.ref);
+			far = pk_far(&s);
+		}
+	}
+done:
+	for (unsigned f = s.found; f; f &= f - 1) {
+		int j = __builtin_ctz(f);
+		t[j] = s.best[j];
+		slot[j] = s.slot[j];
+		b[j][0] = s.b[j][0];
+		b[j][1] = s.b[j][1];
+		b[j][2] = s.b[j][2];
+		if (!((double)s.best[j] < tmax[j]))
+			s.found &= ~(1u << j);
+	}
+	*found = s.found;
+	*tie = s.tie & s.found;
+	return true;
+}
+#endif
+
 
 typedef struct walker {
 	bool (*hit)(const mesh *m, const mesh_ray *r, float tmin, float *tmax, uint32_t *tri, float b[3]);
@@ -656,4 +1059,17 @@ bool mesh_intersect_brute(const mesh *m, const mesh_ray *r, float tmin, float *t
 			found = true;
 		}
 	return found;
+}
+
+bool mesh_intersect_world_packet(const mesh *m, const double (*inv)[4], int n, const ray *r, double tmin,
+                                 const double *tmax, double *t, uint32_t *slot, float (*b)[3], unsigned *found,
+                                 unsigned *tie)
+{
+#if defined(HAVE_AVX2_WALK)
+	if (n >= 1 && n <= MESH_PACKET_MAX && mesh_isa_active() >= MESH_ISA_AVX2)
+		return packet_walk(m, inv, n, r, tmin, tmax, t, slot, b, found, tie);
+#else
+	(void)m, (void)inv, (void)n, (void)r, (void)tmin, (void)tmax, (void)t, (void)slot, (void)b, (void)found, (void)tie;
+#endif
+	return false;
 }
