@@ -16,6 +16,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "base/nearest.h"
 #include "rtsh/filesrc.h"
@@ -133,6 +136,59 @@ static bool fail_tok(parser *p, const tok *t, const char *elem, const char *fiel
 
 static bool is_blank(char c) { return c == ' ' || c == '\t'; }
 
+/* The bytes lex_line looks at: control characters (all but the tab, and
+ * DEL), and those that may end a token's run of plain bytes (blanks, the
+ * comments' '#' and '/', the quote). */
+enum { LEX_CONTROL = 1, LEX_STOP = 2 };
+static const unsigned char lex_class[256] = {
+	[0] = LEX_CONTROL, [1] = LEX_CONTROL, [2] = LEX_CONTROL, [3] = LEX_CONTROL, [4] = LEX_CONTROL,
+	[5] = LEX_CONTROL, [6] = LEX_CONTROL, [7] = LEX_CONTROL, [8] = LEX_CONTROL, ['\t'] = LEX_STOP,
+	[10] = LEX_CONTROL, [11] = LEX_CONTROL, [12] = LEX_CONTROL, [13] = LEX_CONTROL, [14] = LEX_CONTROL,
+	[15] = LEX_CONTROL, [16] = LEX_CONTROL, [17] = LEX_CONTROL, [18] = LEX_CONTROL, [19] = LEX_CONTROL,
+	[20] = LEX_CONTROL, [21] = LEX_CONTROL, [22] = LEX_CONTROL, [23] = LEX_CONTROL, [24] = LEX_CONTROL,
+	[25] = LEX_CONTROL, [26] = LEX_CONTROL, [27] = LEX_CONTROL, [28] = LEX_CONTROL, [29] = LEX_CONTROL,
+	[30] = LEX_CONTROL, [31] = LEX_CONTROL, [' '] = LEX_STOP, ['#'] = LEX_STOP, ['/'] = LEX_STOP,
+	['"'] = LEX_STOP, [0x7F] = LEX_CONTROL,
+};
+
+/* The index of the first byte of s[i..len) whose class has `bits`, or len:
+ * sixteen bytes at a time with SSE2 (a .rt file of a million objects is 66
+ * MB read a byte at a time twice), the rest by the table. */
+#if defined(__SSE2__)
+static inline unsigned lex_mask16(__m128i x, unsigned bits)
+{
+	__m128i m = _mm_setzero_si128();
+	if (bits & LEX_CONTROL) {
+		/* x <= 0x1F except the tab, or DEL */
+		__m128i low = _mm_cmpeq_epi8(_mm_max_epu8(x, _mm_set1_epi8(0x1F)), _mm_set1_epi8(0x1F));
+		low = _mm_andnot_si128(_mm_cmpeq_epi8(x, _mm_set1_epi8('\t')), low);
+		m = _mm_or_si128(low, _mm_cmpeq_epi8(x, _mm_set1_epi8(0x7F)));
+	}
+	if (bits & LEX_STOP) {
+		m = _mm_or_si128(m, _mm_cmpeq_epi8(x, _mm_set1_epi8(' ')));
+		m = _mm_or_si128(m, _mm_cmpeq_epi8(x, _mm_set1_epi8('\t')));
+		m = _mm_or_si128(m, _mm_cmpeq_epi8(x, _mm_set1_epi8('#')));
+		m = _mm_or_si128(m, _mm_cmpeq_epi8(x, _mm_set1_epi8('/')));
+		m = _mm_or_si128(m, _mm_cmpeq_epi8(x, _mm_set1_epi8('"')));
+	}
+	return (unsigned)_mm_movemask_epi8(m);
+}
+#endif
+
+static size_t lex_find(const char *s, size_t i, size_t len, unsigned bits)
+{
+#if defined(__SSE2__)
+	for (; i + 16 <= len; i += 16) {
+		unsigned m = lex_mask16(_mm_loadu_si128((const __m128i *)(const void *)(s + i)), bits);
+		if (m)
+			return i + (size_t)__builtin_ctz(m);
+	}
+#endif
+	while (i < len && !(lex_class[(unsigned char)s[i]] & bits))
+		i++;
+	return i;
+}
+
 static bool comment_at(const char *s, size_t i, size_t len)
 {
 	return s[i] == '#' || (s[i] == '/' && i + 1 < len && s[i + 1] == '/');
@@ -174,13 +230,12 @@ static bool lex_line(parser *p, const char *s, size_t len)
 	p->endcol = 1;
 	if (len > RT_FILE_MAX)
 		return fail(p, 0, "the line is longer than 1 GiB; expected a shorter line");
-	for (size_t i = 0; i < len; i++) {
-		unsigned char c = (unsigned char)s[i];
-		if ((c < 0x20 && c != '\t') || c == 0x7F) {
-			if (c == 0)
-				return fail(p, (int)i + 1, "a NUL byte; expected text (is this a binary file?)");
-			return fail(p, (int)i + 1, "control character 0x%02X; expected text", c);
-		}
+	size_t bad = lex_find(s, 0, len, LEX_CONTROL);
+	if (bad < len) {
+		unsigned char c = (unsigned char)s[bad];
+		if (c == 0)
+			return fail(p, (int)bad + 1, "a NUL byte; expected text (is this a binary file?)");
+		return fail(p, (int)bad + 1, "control character 0x%02X; expected text", c);
 	}
 	if (len + 2 > p->cap_text) {
 		char *n = realloc(p->text, len + 2);
@@ -215,14 +270,21 @@ static bool lex_line(parser *p, const char *s, size_t len)
 			continue;
 		}
 		for (;;) {
-			while (i < len && !is_blank(s[i]) && !comment_at(s, i, len)) {
+			for (;;) {
+				/* the token's plain bytes, then what stopped them */
+				size_t e = lex_find(s, i, len, LEX_STOP);
+				memcpy(out, s + i, e - i);
+				out += e - i;
+				i = e;
+				if (i == len || is_blank(s[i]) || comment_at(s, i, len))
+					break;
 				if (s[i] == '"' && out > t.s && out[-1] == '=') {
 					/* KEY="a file name" */
 					if (!copy_quoted(p, s, len, &i, &out, "KEY=\"NAME\""))
 						return false;
 					continue;
 				}
-				*out++ = s[i++];
+				*out++ = s[i++]; /* a quote not after '=', a '/' alone */
 			}
 			t.endcol = (int)i + 1;
 			size_t j = i;
@@ -1292,9 +1354,12 @@ static bool parse_text(parser *p, const char *text, size_t len)
 	size_t i = 0;
 	p->line = 1;
 	while (i < len) {
-		size_t j = i;
-		while (j < len && text[j] != '\n' && text[j] != '\r')
-			j++;
+		/* the line ends at the first '\n' or '\r' */
+		const char *nl = memchr(text + i, '\n', len - i);
+		size_t j = nl ? (size_t)(nl - text) : len;
+		const char *cr = memchr(text + i, '\r', j - i);
+		if (cr)
+			j = (size_t)(cr - text);
 		if ((p->line & 4095) == 0 && p->cancel && atomic_load(p->cancel))
 			return fail(p, 0, "stopped");
 		if (!parse_line(p, text + i, j - i))

@@ -3,6 +3,7 @@
 
 #include "rtsh/num.h"
 #include "rtsh/scene.h"
+#include "rtsh/srgb.h"
 
 static void assert_identity(mat4 m, double tol)
 {
@@ -292,18 +293,188 @@ static void test_scan_matches_strtod(void **state)
 	}
 }
 
+/* The 8-bit code of linear v from the definition: the k whose interval
+ * [decode((k - 0.5) / 255), decode((k + 0.5) / 255)) holds v, clamped;
+ * found from 255 x the encoding and corrected by those bounds. */
+static int srgb8_reference(double v)
+{
+	if (!(v > 0.0))
+		return 0;
+	if (v >= 1.0)
+		return 255;
+	double e = v <= 0.0031308 ? v * 12.92 : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
+	int k = (int)floor(255.0 * e + 0.5);
+	k = k < 0 ? 0 : k > 255 ? 255 : k;
+	while (k < 255 && v >= srgb_to_linear((k + 0.5) / 255.0))
+		k++;
+	while (k > 0 && v < srgb_to_linear((k - 0.5) / 255.0))
+		k--;
+	return k;
+}
+
+static void check_srgb8_n(const float *in, size_t n, double gain)
+{
+	uint8_t out[64];
+	assert_true(n <= 64);
+	linear_to_srgb8_n(in, gain, out, n);
+	for (size_t i = 0; i < n; i++)
+		if (out[i] != srgb8_reference(in[i] * gain))
+			fail_msg("linear_to_srgb8_n(%.9g x %.17g) = %d; the definition gives %d", (double)in[i], gain,
+			         out[i], srgb8_reference(in[i] * gain));
+}
+
+/* linear_to_srgb8_n, whose buckets are cut by the bits of the value: every
+ * bucket's first and last float, the floats around every code's lower
+ * bound, the edges, and random values and gains, against the definition. */
+static void test_srgb8_codes(void **state)
+{
+	(void)state;
+	float in[64];
+	size_t n = 0;
+	/* floats from 2^-14 to 1: each 1/1024 of a binade's first and last */
+	for (uint32_t b = 0; b < 14u * 1024u; b++) {
+		uint32_t first = ((uint32_t)(127 - 14) << 23) + (b << 13), last = first + 0x1fff;
+		memcpy(&in[n++], &first, sizeof first);
+		memcpy(&in[n++], &last, sizeof last);
+		if (n == 64) {
+			check_srgb8_n(in, n, 1.0);
+			n = 0;
+		}
+	}
+	/* around each code's lower bound, in floats (gain 1) and in doubles
+	 * (the float 1 times a gain that is the bound's neighbour) */
+	for (int k = 1; k < 256; k++) {
+		double t = srgb_to_linear((k - 0.5) / 255.0);
+		float f = (float)t;
+		for (int d = 0; d < 4; d++) {
+			f = nextafterf(f, 0.0f);
+		}
+		for (int d = 0; d < 9; d++, f = nextafterf(f, 2.0f))
+			check_srgb8_n(&f, 1, 1.0);
+		float one = 1.0f;
+		double g = t;
+		for (int d = 0; d < 4; d++)
+			g = nextafter(g, 0.0);
+		for (int d = 0; d < 9; d++, g = nextafter(g, 2.0))
+			check_srgb8_n(&one, 1, g);
+	}
+	float edges[] = {0.0f, -0.0f, -1.0f, NAN, INFINITY, -INFINITY, 1.0f, nextafterf(1.0f, 0.0f), 0x1p-13f,
+	                 nextafterf(0x1p-13f, 0.0f), 0x1p-149f, 1e-30f, 2.0f, 1e30f};
+	size_t ne = sizeof edges / sizeof edges[0];
+	check_srgb8_n(edges, ne, 1.0);
+	check_srgb8_n(edges, ne, 0.5);
+	check_srgb8_n(edges, ne, 3.7);
+	test_rng r = {7};
+	for (int round = 0; round < 20000; round++) {
+		double gain = exp2(trange(&r, -4.0, 4.0));
+		for (int i = 0; i < 64; i++)
+			in[i] = (float)(round % 2 ? trange(&r, 0.0, 1.2) : exp2(trange(&r, -16.0, 0.5)));
+		check_srgb8_n(in, 64, round % 3 ? gain : 1.0);
+	}
+}
+
+/* object_validate passes the common objects (no shear, direction and sizes
+ * within 1e-50..1e50) without building their transform: each one it passes
+ * must have a transform object_xform can make. Random kinds, directions
+ * (some within 1e-7..1e-20 of straight down, where the rotation is the
+ * least exact), twists, positions, and lengths and sizes from 1e-120 to
+ * 1e120 (beyond the bounds, where the transform can fail: those the
+ * shortcut must leave to the full check). */
+static void test_validate_without_transform(void **state)
+{
+	(void)state;
+	test_rng r = {11};
+	int passed = 0, shortcut_range = 0;
+	for (int k = 0; k < 200000; k++) {
+		obj_kind kind = (obj_kind)(k % OBJ_KIND_COUNT);
+		if (obj_kind_flags(kind) & (KIND_VERTICES | KIND_MODEL))
+			continue;
+		object o = object_make(kind, v3(1, 1, 1));
+		vec3 d = k % 5 == 0 ? v3(pow(10.0, trange(&r, -20, -7)) * trange(&r, -1, 1), -1,
+		                         pow(10.0, trange(&r, -20, -7)) * trange(&r, -1, 1))
+		                    : tdir(&r);
+		double wide = k % 2 ? 120 : 55;
+		o.dir = v3_scale(d, pow(10.0, trange(&r, -wide, wide)));
+		o.scale = v3(pow(10.0, trange(&r, -wide, wide)), pow(10.0, trange(&r, -wide, wide)),
+		             pow(10.0, trange(&r, -wide, wide)));
+		if (k % 3 == 0)
+			o.scale = v3(o.scale.x, o.scale.x, o.scale.x);
+		o.twist = k % 4 ? trange(&r, -1e6, 1e6) : 0;
+		o.pos = v3(trange(&r, -1e300, 1e300), trange(&r, -1, 1), pow(10.0, trange(&r, -300, 300)));
+		xform x;
+		if (object_validate(&o, NULL)) {
+			passed++;
+			if (!object_xform(&o, &x))
+				fail_msg("kind %d dir %g,%g,%g scale %g,%g,%g twist %g: validated, but no transform", kind,
+				         o.dir.x, o.dir.y, o.dir.z, o.scale.x, o.scale.y, o.scale.z, o.twist);
+		}
+		double len = v3_len(o.dir);
+		shortcut_range += len >= 1e-50 && len <= 1e50;
+	}
+	assert_true(passed > 50000 && shortcut_range > 50000);
+}
+
+/* The short decimals num_scan reads in one pass (at most 15 digits, no
+ * exponent) and those just beyond (16 digits, leading zeros counted):
+ * every length from 1 to 17 digits with the point at every place, signs,
+ * leading zeros, against strtod, bit for bit (-0 included). */
+static void test_scan_short_decimals(void **state)
+{
+	(void)state;
+	uint64_t r = 99;
+	for (int n = 1; n <= 17; n++)
+		for (int point = 0; point <= n; point++)
+			for (int k = 0; k < 40; k++) {
+				char t[40];
+				size_t len = 0;
+				if (k % 3)
+					t[len++] = k % 3 == 1 ? '-' : '+';
+				for (int i = 0; i < n; i++) {
+					if (i == point && point > 0)
+						t[len++] = '.';
+					r = r * 6364136223846793005ull + 1442695040888963407ull;
+					int digit = (int)((r >> 59) % 10);
+					if (k % 4 == 0 && i < n / 2)
+						digit = 0; /* leading zeros */
+					if (k == 39)
+						digit = 0; /* all zeros: 0 or -0 */
+					t[len++] = (char)('0' + digit);
+				}
+				if (point == n && k % 2)
+					t[len++] = '.'; /* "12." */
+				if (point == 0 && k % 5 == 1) {
+					memmove(t + (k % 3 ? 2 : 1), t + (k % 3 ? 1 : 0), len - (k % 3 ? 1 : 0));
+					t[k % 3 ? 1 : 0] = '.'; /* ".5", "-.5" */
+					len++;
+				}
+				t[len] = '\0';
+				double v, want = strtod(t, NULL);
+				assert_int_equal(num_scan_str(t, 1e300, &v), NUM_OK);
+				if (memcmp(&v, &want, sizeof v) != 0)
+					fail_msg("%s: num_scan %.17g, strtod %.17g", t, v, want);
+			}
+	double v;
+	const char *bad[] = {"-", "+", ".", "-.", "1.2.3", "1-", "--1", "1 ", "0x1"};
+	for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++)
+		assert_int_equal(num_scan_str(bad[i], 1e300, &v), NUM_BAD);
+	assert_int_equal(num_scan_str("123456789012345", 1e14, &v), NUM_BIG);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_inverse_product_is_identity),
 		cmocka_unit_test(test_add_decimal),
 		cmocka_unit_test(test_scan_matches_strtod),
+		cmocka_unit_test(test_scan_short_decimals),
 		cmocka_unit_test(test_singular_matrices_are_refused),
 		cmocka_unit_test(test_points_vectors_normals),
 		cmocka_unit_test(test_transform_composition),
 		cmocka_unit_test(test_orient),
 		cmocka_unit_test(test_object_rotate),
 		cmocka_unit_test(test_object_xform_sizes),
+		cmocka_unit_test(test_srgb8_codes),
+		cmocka_unit_test(test_validate_without_transform),
 	};
 	return cmocka_run_group_tests_name("math", tests, NULL, NULL);
 }
