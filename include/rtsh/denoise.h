@@ -21,8 +21,10 @@
  * fixed set of 32 of each, the same for every pixel, so that the feature is
  * smooth; through a glossy metal that is looked through, its own highlight
  * too, the lamps from 8 directions a sample of its own lobe, 64 fixed ones
- * in all): it explains shadows, highlights and the sky's contact shadows
- * that albedo and normal do not. The job also keeps the mean
+ * in all; at an edge pixel that lobe's light over the DENOISE_EDGE_SAMPLES
+ * positions, one direction each, so that how much of the pixel a
+ * highlight covers is as well known as its albedo): it explains shadows,
+ * highlights and the sky's contact shadows that albedo and normal do not. The job also keeps the mean
  * radiance and squared brightness of the even-numbered samples: with
  * those of all of them they split the samples into two independent halves,
  * and the albedo at the even samples' and all the samples' own positions.
@@ -75,11 +77,12 @@
  *        halves,
  *   14   the direct light's brightness (see above),
  *   15-17 the mean albedo at the even-numbered samples' own camera rays,
- *        18-20 at all of them (the first DENOISE_FEATURE_SAMPLES).
- * 0-6, 8, 9 and 14 are means over the first DENOISE_FEATURE_SAMPLES
+ *        18-20 at all of them (the first DENOISE_FEATURE_SAMPLES),
+ *   21   the part of 14 that glossy lobes looked through send.
+ * 0-6, 8, 9 and 21 are means over the first DENOISE_FEATURE_SAMPLES
  * samples' camera rays, or over DENOISE_EDGE_SAMPLES positions where those
- * disagree. */
-#define DENOISE_FEATURES 21
+ * disagree; 14 is 21 and the rest's mean over the first samples. */
+#define DENOISE_FEATURES 22
 /* The features are the mean of at most this many samples per pixel... */
 #define DENOISE_FEATURE_SAMPLES 8
 /* ...or of this many camera positions (first hits only, no paths) at a
@@ -89,8 +92,8 @@
 #define DENOISE_EDGE_SAMPLES 64
 /* Doubles of a pixel's feature sums over a run of its samples
  * (denoise_sample): 0-6 and 8-9 as the features, 7 the direct light, 10-12
- * the albedo of the even-numbered samples. */
-#define DENOISE_ACC 13
+ * the albedo of the even-numbered samples, 13 the glossy lobes' part of 7. */
+#define DENOISE_ACC 14
 
 /* Gives fb its feature buffer (cleared) if it has none, so that path-mode
  * render jobs into it record features; false when out of memory. */

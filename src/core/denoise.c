@@ -67,13 +67,34 @@ static void fixed_u(unsigned idx, unsigned n, double u[3])
 	u[0] = g - (double)(long)g;
 }
 
+/* Which point of a fixed set of n the q-th direction of sample ks takes:
+ * each of the first DENOISE_FEATURE_SAMPLES samples the points ks,
+ * ks + DENOISE_FEATURE_SAMPLES, ... (its share, n / DENOISE_FEATURE_SAMPLES
+ * of them); an edge pixel's later camera positions (ks from
+ * DENOISE_FEATURE_SAMPLES to DENOISE_EDGE_SAMPLES) one point each, ks
+ * modulo n (feature_dirs), so that over the 64 positions every point of
+ * the set is taken as often. */
+static unsigned set_index(int q, int ks, unsigned n)
+{
+	if (ks < DENOISE_FEATURE_SAMPLES)
+		return (unsigned)(q * DENOISE_FEATURE_SAMPLES + ks);
+	return (unsigned)ks % n;
+}
+
+/* How many directions (or points) of its set sample ks takes: its share
+ * (per) among the first DENOISE_FEATURE_SAMPLES, else one. */
+static int feature_dirs(int ks, int per)
+{
+	return ks < DENOISE_FEATURE_SAMPLES ? per : 1;
+}
+
 /* Emitters sampled for the direct-light feature at most (more: these many
  * picked, their light scaled up). */
 #define DIRECT_EMITTERS 4
 
 /* The direct light that the point lights and the lamps send through b at p
  * (on object self) toward the eye, as brightness: the point lights
- * exactly, each lamp from 4 points of the solid angle (or area)
+ * exactly, each lamp from 4 points (an edge position's: 1) of the solid angle (or area)
  * emitter_sample maps them to, sample ks taking its share of one fixed
  * Hammersley set of 4 DENOISE_FEATURE_SAMPLES (hammersley): the same
  * points for every pixel, so that the feature is a smooth function of the
@@ -84,6 +105,7 @@ static void fixed_u(unsigned idx, unsigned n, double u[3])
 static double direct_feature(const world *w, const bsdf *b, vec3 p, uint32_t self, int ks, double r1, bool lamps)
 {
 	double sum = 0.0;
+	int nq = feature_dirs(ks, 4);
 	if (!b->smooth)
 		return 0.0;
 	for (size_t i = 0; i < w->nlights; i++) {
@@ -106,9 +128,9 @@ static double direct_feature(const world *w, const bsdf *b, vec3 p, uint32_t sel
 		if (e->object == self)
 			continue;
 		double part = 0.0;
-		for (int q = 0; q < 4; q++) {
+		for (int q = 0; q < nq; q++) {
 			double u1, u2;
-			hammersley((unsigned)(q * DENOISE_FEATURE_SAMPLES + ks % DENOISE_FEATURE_SAMPLES), 4 * DENOISE_FEATURE_SAMPLES, &u1, &u2);
+			hammersley(set_index(q, ks, 4 * DENOISE_FEATURE_SAMPLES), 4 * DENOISE_FEATURE_SAMPLES, &u1, &u2);
 			vec3 wi;
 			double pdf, t;
 			if (!emitter_sample(e, p, u1, u2, &wi, &pdf, &t) || !(pdf > 0.0))
@@ -122,7 +144,7 @@ static double direct_feature(const world *w, const bsdf *b, vec3 p, uint32_t sel
 				continue;
 			part += lum_d(v3_mul(f, w->mats[e->mat].emission)) * c / pdf;
 		}
-		sum += part * 0.25 * (double)ne / (double)pick;
+		sum += part / nq * (double)ne / (double)pick;
 	}
 	return sum;
 }
@@ -154,10 +176,10 @@ static double env_feature(const world *w, const bsdf *b, vec3 p, int k)
 	if (!b->smooth || !env_lit(w))
 		return 0.0;
 	double sum = 0.0;
-	for (int q = 0; q < ENV_DIRS; q++) {
-		unsigned idx = (unsigned)(q * DENOISE_FEATURE_SAMPLES + k % DENOISE_FEATURE_SAMPLES);
+	int nq = feature_dirs(k, ENV_DIRS);
+	for (int q = 0; q < nq; q++) {
 		double u[3];
-		fixed_u(idx, ENV_SET, u);
+		fixed_u(set_index(q, k, ENV_SET), ENV_SET, u);
 		bsdf_sample sm;
 		if (!bsdf_sample_u(b, u, &sm) || sm.transmit)
 			continue;
@@ -166,7 +188,7 @@ static double env_feature(const world *w, const bsdf *b, vec3 p, int k)
 			continue;
 		sum += lum_d(v3_mul(sm.weight, world_background(w, sm.wi, MODE_PATH)));
 	}
-	return sum / ENV_DIRS;
+	return sum / nq;
 }
 
 /* Directions of a glossy lobe's lamp feature per sample (LOBE_DIRS x
@@ -186,10 +208,10 @@ static double lobe_feature(const world *w, const bsdf *b, vec3 p, int ks)
 	if (!b->smooth || w->nemitters == 0)
 		return 0.0;
 	double sum = 0.0;
-	for (int q = 0; q < LOBE_DIRS; q++) {
-		unsigned idx = (unsigned)(q * DENOISE_FEATURE_SAMPLES + ks % DENOISE_FEATURE_SAMPLES);
+	int nq = feature_dirs(ks, LOBE_DIRS);
+	for (int q = 0; q < nq; q++) {
 		double u[3];
-		fixed_u(idx, LOBE_DIRS * DENOISE_FEATURE_SAMPLES, u);
+		fixed_u(set_index(q, ks, LOBE_DIRS * DENOISE_FEATURE_SAMPLES), LOBE_DIRS * DENOISE_FEATURE_SAMPLES, u);
 		bsdf_sample sm;
 		if (!bsdf_sample_u(b, u, &sm) || sm.transmit)
 			continue;
@@ -201,16 +223,19 @@ static double lobe_feature(const world *w, const bsdf *b, vec3 p, int ks)
 		if (e.x + e.y + e.z > 0.0)
 			sum += lum_d(v3_mul(sm.weight, e));
 	}
-	return sum / LOBE_DIRS;
+	return sum / nq;
 }
 
-/* What the camera ray r shows first, in f (albedo, normal, depth). A
+/* What the camera ray r shows first, in f (albedo, normal, depth; with
+ * ks >= 0 the direct light, 7, and of it the part of glossy lobes looked
+ * through, 8: at an edge position, ks from DENOISE_FEATURE_SAMPLES on,
+ * that part alone). A
  * surface that is mostly a perfect mirror, a metal of little fuzz or glass
  * is looked through (up to four times): its features are those of the
  * surface seen in it, the albedo tinted by the mirror's or the glass's
  * colour, the depth the length of the whole path. Glass is followed along the refracted ray unless the
  * reflection is total. */
-static void first_surface(const world *w, ray r, int ks, double f[8])
+static void first_surface(const world *w, ray r, int ks, double f[9])
 {
 	vec3 tint = v3(1, 1, 1);
 	uint64_t bits[2];
@@ -267,7 +292,7 @@ static void first_surface(const world *w, ray r, int ks, double f[8])
 			f[4] += b.n.y;
 			f[5] += b.n.z;
 			f[6] += dist;
-			if (ks >= 0 && !(e.x + e.y + e.z > 0.0)) {
+			if (ks >= 0 && ks < DENOISE_FEATURE_SAMPLES && !(e.x + e.y + e.z > 0.0)) {
 				vec3 p = offset_point(w, h.p, b.n);
 				f[7] += (direct_feature(w, &b, p, h.object, ks, r1, true) + env_feature(w, &b, p, ks)) * lum_d(tint);
 			}
@@ -275,7 +300,9 @@ static void first_surface(const world *w, ray r, int ks, double f[8])
 		}
 		if (ks >= 0 && b.smooth) { /* a glossy lobe looked through: its own highlights */
 			vec3 p = offset_point(w, h.p, b.n);
-			f[7] += (direct_feature(w, &b, p, h.object, ks, r1, false) + lobe_feature(w, &b, p, ks)) * lum_d(tint);
+			double l = (direct_feature(w, &b, p, h.object, ks, r1, false) + lobe_feature(w, &b, p, ks)) * lum_d(tint);
+			f[7] += l;
+			f[8] += l;
 		}
 		if (b.smooth && !gl) {
 			gl = true;
@@ -303,7 +330,7 @@ static inline double albedo_divisor(double a)
 
 void denoise_sample(const world *w, ray r, int k, double *acc)
 {
-	double f[8] = {0};
+	double f[9] = {0};
 	first_surface(w, r, k, f);
 	for (int q = 0; q < 8; q++)
 		acc[q] += f[q];
@@ -312,6 +339,7 @@ void denoise_sample(const world *w, ray r, int k, double *acc)
 	if (!(k & 1))
 		for (int q = 0; q < 3; q++)
 			acc[10 + q] += f[q];
+	acc[13] += f[8];
 }
 
 /* Whether the first hits of a pixel's samples differ: albedo or depth
@@ -345,6 +373,7 @@ void denoise_features(const world *w, const render_settings *s, int px, int py, 
 		if (k != 7)
 			f[k] = (float)(((double)f[k] * n0 + acc[k]) / n1);
 	f[14] = (float)(((double)f[14] * n0 + acc[7]) / n1);
+	f[21] = (float)(((double)f[21] * n0 + acc[13]) / n1);
 	/* the albedo of the radiance samples' own positions: the even ones
 	 * and all of them */
 	int ne0 = (n0 + 1) / 2, ne1 = (n1 + 1) / 2;
@@ -355,22 +384,33 @@ void denoise_features(const world *w, const render_settings *s, int px, int py, 
 	}
 	if (n1 < DENOISE_FEATURE_SAMPLES || !features_vary(f))
 		return;
-	/* An edge: more camera positions, the radiance samples' own (the
-	 * direct light stays the mean of the first ones). */
-	double sum[10];
+	/* An edge: more camera positions, the radiance samples' own. The
+	 * direct light seen through glossy lobes too, from one direction
+	 * (point) of each set a position (feature_dirs), so that how much of
+	 * the pixel a highlight covers is known as well as where the edge is
+	 * (from the first samples alone a highlight's edge in a glossy metal
+	 * was as noisy as the radiance); the rest of the direct light stays
+	 * the mean of the first samples (refined too, it helped little for
+	 * its cost: a shadow ray a position). */
+	double sum[10], lobe = (double)f[21] * n1;
 	for (int k = 0; k < 10; k++)
 		sum[k] = (double)f[k] * n1;
 	for (int k = n1; k < DENOISE_EDGE_SAMPLES; k++) {
-		double one[8] = {0};
-		first_surface(w, render_sample_ray(w, s, px, py, fw, fh, k), -1, one);
+		double one[9] = {0};
+		first_surface(w, render_sample_ray(w, s, px, py, fw, fh, k), k, one);
 		for (int q = 0; q < 8; q++)
-			sum[q] += one[q];
+			if (q != 7)
+				sum[q] += one[q];
 		sum[8] += one[0] * one[0] + one[1] * one[1] + one[2] * one[2];
 		sum[9] += one[6] * one[6];
+		lobe += one[8];
 	}
 	for (int k = 0; k < 10; k++)
 		if (k != 7)
 			f[k] = (float)(sum[k] / DENOISE_EDGE_SAMPLES);
+	lobe /= DENOISE_EDGE_SAMPLES;
+	f[14] = (float)((double)f[14] - (double)f[21] + lobe);
+	f[21] = (float)lobe;
 }
 
 /* --- the filter ------------------------------------------------------------ */

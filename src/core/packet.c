@@ -363,33 +363,39 @@ static bool model_packet(const world *w, int n, const ray *r, double tmin, doubl
 	const prim *p = &w->prims[0];
 	const prim_inst *in = &w->insts[p->u.index];
 	double tm[PACKET_MAX], t[PACKET_MAX];
-	const prim_plane *best_plane[PACKET_MAX];
+	const prim_plane *best_plane[PACKET_MAX] = {NULL};
 	uint32_t slot[PACKET_MAX];
 	float b[PACKET_MAX][3];
-	for (int i = 0; i < n; i++) {
-		tm[i] = tmax;
-		best_plane[i] = NULL;
-	}
-	for (size_t k = 0; k < w->nplanes; k++)
-		for (int i = 0; i < n; i++) {
-			double tp;
-			if (plane_hit(&w->planes[k], &r[i], tmin, tm[i], &tp)) {
-				tm[i] = tp;
-				best_plane[i] = &w->planes[k];
+	if (w->nplanes) {
+		for (int i = 0; i < n; i++)
+			tm[i] = tmax;
+		for (size_t k = 0; k < w->nplanes; k++)
+			for (int i = 0; i < n; i++) {
+				double tp;
+				if (plane_hit(&w->planes[k], &r[i], tmin, tm[i], &tp)) {
+					tm[i] = tp;
+					best_plane[i] = &w->planes[k];
+				}
 			}
-		}
+	}
 	unsigned got, tie;
-	if (!mesh_intersect_world_packet(in->mesh, in->inv, n, r, tmin, tm, t, slot, b, &got, &tie))
+	if (!mesh_intersect_world_packet(in->mesh, in->inv, n, r, tmin, tmax, w->nplanes ? tm : NULL, t, slot, b, &got,
+	                                 &tie))
 		return false;
 	world_rays_count(n);
-	for (int i = 0; i < n; i++) {
-		if (got >> i & 1u) {
-			th[i] = (trace_hit){t[i], p, NULL, {(double)slot[i], b[i][1], b[i][2]}};
-			found[i] = true;
-		} else {
-			th[i] = (trace_hit){tm[i], NULL, best_plane[i], {0, 0, 0}};
+	if (w->nplanes) {
+		for (int i = 0; i < n; i++) {
 			found[i] = best_plane[i] != NULL;
+			if (found[i] && !(got >> i & 1u))
+				th[i] = (trace_hit){tm[i], NULL, best_plane[i], {0, 0, 0}};
 		}
+	} else {
+		memset(found, 0, (size_t)n * sizeof *found);
+	}
+	for (unsigned g = got; g; g &= g - 1) {
+		int i = __builtin_ctz(g);
+		th[i] = (trace_hit){t[i], p, NULL, {(double)slot[i], b[i][1], b[i][2]}};
+		found[i] = true;
 	}
 	for (; tie; tie &= tie - 1) {
 		int i = __builtin_ctz(tie);

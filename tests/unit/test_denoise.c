@@ -707,6 +707,45 @@ static void test_lamp_through_glossy(void **state)
 	}
 }
 
+/* An edge pixel's highlight in a glossy metal is a mean over the same 64
+ * camera positions as its albedo: a checkered white metal of fuzz 0.05
+ * (looked through, test_lamp_through_glossy) at z = 2.5 facing the camera
+ * at the origin, and behind the camera a lamp of radiance 5 that fills its
+ * lobe about every mirror direction of the centre pixel, no sky. At each
+ * position the metal's features are its own (the lamp is blurred by the
+ * lobe) and its direct light is the lamp through the lobe, 5 x the
+ * metal's tint there (its colour at normal incidence, to 1%,
+ * test_lamp_through_glossy): so over any positions the direct light is 5
+ * x the brightness of the mean albedo over the same positions. The centre
+ * pixel of 9 at 10 degrees (0.049 units wide there) straddles the
+ * checker's corner at the origin, a quarter of a pixel off its centre
+ * (its features vary), so its albedo is the mean over 64 positions; the
+ * direct light of the first 8 alone would be off by their share of each
+ * square. */
+static void test_edge_direct_feature(void **state)
+{
+	(void)state;
+	scene *s = load_text("C 0.012,0.007,0 0,0,1 10\nA 0 255,255,255\n"
+	                     "pl 0,0,2.5 0,0,-1 1,1,1 255,255,255 0 0 1 1 metal=1 fuzz=0.05 checker=1\n"
+	                     "sp 0,0,-5 0,1,0 5,5,5 255,255,255 0 0 1 0 emit=5\n");
+	world *w = world_build(s, NULL);
+	assert_non_null(w);
+	render_settings set = path_settings(9, 9, 8, 3, 5);
+	framebuffer *fb = fb_new(9, 9);
+	assert_true(fb && denoise_prepare(fb));
+	render_job job = {.w = w, .set = set, .fb = fb, .sample_begin = 0, .sample_end = 8};
+	assert_int_equal(render_run(&job, NULL), RENDER_DONE);
+	const float *f = fb->feat + (size_t)(4 * 9 + 4) * DENOISE_FEATURES;
+	double a = 0.2126 * f[0] + 0.7152 * f[1] + 0.0722 * f[2];
+	double a2 = (double)f[0] * f[0] + (double)f[1] * f[1] + (double)f[2] * f[2];
+	assert_true(f[8] - a2 > 1e-3); /* an edge: its albedo varies */
+	print_message("edge pixel: mean albedo brightness %.4f, direct light %.4f (expected %.4f)\n", a, f[14], 5 * a);
+	assert_near(f[14], 5 * a, 0.01 * 5 * a);
+	fb_free(fb);
+	world_free(w);
+	scene_free(s);
+}
+
 /* Features recorded in passes equal those of one pass, and mean the first
  * DENOISE_FEATURE_SAMPLES samples; the mean square covers every sample. */
 static void test_features_in_passes(void **state)
@@ -799,6 +838,7 @@ int main(void)
 		cmocka_unit_test(test_direct_feature),
 		cmocka_unit_test(test_env_feature),
 		cmocka_unit_test(test_lamp_through_glossy),
+		cmocka_unit_test(test_edge_direct_feature),
 		cmocka_unit_test(test_features_in_passes),
 		cmocka_unit_test(test_modes),
 		cmocka_unit_test(test_setting),
