@@ -288,6 +288,11 @@ bool mesh_occluded_world(const mesh *m, const double (*inv)[4], const ray *r, do
 bool mesh_intersect_world_packet(const mesh *m, const double (*inv)[4], int n, const ray *r, double tmin,
                                  double tmax, const double *tmax_each, double *t, uint32_t *slot, float (*b)[3],
                                  unsigned *found, unsigned *tie);
+/* mesh_occluded_world for rays r[0..n) at once, each in (tmin, tmax[i]):
+ * bit i of *occ set when something lies on ray i there (the same answers as
+ * the single rays'). False when the packet is not traced, as above. */
+bool mesh_occluded_world_packet(const mesh *m, const double (*inv)[4], int n, const ray *r, double tmin,
+                                const double *tmax, unsigned *occ);
 /* The vector unit the walk uses: AVX2 where the processor has it (one slab
  * test for a node's eight children; with AVX-512's registers where it has
  * those too), else SSE2 (two), else scalar code. Each finds the very same

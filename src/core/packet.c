@@ -496,10 +496,43 @@ static void leaf_occluded(const world *w, pk_state *s, unsigned *live, const pri
 	}
 }
 
+/* Shadow rays on a lone model: the planes first for each ray, as
+ * world_occluded, then the rays they leave through the model's triangle
+ * tree in one packet (mesh_occluded_world_packet). False when that packet
+ * is not traced: the caller traces each ray alone. */
+static bool model_occluded(const world *w, int n, const ray *r, double tmin, const double *tmax, bool *occ)
+{
+	const prim_inst *in = &w->insts[w->prims[0].u.index];
+	ray rl[PACKET_MAX];
+	double tl[PACKET_MAX];
+	int at[PACKET_MAX], nl = 0;
+	for (int i = 0; i < n; i++) {
+		double t;
+		bool blocked = false;
+		for (size_t k = 0; k < w->nplanes && !blocked; k++)
+			blocked = plane_hit(&w->planes[k], &r[i], tmin, tmax[i], &t);
+		occ[i] = blocked;
+		if (!blocked) {
+			rl[nl] = r[i];
+			tl[nl] = tmax[i];
+			at[nl++] = i;
+		}
+	}
+	unsigned got = 0;
+	if (nl > 0 && !mesh_occluded_world_packet(in->mesh, in->inv, nl, rl, tmin, tl, &got))
+		return false;
+	world_rays_count(n);
+	for (int k = 0; k < nl; k++)
+		occ[at[k]] = got >> k & 1u;
+	return true;
+}
+
 void world_occluded_packet(const world *w, int n, const ray *r, double tmin, const double *tmax, bool *occ)
 {
 	pk_ray q;
 	bool lone_model = w->nprims == 1 && w->prims[0].tag == PRIM_MESH;
+	if (lone_model && n >= 2 && n <= PACKET_MAX && model_occluded(w, n, r, tmin, tmax, occ))
+		return;
 	if (n < 2 || n > PACKET_MAX || lone_model || !packet_prepare(r, n, &q)) {
 		for (int i = 0; i < n; i++)
 			occ[i] = world_occluded(w, &r[i], tmin, tmax[i]);

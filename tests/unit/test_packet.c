@@ -321,7 +321,7 @@ static void test_prepare_edges(void **state)
 
 /* The packets mesh_intersect_world_packet traced, and the ties it reported
  * (check_model). */
-static long model_traced, model_ties;
+static long model_traced, model_ties, model_occluded_traced;
 
 /* mesh_intersect_world_packet itself against mesh_intersect_world_coherent
  * ray by ray, on the lone model of w, each ray to its own tmax: the beyond
@@ -341,6 +341,13 @@ static void check_model(const world *w, const ray *r, int n, int turn)
 		tm[i] = !fs[i] || k == 0 ? INFINITY : k == 1 ? ts[i] : k == 2 ? 0.5 * ts[i] : 2.0 * ts[i];
 		if (tm[i] < INFINITY) /* again to that tmax */
 			fs[i] = mesh_intersect_world_coherent(in->mesh, in->inv, &r[i], 0.0, tm[i], &ts[i], &ss[i], bs[i]);
+	}
+	/* shadow packets: whether anything lies on each ray up to its tmax */
+	unsigned occ;
+	if (mesh_occluded_world_packet(in->mesh, in->inv, n, r, 0.0, tm, &occ)) {
+		model_occluded_traced++;
+		for (int i = 0; i < n; i++)
+			assert_int_equal(occ >> i & 1u, mesh_occluded_world(in->mesh, in->inv, &r[i], 0.0, tm[i]));
 	}
 	unsigned got, tie;
 	/* each its own tmax, or (every other turn, when they are all
@@ -537,7 +544,7 @@ static void test_model_ties(void **state)
 static void test_model_packets(void **state)
 {
 	(void)state;
-	long traced = model_traced;
+	long traced = model_traced, occluded = model_occluded_traced;
 	const char *bunny = "../shared/models/stanford-bunny.obj";
 	char text[512];
 	if (access(bunny, R_OK) == 0) {
@@ -554,8 +561,10 @@ static void test_model_packets(void **state)
 	                  "pl 0,0,0 0,1,0 200,200,200\npl 0,0,3 0,0,-1 100,200,100\n"
 	                  "mesh scenes/models/spot/spot_triangulated.obj 0,0.74,0 0.3,1,0.1 1.5 255,255,255 twist=-40\n",
 	                  96, 54, 200);
-	if (have_model_packets())
+	if (have_model_packets()) {
 		assert_true(model_traced - traced > 1000);
+		assert_true(model_occluded_traced - occluded > 1000);
+	}
 }
 
 int main(void)
@@ -569,7 +578,7 @@ int main(void)
 		cmocka_unit_test(test_model_packets),
 	};
 	int rc = cmocka_run_group_tests(tests, NULL, NULL);
-	printf("packets: %ld, rays that hit: %ld; the model's own packets: %ld, ties among them: %ld\n", packets, rays_hit,
-	       model_traced, model_ties);
+	printf("packets: %ld, rays that hit: %ld; the model's own packets: %ld, ties among them: %ld; shadow packets: %ld\n",
+	       packets, rays_hit, model_traced, model_ties, model_occluded_traced);
 	return rc;
 }

@@ -612,6 +612,7 @@ typedef struct mesh_packet {
 	float b[MESH_PACKET_MAX][3];
 	unsigned found, tie;
 	bool ready; /* the triangle set-up is made (pk_ready, at the packet's first leaf) */
+	bool any;   /* any hit will do (mesh_occluded_world_packet) */
 	float tmin0;    /* the query's tmin as a float */
 	float eps;      /* the mesh's self-hit guard */
 } mesh_packet;
@@ -713,6 +714,15 @@ static AVX2 inline void pk_ready(mesh_packet *s)
  * no hit, as for the single ray). */
 static inline void pk_take(mesh_packet *s, int i, uint32_t slot, float th, float b0, float b1, float b2)
 {
+	if (s->any) {
+		/* any hit will do: the ray is done (no leaf lets it in again,
+		 * no block finds it a hit, the packet does not wait for it) */
+		s->best[i] = th;
+		s->bt[i] = -INFINITY;
+		s->bs[i] = -INFINITY;
+		s->found |= 1u << i;
+		return;
+	}
 	if (th < s->best[i]) {
 		s->best[i] = th;
 		s->bt[i] = next_upf(th);
@@ -911,9 +921,11 @@ static AVX2 inline float pk_hmax(__m256 a)
 
 static AVX2 __attribute__((noinline)) bool packet_walk(const mesh *m, const double (*M)[4], int n, const ray *wr,
                                                        double tmin, double tmax1, const double *tmax, double *t,
-                                                       uint32_t *slot, float (*b)[3], unsigned *found, unsigned *tie)
+                                                       uint32_t *slot, float (*b)[3], unsigned *found, unsigned *tie,
+                                                       bool any)
 {
 	_Alignas(32) mesh_packet s;
+	s.any = any;
 	float box_tmin = (float)tmin;
 	/* the rays in the model's floats by component, as the single walk
 	 * makes them (world_ray_floats: its operations in its order, four rays
@@ -1276,10 +1288,33 @@ bool mesh_intersect_world_packet(const mesh *m, const double (*inv)[4], int n, c
 {
 #if defined(HAVE_AVX2_WALK)
 	if (n >= 1 && n <= MESH_PACKET_MAX && mesh_isa_active() >= MESH_ISA_AVX2)
-		return packet_walk(m, inv, n, r, tmin, tmax, tmax_each, t, slot, b, found, tie);
+		return packet_walk(m, inv, n, r, tmin, tmax, tmax_each, t, slot, b, found, tie, false);
 #else
 	(void)m, (void)inv, (void)n, (void)r, (void)tmin, (void)tmax, (void)tmax_each, (void)t, (void)slot, (void)b,
 		(void)found, (void)tie;
+#endif
+	return false;
+}
+
+bool mesh_occluded_world_packet(const mesh *m, const double (*inv)[4], int n, const ray *r, double tmin,
+                                const double *tmax, unsigned *occ)
+{
+#if defined(HAVE_AVX2_WALK)
+	if (n >= 1 && n <= MESH_PACKET_MAX && mesh_isa_active() >= MESH_ISA_AVX2) {
+		double t[MESH_PACKET_MAX];
+		uint32_t slot[MESH_PACKET_MAX];
+		float b[MESH_PACKET_MAX][3];
+		unsigned tie;
+		/* (a tmax between 3e38 and FLT_MAX: the single ray's float bound,
+		 * inf, lets it find hits it then refuses, and which it meets
+		 * first decides: traced alone) */
+		for (int i = 0; i < n; i++)
+			if (tmax[i] >= 3e38 && tmax[i] < INFINITY)
+				return false;
+		return packet_walk(m, inv, n, r, tmin, 0.0, tmax, t, slot, b, occ, &tie, true);
+	}
+#else
+	(void)m, (void)inv, (void)n, (void)r, (void)tmin, (void)tmax, (void)occ;
 #endif
 	return false;
 }
