@@ -297,6 +297,36 @@ static void leaf_spheres(pk_state *s, const prim *p, const ray *r, double tmin)
 #endif
 }
 
+/* The rays of s meet a model among the objects (a mesh instance in a leaf)
+ * as a packet through its own triangle tree: each ray to the next double
+ * above its nearest so far, as offer expects, and a ray the model's packet
+ * found a tie for meets it again alone. False when the model's packet is
+ * not traced (the caller tests ray by ray). */
+static bool leaf_mesh(const world *w, pk_state *s, const prim *p, const ray *r, double tmin)
+{
+	const prim_inst *in = &w->insts[p->u.index];
+	double tm[PACKET_MAX], t[PACKET_MAX];
+	uint32_t slot[PACKET_MAX];
+	float b[PACKET_MAX][3];
+	unsigned got, tie;
+	for (int i = 0; i < s->n; i++)
+		tm[i] = next_up(s->tmax[i]);
+	if (!mesh_intersect_world_packet(in->mesh, in->inv, s->n, r, tmin, 0.0, tm, t, slot, b, &got, &tie))
+		return false;
+	for (unsigned g = got & ~tie; g; g &= g - 1) {
+		int i = __builtin_ctz(g);
+		offer(s, i, p, t[i], v3((double)slot[i], b[i][1], b[i][2]));
+	}
+	for (; tie; tie &= tie - 1) {
+		int i = __builtin_ctz(tie);
+		double tt;
+		vec3 nl;
+		if (world_prim_hit(w, p, &r[i], tmin, tm[i], &tt, &nl, true))
+			offer(s, i, p, tt, nl);
+	}
+	return true;
+}
+
 /* The farthest of the rays' nearest hits so far. */
 static inline double packet_far(const pk_state *s)
 {
@@ -324,6 +354,8 @@ static void packet_walk(const world *w, pk_state *s, const ray *r, const pk_ray 
 					leaf_spheres(s, &p[k], r, tmin);
 					continue;
 				}
+				if (p[k].tag == PRIM_MESH && leaf_mesh(w, s, &p[k], r, tmin))
+					continue;
 				for (int i = 0; i < s->n; i++) {
 					double t;
 					vec3 nl = {0, 0, 0};
@@ -474,6 +506,9 @@ void world_intersect_packet(const world *w, int n, const ray *r, double tmin, do
 /* The rays of s not yet known to be blocked: bit i for ray i. */
 static void leaf_occluded(const world *w, pk_state *s, unsigned *live, const prim *p, const ray *r, double tmin)
 {
+	/* (a model here is met ray by ray: shadow rays that reach a leaf of the
+	 * object tree come from points far apart, and as one packet through
+	 * the model's tree they made instances.rt 1.6x slower) */
 	if (p->tag != PRIM_SPHERE) {
 		for (unsigned m = *live; m; m &= m - 1) {
 			int i = __builtin_ctz(m);

@@ -172,8 +172,9 @@ static bool check_scene(const char *path, int W, int H, int cones)
 static void test_scenes(void **state)
 {
 	(void)state;
-	const char *paths[] = {"scenes/grid.rt", "scenes/showcase.rt", "scenes/tori.rt", "scenes/instances.rt",
-	                       "scenes/final.rt", "scenes/classic42.rt", "scenes/cornell.rt"};
+	const char *paths[] = {"scenes/grid.rt",   "scenes/showcase.rt",  "scenes/tori.rt",    "scenes/instances.rt",
+	                       "scenes/final.rt",  "scenes/classic42.rt", "scenes/cornell.rt", "scenes/fence.rt",
+	                       "scenes/spot.rt"};
 	for (size_t i = 0; i < sizeof paths / sizeof *paths; i++) {
 		long before = rays_hit;
 		assert_true(check_scene(paths[i], 96, 54, 300));
@@ -500,6 +501,41 @@ static void test_model_ties(void **state)
 	snprintf(text, sizeof text, "C 0,0,-7 0,0,1 70\nL -2,3,-6 0.8 255,255,255\nmesh %s 0,0,1 0,1,0 6 200,200,200\n",
 	         path);
 	check_model_scene(text, 64, 64, 100);
+	/* the model among other objects: the object tree's packets meet it
+	 * as a packet of its own (packet.c's leaf_mesh), ties and all */
+	snprintf(text, sizeof text,
+	         "C 0.1,0.05,-7 0,0,1 50\nL -2,3,-6 0.8 255,255,255\nmesh %s 0,0,1 0,1,0 6 200,200,200\n"
+	         "sp 2.5,2.5,-1 0.5 255,0,0\nsp -2.5,-2.5,3 0.5 0,255,0\n",
+	         path);
+	{
+		rt_error e2;
+		scene *s2 = rt_load_string(text, strlen(text), "ties", NULL, &e2);
+		if (!s2)
+			fail_msg("ties: %s", e2.msg);
+		world *w2 = world_build(s2, &e2);
+		if (!w2)
+			fail_msg("ties: %s", e2.msg);
+		for (int isa = MESH_ISA_SCALAR; isa <= MESH_ISA_BEST; isa++)
+			if (mesh_isa_force((mesh_isa)isa)) {
+				camera_packets(w2, 96, 64, w2->lights[0].pos);
+				cone_packets(w2, w2->bounds.lo, w2->bounds.hi, 300, 7 + (uint64_t)isa, w2->lights[0].pos);
+				/* from points spread over a wide square, toward the copies */
+				test_rng g = {99 + (uint64_t)isa};
+				for (int k = 0; k < 400; k++) {
+					ray r[PACKET_MAX];
+					vec3 o = v3(-4 + 8 * trand(&g), -4 + 8 * trand(&g), -3 - 4 * trand(&g));
+					vec3 at = v3(-1 + 2 * trand(&g), -1 + 2 * trand(&g), 1);
+					for (int i = 0; i < PACKET_MAX; i++) {
+						vec3 oi = v3_add(o, v3(0.5 * trand(&g), 0.5 * trand(&g), 0));
+						r[i] = (ray){oi, v3_sub(v3_add(at, v3(0.3 * trand(&g), 0.3 * trand(&g), 0)), oi)};
+					}
+					check_packet(w2, r, PACKET_MAX, w2->lights[0].pos);
+				}
+			}
+		assert_true(mesh_isa_force(MESH_ISA_BEST));
+		world_free(w2);
+		scene_free(s2);
+	}
 	/* rays exactly through the grid's corners and edges (the model's
 	 * coordinates are the world's here: placed at its own centre at its
 	 * own size; each ray 8 long in z, so that the shear is exact and the
