@@ -1402,6 +1402,29 @@ static double kernel_primary(const world *wd, int w, int h, bool coherent, doubl
 	return cpu_now() - t0;
 }
 
+/* kernel_primary's rays and answers traced as packets of 4x4 pixels
+ * (world_trace_packet: the model's own packet walk), Embree's 4x4 tiles
+ * for rtcIntersect16: CPU time. */
+static double kernel_packet(const world *wd, int w, int h, double *sink)
+{
+	double t0 = cpu_now();
+	for (int y0 = 0; y0 < h; y0 += 4)
+		for (int x0 = 0; x0 < w; x0 += 4) {
+			ray r[PACKET_MAX];
+			trace_hit th[PACKET_MAX];
+			bool found[PACKET_MAX];
+			int n = 0;
+			for (int y = y0; y < y0 + 4 && y < h; y++)
+				for (int x = x0; x < x0 + 4 && x < w; x++)
+					r[n++] = cam_ray(&wd->cam, x + 0.5, y + 0.5, w, h);
+			world_trace_packet(wd, n, r, 0.0, INFINITY, th, found);
+			for (int i = 0; i < n; i++)
+				if (found[i])
+					*sink += world_trace_ng(wd, &r[i], &th[i]).x;
+		}
+	return cpu_now() - t0;
+}
+
 static void bench_mesh(void)
 {
 	bench_mesh_load();
@@ -1441,8 +1464,8 @@ static void bench_mesh(void)
 	world *wd = build(s);
 	double bytes = (double)world_memory(wd) / ntris;
 	double eps = 1e-4 * v3_len(ext);
-	double tp[MAX_RUNS], ts[MAX_RUNS], tpk[MAX_RUNS], tpu[MAX_RUNS], tsk[MAX_RUNS], be[MAX_RUNS], byte_e = -1, pe[MAX_RUNS],
-	    se[MAX_RUNS];
+	double tp[MAX_RUNS], ts[MAX_RUNS], tpk[MAX_RUNS], tpu[MAX_RUNS], tsk[MAX_RUNS], tpp[MAX_RUNS], be[MAX_RUNS], byte_e = -1,
+	    pe[MAX_RUNS], se[MAX_RUNS];
 	double sink = 0; /* the kernel rows' normals, so that none is left out */
 	int ne = 0, npk[EMBREE_PACKETS] = {0};
 	double pkm[EMBREE_PACKETS][MAX_RUNS], pks[EMBREE_PACKETS][MAX_RUNS];
@@ -1476,6 +1499,7 @@ static void bench_mesh(void)
 		 * without it */
 		tpk[i] = kernel_primary(wd, w, h, true, &sink);
 		tpu[i] = kernel_primary(wd, w, h, false, &sink);
+		tpp[i] = kernel_packet(wd, w, h, &sink);
 		t0 = cpu_now();
 		for (long k = 0; k < nsec; k++) {
 			trace_hit th;
@@ -1499,6 +1523,7 @@ static void bench_mesh(void)
 	free(sr);
 	double mb = median(tb, runs), mp = median(tp, runs), ms = median(ts, runs);
 	double mpk = median(tpk, runs), msk = median(tsk, runs), mpu = median(tpu, runs);
+	double mpp = median(tpp, runs), mrpp = (double)w * h / mpp * 1e-6;
 	double mrp = (double)w * h / mp * 1e-6, mrs = (double)nsec / ms * 1e-6;
 	double mrpk = (double)w * h / mpk * 1e-6, mrsk = (double)nsec / msk * 1e-6, mrpu = (double)w * h / mpu * 1e-6;
 	if (sink == 12345.678)
@@ -1540,6 +1565,16 @@ static void bench_mesh(void)
 		         "rtcIntersect%d, %s-pixel tiles, coherent flag (CPU time); rtsh tri-primary %.2fx, rtcIntersect1 %.2f",
 		         4 << k, packet_tiles[k], mrpk / pm, ep);
 	}
+	r = add_row("bunny 69k tris", "tri-primary-packet16", w, h, 1, 1, runs, mpp, mrpp);
+	if (npk[EMBREE_PACKETS - 1])
+		snprintf(r->note, sizeof r->note,
+		         "CPU time; world_trace_packet (4x4 pixels, the model's packet walk) + Ng: %.2fx tri-primary; "
+		         "Embree rtcIntersect16 %.2f Mrays/s: rtsh %.2fx",
+		         mrpp / mrpk, median(pkm[EMBREE_PACKETS - 1], npk[EMBREE_PACKETS - 1]),
+		         mrpp / median(pkm[EMBREE_PACKETS - 1], npk[EMBREE_PACKETS - 1]));
+	else
+		snprintf(r->note, sizeof r->note, "CPU time; world_trace_packet (4x4 pixels, the model's packet walk) + Ng: %.2fx tri-primary",
+		         mrpp / mrpk);
 	if (!ne && !quick) {
 		r = add_row("bunny 69k tris", "embree-mesh", 0, 0, 0, 1, 0, -1, -1);
 		snprintf(r->note, sizeof r->note, "no %s/embree_mesh (needs embree3/rtcore.h)", bench_dir);

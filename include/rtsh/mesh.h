@@ -274,18 +274,25 @@ bool mesh_occluded_world(const mesh *m, const double (*inv)[4], const ray *r, do
 /* The most rays mesh_intersect_world_packet takes at once. */
 #define MESH_PACKET_MAX 16
 /* mesh_intersect_world_coherent for rays r[0..n) (n <= MESH_PACKET_MAX)
- * at once, each in (tmin, tmax[i]): bit i of *found says whether ray i hit,
- * t[i], slot[i] and b[i] what, the same floats as the single ray's. Bit i
- * of *tie: ray i met two triangles at exactly its nearest distance, where
- * the single ray keeps the first it meets in its own order; the caller
- * traces it alone. False when the packet is not traced (the rays' directions
- * do not share each axis's sign, a component is zero or not finite, or the
- * vector unit in use has no packet walk): then the caller traces each ray
- * alone. The rays walk the tree once, culled by interval tests for the
- * packet and their own slab tests at the leaves (mesh_trace.c). */
+ * at once, each in (tmin, tmax_each[i]) (tmax_each NULL: (tmin, tmax) for
+ * all): bit i of *found says whether ray i hit, t[i], slot[i] and b[i]
+ * what (set only for the rays that hit), the same floats as the single
+ * ray's. Bit i of *tie: ray i met two triangles at exactly its nearest
+ * distance, where the single ray keeps the first it meets in its own
+ * order; the caller traces it alone. False when the packet is not traced
+ * (the rays' directions do not share each axis's sign, a component is zero
+ * or not finite, or the vector unit in use has no packet walk): then the
+ * caller traces each ray alone. The rays walk the tree once, culled by
+ * interval tests for the packet and their own slab tests at the leaves
+ * (mesh_trace.c). */
 bool mesh_intersect_world_packet(const mesh *m, const double (*inv)[4], int n, const ray *r, double tmin,
-                                 const double *tmax, double *t, uint32_t *slot, float (*b)[3], unsigned *found,
-                                 unsigned *tie);
+                                 double tmax, const double *tmax_each, double *t, uint32_t *slot, float (*b)[3],
+                                 unsigned *found, unsigned *tie);
+/* mesh_occluded_world for rays r[0..n) at once, each in (tmin, tmax[i]):
+ * bit i of *occ set when something lies on ray i there (the same answers as
+ * the single rays'). False when the packet is not traced, as above. */
+bool mesh_occluded_world_packet(const mesh *m, const double (*inv)[4], int n, const ray *r, double tmin,
+                                const double *tmax, unsigned *occ);
 /* The vector unit the walk uses: AVX2 where the processor has it (one slab
  * test for a node's eight children; with AVX-512's registers where it has
  * those too), else SSE2 (two), else scalar code. Each finds the very same

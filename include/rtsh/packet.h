@@ -33,8 +33,8 @@
 
 /* The nearest hits of rays r[0..n) (n <= PACKET_MAX) with tmin < t < tmax,
  * as world_trace_coherent gives them one by one: found[i] says whether ray i
- * hit, th[i] what. Camera rays, or any rays that start close together and
- * point the same way. */
+ * hit, th[i] what (th[i] is not set where found[i] is false). Camera rays,
+ * or any rays that start close together and point the same way. */
 void world_trace_packet(const world *w, int n, const ray *r, double tmin, double tmax, trace_hit *th, bool *found);
 /* world_trace_packet, then world_finish of each hit into h[i]. */
 void world_intersect_packet(const world *w, int n, const ray *r, double tmin, double tmax, hit *h, bool *found);

@@ -1313,11 +1313,12 @@ static bool parse_tokens(parser *p)
 	const tok *id = &p->toks[0];
 	const elem_def *e = NULL;
 	elem_def obj;
+	/* the first letters compared before the names (a line of a million) */
 	for (size_t i = 0; i < NHEAD && !e; i++)
-		if (strcmp(elements_head[i].id, id->s) == 0)
+		if (elements_head[i].id[0] == id->s[0] && strcmp(elements_head[i].id, id->s) == 0)
 			e = &elements_head[i];
 	for (size_t i = 0; i < NTAIL && !e; i++)
-		if (strcmp(elements_tail[i].id, id->s) == 0)
+		if (elements_tail[i].id[0] == id->s[0] && strcmp(elements_tail[i].id, id->s) == 0)
 			e = &elements_tail[i];
 	obj_kind k;
 	const shape_form *f;

@@ -2,6 +2,8 @@
 #include "rtsh/rules.h"
 
 #include <math.h>
+#include <pthread.h>
+#include <stdint.h>
 #include <stdio.h>
 
 #include "scene/rtfile_priv.h"
@@ -83,6 +85,39 @@ bool sky_validate(const sky *k, rt_error *err)
 	return true;
 }
 
+/* The numeric keys (in table order) that apply to each kind: object_rules
+ * checks those of its object's kind instead of asking every key of the
+ * table (a million loaded spheres asked 30 keys each). Not made (the full
+ * loop instead) if the table outgrows RULE_KEYS_MAX. */
+#define RULE_KEYS_MAX 128
+static uint8_t rule_keys[OBJ_KIND_COUNT][RULE_KEYS_MAX];
+static size_t rule_nkeys[OBJ_KIND_COUNT];
+static bool rule_keys_made;
+static pthread_once_t rule_keys_once = PTHREAD_ONCE_INIT;
+
+static void rule_keys_init(void)
+{
+	if (rt_nkeys > RULE_KEYS_MAX)
+		return;
+	for (int kind = 0; kind < OBJ_KIND_COUNT; kind++)
+		for (size_t i = 0; i < rt_nkeys; i++)
+			if (rt_key_applies(&rt_keys[i], (obj_kind)kind) && rt_keys[i].type == RT_KEY_NUM)
+				rule_keys[kind][rule_nkeys[kind]++] = (uint8_t)i;
+	rule_keys_made = true;
+}
+
+/* Key k's value in o is its default or within its range; false with err
+ * set (the object's kind named `name`) when not. */
+static bool key_rule(const rt_key *k, const object *o, const char *name, rt_error *err)
+{
+	double v = rt_key_get(k, o);
+	if (v == k->def)
+		return true;
+	if (!(v >= k->min && v <= k->max) || (k->is_int && v != floor(v)) || (k->extra && !k->extra(v)))
+		return rt_error_set(err, "%s %s=%g is out of range; expected %s", name, k->name, v, k->expect);
+	return true;
+}
+
 bool object_rules(const object *o, rt_error *err)
 {
 	if (!object_validate(o, err))
@@ -123,16 +158,17 @@ bool object_rules(const object *o, rt_error *err)
 		return rt_error_set(err, "%s material %g %g %g %g is out of range; expected DIFFUSE, "
 		                         "SPECULAR and REFLECTIVE in [0,1], SHININESS in [1,500]",
 		                    name, m->diffuse, m->specular, m->shininess, m->reflective);
-	for (size_t i = 0; i < rt_nkeys; i++) {
-		const rt_key *k = &rt_keys[i];
-		if (!rt_key_applies(k, o->kind) || k->type != RT_KEY_NUM)
-			continue; /* files and U,V pairs are checked where they are read */
-		double v = rt_key_get(k, o);
-		if (v == k->def)
-			continue;
-		if (!(v >= k->min && v <= k->max) || (k->is_int && v != floor(v)) || (k->extra && !k->extra(v)))
-			return rt_error_set(err, "%s %s=%g is out of range; expected %s", name, k->name, v,
-			                    k->expect);
+	/* files and U,V pairs are checked where they are read */
+	pthread_once(&rule_keys_once, rule_keys_init);
+	if (rule_keys_made && (unsigned)o->kind < OBJ_KIND_COUNT) {
+		for (size_t i = 0; i < rule_nkeys[o->kind]; i++)
+			if (!key_rule(&rt_keys[rule_keys[o->kind][i]], o, name, err))
+				return false;
+		return true;
 	}
+	for (size_t i = 0; i < rt_nkeys; i++)
+		if (rt_key_applies(&rt_keys[i], o->kind) && rt_keys[i].type == RT_KEY_NUM &&
+		    !key_rule(&rt_keys[i], o, name, err))
+			return false;
 	return true;
 }

@@ -172,8 +172,9 @@ static bool check_scene(const char *path, int W, int H, int cones)
 static void test_scenes(void **state)
 {
 	(void)state;
-	const char *paths[] = {"scenes/grid.rt", "scenes/showcase.rt", "scenes/tori.rt", "scenes/instances.rt",
-	                       "scenes/final.rt", "scenes/classic42.rt", "scenes/cornell.rt"};
+	const char *paths[] = {"scenes/grid.rt",   "scenes/showcase.rt",  "scenes/tori.rt",    "scenes/instances.rt",
+	                       "scenes/final.rt",  "scenes/classic42.rt", "scenes/cornell.rt", "scenes/fence.rt",
+	                       "scenes/spot.rt"};
 	for (size_t i = 0; i < sizeof paths / sizeof *paths; i++) {
 		long before = rays_hit;
 		assert_true(check_scene(paths[i], 96, 54, 300));
@@ -321,7 +322,7 @@ static void test_prepare_edges(void **state)
 
 /* The packets mesh_intersect_world_packet traced, and the ties it reported
  * (check_model). */
-static long model_traced, model_ties;
+static long model_traced, model_ties, model_occluded_traced;
 
 /* mesh_intersect_world_packet itself against mesh_intersect_world_coherent
  * ray by ray, on the lone model of w, each ray to its own tmax: the beyond
@@ -331,7 +332,7 @@ static long model_traced, model_ties;
 static void check_model(const world *w, const ray *r, int n, int turn)
 {
 	const prim_inst *in = &w->insts[w->prims[0].u.index];
-	double ts[PACKET_MAX], tm[PACKET_MAX], t[PACKET_MAX];
+	double ts[PACKET_MAX], tm[PACKET_MAX] = {0}, t[PACKET_MAX];
 	uint32_t ss[PACKET_MAX], slot[PACKET_MAX];
 	float bs[PACKET_MAX][3], b[PACKET_MAX][3];
 	bool fs[PACKET_MAX];
@@ -342,8 +343,20 @@ static void check_model(const world *w, const ray *r, int n, int turn)
 		if (tm[i] < INFINITY) /* again to that tmax */
 			fs[i] = mesh_intersect_world_coherent(in->mesh, in->inv, &r[i], 0.0, tm[i], &ts[i], &ss[i], bs[i]);
 	}
+	/* shadow packets: whether anything lies on each ray up to its tmax */
+	unsigned occ;
+	if (mesh_occluded_world_packet(in->mesh, in->inv, n, r, 0.0, tm, &occ)) {
+		model_occluded_traced++;
+		for (int i = 0; i < n; i++)
+			assert_int_equal(occ >> i & 1u, mesh_occluded_world(in->mesh, in->inv, &r[i], 0.0, tm[i]));
+	}
 	unsigned got, tie;
-	if (!mesh_intersect_world_packet(in->mesh, in->inv, n, r, 0.0, tm, t, slot, b, &got, &tie))
+	/* each its own tmax, or (every other turn, when they are all
+	 * the same) one for all */
+	bool one = turn % 2 == 0;
+	for (int i = 1; i < n && one; i++)
+		one = tm[i] == tm[0];
+	if (!mesh_intersect_world_packet(in->mesh, in->inv, n, r, 0.0, tm[0], one ? NULL : tm, t, slot, b, &got, &tie))
 		return;
 	model_traced++;
 	for (int i = 0; i < n; i++) {
@@ -488,6 +501,72 @@ static void test_model_ties(void **state)
 	snprintf(text, sizeof text, "C 0,0,-7 0,0,1 70\nL -2,3,-6 0.8 255,255,255\nmesh %s 0,0,1 0,1,0 6 200,200,200\n",
 	         path);
 	check_model_scene(text, 64, 64, 100);
+	/* the model among other objects: the object tree's packets meet it
+	 * as a packet of its own (packet.c's leaf_mesh), ties and all */
+	snprintf(text, sizeof text,
+	         "C 0.1,0.05,-7 0,0,1 50\nL -2,3,-6 0.8 255,255,255\nmesh %s 0,0,1 0,1,0 6 200,200,200\n"
+	         "sp 2.5,2.5,-1 0.5 255,0,0\nsp -2.5,-2.5,3 0.5 0,255,0\n",
+	         path);
+	{
+		rt_error e2;
+		scene *s2 = rt_load_string(text, strlen(text), "ties", NULL, &e2);
+		if (!s2)
+			fail_msg("ties: %s", e2.msg);
+		world *w2 = world_build(s2, &e2);
+		if (!w2)
+			fail_msg("ties: %s", e2.msg);
+		for (int isa = MESH_ISA_SCALAR; isa <= MESH_ISA_BEST; isa++)
+			if (mesh_isa_force((mesh_isa)isa)) {
+				camera_packets(w2, 96, 64, w2->lights[0].pos);
+				cone_packets(w2, w2->bounds.lo, w2->bounds.hi, 300, 7 + (uint64_t)isa, w2->lights[0].pos);
+				/* from points spread over a wide square, toward the copies */
+				test_rng g = {99 + (uint64_t)isa};
+				for (int k = 0; k < 400; k++) {
+					ray r[PACKET_MAX];
+					vec3 o = v3(-4 + 8 * trand(&g), -4 + 8 * trand(&g), -3 - 4 * trand(&g));
+					vec3 at = v3(-1 + 2 * trand(&g), -1 + 2 * trand(&g), 1);
+					for (int i = 0; i < PACKET_MAX; i++) {
+						vec3 oi = v3_add(o, v3(0.5 * trand(&g), 0.5 * trand(&g), 0));
+						r[i] = (ray){oi, v3_sub(v3_add(at, v3(0.3 * trand(&g), 0.3 * trand(&g), 0)), oi)};
+					}
+					check_packet(w2, r, PACKET_MAX, w2->lights[0].pos);
+				}
+			}
+		assert_true(mesh_isa_force(MESH_ISA_BEST));
+		world_free(w2);
+		scene_free(s2);
+	}
+	/* rays exactly through the grid's corners and edges (the model's
+	 * coordinates are the world's here: placed at its own centre at its
+	 * own size; each ray 8 long in z, so that the shear is exact and the
+	 * edge functions there are zeros, recomputed in double) */
+	snprintf(text, sizeof text, "C 0,0,-7 0,0,1 70\nmesh %s 0,0,1 0,1,0 6 200,200,200\n", path);
+	rt_error err;
+	scene *sc = rt_load_string(text, strlen(text), "ties", NULL, &err);
+	if (!sc)
+		fail_msg("ties: %s", err.msg);
+	world *w = world_build(sc, &err);
+	if (!w)
+		fail_msg("ties: %s", err.msg);
+	for (int isa = MESH_ISA_SCALAR; isa <= MESH_ISA_BEST; isa++) {
+		if (!mesh_isa_force((mesh_isa)isa))
+			continue;
+		for (int q = 0; q < 8; q++) {
+			double sx = q & 1 ? -1 : 1, sy = q & 2 ? -1 : 1;
+			ray r[PACKET_MAX];
+			vec3 o = v3(0.25 * (q >> 2), 0.125 * (q >> 2), -6);
+			for (int i = 0; i < PACKET_MAX; i++) {
+				/* corners and edge midpoints of the grid's outer quads */
+				double tx = sx * (2.25 + 0.375 * (i % 3)), ty = sy * (0.75 + 0.375 * (i / 3));
+				r[i] = (ray){o, v3(tx - o.x, ty - o.y, 8)};
+			}
+			check_packet(w, r, PACKET_MAX, v3(0, 0, -10));
+			check_model(w, r, PACKET_MAX, q);
+		}
+	}
+	assert_true(mesh_isa_force(MESH_ISA_BEST));
+	world_free(w);
+	scene_free(sc);
 	unlink(path);
 	if (have_model_packets()) {
 		assert_true(model_traced - traced > 500);
@@ -501,7 +580,7 @@ static void test_model_ties(void **state)
 static void test_model_packets(void **state)
 {
 	(void)state;
-	long traced = model_traced;
+	long traced = model_traced, occluded = model_occluded_traced;
 	const char *bunny = "../shared/models/stanford-bunny.obj";
 	char text[512];
 	if (access(bunny, R_OK) == 0) {
@@ -518,8 +597,10 @@ static void test_model_packets(void **state)
 	                  "pl 0,0,0 0,1,0 200,200,200\npl 0,0,3 0,0,-1 100,200,100\n"
 	                  "mesh scenes/models/spot/spot_triangulated.obj 0,0.74,0 0.3,1,0.1 1.5 255,255,255 twist=-40\n",
 	                  96, 54, 200);
-	if (have_model_packets())
+	if (have_model_packets()) {
 		assert_true(model_traced - traced > 1000);
+		assert_true(model_occluded_traced - occluded > 1000);
+	}
 }
 
 int main(void)
@@ -533,7 +614,7 @@ int main(void)
 		cmocka_unit_test(test_model_packets),
 	};
 	int rc = cmocka_run_group_tests(tests, NULL, NULL);
-	printf("packets: %ld, rays that hit: %ld; the model's own packets: %ld, ties among them: %ld\n", packets, rays_hit,
-	       model_traced, model_ties);
+	printf("packets: %ld, rays that hit: %ld; the model's own packets: %ld, ties among them: %ld; shadow packets: %ld\n",
+	       packets, rays_hit, model_traced, model_ties, model_occluded_traced);
 	return rc;
 }

@@ -12,7 +12,9 @@
 
 #include "rtsh/render.h"
 #include "rtsh/rtfile.h"
+#include "rtsh/rules.h"
 #include "rtsh/settings.h"
+#include "scene/rtfile_priv.h"
 
 #define WILD_DIR "../shared/scenes-wild"
 
@@ -1441,6 +1443,48 @@ static void test_c_locale_numbers(void **state)
 	}
 }
 
+/* object_rules and the numeric keys: for every kind and every numeric key,
+ * a value outside the key's range is refused, naming the key, when the
+ * key applies to the kind (rt_key_applies), and ignored when it does not
+ * (object_rules keeps a list of each kind's keys). */
+static void test_object_rules_keys(void **state)
+{
+	(void)state;
+	int refused = 0, ignored = 0;
+	for (int kind = 0; kind < OBJ_KIND_COUNT; kind++) {
+		object base = object_make((obj_kind)kind, v3(10, 20, 30));
+		if (!object_rules(&base, NULL))
+			continue; /* a kind whose bare object needs more (a model's file) */
+		for (size_t i = 0; i < rt_nkeys; i++) {
+			const rt_key *k = &rt_keys[i];
+			if (k->type != RT_KEY_NUM)
+				continue;
+			double bad = k->max + 1;
+			if (!(k->max < 1e9) || bad == k->def)
+				bad = k->min - 1;
+			if (!(k->min > -1e9) || bad == k->def)
+				continue;
+			object o = base;
+			assert_true(rt_key_set(k, &o, bad));
+			rt_error err;
+			err.msg[0] = '\0';
+			bool ok = object_rules(&o, &err);
+			if (rt_key_applies(k, (obj_kind)kind)) {
+				if (ok || !strstr(err.msg, k->name))
+					fail_msg("kind %s key %s=%g: %s", obj_kind_name((obj_kind)kind), k->name, bad,
+					         ok ? "accepted" : err.msg);
+				refused++;
+			} else {
+				if (!ok)
+					fail_msg("kind %s key %s (not its own)=%g refused: %s", obj_kind_name((obj_kind)kind),
+					         k->name, bad, err.msg);
+				ignored++;
+			}
+		}
+	}
+	assert_true(refused > 20 && ignored > 5);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -1474,6 +1518,7 @@ int main(void)
 		cmocka_unit_test(test_kept_settings_errors),
 		cmocka_unit_test(test_wild_corpus),
 		cmocka_unit_test(test_c_locale_numbers),
+		cmocka_unit_test(test_object_rules_keys),
 	};
 	return cmocka_run_group_tests_name("rtfile", tests, NULL, NULL);
 }

@@ -600,13 +600,19 @@ typedef struct mesh_packet {
 	_Alignas(32) float fx[MESH_PACKET_MAX], fy[MESH_PACKET_MAX], fz[MESH_PACKET_MAX];
 	_Alignas(32) float bs[MESH_PACKET_MAX];
 	_Alignas(32) float dx[MESH_PACKET_MAX], dy[MESH_PACKET_MAX], dz[MESH_PACKET_MAX];
-	ray4 rq[MESH_PACKET_MAX];
-	mesh_ray r[MESH_PACKET_MAX];
-	float best[MESH_PACKET_MAX], tmin[MESH_PACKET_MAX];
+	/* the triangle test's by component (pk_ready): the origin on the
+	 * axes kx, ky, kz, the shear constants, tmin, the next float above
+	 * the best so far */
+	_Alignas(32) float kox[MESH_PACKET_MAX], koy[MESH_PACKET_MAX], koz[MESH_PACKET_MAX];
+	_Alignas(32) float ksx[MESH_PACKET_MAX], ksy[MESH_PACKET_MAX], ksz[MESH_PACKET_MAX];
+	_Alignas(32) float tmin[MESH_PACKET_MAX], bt[MESH_PACKET_MAX];
+	_Alignas(32) int32_t axes[MESH_PACKET_MAX]; /* kx | ky << 2 | kz << 4 */
+	float best[MESH_PACKET_MAX];
 	uint32_t slot[MESH_PACKET_MAX];
 	float b[MESH_PACKET_MAX][3];
 	unsigned found, tie;
-	unsigned ready; /* the rays whose r, rq and tmin are made (at their first leaf) */
+	bool ready; /* the triangle set-up is made (pk_ready, at the packet's first leaf) */
+	bool any;   /* any hit will do (mesh_occluded_world_packet) */
 	float tmin0;    /* the query's tmin as a float */
 	float eps;      /* the mesh's self-hit guard */
 } mesh_packet;
@@ -652,56 +658,240 @@ static AVX2 inline unsigned pk_rays_in(const mesh_packet *s, const mesh_node *p,
 	return m;
 }
 
-/* Ray i meets the blocks of leaf `ref`. */
+/* Every ray's triangle set-up and tmin by component, as ray_leaf_setup
+ * and the single walk's first leaf make them (the same selections and the
+ * same operations, eight rays at a time): the origin on the axes kx, ky,
+ * kz, the shear constants, the axes themselves. */
+static AVX2 inline void pk_ready(mesh_packet *s)
+{
+	const __m256 mag = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff)), zero = _mm256_setzero_ps();
+	const __m256i i0 = _mm256_setzero_si256(), i1 = _mm256_set1_epi32(1), i2 = _mm256_set1_epi32(2);
+	for (int h = 0; h < MESH_PACKET_MAX; h += 8) {
+		__m256 dx = _mm256_load_ps(&s->dx[h]), dy = _mm256_load_ps(&s->dy[h]), dz = _mm256_load_ps(&s->dz[h]);
+		__m256 ax = _mm256_and_ps(dx, mag), ay = _mm256_and_ps(dy, mag), az = _mm256_and_ps(dz, mag);
+		/* kz: 2 when !(max(ax, ay) > az), else 1 when !(ax > ay), else 0 */
+		__m256i kxy = _mm256_castps_si256(_mm256_cmp_ps(ax, ay, _CMP_NGT_UQ)); /* all ones: kz 1 */
+		__m256i zbig = _mm256_castps_si256(_mm256_cmp_ps(_mm256_max_ps(ax, ay), az, _CMP_NGT_UQ));
+		__m256i kz = _mm256_blendv_epi8(_mm256_blendv_epi8(i0, i1, kxy), i2, zbig);
+		/* kx = next[kz], ky = next[kx] (next: 1, 2, 0), swapped when
+		 * d[kz] < 0 */
+		__m256i kz0 = _mm256_cmpeq_epi32(kz, i0), kz1 = _mm256_cmpeq_epi32(kz, i1);
+		__m256i kx = _mm256_blendv_epi8(_mm256_blendv_epi8(i0, i2, kz1), i1, kz0);
+		__m256i ky = _mm256_blendv_epi8(_mm256_blendv_epi8(i1, i0, kz1), i2, kz0);
+		__m256 dkz = _mm256_blendv_ps(_mm256_blendv_ps(dz, dy, _mm256_castsi256_ps(kz1)), dx,
+					      _mm256_castsi256_ps(kz0));
+		__m256i neg = _mm256_castps_si256(_mm256_cmp_ps(dkz, zero, _CMP_LT_OQ));
+		__m256i kx2 = _mm256_blendv_epi8(kx, ky, neg), ky2 = _mm256_blendv_epi8(ky, kx, neg);
+		/* a component by axis k: x, y or z of each lane */
+#define PICK(k, vx, vy, vz)                                                                                            \
+	_mm256_blendv_ps(_mm256_blendv_ps(vz, vy, _mm256_castsi256_ps(_mm256_cmpeq_epi32(k, i1))), vx,                 \
+			 _mm256_castsi256_ps(_mm256_cmpeq_epi32(k, i0)))
+		__m256 ox = _mm256_load_ps(&s->ox[h]), oy = _mm256_load_ps(&s->oy[h]), oz = _mm256_load_ps(&s->oz[h]);
+		__m256 sz = PICK(kz, _mm256_load_ps(&s->ix[h]), _mm256_load_ps(&s->iy[h]), _mm256_load_ps(&s->iz[h]));
+		_mm256_store_ps(&s->ksz[h], sz);
+		_mm256_store_ps(&s->ksx[h], _mm256_mul_ps(PICK(kx2, dx, dy, dz), sz));
+		_mm256_store_ps(&s->ksy[h], _mm256_mul_ps(PICK(ky2, dx, dy, dz), sz));
+		_mm256_store_ps(&s->kox[h], PICK(kx2, ox, oy, oz));
+		_mm256_store_ps(&s->koy[h], PICK(ky2, ox, oy, oz));
+		_mm256_store_ps(&s->koz[h], PICK(kz, ox, oy, oz));
+#undef PICK
+		__m256i axes = _mm256_or_si256(_mm256_or_si256(kx2, _mm256_slli_epi32(ky2, 2)), _mm256_slli_epi32(kz, 4));
+		_mm256_store_si256((__m256i *)&s->axes[h], axes);
+		/* tmin raised to eps / |d| (tm > g ? tm : g, as maxps) */
+		__m256 tm = _mm256_set1_ps(s->tmin0);
+		if (s->eps > 0.0f) {
+			__m256 dd = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)), _mm256_mul_ps(dz, dz));
+			tm = _mm256_max_ps(tm, _mm256_div_ps(_mm256_set1_ps(s->eps), _mm256_sqrt_ps(dd)));
+		}
+		_mm256_store_ps(&s->tmin[h], tm);
+	}
+	s->ready = 1;
+}
+
+/* Ray i's pick in one block (block_sse's answer: distance th, slot, its
+ * barycentrics): nearer than its best, it is the new best; at exactly its
+ * best, from another block, a tie (at the query's tmax with nothing found:
+ * no hit, as for the single ray). */
+static inline void pk_take(mesh_packet *s, int i, uint32_t slot, float th, float b0, float b1, float b2)
+{
+	if (s->any) {
+		/* any hit will do: the ray is done (no leaf lets it in again,
+		 * no block finds it a hit, the packet does not wait for it) */
+		s->best[i] = th;
+		s->bt[i] = -INFINITY;
+		s->bs[i] = -INFINITY;
+		s->found |= 1u << i;
+		return;
+	}
+	if (th < s->best[i]) {
+		s->best[i] = th;
+		s->bt[i] = next_upf(th);
+		s->bs[i] = s->bt[i] * BVH_SLAB_SLACK;
+		s->slot[i] = slot;
+		s->b[i][0] = b0;
+		s->b[i][1] = b1;
+		s->b[i][2] = b2;
+		s->found |= 1u << i;
+		s->tie &= ~(1u << i);
+	} else if (s->found >> i & 1u) {
+		s->tie |= 1u << i;
+	}
+}
+
+/* Ray i meets the blocks of leaf `ref`, with the single ray's block test
+ * (its bound the next float above its best, so that a triangle at exactly
+ * that distance is seen). */
 static AVX2 inline void pk_leaf(const mesh *m, mesh_packet *s, int i, uint32_t ref)
 {
 	uint32_t first = ref & (MESH_MAX_BLOCKS - 1), nb = ((ref & ~MESH_LEAF) >> MESH_LEAF_SHIFT) + 1;
-	mesh_ray *r = &s->r[i];
-	if (!(s->ready >> i & 1u)) {
-		/* the triangle test's set-up and tmin, as the single walk makes
-		 * them at its first leaf */
-		r->o[0] = s->ox[i];
-		r->o[1] = s->oy[i];
-		r->o[2] = s->oz[i];
-		r->d[0] = s->dx[i];
-		r->d[1] = s->dy[i];
-		r->d[2] = s->dz[i];
-		r->inv[0] = s->ix[i];
-		r->inv[1] = s->iy[i];
-		r->inv[2] = s->iz[i];
-		ray_leaf_setup(r);
-		ray4_make(r, &s->rq[i]);
-		float tm = s->tmin0;
-		if (s->eps > 0.0f) {
-			float g = s->eps / sqrtf(r->d[0] * r->d[0] + r->d[1] * r->d[1] + r->d[2] * r->d[2]);
-			tm = tm > g ? tm : g;
-		}
-		s->tmin[i] = tm;
-		s->ready |= 1u << i;
-	}
-	float old = s->best[i];
+	mesh_ray r;
+	r.o[0] = s->ox[i];
+	r.o[1] = s->oy[i];
+	r.o[2] = s->oz[i];
+	r.kx = s->axes[i] & 3;
+	r.ky = s->axes[i] >> 2 & 3;
+	r.kz = s->axes[i] >> 4;
+	r.sx = s->ksx[i];
+	r.sy = s->ksy[i];
+	r.sz = s->ksz[i];
+	ray4 rq;
+	ray4_make(&r, &rq);
 	for (uint32_t k = 0; k < nb; k++) {
-		float bt = next_upf(s->best[i]), bb[3];
-		int l = block_sse(m, first + k, &m->blk[first + k], r, &s->rq[i], s->tmin[i], &bt, bb);
-		if (l < 0)
+		float bt = s->bt[i], bb[3];
+		int l = block_sse(m, first + k, &m->blk[first + k], &r, &rq, s->tmin[i], &bt, bb);
+		if (l >= 0)
+			pk_take(s, i, 4 * (first + k) + (uint32_t)l, bt, bb[0], bb[1], bb[2]);
+	}
+}
+
+/* The rays `in` (ready, with the same axes kx, ky, kz) meet the blocks of
+ * leaf `ref` eight at a time: each triangle of a block against eight rays
+ * in one register, block_sse's operations in its order lane by lane (the
+ * lanes are rays here, not triangles), and per ray the block's pick as
+ * block_sse makes it: the nearest of the triangles with tmin < t < bt, the
+ * first on a tie. No cut-outs here (pk_leaf has them). */
+static AVX2 inline void pk_leaf_rays(const mesh *m, mesh_packet *s, unsigned in, uint32_t ref, int kx, int ky, int kz)
+{
+	uint32_t first = ref & (MESH_MAX_BLOCKS - 1), nb = ((ref & ~MESH_LEAF) >> MESH_LEAF_SHIFT) + 1;
+	const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f), inf = _mm256_set1_ps(INFINITY);
+	const __m256i bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+	for (int h = 0; h < MESH_PACKET_MAX; h += 8) {
+		unsigned hm = in >> h & 0xffu;
+		if (!hm)
 			continue;
-		uint32_t slot = 4 * (first + k) + (uint32_t)l;
-		if (bt < s->best[i]) {
-			s->best[i] = bt;
-			s->slot[i] = slot;
-			s->b[i][0] = bb[0];
-			s->b[i][1] = bb[1];
-			s->b[i][2] = bb[2];
-			s->found |= 1u << i;
-			s->tie &= ~(1u << i);
-		} else if (s->found >> i & 1u) {
-			/* bt is the distance so far, from another block (or the
-			 * query's tmax: no hit, as for the single ray) */
-			s->tie |= 1u << i;
+		const __m256 act = _mm256_castsi256_ps(
+			_mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32((int)hm), bits), bits));
+		const __m256 ox = _mm256_load_ps(&s->kox[h]), oy = _mm256_load_ps(&s->koy[h]), oz = _mm256_load_ps(&s->koz[h]);
+		const __m256 sx = _mm256_load_ps(&s->ksx[h]), sy = _mm256_load_ps(&s->ksy[h]), sz = _mm256_load_ps(&s->ksz[h]);
+		const __m256 tmin = _mm256_load_ps(&s->tmin[h]);
+		for (uint32_t k = 0; k < nb; k++) {
+			const mesh_tri4 *q = &m->blk[first + k];
+			const __m256 bt = _mm256_load_ps(&s->bt[h]);
+			__m256 pick = inf, pu = zero, pv = zero, pw = zero;
+			__m256i pl = _mm256_set1_epi32(-1);
+			for (int l = 0; l < 4; l++) {
+				__m256 az = _mm256_sub_ps(_mm256_set1_ps(q->v[kz][l]), oz);
+				__m256 bz = _mm256_sub_ps(_mm256_set1_ps(q->v[3 + kz][l]), oz);
+				__m256 cz = _mm256_sub_ps(_mm256_set1_ps(q->v[6 + kz][l]), oz);
+				__m256 ax = _mm256_sub_ps(_mm256_sub_ps(_mm256_set1_ps(q->v[kx][l]), ox), _mm256_mul_ps(sx, az));
+				__m256 ay = _mm256_sub_ps(_mm256_sub_ps(_mm256_set1_ps(q->v[ky][l]), oy), _mm256_mul_ps(sy, az));
+				__m256 bx = _mm256_sub_ps(_mm256_sub_ps(_mm256_set1_ps(q->v[3 + kx][l]), ox), _mm256_mul_ps(sx, bz));
+				__m256 by = _mm256_sub_ps(_mm256_sub_ps(_mm256_set1_ps(q->v[3 + ky][l]), oy), _mm256_mul_ps(sy, bz));
+				__m256 cx = _mm256_sub_ps(_mm256_sub_ps(_mm256_set1_ps(q->v[6 + kx][l]), ox), _mm256_mul_ps(sx, cz));
+				__m256 cy = _mm256_sub_ps(_mm256_sub_ps(_mm256_set1_ps(q->v[6 + ky][l]), oy), _mm256_mul_ps(sy, cz));
+				__m256 u = _mm256_sub_ps(_mm256_mul_ps(cx, by), _mm256_mul_ps(cy, bx));
+				__m256 v = _mm256_sub_ps(_mm256_mul_ps(ax, cy), _mm256_mul_ps(ay, cx));
+				__m256 w = _mm256_sub_ps(_mm256_mul_ps(bx, ay), _mm256_mul_ps(by, ax));
+				__m256 lo = _mm256_min_ps(_mm256_min_ps(u, v), w), hi = _mm256_max_ps(_mm256_max_ps(u, v), w);
+				unsigned zm = (unsigned)_mm256_movemask_ps(
+						      _mm256_or_ps(_mm256_cmp_ps(lo, zero, _CMP_EQ_OQ), _mm256_cmp_ps(hi, zero, _CMP_EQ_OQ))) &
+					      hm;
+				if (zm) {
+					/* an edge function at zero: in double, as wt_test */
+					_Alignas(32) float fu[8], fv[8], fw[8], fax[8], fay[8], fbx[8], fby[8], fcx[8], fcy[8];
+					_mm256_store_ps(fu, u);
+					_mm256_store_ps(fv, v);
+					_mm256_store_ps(fw, w);
+					_mm256_store_ps(fax, ax);
+					_mm256_store_ps(fay, ay);
+					_mm256_store_ps(fbx, bx);
+					_mm256_store_ps(fby, by);
+					_mm256_store_ps(fcx, cx);
+					_mm256_store_ps(fcy, cy);
+					for (; zm; zm &= zm - 1) {
+						int j = __builtin_ctz(zm);
+						fu[j] = (float)((double)fcx[j] * fby[j] - (double)fcy[j] * fbx[j]);
+						fv[j] = (float)((double)fax[j] * fcy[j] - (double)fay[j] * fcx[j]);
+						fw[j] = (float)((double)fbx[j] * fay[j] - (double)fby[j] * fax[j]);
+					}
+					u = _mm256_load_ps(fu);
+					v = _mm256_load_ps(fv);
+					w = _mm256_load_ps(fw);
+					lo = _mm256_min_ps(_mm256_min_ps(u, v), w);
+					hi = _mm256_max_ps(_mm256_max_ps(u, v), w);
+				}
+				__m256 out = _mm256_and_ps(_mm256_cmp_ps(lo, zero, _CMP_LT_OQ), _mm256_cmp_ps(hi, zero, _CMP_GT_OQ));
+				/* no ray of the eight meets it: the next (coherent rays
+				 * mostly agree; a NaN lane goes on, to fail on its
+				 * distance) */
+				if (!_mm256_movemask_ps(_mm256_andnot_ps(out, act)))
+					continue;
+				__m256 det = _mm256_add_ps(_mm256_add_ps(u, v), w);
+				__m256 tt = _mm256_mul_ps(
+					_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(u, az), _mm256_mul_ps(v, bz)), _mm256_mul_ps(w, cz)), sz);
+				__m256 inv = _mm256_div_ps(one, det);
+				__m256 th = _mm256_mul_ps(tt, inv);
+				__m256 ok = _mm256_andnot_ps(out, _mm256_and_ps(_mm256_cmp_ps(th, tmin, _CMP_GT_OQ),
+										_mm256_cmp_ps(th, bt, _CMP_LT_OQ)));
+				/* the nearest so far in the block, the first on a tie */
+				__m256 better = _mm256_and_ps(_mm256_and_ps(ok, act), _mm256_cmp_ps(th, pick, _CMP_LT_OQ));
+				if (!_mm256_movemask_ps(better))
+					continue;
+				pick = _mm256_blendv_ps(pick, th, better);
+				pl = _mm256_castps_si256(
+					_mm256_blendv_ps(_mm256_castsi256_ps(pl), _mm256_castsi256_ps(_mm256_set1_epi32(l)), better));
+				pu = _mm256_blendv_ps(pu, _mm256_mul_ps(u, inv), better);
+				pv = _mm256_blendv_ps(pv, _mm256_mul_ps(v, inv), better);
+				pw = _mm256_blendv_ps(pw, _mm256_mul_ps(w, inv), better);
+			}
+			unsigned got = ~(unsigned)_mm256_movemask_ps(_mm256_castsi256_ps(pl)) & hm;
+			if (!got)
+				continue;
+			_Alignas(32) float fp[8], fu[8], fv[8], fw[8];
+			_Alignas(32) int32_t fl[8];
+			_mm256_store_ps(fp, pick);
+			_mm256_store_ps(fu, pu);
+			_mm256_store_ps(fv, pv);
+			_mm256_store_ps(fw, pw);
+			_mm256_store_si256((__m256i *)fl, pl);
+			for (; got; got &= got - 1) {
+				int j = __builtin_ctz(got);
+				pk_take(s, h + j, 4 * (first + k) + (uint32_t)fl[j], fp[j], fu[j], fv[j], fw[j]);
+			}
 		}
 	}
-	if (s->best[i] != old)
-		s->bs[i] = next_upf(s->best[i]) * BVH_SLAB_SLACK;
+}
+
+/* The rays `in` meet the blocks of leaf `ref`: eight at a time when they
+ * share their axes and the model has no cut-outs, else one by one. */
+static AVX2 inline void pk_leaf_all(const mesh *m, mesh_packet *s, unsigned in, uint32_t ref)
+{
+	if (!s->ready)
+		pk_ready(s);
+	/* the rays whose axes are the first's, in vector registers (the
+	 * axes were just stored as vectors: a scalar load would wait) */
+	int i0 = __builtin_ctz(in);
+	__m256i a0 = _mm256_load_si256((const __m256i *)&s->axes[0]), a1 = _mm256_load_si256((const __m256i *)&s->axes[8]);
+	__m256i first = _mm256_permutevar8x32_epi32(i0 < 8 ? a0 : a1, _mm256_set1_epi32(i0 & 7));
+	unsigned same = (unsigned)_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(a0, first))) |
+			(unsigned)_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(a1, first))) << 8;
+	if (!m->cuts && (in & (in - 1)) && !(in & ~same)) {
+		int ax = _mm256_cvtsi256_si32(first);
+		pk_leaf_rays(m, s, in, ref, ax & 3, ax >> 2 & 3, ax >> 4);
+		return;
+	}
+	for (; in; in &= in - 1)
+		pk_leaf(m, s, __builtin_ctz(in), ref);
 }
 
 /* The highest of the rays' bs: where the packet prunes. */
@@ -730,10 +920,12 @@ static AVX2 inline float pk_hmax(__m256 a)
 }
 
 static AVX2 __attribute__((noinline)) bool packet_walk(const mesh *m, const double (*M)[4], int n, const ray *wr,
-                                                       double tmin, const double *tmax, double *t, uint32_t *slot,
-                                                       float (*b)[3], unsigned *found, unsigned *tie)
+                                                       double tmin, double tmax1, const double *tmax, double *t,
+                                                       uint32_t *slot, float (*b)[3], unsigned *found, unsigned *tie,
+                                                       bool any)
 {
 	_Alignas(32) mesh_packet s;
+	s.any = any;
 	float box_tmin = (float)tmin;
 	/* the rays in the model's floats by component, as the single walk
 	 * makes them (world_ray_floats: its operations in its order, four rays
@@ -743,7 +935,6 @@ static AVX2 __attribute__((noinline)) bool packet_walk(const mesh *m, const doub
 	{
 		_Static_assert(sizeof(ray) == 6 * sizeof(double) && offsetof(ray, d) == 3 * sizeof(double),
 			       "ray: six doubles o, d");
-		const __m128i idx = _mm_setr_epi32(0, 6, 12, 18);
 		const __m256d m00 = _mm256_set1_pd(M[0][0]), m01 = _mm256_set1_pd(M[0][1]), m02 = _mm256_set1_pd(M[0][2]),
 			      m03 = _mm256_set1_pd(M[0][3]);
 		const __m256d m10 = _mm256_set1_pd(M[1][0]), m11 = _mm256_set1_pd(M[1][1]), m12 = _mm256_set1_pd(M[1][2]),
@@ -753,10 +944,23 @@ static AVX2 __attribute__((noinline)) bool packet_walk(const mesh *m, const doub
 		const __m256d huge = _mm256_set1_pd(3e38);
 		const __m256i pick = _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6);
 		for (; i + 4 <= n; i += 4) {
-			const double *base = &wr[i].o.x;
-			__m256d px = _mm256_i32gather_pd(base, idx, 8), py = _mm256_i32gather_pd(base + 1, idx, 8);
-			__m256d pz = _mm256_i32gather_pd(base + 2, idx, 8), vx = _mm256_i32gather_pd(base + 3, idx, 8);
-			__m256d vy = _mm256_i32gather_pd(base + 4, idx, 8), vz = _mm256_i32gather_pd(base + 5, idx, 8);
+			/* the four rays' 24 doubles turned into six registers of
+			 * one component each (loads and shuffles: gathers are slow) */
+			const ray *q4 = &wr[i];
+			__m256d a0 = _mm256_loadu_pd(&q4[0].o.x), a1 = _mm256_loadu_pd(&q4[1].o.x);
+			__m256d a2 = _mm256_loadu_pd(&q4[2].o.x), a3 = _mm256_loadu_pd(&q4[3].o.x);
+			/* a_k: o.x o.y o.z d.x of ray k; c_k: d.y d.z of ray k */
+			__m128d c0 = _mm_loadu_pd(&q4[0].d.y), c1 = _mm_loadu_pd(&q4[1].d.y);
+			__m128d c2 = _mm_loadu_pd(&q4[2].d.y), c3 = _mm_loadu_pd(&q4[3].d.y);
+			__m256d t0 = _mm256_unpacklo_pd(a0, a1); /* ox0 ox1 oz0 oz1 */
+			__m256d t1 = _mm256_unpackhi_pd(a0, a1); /* oy0 oy1 dx0 dx1 */
+			__m256d t2 = _mm256_unpacklo_pd(a2, a3); /* ox2 ox3 oz2 oz3 */
+			__m256d t3 = _mm256_unpackhi_pd(a2, a3); /* oy2 oy3 dx2 dx3 */
+			__m256d px = _mm256_permute2f128_pd(t0, t2, 0x20), pz = _mm256_permute2f128_pd(t0, t2, 0x31);
+			__m256d py = _mm256_permute2f128_pd(t1, t3, 0x20), vx = _mm256_permute2f128_pd(t1, t3, 0x31);
+			__m256d c01 = _mm256_set_m128d(c1, c0), c23 = _mm256_set_m128d(c3, c2); /* dy0 dz0 dy1 dz1 */
+			__m256d u0 = _mm256_unpacklo_pd(c01, c23), u1 = _mm256_unpackhi_pd(c01, c23); /* dy0 dy2 dy1 dy3 */
+			__m256d vy = _mm256_permute4x64_pd(u0, 0xd8), vz = _mm256_permute4x64_pd(u1, 0xd8);
 			__m256d a, bq, c, e, f, g;
 			if (up) {
 				a = _mm256_add_pd(_mm256_mul_pd(m00, px), m03);
@@ -788,11 +992,13 @@ static AVX2 __attribute__((noinline)) bool packet_walk(const mesh *m, const doub
 			_mm_store_ps(&s.dx[i], _mm256_cvtpd_ps(e));
 			_mm_store_ps(&s.dy[i], _mm256_cvtpd_ps(f));
 			_mm_store_ps(&s.dz[i], _mm256_cvtpd_ps(g));
-			/* best: tmax < 3e38 ? (float)tmax : inf */
-			__m256d tm = _mm256_loadu_pd(&tmax[i]);
-			__m128 lt = _mm256_castps256_ps128(
-				_mm256_permutevar8x32_ps(_mm256_castpd_ps(_mm256_cmp_pd(tm, huge, _CMP_LT_OQ)), pick));
-			_mm_storeu_ps(&s.best[i], _mm_blendv_ps(_mm_set1_ps(INFINITY), _mm256_cvtpd_ps(tm), lt));
+			if (tmax) {
+				/* best: tmax < 3e38 ? (float)tmax : inf */
+				__m256d tm = _mm256_loadu_pd(&tmax[i]);
+				__m128 lt = _mm256_castps256_ps128(_mm256_permutevar8x32_ps(
+					_mm256_castpd_ps(_mm256_cmp_pd(tm, huge, _CMP_LT_OQ)), pick));
+				_mm_storeu_ps(&s.best[i], _mm_blendv_ps(_mm_set1_ps(INFINITY), _mm256_cvtpd_ps(tm), lt));
+			}
 		}
 	}
 	for (; i < n; i++) {
@@ -804,10 +1010,24 @@ static AVX2 __attribute__((noinline)) bool packet_walk(const mesh *m, const doub
 		s.dx[i] = d[0];
 		s.dy[i] = d[1];
 		s.dz[i] = d[2];
-		s.best[i] = tmax[i] < 3e38 ? (float)tmax[i] : INFINITY;
+		if (tmax)
+			s.best[i] = tmax[i] < 3e38 ? (float)tmax[i] : INFINITY;
 	}
-	for (i = 0; i < n; i++)
-		s.bs[i] = next_upf(s.best[i]) * BVH_SLAB_SLACK;
+	if (tmax) {
+		for (i = 0; i < n; i++) {
+			s.bt[i] = next_upf(s.best[i]);
+			s.bs[i] = s.bt[i] * BVH_SLAB_SLACK;
+		}
+	} else {
+		/* one tmax for all */
+		float b1 = tmax1 < 3e38 ? (float)tmax1 : INFINITY, t1 = next_upf(b1);
+		const __m256 vb = _mm256_set1_ps(b1), vt = _mm256_set1_ps(t1), vs = _mm256_set1_ps(t1 * BVH_SLAB_SLACK);
+		for (i = 0; i < MESH_PACKET_MAX; i += 8) {
+			_mm256_store_ps(&s.best[i], vb);
+			_mm256_store_ps(&s.bt[i], vt);
+			_mm256_store_ps(&s.bs[i], vs);
+		}
+	}
 	for (i = n; i < MESH_PACKET_MAX; i++) {
 		s.ox[i] = s.ox[0];
 		s.oy[i] = s.oy[0];
@@ -816,6 +1036,7 @@ static AVX2 __attribute__((noinline)) bool packet_walk(const mesh *m, const doub
 		s.dy[i] = s.dy[0];
 		s.dz[i] = s.dz[0];
 		s.bs[i] = -INFINITY; /* never enters a leaf, never raises pk_far */
+		s.bt[i] = 0.0f;      /* (read by pk_leaf_rays, never used) */
 	}
 	/* the inverses (1 / d, correctly rounded as ray_node_setup's), the far
 	 * ones inv S; the signs each axis shares; per axis the origin to
@@ -864,7 +1085,7 @@ static AVX2 __attribute__((noinline)) bool packet_walk(const mesh *m, const doub
 	}
 	if (_mm256_movemask_ps(bad))
 		return false;
-	s.ready = 0;
+	s.ready = false;
 	s.tmin0 = box_tmin;
 	s.eps = m->eps;
 	const size_t rn0 = rn[0], rn1 = rn[1], rn2 = rn[2];
@@ -916,8 +1137,8 @@ static AVX2 __attribute__((noinline)) bool packet_walk(const mesh *m, const doub
 			}
 			unsigned in = pk_rays_in(&s, (const mesh_node *)((const char *)nodes + e.parent), e.k, box_tmin, rn0,
 						 rn1, rn2);
-			for (; in; in &= in - 1)
-				pk_leaf(m, &s, __builtin_ctz(in), e.ref);
+			if (in)
+				pk_leaf_all(m, &s, in, e.ref);
 			far = pk_far(&s);
 		}
 	}
@@ -929,7 +1150,7 @@ done:
 		b[j][0] = s.b[j][0];
 		b[j][1] = s.b[j][1];
 		b[j][2] = s.b[j][2];
-		if (!((double)s.best[j] < tmax[j]))
+		if (!((double)s.best[j] < (tmax ? tmax[j] : tmax1)))
 			s.found &= ~(1u << j);
 	}
 	*found = s.found;
@@ -1062,14 +1283,38 @@ bool mesh_intersect_brute(const mesh *m, const mesh_ray *r, float tmin, float *t
 }
 
 bool mesh_intersect_world_packet(const mesh *m, const double (*inv)[4], int n, const ray *r, double tmin,
-                                 const double *tmax, double *t, uint32_t *slot, float (*b)[3], unsigned *found,
-                                 unsigned *tie)
+                                 double tmax, const double *tmax_each, double *t, uint32_t *slot, float (*b)[3],
+                                 unsigned *found, unsigned *tie)
 {
 #if defined(HAVE_AVX2_WALK)
 	if (n >= 1 && n <= MESH_PACKET_MAX && mesh_isa_active() >= MESH_ISA_AVX2)
-		return packet_walk(m, inv, n, r, tmin, tmax, t, slot, b, found, tie);
+		return packet_walk(m, inv, n, r, tmin, tmax, tmax_each, t, slot, b, found, tie, false);
 #else
-	(void)m, (void)inv, (void)n, (void)r, (void)tmin, (void)tmax, (void)t, (void)slot, (void)b, (void)found, (void)tie;
+	(void)m, (void)inv, (void)n, (void)r, (void)tmin, (void)tmax, (void)tmax_each, (void)t, (void)slot, (void)b,
+		(void)found, (void)tie;
+#endif
+	return false;
+}
+
+bool mesh_occluded_world_packet(const mesh *m, const double (*inv)[4], int n, const ray *r, double tmin,
+                                const double *tmax, unsigned *occ)
+{
+#if defined(HAVE_AVX2_WALK)
+	if (n >= 1 && n <= MESH_PACKET_MAX && mesh_isa_active() >= MESH_ISA_AVX2) {
+		double t[MESH_PACKET_MAX];
+		uint32_t slot[MESH_PACKET_MAX];
+		float b[MESH_PACKET_MAX][3];
+		unsigned tie;
+		/* (a tmax between 3e38 and FLT_MAX: the single ray's float bound,
+		 * inf, lets it find hits it then refuses, and which it meets
+		 * first decides: traced alone) */
+		for (int i = 0; i < n; i++)
+			if (tmax[i] >= 3e38 && tmax[i] < INFINITY)
+				return false;
+		return packet_walk(m, inv, n, r, tmin, 0.0, tmax, t, slot, b, occ, &tie, true);
+	}
+#else
+	(void)m, (void)inv, (void)n, (void)r, (void)tmin, (void)tmax, (void)occ;
 #endif
 	return false;
 }
