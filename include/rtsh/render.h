@@ -2,7 +2,8 @@
  *
  * A render job traces a range of samples [sample_begin, sample_end) for
  * every pixel of a framebuffer, with `threads` workers pulling small tiles
- * from a shared atomic counter. Every random number is a function of
+ * from a shared atomic counter (the thread that calls render_run is one of
+ * them). Every random number is a function of
  * (pixel, sample, seed), and each pixel's samples are summed in sample order,
  * so the image is bit-identical for any thread count, any tile order and any
  * split of the samples into passes (progressive preview == batch render).
@@ -116,7 +117,8 @@ typedef void (*render_progress_fn)(void *ctx, long done, long total);
 
 /* Called with the rows y0 <= y < y1 of the image once every tile of them is
  * finished, their fb->srgb8 codes final: in order from the top, every row
- * once, always on the thread that runs render_run, while the other tiles
+ * once, always on the thread that runs render_run (between its own tiles,
+ * then while the other workers finish theirs), while the other tiles
  * still render (a file is written as the picture is made: image.h's
  * image_write_rendered). False stops the render (RENDER_FAILED); the
  * callback keeps its own error. */
