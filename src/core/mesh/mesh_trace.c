@@ -1043,44 +1043,45 @@ static AVX2 __attribute__((noinline)) bool packet_walk(const mesh *m, const doub
 	 * subtract from the near planes (the farthest along the direction) and
 	 * from the far ones (the farthest back), the inverses' and the far
 	 * inverses' ranges. The bounds need finite origins and finite, non-zero
-	 * inverses (a NaN fails too). */
+	 * inverses (a NaN fails too). Of one sign, the inverses' extremes are
+	 * the largest and smallest in magnitude, so an infinite or zero one is
+	 * among them; and inv S is monotonic in inv, so the far inverses' range
+	 * is the extremes' times S, the same floats as the rays' own. */
 	const __m256 one = _mm256_set1_ps(1.0f), slack = _mm256_set1_ps(BVH_SLAB_SLACK), big = _mm256_set1_ps(FLT_MAX);
-	const __m256 mag = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff)), zero = _mm256_setzero_ps();
+	const __m256 mag = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
 	float *oa[3] = {s.ox, s.oy, s.oz}, *da[3] = {s.dx, s.dy, s.dz}, *ia[3] = {s.ix, s.iy, s.iz},
 	      *fa[3] = {s.fx, s.fy, s.fz};
 	__m256 on[3], of[3], ilo[3], ihi[3], flo[3], fhi[3];
 	size_t rn[3];
-	__m256 bad = zero;
+	__m256 bad = _mm256_setzero_ps();
 	for (int a = 0; a < 3; a++) {
 		__m256 olo = _mm256_load_ps(oa[a]), ohi = olo, il = _mm256_set1_ps(INFINITY), ih = _mm256_set1_ps(-INFINITY);
-		__m256 fl = il, fh = ih;
 		unsigned negs = 0;
 		for (int h = 0; h < MESH_PACKET_MAX; h += 8) {
 			__m256 o = _mm256_load_ps(oa[a] + h), inv = _mm256_div_ps(one, _mm256_load_ps(da[a] + h));
-			__m256 f = _mm256_mul_ps(inv, slack);
 			_mm256_store_ps(ia[a] + h, inv);
-			_mm256_store_ps(fa[a] + h, f);
+			_mm256_store_ps(fa[a] + h, _mm256_mul_ps(inv, slack));
 			bad = _mm256_or_ps(bad, _mm256_cmp_ps(_mm256_and_ps(o, mag), big, _CMP_NLE_UQ));
-			bad = _mm256_or_ps(bad, _mm256_cmp_ps(_mm256_and_ps(inv, mag), big, _CMP_NLE_UQ));
-			bad = _mm256_or_ps(bad, _mm256_cmp_ps(_mm256_and_ps(f, mag), big, _CMP_NLE_UQ));
-			bad = _mm256_or_ps(bad, _mm256_cmp_ps(inv, zero, _CMP_EQ_OQ));
+			bad = _mm256_or_ps(bad, _mm256_cmp_ps(inv, inv, _CMP_UNORD_Q));
 			negs |= (unsigned)_mm256_movemask_ps(inv) << h;
 			olo = _mm256_min_ps(olo, o);
 			ohi = _mm256_max_ps(ohi, o);
 			il = _mm256_min_ps(il, inv);
 			ih = _mm256_max_ps(ih, inv);
-			fl = _mm256_min_ps(fl, f);
-			fh = _mm256_max_ps(fh, f);
 		}
 		if (negs != 0 && negs != 0xffffu)
 			return false;
 		bool neg = negs != 0;
+		float l = pk_hmin(il), hh = pk_hmax(ih), fl = l * BVH_SLAB_SLACK, fh = hh * BVH_SLAB_SLACK;
+		if (!(fabsf(l) <= FLT_MAX && fabsf(hh) <= FLT_MAX && l != 0.0f && hh != 0.0f && fabsf(fl) <= FLT_MAX &&
+		      fabsf(fh) <= FLT_MAX))
+			return false;
 		on[a] = _mm256_set1_ps(neg ? pk_hmin(olo) : pk_hmax(ohi));
 		of[a] = _mm256_set1_ps(neg ? pk_hmax(ohi) : pk_hmin(olo));
-		ilo[a] = _mm256_set1_ps(pk_hmin(il));
-		ihi[a] = _mm256_set1_ps(pk_hmax(ih));
-		flo[a] = _mm256_set1_ps(pk_hmin(fl));
-		fhi[a] = _mm256_set1_ps(pk_hmax(fh));
+		ilo[a] = _mm256_set1_ps(l);
+		ihi[a] = _mm256_set1_ps(hh);
+		flo[a] = _mm256_set1_ps(fl);
+		fhi[a] = _mm256_set1_ps(fh);
 		rn[a] = (size_t)(MESH_LO(a) + neg) * MESH_ROW;
 	}
 	if (_mm256_movemask_ps(bad))
