@@ -44,10 +44,13 @@
  * so the fit of each half depends on that half's samples alone, and the
  * other half's raw pixel estimates the fit's squared error without bias
  * (NFOR's cross-buffer estimate: half a's fit against half b's pixel is
- * off by a's error plus b's noise, whose variance the samples give). Per
- * pixel the fit or the raw pixel's lighting is kept, whichever the estimate,
- * averaged over 9x9 pixels, says is closer: shadows and highlights the features do
- * not see stay sharp. Last, a pixel that is part one surface, part another
+ * off by a's error plus b's noise, whose variance the samples give). A
+ * second fit over the same taps takes the direct light alone (a constant
+ * and its slope), for where few taps are alike. Per pixel a fit or the raw
+ * pixel's lighting is kept, whichever the estimate, averaged over 9x9
+ * pixels, says is closer (where both fits beat the raw pixel, their blend
+ * weighted by their estimated gains on it): shadows and highlights the
+ * features do not see stay sharp. Last, a pixel that is part one surface, part another
  * is regressed on the features of its 3x3 window: it gets the mix of its
  * neighbours that its features say. With one sample there are no halves:
  * the fit is taken.

@@ -463,8 +463,14 @@ typedef struct texel {
 	chan h[NCH];
 } texel;
 
-/* The candidates for a pixel: itself, and the regression. */
-enum { CAND_RAW, CAND_FIT, NCAND };
+/* The candidates for a pixel: itself, the regression on all the
+ * features, and the regression on the direct light alone (a constant and
+ * its slope: where a highlight or a shadow leaves few taps alike, as in a
+ * glossy metal's highlight a few pixels wide, eight unknowns fit the
+ * noise; two do not). */
+enum { CAND_RAW, CAND_FIT, CAND_DIRECT, NCAND };
+/* The regressions' values: those of CAND_FIT, then of CAND_DIRECT. */
+#define NFIT (NCAND - CAND_FIT)
 
 /* What regression_rows reads, one plane a quantity (structure of arrays),
  * so that four neighbouring pixels' values are one load: the guide's six
@@ -485,7 +491,7 @@ typedef struct job {
 	texel *t;               /* the chains; CH_ALL later holds the result */
 	float *pl;              /* the regression's planes (plane), NPL of them */
 	size_t pstride;         /* floats from one plane to the next */
-	float *fit;             /* 3 a pixel: the regression's value */
+	float *fit;             /* 3 x NFIT a pixel: the regressions' values */
 	float *out;
 	float n[NCH];           /* samples in each chain */
 	bool halves;            /* at least two samples: two independent halves */
@@ -888,50 +894,71 @@ static void regression_rows(job *j, int y0, int y1)
 					for (int r = 0; r < NU; r++)
 						zv[r][l] = z[r][0];
 			}
-			v4 fo[5] = {{0}};
+			/* The direct light's fit: the normal equations of the
+			 * constant and regressor 7 are the sub-matrix of the whole
+			 * one's, solved in closed form, all lanes at once: with
+			 * M = (m00 m70; m70 m77), z = (m77, -m70) / det. The same
+			 * ridge (so where the taps' direct light is all alike, the
+			 * taps' weighted mean); a lane without weight is left out. */
+			v4 m00 = a[TRI(0, 0)], m70 = a[TRI(7, 0)];
+			v4 m77 = a[TRI(7, 7)] + m00 * v4_splat(RIDGE);
+			v4 det = m00 * m77 - m70 * m70;
+			v4i okd = (m00 > v4_splat(0.0f)) & (det > v4_splat(1e-6f) * m00 * m77);
+			v4 safe = v4_and(det, okd) + v4_and(v4_splat(1.0f), ~okd);
+			v4 zd0 = v4_and(m77 / safe, okd), zd7 = v4_and(-m70 / safe, okd);
+			v4 fo[5] = {{0}}, fd[5] = {{0}};
 			for (int t = 0; t < nt; t++) {
 				const v4 *v = tv[t];
 				v4 p0 = zv[0] * v[0] + zv[4] * v[4], p1 = zv[1] * v[1] + zv[5] * v[5];
 				v4 p2 = zv[2] * v[2] + zv[6] * v[6], p3 = zv[3] * v[3] + zv[7] * v[7];
 				v4 hv = tw[t] * (p0 + p1 + p2 + p3);
+				v4 hd = tw[t] * (zd0 + zd7 * v[7]);
 #pragma GCC unroll 5
-				for (int c = 0; c < 5; c++)
-					fo[c] += v4_and(hv * v4_load(pdata[c] + tq[t]), tm[t]);
+				for (int c = 0; c < 5; c++) {
+					v4 yv = v4_load(pdata[c] + tq[t]);
+					fo[c] += v4_and(hv * yv, tm[t]);
+					fd[c] += v4_and(hd * yv, tm[t]);
+				}
 			}
 			for (int l = 0; l < lanes; l++) {
 				size_t pi = (size_t)i + (size_t)l;
 				const chan *r0 = j->t[pi].h;
 				float am = lum(j->am + pi * 3), am2 = am * am;
-				float *fit = j->fit + pi * 3, err[NCAND];
+				float *fit = j->fit + pi * 3 * NFIT, *fitd = fit + 3;
 				if (!ok[l]) {
 					memcpy(fit, r0[CH_ALL].c, sizeof r0[CH_ALL].c);
+					memcpy(fitd, r0[CH_ALL].c, sizeof r0[CH_ALL].c);
 					perr[CAND_RAW][pi] = 0.0f; /* the raw pixel */
 					perr[CAND_FIT][pi] = INFINITY;
+					perr[CAND_DIRECT][pi] = INFINITY;
 					continue;
 				}
-				for (int k = 0; k < 3; k++)
+				for (int k = 0; k < 3; k++) {
 					fit[k] = fo[k][l];
+					fitd[k] = okd[l] ? fd[k][l] : r0[CH_ALL].c[k];
+				}
 				if (!j->halves) {
 					/* One sample: no halves, no error estimate; the fit. */
 					perr[CAND_RAW][pi] = INFINITY;
 					perr[CAND_FIT][pi] = 0.0f;
+					perr[CAND_DIRECT][pi] = INFINITY;
 					continue;
 				}
-				/* The raw pixel estimated the same way as the fit, so
-				 * that the two estimates share their noise. */
-				err[CAND_RAW] = cross_error(r0, na, nb, lum(r0[CH_A].c), lum(r0[CH_B].c)) * am2;
-				err[CAND_FIT] = cross_error(r0, na, nb, fo[3][l], fo[4][l]) * am2;
-				for (int c = 0; c < NCAND; c++)
-					perr[c][pi] = err[c];
+				/* The raw pixel estimated the same way as the fits, so
+				 * that the estimates share their noise. */
+				perr[CAND_RAW][pi] = cross_error(r0, na, nb, lum(r0[CH_A].c), lum(r0[CH_B].c)) * am2;
+				perr[CAND_FIT][pi] = cross_error(r0, na, nb, fo[3][l], fo[4][l]) * am2;
+				perr[CAND_DIRECT][pi] = okd[l] ? cross_error(r0, na, nb, fd[3][l], fd[4][l]) * am2 : INFINITY;
 			}
 		}
 }
 
 /* Chooses per pixel the candidate whose estimated error, averaged over
  * (2 PICK_R + 1)^2 pixels, is the least (NFOR filters its errors before
- * choosing too: one pixel's estimate is as noisy as the pixel), times
- * the albedo again, into the all-samples chain (radiance, and the noise
- * variance of the mean's brightness). */
+ * choosing too: one pixel's estimate is as noisy as the pixel), or where
+ * both regressions are estimated to beat the raw pixel their blend by
+ * those estimates; times the albedo again, into the all-samples chain
+ * (radiance, and the noise variance of the mean's brightness). */
 static void pick_rows(job *j, int y0, int y1)
 {
 	int w = j->fb->w, h = j->fb->h;
@@ -967,8 +994,21 @@ static void pick_rows(job *j, int y0, int y1)
 					if (s[c] < s[best])
 						best = c;
 				chan *o = &j->t[i].h[CH_ALL];
-				const float *am = j->am + i * 3, *c = best == CAND_RAW ? o->c : j->fit + i * 3;
+				const float *am = j->am + i * 3, *c = best == CAND_RAW ? o->c : j->fit + (i * NFIT + (size_t)(best - CAND_FIT)) * 3;
 				float l = lum(am);
+				float mix[3];
+				if (s[CAND_FIT] < s[CAND_RAW] && s[CAND_DIRECT] < s[CAND_RAW]) {
+					/* Both fits beat the raw pixel: their blend, each
+					 * weighted by how much it is estimated to gain on
+					 * the raw pixel (a choice between two estimates
+					 * that close is as noisy as they are). */
+					const float *f1 = j->fit + i * NFIT * 3, *f2 = f1 + 3;
+					float g1 = s[CAND_RAW] - s[CAND_FIT], g2 = s[CAND_RAW] - s[CAND_DIRECT];
+					float w1 = g1 / (g1 + g2);
+					for (int k = 0; k < 3; k++)
+						mix[k] = w1 * f1[k] + (1.0f - w1) * f2[k];
+					c = mix;
+				}
 				for (int k = 0; k < 3; k++) {
 					float v = c[k] * am[k];
 					o->c[k] = v > 0 ? v : 0;
@@ -1115,7 +1155,7 @@ bool denoise_image(const framebuffer *fb, float *out, int threads)
 	j.t = malloc(n * sizeof *j.t);
 	j.pstride = n + 2 * PL_PAD;
 	j.pl = calloc(NPL * j.pstride, sizeof *j.pl); /* the pads zero */
-	j.fit = malloc(n * 3 * sizeof *j.fit);
+	j.fit = malloc(n * 3 * NFIT * sizeof *j.fit);
 	pthread_t *tid = malloc((size_t)threads * sizeof *tid);
 	worker_arg *args = malloc((size_t)threads * sizeof *args);
 	bool ok = j.g && j.am && j.mixed && j.t && j.pl && j.fit && tid && args;

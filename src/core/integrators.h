@@ -10,6 +10,10 @@
  * the integrator draws numbers (integrator.sampled). */
 ray camera_sample_ray(const world *w, const render_settings *s, bool sampled, int px, int py, int fw, int fh,
                       int sample, sampler *sp);
+/* camera_sample_ray of every pixel of the block [x0, x1) x [y0, y1), row
+ * by row, into r[i] and sp[i]: the same rays to the bit (camera.c). */
+void camera_block_rays(const world *w, const render_settings *s, bool sampled, int x0, int y0, int x1, int y1,
+                       int fw, int fh, int sample, ray *r, sampler *sp);
 
 /* One integrator (integrators.def names it, its file defines it). */
 typedef struct integrator {

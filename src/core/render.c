@@ -138,9 +138,7 @@ static void block_add(const world *w, const render_settings *s, int x0, int y0, 
 		sampler sp[PACKET_MAX];
 		hit h[PACKET_MAX];
 		bool found[PACKET_MAX];
-		for (int y = y0, i = 0; y < y1; y++)
-			for (int x = x0; x < x1; x++, i++)
-				r[i] = camera_sample_ray(w, s, in->sampled, x, y, fw, fh, k, &sp[i]);
+		camera_block_rays(w, s, in->sampled, x0, y0, x1, y1, fw, fh, k, r, sp);
 		world_intersect_packet(w, n, r, 0.0, INFINITY, h, found);
 		uint32_t known[PACKET_MAX], blocked[PACKET_MAX];
 		if (in->shadow_packets)

@@ -18,6 +18,7 @@
 #include "rtsh/rtfile.h"
 #include "rtsh/scene.h"
 #include "rtsh/world.h"
+#include "core/integrators.h"
 
 /* The sRGB decoding of an 8-bit code, from IEC 61966-2-1. */
 static double srgb_decode(double code)
@@ -727,6 +728,54 @@ static void test_write_rendered(void **state)
 	world_free(wd);
 }
 
+/* A block's camera rays (camera_block_rays, which shares each column's and
+ * row's terms for one centred sample through a pinhole) are the rays
+ * camera_sample_ray gives pixel by pixel, to the bit: cameras with
+ * horizontal and vertical fields of view, a roll, an orthographic one,
+ * one and several samples, Whitted and path mode, blocks at the edges of
+ * odd image sizes. */
+static void test_block_rays_bits(void **state)
+{
+	(void)state;
+	test_rng r = {5};
+	const int sizes[][2] = {{37, 21}, {1920, 1080}, {5, 301}, {1, 1}};
+	for (int k = 0; k < 400; k++) {
+		camera c = {v3(trange(&r, -9, 9), trange(&r, -9, 9), trange(&r, -9, 9)), tdir(&r), trange(&r, 1, 170),
+		            k % 3 == 1, k % 7 == 3 ? trange(&r, 0.5, 4) : 0, k % 5 == 2 ? trange(&r, -180, 180) : 0};
+		scene *s = scene_new();
+		assert_true(scene_add_camera(s, &c, NULL));
+		world *wd = world_build(s, NULL);
+		assert_non_null(wd);
+		render_settings set = render_settings_default();
+		const int *sz = sizes[k % 4];
+		set.width = sz[0];
+		set.height = sz[1];
+		set.samples = k % 4 == 3 ? 4 : 1;
+		set.mode = k % 6 == 5 ? MODE_PATH : MODE_WHITTED;
+		bool sampled = k % 6 == 5;
+		int x0 = (int)(trange(&r, 0, 1) * set.width), y0 = (int)(trange(&r, 0, 1) * set.height);
+		x0 = x0 >= set.width ? set.width - 1 : x0;
+		y0 = y0 >= set.height ? set.height - 1 : y0;
+		int x1 = x0 + 4 < set.width ? x0 + 4 : set.width, y1 = y0 + 4 < set.height ? y0 + 4 : set.height;
+		ray got[16];
+		sampler gs[16];
+		camera_block_rays(wd, &set, sampled, x0, y0, x1, y1, set.width, set.height, k % 3, got, gs);
+		for (int y = y0, i = 0; y < y1; y++)
+			for (int x = x0; x < x1; x++, i++) {
+				sampler ws;
+				ray want = camera_sample_ray(wd, &set, sampled, x, y, set.width, set.height, k % 3, &ws);
+				if (memcmp(&got[i], &want, sizeof want) != 0 || gs[i].key != ws.key || gs[i].index != ws.index ||
+				    gs[i].rindex != ws.rindex || gs[i].dim != ws.dim)
+					fail_msg("camera %d pixel %d,%d of %dx%d: dir %.17g,%.17g,%.17g, pixel by pixel "
+					         "%.17g,%.17g,%.17g",
+					         k, x, y, set.width, set.height, got[i].d.x, got[i].d.y, got[i].d.z, want.d.x,
+					         want.d.y, want.d.z);
+			}
+		world_free(wd);
+		scene_free(s);
+	}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -740,6 +789,7 @@ int main(void)
 		cmocka_unit_test(test_srgb),
 		cmocka_unit_test(test_image_files),
 		cmocka_unit_test(test_srgb8_in_tiles),
+		cmocka_unit_test(test_block_rays_bits),
 		cmocka_unit_test(test_rows_while_rendering),
 		cmocka_unit_test(test_write_rendered),
 		cmocka_unit_test(test_basic_silhouette),
