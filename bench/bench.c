@@ -1404,8 +1404,8 @@ static double kernel_primary(const world *wd, int w, int h, bool coherent, doubl
 
 /* kernel_primary's rays and answers traced as packets of 4x4 pixels
  * (world_trace_packet: the model's own packet walk), Embree's 4x4 tiles
- * for rtcIntersect16: CPU time. */
-static double kernel_packet(const world *wd, int w, int h, double *sink)
+ * for rtcIntersect16: CPU time of one pass. */
+static double kernel_packet_pass(const world *wd, int w, int h, double *sink)
 {
 	double t0 = cpu_now();
 	for (int y0 = 0; y0 < h; y0 += 4)
@@ -1423,6 +1423,20 @@ static double kernel_packet(const world *wd, int w, int h, double *sink)
 					*sink += world_trace_ng(wd, &r[i], &th[i]).x;
 		}
 	return cpu_now() - t0;
+}
+
+/* The fastest of three passes after one that warms the caches: what
+ * embree_packets.h gives for Embree's packet rows, so that the two compare
+ * alike. */
+static double kernel_packet(const world *wd, int w, int h, double *sink)
+{
+	double best = -1;
+	for (int pass = 0; pass < 4; pass++) {
+		double t = kernel_packet_pass(wd, w, h, sink);
+		if (pass > 0 && (best < 0 || t < best))
+			best = t;
+	}
+	return best;
 }
 
 static void bench_mesh(void)
@@ -1568,12 +1582,13 @@ static void bench_mesh(void)
 	r = add_row("bunny 69k tris", "tri-primary-packet16", w, h, 1, 1, runs, mpp, mrpp);
 	if (npk[EMBREE_PACKETS - 1])
 		snprintf(r->note, sizeof r->note,
-		         "CPU time; world_trace_packet (4x4 pixels, the model's packet walk) + Ng: %.2fx tri-primary; "
-		         "Embree rtcIntersect16 %.2f Mrays/s: rtsh %.2fx",
+		         "CPU, best of 3 after a warm-up (as Embree's); world_trace_packet 4x4 + Ng: %.2fx tri-primary; "
+		         "rtcIntersect16 %.2f: rtsh %.2fx",
 		         mrpp / mrpk, median(pkm[EMBREE_PACKETS - 1], npk[EMBREE_PACKETS - 1]),
 		         mrpp / median(pkm[EMBREE_PACKETS - 1], npk[EMBREE_PACKETS - 1]));
 	else
-		snprintf(r->note, sizeof r->note, "CPU time; world_trace_packet (4x4 pixels, the model's packet walk) + Ng: %.2fx tri-primary",
+		snprintf(r->note, sizeof r->note,
+		         "CPU, best of 3 after a warm-up (as Embree's); world_trace_packet 4x4 + Ng: %.2fx tri-primary",
 		         mrpp / mrpk);
 	if (!ne && !quick) {
 		r = add_row("bunny 69k tris", "embree-mesh", 0, 0, 0, 1, 0, -1, -1);

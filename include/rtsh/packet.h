@@ -19,7 +19,13 @@
  * rule stays the single ray's and today's pictures stay the same. Rays fall
  * back to the single walk as well when the packet would not be coherent:
  * when their directions do not share each axis's sign, or a component is
- * zero. */
+ * zero.
+ *
+ * A model's triangles are walked by packets of their own
+ * (mesh_intersect_world_packet, mesh_occluded_world_packet, mesh.h): for a
+ * lone model (the world's only primitive beside planes) by camera and
+ * shadow packets, for a model among other objects by the camera packets
+ * at the object tree's leaf; the same answers as its single rays. */
 #ifndef RTSH_PACKET_H
 #define RTSH_PACKET_H
 

@@ -388,52 +388,53 @@ render_status render_run(render_job *job, rt_error *err)
 	int n = render_threads(&job->set);
 	if (n > sh.tiles)
 		n = (int)sh.tiles;
-	atomic_init(&sh.running, n);
+	/* This thread is one of the n: n - 1 workers start beside it. */
+	atomic_init(&sh.running, n - 1);
 	pthread_mutex_init(&sh.lock, NULL);
 	pthread_cond_init(&sh.finished, NULL);
 
-	pthread_t *tid = n > 1 ? calloc((size_t)n, sizeof *tid) : NULL;
+	pthread_t *tid = n > 1 ? calloc((size_t)(n - 1), sizeof *tid) : NULL;
 	int started = 0;
 	if (tid)
-		for (; started < n; started++)
+		for (; started < n - 1; started++)
 			if (pthread_create(&tid[started], NULL, worker, &sh) != 0)
 				break;
-	if (started == 0) {
-		/* One thread (or none could start): work here, reporting about
-		 * every 100 ms. */
-		double last = now_seconds();
-		for (;;) {
-			if ((job->cancel && atomic_load(job->cancel)) || atomic_load(&sh.stop))
-				break;
-			long t = atomic_fetch_add(&sh.next, 1);
-			if (t >= sh.tiles)
-				break;
-			render_tile(&sh, t);
-			atomic_fetch_add(&sh.done, 1);
-			if (sh.band_left) {
-				atomic_fetch_sub(&sh.band_left[t / sh.tiles_x], 1);
-				hand_rows(&sh);
-			}
-			if (job->progress && now_seconds() - last >= 0.1) {
-				last = now_seconds();
-				report(job, &sh);
-			}
-		}
-	} else {
-		if (started < n) {
-			/* Fewer threads than asked: the missing ones count as finished. */
-			pthread_mutex_lock(&sh.lock);
-			atomic_fetch_sub(&sh.running, n - started);
-			pthread_mutex_unlock(&sh.lock);
-		}
+	if (started < n - 1) {
+		/* Fewer threads than asked: the missing ones count as finished. */
 		pthread_mutex_lock(&sh.lock);
-		/* progress every 100 ms: a band that wakes this thread early
-		 * does not move the deadline */
+		atomic_fetch_sub(&sh.running, n - 1 - started);
+		pthread_mutex_unlock(&sh.lock);
+	}
+	/* Tiles here too, handing the finished bands to job->rows between
+	 * them (no third thread to wake on two cores), reporting about every
+	 * 100 ms. */
+	double last = now_seconds();
+	for (;;) {
+		if ((job->cancel && atomic_load(job->cancel)) || atomic_load(&sh.stop))
+			break;
+		long t = atomic_fetch_add(&sh.next, 1);
+		if (t >= sh.tiles)
+			break;
+		render_tile(&sh, t);
+		atomic_fetch_add(&sh.done, 1);
+		if (sh.band_left) {
+			atomic_fetch_sub(&sh.band_left[t / sh.tiles_x], 1);
+			hand_rows(&sh);
+		}
+		if (job->progress && now_seconds() - last >= 0.1) {
+			last = now_seconds();
+			report(job, &sh);
+		}
+	}
+	if (started > 0) {
+		/* The workers' last tiles: their bands are handed over as they
+		 * finish; progress every 100 ms (a band that wakes this thread
+		 * early does not move the deadline). */
+		pthread_mutex_lock(&sh.lock);
 		struct timespec deadline;
 		in_100ms(&deadline);
 		while (atomic_load(&sh.running) > 0) {
 			if (!atomic_load(&sh.stop) && band_ready(&sh)) {
-				/* the file is written while the workers render */
 				pthread_mutex_unlock(&sh.lock);
 				hand_rows(&sh);
 				pthread_mutex_lock(&sh.lock);
