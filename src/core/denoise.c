@@ -234,7 +234,8 @@ static double lobe_feature(const world *w, const bsdf *b, vec3 p, int ks)
  * is looked through (up to four times): its features are those of the
  * surface seen in it, the albedo tinted by the mirror's or the glass's
  * colour, the depth the length of the whole path. Glass is followed along the refracted ray unless the
- * reflection is total. */
+ * reflection is total, the albedo tinted by its transmitted share 1 - F
+ * and its reflected share F added as white (the Phong family's glass). */
 static void first_surface(const world *w, ray r, int ks, double f[9])
 {
 	vec3 tint = v3(1, 1, 1);
@@ -247,13 +248,15 @@ static void first_surface(const world *w, ray r, int ks, double f[9])
 	bool gl = false;
 	vec3 gl_a = v3(0, 0, 0), gl_n = v3(0, 0, 0);
 	double gl_d = 0.0;
+	/* the glass surfaces' reflections on the way, as albedo */
+	vec3 refl = v3(0, 0, 0);
 	for (int k = 0;; k++) {
 		hit h;
 		if (!(k == 0 ? world_intersect_coherent : world_intersect)(w, &r, 0.0, INFINITY, &h)) {
 			/* The sky: its own colour, no normal, no depth. */
-			f[0] += clamp01(tint.x);
-			f[1] += clamp01(tint.y);
-			f[2] += clamp01(tint.z);
+			f[0] += clamp01(tint.x + refl.x);
+			f[1] += clamp01(tint.y + refl.y);
+			f[2] += clamp01(tint.z + refl.z);
 			return;
 		}
 		const mat_lin *m = &w->mats[h.mat]; /* a model's own material, too */
@@ -282,7 +285,7 @@ static void first_surface(const world *w, ray r, int ks, double f[9])
 				 * surface's, so that no filter mixes the two. */
 				a = v3_mul(v3_add(v3_scale(a, 0.0), e), tint);
 			} else {
-				a = v3_mul(a, tint);
+				a = v3_add(v3_mul(a, tint), refl);
 				a = v3(clamp01(a.x), clamp01(a.y), clamp01(a.z));
 			}
 			f[0] += a.x;
@@ -310,6 +313,18 @@ static void first_surface(const world *w, ray r, int ks, double f[9])
 			gl_a = v3(clamp01(gl_a.x), clamp01(gl_a.y), clamp01(gl_a.z));
 			gl_n = b.n;
 			gl_d = dist;
+		}
+		if (follow == 2 && b.family == MAT_PHONG) {
+			/* Glass that is looked through sends back its Fresnel share
+			 * F of the light (the paths reflect with probability F):
+			 * the surface behind is tinted by 1 - F, and F joins the
+			 * albedo as a white reflection's, so that dividing the
+			 * radiance by the albedo does not blow the reflection up
+			 * where what lies behind is dark. */
+			double eta = b.front ? b.ior : 1.0 / b.ior, cos_t;
+			double fr = fresnel_dielectric(b.cos_o, eta, &cos_t);
+			refl = v3_add(refl, v3_scale(tint, b.wg * fr));
+			tt = v3_scale(tt, 1.0 - fr);
 		}
 		tint = v3_mul(tint, tt);
 		if (follow == 1)

@@ -16,7 +16,8 @@
  *   - an edge pixel's highlight in a glossy metal: 5 x the mean albedo over
  *     the same 64 positions as the albedo;
  *   - the features seen through a mirror are the reflected wall's, at the
- *     distance of the whole path;
+ *     distance of the whole path; through glass 1 - F of the wall's albedo
+ *     and F of white (Fresnel at normal incidence);
  *   - the result is identical for any thread count; whitted mode is never
  *     touched; the setting parses auto, on and off. */
 #include "testutil.h"
@@ -643,6 +644,32 @@ static void test_features_through_mirror(void **state)
 	}
 }
 
+/* Glass looked through: a clear glass plane (ior 1.5) at z = 2 facing the
+ * camera at the origin, an orange Lambertian wall behind it at z = 4. At
+ * normal incidence the glass reflects F = ((1.5 - 1) / (1.5 + 1))^2 = 0.04
+ * of the light (Fresnel) and passes the rest, so the centre pixel's albedo
+ * feature is 0.96 x the wall's plus 0.04 of a white reflection; the normal
+ * and depth are the wall's (the refracted ray goes straight on). */
+static void test_features_through_glass(void **state)
+{
+	(void)state;
+	scene *s = load_text("C 0,0,0 0,0,1 10\npl 0,0,2 0,0,-1 1,1,1 255,255,255 0 0 1 0 ior=1.5\n"
+	                     "pl 0,0,4 0,0,-1 1,1,1 180,100,50 1 0 1 0\n");
+	world *w = world_build(s, NULL);
+	assert_non_null(w);
+	double f[DENOISE_ACC] = {0};
+	denoise_sample(w, cam_ray(&w->cam, 4.5, 4.5, 9, 9), 0, f);
+	vec3 wall = srgb255_to_linear(v3(180, 100, 50));
+	const double F = 0.04;
+	assert_near(f[0], (1 - F) * wall.x + F, 1e-4);
+	assert_near(f[1], (1 - F) * wall.y + F, 1e-4);
+	assert_near(f[2], (1 - F) * wall.z + F, 1e-4);
+	assert_near(f[5], -1.0, 1e-3);
+	assert_near(f[6], 4.0, 1e-3);
+	world_free(w);
+	scene_free(s);
+}
+
 /* The direct-light feature (acc[7]): a white Lambertian wall at z = 2
  * facing the camera at the origin, a point light of ratio 0.5 at (0, 1, 0).
  * The centre pixel's ray meets the wall at (0, 0, 2); the light is seen
@@ -903,6 +930,7 @@ int main(void)
 		cmocka_unit_test(test_highlight_blocks),
 		cmocka_unit_test(test_threads),
 		cmocka_unit_test(test_features_through_mirror),
+		cmocka_unit_test(test_features_through_glass),
 		cmocka_unit_test(test_direct_feature),
 		cmocka_unit_test(test_env_feature),
 		cmocka_unit_test(test_lamp_through_glossy),

@@ -440,11 +440,11 @@ static PK_TARGET __attribute__((noinline)) bool PK(walk)(const mesh *m, const do
 	float far = PK(far)(&s);
 	pk_entry stack[MESH_STACK];
 	int sp = 0;
-	uint32_t ref = 0; /* the root node */
+	pk_entry cur = {0, 0.0f, 0, 0}; /* the root node */
 	const mesh_node *nodes = m->nodes;
 	for (;;) {
-		{
-			const mesh_node *nd = (const mesh_node *)((const char *)nodes + ref);
+		if (!(cur.ref & MESH_LEAF)) {
+			const mesh_node *nd = (const mesh_node *)((const char *)nodes + cur.ref);
 			__m256 t0 = t0_8, t1 = _mm256_set1_ps(far);
 			for (int a = 0; a < 3; a++) {
 				size_t r0 = rn[a];
@@ -457,38 +457,43 @@ static PK_TARGET __attribute__((noinline)) bool PK(walk)(const mesh *m, const do
 			_Alignas(32) float tn[MESH_WIDTH];
 			_mm256_store_ps(tn, t0);
 			unsigned hm = (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ));
-			/* the children, farthest first, so the nearest is on top */
-			int base = sp;
-			for (; hm; hm &= hm - 1) {
-				uint32_t k = (uint32_t)__builtin_ctz(hm);
-				pk_entry e = {nd->child[k], tn[k], ref, k};
-				int j = sp++;
-				while (j > base && stack[j - 1].t < e.t) {
-					stack[j] = stack[j - 1];
-					j--;
+			if (hm) {
+				uint32_t parent = cur.ref;
+				if (!(hm & (hm - 1))) { /* one child: on to it */
+					uint32_t k = (uint32_t)__builtin_ctz(hm);
+					cur = (pk_entry){nd->child[k], tn[k], parent, k};
+					continue;
 				}
-				stack[j] = e;
+				/* the children, farthest first, so the nearest is on
+				 * top: on to it, the others wait */
+				int base = sp;
+				for (; hm; hm &= hm - 1) {
+					uint32_t k = (uint32_t)__builtin_ctz(hm);
+					pk_entry e = {nd->child[k], tn[k], parent, k};
+					int j = sp++;
+					while (j > base && stack[j - 1].t < e.t) {
+						stack[j] = stack[j - 1];
+						j--;
+					}
+					stack[j] = e;
+				}
+				cur = stack[--sp];
+				continue;
 			}
-		}
-		/* the next entry the packet may still need */
-		for (;;) {
-			while (sp > 0 && stack[sp - 1].t > far)
-				sp--;
-			if (sp == 0)
-				goto done;
-			pk_entry e = stack[--sp];
-			if (!(e.ref & MESH_LEAF)) {
-				ref = e.ref;
-				break;
-			}
-			unsigned in = PK(rays_in)(&s, (const mesh_node *)((const char *)nodes + e.parent), e.k, box_tmin, rn0,
-						 rn1, rn2);
+		} else {
+			unsigned in = PK(rays_in)(&s, (const mesh_node *)((const char *)nodes + cur.parent), cur.k, box_tmin,
+						 rn0, rn1, rn2);
 			if (in)
-				PK(leaf_all)(m, &s, in, e.ref);
+				PK(leaf_all)(m, &s, in, cur.ref);
 			far = PK(far)(&s);
 		}
+		/* the next entry the packet may still need */
+		while (sp > 0 && stack[sp - 1].t > far)
+			sp--;
+		if (sp == 0)
+			break;
+		cur = stack[--sp];
 	}
-done:
 	for (unsigned f = s.found; f; f &= f - 1) {
 		int j = __builtin_ctz(f);
 		t[j] = s.best[j];
