@@ -253,10 +253,14 @@ static void first_surface(const world *w, ray r, int ks, double f[9])
 	for (int k = 0;; k++) {
 		hit h;
 		if (!(k == 0 ? world_intersect_coherent : world_intersect)(w, &r, 0.0, INFINITY, &h)) {
-			/* The sky: its own colour, no normal, no depth. */
-			f[0] += clamp01(tint.x + refl.x);
-			f[1] += clamp01(tint.y + refl.y);
-			f[2] += clamp01(tint.z + refl.z);
+			/* The sky: its own colour in that direction as albedo (so
+			 * that its lighting is one, and the sky seen through glass
+			 * or a mirror is told from the open sky by its colour), no
+			 * normal, no depth. */
+			vec3 bg = v3_mul(tint, world_background(w, r.d, MODE_PATH));
+			f[0] += clamp01(bg.x + refl.x);
+			f[1] += clamp01(bg.y + refl.y);
+			f[2] += clamp01(bg.z + refl.z);
 			return;
 		}
 		const mat_lin *m = &w->mats[h.mat]; /* a model's own material, too */
