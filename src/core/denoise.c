@@ -255,9 +255,11 @@ static void first_surface(const world *w, ray r, int ks, double f[9])
 		if (!(k == 0 ? world_intersect_coherent : world_intersect)(w, &r, 0.0, INFINITY, &h)) {
 			/* The sky: its own colour in that direction as albedo (so
 			 * that its lighting is one, and the sky seen through glass
-			 * or a mirror is told from the open sky by its colour), no
-			 * normal, no depth. */
-			vec3 bg = v3_mul(tint, world_background(w, r.d, MODE_PATH));
+			 * or a mirror is told from the open sky by its colour); a
+			 * black background white, as a surface's tint; no normal,
+			 * no depth. */
+			vec3 back = world_background(w, r.d, MODE_PATH);
+			vec3 bg = back.x > 0.0 || back.y > 0.0 || back.z > 0.0 ? v3_mul(tint, back) : tint;
 			f[0] += clamp01(bg.x + refl.x);
 			f[1] += clamp01(bg.y + refl.y);
 			f[2] += clamp01(bg.z + refl.z);
