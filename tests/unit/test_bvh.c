@@ -366,6 +366,35 @@ static void test_huge_coordinates(void **state)
 	}
 }
 
+/* The SAH's half area of a float box, from its definition: xy + yz + zx of
+ * the extents, in doubles (so not rounded to float), and 0 for a box empty
+ * or NaN on any one axis (each axis alone: the SSE2 version tests z apart
+ * from x and y). */
+static void test_half_area(void **state)
+{
+	(void)state;
+	bvh_fbox b = {{0, 0, 0, 7}, {1, 2, 3, 0}};
+	assert_true(bvh_fbox_half_area(&b) == 11.0); /* 2 + 6 + 3; lane 3 ignored */
+	/* extents 2^24 + 1 and 1 + 2^-23: products not representable in float */
+	bvh_fbox c = {{-16777216.0f, 0, 0, 1}, {1.0f, 1.0f + 0x1p-23f, 1.0f, 0}};
+	double e0 = 16777217.0, e1 = 1.0 + 0x1p-23, e2 = 1.0;
+	assert_true(bvh_fbox_half_area(&c) == e0 * e1 + e1 * e2 + e2 * e0);
+	bvh_fbox flat = {{1, 1, 1, 1}, {1, 5, 9, 0}};
+	assert_true(bvh_fbox_half_area(&flat) == 4.0 * 8.0); /* x extent 0 */
+	for (int a = 0; a < 3; a++) {
+		bvh_fbox e = b;
+		e.lo[a] = 4.0f; /* lo > hi on axis a: empty */
+		assert_true(bvh_fbox_half_area(&e) == 0.0);
+		e = b;
+		e.hi[a] = NAN;
+		assert_true(bvh_fbox_half_area(&e) == 0.0);
+		e = b;
+		e.lo[a] = INFINITY; /* the empty box's corner */
+		e.hi[a] = -INFINITY;
+		assert_true(bvh_fbox_half_area(&e) == 0.0);
+	}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -377,6 +406,7 @@ int main(void)
 		cmocka_unit_test(test_one_object),
 		cmocka_unit_test(test_same_centroid),
 		cmocka_unit_test(test_huge_coordinates),
+		cmocka_unit_test(test_half_area),
 	};
 	return cmocka_run_group_tests_name("bvh", tests, NULL, NULL);
 }
