@@ -395,6 +395,46 @@ static void test_half_area(void **state)
 	}
 }
 
+/* The largest float <= v (below) or the least float >= v, from the
+ * definition: the nearest float stepped until it is on the right side. */
+static float float_side(double v, bool below)
+{
+	float f = (float)v;
+	while (below ? (double)f > v : (double)f < v)
+		f = nextafterf(f, below ? -INFINITY : INFINITY);
+	return f;
+}
+
+/* The builder's float boxes hold each double box: the root's bounds of a
+ * one-box tree are its corners rounded outward to the nearest floats, at
+ * zeros (a tiny negative lower corner: the least negative subnormal), at
+ * the top of the float range (past it: infinity, and FLT_MAX below) and for
+ * values of each sign that round either way. */
+static void test_float_boxes(void **state)
+{
+	(void)state;
+	static const double v[] = {0.1, -0.1, 1.0 / 3.0, -1.0 / 3.0, 3.0, -3.0, 0.0, 1e-50, -1e-50, 1e-40,
+	                           -1e-40, 1e39, -1e39, 3.4028235677973366e38, -3.4028235677973366e38,
+	                           16777217.0, -16777217.0, 0.7, 2.5e-38};
+	size_t nv = sizeof v / sizeof v[0];
+	for (size_t i = 0; i < nv; i++)
+		for (int a = 0; a < 3; a++) {
+			/* axis a gets v[i] on both corners, the others v[i + 1] and v[i + 2] */
+			double c[3] = {v[(i + 1) % nv], v[(i + 2) % nv], v[(i + 1) % nv]};
+			c[a] = v[i];
+			box x = {{c[0], c[1], c[2]}, {c[0], c[1], c[2]}};
+			bvh2 t;
+			rt_error err;
+			assert_true(bvh2_build(&x, 1, &(bvh_build_opts){.trav = 4}, &t, &err));
+			for (int k = 0; k < 3; k++) {
+				float lo = float_side(c[k], true), hi = float_side(c[k], false);
+				assert_true(memcmp(&t.bounds.lo[k], &lo, sizeof lo) == 0);
+				assert_true(memcmp(&t.bounds.hi[k], &hi, sizeof hi) == 0);
+			}
+			bvh2_free(&t);
+		}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -407,6 +447,7 @@ int main(void)
 		cmocka_unit_test(test_same_centroid),
 		cmocka_unit_test(test_huge_coordinates),
 		cmocka_unit_test(test_half_area),
+		cmocka_unit_test(test_float_boxes),
 	};
 	return cmocka_run_group_tests_name("bvh", tests, NULL, NULL);
 }
