@@ -272,32 +272,32 @@ static bool binning_make(const fbox *cb, size_t n, binning *bn)
 	return any;
 }
 
-/* Adds refs[0, n) to the bins of binning bn on each axis: the box and
- * the summed cost. */
-static void bin_refs(const fbox *refs, size_t n, const binning *bn, fbox bbox[3][BINS], float bcost[3][BINS])
+/* Adds refs[0, n) to the bins of binning bn on each axis: the box, and
+ * the summed cost in lane 3 of its upper corner (the references' is 0; the
+ * sums are made in the references' order). */
+static void bin_refs(const fbox *refs, size_t n, const binning *bn, fbox bbox[3][BINS])
 {
 #if defined(__SSE2__)
 	/* the same operations as the loop below, the reference and its bins
 	 * in registers */
 	__m128 blo = _mm_loadu_ps(bn->lo), bsc = _mm_loadu_ps(bn->scale), zero = _mm_setzero_ps(),
 	       top = _mm_set1_ps((float)(bn->nbins - 1));
+	/* lane 3 only, and -0 in lanes 0-2: x + -0 is x, -0 and NaN included */
+	__m128 lane3 = _mm_castsi128_ps(_mm_set_epi32(-1, 0, 0, 0)), negz = _mm_set_ps(0.0f, -0.0f, -0.0f, -0.0f);
 	for (size_t i = 0; i < n; i++) {
 		__m128 lo = _mm_loadu_ps(refs[i].lo), hi = _mm_loadu_ps(refs[i].hi);
-		float cost = _mm_cvtss_f32(_mm_shuffle_ps(lo, lo, _MM_SHUFFLE(3, 3, 3, 3)));
+		__m128 cost = _mm_or_ps(_mm_and_ps(lo, lane3), negz); /* (-0, -0, -0, cost) */
 		__m128 v = _mm_mul_ps(_mm_sub_ps(_mm_add_ps(lo, hi), blo), bsc);
 		__m128i k = _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(v, zero), top));
 		int k0 = _mm_cvtsi128_si32(k), k1 = _mm_cvtsi128_si32(_mm_shuffle_epi32(k, 1)),
 		    k2 = _mm_cvtsi128_si32(_mm_shuffle_epi32(k, 2));
-		bcost[0][k0] += cost;
-		bcost[1][k1] += cost;
-		bcost[2][k2] += cost;
 		fbox *x = &bbox[0][k0], *y = &bbox[1][k1], *z = &bbox[2][k2];
 		_mm_storeu_ps(x->lo, _mm_min_ps(_mm_loadu_ps(x->lo), lo));
-		_mm_storeu_ps(x->hi, _mm_max_ps(_mm_loadu_ps(x->hi), hi));
+		_mm_storeu_ps(x->hi, _mm_add_ps(_mm_max_ps(_mm_loadu_ps(x->hi), hi), cost));
 		_mm_storeu_ps(y->lo, _mm_min_ps(_mm_loadu_ps(y->lo), lo));
-		_mm_storeu_ps(y->hi, _mm_max_ps(_mm_loadu_ps(y->hi), hi));
+		_mm_storeu_ps(y->hi, _mm_add_ps(_mm_max_ps(_mm_loadu_ps(y->hi), hi), cost));
 		_mm_storeu_ps(z->lo, _mm_min_ps(_mm_loadu_ps(z->lo), lo));
-		_mm_storeu_ps(z->hi, _mm_max_ps(_mm_loadu_ps(z->hi), hi));
+		_mm_storeu_ps(z->hi, _mm_add_ps(_mm_max_ps(_mm_loadu_ps(z->hi), hi), cost));
 	}
 #else
 	for (size_t i = 0; i < n; i++) {
@@ -307,8 +307,8 @@ static void bin_refs(const fbox *refs, size_t n, const binning *bn, fbox bbox[3]
 		centroid2(r, c);
 		bin_index(c, bn->lo, bn->scale, bn->nbins, k);
 		for (int a = 0; a < 3; a++) {
-			bcost[a][k[a]] += r->lo[3];
-			fbox_union(&bbox[a][k[a]], r);
+			fbox_union(&bbox[a][k[a]], r); /* lane 3: the sum stays (>= 0) */
+			bbox[a][k[a]].hi[3] += r->lo[3];
 		}
 	}
 #endif
@@ -330,16 +330,13 @@ static split find_split(const builder *b, size_t begin, size_t end, const fbox *
 	if (!binning_make(cb, end - begin, &bn))
 		return best;
 	int nbins = bn.nbins;
-	/* per bin: the box and the summed cost (every cost is >= 1, so a
-	 * bin is empty when its cost is 0; float sums are exact to 2^24) */
+	/* per bin: the box and the summed cost in hi[3] (every cost is >= 1,
+	 * so a bin is empty when its cost is 0; float sums are exact to 2^24) */
 	fbox bbox[3][BINS];
-	float bcost[3][BINS];
 	for (int a = 0; a < 3; a++)
-		for (int k = 0; k < nbins; k++) {
+		for (int k = 0; k < nbins; k++)
 			bbox[a][k] = fbox_empty();
-			bcost[a][k] = 0.0f;
-		}
-	bin_refs(b->refs + begin, end - begin, &bn, bbox, bcost);
+	bin_refs(b->refs + begin, end - begin, &bn, bbox);
 	for (int a = 0; a < 3; a++) {
 		if (!bn.usable[a])
 			continue;
@@ -349,7 +346,7 @@ static split find_split(const builder *b, size_t begin, size_t end, const fbox *
 		double sum = 0.0;
 		for (int k = nbins - 1; k > 0; k--) {
 			fbox_union(&acc, &bbox[a][k]);
-			sum += bcost[a][k];
+			sum += bbox[a][k].hi[3];
 			right_area[k] = sum > 0.0 ? fbox_half_area(&acc) : 0.0;
 			right_cost[k] = sum;
 		}
@@ -357,7 +354,7 @@ static split find_split(const builder *b, size_t begin, size_t end, const fbox *
 		sum = 0.0;
 		for (int k = 0; k < nbins - 1; k++) {
 			fbox_union(&acc, &bbox[a][k]);
-			sum += bcost[a][k];
+			sum += bbox[a][k].hi[3];
 			if (sum == 0.0 || right_cost[k + 1] == 0.0)
 				continue;
 			/* the left term is >= 0: a right term that alone reaches
@@ -377,6 +374,7 @@ static split find_split(const builder *b, size_t begin, size_t end, const fbox *
 		best.lb = best.rb = fbox_empty();
 		for (int k = 0; k < nbins; k++)
 			fbox_union(k < best.at ? &best.lb : &best.rb, &bbox[best.axis][k]);
+		best.lb.hi[3] = best.rb.hi[3] = 0.0f; /* a box's, not the costs' */
 	}
 	return best;
 }
