@@ -562,47 +562,13 @@ static bool model_occluded(const world *w, int n, const ray *r, double tmin, con
 	return true;
 }
 
-/* Shadow packets whose rays go apart (the lit points of 1M small spheres,
- * far apart within a 4x4 block) cost more than their rays alone: the
- * packet's interval lets through children that no ray enters, and every
- * ray is then tested against the node. In a tree of SPLIT_TREE nodes or
- * more, a packet that has tested more than SPLIT_RAYS rays a node over its
- * first SPLIT_NODES nodes is given up and its live rays traced alone; a
- * thread whose packets were given up SPLIT_SCORE times more than not
- * traces the next ones alone at once, trying one in SPLIT_PROBE as a
- * packet again. (Instructions of the shadow packets of spheres-N at
- * 480x270, old -> new: 3k +8%, 10k -7%, 30k -22%, 100k -37%; below
- * about 5k spheres the packets' shared leaf tests win, hence the tree's
- * size: 1k 88 nodes, 10k about 900.) Only the time depends on this, not
- * what is found: each ray's answer is the same either way. */
-enum { SPLIT_NODES = 8, SPLIT_RAYS = 4, SPLIT_SCORE = 4, SPLIT_PROBE = 8, SPLIT_TREE = 1024 };
-
-static _Thread_local struct {
-	int score; /* packets given up less those finished, 0..2 SPLIT_SCORE */
-	unsigned tick;
-} shadow_split;
-
-static bool shadow_alone(bool big)
-{
-	return big && shadow_split.score >= SPLIT_SCORE && ++shadow_split.tick % SPLIT_PROBE != 0;
-}
-
-static void shadow_note(bool given_up)
-{
-	if (given_up)
-		shadow_split.score += shadow_split.score < 2 * SPLIT_SCORE;
-	else
-		shadow_split.score -= shadow_split.score > 0;
-}
-
 void world_occluded_packet(const world *w, int n, const ray *r, double tmin, const double *tmax, bool *occ)
 {
 	pk_ray q;
 	bool lone_model = w->nprims == 1 && w->prims[0].tag == PRIM_MESH;
 	if (lone_model && n >= 2 && n <= PACKET_MAX && model_occluded(w, n, r, tmin, tmax, occ))
 		return;
-	bool big = w->nprims && w->tree && w->tree->nnodes >= SPLIT_TREE;
-	if (n < 2 || n > PACKET_MAX || lone_model || shadow_alone(big) || !packet_prepare(r, n, &q)) {
+	if (n < 2 || n > PACKET_MAX || lone_model || !packet_prepare(r, n, &q)) {
 		for (int i = 0; i < n; i++)
 			occ[i] = world_occluded(w, &r[i], tmin, tmax[i]);
 		return;
@@ -637,13 +603,12 @@ void world_occluded_packet(const world *w, int n, const ray *r, double tmin, con
 		 * wide interval: with 1M small spheres it let through most of the
 		 * tree). The rays are tried in turn until they cover what the
 		 * interval let through, and a packet whose first 32 nodes culled
-		 * nothing stops trying (the grid's packets are that tight); one
-		 * that needs most of its rays for that is given up (above). */
+		 * nothing stops trying (the grid's packets are that tight). */
 		bvh_ray one[PACKET_MAX];
 		float ftmax1[PACKET_MAX];
 		unsigned ready = 0; /* the rays whose one[] is filled */
-		bool refine = true, given_up = false;
-		int tried = 0, culled = 0, tests = 0;
+		bool refine = true;
+		int tried = 0, culled = 0;
 		bvh_entry stack[BVH_STACK];
 		int sp = 0;
 		uint32_t child = w->tree->root, meta = w->tree->root_meta;
@@ -661,8 +626,7 @@ void world_occluded_packet(const world *w, int n, const ray *r, double tmin, con
 				if (m && refine) {
 					unsigned got = 0;
 					float t1[BVH_WIDTH];
-					unsigned lv = live;
-					for (; lv && (got & m) != m; lv &= lv - 1) {
+					for (unsigned lv = live; lv && (got & m) != m; lv &= lv - 1) {
 						int i = __builtin_ctz(lv);
 						if (!(ready >> i & 1u)) {
 							bvh_ray_prepare(&r[i], &one[i]);
@@ -671,13 +635,7 @@ void world_occluded_packet(const world *w, int n, const ray *r, double tmin, con
 						}
 						got |= bvh_slab4(&nodes[child], &one[i], ftmin, ftmax1[i], t1);
 					}
-					if (++tried <= SPLIT_NODES && big) {
-						tests += __builtin_popcount(live) - __builtin_popcount(lv);
-						if (tried == SPLIT_NODES && tests > SPLIT_RAYS * SPLIT_NODES) {
-							given_up = true;
-							break;
-						}
-					}
+					tried++;
 					culled += (m & ~got) != 0;
 					m &= got;
 					/* a packet whose interval is tight wastes the rays'
@@ -694,17 +652,6 @@ void world_occluded_packet(const world *w, int n, const ray *r, double tmin, con
 			sp--;
 			child = stack[sp].child;
 			meta = stack[sp].meta;
-		}
-		if (big)
-			shadow_note(given_up);
-		if (given_up) {
-			/* the rays not yet blocked, alone (each counts itself) */
-			world_rays_count(-__builtin_popcount(live));
-			for (unsigned lv = live; lv; lv &= lv - 1) {
-				int i = __builtin_ctz(lv);
-				if (world_occluded(w, &r[i], tmin, tmax[i]))
-					live &= ~(1u << i);
-			}
 		}
 	}
 	for (int i = 0; i < n; i++)

@@ -210,10 +210,10 @@ static void test_bunny(void **state)
 }
 
 /* Shadow packets whose rays go apart in a big tree (the 1M-sphere scene's
- * case): 4 x 4 blocks of pixels S apart, so that the lit points are far
- * apart, toward each light in turn. The packets the walk gives up to
- * single rays, and those a thread then traces ray by ray, must give each
- * ray its own answer and count each ray once. */
+ * case, where the packet's interval lets through children no ray enters):
+ * 4 x 4 blocks of pixels S apart, so that the lit points are far apart,
+ * toward each light in turn. Each ray must get its own answer, and be
+ * counted once. */
 static void shadow_block(const world *w, int W, int H, int S, int x0, int y0, vec3 lamp, long *blocked, long *lit)
 {
 	ray sr[PACKET_MAX];
@@ -251,7 +251,7 @@ static void test_split_shadows(void **state)
 	world *w = world_build(s, &err);
 	if (!w)
 		fail_msg("world_build: %s", err.msg);
-	assert_true(w->tree->nnodes >= 1024); /* packet.c's SPLIT_TREE */
+	assert_true(w->tree->nnodes >= 1024); /* a deep tree: 30k spheres */
 	assert_true(w->nlights >= 2);
 	enum { W = 160, H = 96, S = 3 };
 	long blocked = 0, lit = 0, k = 0;
