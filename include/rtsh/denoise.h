@@ -11,7 +11,10 @@
  * taken (first hits only), so that the features of an edge pixel are as
  * well antialiased as that many samples would make its colour.
  *
- * A lamp's albedo feature is its emission, far from any surface's, so that
+ * The sky's albedo feature is its colour in that direction (a black
+ * background's is white); through glass the surface behind is tinted by the
+ * share the glass lets through and the share it reflects is added as
+ * white. A lamp's albedo feature is its emission, far from any surface's, so that
  * no filter mixes a lamp with what lies next to it; but a lamp seen through
  * a glossy metal (not a perfect mirror) is blurred by it, and there the
  * metal's own features are taken. A further feature is the direct light

@@ -22,9 +22,14 @@ static void decode_table_init(void)
 		decode_table[i] = srgb_to_linear(i / 255.0);
 }
 
+static inline bool whole_code(double code)
+{
+	return code >= 0.0 && code <= 255.0 && code == (double)(int)code;
+}
+
 double srgb8_to_linear(double code)
 {
-	if (code >= 0.0 && code <= 255.0 && code == (double)(int)code) {
+	if (whole_code(code)) {
 		pthread_once(&decode_once, decode_table_init);
 		return decode_table[(int)code];
 	}
@@ -33,6 +38,11 @@ double srgb8_to_linear(double code)
 
 vec3 srgb255_to_linear(vec3 c)
 {
+	/* srgb8_to_linear of each, the table made once for the three */
+	if (whole_code(c.x) && whole_code(c.y) && whole_code(c.z)) {
+		pthread_once(&decode_once, decode_table_init);
+		return v3(decode_table[(int)c.x], decode_table[(int)c.y], decode_table[(int)c.z]);
+	}
 	return v3(srgb8_to_linear(c.x), srgb8_to_linear(c.y), srgb8_to_linear(c.z));
 }
 

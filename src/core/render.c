@@ -155,17 +155,18 @@ static void block_add(const world *w, const render_settings *s, int x0, int y0, 
 				acc[i][0] += c.x;
 				acc[i][1] += c.y;
 				acc[i][2] += c.z;
-				if (feat[i]) {
+				if (any_feat && feat[i]) {
 					denoise_radiance(c, k, ra[i]);
 					if (k < DENOISE_FEATURE_SAMPLES) /* what this sample's ray first sees */
 						denoise_sample(w, render_sample_ray(w, s, x, y, fw, fh, k), k, fa[i]);
 				}
 			}
 	}
-	for (int y = y0, i = 0; y < y1; y++)
-		for (int x = x0; x < x1; x++, i++)
-			if (feat[i])
-				denoise_features(w, s, x, y, fw, fh, s0, s1, ra[i], fa[i], feat[i]);
+	if (any_feat)
+		for (int y = y0, i = 0; y < y1; y++)
+			for (int x = x0; x < x1; x++, i++)
+				if (feat[i])
+					denoise_features(w, s, x, y, fw, fh, s0, s1, ra[i], fa[i], feat[i]);
 	mesh_alpha_hashed(false);
 }
 
@@ -214,19 +215,24 @@ static void render_tile(shared *sh, long t)
 					fp[k] = feat ? fb->feat + i / 3 * DENOISE_FEATURES : NULL;
 				}
 			block_add(job->w, &job->set, bx, by, ex, ey, fb->w, fb->h, job->sample_begin, job->sample_end, acc, fp);
-			for (int y = by, k = 0; y < ey; y++)
-				for (int x = bx; x < ex; x++, k++) {
-					size_t i = ((size_t)y * (size_t)fb->w + (size_t)x) * 3;
-					if (fb->sum) {
-						fb->sum[i] = acc[k][0];
-						fb->sum[i + 1] = acc[k][1];
-						fb->sum[i + 2] = acc[k][2];
+			double *sum = fb->sum;
+			float *rgb = fb->rgb;
+			for (int y = by, k = 0; y < ey; y++) {
+				/* the row's floats: the image's, or the tile's own */
+				float *o = rgb ? rgb + ((size_t)y * (size_t)fb->w + (size_t)bx) * 3
+				               : own + ((size_t)(y - y0) * RENDER_TILE + (size_t)(bx - x0)) * 3;
+				for (int x = bx; x < ex; x++, k++, o += 3) {
+					if (sum) {
+						size_t i = ((size_t)y * (size_t)fb->w + (size_t)x) * 3;
+						sum[i] = acc[k][0];
+						sum[i + 1] = acc[k][1];
+						sum[i + 2] = acc[k][2];
 					}
-					float *o = fb->rgb ? fb->rgb + i : own + ((size_t)(y - y0) * RENDER_TILE + (size_t)(x - x0)) * 3;
 					o[0] = (float)(acc[k][0] * inv);
 					o[1] = (float)(acc[k][1] * inv);
 					o[2] = (float)(acc[k][2] * inv);
 				}
+			}
 		}
 	if (fb->rgb && fb->srgb8)
 		tile_srgb8(fb, x0, y0, x1, y1);

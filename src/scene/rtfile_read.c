@@ -336,7 +336,7 @@ static const range R_COLOR42 = {0, 255, false, true,
 static const range R_SCALE = {0, RT_NUM_MAX, true, false, "three numbers > 0"};
 
 /* NULL when v is in r, else what is wrong. */
-static const char *range_problem(const range *r, double v)
+static inline const char *range_problem(const range *r, double v)
 {
 	if (r->whole && v != floor(v))
 		return "not a whole number";
@@ -370,6 +370,25 @@ static bool get_num(parser *p, const tok *t, const char *elem, const char *field
 static bool get_tuple(parser *p, const tok *t, const char *elem, const char *field, int n,
                       const char *shape, const range *r, double *out)
 {
+	/* The common well-formed tuple in one pass: split at the first n - 1
+	 * commas, each part a number in range (a part with a comma left in it
+	 * is no number). Anything else, and every message, from the full pass
+	 * below, which reads the same parts the same way. */
+	if (n <= 8) {
+		double v[8];
+		const char *c = t->s, *end = t->s + t->len;
+		int k = 0;
+		for (; k < n; k++) {
+			const char *e = k + 1 < n ? memchr(c, ',', (size_t)(end - c)) : end;
+			if (!e || num_parse(c, (size_t)(e - c), &v[k]) != NUM_OK || range_problem(r, v[k]))
+				break;
+			c = e + 1;
+		}
+		if (k == n) {
+			memcpy(out, v, (size_t)n * sizeof *v);
+			return true;
+		}
+	}
 	int count = 1;
 	for (size_t i = 0; i < t->len; i++) {
 		if (t->s[i] != ',')

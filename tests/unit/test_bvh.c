@@ -366,6 +366,75 @@ static void test_huge_coordinates(void **state)
 	}
 }
 
+/* The SAH's half area of a float box, from its definition: xy + yz + zx of
+ * the extents, in doubles (so not rounded to float), and 0 for a box empty
+ * or NaN on any one axis (each axis alone: the SSE2 version tests z apart
+ * from x and y). */
+static void test_half_area(void **state)
+{
+	(void)state;
+	bvh_fbox b = {{0, 0, 0, 7}, {1, 2, 3, 0}};
+	assert_true(bvh_fbox_half_area(&b) == 11.0); /* 2 + 6 + 3; lane 3 ignored */
+	/* extents 2^24 + 1 and 1 + 2^-23: products not representable in float */
+	bvh_fbox c = {{-16777216.0f, 0, 0, 1}, {1.0f, 1.0f + 0x1p-23f, 1.0f, 0}};
+	double e0 = 16777217.0, e1 = 1.0 + 0x1p-23, e2 = 1.0;
+	assert_true(bvh_fbox_half_area(&c) == e0 * e1 + e1 * e2 + e2 * e0);
+	bvh_fbox flat = {{1, 1, 1, 1}, {1, 5, 9, 0}};
+	assert_true(bvh_fbox_half_area(&flat) == 4.0 * 8.0); /* x extent 0 */
+	for (int a = 0; a < 3; a++) {
+		bvh_fbox e = b;
+		e.lo[a] = 4.0f; /* lo > hi on axis a: empty */
+		assert_true(bvh_fbox_half_area(&e) == 0.0);
+		e = b;
+		e.hi[a] = NAN;
+		assert_true(bvh_fbox_half_area(&e) == 0.0);
+		e = b;
+		e.lo[a] = INFINITY; /* the empty box's corner */
+		e.hi[a] = -INFINITY;
+		assert_true(bvh_fbox_half_area(&e) == 0.0);
+	}
+}
+
+/* The largest float <= v (below) or the least float >= v, from the
+ * definition: the nearest float stepped until it is on the right side. */
+static float float_side(double v, bool below)
+{
+	float f = (float)v;
+	while (below ? (double)f > v : (double)f < v)
+		f = nextafterf(f, below ? -INFINITY : INFINITY);
+	return f;
+}
+
+/* The builder's float boxes hold each double box: the root's bounds of a
+ * one-box tree are its corners rounded outward to the nearest floats, at
+ * zeros (a tiny negative lower corner: the least negative subnormal), at
+ * the top of the float range (past it: infinity, and FLT_MAX below) and for
+ * values of each sign that round either way. */
+static void test_float_boxes(void **state)
+{
+	(void)state;
+	static const double v[] = {0.1, -0.1, 1.0 / 3.0, -1.0 / 3.0, 3.0, -3.0, 0.0, 1e-50, -1e-50, 1e-40,
+	                           -1e-40, 1e39, -1e39, 3.4028235677973366e38, -3.4028235677973366e38,
+	                           16777217.0, -16777217.0, 0.7, 2.5e-38};
+	size_t nv = sizeof v / sizeof v[0];
+	for (size_t i = 0; i < nv; i++)
+		for (int a = 0; a < 3; a++) {
+			/* axis a gets v[i] on both corners, the others v[i + 1] and v[i + 2] */
+			double c[3] = {v[(i + 1) % nv], v[(i + 2) % nv], v[(i + 1) % nv]};
+			c[a] = v[i];
+			box x = {{c[0], c[1], c[2]}, {c[0], c[1], c[2]}};
+			bvh2 t;
+			rt_error err;
+			assert_true(bvh2_build(&x, 1, &(bvh_build_opts){.trav = 4}, &t, &err));
+			for (int k = 0; k < 3; k++) {
+				float lo = float_side(c[k], true), hi = float_side(c[k], false);
+				assert_true(memcmp(&t.bounds.lo[k], &lo, sizeof lo) == 0);
+				assert_true(memcmp(&t.bounds.hi[k], &hi, sizeof hi) == 0);
+			}
+			bvh2_free(&t);
+		}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -377,6 +446,8 @@ int main(void)
 		cmocka_unit_test(test_one_object),
 		cmocka_unit_test(test_same_centroid),
 		cmocka_unit_test(test_huge_coordinates),
+		cmocka_unit_test(test_half_area),
+		cmocka_unit_test(test_float_boxes),
 	};
 	return cmocka_run_group_tests_name("bvh", tests, NULL, NULL);
 }

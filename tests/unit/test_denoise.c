@@ -17,7 +17,7 @@
  *     the same 64 positions as the albedo;
  *   - the features seen through a mirror are the reflected wall's, at the
  *     distance of the whole path; through glass 1 - F of the wall's albedo
- *     and F of white (Fresnel at normal incidence);
+ *     and F of white (Fresnel at normal incidence); the sky's, its colour;
  *   - the result is identical for any thread count; whitted mode is never
  *     touched; the setting parses auto, on and off. */
 #include "testutil.h"
@@ -670,6 +670,33 @@ static void test_features_through_glass(void **state)
 	scene_free(s);
 }
 
+/* The sky's albedo feature is its colour in that direction: a uniform sky
+ * of radiance 0.5 seen directly gives 0.5; through the clear glass plane
+ * of test_features_through_glass, with nothing behind, 0.96 x 0.5 of the
+ * sky and 0.04 of a white reflection: 0.52. Depth 0 (the sky's, even
+ * through the glass). */
+static void test_sky_feature(void **state)
+{
+	(void)state;
+	const char *texts[2] = {
+		"C 0,0,0 0,0,1 10\nsky 255,255,255 255,255,255 0.5\n",
+		"C 0,0,0 0,0,1 10\nsky 255,255,255 255,255,255 0.5\npl 0,0,2 0,0,-1 1,1,1 255,255,255 0 0 1 0 ior=1.5\n",
+	};
+	const double want[2] = {0.5, 0.96 * 0.5 + 0.04};
+	for (int c = 0; c < 2; c++) {
+		scene *s = load_text(texts[c]);
+		world *w = world_build(s, NULL);
+		assert_non_null(w);
+		double f[DENOISE_ACC] = {0};
+		denoise_sample(w, cam_ray(&w->cam, 4.5, 4.5, 9, 9), 0, f);
+		for (int k = 0; k < 3; k++)
+			assert_near(f[k], want[c], 1e-4);
+		assert_near(f[6], 0.0, 1e-9); /* the sky has no depth, through glass too */
+		world_free(w);
+		scene_free(s);
+	}
+}
+
 /* The direct-light feature (acc[7]): a white Lambertian wall at z = 2
  * facing the camera at the origin, a point light of ratio 0.5 at (0, 1, 0).
  * The centre pixel's ray meets the wall at (0, 0, 2); the light is seen
@@ -931,6 +958,7 @@ int main(void)
 		cmocka_unit_test(test_threads),
 		cmocka_unit_test(test_features_through_mirror),
 		cmocka_unit_test(test_features_through_glass),
+		cmocka_unit_test(test_sky_feature),
 		cmocka_unit_test(test_direct_feature),
 		cmocka_unit_test(test_env_feature),
 		cmocka_unit_test(test_lamp_through_glossy),

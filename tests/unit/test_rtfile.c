@@ -538,6 +538,20 @@ static void test_number_traps(void **state)
 	expect_error("A 0.2 1,2,3,4\nC 0,0,0 0,0,1 70\n", 1, 7, "has 4 components; expected R,G,B");
 	expect_error("A 0.2 1,x,3\nC 0,0,0 0,0,1 70\n", 1, 7,
 	             "colour \"1,x,3\" has a component that is not a number");
+	/* Tuples the one-pass split does not take, each with the full pass's
+	 * message: the third part holding a comma, an empty part before a
+	 * fourth, a component out of range after good ones. */
+	expect_error("A 0.2 1,2,3,\nC 0,0,0 0,0,1 70\n", 1, 7, "has an empty component");
+	expect_error("A 0.2 1,2,3,x\nC 0,0,0 0,0,1 70\n", 1, 7, "has 4 components; expected R,G,B");
+	expect_error("A 0.2 1,,2,3\nC 0,0,0 0,0,1 70\n", 1, 7, "has an empty component");
+	expect_error("C 0,0,0 0,0,1 70\nL 1,2,3e21 1\n", 2, 3, "is out of range; expected a magnitude up to 1e20");
+	expect_error("A 0.2 1,2,256\nC 0,0,0 0,0,1 70\n", 1, 7, "has a component that is out of range");
+	/* and the values the one pass reads: strtod's */
+	scene *t = load_ok("C 0.5,-0,1e-3 0,0,1 70\nL +2.25,.5,7. 1\n");
+	assert_true(t->cams[0].pos.x == 0.5 && t->cams[0].pos.y == 0 && signbit(t->cams[0].pos.y) &&
+	            t->cams[0].pos.z == strtod("1e-3", NULL));
+	assert_true(v3_eq(t->lights[0].pos, v3(2.25, 0.5, 7.0)));
+	scene_free(t);
 	/* Whole numbers where they are required. */
 	expect_error("R 10.5 10\nC 0,0,0 0,0,1 70\n", 1, 3,
 	             "resolution width \"10.5\" is not a whole number; expected a whole number");

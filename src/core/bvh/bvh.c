@@ -130,14 +130,29 @@ static inline void fbox_add_point(fbox *a, const float p[4])
 }
 #endif
 
-/* Inline in the bins' sweeps, which call it some 90 times a node. */
+/* Inline in the bins' sweeps, which call it some 90 times a node. The
+ * SSE2 version widens two lanes at a time and does the same double
+ * operations in the same order (the same result, bit for bit), with the
+ * sign test of the three extents in one compare. */
 static inline double fbox_half_area(const fbox *b)
 {
+#if defined(__SSE2__)
+	__m128 lo = _mm_loadu_ps(b->lo), hi = _mm_loadu_ps(b->hi);
+	__m128d e01 = _mm_sub_pd(_mm_cvtps_pd(hi), _mm_cvtps_pd(lo));
+	__m128d e2x = _mm_sub_pd(_mm_cvtps_pd(_mm_movehl_ps(hi, hi)), _mm_cvtps_pd(_mm_movehl_ps(lo, lo)));
+	__m128d zero = _mm_setzero_pd();
+	/* e0 >= 0, e1 >= 0 and e2 >= 0 (false for NaN) */
+	if ((_mm_movemask_pd(_mm_cmpge_pd(e01, zero)) & 3) != 3 || !_mm_ucomige_sd(e2x, zero))
+		return 0.0;
+	double e0 = _mm_cvtsd_f64(e01), e1 = _mm_cvtsd_f64(_mm_unpackhi_pd(e01, e01)), e2 = _mm_cvtsd_f64(e2x);
+	return e0 * e1 + e1 * e2 + e2 * e0;
+#else
 	double e0 = (double)b->hi[0] - (double)b->lo[0], e1 = (double)b->hi[1] - (double)b->lo[1],
 	       e2 = (double)b->hi[2] - (double)b->lo[2];
 	if (!(e0 >= 0.0 && e1 >= 0.0 && e2 >= 0.0))
 		return 0.0;
 	return e0 * e1 + e1 * e2 + e2 * e0;
+#endif
 }
 
 double bvh_fbox_half_area(const fbox *b)
@@ -145,6 +160,7 @@ double bvh_fbox_half_area(const fbox *b)
 	return fbox_half_area(b);
 }
 
+#if !defined(__SSE2__)
 /* The float next to finite f towards -inf (down) or +inf: one step of
  * its bit pattern away from zero or towards it (what nextafterf does, in
  * line: the root pass calls it for most bounds). Zero and infinities are
@@ -172,6 +188,35 @@ static inline float float_up(double v)
 	float f = (float)v;
 	return (double)f < v ? float_step(f, false) : f;
 }
+#endif
+
+#if defined(__SSE2__)
+/* The float box lanes of v: float_down of each (down)
+ * or float_up, the same floats; lane 3 is 0. (float)v and the conversion
+ * here both round to nearest; where the float overshoots, its bit pattern
+ * moves one step: down from a positive float or up from a negative one is
+ * one less, the other way one more, and from a zero the least subnormal
+ * of the direction's sign. NaN never overshoots. */
+static inline __m128 float_round3(const vec3 *v, bool down)
+{
+	__m128d v01 = _mm_loadu_pd(&v->x), v2 = _mm_load_sd(&v->z);
+	__m128 f = _mm_movelh_ps(_mm_cvtpd_ps(v01), _mm_cvtpd_ps(v2));
+	__m128d b01 = _mm_cvtps_pd(f), b2 = _mm_cvtps_pd(_mm_movehl_ps(f, f));
+	__m128d o01 = down ? _mm_cmpgt_pd(b01, v01) : _mm_cmplt_pd(b01, v01);
+	__m128d o2 = down ? _mm_cmpgt_pd(b2, v2) : _mm_cmplt_pd(b2, v2);
+	/* the 64-bit masks as 32-bit lanes 0-2 (lane 3: 0 against 0, false) */
+	__m128i over = _mm_castps_si128(_mm_shuffle_ps(_mm_castpd_ps(o01), _mm_castpd_ps(o2), _MM_SHUFFLE(2, 0, 2, 0)));
+	__m128i u = _mm_castps_si128(f);
+	__m128i pos = _mm_castps_si128(_mm_cmpgt_ps(f, _mm_setzero_ps())); /* -1 where f > 0 */
+	__m128i twice = _mm_add_epi32(pos, pos);
+	__m128i step = down ? _mm_add_epi32(_mm_set1_epi32(1), twice) : _mm_sub_epi32(_mm_set1_epi32(-1), twice);
+	__m128i zero = _mm_castps_si128(_mm_cmpeq_ps(f, _mm_setzero_ps()));
+	__m128i moved = _mm_add_epi32(u, step);
+	moved = _mm_or_si128(_mm_and_si128(zero, _mm_set1_epi32(down ? (int)0x80000001u : 1)),
+	                     _mm_andnot_si128(zero, moved));
+	return _mm_castsi128_ps(_mm_or_si128(_mm_and_si128(over, moved), _mm_andnot_si128(over, u)));
+}
+#endif
 
 /* Fewer bins for small nodes: most nodes are small, and 16 bins on three
  * axes would cost more to set up and sweep than the binning itself. */
@@ -315,8 +360,12 @@ static split find_split(const builder *b, size_t begin, size_t end, const fbox *
 			sum += bcost[a][k];
 			if (sum == 0.0 || right_cost[k + 1] == 0.0)
 				continue;
-			double cost = fbox_half_area(&acc) * leaf_cost(b, sum) +
-			              right_area[k + 1] * leaf_cost(b, right_cost[k + 1]);
+			/* the left term is >= 0: a right term that alone reaches
+			 * the best cost cannot win, and its left area is not needed */
+			double right = right_area[k + 1] * leaf_cost(b, right_cost[k + 1]);
+			if (!(right < best.cost))
+				continue;
+			double cost = fbox_half_area(&acc) * leaf_cost(b, sum) + right;
 			if (cost < best.cost) {
 				best.cost = cost;
 				best.axis = a;
@@ -742,8 +791,15 @@ bool bvh2_build(const box *bounds, size_t n, const bvh_build_opts *o, bvh2 *t, r
 	for (size_t i = 0; i < n; i++) {
 		fbox *r = &b.refs[i];
 		const box *x = &bounds[i];
-		*r = (fbox){{float_down(x->lo.x), float_down(x->lo.y), float_down(x->lo.z), o->costs ? o->costs[i] : 1.0f},
+		float cost = o->costs ? o->costs[i] : 1.0f;
+#if defined(__SSE2__)
+		/* lane 3 of the lower corner: the cost (its bits or'ed onto 0) */
+		_mm_storeu_ps(r->lo, _mm_or_ps(float_round3(&x->lo, true), _mm_set_ps(cost, 0, 0, 0)));
+		_mm_storeu_ps(r->hi, float_round3(&x->hi, false));
+#else
+		*r = (fbox){{float_down(x->lo.x), float_down(x->lo.y), float_down(x->lo.z), cost},
 		            {float_up(x->hi.x), float_up(x->hi.y), float_up(x->hi.z), 0}};
+#endif
 		b.ids[i] = (uint32_t)i;
 		float c[4];
 		centroid2(r, c);
