@@ -23,6 +23,8 @@
 
 #include <unistd.h>
 
+#include "core/bvh/bvh.h"
+#include "rtsh/generate.h"
 #include "rtsh/mesh.h"
 #include "rtsh/packet.h"
 #include "rtsh/rtfile.h"
@@ -203,6 +205,61 @@ static void test_bunny(void **state)
 		if (mesh_isa_force((mesh_isa)isa))
 			camera_packets(w, 64, 48, w->lights[0].pos);
 	assert_true(mesh_isa_force(MESH_ISA_BEST));
+	world_free(w);
+	scene_free(s);
+}
+
+/* Shadow packets whose rays go apart in a big tree (the 1M-sphere scene's
+ * case, where the packet's interval lets through children no ray enters):
+ * 4 x 4 blocks of pixels S apart, so that the lit points are far apart,
+ * toward each light in turn. Each ray must get its own answer, and be
+ * counted once. */
+static void shadow_block(const world *w, int W, int H, int S, int x0, int y0, vec3 lamp, long *blocked, long *lit)
+{
+	ray sr[PACKET_MAX];
+	double smax[PACKET_MAX];
+	int n = 0;
+	for (int j = 0; j < PACKET_MAX; j++) {
+		ray r = cam_ray(&w->cam, x0 + S * (j % 4) + 0.5, y0 + S * (j / 4) + 0.5, W, H);
+		hit h;
+		if (!world_intersect(w, &r, 0.0, INFINITY, &h))
+			continue;
+		vec3 p = v3_add(h.p, v3_scale(h.n, h.front ? 1e-6 : -1e-6));
+		vec3 to = v3_sub(lamp, p);
+		sr[n] = (ray){p, v3_norm(to)};
+		smax[n++] = v3_len(to);
+	}
+	bool op[PACKET_MAX];
+	world_rays_reset();
+	world_occluded_packet(w, n, sr, 0.0, smax, op);
+	assert_int_equal(world_rays_traced(), (uint64_t)n);
+	for (int i = 0; i < n; i++) {
+		assert_int_equal(op[i], world_occluded(w, &sr[i], 0.0, smax[i]));
+		*blocked += op[i];
+		*lit += !op[i];
+	}
+}
+
+static void test_split_shadows(void **state)
+{
+	(void)state;
+	gen_opts o = {.spheres_only = true};
+	rt_error err;
+	scene *s = scene_generate(30000, 1, &o, &err);
+	if (!s)
+		fail_msg("generate: %s", err.msg);
+	world *w = world_build(s, &err);
+	if (!w)
+		fail_msg("world_build: %s", err.msg);
+	assert_true(w->tree->nnodes >= 1024); /* a deep tree: 30k spheres */
+	assert_true(w->nlights >= 2);
+	enum { W = 160, H = 96, S = 3 };
+	long blocked = 0, lit = 0, k = 0;
+	for (int y0 = 0; y0 + 4 * S <= H; y0 += 2)
+		for (int x0 = 0; x0 + 4 * S <= W; x0 += 2, k++)
+			shadow_block(w, W, H, S, x0, y0, w->lights[k % (long)w->nlights].pos, &blocked, &lit);
+	/* both answers, many times */
+	assert_true(blocked > 500 && lit > 500);
 	world_free(w);
 	scene_free(s);
 }
@@ -609,6 +666,7 @@ int main(void)
 		cmocka_unit_test(test_ties),
 		cmocka_unit_test(test_prepare_edges),
 		cmocka_unit_test(test_scenes),
+		cmocka_unit_test(test_split_shadows),
 		cmocka_unit_test(test_bunny),
 		cmocka_unit_test(test_model_ties),
 		cmocka_unit_test(test_model_packets),
