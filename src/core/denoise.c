@@ -503,15 +503,15 @@ enum { CAND_RAW, CAND_FIT, CAND_DIRECT, NCAND };
 #define NFIT (NCAND - CAND_FIT)
 
 /* What regression_rows reads, one plane a quantity (structure of arrays),
- * so that four neighbouring pixels' values are one load: the guide's six
+ * so that neighbouring pixels' values are one load: the guide's six
  * scaled features, depth, direct light, depth gradient, and what the
  * regression fits (all the samples' colour and each half's brightness);
  * and what it writes for pick_rows, the candidates' estimated squared
  * errors.
  * Each plane has PL_PAD floats of zeros before and after it, so that the
- * loads of four pixels at a row's ends stay inside. */
+ * loads of eight pixels at a row's ends stay inside. */
 enum { PL_F0, PL_Z = 6, PL_D, PL_GX, PL_GY, PL_DATA, PL_ERR = PL_DATA + 5, NPL = PL_ERR + NCAND };
-#define PL_PAD 8
+#define PL_PAD 16
 
 typedef struct job {
 	const framebuffer *fb;
@@ -735,16 +735,11 @@ static float cross_error(const chan *r, float na, float nb, float la, float lb)
 	       0.25f * (la - lb) * (la - lb);
 }
 
-/* Four floats in one SIMD register (a GCC and Clang extension), for the
- * regression's sums. */
+/* Four floats in one SIMD register (a GCC and Clang extension), for
+ * pick_rows's sums. */
 typedef float v4 __attribute__((vector_size(16)));
 /* Four ints: the lanes' masks (all bits set where true). */
 typedef int v4i __attribute__((vector_size(16)));
-
-static inline v4 v4_splat(float x)
-{
-	return (v4){x, x, x, x};
-}
 
 static inline v4i v4_isplat(int x)
 {
@@ -758,24 +753,63 @@ static inline v4 v4_load(const float *p)
 	return v;
 }
 
-
 static inline v4 v4_and(v4 x, v4i m)
 {
 	return (v4)((v4i)x & m);
 }
 
-static inline v4 v4_abs(v4 x)
+/* Eight floats, for the regression: one AVX register where the processor
+ * has AVX2 (regression_rows runs a copy of its code built for it), two SSE
+ * registers elsewhere; the same operations lane by lane either way. The
+ * helpers taking them are always inlined (GCC notes that passing them to a
+ * function would change the ABI without AVX: they are never passed). */
+#pragma GCC diagnostic ignored "-Wpsabi"
+typedef float v8 __attribute__((vector_size(32)));
+typedef int v8i __attribute__((vector_size(32)));
+#define V8_INLINE static inline __attribute__((always_inline))
+
+V8_INLINE v8 v8_splat(float x)
 {
-	return (v4)((v4i)x & v4_isplat(0x7fffffff));
+	return (v8){x, x, x, x, x, x, x, x};
+}
+
+V8_INLINE v8i v8_isplat(int x)
+{
+	return (v8i){x, x, x, x, x, x, x, x};
+}
+
+V8_INLINE v8 v8_load(const float *p)
+{
+	v8 v;
+	memcpy(&v, p, sizeof v);
+	return v;
+}
+
+V8_INLINE v8 v8_and(v8 x, v8i m)
+{
+	return (v8)((v8i)x & m);
+}
+
+/* Whether some lane of the mask m is set. */
+V8_INLINE bool v8_any(v8i m)
+{
+	typedef long long v4ll __attribute__((vector_size(32)));
+	v4ll t = (v4ll)m;
+	return (t[0] | t[1] | t[2] | t[3]) != 0;
+}
+
+V8_INLINE v8 v8_abs(v8 x)
+{
+	return (v8)((v8i)x & v8_isplat(0x7fffffff));
 }
 
 /* exp(-x) for x >= 0 as (1 - x/16)^16 (its limit definition), 0 from
- * x = 16 on: within 0.03 of it everywhere, four multiplications; of four
+ * x = 16 on: within 0.03 of it everywhere, four multiplications; of eight
  * values. */
-static inline v4 v4_exp_fast(v4 x)
+V8_INLINE v8 v8_exp_fast(v8 x)
 {
-	v4 t = v4_splat(1.0f) - x * v4_splat(1.0f / 16);
-	t = v4_and(t, t > v4_splat(0.0f));
+	v8 t = v8_splat(1.0f) - x * v8_splat(1.0f / 16);
+	t = v8_and(t, t > v8_splat(0.0f));
 	t *= t;
 	t *= t;
 	t *= t;
@@ -790,10 +824,10 @@ static inline v4 v4_exp_fast(v4 x)
 /* Rows [r0, r1) of the normal equations' lower triangle in a: each sum
  * over the taps in their order, a few rows at a time so that their sums
  * stay in registers. */
-static inline __attribute__((always_inline)) void normal_rows(v4 *a, int nt, const v4 *tw, v4 (*tv)[NU],
+static inline __attribute__((always_inline)) void normal_rows(v8 *a, int nt, const v8 *tw, v8 (*tv)[NU],
                                                               int r0, int r1)
 {
-	v4 s[NU * 2];
+	v8 s[NU * 2];
 	int n = TRI(r1, 0) - TRI(r0, 0);
 #pragma GCC unroll 16
 	for (int k = 0; k < n; k++)
@@ -802,7 +836,7 @@ static inline __attribute__((always_inline)) void normal_rows(v4 *a, int nt, con
 #pragma GCC unroll 8
 		for (int r = r0; r < r1; r++) {
 			/* regressor 0 is 1: times it, a product is itself exactly */
-			v4 wv = r == 0 ? tw[t] : tw[t] * tv[t][r];
+			v8 wv = r == 0 ? tw[t] : tw[t] * tv[t][r];
 			s[TRI(r, 0) - TRI(r0, 0)] += wv;
 #pragma GCC unroll 8
 			for (int c = 1; c <= r; c++)
@@ -814,6 +848,70 @@ static inline __attribute__((always_inline)) void normal_rows(v4 *a, int nt, con
 		a[TRI(r0, 0) + k] = s[k];
 }
 
+/* Each lane's solve of the regression's normal equations (lower triangle
+ * a, TRI) with their ridge, M z = (1, 0, ..., 0): solve's operations for
+ * n = NU and that one right-hand side, in its order, lane by lane, so that
+ * every lane's z is the bits solve gives its pixel. Returns the lanes whose
+ * system was positive definite (z is +0 in the others). */
+V8_INLINE v8i solve_lanes(const v8 *a, v8 zv[NU])
+{
+	v8 m[NU][NU];
+#pragma GCC unroll 8
+	for (int r = 0; r < NU; r++)
+#pragma GCC unroll 8
+		for (int c = 0; c <= r; c++)
+			m[r][c] = a[TRI(r, c)];
+	v8 ridge = m[0][0] * v8_splat(RIDGE);
+#pragma GCC unroll 8
+	for (int r = 1; r < NU; r++)
+		m[r][r] += ridge;
+	v8i ok = v8_isplat(-1);
+	v8 inv[NU];
+#pragma GCC unroll 8
+	for (int c = 0; c < NU; c++) {
+		v8 d = m[c][c];
+#pragma GCC unroll 8
+		for (int k = 0; k < c; k++)
+			d -= m[c][k] * m[c][k];
+		ok &= d > v8_splat(1e-12f);
+		/* a failed lane goes on with 1 (its z is dropped) */
+		d = v8_and(d, ok) + v8_and(v8_splat(1.0f), ~ok);
+		for (int l = 0; l < 8; l++)
+			d[l] = sqrtf(d[l]);
+		m[c][c] = d;
+		inv[c] = v8_splat(1.0f) / d;
+#pragma GCC unroll 8
+		for (int r = c + 1; r < NU; r++) {
+			v8 v = m[r][c];
+#pragma GCC unroll 8
+			for (int k = 0; k < c; k++)
+				v -= m[r][k] * m[c][k];
+			m[r][c] = v * inv[c];
+		}
+	}
+	v8 z[NU];
+#pragma GCC unroll 8
+	for (int r = 0; r < NU; r++) {
+		v8 v = v8_splat(r == 0 ? 1.0f : 0.0f);
+#pragma GCC unroll 8
+		for (int k = 0; k < r; k++)
+			v -= m[r][k] * z[k];
+		z[r] = v * inv[r];
+	}
+#pragma GCC unroll 8
+	for (int r = NU - 1; r >= 0; r--) {
+		v8 v = z[r];
+#pragma GCC unroll 8
+		for (int k = r + 1; k < NU; k++)
+			v -= m[k][r] * zv[k];
+		zv[r] = v * inv[r];
+	}
+#pragma GCC unroll 8
+	for (int r = 0; r < NU; r++)
+		zv[r] = v8_and(zv[r], ok);
+	return ok;
+}
+
 /* Weighted first-order regression (NFOR, Bitterli et al. 2016, without its
  * colour weights) of the radiance over albedo on the screen position, the
  * normal and the depth, over the window around each pixel of rows
@@ -823,13 +921,13 @@ static inline __attribute__((always_inline)) void normal_rows(v4 *a, int nt, con
  * brightness depends on that half's samples only, and cross_error
  * estimates the fit's error honestly.
  *
- * Four neighbouring pixels of a row at a time, one in each SIMD lane
- * (their planes: one load for the four): each lane does the one pixel's
+ * Eight neighbouring pixels of a row at a time, one in each SIMD lane
+ * (their planes: one load for the eight): each lane does the one pixel's
  * operations in the one pixel's order, so the results are those of a
  * pixel alone to the bit. A tap that is outside the image or has no
  * weight for a lane adds +0 to that lane's sums (masked), which leaves
  * them as they were, as if it had been skipped. */
-static void regression_rows(job *j, int y0, int y1)
+V8_INLINE void regression_body(job *j, int y0, int y1)
 {
 	int w = j->fb->w, h = j->fb->h;
 	float na = j->n[CH_A], nb = j->n[CH_B];
@@ -843,55 +941,56 @@ static void regression_rows(job *j, int y0, int y1)
 	for (int c = 0; c < NCAND; c++)
 		perr[c] = plane(j, PL_ERR + c);
 	for (int y = y0; y < y1; y++)
-		for (int x = 0; x < w; x += 4) {
+		for (int x = 0; x < w; x += 8) {
 			ptrdiff_t i = (ptrdiff_t)y * w + x;
-			v4 gf[6];
+			v8 gf[6];
 			for (int k = 0; k < 6; k++)
-				gf[k] = v4_load(pf[k] + i);
-			v4 gz = v4_load(pz + i), gd = v4_load(pd + i), ggx = v4_load(pgx + i), ggy = v4_load(pgy + i);
-			v4 inv_z = v4_splat(1.0f) / (v4_splat(SIGMA_Z) * gz + v4_splat(1e-6f));
+				gf[k] = v8_load(pf[k] + i);
+			v8 gz = v8_load(pz + i), gd = v8_load(pd + i), ggx = v8_load(pgx + i), ggy = v8_load(pgy + i);
+			v8 inv_z = v8_splat(1.0f) / (v8_splat(SIGMA_Z) * gz + v8_splat(1e-6f));
 			/* the direct light's slope, in shares of its value */
-			v4 dscale = v4_splat(1.0f) / (v4_splat(0.5f) * v4_abs(gd) + v4_splat(0.05f));
-			v4i lane = {x, x + 1, x + 2, x + 3};
+			v8 dscale = v8_splat(1.0f) / (v8_splat(0.5f) * v8_abs(gd) + v8_splat(0.05f));
+			v8i lane = {x, x + 1, x + 2, x + 3, x + 4, x + 5, x + 6, x + 7};
 			/* The taps with a weight in some lane: the weights (0 where
 			 * none), regressors, masks and where the tap's data are. */
-			v4 tw[TAPS], tv[TAPS][NU];
-			v4i tm[TAPS];
+			v8 tw[TAPS], tv[TAPS][NU];
+			v8i tm[TAPS];
 			ptrdiff_t tq[TAPS];
 			/* The normal equations' lower triangle (what solve reads). */
-			v4 a[NTRI] = {{0}};
+			v8 a[NTRI] = {{0}};
 			int nt = 0;
 			for (int dy = -WIN; dy <= WIN; dy++) {
 				int qy = y + dy;
 				if (qy < 0 || qy >= h)
 					continue;
 				for (int dx = -WIN; dx <= WIN; dx++) {
-					v4i qx = lane + v4_isplat(dx);
-					v4i in = (qx >= v4_isplat(0)) & (qx < v4_isplat(w));
-					if (!(in[0] | in[1] | in[2] | in[3]))
+					/* no lane's tap inside the image: only +0 to add */
+					if (x + dx + 7 < 0 || x + dx >= w)
 						continue;
+					v8i qx = lane + v8_isplat(dx);
+					v8i in = (qx >= v8_isplat(0)) & (qx < v8_isplat(w));
 					ptrdiff_t q = (ptrdiff_t)qy * w + x + dx;
-					v4 e = v4_splat(0.0f);
+					v8 e = v8_splat(0.0f);
 #pragma GCC unroll 6
 					for (int k = 0; k < 6; k++) {
-						v4 d = gf[k] - v4_load(pf[k] + q);
+						v8 d = gf[k] - v8_load(pf[k] + q);
 						e += d * d;
 					}
-					v4 qz = v4_load(pz + q);
-					e += v4_abs(qz - (gz + ggx * v4_splat((float)dx) + ggy * v4_splat((float)dy))) * inv_z;
-					v4 wt = v4_exp_fast(e);
-					v4i m = in & (wt > v4_splat(0.0f));
-					if (!(m[0] | m[1] | m[2] | m[3]))
+					v8 qz = v8_load(pz + q);
+					e += v8_abs(qz - (gz + ggx * v8_splat((float)dx) + ggy * v8_splat((float)dy))) * inv_z;
+					v8 wt = v8_exp_fast(e);
+					v8i m = in & (wt > v8_splat(0.0f));
+					if (!v8_any(m))
 						continue;
-					v4 tww = v4_and(wt, m);
-					v4 *v = tv[nt];
-					v[0] = v4_splat(1.0f);
-					v[1] = v4_splat((float)dx * (1.0f / WIN));
-					v[2] = v4_splat((float)dy * (1.0f / WIN));
+					v8 tww = v8_and(wt, m);
+					v8 *v = tv[nt];
+					v[0] = v8_splat(1.0f);
+					v[1] = v8_splat((float)dx * (1.0f / WIN));
+					v[2] = v8_splat((float)dy * (1.0f / WIN));
 					for (int k = 3; k < 6; k++)
-						v[k] = v4_and(v4_load(pf[k] + q) - gf[k], m);
-					v[6] = v4_and((qz - gz) * inv_z, m);
-					v[7] = v4_and((v4_load(pd + q) - gd) * dscale, m);
+						v[k] = v8_and(v8_load(pf[k] + q) - gf[k], m);
+					v[6] = v8_and((qz - gz) * inv_z, m);
+					v[7] = v8_and((v8_load(pd + q) - gd) * dscale, m);
 					tw[nt] = tww;
 					tm[nt] = m;
 					tq[nt] = q;
@@ -906,48 +1005,33 @@ static void regression_rows(job *j, int y0, int y1)
 			 * with h_t the tap's weight times z . (its regressors),
 			 * M z = (1, 0, ..., 0): one solve for all the right-hand
 			 * sides. */
-			bool ok[4] = {false, false, false, false};
-			v4 zv[NU] = {{0}};
-			int lanes = w - x < 4 ? w - x : 4;
-			for (int l = 0; l < lanes; l++) {
-				float m[NU][MIX_NU] = {{0}}, e0[NU][NRHS] = {{1.0f}}, z[NU][NRHS];
-#pragma GCC unroll 8
-				for (int r = 0; r < NU; r++)
-#pragma GCC unroll 8
-					for (int c = 0; c <= r; c++)
-						m[r][c] = a[TRI(r, c)][l];
-				float ridge = m[0][0] * RIDGE;
-				for (int r = 1; r < NU; r++)
-					m[r][r] += ridge;
-				ok[l] = solve(NU, m, 1, e0, z);
-				if (ok[l])
-					for (int r = 0; r < NU; r++)
-						zv[r][l] = z[r][0];
-			}
+			v8 zv[NU];
+			v8i ok = solve_lanes(a, zv);
+			int lanes = w - x < 8 ? w - x : 8;
 			/* The direct light's fit: the normal equations of the
 			 * constant and regressor 7 are the sub-matrix of the whole
 			 * one's, solved in closed form, all lanes at once: with
 			 * M = (m00 m70; m70 m77), z = (m77, -m70) / det. With a
 			 * ridge (so where the taps' direct light is all alike, the
 			 * taps' weighted mean); a lane without weight is left out. */
-			v4 m00 = a[TRI(0, 0)], m70 = a[TRI(7, 0)];
-			v4 m77 = a[TRI(7, 7)] + m00 * v4_splat(DIRECT_RIDGE);
-			v4 det = m00 * m77 - m70 * m70;
-			v4i okd = (m00 > v4_splat(0.0f)) & (det > v4_splat(1e-6f) * m00 * m77);
-			v4 safe = v4_and(det, okd) + v4_and(v4_splat(1.0f), ~okd);
-			v4 zd0 = v4_and(m77 / safe, okd), zd7 = v4_and(-m70 / safe, okd);
-			v4 fo[5] = {{0}}, fd[5] = {{0}};
+			v8 m00 = a[TRI(0, 0)], m70 = a[TRI(7, 0)];
+			v8 m77 = a[TRI(7, 7)] + m00 * v8_splat(DIRECT_RIDGE);
+			v8 det = m00 * m77 - m70 * m70;
+			v8i okd = (m00 > v8_splat(0.0f)) & (det > v8_splat(1e-6f) * m00 * m77);
+			v8 safe = v8_and(det, okd) + v8_and(v8_splat(1.0f), ~okd);
+			v8 zd0 = v8_and(m77 / safe, okd), zd7 = v8_and(-m70 / safe, okd);
+			v8 fo[5] = {{0}}, fd[5] = {{0}};
 			for (int t = 0; t < nt; t++) {
-				const v4 *v = tv[t];
-				v4 p0 = zv[0] * v[0] + zv[4] * v[4], p1 = zv[1] * v[1] + zv[5] * v[5];
-				v4 p2 = zv[2] * v[2] + zv[6] * v[6], p3 = zv[3] * v[3] + zv[7] * v[7];
-				v4 hv = tw[t] * (p0 + p1 + p2 + p3);
-				v4 hd = tw[t] * (zd0 + zd7 * v[7]);
+				const v8 *v = tv[t];
+				v8 p0 = zv[0] * v[0] + zv[4] * v[4], p1 = zv[1] * v[1] + zv[5] * v[5];
+				v8 p2 = zv[2] * v[2] + zv[6] * v[6], p3 = zv[3] * v[3] + zv[7] * v[7];
+				v8 hv = tw[t] * (p0 + p1 + p2 + p3);
+				v8 hd = tw[t] * (zd0 + zd7 * v[7]);
 #pragma GCC unroll 5
 				for (int c = 0; c < 5; c++) {
-					v4 yv = v4_load(pdata[c] + tq[t]);
-					fo[c] += v4_and(hv * yv, tm[t]);
-					fd[c] += v4_and(hd * yv, tm[t]);
+					v8 yv = v8_load(pdata[c] + tq[t]);
+					fo[c] += v8_and(hv * yv, tm[t]);
+					fd[c] += v8_and(hd * yv, tm[t]);
 				}
 			}
 			for (int l = 0; l < lanes; l++) {
@@ -981,6 +1065,31 @@ static void regression_rows(job *j, int y0, int y1)
 				perr[CAND_DIRECT][pi] = okd[l] ? cross_error(r0, na, nb, fd[3][l], fd[4][l]) * am2 : INFINITY;
 			}
 		}
+}
+
+/* regression_body built for processors with AVX2 (eight floats a
+ * register) and for any x86-64 or other processor; which runs is asked of
+ * the processor, not of an ifunc (ThreadSanitizer does not start before
+ * ifunc resolvers). The same floats either way: the same operations lane
+ * by lane, no fused multiply-adds (-ffp-contract=off is GCC's default
+ * under -std=c17; "avx2" does not enable FMA). */
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+__attribute__((target("avx2"))) static void regression_rows_avx2(job *j, int y0, int y1)
+{
+	regression_body(j, y0, y1);
+}
+#define HAVE_AVX2_COPY 1
+#endif
+
+static void regression_rows(job *j, int y0, int y1)
+{
+#ifdef HAVE_AVX2_COPY
+	if (__builtin_cpu_supports("avx2")) {
+		regression_rows_avx2(j, y0, y1);
+		return;
+	}
+#endif
+	regression_body(j, y0, y1);
 }
 
 /* Chooses per pixel the candidate whose estimated error, averaged over
