@@ -735,31 +735,10 @@ static float cross_error(const chan *r, float na, float nb, float la, float lb)
 	       0.25f * (la - lb) * (la - lb);
 }
 
-/* Four floats in one SIMD register (a GCC and Clang extension), for
- * pick_rows's sums. */
-typedef float v4 __attribute__((vector_size(16)));
-/* Four ints: the lanes' masks (all bits set where true). */
-typedef int v4i __attribute__((vector_size(16)));
-
-static inline v4i v4_isplat(int x)
-{
-	return (v4i){x, x, x, x};
-}
-
-static inline v4 v4_load(const float *p)
-{
-	v4 v;
-	memcpy(&v, p, sizeof v);
-	return v;
-}
-
-static inline v4 v4_and(v4 x, v4i m)
-{
-	return (v4)((v4i)x & m);
-}
-
-/* Eight floats, for the regression: one AVX register where the processor
- * has AVX2 (regression_rows runs a copy of its code built for it), two SSE
+/* Eight floats in one SIMD value (a GCC and Clang extension), for the
+ * regression and the choice: one AVX register where the processor
+ * has AVX2 (regression_rows and pick_rows run a copy of their code built
+ * for it), two SSE
  * registers elsewhere; the same operations lane by lane either way. The
  * helpers taking them are always inlined (GCC notes that passing them to a
  * function would change the ABI without AVX: they are never passed). */
@@ -940,6 +919,12 @@ V8_INLINE void regression_body(job *j, int y0, int y1)
 	float *perr[NCAND];
 	for (int c = 0; c < NCAND; c++)
 		perr[c] = plane(j, PL_ERR + c);
+	/* the taps' offsets, and over WIN (the regressors), eight of each */
+	v8 off[2 * WIN + 1], offw[2 * WIN + 1];
+	for (int d = -WIN; d <= WIN; d++) {
+		off[d + WIN] = v8_splat((float)d);
+		offw[d + WIN] = v8_splat((float)d * (1.0f / WIN));
+	}
 	for (int y = y0; y < y1; y++)
 		for (int x = 0; x < w; x += 8) {
 			ptrdiff_t i = (ptrdiff_t)y * w + x;
@@ -977,7 +962,7 @@ V8_INLINE void regression_body(job *j, int y0, int y1)
 						e += d * d;
 					}
 					v8 qz = v8_load(pz + q);
-					e += v8_abs(qz - (gz + ggx * v8_splat((float)dx) + ggy * v8_splat((float)dy))) * inv_z;
+					e += v8_abs(qz - (gz + ggx * off[dx + WIN] + ggy * off[dy + WIN])) * inv_z;
 					v8 wt = v8_exp_fast(e);
 					v8i m = in & (wt > v8_splat(0.0f));
 					if (!v8_any(m))
@@ -985,8 +970,8 @@ V8_INLINE void regression_body(job *j, int y0, int y1)
 					v8 tww = v8_and(wt, m);
 					v8 *v = tv[nt];
 					v[0] = v8_splat(1.0f);
-					v[1] = v8_splat((float)dx * (1.0f / WIN));
-					v[2] = v8_splat((float)dy * (1.0f / WIN));
+					v[1] = offw[dx + WIN];
+					v[2] = offw[dy + WIN];
 					for (int k = 3; k < 6; k++)
 						v[k] = v8_and(v8_load(pf[k] + q) - gf[k], m);
 					v[6] = v8_and((qz - gz) * inv_z, m);
@@ -1098,31 +1083,36 @@ static void regression_rows(job *j, int y0, int y1)
  * both regressions are estimated to beat the raw pixel their blend by
  * those estimates; times the albedo again, into the all-samples chain
  * (radiance, and the noise variance of the mean's brightness). */
-static void pick_rows(job *j, int y0, int y1)
+V8_INLINE void pick_body(job *j, int y0, int y1)
 {
 	int w = j->fb->w, h = j->fb->h;
 	const float *perr[NCAND];
 	for (int c = 0; c < NCAND; c++)
 		perr[c] = plane(j, PL_ERR + c);
 	for (int y = y0; y < y1; y++)
-		for (int x0 = 0; x0 < w; x0 += 4) {
-			/* Four pixels' sums, one in each lane, each over its window
+		for (int x0 = 0; x0 < w; x0 += 8) {
+			/* Eight pixels' sums, one in each lane, each over its window
 			 * in the one pixel's order; a tap outside the image adds +0
 			 * (masked), as if skipped. */
-			v4i lane = {x0, x0 + 1, x0 + 2, x0 + 3};
-			v4 sv[NCAND] = {{0}};
+			v8i lane = {x0, x0 + 1, x0 + 2, x0 + 3, x0 + 4, x0 + 5, x0 + 6, x0 + 7};
+			v8i in[2 * PICK_R + 1];
+			for (int dx = -PICK_R; dx <= PICK_R; dx++) {
+				v8i qx = lane + v8_isplat(dx);
+				in[dx + PICK_R] = (qx >= v8_isplat(0)) & (qx < v8_isplat(w));
+			}
+			v8 sv[NCAND] = {{0}};
 			for (int qy = y - PICK_R; qy <= y + PICK_R; qy++) {
 				if (qy < 0 || qy >= h)
 					continue;
+#pragma GCC unroll 9
 				for (int dx = -PICK_R; dx <= PICK_R; dx++) {
-					v4i qx = lane + v4_isplat(dx);
-					v4i in = (qx >= v4_isplat(0)) & (qx < v4_isplat(w));
 					ptrdiff_t q = (ptrdiff_t)qy * w + x0 + dx;
+#pragma GCC unroll 3
 					for (int c = 0; c < NCAND; c++)
-						sv[c] += v4_and(v4_load(perr[c] + q), in);
+						sv[c] += v8_and(v8_load(perr[c] + q), in[dx + PICK_R]);
 				}
 			}
-			int lanes = w - x0 < 4 ? w - x0 : 4;
+			int lanes = w - x0 < 8 ? w - x0 : 8;
 			for (int ln = 0; ln < lanes; ln++) {
 				size_t i = (size_t)y * w + (size_t)(x0 + ln);
 				float s[NCAND];
@@ -1155,6 +1145,25 @@ static void pick_rows(job *j, int y0, int y1)
 				o->v = o->v / j->n[CH_ALL] * l * l;
 			}
 		}
+}
+
+/* pick_body for processors with AVX2 and for any (as regression_rows). */
+#ifdef HAVE_AVX2_COPY
+__attribute__((target("avx2"))) static void pick_rows_avx2(job *j, int y0, int y1)
+{
+	pick_body(j, y0, y1);
+}
+#endif
+
+static void pick_rows(job *j, int y0, int y1)
+{
+#ifdef HAVE_AVX2_COPY
+	if (__builtin_cpu_supports("avx2")) {
+		pick_rows_avx2(j, y0, y1);
+		return;
+	}
+#endif
+	pick_body(j, y0, y1);
 }
 
 /* A pixel whose features vary inside it (part one surface, part another):
