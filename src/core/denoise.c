@@ -735,435 +735,59 @@ static float cross_error(const chan *r, float na, float nb, float la, float lb)
 	       0.25f * (la - lb) * (la - lb);
 }
 
-/* Eight floats in one SIMD value (a GCC and Clang extension), for the
- * regression and the choice: one AVX register where the processor
- * has AVX2 (regression_rows and pick_rows run a copy of their code built
- * for it), two SSE
- * registers elsewhere; the same operations lane by lane either way. The
- * helpers taking them are always inlined (GCC notes that passing them to a
- * function would change the ABI without AVX: they are never passed). */
-#pragma GCC diagnostic ignored "-Wpsabi"
-typedef float v8 __attribute__((vector_size(32)));
-typedef int v8i __attribute__((vector_size(32)));
-#define V8_INLINE static inline __attribute__((always_inline))
-
-V8_INLINE v8 v8_splat(float x)
-{
-	return (v8){x, x, x, x, x, x, x, x};
-}
-
-V8_INLINE v8i v8_isplat(int x)
-{
-	return (v8i){x, x, x, x, x, x, x, x};
-}
-
-V8_INLINE v8 v8_load(const float *p)
-{
-	v8 v;
-	memcpy(&v, p, sizeof v);
-	return v;
-}
-
-V8_INLINE v8 v8_and(v8 x, v8i m)
-{
-	return (v8)((v8i)x & m);
-}
-
-/* Whether some lane of the mask m is set. */
-V8_INLINE bool v8_any(v8i m)
-{
-	typedef long long v4ll __attribute__((vector_size(32)));
-	v4ll t = (v4ll)m;
-	return (t[0] | t[1] | t[2] | t[3]) != 0;
-}
-
-V8_INLINE v8 v8_abs(v8 x)
-{
-	return (v8)((v8i)x & v8_isplat(0x7fffffff));
-}
-
-/* exp(-x) for x >= 0 as (1 - x/16)^16 (its limit definition), 0 from
- * x = 16 on: within 0.03 of it everywhere, four multiplications; of eight
- * values. */
-V8_INLINE v8 v8_exp_fast(v8 x)
-{
-	v8 t = v8_splat(1.0f) - x * v8_splat(1.0f / 16);
-	t = v8_and(t, t > v8_splat(0.0f));
-	t *= t;
-	t *= t;
-	t *= t;
-	return t * t;
-}
-
 /* Where the sum of row r and column c (c <= r) of the normal equations is
  * kept: their lower triangle, row by row. */
 #define TRI(r, c) ((r) * ((r) + 1) / 2 + (c))
 #define NTRI (NU * (NU + 1) / 2)
 
-/* Rows [r0, r1) of the normal equations' lower triangle in a: each sum
- * over the taps in their order, a few rows at a time so that their sums
- * stay in registers. */
-static inline __attribute__((always_inline)) void normal_rows(v8 *a, int nt, const v8 *tw, v8 (*tv)[NU],
-                                                              int r0, int r1)
-{
-	v8 s[NU * 2];
-	int n = TRI(r1, 0) - TRI(r0, 0);
-#pragma GCC unroll 16
-	for (int k = 0; k < n; k++)
-		s[k] = a[TRI(r0, 0) + k];
-	for (int t = 0; t < nt; t++) {
-#pragma GCC unroll 8
-		for (int r = r0; r < r1; r++) {
-			/* regressor 0 is 1: times it, a product is itself exactly */
-			v8 wv = r == 0 ? tw[t] : tw[t] * tv[t][r];
-			s[TRI(r, 0) - TRI(r0, 0)] += wv;
-#pragma GCC unroll 8
-			for (int c = 1; c <= r; c++)
-				s[TRI(r, c) - TRI(r0, 0)] += wv * tv[t][c];
-		}
-	}
-#pragma GCC unroll 16
-	for (int k = 0; k < n; k++)
-		a[TRI(r0, 0) + k] = s[k];
-}
-
-/* Each lane's solve of the regression's normal equations (lower triangle
- * a, TRI) with their ridge, M z = (1, 0, ..., 0): solve's operations for
- * n = NU and that one right-hand side, in its order, lane by lane, so that
- * every lane's z is the bits solve gives its pixel. Returns the lanes whose
- * system was positive definite (z is +0 in the others). */
-V8_INLINE v8i solve_lanes(const v8 *a, v8 zv[NU])
-{
-	v8 m[NU][NU];
-#pragma GCC unroll 8
-	for (int r = 0; r < NU; r++)
-#pragma GCC unroll 8
-		for (int c = 0; c <= r; c++)
-			m[r][c] = a[TRI(r, c)];
-	v8 ridge = m[0][0] * v8_splat(RIDGE);
-#pragma GCC unroll 8
-	for (int r = 1; r < NU; r++)
-		m[r][r] += ridge;
-	v8i ok = v8_isplat(-1);
-	v8 inv[NU];
-#pragma GCC unroll 8
-	for (int c = 0; c < NU; c++) {
-		v8 d = m[c][c];
-#pragma GCC unroll 8
-		for (int k = 0; k < c; k++)
-			d -= m[c][k] * m[c][k];
-		ok &= d > v8_splat(1e-12f);
-		/* a failed lane goes on with 1 (its z is dropped) */
-		d = v8_and(d, ok) + v8_and(v8_splat(1.0f), ~ok);
-		for (int l = 0; l < 8; l++)
-			d[l] = sqrtf(d[l]);
-		m[c][c] = d;
-		inv[c] = v8_splat(1.0f) / d;
-#pragma GCC unroll 8
-		for (int r = c + 1; r < NU; r++) {
-			v8 v = m[r][c];
-#pragma GCC unroll 8
-			for (int k = 0; k < c; k++)
-				v -= m[r][k] * m[c][k];
-			m[r][c] = v * inv[c];
-		}
-	}
-	v8 z[NU];
-#pragma GCC unroll 8
-	for (int r = 0; r < NU; r++) {
-		v8 v = v8_splat(r == 0 ? 1.0f : 0.0f);
-#pragma GCC unroll 8
-		for (int k = 0; k < r; k++)
-			v -= m[r][k] * z[k];
-		z[r] = v * inv[r];
-	}
-#pragma GCC unroll 8
-	for (int r = NU - 1; r >= 0; r--) {
-		v8 v = z[r];
-#pragma GCC unroll 8
-		for (int k = r + 1; k < NU; k++)
-			v -= m[k][r] * zv[k];
-		zv[r] = v * inv[r];
-	}
-#pragma GCC unroll 8
-	for (int r = 0; r < NU; r++)
-		zv[r] = v8_and(zv[r], ok);
-	return ok;
-}
-
-/* Weighted first-order regression (NFOR, Bitterli et al. 2016, without its
- * colour weights) of the radiance over albedo on the screen position, the
- * normal and the depth, over the window around each pixel of rows
- * [y0, y1), evaluated at the pixel. The taps are weighted by how alike
- * their features are (albedo, normal, depth off the pixel's plane) and by
- * nothing else: no weight depends on the noise, so the fit of each half's
- * brightness depends on that half's samples only, and cross_error
- * estimates the fit's error honestly.
- *
- * Eight neighbouring pixels of a row at a time, one in each SIMD lane
- * (their planes: one load for the eight): each lane does the one pixel's
- * operations in the one pixel's order, so the results are those of a
- * pixel alone to the bit. A tap that is outside the image or has no
- * weight for a lane adds +0 to that lane's sums (masked), which leaves
- * them as they were, as if it had been skipped. */
-V8_INLINE void regression_body(job *j, int y0, int y1)
-{
-	int w = j->fb->w, h = j->fb->h;
-	float na = j->n[CH_A], nb = j->n[CH_B];
-	const float *pf[6], *pdata[5];
-	for (int k = 0; k < 6; k++)
-		pf[k] = plane(j, PL_F0 + k);
-	for (int k = 0; k < 5; k++)
-		pdata[k] = plane(j, PL_DATA + k);
-	const float *pz = plane(j, PL_Z), *pd = plane(j, PL_D), *pgx = plane(j, PL_GX), *pgy = plane(j, PL_GY);
-	float *perr[NCAND];
-	for (int c = 0; c < NCAND; c++)
-		perr[c] = plane(j, PL_ERR + c);
-	/* the taps' offsets, and over WIN (the regressors), eight of each */
-	v8 off[2 * WIN + 1], offw[2 * WIN + 1];
-	for (int d = -WIN; d <= WIN; d++) {
-		off[d + WIN] = v8_splat((float)d);
-		offw[d + WIN] = v8_splat((float)d * (1.0f / WIN));
-	}
-	for (int y = y0; y < y1; y++)
-		for (int x = 0; x < w; x += 8) {
-			ptrdiff_t i = (ptrdiff_t)y * w + x;
-			v8 gf[6];
-			for (int k = 0; k < 6; k++)
-				gf[k] = v8_load(pf[k] + i);
-			v8 gz = v8_load(pz + i), gd = v8_load(pd + i), ggx = v8_load(pgx + i), ggy = v8_load(pgy + i);
-			v8 inv_z = v8_splat(1.0f) / (v8_splat(SIGMA_Z) * gz + v8_splat(1e-6f));
-			/* the direct light's slope, in shares of its value */
-			v8 dscale = v8_splat(1.0f) / (v8_splat(0.5f) * v8_abs(gd) + v8_splat(0.05f));
-			v8i lane = {x, x + 1, x + 2, x + 3, x + 4, x + 5, x + 6, x + 7};
-			/* The taps with a weight in some lane: the weights (0 where
-			 * none), regressors, masks and where the tap's data are. */
-			v8 tw[TAPS], tv[TAPS][NU];
-			v8i tm[TAPS];
-			ptrdiff_t tq[TAPS];
-			/* The normal equations' lower triangle (what solve reads). */
-			v8 a[NTRI] = {{0}};
-			int nt = 0;
-			for (int dy = -WIN; dy <= WIN; dy++) {
-				int qy = y + dy;
-				if (qy < 0 || qy >= h)
-					continue;
-				for (int dx = -WIN; dx <= WIN; dx++) {
-					/* no lane's tap inside the image: only +0 to add */
-					if (x + dx + 7 < 0 || x + dx >= w)
-						continue;
-					v8i qx = lane + v8_isplat(dx);
-					v8i in = (qx >= v8_isplat(0)) & (qx < v8_isplat(w));
-					ptrdiff_t q = (ptrdiff_t)qy * w + x + dx;
-					v8 e = v8_splat(0.0f);
-#pragma GCC unroll 6
-					for (int k = 0; k < 6; k++) {
-						v8 d = gf[k] - v8_load(pf[k] + q);
-						e += d * d;
-					}
-					v8 qz = v8_load(pz + q);
-					e += v8_abs(qz - (gz + ggx * off[dx + WIN] + ggy * off[dy + WIN])) * inv_z;
-					v8 wt = v8_exp_fast(e);
-					v8i m = in & (wt > v8_splat(0.0f));
-					if (!v8_any(m))
-						continue;
-					v8 tww = v8_and(wt, m);
-					v8 *v = tv[nt];
-					v[0] = v8_splat(1.0f);
-					v[1] = offw[dx + WIN];
-					v[2] = offw[dy + WIN];
-					for (int k = 3; k < 6; k++)
-						v[k] = v8_and(v8_load(pf[k] + q) - gf[k], m);
-					v[6] = v8_and((qz - gz) * inv_z, m);
-					v[7] = v8_and((v8_load(pd + q) - gd) * dscale, m);
-					tw[nt] = tww;
-					tm[nt] = m;
-					tq[nt] = q;
-					nt++;
-				}
-			}
-			normal_rows(a, nt, tw, tv, 0, 4);
-			normal_rows(a, nt, tw, tv, 4, 6);
-			normal_rows(a, nt, tw, tv, 6, 7);
-			normal_rows(a, nt, tw, tv, 7, 8);
-			/* Each lane's solve: the fit at the pixel is sum_t h_t y_t,
-			 * with h_t the tap's weight times z . (its regressors),
-			 * M z = (1, 0, ..., 0): one solve for all the right-hand
-			 * sides. */
-			v8 zv[NU];
-			v8i ok = solve_lanes(a, zv);
-			int lanes = w - x < 8 ? w - x : 8;
-			/* The direct light's fit: the normal equations of the
-			 * constant and regressor 7 are the sub-matrix of the whole
-			 * one's, solved in closed form, all lanes at once: with
-			 * M = (m00 m70; m70 m77), z = (m77, -m70) / det. With a
-			 * ridge (so where the taps' direct light is all alike, the
-			 * taps' weighted mean); a lane without weight is left out. */
-			v8 m00 = a[TRI(0, 0)], m70 = a[TRI(7, 0)];
-			v8 m77 = a[TRI(7, 7)] + m00 * v8_splat(DIRECT_RIDGE);
-			v8 det = m00 * m77 - m70 * m70;
-			v8i okd = (m00 > v8_splat(0.0f)) & (det > v8_splat(1e-6f) * m00 * m77);
-			v8 safe = v8_and(det, okd) + v8_and(v8_splat(1.0f), ~okd);
-			v8 zd0 = v8_and(m77 / safe, okd), zd7 = v8_and(-m70 / safe, okd);
-			v8 fo[5] = {{0}}, fd[5] = {{0}};
-			for (int t = 0; t < nt; t++) {
-				const v8 *v = tv[t];
-				v8 p0 = zv[0] * v[0] + zv[4] * v[4], p1 = zv[1] * v[1] + zv[5] * v[5];
-				v8 p2 = zv[2] * v[2] + zv[6] * v[6], p3 = zv[3] * v[3] + zv[7] * v[7];
-				v8 hv = tw[t] * (p0 + p1 + p2 + p3);
-				v8 hd = tw[t] * (zd0 + zd7 * v[7]);
-#pragma GCC unroll 5
-				for (int c = 0; c < 5; c++) {
-					v8 yv = v8_load(pdata[c] + tq[t]);
-					fo[c] += v8_and(hv * yv, tm[t]);
-					fd[c] += v8_and(hd * yv, tm[t]);
-				}
-			}
-			for (int l = 0; l < lanes; l++) {
-				size_t pi = (size_t)i + (size_t)l;
-				const chan *r0 = j->t[pi].h;
-				float am = lum(j->am + pi * 3), am2 = am * am;
-				float *fit = j->fit + pi * 3 * NFIT, *fitd = fit + 3;
-				if (!ok[l]) {
-					memcpy(fit, r0[CH_ALL].c, sizeof r0[CH_ALL].c);
-					memcpy(fitd, r0[CH_ALL].c, sizeof r0[CH_ALL].c);
-					perr[CAND_RAW][pi] = 0.0f; /* the raw pixel */
-					perr[CAND_FIT][pi] = INFINITY;
-					perr[CAND_DIRECT][pi] = INFINITY;
-					continue;
-				}
-				for (int k = 0; k < 3; k++) {
-					fit[k] = fo[k][l];
-					fitd[k] = okd[l] ? fd[k][l] : r0[CH_ALL].c[k];
-				}
-				if (!j->halves) {
-					/* One sample: no halves, no error estimate; the fit. */
-					perr[CAND_RAW][pi] = INFINITY;
-					perr[CAND_FIT][pi] = 0.0f;
-					perr[CAND_DIRECT][pi] = INFINITY;
-					continue;
-				}
-				/* The raw pixel estimated the same way as the fits, so
-				 * that the estimates share their noise. */
-				perr[CAND_RAW][pi] = cross_error(r0, na, nb, lum(r0[CH_A].c), lum(r0[CH_B].c)) * am2;
-				perr[CAND_FIT][pi] = cross_error(r0, na, nb, fo[3][l], fo[4][l]) * am2;
-				perr[CAND_DIRECT][pi] = okd[l] ? cross_error(r0, na, nb, fd[3][l], fd[4][l]) * am2 : INFINITY;
-			}
-		}
-}
-
-/* regression_body built for processors with AVX2 (eight floats a
- * register) and for any x86-64 or other processor; which runs is asked of
- * the processor, not of an ifunc (ThreadSanitizer does not start before
- * ifunc resolvers). The same floats either way: the same operations lane
- * by lane, no fused multiply-adds (-ffp-contract=off is GCC's default
- * under -std=c17; "avx2" does not enable FMA). */
+/* The regression (regression_rows) and the choice (pick_rows) several
+ * pixels at a time (denoise_lanes.h): eight where the processor has AVX2
+ * (a copy built for it, chosen when the filter runs: not by an ifunc,
+ * which ThreadSanitizer cannot start before), else four. The same floats
+ * either way: the same operations lane by lane, and no fused
+ * multiply-adds (-ffp-contract=off is GCC's default under -std=c17, and
+ * "avx2" does not enable FMA). Their vectors are never passed to a
+ * function (all inlined): GCC's note that it would change the ABI
+ * without AVX is off. */
+#pragma GCC diagnostic ignored "-Wpsabi"
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-__attribute__((target("avx2"))) static void regression_rows_avx2(job *j, int y0, int y1)
-{
-	regression_body(j, y0, y1);
-}
 #define HAVE_AVX2_COPY 1
+#define VL 8
+#define LANES(name) name##_8
+#define LANES_TARGET __attribute__((target("avx2")))
+#include "denoise_lanes.h"
+#undef VL
+#undef LANES
+#undef LANES_TARGET
 #endif
+#define VL 4
+#define LANES(name) name##_4
+#define LANES_TARGET
+#include "denoise_lanes.h"
+#undef VL
+#undef LANES
+#undef LANES_TARGET
 
 static void regression_rows(job *j, int y0, int y1)
 {
 #ifdef HAVE_AVX2_COPY
 	if (__builtin_cpu_supports("avx2")) {
-		regression_rows_avx2(j, y0, y1);
+		regression_rows_8(j, y0, y1);
 		return;
 	}
 #endif
-	regression_body(j, y0, y1);
+	regression_rows_4(j, y0, y1);
 }
-
-/* Chooses per pixel the candidate whose estimated error, averaged over
- * (2 PICK_R + 1)^2 pixels, is the least (NFOR filters its errors before
- * choosing too: one pixel's estimate is as noisy as the pixel), or where
- * both regressions are estimated to beat the raw pixel their blend by
- * those estimates; times the albedo again, into the all-samples chain
- * (radiance, and the noise variance of the mean's brightness). */
-V8_INLINE void pick_body(job *j, int y0, int y1)
-{
-	int w = j->fb->w, h = j->fb->h;
-	const float *perr[NCAND];
-	for (int c = 0; c < NCAND; c++)
-		perr[c] = plane(j, PL_ERR + c);
-	for (int y = y0; y < y1; y++)
-		for (int x0 = 0; x0 < w; x0 += 8) {
-			/* Eight pixels' sums, one in each lane, each over its window
-			 * in the one pixel's order; a tap outside the image adds +0
-			 * (masked), as if skipped. */
-			v8i lane = {x0, x0 + 1, x0 + 2, x0 + 3, x0 + 4, x0 + 5, x0 + 6, x0 + 7};
-			v8i in[2 * PICK_R + 1];
-			for (int dx = -PICK_R; dx <= PICK_R; dx++) {
-				v8i qx = lane + v8_isplat(dx);
-				in[dx + PICK_R] = (qx >= v8_isplat(0)) & (qx < v8_isplat(w));
-			}
-			v8 sv[NCAND] = {{0}};
-			for (int qy = y - PICK_R; qy <= y + PICK_R; qy++) {
-				if (qy < 0 || qy >= h)
-					continue;
-#pragma GCC unroll 9
-				for (int dx = -PICK_R; dx <= PICK_R; dx++) {
-					ptrdiff_t q = (ptrdiff_t)qy * w + x0 + dx;
-#pragma GCC unroll 3
-					for (int c = 0; c < NCAND; c++)
-						sv[c] += v8_and(v8_load(perr[c] + q), in[dx + PICK_R]);
-				}
-			}
-			int lanes = w - x0 < 8 ? w - x0 : 8;
-			for (int ln = 0; ln < lanes; ln++) {
-				size_t i = (size_t)y * w + (size_t)(x0 + ln);
-				float s[NCAND];
-				for (int c = 0; c < NCAND; c++)
-					s[c] = sv[c][ln];
-				int best = CAND_RAW;
-				for (int c = 1; c < NCAND; c++)
-					if (s[c] < s[best])
-						best = c;
-				chan *o = &j->t[i].h[CH_ALL];
-				const float *am = j->am + i * 3, *c = best == CAND_RAW ? o->c : j->fit + (i * NFIT + (size_t)(best - CAND_FIT)) * 3;
-				float l = lum(am);
-				float mix[3];
-				if (s[CAND_FIT] < s[CAND_RAW] && s[CAND_DIRECT] < s[CAND_RAW]) {
-					/* Both fits beat the raw pixel: their blend, each
-					 * weighted by how much it is estimated to gain on
-					 * the raw pixel (a choice between two estimates
-					 * that close is as noisy as they are). */
-					const float *f1 = j->fit + i * NFIT * 3, *f2 = f1 + 3;
-					float g1 = s[CAND_RAW] - s[CAND_FIT], g2 = s[CAND_RAW] - s[CAND_DIRECT];
-					float w1 = g1 / (g1 + g2);
-					for (int k = 0; k < 3; k++)
-						mix[k] = w1 * f1[k] + (1.0f - w1) * f2[k];
-					c = mix;
-				}
-				for (int k = 0; k < 3; k++) {
-					float v = c[k] * am[k];
-					o->c[k] = v > 0 ? v : 0;
-				}
-				o->v = o->v / j->n[CH_ALL] * l * l;
-			}
-		}
-}
-
-/* pick_body for processors with AVX2 and for any (as regression_rows). */
-#ifdef HAVE_AVX2_COPY
-__attribute__((target("avx2"))) static void pick_rows_avx2(job *j, int y0, int y1)
-{
-	pick_body(j, y0, y1);
-}
-#endif
 
 static void pick_rows(job *j, int y0, int y1)
 {
 #ifdef HAVE_AVX2_COPY
 	if (__builtin_cpu_supports("avx2")) {
-		pick_rows_avx2(j, y0, y1);
+		pick_rows_8(j, y0, y1);
 		return;
 	}
 #endif
-	pick_body(j, y0, y1);
+	pick_rows_4(j, y0, y1);
 }
 
 /* A pixel whose features vary inside it (part one surface, part another):
