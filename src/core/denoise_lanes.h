@@ -30,7 +30,7 @@ typedef long long vll __attribute__((vector_size(VL * 4)));
 
 LANES_INLINE vf vf_splat(float x)
 {
-	vf v;
+	vf v = {0};
 	for (int l = 0; l < VL; l++)
 		v[l] = x;
 	return v;
@@ -38,7 +38,7 @@ LANES_INLINE vf vf_splat(float x)
 
 LANES_INLINE vi vi_splat(int x)
 {
-	vi v;
+	vi v = {0};
 	for (int l = 0; l < VL; l++)
 		v[l] = x;
 	return v;
@@ -47,7 +47,7 @@ LANES_INLINE vi vi_splat(int x)
 /* x, x + 1, ..., x + VL - 1: the lanes' columns */
 LANES_INLINE vi vi_lanes(int x)
 {
-	vi v;
+	vi v = {0};
 	for (int l = 0; l < VL; l++)
 		v[l] = x + l;
 	return v;
