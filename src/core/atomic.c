@@ -465,6 +465,46 @@ static bool copy_xattrs(const char *from, int fd, char *failed, size_t fsize)
 	return ok;
 }
 
+/* The old file's cached pages are dropped while the new one is written,
+ * by a thread of their own: otherwise the rename frees them (about 0.4 ms
+ * for 6 MB, loaded) on the save's serial tail (issue 29). Only its cache:
+ * its bytes stay on the disk until the rename, so an interrupted save still
+ * leaves it whole. Small files are not worth a thread. */
+#define DROP_CACHE_MIN ((off_t)1 << 20)
+
+typedef struct cache_drop {
+	pthread_t thread;
+	bool running;
+} cache_drop;
+
+static void *drop_cache(void *arg)
+{
+	int fd = (int)(intptr_t)arg;
+	(void)posix_fadvise(fd, 0, 0, POSIX_FADV_DONTNEED);
+	close(fd);
+	return NULL;
+}
+
+static void cache_drop_start(cache_drop *d, const char *target, const struct stat *old)
+{
+	d->running = false;
+	if (!old || !S_ISREG(old->st_mode) || old->st_size < DROP_CACHE_MIN)
+		return;
+	int fd = open(target, O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+	if (fd < 0)
+		return; /* unreadable: its pages stay, nothing else changes */
+	d->running = pthread_create(&d->thread, NULL, drop_cache, (void *)(intptr_t)fd) == 0;
+	if (!d->running)
+		close(fd);
+}
+
+static void cache_drop_end(cache_drop *d)
+{
+	if (d->running)
+		pthread_join(d->thread, NULL);
+	d->running = false;
+}
+
 typedef enum replace_result {
 	REPLACED,
 	FAILED,
@@ -533,9 +573,12 @@ static replace_result replace(const char *path, const char *target, const struct
 		rt_error_at(err, path, 0, 0, "cannot write (%s)", strerror(errno));
 		goto fail_fd;
 	}
+	cache_drop drop;
+	cache_drop_start(&drop, target, old);
 	errno = 0;
 	bool ok = write(f, ctx, err);
 	int e = errno;
+	cache_drop_end(&drop);
 	if (!ok && ferror(f) && e) /* the writer stopped on a write error: say which */
 		rt_error_at(err, path, 0, 0, "write failed (%s)", strerror(e));
 	if (ok && (fflush(f) != 0 || ferror(f) || fsync(fd) != 0))

@@ -1,6 +1,7 @@
 /* rtsh — tests of file_write_atomic (what a failing writer leaves, the
  * temporary files, links, modes, extended attributes and ACLs, notes) and
  * of the memory estimates. */
+#define _GNU_SOURCE /* preadv2, RWF_NOWAIT */
 #include "testutil.h"
 
 #include <dirent.h>
@@ -8,6 +9,8 @@
 #include <fcntl.h>
 #include <time.h>
 #include <sys/stat.h>
+#include <sys/uio.h>
+#include <sys/vfs.h>
 #include <sys/xattr.h>
 #include <unistd.h>
 
@@ -103,6 +106,67 @@ static void test_failing_writer_keeps_the_old_file(void **state)
 	assert_int_equal(lstat(lpath, &st), 0);
 	assert_true(S_ISLNK(st.st_mode));
 	assert_string_equal(slurp(other), "via link\n");
+}
+
+/* The byte at offset i of the big old file below. */
+static unsigned char big_byte(size_t i)
+{
+	return (unsigned char)(i * 7 % 251);
+}
+
+/* Whether the page at off of the file at path is in the page cache: a
+ * read that must not wait for the disk (RWF_NOWAIT) fails with EAGAIN
+ * when it is not. */
+static bool page_cached(const char *path, off_t off)
+{
+	int fd = open(path, O_RDONLY);
+	assert_true(fd >= 0);
+	char b[16];
+	struct iovec v = {b, sizeof b};
+	ssize_t n = preadv2(fd, &v, 1, off, RWF_NOWAIT);
+	int e = errno;
+	close(fd);
+	assert_true(n == (ssize_t)sizeof b || (n < 0 && e == EAGAIN));
+	return n == (ssize_t)sizeof b;
+}
+
+/* A save over a file of 1 MB or more drops the old file's cached pages
+ * while it writes (so that the rename does not free them on the save's
+ * tail), and still leaves the old bytes whole when the writer fails. */
+static void test_big_old_file_uncached_and_kept(void **state)
+{
+	(void)state;
+	struct statfs fs;
+	assert_int_equal(statfs(dir, &fs), 0);
+	if (fs.f_type == 0x01021994) /* tmpfs: its pages are the file, never dropped */
+		skip();
+	char path[128];
+	snprintf(path, sizeof path, "%s/big.ppm", dir);
+	size_t n = (size_t)2 << 20;
+	unsigned char *data = malloc(n);
+	assert_non_null(data);
+	for (size_t i = 0; i < n; i++)
+		data[i] = big_byte(i);
+	int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+	assert_true(fd >= 0);
+	assert_true(write(fd, data, n) == (ssize_t)n);
+	assert_int_equal(fsync(fd), 0); /* clean pages: the ones a drop may drop */
+	assert_int_equal(close(fd), 0);
+	assert_true(page_cached(path, (off_t)n / 2));
+	rt_error err;
+	assert_false(file_write_atomic(path, write_half_then_fail, "new content that fails\n", &err));
+	assert_false(page_cached(path, (off_t)n / 2));
+	FILE *f = fopen(path, "rb");
+	assert_non_null(f);
+	assert_true(fread(data, 1, n, f) == n);
+	assert_int_equal(fgetc(f), EOF);
+	fclose(f);
+	size_t bad = 0;
+	for (size_t i = 0; i < n; i++)
+		bad += data[i] != big_byte(i);
+	assert_int_equal(bad, 0);
+	free(data);
+	assert_int_equal(count_prefix(".big.ppm.tmp."), 0);
 }
 
 static void test_mode_is_kept(void **state)
@@ -466,6 +530,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_failing_writer_keeps_the_old_file),
+		cmocka_unit_test(test_big_old_file_uncached_and_kept),
 		cmocka_unit_test(test_mode_is_kept),
 		cmocka_unit_test(test_stale_temporary_files),
 		cmocka_unit_test(test_xattrs_and_acls_are_kept),
