@@ -3,6 +3,7 @@
 #include "rtsh/denoise.h"
 
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
@@ -905,6 +906,71 @@ static void *worker(void *arg)
 	return NULL;
 }
 
+/* The arrays of one call (the job's): one block, with its planes' pads
+ * zero (calloc; no pass writes them). A block of at most SCRATCH_KEEP bytes
+ * is kept for the next call of as many pixels (the preview's frames): a new
+ * one is 4.7 MB at 200x120, and its pages, returned to the kernel when it
+ * was freed, cost about 1100 page faults a call, the kernel zeroing each.
+ * One block is kept at a time (the last one given back). Every array is
+ * written before it is read in a call, so what a kept block held does not
+ * matter. */
+#define SCRATCH_KEEP ((size_t)64 << 20)
+typedef struct scratch {
+	size_t n;     /* pixels */
+	size_t bytes; /* of the whole block */
+} scratch;
+enum { SC_G, SC_AM, SC_MIXED, SC_T, SC_PL, SC_FIT, NSC };
+static _Atomic(scratch *) kept_scratch;
+
+static size_t scratch_round(size_t x)
+{
+	return (x + 63) & ~(size_t)63;
+}
+
+/* Where each array starts in a block for n pixels (off); its bytes. */
+static size_t scratch_layout(size_t n, size_t off[NSC])
+{
+	size_t size[NSC] = {
+		[SC_G] = n * sizeof(guide),
+		[SC_AM] = n * 3 * sizeof(float),
+		[SC_MIXED] = n * sizeof(bool),
+		[SC_T] = n * sizeof(texel),
+		[SC_PL] = NPL * (n + 2 * PL_PAD) * sizeof(float),
+		[SC_FIT] = n * 3 * NFIT * sizeof(float),
+	};
+	size_t at = scratch_round(sizeof(scratch));
+	for (int k = 0; k < NSC; k++) {
+		off[k] = at;
+		at += scratch_round(size[k]);
+	}
+	return at;
+}
+
+/* The kept block when it is for n pixels, else a new one; NULL when out of
+ * memory. */
+static scratch *scratch_take(size_t n, size_t off[NSC])
+{
+	size_t bytes = scratch_layout(n, off);
+	scratch *s = atomic_exchange(&kept_scratch, NULL);
+	if (s && s->n == n)
+		return s;
+	free(s);
+	s = calloc(1, bytes);
+	if (s) {
+		s->n = n;
+		s->bytes = bytes;
+	}
+	return s;
+}
+
+/* Keeps s (if small enough) in place of the block kept before, or frees it. */
+static void scratch_give(scratch *s)
+{
+	if (s && s->bytes <= SCRATCH_KEEP)
+		s = atomic_exchange(&kept_scratch, s);
+	free(s);
+}
+
 bool denoise_image(const framebuffer *fb, float *out, int threads)
 {
 	int w = fb->w, h = fb->h;
@@ -921,16 +987,21 @@ bool denoise_image(const framebuffer *fb, float *out, int threads)
 	j.n[CH_A] = j.halves ? (float)((fb->spp + 1) / 2) : 1.0f;
 	j.n[CH_B] = j.halves ? (float)(fb->spp / 2) : 1.0f;
 	j.n[CH_ALL] = fb->spp > 1 ? (float)fb->spp : 1.0f;
-	j.g = malloc(n * sizeof *j.g);
-	j.am = malloc(n * 3 * sizeof *j.am);
-	j.mixed = malloc(n * sizeof *j.mixed);
-	j.t = malloc(n * sizeof *j.t);
+	size_t off[NSC];
+	scratch *sc = scratch_take(n, off);
+	if (sc) {
+		char *base = (char *)sc;
+		j.g = (guide *)(void *)(base + off[SC_G]);
+		j.am = (float *)(void *)(base + off[SC_AM]);
+		j.mixed = (bool *)(void *)(base + off[SC_MIXED]);
+		j.t = (texel *)(void *)(base + off[SC_T]);
+		j.pl = (float *)(void *)(base + off[SC_PL]); /* the pads zero */
+		j.fit = (float *)(void *)(base + off[SC_FIT]);
+	}
 	j.pstride = n + 2 * PL_PAD;
-	j.pl = calloc(NPL * j.pstride, sizeof *j.pl); /* the pads zero */
-	j.fit = malloc(n * 3 * NFIT * sizeof *j.fit);
 	pthread_t *tid = malloc((size_t)threads * sizeof *tid);
 	worker_arg *args = malloc((size_t)threads * sizeof *args);
-	bool ok = j.g && j.am && j.mixed && j.t && j.pl && j.fit && tid && args;
+	bool ok = sc && tid && args;
 	if (ok) {
 		pthread_mutex_init(&j.lock, NULL);
 		pthread_cond_init(&j.go_cond, NULL);
@@ -959,6 +1030,7 @@ bool denoise_image(const framebuffer *fb, float *out, int threads)
 		pthread_mutex_destroy(&j.lock);
 		pthread_cond_destroy(&j.go_cond);
 	}
-	mem_free_all(j.g, j.am, j.mixed, j.t, j.pl, j.fit, tid, args);
+	scratch_give(sc);
+	mem_free_all(tid, args);
 	return ok;
 }
