@@ -503,15 +503,15 @@ enum { CAND_RAW, CAND_FIT, CAND_DIRECT, NCAND };
 #define NFIT (NCAND - CAND_FIT)
 
 /* What regression_rows reads, one plane a quantity (structure of arrays),
- * so that four neighbouring pixels' values are one load: the guide's six
+ * so that neighbouring pixels' values are one load: the guide's six
  * scaled features, depth, direct light, depth gradient, and what the
  * regression fits (all the samples' colour and each half's brightness);
  * and what it writes for pick_rows, the candidates' estimated squared
  * errors.
  * Each plane has PL_PAD floats of zeros before and after it, so that the
- * loads of four pixels at a row's ends stay inside. */
+ * loads of eight pixels at a row's ends stay inside. */
 enum { PL_F0, PL_Z = 6, PL_D, PL_GX, PL_GY, PL_DATA, PL_ERR = PL_DATA + 5, NPL = PL_ERR + NCAND };
-#define PL_PAD 8
+#define PL_PAD 16
 
 typedef struct job {
 	const framebuffer *fb;
@@ -735,317 +735,59 @@ static float cross_error(const chan *r, float na, float nb, float la, float lb)
 	       0.25f * (la - lb) * (la - lb);
 }
 
-/* Four floats in one SIMD register (a GCC and Clang extension), for the
- * regression's sums. */
-typedef float v4 __attribute__((vector_size(16)));
-/* Four ints: the lanes' masks (all bits set where true). */
-typedef int v4i __attribute__((vector_size(16)));
-
-static inline v4 v4_splat(float x)
-{
-	return (v4){x, x, x, x};
-}
-
-static inline v4i v4_isplat(int x)
-{
-	return (v4i){x, x, x, x};
-}
-
-static inline v4 v4_load(const float *p)
-{
-	v4 v;
-	memcpy(&v, p, sizeof v);
-	return v;
-}
-
-
-static inline v4 v4_and(v4 x, v4i m)
-{
-	return (v4)((v4i)x & m);
-}
-
-static inline v4 v4_abs(v4 x)
-{
-	return (v4)((v4i)x & v4_isplat(0x7fffffff));
-}
-
-/* exp(-x) for x >= 0 as (1 - x/16)^16 (its limit definition), 0 from
- * x = 16 on: within 0.03 of it everywhere, four multiplications; of four
- * values. */
-static inline v4 v4_exp_fast(v4 x)
-{
-	v4 t = v4_splat(1.0f) - x * v4_splat(1.0f / 16);
-	t = v4_and(t, t > v4_splat(0.0f));
-	t *= t;
-	t *= t;
-	t *= t;
-	return t * t;
-}
-
 /* Where the sum of row r and column c (c <= r) of the normal equations is
  * kept: their lower triangle, row by row. */
 #define TRI(r, c) ((r) * ((r) + 1) / 2 + (c))
 #define NTRI (NU * (NU + 1) / 2)
 
-/* Rows [r0, r1) of the normal equations' lower triangle in a: each sum
- * over the taps in their order, a few rows at a time so that their sums
- * stay in registers. */
-static inline __attribute__((always_inline)) void normal_rows(v4 *a, int nt, const v4 *tw, v4 (*tv)[NU],
-                                                              int r0, int r1)
-{
-	v4 s[NU * 2];
-	int n = TRI(r1, 0) - TRI(r0, 0);
-#pragma GCC unroll 16
-	for (int k = 0; k < n; k++)
-		s[k] = a[TRI(r0, 0) + k];
-	for (int t = 0; t < nt; t++) {
-#pragma GCC unroll 8
-		for (int r = r0; r < r1; r++) {
-			/* regressor 0 is 1: times it, a product is itself exactly */
-			v4 wv = r == 0 ? tw[t] : tw[t] * tv[t][r];
-			s[TRI(r, 0) - TRI(r0, 0)] += wv;
-#pragma GCC unroll 8
-			for (int c = 1; c <= r; c++)
-				s[TRI(r, c) - TRI(r0, 0)] += wv * tv[t][c];
-		}
-	}
-#pragma GCC unroll 16
-	for (int k = 0; k < n; k++)
-		a[TRI(r0, 0) + k] = s[k];
-}
+/* The regression (regression_rows) and the choice (pick_rows) several
+ * pixels at a time (denoise_lanes.h): eight where the processor has AVX2
+ * (a copy built for it, chosen when the filter runs: not by an ifunc,
+ * which ThreadSanitizer cannot start before), else four. The same floats
+ * either way: the same operations lane by lane, and no fused
+ * multiply-adds (-ffp-contract=off is GCC's default under -std=c17, and
+ * "avx2" does not enable FMA). Their vectors are never passed to a
+ * function (all inlined): GCC's note that it would change the ABI
+ * without AVX is off. */
+#pragma GCC diagnostic ignored "-Wpsabi"
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define HAVE_AVX2_COPY 1
+#define VL 8
+#define LANES(name) name##_8
+#define LANES_TARGET __attribute__((target("avx2")))
+#include "denoise_lanes.h"
+#undef VL
+#undef LANES
+#undef LANES_TARGET
+#endif
+#define VL 4
+#define LANES(name) name##_4
+#define LANES_TARGET
+#include "denoise_lanes.h"
+#undef VL
+#undef LANES
+#undef LANES_TARGET
 
-/* Weighted first-order regression (NFOR, Bitterli et al. 2016, without its
- * colour weights) of the radiance over albedo on the screen position, the
- * normal and the depth, over the window around each pixel of rows
- * [y0, y1), evaluated at the pixel. The taps are weighted by how alike
- * their features are (albedo, normal, depth off the pixel's plane) and by
- * nothing else: no weight depends on the noise, so the fit of each half's
- * brightness depends on that half's samples only, and cross_error
- * estimates the fit's error honestly.
- *
- * Four neighbouring pixels of a row at a time, one in each SIMD lane
- * (their planes: one load for the four): each lane does the one pixel's
- * operations in the one pixel's order, so the results are those of a
- * pixel alone to the bit. A tap that is outside the image or has no
- * weight for a lane adds +0 to that lane's sums (masked), which leaves
- * them as they were, as if it had been skipped. */
 static void regression_rows(job *j, int y0, int y1)
 {
-	int w = j->fb->w, h = j->fb->h;
-	float na = j->n[CH_A], nb = j->n[CH_B];
-	const float *pf[6], *pdata[5];
-	for (int k = 0; k < 6; k++)
-		pf[k] = plane(j, PL_F0 + k);
-	for (int k = 0; k < 5; k++)
-		pdata[k] = plane(j, PL_DATA + k);
-	const float *pz = plane(j, PL_Z), *pd = plane(j, PL_D), *pgx = plane(j, PL_GX), *pgy = plane(j, PL_GY);
-	float *perr[NCAND];
-	for (int c = 0; c < NCAND; c++)
-		perr[c] = plane(j, PL_ERR + c);
-	for (int y = y0; y < y1; y++)
-		for (int x = 0; x < w; x += 4) {
-			ptrdiff_t i = (ptrdiff_t)y * w + x;
-			v4 gf[6];
-			for (int k = 0; k < 6; k++)
-				gf[k] = v4_load(pf[k] + i);
-			v4 gz = v4_load(pz + i), gd = v4_load(pd + i), ggx = v4_load(pgx + i), ggy = v4_load(pgy + i);
-			v4 inv_z = v4_splat(1.0f) / (v4_splat(SIGMA_Z) * gz + v4_splat(1e-6f));
-			/* the direct light's slope, in shares of its value */
-			v4 dscale = v4_splat(1.0f) / (v4_splat(0.5f) * v4_abs(gd) + v4_splat(0.05f));
-			v4i lane = {x, x + 1, x + 2, x + 3};
-			/* The taps with a weight in some lane: the weights (0 where
-			 * none), regressors, masks and where the tap's data are. */
-			v4 tw[TAPS], tv[TAPS][NU];
-			v4i tm[TAPS];
-			ptrdiff_t tq[TAPS];
-			/* The normal equations' lower triangle (what solve reads). */
-			v4 a[NTRI] = {{0}};
-			int nt = 0;
-			for (int dy = -WIN; dy <= WIN; dy++) {
-				int qy = y + dy;
-				if (qy < 0 || qy >= h)
-					continue;
-				for (int dx = -WIN; dx <= WIN; dx++) {
-					v4i qx = lane + v4_isplat(dx);
-					v4i in = (qx >= v4_isplat(0)) & (qx < v4_isplat(w));
-					if (!(in[0] | in[1] | in[2] | in[3]))
-						continue;
-					ptrdiff_t q = (ptrdiff_t)qy * w + x + dx;
-					v4 e = v4_splat(0.0f);
-#pragma GCC unroll 6
-					for (int k = 0; k < 6; k++) {
-						v4 d = gf[k] - v4_load(pf[k] + q);
-						e += d * d;
-					}
-					v4 qz = v4_load(pz + q);
-					e += v4_abs(qz - (gz + ggx * v4_splat((float)dx) + ggy * v4_splat((float)dy))) * inv_z;
-					v4 wt = v4_exp_fast(e);
-					v4i m = in & (wt > v4_splat(0.0f));
-					if (!(m[0] | m[1] | m[2] | m[3]))
-						continue;
-					v4 tww = v4_and(wt, m);
-					v4 *v = tv[nt];
-					v[0] = v4_splat(1.0f);
-					v[1] = v4_splat((float)dx * (1.0f / WIN));
-					v[2] = v4_splat((float)dy * (1.0f / WIN));
-					for (int k = 3; k < 6; k++)
-						v[k] = v4_and(v4_load(pf[k] + q) - gf[k], m);
-					v[6] = v4_and((qz - gz) * inv_z, m);
-					v[7] = v4_and((v4_load(pd + q) - gd) * dscale, m);
-					tw[nt] = tww;
-					tm[nt] = m;
-					tq[nt] = q;
-					nt++;
-				}
-			}
-			normal_rows(a, nt, tw, tv, 0, 4);
-			normal_rows(a, nt, tw, tv, 4, 6);
-			normal_rows(a, nt, tw, tv, 6, 7);
-			normal_rows(a, nt, tw, tv, 7, 8);
-			/* Each lane's solve: the fit at the pixel is sum_t h_t y_t,
-			 * with h_t the tap's weight times z . (its regressors),
-			 * M z = (1, 0, ..., 0): one solve for all the right-hand
-			 * sides. */
-			bool ok[4] = {false, false, false, false};
-			v4 zv[NU] = {{0}};
-			int lanes = w - x < 4 ? w - x : 4;
-			for (int l = 0; l < lanes; l++) {
-				float m[NU][MIX_NU] = {{0}}, e0[NU][NRHS] = {{1.0f}}, z[NU][NRHS];
-#pragma GCC unroll 8
-				for (int r = 0; r < NU; r++)
-#pragma GCC unroll 8
-					for (int c = 0; c <= r; c++)
-						m[r][c] = a[TRI(r, c)][l];
-				float ridge = m[0][0] * RIDGE;
-				for (int r = 1; r < NU; r++)
-					m[r][r] += ridge;
-				ok[l] = solve(NU, m, 1, e0, z);
-				if (ok[l])
-					for (int r = 0; r < NU; r++)
-						zv[r][l] = z[r][0];
-			}
-			/* The direct light's fit: the normal equations of the
-			 * constant and regressor 7 are the sub-matrix of the whole
-			 * one's, solved in closed form, all lanes at once: with
-			 * M = (m00 m70; m70 m77), z = (m77, -m70) / det. With a
-			 * ridge (so where the taps' direct light is all alike, the
-			 * taps' weighted mean); a lane without weight is left out. */
-			v4 m00 = a[TRI(0, 0)], m70 = a[TRI(7, 0)];
-			v4 m77 = a[TRI(7, 7)] + m00 * v4_splat(DIRECT_RIDGE);
-			v4 det = m00 * m77 - m70 * m70;
-			v4i okd = (m00 > v4_splat(0.0f)) & (det > v4_splat(1e-6f) * m00 * m77);
-			v4 safe = v4_and(det, okd) + v4_and(v4_splat(1.0f), ~okd);
-			v4 zd0 = v4_and(m77 / safe, okd), zd7 = v4_and(-m70 / safe, okd);
-			v4 fo[5] = {{0}}, fd[5] = {{0}};
-			for (int t = 0; t < nt; t++) {
-				const v4 *v = tv[t];
-				v4 p0 = zv[0] * v[0] + zv[4] * v[4], p1 = zv[1] * v[1] + zv[5] * v[5];
-				v4 p2 = zv[2] * v[2] + zv[6] * v[6], p3 = zv[3] * v[3] + zv[7] * v[7];
-				v4 hv = tw[t] * (p0 + p1 + p2 + p3);
-				v4 hd = tw[t] * (zd0 + zd7 * v[7]);
-#pragma GCC unroll 5
-				for (int c = 0; c < 5; c++) {
-					v4 yv = v4_load(pdata[c] + tq[t]);
-					fo[c] += v4_and(hv * yv, tm[t]);
-					fd[c] += v4_and(hd * yv, tm[t]);
-				}
-			}
-			for (int l = 0; l < lanes; l++) {
-				size_t pi = (size_t)i + (size_t)l;
-				const chan *r0 = j->t[pi].h;
-				float am = lum(j->am + pi * 3), am2 = am * am;
-				float *fit = j->fit + pi * 3 * NFIT, *fitd = fit + 3;
-				if (!ok[l]) {
-					memcpy(fit, r0[CH_ALL].c, sizeof r0[CH_ALL].c);
-					memcpy(fitd, r0[CH_ALL].c, sizeof r0[CH_ALL].c);
-					perr[CAND_RAW][pi] = 0.0f; /* the raw pixel */
-					perr[CAND_FIT][pi] = INFINITY;
-					perr[CAND_DIRECT][pi] = INFINITY;
-					continue;
-				}
-				for (int k = 0; k < 3; k++) {
-					fit[k] = fo[k][l];
-					fitd[k] = okd[l] ? fd[k][l] : r0[CH_ALL].c[k];
-				}
-				if (!j->halves) {
-					/* One sample: no halves, no error estimate; the fit. */
-					perr[CAND_RAW][pi] = INFINITY;
-					perr[CAND_FIT][pi] = 0.0f;
-					perr[CAND_DIRECT][pi] = INFINITY;
-					continue;
-				}
-				/* The raw pixel estimated the same way as the fits, so
-				 * that the estimates share their noise. */
-				perr[CAND_RAW][pi] = cross_error(r0, na, nb, lum(r0[CH_A].c), lum(r0[CH_B].c)) * am2;
-				perr[CAND_FIT][pi] = cross_error(r0, na, nb, fo[3][l], fo[4][l]) * am2;
-				perr[CAND_DIRECT][pi] = okd[l] ? cross_error(r0, na, nb, fd[3][l], fd[4][l]) * am2 : INFINITY;
-			}
-		}
+#ifdef HAVE_AVX2_COPY
+	if (__builtin_cpu_supports("avx2")) {
+		regression_rows_8(j, y0, y1);
+		return;
+	}
+#endif
+	regression_rows_4(j, y0, y1);
 }
 
-/* Chooses per pixel the candidate whose estimated error, averaged over
- * (2 PICK_R + 1)^2 pixels, is the least (NFOR filters its errors before
- * choosing too: one pixel's estimate is as noisy as the pixel), or where
- * both regressions are estimated to beat the raw pixel their blend by
- * those estimates; times the albedo again, into the all-samples chain
- * (radiance, and the noise variance of the mean's brightness). */
 static void pick_rows(job *j, int y0, int y1)
 {
-	int w = j->fb->w, h = j->fb->h;
-	const float *perr[NCAND];
-	for (int c = 0; c < NCAND; c++)
-		perr[c] = plane(j, PL_ERR + c);
-	for (int y = y0; y < y1; y++)
-		for (int x0 = 0; x0 < w; x0 += 4) {
-			/* Four pixels' sums, one in each lane, each over its window
-			 * in the one pixel's order; a tap outside the image adds +0
-			 * (masked), as if skipped. */
-			v4i lane = {x0, x0 + 1, x0 + 2, x0 + 3};
-			v4 sv[NCAND] = {{0}};
-			for (int qy = y - PICK_R; qy <= y + PICK_R; qy++) {
-				if (qy < 0 || qy >= h)
-					continue;
-				for (int dx = -PICK_R; dx <= PICK_R; dx++) {
-					v4i qx = lane + v4_isplat(dx);
-					v4i in = (qx >= v4_isplat(0)) & (qx < v4_isplat(w));
-					ptrdiff_t q = (ptrdiff_t)qy * w + x0 + dx;
-					for (int c = 0; c < NCAND; c++)
-						sv[c] += v4_and(v4_load(perr[c] + q), in);
-				}
-			}
-			int lanes = w - x0 < 4 ? w - x0 : 4;
-			for (int ln = 0; ln < lanes; ln++) {
-				size_t i = (size_t)y * w + (size_t)(x0 + ln);
-				float s[NCAND];
-				for (int c = 0; c < NCAND; c++)
-					s[c] = sv[c][ln];
-				int best = CAND_RAW;
-				for (int c = 1; c < NCAND; c++)
-					if (s[c] < s[best])
-						best = c;
-				chan *o = &j->t[i].h[CH_ALL];
-				const float *am = j->am + i * 3, *c = best == CAND_RAW ? o->c : j->fit + (i * NFIT + (size_t)(best - CAND_FIT)) * 3;
-				float l = lum(am);
-				float mix[3];
-				if (s[CAND_FIT] < s[CAND_RAW] && s[CAND_DIRECT] < s[CAND_RAW]) {
-					/* Both fits beat the raw pixel: their blend, each
-					 * weighted by how much it is estimated to gain on
-					 * the raw pixel (a choice between two estimates
-					 * that close is as noisy as they are). */
-					const float *f1 = j->fit + i * NFIT * 3, *f2 = f1 + 3;
-					float g1 = s[CAND_RAW] - s[CAND_FIT], g2 = s[CAND_RAW] - s[CAND_DIRECT];
-					float w1 = g1 / (g1 + g2);
-					for (int k = 0; k < 3; k++)
-						mix[k] = w1 * f1[k] + (1.0f - w1) * f2[k];
-					c = mix;
-				}
-				for (int k = 0; k < 3; k++) {
-					float v = c[k] * am[k];
-					o->c[k] = v > 0 ? v : 0;
-				}
-				o->v = o->v / j->n[CH_ALL] * l * l;
-			}
-		}
+#ifdef HAVE_AVX2_COPY
+	if (__builtin_cpu_supports("avx2")) {
+		pick_rows_8(j, y0, y1);
+		return;
+	}
+#endif
+	pick_rows_4(j, y0, y1);
 }
 
 /* A pixel whose features vary inside it (part one surface, part another):
