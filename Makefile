@@ -29,10 +29,11 @@ WARN    := -Wall -Wextra -Wpedantic -Werror -Wshadow -Wstrict-prototypes -Wmissi
 CPPFLAGS += -Iinclude -Isrc -I$(BUILD) -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -DRTSH_VERSION=\"$(VERSION)\"
 CFLAGS  ?= $(OPT) -g
 CFLAGS  += $(CSTD) $(WARN) -fno-math-errno -pthread -MMD -MP
-# assimp and libXpm are opened when a model or an XPM image first needs them
-# (src/base/dynlib.h): not linked, so that no other start-up maps them (with
-# libstdc++ and five X11 libraries). Their headers are still needed to build.
-LDLIBS_CORE := -lpng -lcjson -lstb -lm -pthread
+# assimp, libXpm and cJSON are opened when a model, an XPM image or a glTF
+# first needs them (src/base/dynlib.h): not linked, so that no other start-up
+# maps them (with libstdc++ and five X11 libraries). Their headers are still
+# needed to build.
+LDLIBS_CORE := -lpng -lstb -lm -pthread
 # libsixel carries its own copy of stb_image: libstb (in LDLIBS_CORE) must come first
 # so that the scene loader's stbi_* calls reach libstb, not libsixel's.
 LDLIBS_FRONT := -lreadline -lncursesw $(LDLIBS_CORE) -lsixel -lz

@@ -1,6 +1,6 @@
-/* Libraries opened on first use (base/dynlib.h): assimp and libXpm are not
- * linked, so a process maps them only when a model or an XPM image needs
- * them; dynlib_open's answers for a library or a function that is missing.
+/* Libraries opened on first use (base/dynlib.h): assimp, libXpm and cJSON
+ * are not linked, so a process maps them only when a model, an XPM image or
+ * a glTF needs them; dynlib_open's answers for a library or a function that is missing.
  * This test binary is linked as rtsh is (LDLIBS_FRONT). */
 #include "testutil.h"
 #include "tmpdir.h"
@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "base/dynlib.h"
+#include "rtsh/gltf.h"
 #include "rtsh/mesh.h"
 #include "rtsh/texture.h"
 
@@ -36,6 +37,7 @@ static void test_not_mapped_at_start(void **state)
 	assert_false(mapped("libdraco")); /* (not libstdc++: the sanitizers' runtimes bring it) */
 	assert_false(mapped("libXpm"));
 	assert_false(mapped("libX11"));
+	assert_false(mapped("libcjson"));
 }
 
 /* An STL (read by assimp) loads assimp; the triangle is the file's. */
@@ -66,6 +68,25 @@ static void test_xpm_loads_libxpm(void **state)
 	assert_true(p[0] == 1.0f && p[1] == 0.0f && p[2] == 0.0f);
 	free(p);
 	assert_true(mapped("libXpm"));
+}
+
+/* A glTF (its JSON read by cJSON) loads cJSON; its one camera stands
+ * where its node puts it, (1, 2, 3), mirrored into the scene's frame (X
+ * negated, as test_gltf's cameras): (-1, 2, 3). */
+static void test_gltf_loads_cjson(void **state)
+{
+	(void)state;
+	const char *g = "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
+	                "\"nodes\":[{\"camera\":0,\"translation\":[1,2,3]}],"
+	                "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.5,\"znear\":0.1}}]}";
+	gltf_info gi;
+	rt_error err = {0};
+	if (!gltf_parse_info("t.gltf", g, strlen(g), &gi, &err))
+		fail_msg("%s", err.msg);
+	assert_int_equal(gi.ncams, 1);
+	assert_true(gi.cams[0].pos.x == -1 && gi.cams[0].pos.y == 2 && gi.cams[0].pos.z == 3);
+	gltf_info_free(&gi);
+	assert_true(mapped("libcjson"));
 }
 
 static void test_missing_library(void **state)
@@ -111,6 +132,7 @@ int main(void)
 	    cmocka_unit_test(test_not_mapped_at_start), /* first: before any reader ran */
 	    cmocka_unit_test(test_model_loads_assimp),
 	    cmocka_unit_test(test_xpm_loads_libxpm),
+	    cmocka_unit_test(test_gltf_loads_cjson),
 	    cmocka_unit_test(test_missing_library),
 	    cmocka_unit_test(test_missing_function),
 	    cmocka_unit_test(test_functions_called),

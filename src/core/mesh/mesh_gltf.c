@@ -35,12 +35,44 @@
 
 #include <cjson/cJSON.h>
 
+#include "base/dynlib.h"
 #include "core/mesh/mesh_io.h"
 #include "rtsh/filesrc.h"
 #include "rtsh/gltf.h"
 #include "rtsh/memory.h"
 #include "rtsh/mesh.h"
 #include "rtsh/texture.h"
+
+/* cJSON, opened on the first glTF (base/dynlib.h): a process that reads no
+ * glTF does not map it (issue 29: the start-up's serial time). */
+#ifndef RTSH_CJSON_SONAME
+#define RTSH_CJSON_SONAME "libcjson.so.1"
+#endif
+
+static struct {
+	cJSON *(*parse)(const char *value, size_t len, const char **end, cJSON_bool null_terminated);
+	void (*del)(cJSON *item);
+	cJSON *(*get)(const cJSON *object, const char *name);
+	cJSON_bool (*is_string)(const cJSON *item);
+	cJSON_bool (*is_array)(const cJSON *item);
+	cJSON_bool (*is_number)(const cJSON *item);
+	cJSON_bool (*is_object)(const cJSON *item);
+	cJSON_bool (*is_true)(const cJSON *item);
+} cj;
+static bool cj_ok;
+static char cj_why[256];
+static pthread_once_t cj_once = PTHREAD_ONCE_INIT;
+
+static void cj_open(void)
+{
+	const dynlib_fn fns[] = {
+	    {"cJSON_ParseWithLengthOpts", &cj.parse}, {"cJSON_Delete", &cj.del},
+	    {"cJSON_GetObjectItemCaseSensitive", &cj.get}, {"cJSON_IsString", &cj.is_string},
+	    {"cJSON_IsArray", &cj.is_array}, {"cJSON_IsNumber", &cj.is_number},
+	    {"cJSON_IsObject", &cj.is_object}, {"cJSON_IsTrue", &cj.is_true},
+	};
+	cj_ok = dynlib_open(RTSH_CJSON_SONAME, fns, sizeof fns / sizeof fns[0], cj_why, sizeof cj_why);
+}
 
 #define WHERE_MAX 96
 #define WHERE2_MAX 256 /* a path built on a WHERE_MAX one */
@@ -153,6 +185,10 @@ static bool parse_json(gl *g, const char *json, size_t n, size_t start)
 	size_t marks = 1;
 	for (size_t i = 0; i < n; i++)
 		marks += json[i] == ',' || json[i] == '[' || json[i] == '{' || json[i] == ':';
+	pthread_once(&cj_once, cj_open);
+	if (!cj_ok)
+		return fail(g, NULL, "cannot read the glTF: cJSON cannot be loaded (%s); expected %s installed", cj_why,
+		            RTSH_CJSON_SONAME);
 	char what[300];
 	snprintf(what, sizeof what, "the JSON of %s", g->name);
 	if (!mem_check((double)marks * sizeof(cJSON) + (double)n, what, g->err))
@@ -163,13 +199,13 @@ static bool parse_json(gl *g, const char *json, size_t n, size_t start)
 	 * the shell's) */
 	static pthread_mutex_t parse_lock = PTHREAD_MUTEX_INITIALIZER;
 	pthread_mutex_lock(&parse_lock);
-	g->root = cJSON_ParseWithLengthOpts(json, n, &end, false);
+	g->root = cj.parse(json, n, &end, false);
 	pthread_mutex_unlock(&parse_lock);
 	if (!g->root) {
 		size_t at = end && end >= json && end <= json + n ? (size_t)(end - json) : 0;
 		return fail(g, NULL, "byte %zu: not valid JSON; expected a JSON object (RFC 8259)", start + at);
 	}
-	if (!cJSON_IsObject(g->root))
+	if (!cj.is_object(g->root))
 		return fail(g, NULL, "byte %zu: the JSON is not an object; expected a glTF object {...}", start);
 	return true;
 }
@@ -178,7 +214,7 @@ static bool parse_json(gl *g, const char *json, size_t n, size_t start)
 
 static const cJSON *key(const cJSON *o, const char *k)
 {
-	return cJSON_IsObject(o) ? cJSON_GetObjectItemCaseSensitive(o, k) : NULL;
+	return cj.is_object(o) ? cj.get(o, k) : NULL;
 }
 
 /* An index at o[k] into a table of n: false (err set) when present and not
@@ -193,8 +229,8 @@ static bool get_index(gl *g, const cJSON *o, const char *k, const char *where, s
 			return fail(g, where, "no \"%s\"; expected an index into %s", k, tname);
 		return true;
 	}
-	double d = cJSON_IsNumber(v) ? v->valuedouble : -1;
-	if (!cJSON_IsNumber(v) || !(d >= 0) || d != floor(d) || d >= (double)n) {
+	double d = cj.is_number(v) ? v->valuedouble : -1;
+	if (!cj.is_number(v) || !(d >= 0) || d != floor(d) || d >= (double)n) {
 		if (n == 0)
 			return fail(g, where, "%s: %s has no entries; expected none to refer to", k, tname);
 		return fail(g, where, "%s: not an index into %s; expected an integer from 0 to %zu", k, tname, n - 1);
@@ -211,7 +247,7 @@ static bool get_num(gl *g, const cJSON *o, const char *k, const char *where, dou
 	*out = def;
 	if (!v)
 		return true;
-	if (!cJSON_IsNumber(v) || !(v->valuedouble >= lo && v->valuedouble <= hi))
+	if (!cj.is_number(v) || !(v->valuedouble >= lo && v->valuedouble <= hi))
 		return fail(g, where, "%s: not a number from %g to %g; expected one", k, lo, hi);
 	*out = v->valuedouble;
 	return true;
@@ -238,13 +274,13 @@ static bool get_nums(gl *g, const cJSON *o, const char *k, const char *where, in
 	if (!v)
 		return true;
 	int i = 0;
-	const cJSON *e = cJSON_IsArray(v) ? v->child : NULL;
+	const cJSON *e = cj.is_array(v) ? v->child : NULL;
 	for (; e && i < n; e = e->next, i++) {
-		if (!cJSON_IsNumber(e) || !(e->valuedouble >= lo && e->valuedouble <= hi))
+		if (!cj.is_number(e) || !(e->valuedouble >= lo && e->valuedouble <= hi))
 			return fail(g, where, "%s[%d]: not a number from %g to %g; expected one", k, i, lo, hi);
 		out[i] = e->valuedouble;
 	}
-	if (!cJSON_IsArray(v) || i != n || e)
+	if (!cj.is_array(v) || i != n || e)
 		return fail(g, where, "%s: not an array of %d numbers; expected %d", k, n, n);
 	return true;
 }
@@ -258,7 +294,7 @@ static bool get_table(gl *g, const char *k, table *t)
 	t->n = 0;
 	if (!a)
 		return true;
-	if (!cJSON_IsArray(a))
+	if (!cj.is_array(a))
 		return fail(g, k, "not an array; expected [...]");
 	size_t n = 0;
 	for (const cJSON *e = a->child; e; e = e->next)
@@ -269,7 +305,7 @@ static bool get_table(gl *g, const char *k, table *t)
 	if (!t->v)
 		return fail(g, k, "out of memory");
 	for (const cJSON *e = a->child; e; e = e->next) {
-		if (!cJSON_IsObject(e))
+		if (!cj.is_object(e))
 			return fail(g, NULL, "%s[%zu]: not an object; expected {...}", k, t->n);
 		t->v[t->n++] = e;
 	}
@@ -278,7 +314,8 @@ static bool get_table(gl *g, const char *k, table *t)
 
 static void gl_free(gl *g)
 {
-	cJSON_Delete(g->root);
+	if (g->root) /* (NULL too when cJSON could not be loaded) */
+		cj.del(g->root);
 	table *ts[] = {&g->nodes, &g->meshes, &g->accessors, &g->views, &g->buffers, &g->materials,
 	               &g->textures, &g->images, &g->samplers, &g->cameras, &g->lights};
 	for (size_t i = 0; i < sizeof ts / sizeof ts[0]; i++)
@@ -298,20 +335,20 @@ static bool gl_open(gl *g, const char *buf, size_t len)
 	if (!split(g, (const unsigned char *)buf, len, &json, &njson, &jstart) || !parse_json(g, json, njson, jstart))
 		return false;
 	const cJSON *asset = key(g->root, "asset"), *ver = key(asset, "version");
-	if (!cJSON_IsString(ver) || ver->valuestring[0] != '2' || ver->valuestring[1] != '.')
+	if (!cj.is_string(ver) || ver->valuestring[0] != '2' || ver->valuestring[1] != '.')
 		return fail(g, "asset.version", "not \"2.x\"; expected a glTF 2.0 file");
 	const cJSON *req = key(g->root, "extensionsRequired");
 	static const char *const known[] = {"KHR_lights_punctual", "KHR_texture_transform", "KHR_materials_emissive_strength",
 	                                    "KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume",
 	                                    "KHR_materials_clearcoat", "KHR_materials_specular"};
 	int i = 0;
-	for (const cJSON *e = cJSON_IsArray(req) ? req->child : NULL; e; e = e->next, i++) {
+	for (const cJSON *e = cj.is_array(req) ? req->child : NULL; e; e = e->next, i++) {
 		bool ok = false;
-		for (size_t k = 0; cJSON_IsString(e) && k < sizeof known / sizeof known[0]; k++)
+		for (size_t k = 0; cj.is_string(e) && k < sizeof known / sizeof known[0]; k++)
 			ok |= strcmp(e->valuestring, known[k]) == 0;
 		if (!ok)
 			return fail(g, NULL, "extensionsRequired[%d]: \"%.60s\" is not read by rtsh; expected only %s, %s, %s, "
-			            "%s, %s, %s, %s or %s", i, cJSON_IsString(e) ? e->valuestring : "?", known[0], known[1],
+			            "%s, %s, %s, %s or %s", i, cj.is_string(e) ? e->valuestring : "?", known[0], known[1],
 			            known[2], known[3], known[4], known[5], known[6], known[7]);
 	}
 	if (!get_table(g, "nodes", &g->nodes) || !get_table(g, "meshes", &g->meshes) ||
@@ -323,7 +360,7 @@ static bool gl_open(gl *g, const char *buf, size_t len)
 	/* KHR_lights_punctual's lights sit in the root's extensions */
 	const cJSON *la = key(key(key(g->root, "extensions"), "KHR_lights_punctual"), "lights");
 	if (la) {
-		if (!cJSON_IsArray(la))
+		if (!cj.is_array(la))
 			return fail(g, "extensions.KHR_lights_punctual.lights", "not an array; expected [...]");
 		size_t n = 0;
 		for (const cJSON *e = la->child; e; e = e->next)
@@ -434,7 +471,7 @@ static bool buffer(gl *g, size_t i, const unsigned char **p, size_t *len)
 				            "first buffer of a .glb");
 			g->buf[i] = (unsigned char *)g->bin;
 			g->buflen[i] = g->nbin;
-		} else if (!cJSON_IsString(uri)) {
+		} else if (!cj.is_string(uri)) {
 			return fail(g, where, "uri: not a string; expected a data: URI or a file name");
 		} else if (strncmp(uri->valuestring, "data:", 5) == 0) {
 			if (!(g->buf[i] = data_uri(g, uri->valuestring, where, &g->buflen[i])))
@@ -523,9 +560,9 @@ static bool accessor(gl *g, size_t i, const char *use, int ncomp, const int *typ
 	const cJSON *o = g->accessors.v[i];
 	static const char *const tnames[] = {"SCALAR", "VEC2", "VEC3", "VEC4"};
 	const cJSON *ty = key(o, "type");
-	if (!cJSON_IsString(ty) || strcmp(ty->valuestring, tnames[ncomp - 1]) != 0)
-		return fail(g, where, "type %s%.20s%s for %s; expected \"%s\"", cJSON_IsString(ty) ? "\"" : "",
-		            cJSON_IsString(ty) ? ty->valuestring : "missing", cJSON_IsString(ty) ? "\"" : "", use,
+	if (!cj.is_string(ty) || strcmp(ty->valuestring, tnames[ncomp - 1]) != 0)
+		return fail(g, where, "type %s%.20s%s for %s; expected \"%s\"", cj.is_string(ty) ? "\"" : "",
+		            cj.is_string(ty) ? ty->valuestring : "missing", cj.is_string(ty) ? "\"" : "", use,
 		            tnames[ncomp - 1]);
 	double ct, count, off;
 	long v;
@@ -547,7 +584,7 @@ static bool accessor(gl *g, size_t i, const char *use, int ncomp, const int *typ
 	if (key(o, "sparse"))
 		return fail(g, where, "sparse: sparse accessors are not read by rtsh; expected a plain accessor");
 	const cJSON *nm = key(o, "normalized");
-	*a = (acc){.count = (size_t)count, .ctype = (int)ct, .ncomp = ncomp, .norm = cJSON_IsTrue(nm)};
+	*a = (acc){.count = (size_t)count, .ctype = (int)ct, .ncomp = ncomp, .norm = cj.is_true(nm)};
 	size_t esize = (size_t)comp_size(a->ctype) * (size_t)ncomp;
 	if (v < 0)
 		return true; /* zeros */
@@ -697,9 +734,9 @@ static bool walk(gl *g)
 	const cJSON *scenes = key(g->root, "scenes");
 	long sc = -1;
 	size_t nscenes = 0;
-	for (const cJSON *e = cJSON_IsArray(scenes) ? scenes->child : NULL; e; e = e->next)
+	for (const cJSON *e = cj.is_array(scenes) ? scenes->child : NULL; e; e = e->next)
 		nscenes++;
-	if (scenes && !cJSON_IsArray(scenes)) {
+	if (scenes && !cj.is_array(scenes)) {
 		free(stack);
 		return fail(g, "scenes", "not an array; expected [...]");
 	}
@@ -718,7 +755,7 @@ static bool walk(gl *g)
 			s = s->next;
 		const cJSON *roots = key(s, "nodes");
 		snprintf(where, sizeof where, "scenes[%ld]", sc);
-		if (roots && !cJSON_IsArray(roots))
+		if (roots && !cj.is_array(roots))
 			ok = fail(g, where, "nodes: not an array; expected [...]");
 		/* pushed in reverse, so that the walk goes in the file's order */
 		size_t nr = 0;
@@ -731,7 +768,7 @@ static bool walk(gl *g)
 		for (const cJSON *e = ok && roots ? roots->child : NULL; e; e = e->next)
 			rv[k++] = e;
 		for (size_t j = nr; ok && j-- > 0;) {
-			double d = cJSON_IsNumber(rv[j]) ? rv[j]->valuedouble : -1;
+			double d = cj.is_number(rv[j]) ? rv[j]->valuedouble : -1;
 			if (!(d >= 0 && d < (double)n && d == floor(d)))
 				ok = fail(g, where, "nodes[%zu]: not an index into nodes; expected an integer from 0 to %zu", j,
 				          n - 1);
@@ -751,8 +788,8 @@ static bool walk(gl *g)
 			ok = fail(g, NULL, "out of memory");
 		for (size_t i = 0; ok && i < n; i++) {
 			const cJSON *c = key(g->nodes.v[i], "children");
-			for (const cJSON *e = cJSON_IsArray(c) ? c->child : NULL; e; e = e->next)
-				if (cJSON_IsNumber(e) && e->valuedouble >= 0 && e->valuedouble < (double)n)
+			for (const cJSON *e = cj.is_array(c) ? c->child : NULL; e; e = e->next)
+				if (cj.is_number(e) && e->valuedouble >= 0 && e->valuedouble < (double)n)
 					child[(size_t)e->valuedouble] = 1;
 		}
 		for (size_t i = n; ok && i-- > 0;)
@@ -774,7 +811,7 @@ static bool walk(gl *g)
 		g->order[g->norder++] = i;
 		snprintf(where, sizeof where, "nodes[%d]", i);
 		const cJSON *c = key(g->nodes.v[i], "children");
-		if (c && !cJSON_IsArray(c)) {
+		if (c && !cj.is_array(c)) {
 			ok = fail(g, where, "children: not an array; expected [...]");
 			break;
 		}
@@ -791,7 +828,7 @@ static bool walk(gl *g)
 		top += nc;
 		size_t j = 0;
 		for (const cJSON *e = c ? c->child : NULL; ok && e; e = e->next, j++) {
-			double d = cJSON_IsNumber(e) ? e->valuedouble : -1;
+			double d = cj.is_number(e) ? e->valuedouble : -1;
 			if (!(d >= 0 && d < (double)n && d == floor(d)))
 				ok = fail(g, where, "children[%zu]: not an index into nodes; expected an integer from 0 to %zu", j,
 				          n - 1);
@@ -841,7 +878,7 @@ static bool primitive(gl *g, size_t m, size_t k, const cJSON *pr, prim *p)
 	const cJSON *at = key(pr, "attributes");
 	long ia;
 	snprintf(use, sizeof use, "%s.attributes", where);
-	if (!cJSON_IsObject(at))
+	if (!cj.is_object(at))
 		return fail(g, use, "missing or not an object; expected {\"POSITION\": ...}");
 	snprintf(use, sizeof use, "%s.attributes.POSITION", where);
 	if (!get_index(g, at, "POSITION", use, g->accessors.n, "accessors", true, &ia) ||
@@ -984,9 +1021,9 @@ static bool image_bytes(gl *g, long im, img_bytes *ib)
 	long bv;
 	if (!get_index(g, img, "bufferView", iw, g->views.n, "bufferViews", false, &bv))
 		return false;
-	bool in_uri = bv < 0 && cJSON_IsString(uri) && strncmp(uri->valuestring, "data:", 5) == 0;
+	bool in_uri = bv < 0 && cj.is_string(uri) && strncmp(uri->valuestring, "data:", 5) == 0;
 	const char *ext = "png";
-	if ((cJSON_IsString(mime) && strcmp(mime->valuestring, "image/jpeg") == 0) ||
+	if ((cj.is_string(mime) && strcmp(mime->valuestring, "image/jpeg") == 0) ||
 	    (in_uri && strncmp(uri->valuestring, "data:image/jpeg", 15) == 0))
 		ext = "jpg";
 	snprintf(ib->name, sizeof ib->name, "%s: images[%ld].%s", g->name, im, ext);
@@ -998,7 +1035,7 @@ static bool image_bytes(gl *g, long im, img_bytes *ib)
 			return false;
 		ib->data = ib->own;
 		return true;
-	} else if (cJSON_IsString(uri)) {
+	} else if (cj.is_string(uri)) {
 		ib->file = uri_file(g->dir ? g->dir : "", uri->valuestring);
 		return ib->file ? true : fail(g, iw, "out of memory");
 	}
@@ -1125,7 +1162,7 @@ static bool material(gl *g, mesh_builder *b, texture **cache, size_t i, mesh_mat
 		return false;
 	const cJSON *am = key(o, "alphaMode");
 	if (am) {
-		const char *s = cJSON_IsString(am) ? am->valuestring : "";
+		const char *s = cj.is_string(am) ? am->valuestring : "";
 		m->alpha_mode = strcmp(s, "MASK") == 0 ? MESH_ALPHA_MASK : strcmp(s, "BLEND") == 0 ? MESH_ALPHA_BLEND : 0;
 		if (!m->alpha_mode && strcmp(s, "OPAQUE") != 0)
 			return fail(g, where, "alphaMode: not \"OPAQUE\", \"MASK\" or \"BLEND\"; expected one of them");
@@ -1234,7 +1271,7 @@ static bool material(gl *g, mesh_builder *b, texture **cache, size_t i, mesh_mat
 	if (!tex_info(g, b, cache, key(o, "emissiveTexture"), w2, true, &m->map_emit, &m->tex_emit))
 		return false;
 	const cJSON *nm = key(o, "name");
-	if (cJSON_IsString(nm) && !(m->name = strdup(nm->valuestring)))
+	if (cj.is_string(nm) && !(m->name = strdup(nm->valuestring)))
 		return fail(g, where, "out of memory");
 	return true;
 }
@@ -1291,7 +1328,7 @@ static mesh *build(gl *g)
 			continue;
 		const cJSON *prs = key(g->meshes.v[mi], "primitives");
 		snprintf(where, sizeof where, "meshes[%ld]", mi);
-		if (!cJSON_IsArray(prs))
+		if (!cj.is_array(prs))
 			return fail(g, where, "primitives: missing or not an array; expected [...]"), NULL;
 		size_t k = 0;
 		for (const cJSON *pr = prs->child; pr; pr = pr->next, k++) {
@@ -1447,13 +1484,13 @@ static bool info(gl *g, gltf_info *out)
 				return fail(g, where, "a camera whose transform is singular; expected one that keeps directions");
 			c->fwd = v3_norm(c->fwd);
 			c->up = v3_norm(c->up);
-			bool ortho = cJSON_IsString(ty) && strcmp(ty->valuestring, "orthographic") == 0;
-			if (!ortho && !(cJSON_IsString(ty) && strcmp(ty->valuestring, "perspective") == 0))
+			bool ortho = cj.is_string(ty) && strcmp(ty->valuestring, "orthographic") == 0;
+			if (!ortho && !(cj.is_string(ty) && strcmp(ty->valuestring, "perspective") == 0))
 				return fail(g, w2, "type: not \"perspective\" or \"orthographic\"; expected one of them");
 			c->ortho = ortho;
 			const cJSON *pp = key(cam, ortho ? "orthographic" : "perspective");
 			snprintf(w2, sizeof w2, "cameras[%ld].%s", ci, ortho ? "orthographic" : "perspective");
-			if (!cJSON_IsObject(pp))
+			if (!cj.is_object(pp))
 				return fail(g, w2, "missing; expected the camera's projection {...}");
 			if (ortho) {
 				if (!get_num(g, pp, "xmag", w2, -1e300, 1e300, 0, &c->xmag) ||
@@ -1479,9 +1516,9 @@ static bool info(gl *g, gltf_info *out)
 			gltf_light *l = &out->lights[out->nlights++];
 			const cJSON *lo = g->lights.v[li], *ty = key(lo, "type");
 			snprintf(w2, sizeof w2, "extensions.KHR_lights_punctual.lights[%ld]", li);
-			if (!cJSON_IsObject(lo))
+			if (!cj.is_object(lo))
 				return fail(g, w2, "not an object; expected {...}");
-			const char *t = cJSON_IsString(ty) ? ty->valuestring : "";
+			const char *t = cj.is_string(ty) ? ty->valuestring : "";
 			l->type = strcmp(t, "point") == 0 ? GLTF_POINT : strcmp(t, "spot") == 0 ? GLTF_SPOT
 			          : strcmp(t, "directional") == 0 ? GLTF_DIRECTIONAL : -1;
 			if (l->type < 0)
@@ -1516,13 +1553,13 @@ static bool info(gl *g, gltf_info *out)
 		if (mi >= 0)
 			out->mesh_nodes[out->nmesh_nodes++] = (long)i;
 		const cJSON *prs = mi >= 0 ? key(g->meshes.v[mi], "primitives") : NULL;
-		for (const cJSON *pr = cJSON_IsArray(prs) ? prs->child : NULL; pr; pr = pr->next) {
+		for (const cJSON *pr = cj.is_array(prs) ? prs->child : NULL; pr; pr = pr->next) {
 			const cJSON *mat = key(pr, "material");
-			if (!cJSON_IsNumber(mat) || !(mat->valuedouble >= 0 && mat->valuedouble < (double)g->materials.n))
+			if (!cj.is_number(mat) || !(mat->valuedouble >= 0 && mat->valuedouble < (double)g->materials.n))
 				continue;
 			const cJSON *ef = key(g->materials.v[(size_t)mat->valuedouble], "emissiveFactor");
-			for (const cJSON *e = cJSON_IsArray(ef) ? ef->child : NULL; e; e = e->next)
-				out->emissive |= cJSON_IsNumber(e) && e->valuedouble > 0;
+			for (const cJSON *e = cj.is_array(ef) ? ef->child : NULL; e; e = e->next)
+				out->emissive |= cj.is_number(e) && e->valuedouble > 0;
 		}
 	}
 	return true;
