@@ -5,6 +5,7 @@
 #ifndef RTSH_DYNLIB_H
 #define RTSH_DYNLIB_H
 
+#include <pthread.h>
 #include <stdbool.h>
 #include <stddef.h>
 
@@ -20,5 +21,15 @@ typedef struct dynlib_fn {
  * library or one of its functions is missing; the pointers are then left
  * unusable. Not thread-safe by itself: call it under pthread_once. */
 bool dynlib_open(const char *soname, const dynlib_fn *fns, size_t n, char *why, size_t wsize);
+
+/* A library's state in the reader that opens it on first use: once runs
+ * the reader's opener (which sets ok and why by dynlib_open); static,
+ * initialised with DYNLIB_LAZY. */
+typedef struct dynlib_lazy {
+	pthread_once_t once;
+	bool ok;
+	char why[256];
+} dynlib_lazy;
+#define DYNLIB_LAZY {PTHREAD_ONCE_INIT, false, ""}
 
 #endif

@@ -769,26 +769,22 @@ static float cross_error(const chan *r, float na, float nb, float la, float lb)
 #undef LANES
 #undef LANES_TARGET
 
+/* Rows y0..y1 of the lane pass fn: its 8-lane copy where the processor
+ * has AVX2, else its 4-lane one. */
+#ifdef HAVE_AVX2_COPY
+#define LANES_ROWS(fn, j, y0, y1) (__builtin_cpu_supports("avx2") ? fn##_8(j, y0, y1) : fn##_4(j, y0, y1))
+#else
+#define LANES_ROWS(fn, j, y0, y1) fn##_4(j, y0, y1)
+#endif
+
 static void regression_rows(job *j, int y0, int y1)
 {
-#ifdef HAVE_AVX2_COPY
-	if (__builtin_cpu_supports("avx2")) {
-		regression_rows_8(j, y0, y1);
-		return;
-	}
-#endif
-	regression_rows_4(j, y0, y1);
+	LANES_ROWS(regression_rows, j, y0, y1);
 }
 
 static void pick_rows(job *j, int y0, int y1)
 {
-#ifdef HAVE_AVX2_COPY
-	if (__builtin_cpu_supports("avx2")) {
-		pick_rows_8(j, y0, y1);
-		return;
-	}
-#endif
-	pick_rows_4(j, y0, y1);
+	LANES_ROWS(pick_rows, j, y0, y1);
 }
 
 /* A pixel whose features vary inside it (part one surface, part another):

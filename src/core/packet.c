@@ -531,6 +531,17 @@ static void leaf_occluded(const world *w, pk_state *s, unsigned *live, const pri
 	}
 }
 
+/* Whether a plane of w blocks r between tmin and tmax (world_occluded's
+ * planes, tested before its tree: model_occluded, world_occluded_packet). */
+static bool planes_block(const world *w, const ray *r, double tmin, double tmax)
+{
+	double t;
+	for (size_t k = 0; k < w->nplanes; k++)
+		if (plane_hit(&w->planes[k], r, tmin, tmax, &t))
+			return true;
+	return false;
+}
+
 /* Shadow rays on a lone model: the planes first for each ray, as
  * world_occluded, then the rays they leave through the model's triangle
  * tree in one packet (mesh_occluded_world_packet). False when that packet
@@ -542,10 +553,7 @@ static bool model_occluded(const world *w, int n, const ray *r, double tmin, con
 	double tl[PACKET_MAX];
 	int at[PACKET_MAX], nl = 0;
 	for (int i = 0; i < n; i++) {
-		double t;
-		bool blocked = false;
-		for (size_t k = 0; k < w->nplanes && !blocked; k++)
-			blocked = plane_hit(&w->planes[k], &r[i], tmin, tmax[i], &t);
+		bool blocked = planes_block(w, &r[i], tmin, tmax[i]);
 		occ[i] = blocked;
 		if (!blocked) {
 			rl[nl] = r[i];
@@ -579,10 +587,7 @@ void world_occluded_packet(const world *w, int n, const ray *r, double tmin, con
 	s.one_o = false;
 	unsigned live = 0;
 	for (int i = 0; i < n; i++) {
-		double t;
-		bool blocked = false;
-		for (size_t k = 0; k < w->nplanes && !blocked; k++)
-			blocked = plane_hit(&w->planes[k], &r[i], tmin, tmax[i], &t);
+		bool blocked = planes_block(w, &r[i], tmin, tmax[i]);
 		occ[i] = blocked;
 		live |= (unsigned)!blocked << i;
 		s.tmax[i] = tmax[i];

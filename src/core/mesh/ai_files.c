@@ -13,9 +13,7 @@
 #include "rtsh/filesrc.h"
 
 static ai_lib ai;
-static bool ai_ok;
-static char ai_why[256];
-static pthread_once_t ai_once = PTHREAD_ONCE_INIT;
+static dynlib_lazy ai_lazy = DYNLIB_LAZY;
 
 static void ai_open_lib(void)
 {
@@ -27,15 +25,15 @@ static void ai_open_lib(void)
 	    {"aiGetMaterialFloatArray", &ai.get_material_float_array},
 	    {"aiGetMaterialTexture", &ai.get_material_texture},
 	};
-	ai_ok = dynlib_open(RTSH_ASSIMP_SONAME, fns, sizeof fns / sizeof fns[0], ai_why, sizeof ai_why);
+	ai_lazy.ok = dynlib_open(RTSH_ASSIMP_SONAME, fns, sizeof fns / sizeof fns[0], ai_lazy.why, sizeof ai_lazy.why);
 }
 
 const ai_lib *ai_lib_get(const char *path, rt_error *err)
 {
-	pthread_once(&ai_once, ai_open_lib);
-	if (!ai_ok) {
+	pthread_once(&ai_lazy.once, ai_open_lib);
+	if (!ai_lazy.ok) {
 		rt_error_set(err, "%s: cannot read the model: assimp cannot be loaded (%s); expected %s installed", path,
-		             ai_why, RTSH_ASSIMP_SONAME);
+		             ai_lazy.why, RTSH_ASSIMP_SONAME);
 		return NULL;
 	}
 	return &ai;

@@ -59,9 +59,7 @@ static struct {
 	cJSON_bool (*is_object)(const cJSON *item);
 	cJSON_bool (*is_true)(const cJSON *item);
 } cj;
-static bool cj_ok;
-static char cj_why[256];
-static pthread_once_t cj_once = PTHREAD_ONCE_INIT;
+static dynlib_lazy cj_lazy = DYNLIB_LAZY;
 
 static void cj_open(void)
 {
@@ -71,7 +69,7 @@ static void cj_open(void)
 	    {"cJSON_IsArray", &cj.is_array}, {"cJSON_IsNumber", &cj.is_number},
 	    {"cJSON_IsObject", &cj.is_object}, {"cJSON_IsTrue", &cj.is_true},
 	};
-	cj_ok = dynlib_open(RTSH_CJSON_SONAME, fns, sizeof fns / sizeof fns[0], cj_why, sizeof cj_why);
+	cj_lazy.ok = dynlib_open(RTSH_CJSON_SONAME, fns, sizeof fns / sizeof fns[0], cj_lazy.why, sizeof cj_lazy.why);
 }
 
 #define WHERE_MAX 96
@@ -185,9 +183,9 @@ static bool parse_json(gl *g, const char *json, size_t n, size_t start)
 	size_t marks = 1;
 	for (size_t i = 0; i < n; i++)
 		marks += json[i] == ',' || json[i] == '[' || json[i] == '{' || json[i] == ':';
-	pthread_once(&cj_once, cj_open);
-	if (!cj_ok)
-		return fail(g, NULL, "cannot read the glTF: cJSON cannot be loaded (%s); expected %s installed", cj_why,
+	pthread_once(&cj_lazy.once, cj_open);
+	if (!cj_lazy.ok)
+		return fail(g, NULL, "cannot read the glTF: cJSON cannot be loaded (%s); expected %s installed", cj_lazy.why,
 		            RTSH_CJSON_SONAME);
 	char what[300];
 	snprintf(what, sizeof what, "the JSON of %s", g->name);

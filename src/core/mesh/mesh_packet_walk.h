@@ -153,27 +153,7 @@ static PK_TARGET inline void PK(leaf_rays)(const mesh *m, mesh_packet *s, unsign
 					      hm;
 				if (zm) {
 					/* an edge function at zero: in double, as wt_test */
-					_Alignas(32) float fu[8], fv[8], fw[8], fax[8], fay[8], fbx[8], fby[8], fcx[8], fcy[8];
-					_mm256_store_ps(fu, u);
-					_mm256_store_ps(fv, v);
-					_mm256_store_ps(fw, w);
-					_mm256_store_ps(fax, ax);
-					_mm256_store_ps(fay, ay);
-					_mm256_store_ps(fbx, bx);
-					_mm256_store_ps(fby, by);
-					_mm256_store_ps(fcx, cx);
-					_mm256_store_ps(fcy, cy);
-					for (; zm; zm &= zm - 1) {
-						int j = __builtin_ctz(zm);
-						fu[j] = (float)((double)fcx[j] * fby[j] - (double)fcy[j] * fbx[j]);
-						fv[j] = (float)((double)fax[j] * fcy[j] - (double)fay[j] * fcx[j]);
-						fw[j] = (float)((double)fbx[j] * fay[j] - (double)fby[j] * fax[j]);
-					}
-					u = _mm256_load_ps(fu);
-					v = _mm256_load_ps(fv);
-					w = _mm256_load_ps(fw);
-					lo = _mm256_min_ps(_mm256_min_ps(u, v), w);
-					hi = _mm256_max_ps(_mm256_max_ps(u, v), w);
+					EDGES_IN_DOUBLE(8, __m256, _mm256_store_ps, _mm256_load_ps, _mm256_min_ps, _mm256_max_ps);
 				}
 				__m256 out = _mm256_and_ps(_mm256_cmp_ps(lo, zero, _CMP_LT_OQ), _mm256_cmp_ps(hi, zero, _CMP_GT_OQ));
 				/* no ray of the eight meets it: the next (coherent rays

@@ -211,6 +211,39 @@ static inline __attribute__((always_inline)) void ray4_make(const mesh_ray *r, r
 	q->sz = _mm_set1_ps(r->sz);
 }
 
+/* The edge functions of the lanes in zm (those a float made zero) again in
+ * double, as wt_test does: block_sse and the packet walk's leaf. f holds
+ * 9 rows of n lanes: u, v, w, ax, ay, bx, by, cx, cy; u, v and w are
+ * rewritten. */
+static inline __attribute__((always_inline)) void edges_in_double(unsigned zm, float *f, int n)
+{
+	const float *ax = f + 3 * n, *ay = f + 4 * n, *bx = f + 5 * n, *by = f + 6 * n, *cx = f + 7 * n,
+		    *cy = f + 8 * n;
+	for (; zm; zm &= zm - 1) {
+		int l = __builtin_ctz(zm);
+		f[l] = (float)((double)cx[l] * by[l] - (double)cy[l] * bx[l]);
+		f[n + l] = (float)((double)ax[l] * cy[l] - (double)ay[l] * cx[l]);
+		f[2 * n + l] = (float)((double)bx[l] * ay[l] - (double)by[l] * ax[l]);
+	}
+}
+
+/* Where a lane's lowest or highest edge function came out zero (the lanes
+ * in zm), u, v and w again by edges_in_double and lo and hi of them, for a
+ * unit of N floats of type V with its STORE, LOAD, MIN and MAX: the names
+ * u, v, w, ax ... cy, lo, hi and zm are the caller's (block_sse and the
+ * packet walk's leaf, as wt_test). */
+#define EDGES_IN_DOUBLE(N, V, STORE, LOAD, MIN, MAX)                                                                \
+	do {                                                                                                        \
+		_Alignas(4 * (N)) float f_[9][N];                                                                   \
+		const V e_[9] = {u, v, w, ax, ay, bx, by, cx, cy};                                                   \
+		for (int r_ = 0; r_ < 9; r_++)                                                                      \
+			STORE(f_[r_], e_[r_]);                                                                      \
+		edges_in_double(zm, f_[0], N);                                                                      \
+		u = LOAD(f_[0]), v = LOAD(f_[1]), w = LOAD(f_[2]);                                                  \
+		lo = MIN(MIN(u, v), w);                                                                             \
+		hi = MAX(MAX(u, v), w);                                                                             \
+	} while (0)
+
 /* block_scalar's test on the four lanes at once (wt_test's operations in
  * its order; an edge function that is zero in some lane is recomputed in
  * double for that lane, as wt_test does). */
@@ -237,27 +270,7 @@ static inline __attribute__((always_inline)) int block_sse(const mesh *m, uint32
 	__m128 lo = _mm_min_ps(_mm_min_ps(u, v), w), hi = _mm_max_ps(_mm_max_ps(u, v), w);
 	unsigned zm = (unsigned)_mm_movemask_ps(_mm_or_ps(_mm_cmpeq_ps(lo, zero), _mm_cmpeq_ps(hi, zero)));
 	if (zm) {
-		_Alignas(16) float fu[4], fv[4], fw[4], fax[4], fay[4], fbx[4], fby[4], fcx[4], fcy[4];
-		_mm_store_ps(fu, u);
-		_mm_store_ps(fv, v);
-		_mm_store_ps(fw, w);
-		_mm_store_ps(fax, ax);
-		_mm_store_ps(fay, ay);
-		_mm_store_ps(fbx, bx);
-		_mm_store_ps(fby, by);
-		_mm_store_ps(fcx, cx);
-		_mm_store_ps(fcy, cy);
-		for (; zm; zm &= zm - 1) {
-			int l = __builtin_ctz(zm);
-			fu[l] = (float)((double)fcx[l] * fby[l] - (double)fcy[l] * fbx[l]);
-			fv[l] = (float)((double)fax[l] * fcy[l] - (double)fay[l] * fcx[l]);
-			fw[l] = (float)((double)fbx[l] * fay[l] - (double)fby[l] * fax[l]);
-		}
-		u = _mm_load_ps(fu);
-		v = _mm_load_ps(fv);
-		w = _mm_load_ps(fw);
-		lo = _mm_min_ps(_mm_min_ps(u, v), w);
-		hi = _mm_max_ps(_mm_max_ps(u, v), w);
+		EDGES_IN_DOUBLE(4, __m128, _mm_store_ps, _mm_load_ps, _mm_min_ps, _mm_max_ps);
 	}
 	/* (a NaN lane fails below, on its NaN distance) */
 	__m128 neg = _mm_cmplt_ps(lo, zero);

@@ -405,9 +405,7 @@ static struct {
 	void (*free_image)(XpmImage *image);
 	char *(*error_string)(int errcode);
 } xpm;
-static bool xpm_ok;
-static char xpm_why[256];
-static pthread_once_t xpm_once = PTHREAD_ONCE_INIT;
+static dynlib_lazy xpm_lazy = DYNLIB_LAZY;
 
 static void xpm_open(void)
 {
@@ -416,7 +414,7 @@ static void xpm_open(void)
 	    {"XpmFreeXpmImage", &xpm.free_image},
 	    {"XpmGetErrorString", &xpm.error_string},
 	};
-	xpm_ok = dynlib_open(RTSH_XPM_SONAME, fns, sizeof fns / sizeof fns[0], xpm_why, sizeof xpm_why);
+	xpm_lazy.ok = dynlib_open(RTSH_XPM_SONAME, fns, sizeof fns / sizeof fns[0], xpm_lazy.why, sizeof xpm_lazy.why);
 }
 
 static float *read_xpm(const char *path, const unsigned char *buf, size_t len, bool srgb, int *w, int *h,
@@ -445,10 +443,10 @@ static float *read_xpm(const char *path, const unsigned char *buf, size_t len, b
 		             "per pixel: more than the file holds", path, v[0], v[1], v[2], v[3]);
 		return NULL;
 	}
-	pthread_once(&xpm_once, xpm_open);
-	if (!xpm_ok) {
+	pthread_once(&xpm_lazy.once, xpm_open);
+	if (!xpm_lazy.ok) {
 		rt_error_set(err, "%s: cannot read the XPM image: libXpm cannot be loaded (%s); expected %s installed",
-		             path, xpm_why, RTSH_XPM_SONAME);
+		             path, xpm_lazy.why, RTSH_XPM_SONAME);
 		return NULL;
 	}
 	char *text = malloc(len + 1);
