@@ -214,6 +214,20 @@ static scene *load_text(const char *text)
 	return s;
 }
 
+/* The features of the centre pixel of a 9x9 picture of the scene of text,
+ * summed over its samples 0 .. n - 1 (denoise_sample's accumulator). */
+static void centre_features(const char *text, int n, double f[DENOISE_ACC])
+{
+	scene *s = load_text(text);
+	world *w = world_build(s, NULL);
+	assert_non_null(w);
+	memset(f, 0, DENOISE_ACC * sizeof *f);
+	for (int k = 0; k < n; k++)
+		denoise_sample(w, cam_ray(&w->cam, 4.5, 4.5, 9, 9), k, f);
+	world_free(w);
+	scene_free(s);
+}
+
 /* The mean of the image along rows (vertical = false: a profile across x)
  * or along columns (vertical = true: across y), of the luminance. */
 static void profile(const framebuffer *fb, bool vertical, double *p)
@@ -629,18 +643,13 @@ static void test_features_through_mirror(void **state)
 	vec3 albedo[4] = {wall, v3(1, 1, 1), wall, v3(1, 1, 1)};
 	const double normal_z[4] = {1, -1, 1, -1}, depth[4] = {7, 2, 7, 2};
 	for (int c = 0; c < 4; c++) {
-		scene *s = load_text(texts[c]);
-		world *w = world_build(s, NULL);
-		assert_non_null(w);
-		double f[DENOISE_ACC] = {0};
-		denoise_sample(w, cam_ray(&w->cam, 4.5, 4.5, 9, 9), 0, f);
+		double f[DENOISE_ACC];
+		centre_features(texts[c], 1, f);
 		assert_near(f[0], albedo[c].x, 1e-5);
 		assert_near(f[1], albedo[c].y, 1e-5);
 		assert_near(f[2], albedo[c].z, 1e-5);
 		assert_near(f[5], normal_z[c], 1e-3);
 		assert_near(f[6], depth[c], 1e-3);
-		world_free(w);
-		scene_free(s);
 	}
 }
 
@@ -653,12 +662,10 @@ static void test_features_through_mirror(void **state)
 static void test_features_through_glass(void **state)
 {
 	(void)state;
-	scene *s = load_text("C 0,0,0 0,0,1 10\npl 0,0,2 0,0,-1 1,1,1 255,255,255 0 0 1 0 ior=1.5\n"
-	                     "pl 0,0,4 0,0,-1 1,1,1 180,100,50 1 0 1 0\n");
-	world *w = world_build(s, NULL);
-	assert_non_null(w);
-	double f[DENOISE_ACC] = {0};
-	denoise_sample(w, cam_ray(&w->cam, 4.5, 4.5, 9, 9), 0, f);
+	double f[DENOISE_ACC];
+	centre_features("C 0,0,0 0,0,1 10\npl 0,0,2 0,0,-1 1,1,1 255,255,255 0 0 1 0 ior=1.5\n"
+	                "pl 0,0,4 0,0,-1 1,1,1 180,100,50 1 0 1 0\n",
+	                1, f);
 	vec3 wall = srgb255_to_linear(v3(180, 100, 50));
 	const double F = 0.04;
 	assert_near(f[0], (1 - F) * wall.x + F, 1e-4);
@@ -666,8 +673,6 @@ static void test_features_through_glass(void **state)
 	assert_near(f[2], (1 - F) * wall.z + F, 1e-4);
 	assert_near(f[5], -1.0, 1e-3);
 	assert_near(f[6], 4.0, 1e-3);
-	world_free(w);
-	scene_free(s);
 }
 
 /* The sky's albedo feature is its colour in that direction: a uniform sky
@@ -684,16 +689,11 @@ static void test_sky_feature(void **state)
 	};
 	const double want[2] = {0.5, 0.96 * 0.5 + 0.04};
 	for (int c = 0; c < 2; c++) {
-		scene *s = load_text(texts[c]);
-		world *w = world_build(s, NULL);
-		assert_non_null(w);
-		double f[DENOISE_ACC] = {0};
-		denoise_sample(w, cam_ray(&w->cam, 4.5, 4.5, 9, 9), 0, f);
+		double f[DENOISE_ACC];
+		centre_features(texts[c], 1, f);
 		for (int k = 0; k < 3; k++)
 			assert_near(f[k], want[c], 1e-4);
 		assert_near(f[6], 0.0, 1e-9); /* the sky has no depth, through glass too */
-		world_free(w);
-		scene_free(s);
 	}
 }
 
@@ -715,17 +715,12 @@ static void test_direct_feature(void **state)
 	};
 	const double want[2] = {0.5 * 2.0 / sqrt(5.0), 0.0};
 	for (int c = 0; c < 2; c++) {
-		scene *s = load_text(texts[c]);
-		world *w = world_build(s, NULL);
-		assert_non_null(w);
-		double f[DENOISE_ACC] = {0};
-		denoise_sample(w, cam_ray(&w->cam, 4.5, 4.5, 9, 9), 0, f);
+		double f[DENOISE_ACC];
+		centre_features(texts[c], 1, f);
 		assert_near(f[7], want[c], 1e-4);
 		assert_near(f[6], 2.0, 1e-4); /* the wall, not the sphere */
 		/* sample 0 is even: its albedo is also the even samples' */
 		assert_near(f[10], f[0], 1e-12);
-		world_free(w);
-		scene_free(s);
 	}
 }
 
@@ -770,16 +765,10 @@ static void test_env_feature(void **state)
 	for (int c = 0; c < 5; c++) {
 		char text[512];
 		snprintf(text, sizeof text, "%s%s%s", cam, surface[c], extra[c]);
-		scene *s = load_text(text);
-		world *w = world_build(s, NULL);
-		assert_non_null(w);
-		double f[DENOISE_ACC] = {0};
-		for (int k = 0; k < DENOISE_FEATURE_SAMPLES; k++)
-			denoise_sample(w, cam_ray(&w->cam, 4.5, 4.5, 9, 9), k, f);
+		double f[DENOISE_ACC];
+		centre_features(text, DENOISE_FEATURE_SAMPLES, f);
 		assert_near(f[7] / DENOISE_FEATURE_SAMPLES, want[c], tol[c]);
 		assert_near(f[6] / DENOISE_FEATURE_SAMPLES, 2.0, 1e-9);
-		world_free(w);
-		scene_free(s);
 	}
 }
 
@@ -809,22 +798,16 @@ static void test_lamp_through_glossy(void **state)
 	};
 	const double albedo[2] = {1, 5}, normal_z[2] = {-1, 1}, depth[2] = {2, 6.5};
 	for (int c = 0; c < 2; c++) {
-		scene *s = load_text(texts[c]);
-		world *w = world_build(s, NULL);
-		assert_non_null(w);
-		double f[DENOISE_ACC] = {0};
-		denoise_sample(w, cam_ray(&w->cam, 4.5, 4.5, 9, 9), 0, f);
+		double f[DENOISE_ACC];
+		centre_features(texts[c], 1, f);
 		for (int k = 0; k < 3; k++)
 			assert_near(f[k], albedo[c], 1e-5);
 		assert_near(f[5], normal_z[c], 1e-3);
 		assert_near(f[6], depth[c], 1e-3);
 		if (c == 0) {
-			for (int k = 1; k < DENOISE_FEATURE_SAMPLES; k++)
-				denoise_sample(w, cam_ray(&w->cam, 4.5, 4.5, 9, 9), k, f);
+			centre_features(texts[c], DENOISE_FEATURE_SAMPLES, f);
 			assert_near(f[7] / DENOISE_FEATURE_SAMPLES, 5.0, 0.05);
 		}
-		world_free(w);
-		scene_free(s);
 	}
 }
 

@@ -144,6 +144,20 @@ static void cone_packets(const world *w, vec3 lo, vec3 hi, int count, uint64_t s
 	}
 }
 
+/* The scene of text (named name in messages) and its world; the test
+ * fails on a load or build error. */
+static world *world_of_text(const char *text, const char *name, scene **s)
+{
+	rt_error err;
+	*s = rt_load_string(text, strlen(text), name, NULL, &err);
+	if (!*s)
+		fail_msg("%s: %s", name, err.msg);
+	world *w = world_build(*s, &err);
+	if (!w)
+		fail_msg("%s: %s", name, err.msg);
+	return w;
+}
+
 /* The scene at path on every vector unit; false when it is absent. */
 static bool check_scene(const char *path, int W, int H, int cones)
 {
@@ -194,13 +208,8 @@ static void test_bunny(void **state)
 	}
 	char text[256];
 	snprintf(text, sizeof text, "C 0,0.1,-3.2 0,0,1 40\nL -2,3,-4 0.8 255,255,255\nmesh %s 0,0,0 0,1,0 1 200,200,200\n", path);
-	rt_error err;
-	scene *s = rt_load_string(text, strlen(text), "bunny", NULL, &err);
-	if (!s)
-		fail_msg("bunny: %s", err.msg);
-	world *w = world_build(s, &err);
-	if (!w)
-		fail_msg("bunny: %s", err.msg);
+	scene *s;
+	world *w = world_of_text(text, "bunny", &s);
 	for (int isa = MESH_ISA_SCALAR; isa <= MESH_ISA_BEST; isa++)
 		if (mesh_isa_force((mesh_isa)isa))
 			camera_packets(w, 64, 48, w->lights[0].pos);
@@ -282,13 +291,8 @@ static void test_ties(void **state)
 	                   "tr 2,0,2 1.5,2,2 2.5,2,2 50,100,200\n" /* sharing an edge */
 	                   "cy 0,3,0 0,1,0 1 1 100,100,100\n"
 	                   "cy 0,3,0 0,1,0 1 1 100,200,100\n";
-	rt_error err;
-	scene *s = rt_load_string(text, strlen(text), "ties", NULL, &err);
-	if (!s)
-		fail_msg("ties: %s", err.msg);
-	world *w = world_build(s, &err);
-	if (!w)
-		fail_msg("ties: %s", err.msg);
+	scene *s;
+	world *w = world_of_text(text, "ties", &s);
 	vec3 lamp = w->lights[0].pos;
 	camera_packets(w, 160, 90, lamp);
 	/* rays aimed exactly at the shared edge, the cubes' corners and shared
@@ -493,13 +497,8 @@ static void model_packets(const world *w, int W, int H, int cones, uint64_t seed
 /* A lone model from text on every vector unit. */
 static void check_model_scene(const char *text, int W, int H, int cones)
 {
-	rt_error err;
-	scene *s = rt_load_string(text, strlen(text), "model", NULL, &err);
-	if (!s)
-		fail_msg("model: %s", err.msg);
-	world *w = world_build(s, &err);
-	if (!w)
-		fail_msg("model: %s", err.msg);
+	scene *s;
+	world *w = world_of_text(text, "model", &s);
 	for (int isa = MESH_ISA_SCALAR; isa <= MESH_ISA_BEST; isa++)
 		if (mesh_isa_force((mesh_isa)isa))
 			model_packets(w, W, H, cones, 41 + (uint64_t)isa);
@@ -565,13 +564,8 @@ static void test_model_ties(void **state)
 	         "sp 2.5,2.5,-1 0.5 255,0,0\nsp -2.5,-2.5,3 0.5 0,255,0\n",
 	         path);
 	{
-		rt_error e2;
-		scene *s2 = rt_load_string(text, strlen(text), "ties", NULL, &e2);
-		if (!s2)
-			fail_msg("ties: %s", e2.msg);
-		world *w2 = world_build(s2, &e2);
-		if (!w2)
-			fail_msg("ties: %s", e2.msg);
+		scene *s2;
+		world *w2 = world_of_text(text, "ties", &s2);
 		for (int isa = MESH_ISA_SCALAR; isa <= MESH_ISA_BEST; isa++)
 			if (mesh_isa_force((mesh_isa)isa)) {
 				camera_packets(w2, 96, 64, w2->lights[0].pos);
@@ -598,13 +592,8 @@ static void test_model_ties(void **state)
 	 * own size; each ray 8 long in z, so that the shear is exact and the
 	 * edge functions there are zeros, recomputed in double) */
 	snprintf(text, sizeof text, "C 0,0,-7 0,0,1 70\nmesh %s 0,0,1 0,1,0 6 200,200,200\n", path);
-	rt_error err;
-	scene *sc = rt_load_string(text, strlen(text), "ties", NULL, &err);
-	if (!sc)
-		fail_msg("ties: %s", err.msg);
-	world *w = world_build(sc, &err);
-	if (!w)
-		fail_msg("ties: %s", err.msg);
+	scene *sc;
+	world *w = world_of_text(text, "ties", &sc);
 	for (int isa = MESH_ISA_SCALAR; isa <= MESH_ISA_BEST; isa++) {
 		if (!mesh_isa_force((mesh_isa)isa))
 			continue;
