@@ -526,11 +526,11 @@ render_status render_run(render_job *job, rt_error *err)
 			pthread_join(tid[i], NULL);
 	}
 	free(tid);
+	if (sh.band_left && !atomic_load(&sh.stop))
+		hand_rows(&sh); /* the last bands */
 	pthread_mutex_destroy(&sh.lock);
 	pthread_cond_destroy(&sh.finished);
 	pthread_cond_destroy(&sh.slot_free);
-	if (sh.band_left && !atomic_load(&sh.stop))
-		hand_rows(&sh); /* the last bands */
 	free(sh.band_left);
 	report(job, &sh);
 	if (atomic_load(&sh.stop)) {
