@@ -814,6 +814,22 @@ static void test_block_rays_bits(void **state)
 					         k, x, y, set.width, set.height, got[i].d.x, got[i].d.y, got[i].d.z, want.d.x,
 					         want.d.y, want.d.z);
 			}
+		/* cam_block_rays (what the bench's packet rows and Embree's
+		 * harness use) against cam_ray: blocks of 1 to 4 x 1 to 4 pixels,
+		 * and 17 x 1 (wider than CAM_BLOCK_MAX: pixel by pixel) */
+		int bw = k % 9 == 4 ? 17 : 1 + k % 4, bh = k % 9 == 4 ? 1 : 1 + k / 4 % 4;
+		int bx1 = x0 + bw < set.width ? x0 + bw : set.width, by1 = y0 + bh < set.height ? y0 + bh : set.height;
+		ray cb[17];
+		cam_block_rays(&wd->cam, x0, y0, bx1, by1, set.width, set.height, cb);
+		for (int y = y0, i = 0; y < by1; y++)
+			for (int x = x0; x < bx1; x++, i++) {
+				ray want = cam_ray(&wd->cam, x + 0.5, y + 0.5, set.width, set.height);
+				if (memcmp(&cb[i], &want, sizeof want) != 0)
+					fail_msg("camera %d, cam_block_rays pixel %d,%d of %dx%d: dir %.17g,%.17g,%.17g, cam_ray "
+					         "%.17g,%.17g,%.17g",
+					         k, x, y, set.width, set.height, cb[i].d.x, cb[i].d.y, cb[i].d.z, want.d.x, want.d.y,
+					         want.d.z);
+			}
 		world_free(wd);
 		scene_free(s);
 	}
