@@ -362,7 +362,9 @@ static double primary_pass(const world *wd, int w, int h, bool brute, long *hits
 }
 
 /* primary_pass's rays and hit records traced as packets of 4x4 pixels
- * (world_intersect_packet, packet.h): the same hits. */
+ * (world_intersect_packet, packet.h): the same hits. The rays made as the
+ * render's blocks make them (cam_block_rays: the same bits as cam_ray, a
+ * column's and a row's terms shared), as Embree's packet rows do. */
 static double primary_packet_pass(const world *wd, int w, int h)
 {
 	double t0 = now();
@@ -371,10 +373,8 @@ static double primary_packet_pass(const world *wd, int w, int h)
 			ray r[PACKET_MAX];
 			hit hh[PACKET_MAX];
 			bool found[PACKET_MAX];
-			int n = 0;
-			for (int y = y0; y < y0 + 4 && y < h; y++)
-				for (int x = x0; x < x0 + 4 && x < w; x++)
-					r[n++] = cam_ray(&wd->cam, x + 0.5, y + 0.5, w, h);
+			int x1 = x0 + 4 < w ? x0 + 4 : w, y1 = y0 + 4 < h ? y0 + 4 : h, n = (x1 - x0) * (y1 - y0);
+			cam_block_rays(&wd->cam, x0, y0, x1, y1, w, h, r);
 			world_intersect_packet(wd, n, r, 0.0, INFINITY, hh, found);
 		}
 	return now() - t0;
@@ -445,7 +445,8 @@ static void bench_primary(void)
 	scene_free(s);
 }
 
-/* The camera rays of a w x h image through pixel centres in 4 x 4 blocks,
+/* The camera rays of a w x h image through pixel centres in 4 x 4 blocks
+ * (cam_block_rays, as the render makes them),
  * and shadow rays from their hits toward the first light: single rays
  * (world_intersect_coherent, world_occluded) or packets
  * (world_intersect_packet, world_occluded_packet, packet.h), the same
@@ -469,13 +470,12 @@ static double packet_pass(const world *wd, int w, int h, bool packet, int bw, in
 		 * then traced (timed) */
 		double t0 = now();
 		for (int b = 0; b < nb; b++) {
-			int x0 = bw * b, n = 0, m = 0;
+			int x0 = bw * b, m = 0;
+			int x1 = x0 + bw < w ? x0 + bw : w, y1 = y0 + bh < h ? y0 + bh : h, n = (x1 - x0) * (y1 - y0);
 			ray r[PACKET_MAX];
 			hit hh[PACKET_MAX];
 			bool found[PACKET_MAX];
-			for (int y = y0; y < y0 + bh && y < h; y++)
-				for (int x = x0; x < x0 + bw && x < w; x++, n++)
-					r[n] = cam_ray(&wd->cam, x + 0.5, y + 0.5, w, h);
+			cam_block_rays(&wd->cam, x0, y0, x1, y1, w, h, r);
 			if (packet)
 				world_intersect_packet(wd, n, r, 0.0, INFINITY, hh, found);
 			else
@@ -1404,7 +1404,9 @@ static double kernel_primary(const world *wd, int w, int h, bool coherent, doubl
 
 /* kernel_primary's rays and answers traced as packets of 4x4 pixels
  * (world_trace_packet: the model's own packet walk), Embree's 4x4 tiles
- * for rtcIntersect16: CPU time of one pass. */
+ * for rtcIntersect16: CPU time of one pass. The rays made as the render's
+ * blocks make them (cam_block_rays: cam_ray's bits, a column's and a row's
+ * terms shared), as Embree's packet rows (embree_packets.h) make theirs. */
 static double kernel_packet_pass(const world *wd, int w, int h, double *sink)
 {
 	double t0 = cpu_now();
@@ -1413,10 +1415,8 @@ static double kernel_packet_pass(const world *wd, int w, int h, double *sink)
 			ray r[PACKET_MAX];
 			trace_hit th[PACKET_MAX];
 			bool found[PACKET_MAX];
-			int n = 0;
-			for (int y = y0; y < y0 + 4 && y < h; y++)
-				for (int x = x0; x < x0 + 4 && x < w; x++)
-					r[n++] = cam_ray(&wd->cam, x + 0.5, y + 0.5, w, h);
+			int x1 = x0 + 4 < w ? x0 + 4 : w, y1 = y0 + 4 < h ? y0 + 4 : h, n = (x1 - x0) * (y1 - y0);
+			cam_block_rays(&wd->cam, x0, y0, x1, y1, w, h, r);
 			world_trace_packet(wd, n, r, 0.0, INFINITY, th, found);
 			for (int i = 0; i < n; i++)
 				if (found[i])

@@ -2,7 +2,8 @@
  * and bench/embree_mesh.c (only built where embree3/rtcore.h is installed).
  *
  * embree_packet_rows traces the camera rays of a w x h image (rtsh's
- * cam_ray through each pixel centre, converted to float) in tiles of
+ * cam_ray through each pixel centre, made a tile at a time as rtsh's render
+ * and packet rows make them, cam_block_rays, and converted to float) in tiles of
  * 2x2 pixels with rtcIntersect4, 2x4 (2 wide, 4 tall) with rtcIntersect8
  * and 4x4 with rtcIntersect16, the context flagged coherent, on the calling
  * thread; a tile at the image's edge leaves its missing lanes invalid. It
@@ -39,13 +40,16 @@ static double packet_clock(clockid_t clk)
 		ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;                                       \
 		_Alignas(64) struct TYPE rh;                                                           \
 		_Alignas(64) int valid[N];                                                             \
+		ray tile[N];                                                                           \
 		long hits = 0;                                                                         \
 		for (int y0 = 0; y0 < h; y0 += th)                                                     \
 			for (int x0 = 0; x0 < w; x0 += tw) {                                           \
+				int x1 = x0 + tw < w ? x0 + tw : w, y1 = y0 + th < h ? y0 + th : h;    \
+				cam_block_rays(cv, x0, y0, x1, y1, w, h, tile);                        \
 				for (int k = 0; k < N; k++) {                                          \
 					int x = x0 + k % tw, y = y0 + k / tw;                          \
-					valid[k] = x < w && y < h ? -1 : 0;                            \
-					ray r = cam_ray(cv, (x < w ? x : w - 1) + 0.5, (y < h ? y : h - 1) + 0.5, w, h); \
+					valid[k] = x < x1 && y < y1 ? -1 : 0;                          \
+					ray r = tile[valid[k] ? (y - y0) * (x1 - x0) + x - x0 : 0];    \
 					rh.ray.org_x[k] = (float)r.o.x;                                \
 					rh.ray.org_y[k] = (float)r.o.y;                                \
 					rh.ray.org_z[k] = (float)r.o.z;                                \

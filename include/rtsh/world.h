@@ -304,6 +304,11 @@ cam_view cam_view_make(const camera *c);
 /* The primary ray through the image point (fx, fy) in pixels of a w x h
  * image, (0,0) the top-left corner, (w,h) the bottom-right. */
 ray cam_ray(const cam_view *c, double fx, double fy, int w, int h);
+/* cam_ray through the centre of each pixel of the block [x0, x1) x [y0, y1)
+ * of a w x h image, row by row, into r[0 .. (x1-x0)(y1-y0)): the same rays to
+ * the bit, made faster (the render's packets, the packet rows of bench). */
+#define CAM_BLOCK_MAX 16
+void cam_block_rays(const cam_view *c, int x0, int y0, int x1, int y1, int w, int h, ray *r);
 
 /* For the benchmark (bench/bench.c) and rtsh-mpi's counts: the rays
  * world_intersect and world_occluded traced in the calling thread since the

@@ -475,26 +475,35 @@ static bool copy_xattrs(const char *from, int fd, char *failed, size_t fsize)
 typedef struct cache_drop {
 	pthread_t thread;
 	bool running;
+	int fd; /* the old file, open until cache_drop_release; -1: none */
 } cache_drop;
 
 static void *drop_cache(void *arg)
 {
 	int fd = (int)(intptr_t)arg;
 	(void)posix_fadvise(fd, 0, 0, POSIX_FADV_DONTNEED);
-	close(fd);
+	return NULL;
+}
+
+static void *close_fd(void *arg)
+{
+	close((int)(intptr_t)arg);
 	return NULL;
 }
 
 static void cache_drop_start(cache_drop *d, const char *target, const struct stat *old)
 {
 	d->running = false;
+	d->fd = -1;
 	if (!old || !S_ISREG(old->st_mode) || old->st_size < DROP_CACHE_MIN)
 		return;
 	int fd = open(target, O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
 	if (fd < 0)
 		return; /* unreadable: its pages stay, nothing else changes */
 	d->running = pthread_create(&d->thread, NULL, drop_cache, (void *)(intptr_t)fd) == 0;
-	if (!d->running)
+	if (d->running)
+		d->fd = fd;
+	else
 		close(fd);
 }
 
@@ -503,6 +512,20 @@ static void cache_drop_end(cache_drop *d)
 	if (d->running)
 		pthread_join(d->thread, NULL);
 	d->running = false;
+}
+
+/* After the rename: the old file, no longer linked, is freed (its blocks,
+ * 1.5-2 ms for 6 MB on ext4, issue 29) when its last descriptor closes,
+ * ours: a thread closes it beside the folder's sync (joined by
+ * cache_drop_joined), not the rename on this thread. */
+static void cache_drop_release(cache_drop *d)
+{
+	if (d->fd < 0)
+		return;
+	d->running = pthread_create(&d->thread, NULL, close_fd, (void *)(intptr_t)d->fd) == 0;
+	if (!d->running)
+		close(d->fd);
+	d->fd = -1;
 }
 
 typedef enum replace_result {
@@ -589,9 +612,11 @@ static replace_result replace(const char *path, const char *target, const struct
 		ok = rt_error_at(err, path, 0, 0, "cannot replace the file (%s)", strerror(errno));
 	if (!ok)
 		unlink(tmp);
+	cache_drop_release(&drop);
 	guard_off(&g);
 	if (ok)
 		sync_folder(dir);
+	cache_drop_end(&drop);
 	return ok ? REPLACED : FAILED;
 fail_fd:
 	close(fd);

@@ -62,24 +62,23 @@ ray camera_sample_ray(const world *w, const render_settings *s, bool sampled, in
 	return cam_ray(&w->cam, px + u, py + v, fw, fh);
 }
 
-/* One centred sample through a pinhole (Whitted's one sample per pixel):
- * cam_ray's terms of a column (its x, u and right x u) and of a row (y, v,
- * up x v) are the same for every pixel of the column or row, so the block
- * computes each once, by cam_ray's own expressions in its order, and each
- * pixel adds them and normalises: the same bits, a quarter of the
- * divisions. Anything else goes pixel by pixel. */
-#define BLOCK_RAYS_MAX 16
-void camera_block_rays(const world *w, const render_settings *s, bool sampled, int x0, int y0, int x1, int y1,
-                       int fw, int fh, int sample, ray *r, sampler *sp)
+/* cam_ray through the centre of every pixel of the block [x0, x1) x
+ * [y0, y1), row by row, into r (world.h). Through a pinhole cam_ray's terms
+ * of a column (its x, u and right x u) and of a row (y, v, up x v) are the
+ * same for every pixel of the column or row, so the block computes each
+ * once, by cam_ray's own expressions in its order, and each pixel adds
+ * them and normalises: the same bits, a quarter of the divisions. An
+ * orthographic view, or a block wider or taller than CAM_BLOCK_MAX, goes
+ * pixel by pixel. */
+void cam_block_rays(const cam_view *c, int x0, int y0, int x1, int y1, int fw, int fh, ray *r)
 {
-	const cam_view *c = &w->cam;
-	if (s->samples > 1 || sampled || c->ortho > 0 || x1 - x0 > BLOCK_RAYS_MAX || y1 - y0 > BLOCK_RAYS_MAX) {
+	if (c->ortho > 0 || x1 - x0 > CAM_BLOCK_MAX || y1 - y0 > CAM_BLOCK_MAX) {
 		for (int y = y0, i = 0; y < y1; y++)
 			for (int x = x0; x < x1; x++, i++)
-				r[i] = camera_sample_ray(w, s, sampled, x, y, fw, fh, sample, &sp[i]);
+				r[i] = cam_ray(c, x + 0.5, y + 0.5, fw, fh);
 		return;
 	}
-	vec3 col[BLOCK_RAYS_MAX], row[BLOCK_RAYS_MAX];
+	vec3 col[CAM_BLOCK_MAX], row[CAM_BLOCK_MAX];
 	for (int x = x0; x < x1; x++) {
 		double fx = x + 0.5, u = (2.0 * fx / fw - 1.0) * c->tan_half;
 		if (c->vertical)
@@ -93,8 +92,22 @@ void camera_block_rays(const world *w, const render_settings *s, bool sampled, i
 		row[y - y0] = v3_scale(c->up, v);
 	}
 	for (int y = y0, i = 0; y < y1; y++)
-		for (int x = x0; x < x1; x++, i++) {
+		for (int x = x0; x < x1; x++, i++)
 			r[i] = (ray){c->pos, v3_norm(v3_add(c->fwd, v3_add(col[x - x0], row[y - y0])))};
-			sp[i] = (sampler){0, 0, 0, 0};
-		}
+}
+
+/* One centred sample through a pinhole (Whitted's one sample per pixel):
+ * cam_block_rays. Anything else goes pixel by pixel. */
+void camera_block_rays(const world *w, const render_settings *s, bool sampled, int x0, int y0, int x1, int y1,
+                       int fw, int fh, int sample, ray *r, sampler *sp)
+{
+	if (s->samples > 1 || sampled) {
+		for (int y = y0, i = 0; y < y1; y++)
+			for (int x = x0; x < x1; x++, i++)
+				r[i] = camera_sample_ray(w, s, sampled, x, y, fw, fh, sample, &sp[i]);
+		return;
+	}
+	cam_block_rays(&w->cam, x0, y0, x1, y1, fw, fh, r);
+	for (int i = 0, n = (x1 - x0) * (y1 - y0); i < n; i++)
+		sp[i] = (sampler){0, 0, 0, 0};
 }

@@ -169,6 +169,57 @@ static void test_big_old_file_uncached_and_kept(void **state)
 	assert_int_equal(count_prefix(".big.ppm.tmp."), 0);
 }
 
+/* The process's descriptors: how many, and how many name a deleted file. */
+static int open_fds(int *deleted)
+{
+	DIR *d = opendir("/proc/self/fd");
+	assert_non_null(d);
+	int n = 0;
+	*deleted = 0;
+	struct dirent *e;
+	char to[512];
+	while ((e = readdir(d))) {
+		if (e->d_name[0] == '.')
+			continue;
+		n++;
+		ssize_t k = readlinkat(dirfd(d), e->d_name, to, sizeof to - 1);
+		if (k > 0) {
+			to[k] = '\0';
+			*deleted += strstr(to, " (deleted)") != NULL;
+		}
+	}
+	closedir(d);
+	return n;
+}
+
+/* The old file of a save over a big file stays open past the rename (so
+ * that the rename does not free it; a thread's close does): by the time
+ * the save returns it is closed, no descriptor left to it or to anything
+ * deleted, and the new content is in place. */
+static void test_big_old_file_released(void **state)
+{
+	(void)state;
+	char path[128];
+	snprintf(path, sizeof path, "%s/release.ppm", dir);
+	size_t n = (size_t)2 << 20;
+	char *data = malloc(n + 1);
+	assert_non_null(data);
+	memset(data, 'o', n);
+	data[n] = '\0';
+	int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+	assert_true(fd >= 0);
+	assert_true(write(fd, data, n) == (ssize_t)n);
+	assert_int_equal(close(fd), 0);
+	int deleted, before = open_fds(&deleted);
+	assert_int_equal(deleted, 0);
+	rt_error err;
+	assert_true(file_write_atomic(path, write_text, "new\n", &err));
+	assert_int_equal(open_fds(&deleted), before);
+	assert_int_equal(deleted, 0);
+	assert_string_equal(slurp(path), "new\n");
+	free(data);
+}
+
 static void test_mode_is_kept(void **state)
 {
 	(void)state;
@@ -531,6 +582,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_failing_writer_keeps_the_old_file),
 		cmocka_unit_test(test_big_old_file_uncached_and_kept),
+		cmocka_unit_test(test_big_old_file_released),
 		cmocka_unit_test(test_mode_is_kept),
 		cmocka_unit_test(test_stale_temporary_files),
 		cmocka_unit_test(test_xattrs_and_acls_are_kept),
