@@ -404,7 +404,7 @@ void denoise_features(const world *w, const render_settings *s, int px, int py, 
 			f[15 + k] = (float)(((double)f[15 + k] * ne0 + acc[10 + k]) / ne1);
 		f[18 + k] = f[k];
 	}
-	if (n1 < DENOISE_FEATURE_SAMPLES || !features_vary(f))
+	if (n1 < DENOISE_FEATURE_SAMPLES)
 		return;
 	/* An edge: more camera positions, the radiance samples' own. The
 	 * direct light seen through glossy lobes too, from one direction
@@ -413,11 +413,25 @@ void denoise_features(const world *w, const render_settings *s, int px, int py, 
 	 * (from the first samples alone a highlight's edge in a glossy metal
 	 * was as noisy as the radiance); the rest of the direct light stays
 	 * the mean of the first samples (refined too, it helped little for
-	 * its cost: a shadow ray a position). */
+	 * its cost: a shadow ray a position). Where the first positions agree,
+	 * the next DENOISE_PROBE_SAMPLES are taken first: an edge they find
+	 * goes on from them, else the pixel keeps its features as they were
+	 * (an edge covering an eighth of a pixel or less was missed by all the
+	 * first eight, as often by its radiance samples, and the filter took
+	 * the pixel for the surface alone). */
 	double sum[10], lobe = (double)f[21] * n1;
 	for (int k = 0; k < 10; k++)
 		sum[k] = (double)f[k] * n1;
+	bool edge = features_vary(f);
 	for (int k = n1; k < DENOISE_EDGE_SAMPLES; k++) {
+		if (!edge && k == n1 + DENOISE_PROBE_SAMPLES) {
+			float probe[10];
+			for (int q = 0; q < 10; q++)
+				probe[q] = (float)(sum[q] / k);
+			if (!features_vary(probe))
+				return;
+			edge = true;
+		}
 		double one[9] = {0};
 		first_surface(w, render_sample_ray(w, s, px, py, fw, fh, k), k, one);
 		for (int q = 0; q < 8; q++)
@@ -427,9 +441,9 @@ void denoise_features(const world *w, const render_settings *s, int px, int py, 
 		sum[9] += one[6] * one[6];
 		lobe += one[8];
 	}
-	for (int k = 0; k < 10; k++)
-		if (k != 7)
-			f[k] = (float)(sum[k] / DENOISE_EDGE_SAMPLES);
+	for (int q = 0; q < 10; q++)
+		if (q != 7)
+			f[q] = (float)(sum[q] / DENOISE_EDGE_SAMPLES);
 	lobe /= DENOISE_EDGE_SAMPLES;
 	f[14] = (float)((double)f[14] - (double)f[21] + lobe);
 	f[21] = (float)lobe;
