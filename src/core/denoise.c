@@ -376,6 +376,30 @@ static bool features_vary(const float *f)
 	return va > 1e-4 || vz > 1e-4 * (double)f[6] * f[6] || n2 < 0.998;
 }
 
+/* Whether the features of the first n positions (f, their means) and of
+ * the pixel's four corners, DENOISE_PROBE_INSET of a pixel inside it,
+ * vary (features_vary) all together. */
+static bool corners_vary(const world *w, int px, int py, int fw, int fh, const float *f, int n)
+{
+	double sum[10];
+	for (int q = 0; q < 10; q++)
+		sum[q] = (double)f[q] * n;
+	for (int c = 0; c < 4; c++) {
+		double one[9] = {0};
+		double u = c & 1 ? 1.0 - DENOISE_PROBE_INSET : DENOISE_PROBE_INSET;
+		double v = c & 2 ? 1.0 - DENOISE_PROBE_INSET : DENOISE_PROBE_INSET;
+		first_surface(w, cam_ray(&w->cam, px + u, py + v, fw, fh), -1, one);
+		for (int q = 0; q < 7; q++)
+			sum[q] += one[q];
+		sum[8] += one[0] * one[0] + one[1] * one[1] + one[2] * one[2];
+		sum[9] += one[6] * one[6];
+	}
+	float all[10];
+	for (int q = 0; q < 10; q++)
+		all[q] = (float)(sum[q] / (n + 4));
+	return features_vary(all);
+}
+
 void denoise_features(const world *w, const render_settings *s, int px, int py, int fw, int fh,
                       int begin, int end, const double *ra, const double *acc, float *f)
 {
@@ -406,6 +430,14 @@ void denoise_features(const world *w, const render_settings *s, int px, int py, 
 	}
 	if (n1 < DENOISE_FEATURE_SAMPLES)
 		return;
+	/* Where the first positions agree, the pixel's four corners (first
+	 * hits only, DENOISE_PROBE_INSET of a pixel inside it) are looked at
+	 * too: a straight edge through the pixel leaves a corner on each side
+	 * of it, so one that covers a sliver of the pixel, missed by all the
+	 * first positions (as often by its radiance samples, and the filter
+	 * took the pixel for the one surface), is found there. */
+	if (!features_vary(f) && !corners_vary(w, px, py, fw, fh, f, n1))
+		return;
 	/* An edge: more camera positions, the radiance samples' own. The
 	 * direct light seen through glossy lobes too, from one direction
 	 * (point) of each set a position (feature_dirs), so that how much of
@@ -413,25 +445,11 @@ void denoise_features(const world *w, const render_settings *s, int px, int py, 
 	 * (from the first samples alone a highlight's edge in a glossy metal
 	 * was as noisy as the radiance); the rest of the direct light stays
 	 * the mean of the first samples (refined too, it helped little for
-	 * its cost: a shadow ray a position). Where the first positions agree,
-	 * the next DENOISE_PROBE_SAMPLES are taken first: an edge they find
-	 * goes on from them, else the pixel keeps its features as they were
-	 * (an edge covering an eighth of a pixel or less was missed by all the
-	 * first eight, as often by its radiance samples, and the filter took
-	 * the pixel for the surface alone). */
+	 * its cost: a shadow ray a position). */
 	double sum[10], lobe = (double)f[21] * n1;
 	for (int k = 0; k < 10; k++)
 		sum[k] = (double)f[k] * n1;
-	bool edge = features_vary(f);
 	for (int k = n1; k < DENOISE_EDGE_SAMPLES; k++) {
-		if (!edge && k == n1 + DENOISE_PROBE_SAMPLES) {
-			float probe[10];
-			for (int q = 0; q < 10; q++)
-				probe[q] = (float)(sum[q] / k);
-			if (!features_vary(probe))
-				return;
-			edge = true;
-		}
 		double one[9] = {0};
 		first_surface(w, render_sample_ray(w, s, px, py, fw, fh, k), k, one);
 		for (int q = 0; q < 8; q++)

@@ -851,16 +851,17 @@ static void test_edge_direct_feature(void **state)
 }
 
 /* An edge that none of the first DENOISE_FEATURE_SAMPLES camera positions
- * meets, but one of the next DENOISE_PROBE_SAMPLES does, makes the pixel an
- * edge pixel: its features are the mean over all DENOISE_EDGE_SAMPLES
- * positions. The centre pixel of 9 at 10 degrees looks at a white plane at
- * z = 5; a black triangle at z = 2.5 covers the half-plane beyond a
- * straight edge, placed from the positions themselves (render_sample_ray,
- * where their rays cross z = 2.5): across the direction u (of 72 tried)
- * along which a probe lies farthest beyond the first eight, half-way
- * between them. So the first eight all see the plane, and the pixel's
- * albedo must be the plane's less the share covered: the positions beyond
- * the edge, counted. Before the probes it was the plane's alone. */
+ * meets, but that covers a corner of the pixel (DENOISE_PROBE_INSET inside
+ * it), makes the pixel an edge pixel: its features are the mean over all
+ * DENOISE_EDGE_SAMPLES positions. The centre pixel of 9 at 10 degrees
+ * looks at a white plane at z = 5; a black triangle at z = 2.5 covers the
+ * half-plane beyond a straight edge, placed from the positions themselves
+ * (render_sample_ray and the corners' cam_ray, where their rays cross
+ * z = 2.5): across the direction u (of 72 tried) along which a corner and
+ * one of the 64 positions lie farthest beyond the first eight, half-way.
+ * So the first eight all see the plane, and the pixel's albedo must be the
+ * plane's less the share covered: the positions beyond the edge, counted.
+ * Before the corners were looked at it was the plane's alone. */
 static void test_probe_edge(void **state)
 {
 	(void)state;
@@ -869,9 +870,13 @@ static void test_probe_edge(void **state)
 	scene *s0 = load_text(plane);
 	world *w0 = world_build(s0, NULL);
 	assert_non_null(w0);
-	double px[DENOISE_EDGE_SAMPLES], py[DENOISE_EDGE_SAMPLES];
-	for (int k = 0; k < DENOISE_EDGE_SAMPLES; k++) {
-		ray r = render_sample_ray(w0, &set, 4, 4, 9, 9, k);
+	/* the 64 positions, then the 4 corners */
+	double px[DENOISE_EDGE_SAMPLES + 4], py[DENOISE_EDGE_SAMPLES + 4];
+	for (int k = 0; k < DENOISE_EDGE_SAMPLES + 4; k++) {
+		int c = k - DENOISE_EDGE_SAMPLES;
+		double u = c & 1 ? 1 - DENOISE_PROBE_INSET : DENOISE_PROBE_INSET;
+		double v = c & 2 ? 1 - DENOISE_PROBE_INSET : DENOISE_PROBE_INSET;
+		ray r = c < 0 ? render_sample_ray(w0, &set, 4, 4, 9, 9, k) : cam_ray(&w0->cam, 4 + u, 4 + v, 9, 9);
 		px[k] = r.o.x + (2.5 - r.o.z) / r.d.z * r.d.x;
 		py[k] = r.o.y + (2.5 - r.o.z) / r.d.z * r.d.y;
 	}
@@ -879,19 +884,23 @@ static void test_probe_edge(void **state)
 	scene_free(s0);
 	double best_gap = 0, ux = 1, uy = 0, d0 = 0;
 	for (int a = 0; a < 72; a++) {
-		double cx = cos(a * (2 * M_PI / 72)), cy = sin(a * (2 * M_PI / 72)), hi8 = -INFINITY, hi16 = -INFINITY;
-		for (int k = 0; k < DENOISE_FEATURE_SAMPLES + DENOISE_PROBE_SAMPLES; k++) {
+		double cx = cos(a * (2 * M_PI / 72)), cy = sin(a * (2 * M_PI / 72));
+		double hi8 = -INFINITY, hi64 = -INFINITY, hic = -INFINITY;
+		for (int k = 0; k < DENOISE_EDGE_SAMPLES + 4; k++) {
 			double d = px[k] * cx + py[k] * cy;
 			if (k < DENOISE_FEATURE_SAMPLES)
 				hi8 = fmax(hi8, d);
+			else if (k < DENOISE_EDGE_SAMPLES)
+				hi64 = fmax(hi64, d);
 			else
-				hi16 = fmax(hi16, d);
+				hic = fmax(hic, d);
 		}
-		if (hi16 - hi8 > best_gap) {
-			best_gap = hi16 - hi8;
+		double gap = fmin(hi64, hic) - hi8;
+		if (gap > best_gap) {
+			best_gap = gap;
 			ux = cx;
 			uy = cy;
-			d0 = 0.5 * (hi8 + hi16);
+			d0 = hi8 + 0.5 * gap;
 		}
 	}
 	assert_true(best_gap > 0);
