@@ -34,9 +34,8 @@ CFLAGS  += $(CSTD) $(WARN) -fno-math-errno -pthread -MMD -MP
 # maps them (with libstdc++ and five X11 libraries). Their headers are still
 # needed to build.
 LDLIBS_CORE := -lpng -lstb -lm -pthread
-# libsixel carries its own copy of stb_image: libstb (in LDLIBS_CORE) must come first
-# so that the scene loader's stbi_* calls reach libstb, not libsixel's.
-LDLIBS_FRONT := -lreadline -lncursesw $(LDLIBS_CORE) -lsixel -lz
+# libsixel is opened on the first sixel picture (src/term/enc_sixel.c, dlopen), not linked.
+LDLIBS_FRONT := -lreadline -lncursesw $(LDLIBS_CORE) -lz
 
 ifneq ($(SAN),)
 CFLAGS  += -fsanitize=$(SAN) -fno-omit-frame-pointer -fno-sanitize-recover=all

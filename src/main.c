@@ -68,10 +68,10 @@ typedef struct batch_make {
 	rt_error err;
 } batch_make;
 
-static bool batch_rows(void *ctx, const framebuffer *fb, int y0, int y1)
+static bool batch_rows(void *ctx, const framebuffer *fb, int y0, int y1, const uint8_t *codes)
 {
 	batch_make *b = ctx;
-	if (b->rows(b->rows_ctx, fb, y0, y1))
+	if (b->rows(b->rows_ctx, fb, y0, y1, codes))
 		return true;
 	b->write_stopped = true;
 	return false;

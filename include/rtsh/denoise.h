@@ -7,9 +7,13 @@
  * mirrors, glass and metals of little fuzz (a Phong lobe of exponent 200
  * or more) the features are those of the surface seen in them, so
  * reflections keep their own edges. Where those first rays disagree (an
- * edge runs through the pixel) DENOISE_EDGE_SAMPLES camera positions are
- * taken (first hits only), so that the features of an edge pixel are as
- * well antialiased as that many samples would make its colour.
+ * edge runs through the pixel), or where they agree but the pixel's four
+ * corners (DENOISE_PROBE_INSET of a pixel inside it) find something else
+ * (an edge that covers too little of the pixel for the first ones to
+ * meet: a straight edge leaves a corner on each side), DENOISE_EDGE_SAMPLES
+ * camera positions are taken (first hits only), so that the features of an
+ * edge pixel are as well antialiased as that many samples would make its
+ * colour.
  *
  * The sky's albedo feature is its colour in that direction (a black
  * background's is white); through glass the surface behind is tinted by the
@@ -96,6 +100,9 @@
  * is multiplied by again after filtering is then as well antialiased as
  * that many samples would make it. */
 #define DENOISE_EDGE_SAMPLES 64
+/* ...or where the first ones agree, but the pixel's corners, this share of
+ * a pixel inside it on each side, do not. */
+#define DENOISE_PROBE_INSET 0.125
 /* Doubles of a pixel's feature sums over a run of its samples
  * (denoise_sample): 0-6 and 8-9 as the features, 7 the direct light, 10-12
  * the albedo of the even-numbered samples, 13 the glossy lobes' part of 7. */

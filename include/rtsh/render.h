@@ -91,6 +91,9 @@ typedef struct framebuffer {
 	                 * render (image.c uses them when its gain is the same);
 	                 * whoever changes rgb outside a job frees them; NULL: none */
 	double srgb8_gain;
+	int srgb8_ring; /* 0: srgb8 holds every row; k > 0: only a ring of k
+	                 * bands of RENDER_TILE rows, band b in slot b % k, each
+	                 * reused once job->rows has taken it (render_image_rows) */
 } framebuffer;
 
 /* NULL when out of memory or the size is not in 1..RENDER_MAX_DIM. */
@@ -116,13 +119,15 @@ typedef enum render_status {
 typedef void (*render_progress_fn)(void *ctx, long done, long total);
 
 /* Called with the rows y0 <= y < y1 of the image once every tile of them is
- * finished, their fb->srgb8 codes final: in order from the top, every row
- * once, always on the thread that runs render_run (between its own tiles,
- * then while the other workers finish theirs), while the other tiles
- * still render (a file is written as the picture is made: image.h's
- * image_write_rendered). False stops the render (RENDER_FAILED); the
- * callback keeps its own error. */
-typedef bool (*render_rows_fn)(void *ctx, const framebuffer *fb, int y0, int y1);
+ * finished: codes holds their final 8-bit codes, fb->w * 3 bytes a row, the
+ * rows one after another, valid only during the call (with a ring,
+ * framebuffer.srgb8_ring, the slot is rendered into again after it). In
+ * order from the top, every row once, always on the thread that runs
+ * render_run (between its own tiles, then while the other workers finish
+ * theirs), while the other tiles still render (a file is written as the
+ * picture is made: image.h's image_write_rendered). False stops the render
+ * (RENDER_FAILED); the callback keeps its own error. */
+typedef bool (*render_rows_fn)(void *ctx, const framebuffer *fb, int y0, int y1, const uint8_t *codes);
 
 typedef struct render_job {
 	const world *w;
@@ -153,12 +158,16 @@ framebuffer *render_image(const world *w, const render_settings *s, atomic_bool 
  * an 8-bit file written next (batch mode). */
 framebuffer *render_image_srgb8(const world *w, const render_settings *s, atomic_bool *cancel,
                                 render_progress_fn progress, void *ctx, rt_error *err);
-/* The codes alone, handed to rows (render_rows_fn) as bands of tiles finish:
- * the framebuffer returned holds fb->srgb8 (the same codes as
- * render_image_srgb8's) and no float image (rgb NULL: the tiles keep their
- * floats to themselves), unless the image is denoised after its render: then
- * rgb too, and every row is handed over at the end. NULL on failure (err set;
- * when rows returned false, err says the write stopped the render). */
+/* The codes alone (the same as render_image_srgb8's), handed to rows
+ * (render_rows_fn) as bands of tiles finish, through a ring of a few bands
+ * (framebuffer.srgb8_ring: not the whole image's codes, whose first touch
+ * cost page faults; a tile waits when its band's slot is still to be
+ * handed over). The framebuffer returned is a receipt: no float image (rgb
+ * NULL: the tiles keep their floats to themselves) and no codes (freed with
+ * the ring), unless the image is denoised after its render: then it holds
+ * rgb and srgb8, and every row is handed over at the end. NULL on failure
+ * (err set; when rows returned false, err says the write stopped the
+ * render). */
 framebuffer *render_image_rows(const world *w, const render_settings *s, atomic_bool *cancel,
                                render_progress_fn progress, void *ctx, render_rows_fn rows, void *rows_ctx,
                                rt_error *err);

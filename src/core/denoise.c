@@ -376,6 +376,30 @@ static bool features_vary(const float *f)
 	return va > 1e-4 || vz > 1e-4 * (double)f[6] * f[6] || n2 < 0.998;
 }
 
+/* Whether the features of the first n positions (f, their means) and of
+ * the pixel's four corners, DENOISE_PROBE_INSET of a pixel inside it,
+ * vary (features_vary) all together. */
+static bool corners_vary(const world *w, int px, int py, int fw, int fh, const float *f, int n)
+{
+	double sum[10];
+	for (int q = 0; q < 10; q++)
+		sum[q] = (double)f[q] * n;
+	for (int c = 0; c < 4; c++) {
+		double one[9] = {0};
+		double u = c & 1 ? 1.0 - DENOISE_PROBE_INSET : DENOISE_PROBE_INSET;
+		double v = c & 2 ? 1.0 - DENOISE_PROBE_INSET : DENOISE_PROBE_INSET;
+		first_surface(w, cam_ray(&w->cam, px + u, py + v, fw, fh), -1, one);
+		for (int q = 0; q < 7; q++)
+			sum[q] += one[q];
+		sum[8] += one[0] * one[0] + one[1] * one[1] + one[2] * one[2];
+		sum[9] += one[6] * one[6];
+	}
+	float all[10];
+	for (int q = 0; q < 10; q++)
+		all[q] = (float)(sum[q] / (n + 4));
+	return features_vary(all);
+}
+
 void denoise_features(const world *w, const render_settings *s, int px, int py, int fw, int fh,
                       int begin, int end, const double *ra, const double *acc, float *f)
 {
@@ -404,7 +428,15 @@ void denoise_features(const world *w, const render_settings *s, int px, int py, 
 			f[15 + k] = (float)(((double)f[15 + k] * ne0 + acc[10 + k]) / ne1);
 		f[18 + k] = f[k];
 	}
-	if (n1 < DENOISE_FEATURE_SAMPLES || !features_vary(f))
+	if (n1 < DENOISE_FEATURE_SAMPLES)
+		return;
+	/* Where the first positions agree, the pixel's four corners (first
+	 * hits only, DENOISE_PROBE_INSET of a pixel inside it) are looked at
+	 * too: a straight edge through the pixel leaves a corner on each side
+	 * of it, so one that covers a sliver of the pixel, missed by all the
+	 * first positions (as often by its radiance samples, and the filter
+	 * took the pixel for the one surface), is found there. */
+	if (!features_vary(f) && !corners_vary(w, px, py, fw, fh, f, n1))
 		return;
 	/* An edge: more camera positions, the radiance samples' own. The
 	 * direct light seen through glossy lobes too, from one direction
@@ -427,9 +459,9 @@ void denoise_features(const world *w, const render_settings *s, int px, int py, 
 		sum[9] += one[6] * one[6];
 		lobe += one[8];
 	}
-	for (int k = 0; k < 10; k++)
-		if (k != 7)
-			f[k] = (float)(sum[k] / DENOISE_EDGE_SAMPLES);
+	for (int q = 0; q < 10; q++)
+		if (q != 7)
+			f[q] = (float)(sum[q] / DENOISE_EDGE_SAMPLES);
 	lobe /= DENOISE_EDGE_SAMPLES;
 	f[14] = (float)((double)f[14] - (double)f[21] + lobe);
 	f[21] = (float)lobe;

@@ -210,11 +210,11 @@ static void stream_writeback(stream *st)
 	}
 }
 
-static bool ppm_rows(void *vctx, const framebuffer *fb, int y0, int y1)
+static bool ppm_rows(void *vctx, const framebuffer *fb, int y0, int y1, const uint8_t *codes)
 {
 	stream *st = vctx;
 	size_t n = (size_t)(y1 - y0) * (size_t)fb->w * 3;
-	if (fwrite(fb->srgb8 + (size_t)y0 * (size_t)fb->w * 3, 1, n, st->f) != n) {
+	if (fwrite(codes, 1, n, st->f) != n) {
 		st->write_errno = errno ? errno : EIO;
 		return false;
 	}
@@ -274,7 +274,7 @@ static bool write_ppm_rendered(FILE *f, void *vctx, rt_error *err)
 
 /* libpng's errors come back here, not through write_png_rendered's frame: a
  * longjmp across the render would leave its threads running. */
-static bool png_rows(void *vctx, const framebuffer *fb, int y0, int y1)
+static bool png_rows(void *vctx, const framebuffer *fb, int y0, int y1, const uint8_t *codes)
 {
 	stream *st = vctx;
 	if (setjmp(png_jmpbuf(st->png))) {
@@ -284,7 +284,7 @@ static bool png_rows(void *vctx, const framebuffer *fb, int y0, int y1)
 		return false;
 	}
 	for (int y = y0; y < y1; y++)
-		png_write_row(st->png, fb->srgb8 + (size_t)y * (size_t)fb->w * 3);
+		png_write_row(st->png, codes + (size_t)(y - y0) * (size_t)fb->w * 3);
 	if (ferror(st->f)) {
 		st->write_errno = errno ? errno : EIO;
 		return false;

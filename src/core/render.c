@@ -104,10 +104,12 @@ typedef struct shared {
 	_Alignas(64) atomic_int running;
 	pthread_mutex_t lock;
 	pthread_cond_t finished; /* also signalled when a band of tiles is finished (job->rows) */
+	pthread_cond_t slot_free; /* a band handed over: its slot of the ring is free */
 	/* job->rows: the tiles left in each band (row of tiles), the first
 	 * band not yet handed over, and whether a handover failed */
 	atomic_int *band_left;
-	int bands, band_next;
+	int bands;
+	atomic_int band_next;
 	atomic_bool stop;
 } shared;
 
@@ -174,14 +176,23 @@ static void block_add(const world *w, const render_settings *s, int x0, int y0, 
  * walk their rectangles in. */
 #define BLOCK_SIDE 4
 
+/* Row y's 8-bit codes: the image's row, or its row in its band's slot of
+ * the ring (framebuffer.srgb8_ring). */
+static uint8_t *codes_row(const framebuffer *fb, int y)
+{
+	size_t r = (size_t)y;
+	if (fb->srgb8_ring)
+		r = (size_t)(y / RENDER_TILE % fb->srgb8_ring) * RENDER_TILE + (size_t)(y % RENDER_TILE);
+	return fb->srgb8 + r * (size_t)fb->w * 3;
+}
+
 /* The 8-bit codes of a finished tile (framebuffer.srgb8), by the expression
  * of image.c's encoder: the same codes it would make. */
 static void tile_srgb8(framebuffer *fb, int x0, int y0, int x1, int y1)
 {
-	for (int y = y0; y < y1; y++) {
-		size_t i0 = ((size_t)y * (size_t)fb->w + (size_t)x0) * 3;
-		linear_to_srgb8_n(fb->rgb + i0, fb->srgb8_gain, fb->srgb8 + i0, (size_t)(x1 - x0) * 3);
-	}
+	for (int y = y0; y < y1; y++)
+		linear_to_srgb8_n(fb->rgb + ((size_t)y * (size_t)fb->w + (size_t)x0) * 3, fb->srgb8_gain,
+		                  codes_row(fb, y) + (size_t)x0 * 3, (size_t)(x1 - x0) * 3);
 }
 
 static void render_tile(shared *sh, long t)
@@ -239,7 +250,7 @@ static void render_tile(shared *sh, long t)
 	else if (fb->srgb8)
 		for (int y = y0; y < y1; y++) /* the same expression on the same floats */
 			linear_to_srgb8_n(own + (size_t)(y - y0) * RENDER_TILE * 3, fb->srgb8_gain,
-			                  fb->srgb8 + ((size_t)y * (size_t)fb->w + (size_t)x0) * 3, (size_t)(x1 - x0) * 3);
+			                  codes_row(fb, y) + (size_t)x0 * 3, (size_t)(x1 - x0) * 3);
 }
 
 /* A tile is finished: the last of its band wakes the thread that hands the
@@ -253,27 +264,91 @@ static void tile_finished(shared *sh, long t)
 	}
 }
 
-/* Hands the finished bands at the top, in one call, to job->rows; false
- * when it failed (the workers are then told to stop). */
-static bool hand_rows(shared *sh)
+/* Wakes the workers waiting for a slot of the ring (slot_ready). */
+static void slots_freed(shared *sh)
 {
-	int b = sh->band_next;
-	while (b < sh->bands && atomic_load(&sh->band_left[b]) == 0)
-		b++;
-	if (b == sh->band_next)
-		return true;
-	const framebuffer *fb = sh->job->fb;
-	int y0 = sh->band_next * RENDER_TILE, y1 = b * RENDER_TILE < fb->h ? b * RENDER_TILE : fb->h;
-	sh->band_next = b;
-	if (sh->job->rows(sh->job->rows_ctx, fb, y0, y1))
-		return true;
-	atomic_store(&sh->stop, true);
-	return false;
+	if (!sh->job->fb->srgb8_ring)
+		return;
+	pthread_mutex_lock(&sh->lock);
+	pthread_cond_broadcast(&sh->slot_free);
+	pthread_mutex_unlock(&sh->lock);
 }
 
-static bool band_ready(const shared *sh)
+/* Hands the finished bands at the top to job->rows: in one call, or with a
+ * ring a call a band (a slot's rows are contiguous, not two slots'), each
+ * slot free again after its call; false when it failed (the workers are
+ * then told to stop). */
+static bool hand_rows(shared *sh)
 {
-	return sh->band_left && sh->band_next < sh->bands && atomic_load(&sh->band_left[sh->band_next]) == 0;
+	int b = atomic_load(&sh->band_next), e = b;
+	while (e < sh->bands && atomic_load(&sh->band_left[e]) == 0)
+		e++;
+	const framebuffer *fb = sh->job->fb;
+	for (int step = fb->srgb8_ring ? 1 : e - b; b < e; b += step) {
+		int y0 = b * RENDER_TILE, y1 = (b + step) * RENDER_TILE < fb->h ? (b + step) * RENDER_TILE : fb->h;
+		if (!sh->job->rows(sh->job->rows_ctx, fb, y0, y1, codes_row(fb, y0))) {
+			atomic_store(&sh->stop, true);
+			slots_freed(sh); /* the waiting workers see the stop */
+			return false;
+		}
+		atomic_store(&sh->band_next, b + step);
+		slots_freed(sh);
+	}
+	return true;
+}
+
+static bool band_ready(shared *sh)
+{
+	int b = atomic_load(&sh->band_next);
+	return sh->band_left && b < sh->bands && atomic_load(&sh->band_left[b]) == 0;
+}
+
+static bool stopped(const shared *sh)
+{
+	return (sh->job->cancel && atomic_load(sh->job->cancel)) || atomic_load(&sh->stop);
+}
+
+/* The time ms milliseconds from now, for pthread_cond_timedwait. */
+static void in_ms(struct timespec *ts, long ms)
+{
+	clock_gettime(CLOCK_REALTIME, ts);
+	ts->tv_nsec += ms * 1000 * 1000;
+	while (ts->tv_nsec >= 1000000000L) {
+		ts->tv_sec++;
+		ts->tv_nsec -= 1000000000L;
+	}
+}
+
+/* Whether tile t may write its codes: with a ring, once the band that had
+ * its band's slot before it is handed over. Waits until then or until the
+ * render stops (false; a cancel is seen within 20 ms). The thread that
+ * hands the rows over (hands) hands what is finished meanwhile: no other
+ * thread does, and every earlier band's tiles have started, so the wait
+ * ends. */
+static bool slot_ready(shared *sh, long t, bool hands)
+{
+	int b = (int)(t / sh->tiles_x), ring = sh->job->fb->srgb8_ring;
+	if (!ring || b - ring < atomic_load(&sh->band_next))
+		return true;
+	bool ok = true;
+	pthread_mutex_lock(&sh->lock);
+	while (b - ring >= atomic_load(&sh->band_next)) {
+		if (stopped(sh)) {
+			ok = false;
+			break;
+		}
+		if (hands && band_ready(sh)) {
+			pthread_mutex_unlock(&sh->lock);
+			hand_rows(sh);
+			pthread_mutex_lock(&sh->lock);
+			continue;
+		}
+		struct timespec deadline;
+		in_ms(&deadline, 20);
+		pthread_cond_timedwait(hands ? &sh->finished : &sh->slot_free, &sh->lock, &deadline);
+	}
+	pthread_mutex_unlock(&sh->lock);
+	return ok;
 }
 
 void render_rect(const world *w, const render_settings *s, int x0, int y0, int x1, int y1,
@@ -322,7 +397,7 @@ static void *worker(void *arg)
 		    atomic_load_explicit(&sh->stop, memory_order_relaxed))
 			break;
 		long t = atomic_fetch_add(&sh->next, 1);
-		if (t >= sh->tiles)
+		if (t >= sh->tiles || !slot_ready(sh, t, false))
 			break;
 		render_tile(sh, t);
 		atomic_fetch_add(&sh->done, 1);
@@ -342,17 +417,6 @@ static double now_seconds(void)
 	return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
-/* The time 100 ms from now, for pthread_cond_timedwait. */
-static void in_100ms(struct timespec *ts)
-{
-	clock_gettime(CLOCK_REALTIME, ts);
-	ts->tv_nsec += 100 * 1000 * 1000;
-	if (ts->tv_nsec >= 1000000000L) {
-		ts->tv_sec++;
-		ts->tv_nsec -= 1000000000L;
-	}
-}
-
 static void report(render_job *job, shared *sh)
 {
 	if (job->progress)
@@ -368,8 +432,9 @@ render_status render_run(render_job *job, rt_error *err)
 		             job->sample_begin, job->sample_end, fb->spp);
 		return RENDER_FAILED;
 	}
-	if (job->rows && !fb->srgb8) {
-		rt_error_set(err, "a render job handing over rows needs the framebuffer's 8-bit codes");
+	if ((job->rows && !fb->srgb8) || (fb->srgb8_ring && !job->rows)) {
+		rt_error_set(err, "a render job handing over rows needs the framebuffer's 8-bit codes, and a ring of "
+		                  "codes a job handing over rows");
 		return RENDER_FAILED;
 	}
 	shared sh;
@@ -377,7 +442,7 @@ render_status render_run(render_job *job, rt_error *err)
 	sh.tiles_x = (fb->w + RENDER_TILE - 1) / RENDER_TILE;
 	sh.bands = (fb->h + RENDER_TILE - 1) / RENDER_TILE;
 	sh.tiles = (long)sh.tiles_x * sh.bands;
-	sh.band_next = 0;
+	atomic_init(&sh.band_next, 0);
 	sh.band_left = NULL;
 	atomic_init(&sh.stop, false);
 	if (job->rows) {
@@ -398,6 +463,7 @@ render_status render_run(render_job *job, rt_error *err)
 	atomic_init(&sh.running, n - 1);
 	pthread_mutex_init(&sh.lock, NULL);
 	pthread_cond_init(&sh.finished, NULL);
+	pthread_cond_init(&sh.slot_free, NULL);
 
 	pthread_t *tid = n > 1 ? calloc((size_t)(n - 1), sizeof *tid) : NULL;
 	int started = 0;
@@ -419,7 +485,7 @@ render_status render_run(render_job *job, rt_error *err)
 		if ((job->cancel && atomic_load(job->cancel)) || atomic_load(&sh.stop))
 			break;
 		long t = atomic_fetch_add(&sh.next, 1);
-		if (t >= sh.tiles)
+		if (t >= sh.tiles || !slot_ready(&sh, t, true))
 			break;
 		render_tile(&sh, t);
 		atomic_fetch_add(&sh.done, 1);
@@ -438,7 +504,7 @@ render_status render_run(render_job *job, rt_error *err)
 		 * early does not move the deadline). */
 		pthread_mutex_lock(&sh.lock);
 		struct timespec deadline;
-		in_100ms(&deadline);
+		in_ms(&deadline, 100);
 		while (atomic_load(&sh.running) > 0) {
 			if (!atomic_load(&sh.stop) && band_ready(&sh)) {
 				pthread_mutex_unlock(&sh.lock);
@@ -448,7 +514,7 @@ render_status render_run(render_job *job, rt_error *err)
 			}
 			if (pthread_cond_timedwait(&sh.finished, &sh.lock, &deadline) == 0)
 				continue;
-			in_100ms(&deadline);
+			in_ms(&deadline, 100);
 			if (atomic_load(&sh.running) > 0 && job->progress) {
 				pthread_mutex_unlock(&sh.lock);
 				report(job, &sh);
@@ -460,10 +526,11 @@ render_status render_run(render_job *job, rt_error *err)
 			pthread_join(tid[i], NULL);
 	}
 	free(tid);
-	pthread_mutex_destroy(&sh.lock);
-	pthread_cond_destroy(&sh.finished);
 	if (sh.band_left && !atomic_load(&sh.stop))
 		hand_rows(&sh); /* the last bands */
+	pthread_mutex_destroy(&sh.lock);
+	pthread_cond_destroy(&sh.finished);
+	pthread_cond_destroy(&sh.slot_free);
 	free(sh.band_left);
 	report(job, &sh);
 	if (atomic_load(&sh.stop)) {
@@ -506,8 +573,17 @@ static framebuffer *render_image_with(const world *w, const render_settings *s, 
 		return NULL;
 	}
 	if (srgb8 && !denoise) {
-		/* no zeroing: every tile writes its codes (a failed render frees them) */
-		fb->srgb8 = malloc((size_t)fb->w * (size_t)fb->h * 3);
+		/* No zeroing: every tile writes its codes (a failed render frees
+		 * them). Handing rows over, a ring of a few bands: the threads'
+		 * tiles in flight span a band or two, and the codes of the whole
+		 * image, 6 MB at 1920x1080, cost 1500 page faults (issue 29). */
+		size_t kept = (size_t)fb->h;
+		if (rows) {
+			int bands = (fb->h + RENDER_TILE - 1) / RENDER_TILE, ring = render_threads(s) + 6;
+			fb->srgb8_ring = ring < bands ? ring : bands;
+			kept = (size_t)fb->srgb8_ring * RENDER_TILE;
+		}
+		fb->srgb8 = malloc((size_t)fb->w * kept * 3);
 		fb->srgb8_gain = exp2(s->exposure);
 		if (!fb->srgb8) {
 			rt_error_set(err, "out of memory for a %dx%d image", s->width, s->height);
@@ -550,7 +626,7 @@ static framebuffer *render_image_with(const world *w, const render_settings *s, 
 			return NULL;
 		}
 		linear_to_srgb8_n(fb->rgb, fb->srgb8_gain, fb->srgb8, n);
-		if (!rows(rows_ctx, fb, 0, fb->h)) {
+		if (!rows(rows_ctx, fb, 0, fb->h, fb->srgb8)) {
 			rt_error_set(err, "writing the image stopped the render");
 			fb_free(fb);
 			return NULL;

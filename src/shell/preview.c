@@ -135,6 +135,11 @@ int preview_main(const rtsh_options *o)
 	cell_size(&cw, &ch);
 	if (pm == PIXELS_AUTO)
 		pm = isatty(STDOUT_FILENO) ? ask_terminal(&cw, &ch) : PIXELS_OFF;
+	char why[400];
+	if (pm == PIXELS_SIXEL && !pixels_sixel_available(why, sizeof why)) {
+		fprintf(stderr, "rtsh: %s: sixel images cannot be drawn: %s: half blocks\n", file, why);
+		pm = PIXELS_OFF;
+	}
 	/* The symbol set asked for (--symbols); auto: what the terminal is
 	 * known to draw, half blocks into a pipe (the file manager's terminal
 	 * is not known there). */

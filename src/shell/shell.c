@@ -228,6 +228,9 @@ void shell_pixels_notice(shell *sh)
 	    !sh->scr->pix_ops)
 		shell_notice(sh, "%s images do not show in this tmux pane (allow-passthrough on?): half blocks",
 		             sh->set.pixels == PIXELS_KITTY ? "kitty" : "iTerm2");
+	char why[400];
+	if (sh->scr && sh->scr->sixel_missing && !pixels_sixel_available(why, sizeof why))
+		shell_notice(sh, "sixel images cannot be drawn: %s: half blocks", why);
 }
 
 /* Whether the samples were chosen: by `set samples`, -s or the scene. */

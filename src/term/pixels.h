@@ -73,6 +73,10 @@ void pixels_kitty_delete(abuf *out, int id);
  * quantiser, no dithering: a refining picture must not shimmer). False on
  * failure (out unchanged). */
 bool pixels_sixel(abuf *out, const uint8_t *rgb, int w, int h);
+/* Whether libsixel can be loaded (it is opened on the first call); if not,
+ * false with why ("libsixel cannot be loaded (REASON); expected SONAME
+ * installed") when why is not NULL. pixels_sixel is false without it. */
+bool pixels_sixel_available(char *why, size_t size);
 
 /* iTerm2: the picture as an inline PNG stretched over cols x rows cells.
  * False on failure (out unchanged). */

@@ -473,6 +473,10 @@ bool screen_set_pixels(screen *s, int mode)
 		if (mode == PIXELS_OFF && all.tmux && kw && *kw && tmux_passthrough(s))
 			mode = PIXELS_KITTY;
 	}
+	/* libsixel is opened here, on first use (enc_sixel.c) */
+	s->sixel_missing = mode == PIXELS_SIXEL && !pixels_sixel_available(NULL, 0);
+	if (s->sixel_missing)
+		mode = PIXELS_OFF;
 	const char *tm = getenv("TMUX");
 	bool in_tmux = tm && *tm;
 	if (in_tmux && mode != PIXELS_OFF && !(mode == PIXELS_SIXEL && c && c->sixel) && !tmux_passthrough(s))

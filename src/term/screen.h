@@ -52,6 +52,7 @@ typedef struct screen {
 	symbols_kind sym;  /* the symbol set in use (not SYMBOLS_AUTO) */
 	int pixels;        /* pixels_mode asked for (screen_set_pixels) */
 	const encoder_ops *pix_ops; /* the pixel encoder in use; NULL: half blocks */
+	bool sixel_missing; /* sixel chosen, libsixel not loadable: half blocks (the shell says why) */
 	int cell_w, cell_h; /* a cell in pixels (0: not known) */
 	int tmux_pass;     /* inside tmux: 0 not asked yet, 1 passthrough on, -1 off */
 	int pass_x, pass_y; /* with passthrough: the pane's top-left cell outside */

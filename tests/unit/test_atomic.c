@@ -169,6 +169,57 @@ static void test_big_old_file_uncached_and_kept(void **state)
 	assert_int_equal(count_prefix(".big.ppm.tmp."), 0);
 }
 
+/* The process's descriptors: how many, and how many name a deleted file. */
+static int open_fds(int *deleted)
+{
+	DIR *d = opendir("/proc/self/fd");
+	assert_non_null(d);
+	int n = 0;
+	*deleted = 0;
+	struct dirent *e;
+	char to[512];
+	while ((e = readdir(d))) {
+		if (e->d_name[0] == '.')
+			continue;
+		n++;
+		ssize_t k = readlinkat(dirfd(d), e->d_name, to, sizeof to - 1);
+		if (k > 0) {
+			to[k] = '\0';
+			*deleted += strstr(to, " (deleted)") != NULL;
+		}
+	}
+	closedir(d);
+	return n;
+}
+
+/* The old file of a save over a big file stays open past the rename (so
+ * that the rename does not free it; a thread's close does): by the time
+ * the save returns it is closed, no descriptor left to it or to anything
+ * deleted, and the new content is in place. */
+static void test_big_old_file_released(void **state)
+{
+	(void)state;
+	char path[128];
+	snprintf(path, sizeof path, "%s/release.ppm", dir);
+	size_t n = (size_t)2 << 20;
+	char *data = malloc(n + 1);
+	assert_non_null(data);
+	memset(data, 'o', n);
+	data[n] = '\0';
+	int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+	assert_true(fd >= 0);
+	assert_true(write(fd, data, n) == (ssize_t)n);
+	assert_int_equal(close(fd), 0);
+	int deleted, before = open_fds(&deleted);
+	assert_int_equal(deleted, 0);
+	rt_error err;
+	assert_true(file_write_atomic(path, write_text, "new\n", &err));
+	assert_int_equal(open_fds(&deleted), before);
+	assert_int_equal(deleted, 0);
+	assert_string_equal(slurp(path), "new\n");
+	free(data);
+}
+
 static void test_mode_is_kept(void **state)
 {
 	(void)state;
@@ -186,37 +237,53 @@ static void test_mode_is_kept(void **state)
 	}
 }
 
+/* Stale temporary files of the same file are removed (on this thread when
+ * the old file is small; beside the write when it is big, by the thread
+ * that drops its cache), the others are not; the new content is in place. */
 static void test_stale_temporary_files(void **state)
 {
 	(void)state;
-	char path[128], stale[160], old_style[160], live[160], other[160];
-	snprintf(path, sizeof path, "%s/t.txt", dir);
-	/* pid 0x7ffffff0 runs nowhere (above pid_max); our own pid counts as a
-	 * process that no longer runs when the file is older than us. */
-	snprintf(stale, sizeof stale, "%s/.t.txt.tmp.2147483632.Abc123", dir);
-	snprintf(old_style, sizeof old_style, "%s/.t.txt.tmp.Xyz789", dir);
-	snprintf(live, sizeof live, "%s/.t.txt.tmp.1.Abc123", dir); /* init runs */
-	snprintf(other, sizeof other, "%s/.u.txt.tmp.2147483632.Abc123", dir);
-	const char *files[] = {stale, old_style, live, other};
-	for (int i = 0; i < 4; i++) {
-		FILE *f = fopen(files[i], "w");
-		assert_non_null(f);
+	for (int big = 0; big < 2; big++) {
+		char path[128], stale[160], old_style[160], live[160], other[160];
+		snprintf(path, sizeof path, "%s/t.txt", dir);
+		if (big) { /* a 2 MB old file */
+			FILE *f = fopen(path, "w");
+			assert_non_null(f);
+			for (int i = 0; i < 2 << 20; i++)
+				fputc('b', f);
+			assert_int_equal(fclose(f), 0);
+		}
+		/* pid 0x7ffffff0 runs nowhere (above pid_max); our own pid counts as a
+		 * process that no longer runs when the file is older than us. */
+		snprintf(stale, sizeof stale, "%s/.t.txt.tmp.2147483632.Abc123", dir);
+		snprintf(old_style, sizeof old_style, "%s/.t.txt.tmp.Xyz789", dir);
+		snprintf(live, sizeof live, "%s/.t.txt.tmp.1.Abc123", dir); /* init runs */
+		snprintf(other, sizeof other, "%s/.u.txt.tmp.2147483632.Abc123", dir);
+		const char *files[] = {stale, old_style, live, other};
+		for (int i = 0; i < 4; i++) {
+			FILE *f = fopen(files[i], "w");
+			assert_non_null(f);
+			fclose(f);
+			/* an hour before this process started */
+			struct timespec ts[2] = {{time(NULL) - 3600, 0}, {time(NULL) - 3600, 0}};
+			assert_int_equal(utimensat(AT_FDCWD, files[i], ts, 0), 0);
+		}
+		rt_error err;
+		assert_true(file_write_atomic(path, write_text, "t\n", &err));
+		assert_int_equal(access(stale, F_OK), -1);
+		assert_int_equal(access(old_style, F_OK), -1);
+		assert_int_equal(access(live, F_OK), 0);  /* its process runs */
+		assert_int_equal(access(other, F_OK), 0); /* another file's */
+		assert_string_equal(slurp(path), "t\n");
+		/* A temporary file newer than this process is not touched. */
+		FILE *f = fopen(stale, "w");
 		fclose(f);
-		/* an hour before this process started */
-		struct timespec ts[2] = {{time(NULL) - 3600, 0}, {time(NULL) - 3600, 0}};
-		assert_int_equal(utimensat(AT_FDCWD, files[i], ts, 0), 0);
+		assert_true(file_write_atomic(path, write_text, "t\n", &err));
+		assert_int_equal(access(stale, F_OK), 0);
+		assert_int_equal(unlink(stale), 0);
+		assert_int_equal(unlink(live), 0);
+		assert_int_equal(unlink(other), 0);
 	}
-	rt_error err;
-	assert_true(file_write_atomic(path, write_text, "t\n", &err));
-	assert_int_equal(access(stale, F_OK), -1);
-	assert_int_equal(access(old_style, F_OK), -1);
-	assert_int_equal(access(live, F_OK), 0);  /* its process runs */
-	assert_int_equal(access(other, F_OK), 0); /* another file's */
-	/* A temporary file newer than this process is not touched. */
-	FILE *f = fopen(stale, "w");
-	fclose(f);
-	assert_true(file_write_atomic(path, write_text, "t\n", &err));
-	assert_int_equal(access(stale, F_OK), 0);
 }
 
 /* --- extended attributes and ACLs --- */
@@ -531,6 +598,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_failing_writer_keeps_the_old_file),
 		cmocka_unit_test(test_big_old_file_uncached_and_kept),
+		cmocka_unit_test(test_big_old_file_released),
 		cmocka_unit_test(test_mode_is_kept),
 		cmocka_unit_test(test_stale_temporary_files),
 		cmocka_unit_test(test_xattrs_and_acls_are_kept),

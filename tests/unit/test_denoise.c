@@ -850,6 +850,96 @@ static void test_edge_direct_feature(void **state)
 	scene_free(s);
 }
 
+/* An edge that none of the first DENOISE_FEATURE_SAMPLES camera positions
+ * meets, but that covers a corner of the pixel (DENOISE_PROBE_INSET inside
+ * it), makes the pixel an edge pixel: its features are the mean over all
+ * DENOISE_EDGE_SAMPLES positions. The centre pixel of 9 at 10 degrees
+ * looks at a white plane at z = 5; a black triangle at z = 2.5 covers the
+ * half-plane beyond a straight edge, placed from the positions themselves
+ * (render_sample_ray and the corners' cam_ray, where their rays cross
+ * z = 2.5): across the direction u (of 72 tried) along which a corner and
+ * one of the 64 positions lie farthest beyond the first eight, half-way.
+ * So the first eight all see the plane, and the pixel's albedo must be the
+ * plane's less the share covered: the positions beyond the edge, counted.
+ * Before the corners were looked at it was the plane's alone. */
+static void test_probe_edge(void **state)
+{
+	(void)state;
+	const char *plane = "C 0,0,0 0,0,1 10\nA 0.5 255,255,255\npl 0,0,5 0,0,-1 255,255,255\n";
+	render_settings set = path_settings(9, 9, 8, 2, 5);
+	scene *s0 = load_text(plane);
+	world *w0 = world_build(s0, NULL);
+	assert_non_null(w0);
+	/* the 64 positions, then the 4 corners */
+	double px[DENOISE_EDGE_SAMPLES + 4], py[DENOISE_EDGE_SAMPLES + 4];
+	for (int k = 0; k < DENOISE_EDGE_SAMPLES + 4; k++) {
+		int c = k - DENOISE_EDGE_SAMPLES;
+		double u = c & 1 ? 1 - DENOISE_PROBE_INSET : DENOISE_PROBE_INSET;
+		double v = c & 2 ? 1 - DENOISE_PROBE_INSET : DENOISE_PROBE_INSET;
+		ray r = c < 0 ? render_sample_ray(w0, &set, 4, 4, 9, 9, k) : cam_ray(&w0->cam, 4 + u, 4 + v, 9, 9);
+		px[k] = r.o.x + (2.5 - r.o.z) / r.d.z * r.d.x;
+		py[k] = r.o.y + (2.5 - r.o.z) / r.d.z * r.d.y;
+	}
+	world_free(w0);
+	scene_free(s0);
+	double best_gap = 0, ux = 1, uy = 0, d0 = 0;
+	for (int a = 0; a < 72; a++) {
+		double cx = cos(a * (2 * M_PI / 72)), cy = sin(a * (2 * M_PI / 72));
+		double hi8 = -INFINITY, hi64 = -INFINITY, hic = -INFINITY;
+		for (int k = 0; k < DENOISE_EDGE_SAMPLES + 4; k++) {
+			double d = px[k] * cx + py[k] * cy;
+			if (k < DENOISE_FEATURE_SAMPLES)
+				hi8 = fmax(hi8, d);
+			else if (k < DENOISE_EDGE_SAMPLES)
+				hi64 = fmax(hi64, d);
+			else
+				hic = fmax(hic, d);
+		}
+		double gap = fmin(hi64, hic) - hi8;
+		if (gap > best_gap) {
+			best_gap = gap;
+			ux = cx;
+			uy = cy;
+			d0 = hi8 + 0.5 * gap;
+		}
+	}
+	assert_true(best_gap > 0);
+	int covered = 0;
+	for (int k = 0; k < DENOISE_EDGE_SAMPLES; k++)
+		covered += px[k] * ux + py[k] * uy > d0;
+	/* the edge through d0 u along (-uy, ux), the third corner beyond it;
+	 * moved back by 1 (text_all) it covers the whole pixel */
+	char text[512], text_all[512];
+	for (int m = 0; m < 2; m++) {
+		double e = m == 0 ? d0 : d0 - 1;
+		snprintf(m == 0 ? text : text_all, sizeof text, "%str %.9f,%.9f,2.5 %.9f,%.9f,2.5 %.9f,%.9f,2.5 0,0,0\n",
+		         plane, e * ux - 10 * uy, e * uy + 10 * ux, e * ux + 10 * uy, e * uy - 10 * ux, (e + 20) * ux,
+		         (e + 20) * uy);
+	}
+	/* the two surfaces' albedos, each seen alone */
+	double fp[DENOISE_ACC], ft[DENOISE_ACC];
+	centre_features(plane, 1, fp);
+	centre_features(text_all, 1, ft);
+	scene *s = load_text(text);
+	world *w = world_build(s, NULL);
+	assert_non_null(w);
+	framebuffer *fb = fb_new(9, 9);
+	assert_true(fb && denoise_prepare(fb));
+	render_job job = {.w = w, .set = set, .fb = fb, .sample_begin = 0, .sample_end = 8};
+	assert_int_equal(render_run(&job, NULL), RENDER_DONE);
+	const float *f = fb->feat + (size_t)(4 * 9 + 4) * DENOISE_FEATURES;
+	double share = (double)covered / DENOISE_EDGE_SAMPLES, expect = fp[0] * (1 - share) + ft[0] * share;
+	print_message("edge across (%.3f, %.3f), %d of %d positions beyond it; albedo %.4f plane, %.4f triangle: "
+	              "%.5f, expected %.5f\n",
+	              ux, uy, covered, DENOISE_EDGE_SAMPLES, fp[0], ft[0], f[0], expect);
+	assert_true(covered > 0 && covered < DENOISE_EDGE_SAMPLES);
+	assert_true(fabs(fp[0] - ft[0]) > 0.25);
+	assert_near(f[0], expect, 1e-5);
+	fb_free(fb);
+	world_free(w);
+	scene_free(s);
+}
+
 /* Features recorded in passes equal those of one pass, and mean the first
  * DENOISE_FEATURE_SAMPLES samples; the mean square covers every sample. */
 static void test_features_in_passes(void **state)
@@ -946,6 +1036,7 @@ int main(void)
 		cmocka_unit_test(test_env_feature),
 		cmocka_unit_test(test_lamp_through_glossy),
 		cmocka_unit_test(test_edge_direct_feature),
+		cmocka_unit_test(test_probe_edge),
 		cmocka_unit_test(test_features_in_passes),
 		cmocka_unit_test(test_modes),
 		cmocka_unit_test(test_setting),

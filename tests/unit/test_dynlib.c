@@ -1,6 +1,6 @@
-/* Libraries opened on first use (base/dynlib.h): assimp, libXpm and cJSON
- * are not linked, so a process maps them only when a model, an XPM image or
- * a glTF needs them; dynlib_open's answers for a library or a function that is missing.
+/* Libraries opened on first use (base/dynlib.h): assimp, libXpm, cJSON and
+ * libsixel are not linked, so a process maps them only when a model, an XPM
+ * image, a glTF or a sixel picture needs them; dynlib_open's answers for a library or a function that is missing.
  * This test binary is linked as rtsh is (LDLIBS_FRONT). */
 #include "testutil.h"
 #include "tmpdir.h"
@@ -15,6 +15,7 @@
 #include "rtsh/gltf.h"
 #include "rtsh/mesh.h"
 #include "rtsh/texture.h"
+#include "term/pixels.h"
 
 /* Whether a library whose file name holds `name` is mapped in this process. */
 static bool mapped(const char *name)
@@ -38,6 +39,7 @@ static void test_not_mapped_at_start(void **state)
 	assert_false(mapped("libXpm"));
 	assert_false(mapped("libX11"));
 	assert_false(mapped("libcjson"));
+	assert_false(mapped("libsixel"));
 }
 
 /* An STL (read by assimp) loads assimp; the triangle is the file's. */
@@ -89,6 +91,30 @@ static void test_gltf_loads_cjson(void **state)
 	assert_true(mapped("libcjson"));
 }
 
+/* A sixel picture loads libsixel: a 2x1 picture is one DCS sequence (ESC
+ * P ... q, VT340 manual chapter 14) with the raster attributes "1;1;2;1, an
+ * RGB colour register (#0;2;...) and ESC \\ at the end. */
+static void test_sixel_loads_libsixel(void **state)
+{
+	(void)state;
+	char why[400] = "unset";
+	assert_true(pixels_sixel_available(why, sizeof why));
+	assert_string_equal(why, "unset"); /* untouched when it loads */
+	const uint8_t rgb[6] = {255, 0, 0, 0, 0, 255};
+	abuf a;
+	abuf_init(&a);
+	assert_true(pixels_sixel(&a, rgb, 2, 1));
+	abuf_add(&a, "", 1); /* a C string */
+	assert_true(a.len > 4);
+	assert_memory_equal(a.b, "\x1bP", 2);
+	assert_non_null(strchr(a.b, 'q'));
+	assert_non_null(strstr(a.b, "\"1;1;2;1"));
+	assert_non_null(strstr(a.b, "#0;2;"));
+	assert_memory_equal(a.b + a.len - 3, "\x1b\\", 2);
+	abuf_free(&a);
+	assert_true(mapped("libsixel"));
+}
+
 static void test_missing_library(void **state)
 {
 	(void)state;
@@ -133,6 +159,7 @@ int main(void)
 	    cmocka_unit_test(test_model_loads_assimp),
 	    cmocka_unit_test(test_xpm_loads_libxpm),
 	    cmocka_unit_test(test_gltf_loads_cjson),
+	    cmocka_unit_test(test_sixel_loads_libsixel),
 	    cmocka_unit_test(test_missing_library),
 	    cmocka_unit_test(test_missing_function),
 	    cmocka_unit_test(test_functions_called),

@@ -11,6 +11,7 @@
 #include <string.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "rtsh/image.h"
@@ -524,9 +525,11 @@ typedef struct rows_seen {
 	const uint8_t *expect; /* the codes by their definition */
 	int next;              /* the row the next call must start at */
 	int calls, stop_at;    /* stop_at: the call that returns false (0: none) */
+	int slow;              /* the first `slow` calls take 2 ms: the other threads run ahead */
+	const uint8_t *lo, *hi; /* the lowest and highest byte of codes handed over */
 } rows_seen;
 
-static bool rows_check(void *ctx, const framebuffer *fb, int y0, int y1)
+static bool rows_check(void *ctx, const framebuffer *fb, int y0, int y1, const uint8_t *codes)
 {
 	rows_seen *r = ctx;
 	r->calls++;
@@ -534,8 +537,14 @@ static bool rows_check(void *ctx, const framebuffer *fb, int y0, int y1)
 	assert_true(y1 > y0 && y1 <= fb->h);
 	r->next = y1;
 	/* final when handed over */
-	size_t row = (size_t)fb->w * 3;
-	assert_memory_equal(fb->srgb8 + (size_t)y0 * row, r->expect + (size_t)y0 * row, (size_t)(y1 - y0) * row);
+	size_t row = (size_t)fb->w * 3, n = (size_t)(y1 - y0) * row;
+	assert_memory_equal(codes, r->expect + (size_t)y0 * row, n);
+	if (!r->lo || codes < r->lo)
+		r->lo = codes;
+	if (!r->hi || codes + n > r->hi)
+		r->hi = codes + n;
+	if (r->calls <= r->slow)
+		nanosleep(&(struct timespec){0, 2000000}, NULL);
 	return r->calls != r->stop_at;
 }
 
@@ -560,20 +569,54 @@ static void test_rows_while_rendering(void **state)
 		expect[i] = linear_to_srgb8(ref->rgb[i] * gain);
 	for (int threads = 1; threads <= 3; threads++) {
 		set.threads = threads;
-		rows_seen r = {expect, 0, 0, 0};
+		rows_seen r = {expect, 0, 0, 0, 0, NULL, NULL};
 		framebuffer *fb = render_image_rows(wd, &set, NULL, NULL, NULL, rows_check, &r, NULL);
 		assert_non_null(fb);
 		assert_int_equal(r.next, 53);
 		assert_true(r.calls >= 1 && r.calls <= 4);
 		assert_null(fb->rgb);
-		assert_memory_equal(fb->srgb8, expect, n);
 		fb_free(fb);
 		/* a failed handover stops the render */
-		rows_seen stop = {expect, 0, 0, 1};
+		rows_seen stop = {expect, 0, 0, 1, 0, NULL, NULL};
 		rt_error err = {0};
 		assert_null(render_image_rows(wd, &set, NULL, NULL, NULL, rows_check, &stop, &err));
 		assert_int_equal(stop.calls, 1);
 		assert_non_null(strstr(err.msg, "writing the image stopped the render"));
+	}
+	free(expect);
+	fb_free(ref);
+	world_free(wd);
+}
+
+/* A tall picture's codes pass through a ring of a few bands, not the whole
+ * image's (framebuffer.srgb8_ring): the codes handed over lie within
+ * threads + 6 bands of 16 rows; while the first handovers are slow the
+ * other threads wait for their slots instead of writing over rows not yet
+ * handed over: every row's codes are still linear_to_srgb8 of
+ * render_image's floats, in order; with 1, 2 and 3 threads. */
+static void test_rows_ring(void **state)
+{
+	(void)state;
+	world *wd = rows_world();
+	render_settings set = render_settings_default();
+	set.width = 37;
+	set.height = 16 * 30 + 5; /* 31 bands, the last of 5 rows */
+	size_t row = 37 * 3, n = row * (size_t)set.height;
+	framebuffer *ref = render_image(wd, &set, NULL, NULL, NULL, NULL);
+	assert_non_null(ref);
+	uint8_t *expect = malloc(n);
+	assert_non_null(expect);
+	for (size_t i = 0; i < n; i++)
+		expect[i] = linear_to_srgb8(ref->rgb[i]);
+	for (int threads = 1; threads <= 3; threads++) {
+		set.threads = threads;
+		rows_seen r = {expect, 0, 0, 0, 8, NULL, NULL};
+		framebuffer *fb = render_image_rows(wd, &set, NULL, NULL, NULL, rows_check, &r, NULL);
+		assert_non_null(fb);
+		assert_int_equal(r.next, set.height);
+		assert_int_equal(r.calls, 31); /* a call a band */
+		assert_true((size_t)(r.hi - r.lo) <= (size_t)(threads + 6) * 16 * row);
+		fb_free(fb);
 	}
 	free(expect);
 	fb_free(ref);
@@ -591,11 +634,11 @@ typedef struct make_ctx {
 	void *rows_ctx;
 } make_ctx;
 
-static bool count_rows(void *ctx, const framebuffer *fb, int y0, int y1)
+static bool count_rows(void *ctx, const framebuffer *fb, int y0, int y1, const uint8_t *codes)
 {
 	make_ctx *m = ctx;
 	m->rows_calls++;
-	return m->rows(m->rows_ctx, fb, y0, y1);
+	return m->rows(m->rows_ctx, fb, y0, y1, codes);
 }
 
 static framebuffer *make_render(void *ctx, render_rows_fn rows, void *rows_ctx, rt_error *err)
@@ -807,6 +850,7 @@ int main(void)
 		cmocka_unit_test(test_srgb8_in_tiles),
 		cmocka_unit_test(test_block_rays_bits),
 		cmocka_unit_test(test_rows_while_rendering),
+		cmocka_unit_test(test_rows_ring),
 		cmocka_unit_test(test_write_rendered),
 		cmocka_unit_test(test_basic_silhouette),
 	};
