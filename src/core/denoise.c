@@ -831,6 +831,8 @@ static bool mix_pixel(const job *j, int x, int y, float o[3])
 	float a[MIX_NU][MIX_NU] = {{0}}, b[MIX_NU][NRHS] = {{0}}, beta[MIX_NU][NRHS];
 	float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {0, 0, 0};
 	float inv_z = 1.0f / (gp->z + 1e-6f);
+	float vsum = 0; /* the window's noise variances */
+	int ntap = 0;
 	for (int dy = -MIX_R; dy <= MIX_R; dy++)
 		for (int dx = -MIX_R; dx <= MIX_R; dx++) {
 			int qx = x + dx, qy = y + dy;
@@ -839,6 +841,8 @@ static bool mix_pixel(const job *j, int x, int y, float o[3])
 			size_t q = (size_t)qy * w + qx;
 			const guide *gq = &j->g[q];
 			const float *c = j->t[q].h[CH_ALL].c;
+			vsum += j->t[q].h[CH_ALL].v;
+			ntap++;
 			float v[MIX_NU];
 			v[0] = 1;
 			for (int k = 0; k < 6; k++)
@@ -862,13 +866,21 @@ static bool mix_pixel(const job *j, int x, int y, float o[3])
 		return false;
 	/* Within the window's range; and a move the pixel's noise cannot
 	 * explain (more than MIX_K standard deviations of its brightness) is
-	 * cut down to that. */
+	 * cut down to that. That noise is at least the window's mean: where
+	 * all the pixel's samples agree (an edge whose other side they all
+	 * missed, a sliver of a sphere in the sky) their variance is 0, and
+	 * the pixel would keep its one surface's colour whatever its features
+	 * say (metal-fuzz, final and sky-spheres at 128x96 1.630, 1.794, 1.001
+	 * times the 64 samples' error before, 1.599, 1.773, 0.988 with this; a
+	 * floor of a tenth of the mean, or none, within 0.003 of it). */
+	float vmean = vsum / (float)ntap;
 	const chan *p = &j->t[i].h[CH_ALL];
 	float r[3];
 	for (int k = 0; k < 3; k++)
 		r[k] = beta[0][k] < lo[k] ? lo[k] : beta[0][k] > hi[k] ? hi[k] : beta[0][k];
 	float d = fabsf(lum(r) - lum(p->c));
-	float lim = MIX_K * sqrtf(p->v), t = d > lim ? lim / d : 1.0f;
+	float v = p->v > vmean ? p->v : vmean;
+	float lim = MIX_K * sqrtf(v), t = d > lim ? lim / d : 1.0f;
 	for (int k = 0; k < 3; k++)
 		o[k] = p->c[k] + t * (r[k] - p->c[k]);
 	return true;

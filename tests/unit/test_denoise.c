@@ -850,6 +850,74 @@ static void test_edge_direct_feature(void **state)
 	scene_free(s);
 }
 
+/* A pixel whose features say it is a mix of two surfaces but whose
+ * samples all agree (all of them fell on one side: noise variance 0) still
+ * gets the mix its features say: the mixed-pixel step's limit takes the
+ * noise of its 3x3 window as a floor. Left of x = 16 albedo 0.8 and
+ * radiance 0.4, right of it 0.2 and 0.1 (lighting 0.5), each sample
+ * uniformly noisy (sd 0.3); the pixel (16, 12) has the features of half of
+ * each (albedo 0.5 and its spread) and 8 samples of exactly 0.4. The step
+ * fits its window's outputs linearly in the albedo by least squares (the
+ * only feature that varies; a ridge of 1e-3 of the taps), so its value is
+ * that line at 0.5: computed here from the outputs of its 8 neighbours
+ * (which the step leaves as they are) and the pixel's own value before the
+ * step (the same picture with its albedo's spread taken away, so that it
+ * is no mixed pixel). With a variance of 0 the old limit kept that value. */
+static void test_mixed_pixel_agreeing_samples(void **state)
+{
+	(void)state;
+	const int W = 32, H = 24, X = 16, Y = 12, SPP = 8;
+	float *out[2];
+	for (int pass = 0; pass < 2; pass++) {
+		framebuffer *fb = flat_fb(W, H, SPP);
+		test_rng r = {7};
+		for (int y = 0; y < H; y++)
+			for (int x = 0; x < W; x++) {
+				int i = y * W + x;
+				float *f = fb->feat + (size_t)i * DENOISE_FEATURES;
+				float a = x < X ? 0.8f : 0.2f;
+				if (x == X && y == Y) {
+					a = 0.5f;
+					set_pixel(fb, i, 0.4f, 0.4f, 0.4f);
+				} else {
+					noisy_pixel(fb, i, 0.5 * a, 0.3, &r);
+				}
+				f[0] = f[1] = f[2] = a;
+				/* the mean squared albedo: the mixed pixel's of half 0.8,
+				 * half 0.2 (features_vary), unless taken away */
+				f[8] = x == X && y == Y && pass == 0 ? 1.5f * (0.64f + 0.04f) : 3 * a * a;
+				f[9] = f[6] * f[6];
+			}
+		out[pass] = malloc(sizeof(float) * W * H * 3);
+		assert_non_null(out[pass]);
+		assert_true(denoise_image(fb, out[pass], 2));
+		fb_free(fb);
+	}
+	/* the least-squares line through the window's (albedo, output) */
+	double sa = 0, sr = 0, saa = 0, sar = 0;
+	int n = 0;
+	for (int dy = -1; dy <= 1; dy++)
+		for (int dx = -1; dx <= 1; dx++) {
+			int x = X + dx, i = (Y + dy) * W + x;
+			double a = dx == 0 && dy == 0 ? 0.5 : x < X ? 0.8 : 0.2;
+			double v = dx == 0 && dy == 0 ? out[1][i * 3] : out[0][i * 3];
+			sa += a;
+			sr += v;
+			saa += a * a;
+			sar += a * v;
+			n++;
+		}
+	double slope = (sar - sa * sr / n) / (saa - sa * sa / n), expect = sr / n + slope * (0.5 - sa / n);
+	int c = Y * W + X;
+	print_message("mixed pixel, samples all 0.4: before the step %.4f, after %.4f (the window's line at 0.5: "
+	              "%.4f)\n",
+	              out[1][c * 3], out[0][c * 3], expect);
+	assert_true(fabs(out[1][c * 3] - expect) > 0.05);
+	assert_near(out[0][c * 3], expect, 0.01);
+	free(out[0]);
+	free(out[1]);
+}
+
 /* An edge that none of the first DENOISE_FEATURE_SAMPLES camera positions
  * meets, but that covers a corner of the pixel (DENOISE_PROBE_INSET inside
  * it), makes the pixel an edge pixel: its features are the mean over all
@@ -1037,6 +1105,7 @@ int main(void)
 		cmocka_unit_test(test_lamp_through_glossy),
 		cmocka_unit_test(test_edge_direct_feature),
 		cmocka_unit_test(test_probe_edge),
+		cmocka_unit_test(test_mixed_pixel_agreeing_samples),
 		cmocka_unit_test(test_features_in_passes),
 		cmocka_unit_test(test_modes),
 		cmocka_unit_test(test_setting),

@@ -527,6 +527,7 @@ typedef struct rows_seen {
 	int calls, stop_at;    /* stop_at: the call that returns false (0: none) */
 	int slow;              /* the first `slow` calls take 2 ms: the other threads run ahead */
 	const uint8_t *lo, *hi; /* the lowest and highest byte of codes handed over */
+	atomic_bool *cancel;    /* set at the first call (NULL: none) */
 } rows_seen;
 
 static bool rows_check(void *ctx, const framebuffer *fb, int y0, int y1, const uint8_t *codes)
@@ -543,6 +544,8 @@ static bool rows_check(void *ctx, const framebuffer *fb, int y0, int y1, const u
 		r->lo = codes;
 	if (!r->hi || codes + n > r->hi)
 		r->hi = codes + n;
+	if (r->cancel)
+		atomic_store(r->cancel, true);
 	if (r->calls <= r->slow)
 		nanosleep(&(struct timespec){0, 2000000}, NULL);
 	return r->calls != r->stop_at;
@@ -569,7 +572,7 @@ static void test_rows_while_rendering(void **state)
 		expect[i] = linear_to_srgb8(ref->rgb[i] * gain);
 	for (int threads = 1; threads <= 3; threads++) {
 		set.threads = threads;
-		rows_seen r = {expect, 0, 0, 0, 0, NULL, NULL};
+		rows_seen r = {expect, 0, 0, 0, 0, NULL, NULL, NULL};
 		framebuffer *fb = render_image_rows(wd, &set, NULL, NULL, NULL, rows_check, &r, NULL);
 		assert_non_null(fb);
 		assert_int_equal(r.next, 53);
@@ -577,7 +580,7 @@ static void test_rows_while_rendering(void **state)
 		assert_null(fb->rgb);
 		fb_free(fb);
 		/* a failed handover stops the render */
-		rows_seen stop = {expect, 0, 0, 1, 0, NULL, NULL};
+		rows_seen stop = {expect, 0, 0, 1, 0, NULL, NULL, NULL};
 		rt_error err = {0};
 		assert_null(render_image_rows(wd, &set, NULL, NULL, NULL, rows_check, &stop, &err));
 		assert_int_equal(stop.calls, 1);
@@ -610,13 +613,26 @@ static void test_rows_ring(void **state)
 		expect[i] = linear_to_srgb8(ref->rgb[i]);
 	for (int threads = 1; threads <= 3; threads++) {
 		set.threads = threads;
-		rows_seen r = {expect, 0, 0, 0, 8, NULL, NULL};
+		rows_seen r = {expect, 0, 0, 0, 8, NULL, NULL, NULL};
 		framebuffer *fb = render_image_rows(wd, &set, NULL, NULL, NULL, rows_check, &r, NULL);
 		assert_non_null(fb);
 		assert_int_equal(r.next, set.height);
 		assert_int_equal(r.calls, 31); /* a call a band */
 		assert_true((size_t)(r.hi - r.lo) <= (size_t)(threads + 6) * 16 * row);
 		fb_free(fb);
+		/* threads waiting for their slots end when a handover fails, or
+		 * when the render is cancelled: no hang, the right message */
+		rows_seen stop = {expect, 0, 0, 2, 8, NULL, NULL, NULL};
+		rt_error err = {0};
+		assert_null(render_image_rows(wd, &set, NULL, NULL, NULL, rows_check, &stop, &err));
+		assert_int_equal(stop.calls, 2);
+		assert_non_null(strstr(err.msg, "writing the image stopped the render"));
+		atomic_bool cancel = false;
+		rows_seen cut = {expect, 0, 0, 0, 8, NULL, NULL, &cancel};
+		memset(&err, 0, sizeof err);
+		assert_null(render_image_rows(wd, &set, &cancel, NULL, NULL, rows_check, &cut, &err));
+		assert_true(cut.calls >= 1 && cut.calls < 31);
+		assert_non_null(strstr(err.msg, "render stopped"));
 	}
 	free(expect);
 	fb_free(ref);
