@@ -363,6 +363,38 @@ static PK_TARGET __attribute__((noinline)) bool PK(walk)(const mesh *m, const do
 		s.bs[i] = -INFINITY; /* never enters a leaf, never raises PK(far) */
 		s.bt[i] = 0.0f;      /* (read by PK(leaf_rays), never used) */
 	}
+	/* Camera packets beside the model (most of a view's, where the model
+	 * does not fill it): no ray's line passes the sphere about the
+	 * model's box, so none can hit; known before the set-up of the walk
+	 * (its divisions and the root's test). A ray's line misses the sphere
+	 * (centre c, radius R) when |(c - o) x d|^2 > R^2 |d|^2. The test is
+	 * made generous: R^2 raised by 1% and 1e-5 |c - o|^2 |d|^2 added,
+	 * far more than the float roundings of these products (a few parts
+	 * in 1e7 of |c - o|^2 |d|^2) and of a hit's distance; a NaN
+	 * culls nothing. The answer is the walk's: no hit, no tie. */
+	if (!any) {
+		const vec3 bc = box_center(m->bounds), be = v3_sub(m->bounds.hi, m->bounds.lo);
+		const __m256 cx = _mm256_set1_ps((float)bc.x), cy = _mm256_set1_ps((float)bc.y), cz = _mm256_set1_ps((float)bc.z);
+		const __m256 r2 = _mm256_set1_ps((float)(0.25 * v3_dot(be, be) * 1.01)), rel = _mm256_set1_ps(1e-5f);
+		unsigned out = 0;
+		for (int h = 0; h < MESH_PACKET_MAX; h += 8) {
+			__m256 dx = _mm256_load_ps(&s.dx[h]), dy = _mm256_load_ps(&s.dy[h]), dz = _mm256_load_ps(&s.dz[h]);
+			__m256 px = _mm256_sub_ps(cx, _mm256_load_ps(&s.ox[h])), py = _mm256_sub_ps(cy, _mm256_load_ps(&s.oy[h])),
+			       pz = _mm256_sub_ps(cz, _mm256_load_ps(&s.oz[h]));
+			__m256 qx = _mm256_sub_ps(_mm256_mul_ps(py, dz), _mm256_mul_ps(pz, dy));
+			__m256 qy = _mm256_sub_ps(_mm256_mul_ps(pz, dx), _mm256_mul_ps(px, dz));
+			__m256 qz = _mm256_sub_ps(_mm256_mul_ps(px, dy), _mm256_mul_ps(py, dx));
+			__m256 qq = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(qx, qx), _mm256_mul_ps(qy, qy)), _mm256_mul_ps(qz, qz));
+			__m256 dd = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)), _mm256_mul_ps(dz, dz));
+			__m256 pp = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(px, px), _mm256_mul_ps(py, py)), _mm256_mul_ps(pz, pz));
+			__m256 lim = _mm256_mul_ps(_mm256_add_ps(r2, _mm256_mul_ps(rel, pp)), dd);
+			out |= (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(qq, lim, _CMP_GT_OQ)) << h;
+		}
+		if (out == 0xffffu) {
+			*found = *tie = 0;
+			return true;
+		}
+	}
 	/* the inverses (1 / d, correctly rounded as ray_node_setup's), the far
 	 * ones inv S; the signs each axis shares; per axis the origin to
 	 * subtract from the near planes (the farthest along the direction) and
