@@ -364,31 +364,41 @@ static PK_TARGET __attribute__((noinline)) bool PK(walk)(const mesh *m, const do
 		s.bt[i] = 0.0f;      /* (read by PK(leaf_rays), never used) */
 	}
 	/* Camera packets beside the model (most of a view's, where the model
-	 * does not fill it): no ray's line passes the sphere about the
-	 * model's box, so none can hit; known before the set-up of the walk
-	 * (its divisions and the root's test). A ray's line misses the sphere
-	 * (centre c, radius R) when |(c - o) x d|^2 > R^2 |d|^2. The test is
-	 * made generous: R^2 raised by 1% and 1e-5 |c - o|^2 |d|^2 added,
-	 * far more than the float roundings of these products (a few parts
-	 * in 1e7 of |c - o|^2 |d|^2) and of a hit's distance; a NaN
-	 * culls nothing. The answer is the walk's: no hit, no tie. */
+	 * does not fill it): no ray's line passes the model's box, so none can
+	 * hit; known before the set-up of the walk (its divisions and the
+	 * root's test). A line o + t d misses the box (centre c, half sides
+	 * e) when, for some axis k, the component k of q = (c - o) x d
+	 * exceeds what the box spans across it: |q_x| > e_y |d_z| + e_z |d_y|
+	 * and so on (the separating axes of a line and a box, each axis
+	 * crossed with d). The test is made generous: the half sides raised
+	 * by 1%, and 1e-5 of the two products that make q_k added, far more
+	 * than the floats' roundings of q_k (a few parts in 1e7 of them) and
+	 * of a hit; a NaN culls nothing. The answer is the walk's: no hit, no
+	 * tie. */
 	if (!any) {
-		const vec3 bc = box_center(m->bounds), be = v3_sub(m->bounds.hi, m->bounds.lo);
+		const vec3 bc = box_center(m->bounds), be = v3_scale(v3_sub(m->bounds.hi, m->bounds.lo), 0.505);
 		const __m256 cx = _mm256_set1_ps((float)bc.x), cy = _mm256_set1_ps((float)bc.y), cz = _mm256_set1_ps((float)bc.z);
-		const __m256 r2 = _mm256_set1_ps((float)(0.25 * v3_dot(be, be) * 1.01)), rel = _mm256_set1_ps(1e-5f);
+		const __m256 ex = _mm256_set1_ps((float)be.x), ey = _mm256_set1_ps((float)be.y), ez = _mm256_set1_ps((float)be.z);
+		const __m256 rel = _mm256_set1_ps(1e-5f), mag = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
 		unsigned out = 0;
 		for (int h = 0; h < MESH_PACKET_MAX; h += 8) {
 			__m256 dx = _mm256_load_ps(&s.dx[h]), dy = _mm256_load_ps(&s.dy[h]), dz = _mm256_load_ps(&s.dz[h]);
 			__m256 px = _mm256_sub_ps(cx, _mm256_load_ps(&s.ox[h])), py = _mm256_sub_ps(cy, _mm256_load_ps(&s.oy[h])),
 			       pz = _mm256_sub_ps(cz, _mm256_load_ps(&s.oz[h]));
-			__m256 qx = _mm256_sub_ps(_mm256_mul_ps(py, dz), _mm256_mul_ps(pz, dy));
-			__m256 qy = _mm256_sub_ps(_mm256_mul_ps(pz, dx), _mm256_mul_ps(px, dz));
-			__m256 qz = _mm256_sub_ps(_mm256_mul_ps(px, dy), _mm256_mul_ps(py, dx));
-			__m256 qq = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(qx, qx), _mm256_mul_ps(qy, qy)), _mm256_mul_ps(qz, qz));
-			__m256 dd = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)), _mm256_mul_ps(dz, dz));
-			__m256 pp = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(px, px), _mm256_mul_ps(py, py)), _mm256_mul_ps(pz, pz));
-			__m256 lim = _mm256_mul_ps(_mm256_add_ps(r2, _mm256_mul_ps(rel, pp)), dd);
-			out |= (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(qq, lim, _CMP_GT_OQ)) << h;
+			__m256 yz = _mm256_mul_ps(py, dz), zy = _mm256_mul_ps(pz, dy), zx = _mm256_mul_ps(pz, dx),
+			       xz = _mm256_mul_ps(px, dz), xy = _mm256_mul_ps(px, dy), yx = _mm256_mul_ps(py, dx);
+			__m256 ax = _mm256_and_ps(dx, mag), ay = _mm256_and_ps(dy, mag), az = _mm256_and_ps(dz, mag);
+			/* |q_k| against the box's span, the margin added */
+#define SEP(a, b, sa, sb)                                                                                              \
+	_mm256_cmp_ps(_mm256_and_ps(_mm256_sub_ps(a, b), mag),                                                         \
+		      _mm256_add_ps(_mm256_add_ps(sa, sb),                                                             \
+				    _mm256_mul_ps(rel, _mm256_add_ps(_mm256_and_ps(a, mag), _mm256_and_ps(b, mag)))),  \
+		      _CMP_GT_OQ)
+			__m256 sep = _mm256_or_ps(_mm256_or_ps(SEP(yz, zy, _mm256_mul_ps(ey, az), _mm256_mul_ps(ez, ay)),
+							       SEP(zx, xz, _mm256_mul_ps(ez, ax), _mm256_mul_ps(ex, az))),
+						  SEP(xy, yx, _mm256_mul_ps(ex, ay), _mm256_mul_ps(ey, ax)));
+#undef SEP
+			out |= (unsigned)_mm256_movemask_ps(sep) << h;
 		}
 		if (out == 0xffffu) {
 			*found = *tie = 0;
