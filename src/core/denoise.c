@@ -496,8 +496,13 @@ void denoise_features(const world *w, const render_settings *s, int px, int py, 
  * error; 1e-2: 1.528, 1.721, 0.972; 3e-2: 1.538, 1.716, 0.963). */
 #define RIDGE 1e-3f
 #define DIRECT_RIDGE 1e-2f
-/* The candidates' errors are averaged over (2 PICK_R + 1)^2 pixels. */
+/* The candidates' errors are averaged over (2 PICK_R + 1)^2 pixels,
+ * weighted by how alike the pixels' albedo and normal are: exp(-PICK_SCALE
+ * d^2), d^2 their squared distance in the regression's scaled features (a
+ * quarter of the regression's own weight's exponent: wider, since the
+ * estimates are noisier than the radiance). */
 #define PICK_R 4
+#define PICK_SCALE 0.25f
 /* A mixed pixel's regression may move it by at most this many standard
  * deviations of its noise. */
 #define MIX_K 3.0f

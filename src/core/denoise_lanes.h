@@ -345,24 +345,36 @@ LANES_INLINE void regression_body(job *j, int y0, int y1)
  * choosing too: one pixel's estimate is as noisy as the pixel), or where
  * both regressions are estimated to beat the raw pixel their blend by
  * those estimates; times the albedo again, into the all-samples chain
- * (radiance, and the noise variance of the mean's brightness). */
+ * (radiance, and the noise variance of the mean's brightness). The
+ * average is weighted by how alike the pixels' albedo and normal are
+ * (exp(-PICK_SCALE d^2), d their distance as the regression's weights
+ * measure it), so that the estimates of another surface (a highlight's, a
+ * wall's behind an edge) count less than the pixel's own surface's. The
+ * sums are left undivided by the weights' sum: it is the same for every
+ * candidate of the pixel, and neither the choice nor the blend's shares
+ * change with it. */
 LANES_INLINE void pick_body(job *j, int y0, int y1)
 {
 	int w = j->fb->w, h = j->fb->h;
-	const float *perr[NCAND];
+	const float *perr[NCAND], *pf[6];
 	for (int c = 0; c < NCAND; c++)
 		perr[c] = plane(j, PL_ERR + c);
+	for (int k = 0; k < 6; k++)
+		pf[k] = plane(j, PL_F0 + k);
 	for (int y = y0; y < y1; y++)
 		for (int x0 = 0; x0 < w; x0 += VL) {
 			/* VL pixels' sums, one in each lane, each over its window
-			 * in the one pixel's order; a tap outside the image adds +0
-			 * (masked), as if skipped. */
+			 * in the one pixel's order; a tap outside the image or of no
+			 * weight adds +0 (masked), as if skipped. */
 			vi lane = vi_lanes(x0);
 			vi in[2 * PICK_R + 1];
 			for (int dx = -PICK_R; dx <= PICK_R; dx++) {
 				vi qx = lane + vi_splat(dx);
 				in[dx + PICK_R] = (qx >= vi_splat(0)) & (qx < vi_splat(w));
 			}
+			vf gf[6];
+			for (int k = 0; k < 6; k++)
+				gf[k] = vf_load(pf[k] + (ptrdiff_t)y * w + x0);
 			vf sv[NCAND] = {{0}};
 			for (int qy = y - PICK_R; qy <= y + PICK_R; qy++) {
 				if (qy < 0 || qy >= h)
@@ -370,9 +382,20 @@ LANES_INLINE void pick_body(job *j, int y0, int y1)
 #pragma GCC unroll 9
 				for (int dx = -PICK_R; dx <= PICK_R; dx++) {
 					ptrdiff_t q = (ptrdiff_t)qy * w + x0 + dx;
+					vf e = vf_splat(0.0f);
+#pragma GCC unroll 6
+					for (int k = 0; k < 6; k++) {
+						vf d = gf[k] - vf_load(pf[k] + q);
+						e += d * d;
+					}
+					e *= vf_splat(PICK_SCALE);
+					vf wt = vf_exp_fast(&e);
+					/* no weight: skipped (an infinite estimate times 0
+					 * would be a NaN) */
+					vi m = in[dx + PICK_R] & (wt > vf_splat(0.0f));
 #pragma GCC unroll 3
 					for (int c = 0; c < NCAND; c++)
-						sv[c] += vf_and(vf_load(perr[c] + q), in[dx + PICK_R]);
+						sv[c] += vf_and(wt * vf_load(perr[c] + q), m);
 				}
 			}
 			int lanes = w - x0 < VL ? w - x0 : VL;
