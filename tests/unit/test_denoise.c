@@ -581,6 +581,52 @@ static void test_highlight_blocks(void **state)
 	fb_free(fb);
 }
 
+/* A highlight's peak that no feature explains, in a noisy surface: a 3x3
+ * block of albedo 1 (so unlike the surface's 0.2 that no regression tap
+ * crosses) whose samples all agree, 1 at its centre and 0.2 around it, in
+ * a surface of radiance 1 with noise 0.5 a sample (8 samples). At the
+ * centre both regressions are the block's mean (the taps are the block's
+ * 9, all of weight one, symmetric about it: no slope), (1 + 8 x 0.2) / 9 =
+ * 0.2889, and their estimated error is 0.711^2, while the raw pixel's is 0
+ * (its halves agree and have no noise) and exact. Averaged over the 9x9
+ * pixels around it alike, the surface's 72 raw estimates (0.5^2 / 8 each
+ * on average, 2.25 in all) outweigh the block's fits' (0.57) and the
+ * surface's fits' (about 8 / 81 of its raw ones, 0.22), and the centre took
+ * the fits' 0.2889; weighted by how alike the albedo is (the surface's by
+ * exp(-0.25 x 3 x 0.8^2 / 0.08) = exp(-6), as exp_fast has it (1 - 6/16)^16
+ * = 5.4e-4), they count for 0.001, and it keeps its value, 1. */
+static void test_pick_own_surface(void **state)
+{
+	(void)state;
+	const int W = 40, H = 32, X = 20, Y = 16, SPP = 8;
+	framebuffer *fb = flat_fb(W, H, SPP);
+	test_rng r = {31};
+	for (int y = 0; y < H; y++)
+		for (int x = 0; x < W; x++) {
+			int i = y * W + x;
+			float *f = fb->feat + (size_t)i * DENOISE_FEATURES;
+			bool block = abs(x - X) <= 1 && abs(y - Y) <= 1;
+			float a = block ? 1.0f : 0.2f;
+			f[0] = f[1] = f[2] = a;
+			if (block) {
+				float v = x == X && y == Y ? 1.0f : 0.2f;
+				set_pixel(fb, i, v, v, v);
+			} else {
+				noisy_pixel(fb, i, 1.0, 0.5, &r);
+			}
+		}
+	float *out = malloc(sizeof(float) * W * H * 3);
+	assert_non_null(out);
+	assert_true(denoise_image(fb, out, 2));
+	int c = Y * W + X;
+	print_message("the block's centre: %.4f (its samples 1; the block's mean %.4f)\n", out[c * 3],
+	              2.6 / 9);
+	for (int k = 0; k < 3; k++)
+		assert_near(out[c * 3 + k], 1.0, 1e-5);
+	free(out);
+	fb_free(fb);
+}
+
 /* The same picture for 1, 2, 3 and 7 threads, byte for byte, with 1, 3
  * and 8 samples. */
 static void test_threads(void **state)
@@ -1096,6 +1142,7 @@ int main(void)
 		cmocka_unit_test(test_flat_noise),
 		cmocka_unit_test(test_feature_edge),
 		cmocka_unit_test(test_highlight_blocks),
+		cmocka_unit_test(test_pick_own_surface),
 		cmocka_unit_test(test_threads),
 		cmocka_unit_test(test_features_through_mirror),
 		cmocka_unit_test(test_features_through_glass),
