@@ -392,7 +392,7 @@ static long model_traced, model_ties, model_occluded_traced;
  * hit at all is (the distance of a tie is the nearest). */
 static void check_model(const world *w, const ray *r, int n, int turn)
 {
-	const prim_inst *in = &w->insts[w->prims[0].u.index];
+	const prim_inst *in = &w->insts[w->geo[0].index];
 	double ts[PACKET_MAX], tm[PACKET_MAX] = {0}, t[PACKET_MAX];
 	uint32_t ss[PACKET_MAX], slot[PACKET_MAX];
 	float bs[PACKET_MAX][3], b[PACKET_MAX][3];
