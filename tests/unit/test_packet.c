@@ -620,6 +620,62 @@ static void test_model_ties(void **state)
 	}
 }
 
+/* Packets of which every ray but one passes far from the model (beside
+ * the sphere about its box, which lets a packet skip the walk when all its
+ * rays pass outside) and the one, in each lane in turn, meets it: the
+ * packet must find that ray's hit, the single ray's; and a packet whose
+ * rays all pass outside finds nothing. On every vector unit, the model
+ * turned (its matrix whole) and far from the camera. */
+static void test_model_cull(void **state)
+{
+	(void)state;
+	scene *s;
+	world *w = world_of_text("C -9,-6,-15 1,0.6,1.6 30\n"
+	                         "mesh scenes/models/spot/spot_triangulated.obj 0.4,0.3,0.2 0.3,1,0.1 1.5 255,255,255\n",
+	                         "model", &s);
+	assert_true(w->nprims == 1 && w->prims[0].tag == PRIM_MESH);
+	const prim_inst *in = &w->insts[w->prims[0].u.index];
+	vec3 o = w->cam.pos, c = box_center(w->bounds);
+	vec3 d0 = v3_norm(v3_sub(c, o));
+	long traced = 0;
+	for (int isa = MESH_ISA_SCALAR; isa <= MESH_ISA_BEST; isa++) {
+		if (!mesh_isa_force((mesh_isa)isa))
+			continue;
+		for (int j = -1; j < PACKET_MAX; j++) {
+			ray r[PACKET_MAX];
+			for (int i = 0; i < PACKET_MAX; i++) {
+				/* the others turned away, each axis's sign kept */
+				double k = 1.6 + 0.05 * i;
+				vec3 d = i % 3 == 0 ? v3(d0.x * k, d0.y, d0.z) : i % 3 == 1 ? v3(d0.x, d0.y * k, d0.z) : v3(d0.x, d0.y, d0.z * k);
+				r[i] = (ray){o, i == j ? d0 : v3_norm(d)};
+				double t;
+				uint32_t slot;
+				float b[3];
+				assert_int_equal(mesh_intersect_world_coherent(in->mesh, in->inv, &r[i], 0.0, INFINITY, &t, &slot, b),
+				                 i == j);
+			}
+			unsigned got = 1, tie = 1;
+			double t[PACKET_MAX];
+			uint32_t slot[PACKET_MAX];
+			float b[PACKET_MAX][3];
+			if (isa >= MESH_ISA_AVX2) {
+				assert_true(mesh_intersect_world_packet(in->mesh, in->inv, PACKET_MAX, r, 0.0, INFINITY, NULL, t, slot,
+				                                        b, &got, &tie));
+				assert_int_equal(got, j < 0 ? 0u : 1u << j);
+				assert_int_equal(tie, 0u);
+				traced++;
+			}
+			check_model(w, r, PACKET_MAX, j + 1);
+			check_packet(w, r, PACKET_MAX, v3(0, 10, 0));
+		}
+	}
+	assert_true(mesh_isa_force(MESH_ISA_BEST));
+	if (have_model_packets())
+		assert_true(traced >= 17);
+	world_free(w);
+	scene_free(s);
+}
+
 /* Models alone on every vector unit: the bunny (upright: the matrix's
  * zeros skipped), the cow turned (the whole matrix), the fence's glTF
  * cut-outs (alphaMode MASK), spot over a plane (the planes first). */
@@ -659,6 +715,7 @@ int main(void)
 		cmocka_unit_test(test_bunny),
 		cmocka_unit_test(test_model_ties),
 		cmocka_unit_test(test_model_packets),
+		cmocka_unit_test(test_model_cull),
 	};
 	int rc = cmocka_run_group_tests(tests, NULL, NULL);
 	printf("packets: %ld, rays that hit: %ld; the model's own packets: %ld, ties among them: %ld; shadow packets: %ld\n",

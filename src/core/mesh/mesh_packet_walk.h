@@ -363,6 +363,48 @@ static PK_TARGET __attribute__((noinline)) bool PK(walk)(const mesh *m, const do
 		s.bs[i] = -INFINITY; /* never enters a leaf, never raises PK(far) */
 		s.bt[i] = 0.0f;      /* (read by PK(leaf_rays), never used) */
 	}
+	/* Camera packets beside the model (most of a view's, where the model
+	 * does not fill it): no ray's line passes the model's box, so none can
+	 * hit; known before the set-up of the walk (its divisions and the
+	 * root's test). A line o + t d misses the box (centre c, half sides
+	 * e) when, for some axis k, the component k of q = (c - o) x d
+	 * exceeds what the box spans across it: |q_x| > e_y |d_z| + e_z |d_y|
+	 * and so on (the separating axes of a line and a box, each axis
+	 * crossed with d). The test is made generous: the half sides raised
+	 * by 1%, and 1e-5 of the two products that make q_k added, far more
+	 * than the floats' roundings of q_k (a few parts in 1e7 of them) and
+	 * of a hit; a NaN culls nothing. The answer is the walk's: no hit, no
+	 * tie. */
+	if (!any) {
+		const vec3 bc = box_center(m->bounds), be = v3_scale(v3_sub(m->bounds.hi, m->bounds.lo), 0.505);
+		const __m256 cx = _mm256_set1_ps((float)bc.x), cy = _mm256_set1_ps((float)bc.y), cz = _mm256_set1_ps((float)bc.z);
+		const __m256 ex = _mm256_set1_ps((float)be.x), ey = _mm256_set1_ps((float)be.y), ez = _mm256_set1_ps((float)be.z);
+		const __m256 rel = _mm256_set1_ps(1e-5f), mag = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+		unsigned out = 0;
+		for (int h = 0; h < MESH_PACKET_MAX; h += 8) {
+			__m256 dx = _mm256_load_ps(&s.dx[h]), dy = _mm256_load_ps(&s.dy[h]), dz = _mm256_load_ps(&s.dz[h]);
+			__m256 px = _mm256_sub_ps(cx, _mm256_load_ps(&s.ox[h])), py = _mm256_sub_ps(cy, _mm256_load_ps(&s.oy[h])),
+			       pz = _mm256_sub_ps(cz, _mm256_load_ps(&s.oz[h]));
+			__m256 yz = _mm256_mul_ps(py, dz), zy = _mm256_mul_ps(pz, dy), zx = _mm256_mul_ps(pz, dx),
+			       xz = _mm256_mul_ps(px, dz), xy = _mm256_mul_ps(px, dy), yx = _mm256_mul_ps(py, dx);
+			__m256 ax = _mm256_and_ps(dx, mag), ay = _mm256_and_ps(dy, mag), az = _mm256_and_ps(dz, mag);
+			/* |q_k| against the box's span, the margin added */
+#define SEP(a, b, sa, sb)                                                                                              \
+	_mm256_cmp_ps(_mm256_and_ps(_mm256_sub_ps(a, b), mag),                                                         \
+		      _mm256_add_ps(_mm256_add_ps(sa, sb),                                                             \
+				    _mm256_mul_ps(rel, _mm256_add_ps(_mm256_and_ps(a, mag), _mm256_and_ps(b, mag)))),  \
+		      _CMP_GT_OQ)
+			__m256 sep = _mm256_or_ps(_mm256_or_ps(SEP(yz, zy, _mm256_mul_ps(ey, az), _mm256_mul_ps(ez, ay)),
+							       SEP(zx, xz, _mm256_mul_ps(ez, ax), _mm256_mul_ps(ex, az))),
+						  SEP(xy, yx, _mm256_mul_ps(ex, ay), _mm256_mul_ps(ey, ax)));
+#undef SEP
+			out |= (unsigned)_mm256_movemask_ps(sep) << h;
+		}
+		if (out == 0xffffu) {
+			*found = *tie = 0;
+			return true;
+		}
+	}
 	/* the inverses (1 / d, correctly rounded as ray_node_setup's), the far
 	 * ones inv S; the signs each axis shares; per axis the origin to
 	 * subtract from the near planes (the farthest along the direction) and
