@@ -634,7 +634,7 @@ static void test_model_cull(void **state)
 	                         "mesh scenes/models/spot/spot_triangulated.obj 0.4,0.3,0.2 0.3,1,0.1 1.5 255,255,255\n",
 	                         "model", &s);
 	assert_true(w->nprims == 1 && w->prims[0].tag == PRIM_MESH);
-	const prim_inst *in = &w->insts[w->prims[0].u.index];
+	const prim_inst *in = &w->insts[w->geo[0].index];
 	vec3 o = w->cam.pos, c = box_center(w->bounds);
 	vec3 d0 = v3_norm(v3_sub(c, o));
 	long traced = 0;
