@@ -144,37 +144,30 @@ static inline double cam_tan_x(const cam_view *c, int w, int h)
  * the tree's memory. Far from the origin float boxes grow coarse (at 2^31 a
  * float step is 256 units): the tree then visits more, but never misses.
  *
- * One traceable primitive: its kind and object (`prim`, 8 bytes) and, at the
- * same index of a second array, its geometry (`prim_geo`, 32 bytes; see
- * world.c). A sphere with a uniform scale and no shear is traced in world
- * space from its centre and radius; every other shape keeps its
- * world-to-object matrix, and a triangle its vertex and edges, in the side
- * arrays `shapes` and `tris` (in the order of the primitives that use them),
- * so that the records the tree walks over stay small. The two arrays are
- * apart so that a leaf's spheres are 32-byte records side by side, two to
- * a cache line, read without the kinds when every primitive is a sphere
- * (world.spheres_only): with 1M spheres a leaf's three or four spheres took
- * about 3.3 lines as 40-byte records, and these lines were 60% of the last
- * level's misses (bench/README.md, the bigtree2 session). */
+ * One traceable primitive, 40 bytes (see world.c). A sphere with a uniform
+ * scale and no shear is traced in world space from its centre and radius;
+ * every other shape keeps its world-to-object matrix, and a triangle its
+ * vertex and edges, in the side arrays `shapes` and `tris` (in the order of
+ * the primitives that use them), so that the records the tree walks over
+ * stay small. */
 typedef enum prim_tag {
-	PRIM_SPHERE,   /* prim_geo.sph */
-	PRIM_TRIANGLE, /* prim_geo.index into world.tris */
-	PRIM_SHAPE,    /* prim_geo.index into world.shapes: a unit shape and its matrix */
-	PRIM_MESH,     /* prim_geo.index into world.insts: a mesh instance */
+	PRIM_SPHERE,   /* u.sph */
+	PRIM_TRIANGLE, /* u.index into world.tris */
+	PRIM_SHAPE,    /* u.index into world.shapes: a unit shape and its matrix */
+	PRIM_MESH,     /* u.index into world.insts: a mesh instance */
 } prim_tag;
 
 typedef struct prim {
 	uint32_t tag;    /* prim_tag */
 	uint32_t object; /* index into the scene's objects */
+	union {
+		struct {
+			vec3 c;
+			double r;
+		} sph;
+		uint32_t index;
+	} u;
 } prim;
-
-typedef union prim_geo {
-	struct {
-		vec3 c;
-		double r;
-	} sph;
-	uint32_t index;
-} prim_geo;
 
 typedef struct prim_shape {
 	double inv[3][4]; /* world -> object (the last row is 0 0 0 1) */
@@ -218,9 +211,7 @@ typedef struct world {
 	light_lin *lights;
 	size_t nlights;
 	prim *prims;     /* bounded primitives, in BVH order */
-	prim_geo *geo;   /* geo[i]: the geometry of prims[i] (32-byte aligned) */
 	size_t nprims;
-	bool spheres_only; /* every primitive is a PRIM_SPHERE */
 	prim_plane *planes; /* unbounded primitives, tested beside the tree */
 	size_t nplanes;
 	prim_shape *shapes; /* of the PRIM_SHAPE primitives and planes */
@@ -245,12 +236,6 @@ typedef struct world {
 	atomic_long refs; /* references (world_retain / world_release) */
 	const atomic_bool *cancel; /* while world_build runs: its flag (NULL: none) */
 } world;
-
-/* The geometry of primitive p of w. */
-static inline const prim_geo *prim_geo_of(const world *w, const prim *p)
-{
-	return &w->geo[p - w->prims];
-}
 
 /* A ray-surface hit in world space. */
 typedef struct hit {

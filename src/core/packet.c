@@ -222,10 +222,10 @@ typedef struct pk_sphere {
 	__m128d cx, cy, cz, rr;
 } pk_sphere;
 
-static inline pk_sphere pk_sphere_of(const prim_geo *g)
+static inline pk_sphere pk_sphere_of(const prim *p)
 {
-	return (pk_sphere){_mm_set1_pd(g->sph.c.x), _mm_set1_pd(g->sph.c.y), _mm_set1_pd(g->sph.c.z),
-	                   _mm_set1_pd(g->sph.r * g->sph.r)};
+	return (pk_sphere){_mm_set1_pd(p->u.sph.c.x), _mm_set1_pd(p->u.sph.c.y), _mm_set1_pd(p->u.sph.c.z),
+	                   _mm_set1_pd(p->u.sph.r * p->u.sph.r)};
 }
 
 /* Rays i and i + 1 (bits 0 and 1) whose discriminant against the sphere is
@@ -258,11 +258,11 @@ static inline unsigned sphere_disc2_o(const pk_state *s, int i, __m128d ocx, __m
 }
 #endif
 
-static void leaf_spheres(pk_state *s, const prim *p, const prim_geo *g, const ray *r, double tmin)
+static void leaf_spheres(pk_state *s, const prim *p, const ray *r, double tmin)
 {
 	vec3 zero = {0, 0, 0};
 #if defined(__SSE2__)
-	const pk_sphere sph = pk_sphere_of(g);
+	const pk_sphere sph = pk_sphere_of(p);
 	if (s->one_o) {
 		__m128d ocx = _mm_sub_pd(_mm_load_pd(&s->ox[0]), sph.cx), ocy = _mm_sub_pd(_mm_load_pd(&s->oy[0]), sph.cy);
 		__m128d ocz = _mm_sub_pd(_mm_load_pd(&s->oz[0]), sph.cz);
@@ -273,7 +273,7 @@ static void leaf_spheres(pk_state *s, const prim *p, const prim_geo *g, const ra
 			for (; m; m &= m - 1) {
 				int j = i + __builtin_ctz(m);
 				double t;
-				if (j < s->n && sphere_hit(g, &r[j], tmin, next_up(s->tmax[j]), &t))
+				if (j < s->n && sphere_hit(p, &r[j], tmin, next_up(s->tmax[j]), &t))
 					offer(s, j, p, t, zero);
 			}
 		}
@@ -284,14 +284,14 @@ static void leaf_spheres(pk_state *s, const prim *p, const prim_geo *g, const ra
 		for (; m; m &= m - 1) {
 			int j = i + __builtin_ctz(m);
 			double t;
-			if (j < s->n && sphere_hit(g, &r[j], tmin, next_up(s->tmax[j]), &t))
+			if (j < s->n && sphere_hit(p, &r[j], tmin, next_up(s->tmax[j]), &t))
 				offer(s, j, p, t, zero);
 		}
 	}
 #else
 	for (int i = 0; i < s->n; i++) {
 		double t;
-		if (sphere_hit(g, &r[i], tmin, next_up(s->tmax[i]), &t))
+		if (sphere_hit(p, &r[i], tmin, next_up(s->tmax[i]), &t))
 			offer(s, i, p, t, zero);
 	}
 #endif
@@ -304,7 +304,7 @@ static void leaf_spheres(pk_state *s, const prim *p, const prim_geo *g, const ra
  * not traced (the caller tests ray by ray). */
 static bool leaf_mesh(const world *w, pk_state *s, const prim *p, const ray *r, double tmin)
 {
-	const prim_inst *in = &w->insts[prim_geo_of(w, p)->index];
+	const prim_inst *in = &w->insts[p->u.index];
 	double tm[PACKET_MAX], t[PACKET_MAX];
 	uint32_t slot[PACKET_MAX];
 	float b[PACKET_MAX][3];
@@ -340,7 +340,6 @@ static void packet_walk(const world *w, pk_state *s, const ray *r, const pk_ray 
 {
 	const bvh *tree = w->tree;
 	const bvh_node *nodes = tree->nodes;
-	const bool spheres_only = w->spheres_only;
 	double far = packet_far(s);
 	float ftmin = to_float_down(tmin), ftmax = to_float_up(far);
 	bvh_entry stack[BVH_STACK];
@@ -349,11 +348,10 @@ static void packet_walk(const world *w, pk_state *s, const ray *r, const pk_ray 
 	for (;;) {
 		if (meta) {
 			const prim *p = &w->prims[child];
-			const prim_geo *g = &w->geo[child];
 			uint32_t count = meta & ~BVH_LEAF;
 			for (uint32_t k = 0; k < count; k++) {
-				if (spheres_only || p[k].tag == PRIM_SPHERE) {
-					leaf_spheres(s, &p[k], &g[k], r, tmin);
+				if (p[k].tag == PRIM_SPHERE) {
+					leaf_spheres(s, &p[k], r, tmin);
 					continue;
 				}
 				if (p[k].tag == PRIM_MESH && leaf_mesh(w, s, &p[k], r, tmin))
@@ -395,7 +393,7 @@ static void packet_walk(const world *w, pk_state *s, const ray *r, const pk_ray 
 static bool model_packet(const world *w, int n, const ray *r, double tmin, double tmax, trace_hit *th, bool *found)
 {
 	const prim *p = &w->prims[0];
-	const prim_inst *in = &w->insts[prim_geo_of(w, p)->index];
+	const prim_inst *in = &w->insts[p->u.index];
 	double tm[PACKET_MAX], t[PACKET_MAX];
 	const prim_plane *best_plane[PACKET_MAX] = {NULL};
 	uint32_t slot[PACKET_MAX];
@@ -506,13 +504,12 @@ void world_intersect_packet(const world *w, int n, const ray *r, double tmin, do
 /* --- any hit: shadow rays --- */
 
 /* The rays of s not yet known to be blocked: bit i for ray i. */
-static inline void leaf_occluded(const world *w, bool spheres_only, pk_state *s, unsigned *live, const prim *p,
-                                 const prim_geo *g, const ray *r, double tmin)
+static void leaf_occluded(const world *w, pk_state *s, unsigned *live, const prim *p, const ray *r, double tmin)
 {
 	/* (a model here is met ray by ray: shadow rays that reach a leaf of the
 	 * object tree come from points far apart, and as one packet through
 	 * the model's tree they made instances.rt 1.6x slower) */
-	if (!spheres_only && p->tag != PRIM_SPHERE) {
+	if (p->tag != PRIM_SPHERE) {
 		for (unsigned m = *live; m; m &= m - 1) {
 			int i = __builtin_ctz(m);
 			if (world_prim_occluded(w, p, &r[i], tmin, s->tmax[i]))
@@ -520,7 +517,7 @@ static inline void leaf_occluded(const world *w, bool spheres_only, pk_state *s,
 		}
 		return;
 	}
-	const pk_sphere sph = pk_sphere_of(g);
+	const pk_sphere sph = pk_sphere_of(p);
 	for (int i = 0; i < s->n; i += 2) {
 		if (!(*live >> i & 3u))
 			continue;
@@ -528,7 +525,7 @@ static inline void leaf_occluded(const world *w, bool spheres_only, pk_state *s,
 		for (; m; m &= m - 1) {
 			int j = i + __builtin_ctz(m);
 			double t;
-			if (sphere_hit(g, &r[j], tmin, s->tmax[j], &t))
+			if (sphere_hit(p, &r[j], tmin, s->tmax[j], &t))
 				*live &= ~(1u << j);
 		}
 	}
@@ -551,7 +548,7 @@ static bool planes_block(const world *w, const ray *r, double tmin, double tmax)
  * is not traced: the caller traces each ray alone. */
 static bool model_occluded(const world *w, int n, const ray *r, double tmin, const double *tmax, bool *occ)
 {
-	const prim_inst *in = &w->insts[w->geo[0].index];
+	const prim_inst *in = &w->insts[w->prims[0].u.index];
 	ray rl[PACKET_MAX];
 	double tl[PACKET_MAX];
 	int at[PACKET_MAX], nl = 0;
@@ -600,7 +597,6 @@ void world_occluded_packet(const world *w, int n, const ray *r, double tmin, con
 		pk_load_ray(&s, n, &r[0]);
 	if (w->nprims && live) {
 		const bvh_node *nodes = w->tree->nodes;
-		const bool spheres_only = w->spheres_only;
 		float ftmin = to_float_down(tmin);
 		double far = 0;
 		for (int i = 0; i < n; i++)
@@ -624,10 +620,9 @@ void world_occluded_packet(const world *w, int n, const ray *r, double tmin, con
 		for (;;) {
 			if (meta) {
 				const prim *p = &w->prims[child];
-				const prim_geo *g = &w->geo[child];
 				uint32_t count = meta & ~BVH_LEAF;
 				for (uint32_t k = 0; k < count && live; k++)
-					leaf_occluded(w, spheres_only, &s, &live, &p[k], &g[k], r, tmin);
+					leaf_occluded(w, &s, &live, &p[k], r, tmin);
 				if (!live)
 					break;
 			} else {

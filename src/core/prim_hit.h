@@ -30,11 +30,11 @@ static inline float to_float_up(double v)
 
 /* The nearest hit of a world-space sphere in (tmin, tmax); the stable
  * quadratic of Numerical Recipes 5.6. */
-static inline bool sphere_hit(const prim_geo *g, const ray *r, double tmin, double tmax, double *t)
+static inline bool sphere_hit(const prim *p, const ray *r, double tmin, double tmax, double *t)
 {
-	vec3 oc = v3_sub(r->o, g->sph.c);
+	vec3 oc = v3_sub(r->o, p->u.sph.c);
 	double b = v3_dot(oc, r->d), a = v3_dot(r->d, r->d);
-	double c = v3_dot(oc, oc) - g->sph.r * g->sph.r;
+	double c = v3_dot(oc, oc) - p->u.sph.r * p->u.sph.r;
 	double disc = b * b - a * c;
 	if (disc < 0.0)
 		return false;

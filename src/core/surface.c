@@ -222,7 +222,7 @@ static inline vec3 mat3x4_normal(const double (*inv)[4], vec3 n)
 	          inv[0][2] * n.x + inv[1][2] * n.y + inv[2][2] * n.z);
 }
 
-bool surf_make_inst(world *w, const object *o, uint32_t index, prim *p, prim_geo *g, box *b, rt_error *err)
+bool surf_make_inst(world *w, const object *o, uint32_t index, prim *p, box *b, rt_error *err)
 {
 	const mesh *m = w->insts[w->ninsts].mesh;
 	xform x;
@@ -244,10 +244,9 @@ bool surf_make_inst(world *w, const object *o, uint32_t index, prim *p, prim_geo
 			in->fwd[i][j] = fx.m.m[i][j];
 		}
 	memset(p, 0, sizeof *p);
-	memset(g, 0, sizeof *g);
 	p->tag = PRIM_MESH;
 	p->object = index;
-	g->index = (uint32_t)w->ninsts++;
+	p->u.index = (uint32_t)w->ninsts++;
 	*b = xf_box(&fx, m->bounds);
 	return true;
 }
@@ -332,7 +331,7 @@ static bool wants_uv(const world *w, const hit *h)
 
 vec3 surf_inst_ng(const world *w, const prim *p, vec3 nl)
 {
-	const prim_inst *in = &w->insts[prim_geo_of(w, p)->index];
+	const prim_inst *in = &w->insts[p->u.index];
 	vec3 c[3];
 	mesh_corners(in->mesh, (uint32_t)nl.x, c);
 	return mat3x4_normal(in->inv, v3_cross(v3_sub(c[1], c[0]), v3_sub(c[2], c[0])));
@@ -340,7 +339,7 @@ vec3 surf_inst_ng(const world *w, const prim *p, vec3 nl)
 
 void surf_inst_finish(const world *w, const prim *p, const ray *r, vec3 nl, hit *h)
 {
-	const prim_inst *in = &w->insts[prim_geo_of(w, p)->index];
+	const prim_inst *in = &w->insts[p->u.index];
 	const mesh *m = in->mesh;
 	uint32_t slot = (uint32_t)nl.x;
 	mesh_surf s;

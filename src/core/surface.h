@@ -14,14 +14,14 @@ bool surf_begin(world *w, const scene *s, rt_error *err);
  * materials (appended to w->mats). */
 bool surf_material(world *w, const object *o, uint32_t i, rt_error *err);
 /* A mesh object's primitive and world bounds. */
-bool surf_make_inst(world *w, const object *o, uint32_t i, prim *p, prim_geo *g, box *b, rt_error *err);
+bool surf_make_inst(world *w, const object *o, uint32_t i, prim *p, box *b, rt_error *err);
 /* Instance tests: the nearest hit stores (triangle, b1, b2) in *nl;
  * coherent: the ray is a camera ray (mesh_intersect_world_coherent).
  * Inline: every ray on a model passes here (a call layer fewer). */
 static inline bool surf_inst_hit(const world *w, const prim *p, const ray *r, double tmin, double tmax, double *t,
                                  vec3 *nl, bool coherent)
 {
-	const prim_inst *in = &w->insts[prim_geo_of(w, p)->index];
+	const prim_inst *in = &w->insts[p->u.index];
 	uint32_t slot;
 	float b[3];
 	if (!(coherent ? mesh_intersect_world_coherent : mesh_intersect_world)(in->mesh, in->inv, r, tmin, tmax, t, &slot,
@@ -33,7 +33,7 @@ static inline bool surf_inst_hit(const world *w, const prim *p, const ray *r, do
 
 static inline bool surf_inst_occluded(const world *w, const prim *p, const ray *r, double tmin, double tmax)
 {
-	const prim_inst *in = &w->insts[prim_geo_of(w, p)->index];
+	const prim_inst *in = &w->insts[p->u.index];
 	return mesh_occluded_world(in->mesh, in->inv, r, tmin, tmax);
 }
 void surf_inst_finish(const world *w, const prim *p, const ray *r, vec3 nl, hit *h);

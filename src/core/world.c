@@ -75,28 +75,17 @@ static bool is_fast_sphere(const object *o)
 	return o->mat.checker == 0 && !o->mat.texture && !o->mat.normalmap && !o->mat.bump;
 }
 
-/* An array of n (at least 1) prim_geo, 32-byte aligned so that no record
- * straddles two cache lines. */
-static prim_geo *geo_alloc(size_t n)
-{
-	n = n ? n : 1;
-	if (n > SIZE_MAX / sizeof(prim_geo))
-		return NULL;
-	return aligned_alloc(32, n * sizeof(prim_geo));
-}
-
-/* Fills p and its geometry g (and the side record it needs) for object o
- * and its world bounds *b (planes: see make_plane). */
-static bool make_prim(world *w, const object *o, uint32_t index, prim *p, prim_geo *g, box *b, rt_error *err)
+/* Fills p (and the side record it needs) for object o and its world bounds
+ * *b (planes: see make_plane). */
+static bool make_prim(world *w, const object *o, uint32_t index, prim *p, box *b, rt_error *err)
 {
 	if (obj_kind_flags(o->kind) & KIND_MODEL)
-		return surf_make_inst(w, o, index, p, g, b, err);
+		return surf_make_inst(w, o, index, p, b, err);
 	memset(p, 0, sizeof *p);
-	memset(g, 0, sizeof *g);
 	p->object = index;
 	if (obj_kind_flags(o->kind) & KIND_VERTICES) {
 		p->tag = PRIM_TRIANGLE;
-		g->index = (uint32_t)w->ntris;
+		p->u.index = (uint32_t)w->ntris;
 		prim_tri *t = &w->tris[w->ntris++];
 		t->v0 = o->tri[0];
 		t->e1 = v3_sub(o->tri[1], o->tri[0]);
@@ -107,8 +96,8 @@ static bool make_prim(world *w, const object *o, uint32_t index, prim *p, prim_g
 	if (is_fast_sphere(o)) {
 		double r = o->scale.x * 0.5;
 		p->tag = PRIM_SPHERE;
-		g->sph.c = o->pos;
-		g->sph.r = r;
+		p->u.sph.c = o->pos;
+		p->u.sph.r = r;
 		*b = (box){v3_sub(o->pos, v3_splat(r)), v3_add(o->pos, v3_splat(r))};
 		return true;
 	}
@@ -117,7 +106,7 @@ static bool make_prim(world *w, const object *o, uint32_t index, prim *p, prim_g
 		return rt_error_set(err, "object %u (%s) cannot be placed: its transform is not invertible",
 		                    index + 1, obj_kind_name(o->kind));
 	p->tag = PRIM_SHAPE;
-	g->index = (uint32_t)w->nshapes;
+	p->u.index = (uint32_t)w->nshapes;
 	prim_shape *sh = &w->shapes[w->nshapes++];
 	for (int i = 0; i < 3; i++)
 		for (int j = 0; j < 4; j++)
@@ -131,16 +120,15 @@ static bool make_prim(world *w, const object *o, uint32_t index, prim *p, prim_g
 static bool make_plane(world *w, const object *o, uint32_t index, prim_plane *pl, rt_error *err)
 {
 	prim p;
-	prim_geo g;
 	box b;
-	if (!make_prim(w, o, index, &p, &g, &b, err))
+	if (!make_prim(w, o, index, &p, &b, err))
 		return false;
-	const prim_shape *sh = &w->shapes[g.index];
+	const prim_shape *sh = &w->shapes[p.u.index];
 	for (int j = 0; j < 4; j++)
 		pl->h[j] = sh->inv[1][j];
 	pl->n = v3_norm(v3(pl->h[0], pl->h[1], pl->h[2]));
 	pl->object = index;
-	pl->shape = g.index;
+	pl->shape = p.u.index;
 	return true;
 }
 
@@ -150,49 +138,39 @@ static bool make_plane(world *w, const object *o, uint32_t index, prim_plane *pl
 static bool reorder(world *w, const uint32_t *order)
 {
 	prim *prims = malloc((w->nprims ? w->nprims : 1) * sizeof *prims);
-	prim_geo *geo = geo_alloc(w->nprims);
 	prim_shape *shapes = malloc((w->nshapes ? w->nshapes : 1) * sizeof *shapes);
 	prim_tri *tris = malloc((w->ntris ? w->ntris : 1) * sizeof *tris);
-	if (!prims || !geo || !shapes || !tris) {
+	if (!prims || !shapes || !tris) {
 		free(prims);
-		free(geo);
 		free(shapes);
 		free(tris);
 		return false;
 	}
 	/* walked in tree order by every ray: huge pages spare the TLB */
 	mem_huge_pages(prims, w->nprims * sizeof *prims);
-	mem_huge_pages(geo, w->nprims * sizeof *geo);
 	mem_huge_pages(shapes, w->nshapes * sizeof *shapes);
 	mem_huge_pages(tris, w->ntris * sizeof *tris);
-	w->spheres_only = true;
-	for (size_t i = 0; i < w->nprims; i++) {
+	for (size_t i = 0; i < w->nprims; i++)
 		prims[i] = w->prims[order[i]];
-		geo[i] = w->geo[order[i]];
-		w->spheres_only = w->spheres_only && prims[i].tag == PRIM_SPHERE;
-	}
 	size_t ns = 0, nt = 0;
 	for (size_t i = 0; i < w->nplanes; i++) {
 		shapes[ns] = w->shapes[w->planes[i].shape];
 		w->planes[i].shape = (uint32_t)ns++;
 	}
 	for (size_t i = 0; i < w->nprims; i++) {
-		const prim *p = &prims[i];
-		prim_geo *g = &geo[i];
+		prim *p = &prims[i];
 		if (p->tag == PRIM_SHAPE) {
-			shapes[ns] = w->shapes[g->index];
-			g->index = (uint32_t)ns++;
+			shapes[ns] = w->shapes[p->u.index];
+			p->u.index = (uint32_t)ns++;
 		} else if (p->tag == PRIM_TRIANGLE) {
-			tris[nt] = w->tris[g->index];
-			g->index = (uint32_t)nt++;
+			tris[nt] = w->tris[p->u.index];
+			p->u.index = (uint32_t)nt++;
 		}
 	}
 	free(w->prims);
-	free(w->geo);
 	free(w->shapes);
 	free(w->tris);
 	w->prims = prims;
-	w->geo = geo;
 	w->shapes = shapes;
 	w->tris = tris;
 	return true;
@@ -240,13 +218,12 @@ world *world_build_cancel(const scene *s, const atomic_bool *cancel, rt_error *e
 	w->lights = calloc(s->nlights ? s->nlights : 1, sizeof *w->lights);
 	w->mats = calloc(s->nobjs ? s->nobjs : 1, sizeof *w->mats);
 	w->prims = malloc((nbounded ? nbounded : 1) * sizeof *w->prims);
-	w->geo = geo_alloc(nbounded);
 	w->planes = malloc((nplanes ? nplanes : 1) * sizeof *w->planes);
 	w->shapes = malloc((nshapes ? nshapes : 1) * sizeof *w->shapes);
 	w->tris = malloc((ntris ? ntris : 1) * sizeof *w->tris);
 	box *bounds = malloc((nbounded ? nbounded : 1) * sizeof *bounds);
 	uint32_t *order = malloc((nbounded ? nbounded : 1) * sizeof *order);
-	if (!w->lights || !w->mats || !w->prims || !w->geo || !w->planes || !w->shapes || !w->tris || !bounds || !order) {
+	if (!w->lights || !w->mats || !w->prims || !w->planes || !w->shapes || !w->tris || !bounds || !order) {
 		free(bounds);
 		free(order);
 		world_free(w);
@@ -292,7 +269,7 @@ world *world_build_cancel(const scene *s, const atomic_bool *cancel, rt_error *e
 		bool plane = (obj_kind_flags(o->kind) & KIND_UNBOUNDED) != 0;
 		if (!surf_material(w, o, (uint32_t)i, err) ||
 		    (plane ? !make_plane(w, o, (uint32_t)i, &w->planes[w->nplanes], err)
-		           : !make_prim(w, o, (uint32_t)i, &w->prims[w->nprims], &w->geo[w->nprims], &bounds[w->nprims], err))) {
+		           : !make_prim(w, o, (uint32_t)i, &w->prims[w->nprims], &bounds[w->nprims], err))) {
 			free(bounds);
 			free(order);
 			world_free(w);
@@ -359,7 +336,7 @@ void world_release(const world *cw)
 	surf_free(w);
 	envmap_free((envmap *)w->env);
 	bvh_free(w->tree);
-	mem_free_all(w->lights, w->mats, w->prims, w->geo, w->planes, w->shapes, w->tris, w->emitters, w);
+	mem_free_all(w->lights, w->mats, w->prims, w->planes, w->shapes, w->tris, w->emitters, w);
 }
 
 void world_free(world *w)
@@ -388,12 +365,12 @@ static bool other_hit(const world *w, const prim *p, const ray *r, double tmin, 
                       vec3 *nl)
 {
 	if (p->tag == PRIM_TRIANGLE) {
-		const prim_tri *tr = &w->tris[prim_geo_of(w, p)->index];
+		const prim_tri *tr = &w->tris[p->u.index];
 		return tri_intersect(tr->v0, tr->e1, tr->e2, r->o, r->d, tmin, tmax, t);
 	}
 	if (p->tag == PRIM_MESH)
 		return surf_inst_hit(w, p, r, tmin, tmax, t, nl, false);
-	const prim_shape *sh = &w->shapes[prim_geo_of(w, p)->index];
+	const prim_shape *sh = &w->shapes[p->u.index];
 	vec3 o, d;
 	to_object(sh, r, &o, &d);
 	return shape_kinds[sh->kind]->intersect(o, d, sh->tube, tmin, tmax, t, nl);
@@ -403,12 +380,12 @@ static bool other_occluded(const world *w, const prim *p, const ray *r, double t
 {
 	if (p->tag == PRIM_TRIANGLE) {
 		double t;
-		const prim_tri *tr = &w->tris[prim_geo_of(w, p)->index];
+		const prim_tri *tr = &w->tris[p->u.index];
 		return tri_intersect(tr->v0, tr->e1, tr->e2, r->o, r->d, tmin, tmax, &t);
 	}
 	if (p->tag == PRIM_MESH)
 		return surf_inst_occluded(w, p, r, tmin, tmax);
-	const prim_shape *sh = &w->shapes[prim_geo_of(w, p)->index];
+	const prim_shape *sh = &w->shapes[p->u.index];
 	vec3 o, d;
 	to_object(sh, r, &o, &d);
 	return shape_kinds[sh->kind]->occluded(o, d, sh->tube, tmin, tmax);
@@ -416,34 +393,33 @@ static bool other_occluded(const world *w, const prim *p, const ray *r, double t
 
 /* The nearest hit of one primitive in (tmin, tmax); coherent: r is a
  * camera ray (world_trace_coherent). */
-static inline bool prim_hit(const world *w, const prim *p, const prim_geo *g, const ray *r, double tmin,
-                            double tmax, double *t, vec3 *nl, bool coherent)
+static inline bool prim_hit(const world *w, const prim *p, const ray *r, double tmin, double tmax, double *t,
+                            vec3 *nl, bool coherent)
 {
-	if (w->spheres_only || p->tag == PRIM_SPHERE)
-		return sphere_hit(g, r, tmin, tmax, t);
+	if (p->tag == PRIM_SPHERE)
+		return sphere_hit(p, r, tmin, tmax, t);
 	if (p->tag == PRIM_MESH)
 		return surf_inst_hit(w, p, r, tmin, tmax, t, nl, coherent);
 	return other_hit(w, p, r, tmin, tmax, t, nl);
 }
 
-static inline bool prim_occluded(const world *w, const prim *p, const prim_geo *g, const ray *r, double tmin,
-                                 double tmax)
+static inline bool prim_occluded(const world *w, const prim *p, const ray *r, double tmin, double tmax)
 {
 	double t;
-	if (w->spheres_only || p->tag == PRIM_SPHERE)
-		return sphere_hit(g, r, tmin, tmax, &t);
+	if (p->tag == PRIM_SPHERE)
+		return sphere_hit(p, r, tmin, tmax, &t);
 	return other_occluded(w, p, r, tmin, tmax);
 }
 
 bool world_prim_hit(const world *w, const prim *p, const ray *r, double tmin, double tmax, double *t, vec3 *nl,
                     bool coherent)
 {
-	return prim_hit(w, p, prim_geo_of(w, p), r, tmin, tmax, t, nl, coherent);
+	return prim_hit(w, p, r, tmin, tmax, t, nl, coherent);
 }
 
 bool world_prim_occluded(const world *w, const prim *p, const ray *r, double tmin, double tmax)
 {
-	return prim_occluded(w, p, prim_geo_of(w, p), r, tmin, tmax);
+	return prim_occluded(w, p, r, tmin, tmax);
 }
 
 /* The hit record of a plane. */
@@ -473,7 +449,7 @@ static void finish_hit(const world *w, const prim *p, const ray *r, double t, ve
 	h->has_uv = false;
 	vec3 n;
 	if (p->tag == PRIM_SPHERE) {
-		n = v3_norm(v3_sub(h->p, prim_geo_of(w, p)->sph.c));
+		n = v3_norm(v3_sub(h->p, p->u.sph.c));
 		h->local = n;
 		h->front = v3_dot(n, r->d) < 0.0;
 		h->n = n;
@@ -485,11 +461,11 @@ static void finish_hit(const world *w, const prim *p, const ray *r, double t, ve
 	}
 	const prim_shape *shp = NULL;
 	if (p->tag == PRIM_TRIANGLE) {
-		const prim_tri *tr = &w->tris[prim_geo_of(w, p)->index];
+		const prim_tri *tr = &w->tris[p->u.index];
 		n = v3_cross(tr->e1, tr->e2);
 		h->local = h->p;
 	} else {
-		shp = &w->shapes[prim_geo_of(w, p)->index];
+		shp = &w->shapes[p->u.index];
 		const double(*m)[4] = shp->inv;
 		n = (vec3){m[0][0] * nl.x + m[1][0] * nl.y + m[2][0] * nl.z,
 		           m[0][1] * nl.x + m[1][1] * nl.y + m[2][1] * nl.z,
@@ -505,7 +481,7 @@ static void finish_hit(const world *w, const prim *p, const ray *r, double t, ve
 	if (shp) {
 		surf_shape_uv(w, shp, nl, h);
 	} else {
-		const prim_tri *tr = &w->tris[prim_geo_of(w, p)->index];
+		const prim_tri *tr = &w->tris[p->u.index];
 		surf_triangle_uv(w, tr->v0, tr->e1, tr->e2, h);
 	}
 }
@@ -531,7 +507,7 @@ void world_rays_count(int n)
 
 size_t world_memory(const world *w)
 {
-	size_t n = w->nlights * sizeof *w->lights + w->nprims * (sizeof *w->prims + sizeof *w->geo) +
+	size_t n = w->nlights * sizeof *w->lights + w->nprims * sizeof *w->prims +
 	           w->nplanes * sizeof *w->planes + w->nshapes * sizeof *w->shapes +
 	           w->ntris * sizeof *w->tris + w->nmats * sizeof *w->mats +
 	           w->nemitters * sizeof *w->emitters;
@@ -561,13 +537,12 @@ static inline __attribute__((always_inline)) bool walk(const world *w, const ray
 	for (;;) {
 		if (meta) {
 			const prim *p = &w->prims[child];
-			const prim_geo *g = &w->geo[child];
 			uint32_t count = meta & ~BVH_LEAF;
 			for (uint32_t k = 0; k < count; k++)
 				if (any) {
-					if (prim_occluded(w, &p[k], &g[k], r, tmin, tmax))
+					if (prim_occluded(w, &p[k], r, tmin, tmax))
 						return true;
-				} else if (prim_hit(w, &p[k], &g[k], r, tmin, tmax, &t, &nl, coherent)) {
+				} else if (prim_hit(w, &p[k], r, tmin, tmax, &t, &nl, coherent)) {
 					tmax = t;
 					ftmax = to_float_up(tmax);
 					*best = &p[k];
@@ -672,13 +647,13 @@ vec3 world_trace_ng(const world *w, const ray *r, const trace_hit *th)
 	const prim *p = th->prim;
 	switch (p->tag) {
 	case PRIM_SPHERE:
-		return v3_sub(ray_at(*r, th->t), prim_geo_of(w, p)->sph.c);
+		return v3_sub(ray_at(*r, th->t), p->u.sph.c);
 	case PRIM_TRIANGLE:
-		return v3_cross(w->tris[prim_geo_of(w, p)->index].e1, w->tris[prim_geo_of(w, p)->index].e2);
+		return v3_cross(w->tris[p->u.index].e1, w->tris[p->u.index].e2);
 	case PRIM_MESH:
 		return surf_inst_ng(w, p, th->nl);
 	default: {
-		const prim_shape *sh = &w->shapes[prim_geo_of(w, p)->index];
+		const prim_shape *sh = &w->shapes[p->u.index];
 		const double(*m)[4] = (const double(*)[4])sh->inv;
 		vec3 nl = th->nl;
 		return (vec3){m[0][0] * nl.x + m[1][0] * nl.y + m[2][0] * nl.z, m[0][1] * nl.x + m[1][1] * nl.y + m[2][1] * nl.z,
@@ -732,7 +707,7 @@ bool world_intersect_brute(const world *w, const ray *r, double tmin, double tma
 			best_plane = &w->planes[i];
 		}
 	for (size_t i = 0; i < w->nprims; i++)
-		if (prim_hit(w, &w->prims[i], &w->geo[i], r, tmin, tmax, &t, &nl, false)) {
+		if (prim_hit(w, &w->prims[i], r, tmin, tmax, &t, &nl, false)) {
 			tmax = t;
 			best = &w->prims[i];
 			best_n = nl;
@@ -751,7 +726,7 @@ bool world_occluded_brute(const world *w, const ray *r, double tmin, double tmax
 		if (plane_hit(&w->planes[i], r, tmin, tmax, &t))
 			return true;
 	for (size_t i = 0; i < w->nprims; i++)
-		if (prim_occluded(w, &w->prims[i], &w->geo[i], r, tmin, tmax))
+		if (prim_occluded(w, &w->prims[i], r, tmin, tmax))
 			return true;
 	return false;
 }

@@ -435,69 +435,6 @@ static void test_float_boxes(void **state)
 		}
 }
 
-/* The primitives' geometry (world.geo, apart from the kinds and objects in
- * world.prims, bigtree2): record i is primitive i's, whatever order the
- * tree put them in; a fast sphere's record is its centre and half its
- * diameter, exactly; the records are 32 bytes, 32-byte aligned (no record
- * across two cache lines), and 8 + 32 bytes a primitive as the 40-byte
- * record was. spheres_only is set for spheres alone and only then: a cube
- * among them is still a cube to the walks. */
-static void test_sphere_records(void **state)
-{
-	(void)state;
-	assert_int_equal(sizeof(prim_geo), 32);
-	assert_int_equal(sizeof(prim) + sizeof(prim_geo), 40);
-	scene *s = random_scene(5, 0, 1, 1, 0);
-	enum { N = 500 };
-	for (int i = 0; i < N; i++) {
-		object o = object_make(OBJ_SPHERE, v3(9, 9, 9));
-		/* distinct centres and sizes, in an order the tree will change */
-		o.pos = v3((i * 37 % 101) * 0.1, (i * 53 % 97) * 0.1 - 5, (i * 11 % 89) * 0.1);
-		double d = 0.01 + 0.0001 * i;
-		o.scale = v3(d, d, d);
-		assert_true(scene_add_object(s, &o, NULL));
-	}
-	world *w = build(s);
-	assert_int_equal(w->nprims, N);
-	assert_true(w->spheres_only);
-	assert_int_equal((uintptr_t)w->geo % 32, 0);
-	bool seen[N] = {false};
-	for (size_t i = 0; i < w->nprims; i++) {
-		uint32_t ob = w->prims[i].object;
-		assert_true(ob < N && !seen[ob]);
-		seen[ob] = true;
-		assert_int_equal(w->prims[i].tag, PRIM_SPHERE);
-		const object *o = &s->objs[ob];
-		assert_true(w->geo[i].sph.c.x == o->pos.x && w->geo[i].sph.c.y == o->pos.y &&
-		            w->geo[i].sph.c.z == o->pos.z);
-		assert_true(w->geo[i].sph.r == (0.01 + 0.0001 * ob) / 2);
-		assert_true(prim_geo_of(w, &w->prims[i]) == &w->geo[i]);
-	}
-	/* the sphere at the middle of the list, hit along z from outside */
-	const object *mid = &s->objs[N / 2];
-	ray r = {v3(mid->pos.x, mid->pos.y, -100), v3(0, 0, 1)};
-	hit h;
-	assert_true(world_intersect(w, &r, 0, INFINITY, &h));
-	world_free(w);
-
-	/* a cube of side 2 at (50, 0, 0), far from the spheres: met at its
-	 * face x = 49, not at a sphere's distance */
-	object c = object_make(OBJ_CUBE, v3(9, 9, 9));
-	c.pos = v3(50, 0, 0);
-	c.scale = v3(2, 2, 2);
-	assert_true(scene_add_object(s, &c, NULL));
-	w = build(s);
-	assert_false(w->spheres_only);
-	ray rc = {v3(30, 0.25, 0), v3(1, 0, 0)};
-	assert_true(world_intersect(w, &rc, 0, INFINITY, &h));
-	assert_int_equal(h.object, N);
-	assert_true(fabs(h.t - 19.0) < 1e-9);
-	assert_true(world_occluded(w, &rc, 0, 19.5));
-	assert_false(world_occluded(w, &rc, 0, 18.5));
-	world_free(w);
-	scene_free(s);
-}
-
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -511,7 +448,6 @@ int main(void)
 		cmocka_unit_test(test_huge_coordinates),
 		cmocka_unit_test(test_half_area),
 		cmocka_unit_test(test_float_boxes),
-		cmocka_unit_test(test_sphere_records),
 	};
 	return cmocka_run_group_tests_name("bvh", tests, NULL, NULL);
 }

@@ -392,7 +392,7 @@ static long model_traced, model_ties, model_occluded_traced;
  * hit at all is (the distance of a tie is the nearest). */
 static void check_model(const world *w, const ray *r, int n, int turn)
 {
-	const prim_inst *in = &w->insts[w->geo[0].index];
+	const prim_inst *in = &w->insts[w->prims[0].u.index];
 	double ts[PACKET_MAX], tm[PACKET_MAX] = {0}, t[PACKET_MAX];
 	uint32_t ss[PACKET_MAX], slot[PACKET_MAX];
 	float bs[PACKET_MAX][3], b[PACKET_MAX][3];
@@ -634,7 +634,7 @@ static void test_model_cull(void **state)
 	                         "mesh scenes/models/spot/spot_triangulated.obj 0.4,0.3,0.2 0.3,1,0.1 1.5 255,255,255\n",
 	                         "model", &s);
 	assert_true(w->nprims == 1 && w->prims[0].tag == PRIM_MESH);
-	const prim_inst *in = &w->insts[w->geo[0].index];
+	const prim_inst *in = &w->insts[w->prims[0].u.index];
 	vec3 o = w->cam.pos, c = box_center(w->bounds);
 	vec3 d0 = v3_norm(v3_sub(c, o));
 	long traced = 0;
