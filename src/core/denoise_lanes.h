@@ -20,6 +20,7 @@
 #define solve_lanes LANES(solve_lanes)
 #define regression_body LANES(regression_body)
 #define pick_body LANES(pick_body)
+#define feat_dist2 LANES(feat_dist2)
 #define LANES_INLINE static inline __attribute__((always_inline))
 
 /* VL floats in one SIMD value, VL ints (the lanes' masks: all bits set
@@ -65,6 +66,19 @@ LANES_INLINE vf vf_load(const float *p)
  * changes with AVX.) */
 #define vf_and(x, m) ((vf)((vi)(x) & (m)))
 #define vf_abs(x) vf_and(x, vi_splat(0x7fffffff))
+
+/* The squared distance, lane by lane, of the six features at offset q of
+ * the planes pf from the centre pixels' gf. */
+LANES_INLINE vf feat_dist2(const vf *gf, const float *const *pf, ptrdiff_t q)
+{
+	vf e = vf_splat(0.0f);
+#pragma GCC unroll 6
+	for (int k = 0; k < 6; k++) {
+		vf d = gf[k] - vf_load(pf[k] + q);
+		e += d * d;
+	}
+	return e;
+}
 
 /* Whether some lane of the mask *m is set. */
 LANES_INLINE bool vf_any(const vi *m)
@@ -243,12 +257,7 @@ LANES_INLINE void regression_body(job *j, int y0, int y1)
 					vi qx = lane + vi_splat(dx);
 					vi in = (qx >= vi_splat(0)) & (qx < vi_splat(w));
 					ptrdiff_t q = (ptrdiff_t)qy * w + x + dx;
-					vf e = vf_splat(0.0f);
-#pragma GCC unroll 6
-					for (int k = 0; k < 6; k++) {
-						vf d = gf[k] - vf_load(pf[k] + q);
-						e += d * d;
-					}
+					vf e = feat_dist2(gf, pf, q);
 					vf qz = vf_load(pz + q);
 					e += vf_abs(qz - (gz + ggx * off[dx + WIN] + ggy * off[dy + WIN])) * inv_z;
 					vf wt = vf_exp_fast(&e);
@@ -382,12 +391,7 @@ LANES_INLINE void pick_body(job *j, int y0, int y1)
 #pragma GCC unroll 9
 				for (int dx = -PICK_R; dx <= PICK_R; dx++) {
 					ptrdiff_t q = (ptrdiff_t)qy * w + x0 + dx;
-					vf e = vf_splat(0.0f);
-#pragma GCC unroll 6
-					for (int k = 0; k < 6; k++) {
-						vf d = gf[k] - vf_load(pf[k] + q);
-						e += d * d;
-					}
+					vf e = feat_dist2(gf, pf, q);
 					e *= vf_splat(PICK_SCALE);
 					vf wt = vf_exp_fast(&e);
 					/* no weight: skipped (an infinite estimate times 0
@@ -459,3 +463,4 @@ LANES_TARGET static void LANES(pick_rows)(job *j, int y0, int y1)
 #undef solve_lanes
 #undef regression_body
 #undef pick_body
+#undef feat_dist2
