@@ -280,6 +280,8 @@ static void slots_freed(shared *sh)
  * then told to stop). */
 static bool hand_rows(shared *sh)
 {
+	if (atomic_load(&sh->stop)) /* a handover failed: never a band again */
+		return false;
 	int b = atomic_load(&sh->band_next), e = b;
 	while (e < sh->bands && atomic_load(&sh->band_left[e]) == 0)
 		e++;
@@ -339,8 +341,12 @@ static bool slot_ready(shared *sh, long t, bool hands)
 		}
 		if (hands && band_ready(sh)) {
 			pthread_mutex_unlock(&sh->lock);
-			hand_rows(sh);
+			bool handed = hand_rows(sh);
 			pthread_mutex_lock(&sh->lock);
+			if (!handed) {
+				ok = false;
+				break;
+			}
 			continue;
 		}
 		struct timespec deadline;
