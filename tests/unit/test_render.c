@@ -551,6 +551,17 @@ static bool rows_check(void *ctx, const framebuffer *fb, int y0, int y1, const u
 	return r->calls != r->stop_at;
 }
 
+/* The handover that fails (call stop_at, the first `slow` calls slow) stops
+ * the render: no image, no call after it, the message. */
+static void handover_stops(const world *wd, const render_settings *set, const uint8_t *expect, int stop_at, int slow)
+{
+	rows_seen stop = {expect, 0, 0, stop_at, slow, NULL, NULL, NULL};
+	rt_error err = {0};
+	assert_null(render_image_rows(wd, set, NULL, NULL, NULL, rows_check, &stop, &err));
+	assert_int_equal(stop.calls, stop_at);
+	assert_non_null(strstr(err.msg, "writing the image stopped the render"));
+}
+
 /* Every row once, in order, its codes final when handed over and those of
  * linear_to_srgb8 on render_image's floats x 2^exposure; no float image
  * kept; with 1, 2 and 3 threads. A callback that fails stops the render. */
@@ -579,12 +590,7 @@ static void test_rows_while_rendering(void **state)
 		assert_true(r.calls >= 1 && r.calls <= 4);
 		assert_null(fb->rgb);
 		fb_free(fb);
-		/* a failed handover stops the render */
-		rows_seen stop = {expect, 0, 0, 1, 0, NULL, NULL, NULL};
-		rt_error err = {0};
-		assert_null(render_image_rows(wd, &set, NULL, NULL, NULL, rows_check, &stop, &err));
-		assert_int_equal(stop.calls, 1);
-		assert_non_null(strstr(err.msg, "writing the image stopped the render"));
+		handover_stops(wd, &set, expect, 1, 0); /* a failed handover stops the render */
 	}
 	free(expect);
 	fb_free(ref);
@@ -622,14 +628,10 @@ static void test_rows_ring(void **state)
 		fb_free(fb);
 		/* threads waiting for their slots end when a handover fails, or
 		 * when the render is cancelled: no hang, the right message */
-		rows_seen stop = {expect, 0, 0, 2, 8, NULL, NULL, NULL};
-		rt_error err = {0};
-		assert_null(render_image_rows(wd, &set, NULL, NULL, NULL, rows_check, &stop, &err));
-		assert_int_equal(stop.calls, 2);
-		assert_non_null(strstr(err.msg, "writing the image stopped the render"));
+		handover_stops(wd, &set, expect, 2, 8);
 		atomic_bool cancel = false;
 		rows_seen cut = {expect, 0, 0, 0, 8, NULL, NULL, &cancel};
-		memset(&err, 0, sizeof err);
+		rt_error err = {0};
 		assert_null(render_image_rows(wd, &set, &cancel, NULL, NULL, rows_check, &cut, &err));
 		assert_true(cut.calls >= 1 && cut.calls < 31);
 		assert_non_null(strstr(err.msg, "render stopped"));
