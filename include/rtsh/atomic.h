@@ -43,6 +43,12 @@ typedef bool (*file_writer_fn)(FILE *f, void *ctx, rt_error *err);
  * reason from errno) the old file is untouched. */
 bool file_write_atomic(const char *path, file_writer_fn write, void *ctx, rt_error *err);
 
+/* False (err says why, as file_write_atomic would) when path's folder does
+ * not exist, so that no file can be written there: a caller about to spend
+ * a long render on the file asks first. True otherwise, which is no promise
+ * that the write will succeed. */
+bool file_folder_exists(const char *path, rt_error *err);
+
 /* A note on how the last successful file_write_atomic of this thread wrote
  * ("x.rt has 2 hard links: written in place to keep them"), or "" when it
  * replaced or created the file as usual. */

@@ -165,6 +165,19 @@ static void split(const char *path, char *dir, size_t dsize, const char **base)
 	*base = slash ? slash + 1 : path;
 }
 
+bool file_folder_exists(const char *path, rt_error *err)
+{
+	char dir[PATH_MAX];
+	const char *base;
+	split(path, dir, sizeof dir, &base);
+	struct stat st;
+	if (stat(*dir ? dir : ".", &st) == 0 || (errno != ENOENT && errno != ENOTDIR))
+		return true;
+	rt_error_at(err, path, 0, 0, "cannot create a file in that folder (%s); expected a writable folder",
+	            strerror(errno));
+	return false;
+}
+
 /* The file that writing `path` really writes: symbolic links followed, each
  * relative target taken from its link's folder. A link to a missing file
  * gives the missing file's path (it is created). Malloc'ed; NULL with err. */

@@ -102,8 +102,10 @@ bool cmd_save(shell *sh, int argc, char **argv, const char *rest)
 			frame_free(f);
 		}
 	} else if (image_type_of(path)) {
-		const framebuffer *fb = shell_full_image(sh, false);
-		if (!fb)
+		const framebuffer *fb = NULL;
+		if (!file_folder_exists(path, &err)) /* now, not after the render */
+			ok = save_failed(sh, &err);
+		else if (!(fb = shell_full_image(sh, false)))
 			ok = false;
 		else if (!image_write(path, fb, sh->set.exposure, &err))
 			ok = save_failed(sh, &err);
