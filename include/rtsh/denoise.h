@@ -69,6 +69,8 @@
 #define RTSH_DENOISE_H
 
 #include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
 
 #include "rtsh/render.h"
 #include "rtsh/world.h"
@@ -144,9 +146,50 @@ void denoise_sample(const world *w, ray r, int k, double *acc);
 void denoise_features(const world *w, const render_settings *s, int px, int py, int fw, int fh,
                       int begin, int end, const double *ra, const double *acc, float *f);
 
+/* The same for camera positions [begin, end) (end at most
+ * DENOISE_FEATURE_SAMPLES) of no radiance sample: the features of a pixel
+ * whose adaptive samples (render_job.pixel_end) are fewer than
+ * DENOISE_FEATURE_SAMPLES are still made over that many positions (the
+ * albedo at its radiance samples' own positions, 15-20, over its own). */
+void denoise_features_only(const world *w, const render_settings *s, int px, int py, int fw, int fh,
+                           int begin, int end, float *f);
+
 /* Writes the denoised radiance of fb (which has features and samples) to
  * out, w*h*3 linear floats; out may be fb->rgb. threads: the workers to use
  * (>= 1). False when out of memory (out is then untouched). */
 bool denoise_image(const framebuffer *fb, float *out, int threads);
+
+/* Adaptive sampling at the same budget: a denoised render of S samples
+ * spends S x W x H camera paths, DENOISE_FIRST(S) (3/4 of S, even) in
+ * every pixel first, then the rest where the noise is (render_image). */
+#define DENOISE_FIRST(S) ((3 * (S) / 4) & ~1)
+/* ...each pixel at most this many times the mean. */
+#define DENOISE_CAP_TIMES 8
+
+/* The noise about each pixel of fb (features and at least 2 samples a
+ * pixel) into sigma (w*h): the standard deviation of one sample's
+ * brightness over its 8 neighbours, the root of the mean of their
+ * variances, the pixel's own samples left out (so that its count does not
+ * depend on them: a pixel whose first samples happened to miss a bright
+ * path would keep few, and its mean would be low on average). False when
+ * out of memory. */
+bool denoise_sigma(const framebuffer *fb, float *sigma);
+/* Whether a pixel of features f keeps the samples a uniform render gives it
+ * and its noise counts for none of its neighbours: its first positions all
+ * missed the scene (the background or the sky: a path there is one ray,
+ * and its samples spent on a surface would cost a whole path each), or
+ * they see a lamp (albedo feature above 1: a lamp's edge is noise of
+ * radiance far above the display's, and took the samples of the surfaces
+ * around it). */
+bool denoise_fixed(const float *f);
+
+/* Each of n pixels' samples into out: first (even) or more, at most cap,
+ * first + an even number, summing to mean x n (or the even total below it
+ * when (mean - first) x n is odd): the n_p that minimise
+ * sum sigma_p^2 / n_p under those bounds, n_p = clamp(l sigma_p, first,
+ * cap), rounded to pairs by their running sum (deterministic, in pixel
+ * order). Every pixel has a thousandth of the mean sigma added, so that
+ * the budget is spent whatever sigma holds. cap >= mean >= first. */
+void denoise_allocate(const float *sigma, size_t n, int first, int mean, int cap, uint16_t *out);
 
 #endif

@@ -94,6 +94,9 @@ typedef struct framebuffer {
 	int srgb8_ring; /* 0: srgb8 holds every row; k > 0: only a ring of k
 	                 * bands of RENDER_TILE rows, band b in slot b % k, each
 	                 * reused once job->rows has taken it (render_image_rows) */
+	uint16_t *pixel_spp; /* optional: each pixel's own sample count (a
+	                      * denoised render's adaptive samples, denoise.h);
+	                      * NULL: spp samples in every pixel */
 } framebuffer;
 
 /* NULL when out of memory or the size is not in 1..RENDER_MAX_DIM. */
@@ -106,6 +109,9 @@ void fb_clear(framebuffer *fb);
 framebuffer *fb_reuse(framebuffer **fb, int w, int h);
 
 #define RENDER_MAX_DIM 16384
+/* A denoised render of up to this many samples spends them adaptively
+ * (render_image: the pixels' counts are 16-bit). */
+#define RENDER_ADAPTIVE_MAX 4096
 #define RENDER_TILE 16
 
 typedef enum render_status {
@@ -140,6 +146,11 @@ typedef struct render_job {
 	void *progress_ctx;
 	render_rows_fn rows;   /* optional: needs fb->srgb8 */
 	void *rows_ctx;
+	/* optional: pixel i's own end, sample_begin..sample_end (adaptive
+	 * sampling: the pixel's sequence continues where the last pass left
+	 * it); a pixel's features are still made over the first
+	 * DENOISE_FEATURE_SAMPLES positions (denoise.h). NULL: sample_end. */
+	const uint16_t *pixel_end;
 } render_job;
 
 /* Runs the job to the end or until cancelled. On RENDER_DONE the fb holds

@@ -400,17 +400,23 @@ static bool corners_vary(const world *w, int px, int py, int fw, int fh, const f
 	return features_vary(all);
 }
 
-void denoise_features(const world *w, const render_settings *s, int px, int py, int fw, int fh,
-                      int begin, int end, const double *ra, const double *acc, float *f)
+/* denoise_features, and denoise_features_only with ra NULL: then samples
+ * [begin, end) are camera positions of no radiance sample, and the
+ * radiance's features and the albedo at its samples' own positions (7,
+ * 10-13, 15-20) are left as they are. */
+static void features_update(const world *w, const render_settings *s, int px, int py, int fw, int fh,
+                            int begin, int end, const double *ra, const double *acc, float *f)
 {
-	f[7] = (float)(((double)f[7] * begin + ra[0]) / end);
-	/* the even samples: (begin + 1) / 2 of them before, (end + 1) / 2 after */
-	int e0 = (begin + 1) / 2, e1 = (end + 1) / 2;
-	if (e1 > e0)
-		for (int k = 0; k < 3; k++)
-			f[10 + k] = (float)(((double)f[10 + k] * e0 + ra[1 + k]) / e1);
-	if (e1 > e0)
-		f[13] = (float)(((double)f[13] * e0 + ra[4]) / e1);
+	if (ra) {
+		f[7] = (float)(((double)f[7] * begin + ra[0]) / end);
+		/* the even samples: (begin + 1) / 2 of them before, (end + 1) / 2 after */
+		int e0 = (begin + 1) / 2, e1 = (end + 1) / 2;
+		if (e1 > e0)
+			for (int k = 0; k < 3; k++)
+				f[10 + k] = (float)(((double)f[10 + k] * e0 + ra[1 + k]) / e1);
+		if (e1 > e0)
+			f[13] = (float)(((double)f[13] * e0 + ra[4]) / e1);
+	}
 	int n0 = begin < DENOISE_FEATURE_SAMPLES ? begin : DENOISE_FEATURE_SAMPLES;
 	int n1 = end < DENOISE_FEATURE_SAMPLES ? end : DENOISE_FEATURE_SAMPLES;
 	if (n1 <= n0)
@@ -423,7 +429,7 @@ void denoise_features(const world *w, const render_settings *s, int px, int py, 
 	/* the albedo of the radiance samples' own positions: the even ones
 	 * and all of them */
 	int ne0 = (n0 + 1) / 2, ne1 = (n1 + 1) / 2;
-	for (int k = 0; k < 3; k++) {
+	for (int k = 0; k < 3 && ra; k++) {
 		if (ne1 > ne0)
 			f[15 + k] = (float)(((double)f[15 + k] * ne0 + acc[10 + k]) / ne1);
 		f[18 + k] = f[k];
@@ -465,6 +471,25 @@ void denoise_features(const world *w, const render_settings *s, int px, int py, 
 	lobe /= DENOISE_EDGE_SAMPLES;
 	f[14] = (float)((double)f[14] - (double)f[21] + lobe);
 	f[21] = (float)lobe;
+}
+
+void denoise_features(const world *w, const render_settings *s, int px, int py, int fw, int fh,
+                      int begin, int end, const double *ra, const double *acc, float *f)
+{
+	features_update(w, s, px, py, fw, fh, begin, end, ra, acc, f);
+}
+
+void denoise_features_only(const world *w, const render_settings *s, int px, int py, int fw, int fh,
+                           int begin, int end, float *f)
+{
+	double acc[DENOISE_ACC] = {0};
+	if (end > DENOISE_FEATURE_SAMPLES)
+		end = DENOISE_FEATURE_SAMPLES;
+	if (end <= begin)
+		return;
+	for (int k = begin; k < end; k++)
+		denoise_sample(w, render_sample_ray(w, s, px, py, fw, fh, k), k, acc);
+	features_update(w, s, px, py, fw, fh, begin, end, NULL, acc, f);
 }
 
 /* --- the filter ------------------------------------------------------------ */
@@ -561,9 +586,7 @@ typedef struct job {
 	size_t pstride;         /* floats from one plane to the next */
 	float *fit;             /* 3 x NFIT a pixel: the regressions' values */
 	float *out;
-	float n[NCH];           /* samples in each chain */
 	bool halves;            /* at least two samples: two independent halves */
-	bool own;               /* every sample's position has its albedo (features 15-20) */
 	int threads;            /* workers sharing the rows, this thread included */
 	pthread_barrier_t bar;  /* between the passes */
 	pthread_mutex_t lock;
@@ -574,6 +597,21 @@ typedef struct job {
 static inline float lum(const float *c)
 {
 	return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
+}
+
+/* Pixel i's samples: its own (adaptive sampling), or the image's. */
+static inline int pixel_spp(const framebuffer *fb, size_t i)
+{
+	return fb->pixel_spp ? fb->pixel_spp[i] : fb->spp;
+}
+
+/* The samples in each chain of a pixel of spp samples. */
+static inline void chain_n(int spp, float n[NCH])
+{
+	bool halves = spp >= 2;
+	n[CH_A] = halves ? (float)((spp + 1) / 2) : 1.0f;
+	n[CH_B] = halves ? (float)(spp / 2) : 1.0f;
+	n[CH_ALL] = spp > 1 ? (float)spp : 1.0f;
 }
 
 /* Plane k's first pixel (regression_rows). */
@@ -613,12 +651,15 @@ static void setup_rows(job *j, int y0, int y1)
 			g->gy = depth_slope(f + 6, y, h, DENOISE_FEATURES * w);
 			j->mixed[i] = features_vary(f);
 			texel *t = &j->t[i];
-			bool own = j->own;
+			int spp = pixel_spp(fb, i);
+			bool own = spp <= DENOISE_FEATURE_SAMPLES;
+			float nc[NCH];
+			chain_n(spp, nc);
 			for (int k = 0; k < 3; k++) {
 				float c = fb->rgb[i * 3 + k], a = c, b = c;
 				if (j->halves) {
 					a = f[10 + k];
-					b = (c * j->n[CH_ALL] - a * j->n[CH_A]) / j->n[CH_B];
+					b = (c * nc[CH_ALL] - a * nc[CH_A]) / nc[CH_B];
 				}
 				/* Divided by the albedo at the samples' own positions
 				 * where they are all the samples (each half by its
@@ -628,7 +669,7 @@ static void setup_rows(job *j, int y0, int y1)
 				float da = am[k], db = am[k], dc = am[k];
 				if (own && f[k] > ALBEDO_MIN) {
 					float sa = f[15 + k], sc = f[18 + k];
-					float sb = (sc * j->n[CH_ALL] - sa * j->n[CH_A]) / j->n[CH_B];
+					float sb = (sc * nc[CH_ALL] - sa * nc[CH_A]) / nc[CH_B];
 					da = sa > ALBEDO_MIN ? sa : am[k];
 					db = sb > ALBEDO_MIN ? sb : am[k];
 					dc = sc > ALBEDO_MIN ? sc : am[k];
@@ -666,12 +707,15 @@ static void variance_rows(job *j, int y0, int y1)
 			const float *f = fb->feat + i * DENOISE_FEATURES;
 			float am = lum(j->am + i * 3), am2 = am * am;
 			chan *hc = j->t[i].h;
-			if (fb->spp >= 2) {
-				float n = j->n[CH_ALL], m1 = lum(hc[CH_ALL].c) * am;
+			int spp = pixel_spp(fb, i);
+			if (spp >= 2) {
+				float nc[NCH];
+				chain_n(spp, nc);
+				float n = nc[CH_ALL], m1 = lum(hc[CH_ALL].c) * am;
 				float v = (f[7] - m1 * m1) * n / (n - 1) / am2;
 				hc[CH_ALL].v = hc[CH_A].v = hc[CH_B].v = v > 0 ? v : 0;
-				if (fb->spp >= 4) {
-					float na = j->n[CH_A], nb = j->n[CH_B];
+				if (spp >= 4) {
+					float na = nc[CH_A], nb = nc[CH_B];
 					float ma = lum(hc[CH_A].c) * am, mb = lum(hc[CH_B].c) * am;
 					float qa = f[13], qb = (f[7] * n - f[13] * na) / nb;
 					float va = (qa - ma * ma) * na / (na - 1) / am2;
@@ -1027,11 +1071,12 @@ bool denoise_image(const framebuffer *fb, float *out, int threads)
 	if (threads > h)
 		threads = h;
 	job j = {.fb = fb, .out = out};
+	/* halves in every pixel (an adaptive render's pixels have at least
+	 * its first pass's samples, fb->spp counts its mean) */
 	j.halves = fb->spp >= 2;
-	j.own = fb->spp <= DENOISE_FEATURE_SAMPLES;
-	j.n[CH_A] = j.halves ? (float)((fb->spp + 1) / 2) : 1.0f;
-	j.n[CH_B] = j.halves ? (float)(fb->spp / 2) : 1.0f;
-	j.n[CH_ALL] = fb->spp > 1 ? (float)fb->spp : 1.0f;
+	if (fb->pixel_spp)
+		for (size_t i = 0; i < n; i++)
+			j.halves &= fb->pixel_spp[i] >= 2;
 	size_t off[NSC];
 	scratch *sc = scratch_take(n, off);
 	if (sc) {
@@ -1078,4 +1123,106 @@ bool denoise_image(const framebuffer *fb, float *out, int threads)
 	scratch_give(sc);
 	mem_free_all(tid, args);
 	return ok;
+}
+
+/* --- adaptive sampling ------------------------------------------------------ */
+
+/* The noise of one sample's brightness about each pixel of fb (its samples
+ * so far, at least two; features 7): the variance in each pixel from the
+ * mean of the squared brightness and the mean's square, n / (n - 1)
+ * unbiased; then each pixel the root of the mean of its 8 neighbours'
+ * (those inside the image), its own left out. */
+bool denoise_fixed(const float *f)
+{
+	return !(f[6] > 0.0f) || f[0] > 1.0f || f[1] > 1.0f || f[2] > 1.0f;
+}
+
+bool denoise_sigma(const framebuffer *fb, float *sigma)
+{
+	int w = fb->w, h = fb->h;
+	size_t n = (size_t)w * (size_t)h;
+	float *v = malloc(n * sizeof *v);
+	if (!v)
+		return false;
+	for (size_t i = 0; i < n; i++) {
+		int spp = pixel_spp(fb, i);
+		const float *c = fb->rgb + i * 3;
+		double m = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+		double var = spp > 1 ? ((double)fb->feat[i * DENOISE_FEATURES + 7] - m * m) * spp / (spp - 1) : 0.0;
+		v[i] = var > 0 && !denoise_fixed(fb->feat + i * DENOISE_FEATURES) ? (float)var : 0.0f;
+	}
+	for (int y = 0; y < h; y++)
+		for (int x = 0; x < w; x++) {
+			double s = 0;
+			int k = 0;
+			for (int dy = -1; dy <= 1; dy++)
+				for (int dx = -1; dx <= 1; dx++) {
+					int qx = x + dx, qy = y + dy;
+					if (qx < 0 || qy < 0 || qx >= w || qy >= h || (dx == 0 && dy == 0))
+						continue;
+					s += v[(size_t)qy * w + qx];
+					k++;
+				}
+			sigma[(size_t)y * w + x] = k ? (float)sqrt(s / k) : 0.0f;
+		}
+	free(v);
+	return true;
+}
+
+/* A pixel's samples before rounding: l (sigma + floor), clamped to
+ * [first, cap]. */
+static inline double alloc_one(float sigma, double l, double floor_, int first, int cap)
+{
+	double v = l * ((double)sigma + floor_);
+	return v < first ? first : v > cap ? cap : v;
+}
+
+/* The pixels' alloc_one summed. */
+static double alloc_total_floor(const float *sigma, size_t n, double l, double floor_, int first, int cap)
+{
+	double t = 0;
+	for (size_t i = 0; i < n; i++)
+		t += alloc_one(sigma[i], l, floor_, first, cap);
+	return t;
+}
+
+void denoise_allocate(const float *sigma, size_t n, int first, int mean, int cap, uint16_t *out)
+{
+	/* Every pixel a little weight: a black image, or one of a few noisy
+	 * pixels, still spends the whole budget (a thousandth of the mean). */
+	double ms = 0;
+	for (size_t i = 0; i < n; i++)
+		ms += sigma[i];
+	ms = ms > 0 ? ms / (double)n * 1e-3 : 1.0;
+	/* l: the samples per unit of noise, so that the pixels' clamped
+	 * shares sum to mean n (the sum grows with l; bisection) */
+	double total = (double)mean * (double)n, lo = 0, hi = 1;
+	while (alloc_total_floor(sigma, n, hi, ms, first, cap) < total && hi < 1e30)
+		hi *= 2;
+	for (int it = 0; it < 64; it++) {
+		double mid = 0.5 * (lo + hi);
+		if (alloc_total_floor(sigma, n, mid, ms, first, cap) < total)
+			lo = mid;
+		else
+			hi = mid;
+	}
+	/* The pairs of samples above first: each pixel's real share, rounded
+	 * by their running sum (so that they sum to the whole exactly, and
+	 * each pixel gets its share rounded down or up). */
+	long pairs = (long)(((long long)(mean - first) * (long long)n) / 2);
+	double sum = 0;
+	for (size_t i = 0; i < n; i++)
+		sum += alloc_one(sigma[i], hi, ms, first, cap) - first;
+	double run = 0, scale = sum > 0 ? (double)pairs / (0.5 * sum) : 0.0;
+	long given = 0;
+	for (size_t i = 0; i < n; i++) {
+		run += 0.5 * (alloc_one(sigma[i], hi, ms, first, cap) - first) * scale;
+		long upto = i + 1 == n ? pairs : (long)floor(run + 0.5);
+		if (upto > pairs)
+			upto = pairs;
+		if (upto < given)
+			upto = given;
+		out[i] = (uint16_t)(first + 2 * (upto - given));
+		given = upto;
+	}
 }

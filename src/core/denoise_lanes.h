@@ -211,7 +211,6 @@ LANES_INLINE vi solve_lanes(const vf *a, vf zv[NU])
 LANES_INLINE void regression_body(job *j, int y0, int y1)
 {
 	int w = j->fb->w, h = j->fb->h;
-	float na = j->n[CH_A], nb = j->n[CH_B];
 	const float *pf[6], *pdata[5];
 	for (int k = 0; k < 6; k++)
 		pf[k] = plane(j, PL_F0 + k);
@@ -340,6 +339,9 @@ LANES_INLINE void regression_body(job *j, int y0, int y1)
 					perr[CAND_DIRECT][pi] = INFINITY;
 					continue;
 				}
+				float nc[NCH];
+				chain_n(pixel_spp(j->fb, pi), nc);
+				float na = nc[CH_A], nb = nc[CH_B];
 				/* The raw pixel estimated the same way as the fits, so
 				 * that the estimates share their noise. */
 				perr[CAND_RAW][pi] = cross_error(r0, na, nb, lum(r0[CH_A].c), lum(r0[CH_B].c)) * am2;
@@ -432,7 +434,9 @@ LANES_INLINE void pick_body(job *j, int y0, int y1)
 					float v = c[k] * am[k];
 					o->c[k] = v > 0 ? v : 0;
 				}
-				o->v = o->v / j->n[CH_ALL] * l * l;
+				float nc[NCH];
+				chain_n(pixel_spp(j->fb, i), nc);
+				o->v = o->v / nc[CH_ALL] * l * l;
 			}
 		}
 }

@@ -1083,6 +1083,211 @@ static void test_features_in_passes(void **state)
 	scene_free(s);
 }
 
+/* The adaptive budget's rule (denoise_allocate), derived by hand. Every
+ * pixel's noise gets a thousandth of the mean noise added (f), and the
+ * pixels get clamp(l (sigma + f), first, cap) samples, l such that they
+ * sum to mean x n; the pairs above first are rounded by their running sum.
+ * (a) sigma 0, 1, 2, 3, 0.5, 10, first 4, mean 8, cap 32: f = 16.5 / 6 /
+ * 1000 = 0.00275; pixels 0, 1 and 4 stay at 4 (l (1 + f) < 4), so
+ * 12 + l (2 + 3 + 10 + 3f) = 48, l = 36 / 15.00825 = 2.39868: 4.80396,
+ * 7.20264 and 23.99340 samples, pairs above 4: 0.40198, 1.60132, 9.99670;
+ * running sums 0, 0, 0.40198, 2.00330, 2.00330, 12 round to 0, 0, 0, 2,
+ * 2, 12: samples 4, 4, 4, 8, 4, 24 (48 in all).
+ * (b) sigma 100, 1, 1, 1, first 4, mean 8, cap 16: pixel 0 is clamped to
+ * 16; the other three share 32 - 16 equally, 5.333 each, 0.667 pairs:
+ * running sums 6, 6.667, 7.333, 8 round to 6, 7, 7, 8: 16, 6, 4, 6.
+ * (c) no noise anywhere: every pixel the mean, 8. */
+static void test_allocate_rule(void **state)
+{
+	(void)state;
+	uint16_t out[6];
+	const float a[6] = {0, 1, 2, 3, 0.5f, 10};
+	denoise_allocate(a, 6, 4, 8, 32, out);
+	const uint16_t ea[6] = {4, 4, 4, 8, 4, 24};
+	assert_memory_equal(out, ea, sizeof ea);
+	const float b[4] = {100, 1, 1, 1};
+	denoise_allocate(b, 4, 4, 8, 16, out);
+	const uint16_t eb[4] = {16, 6, 4, 6};
+	assert_memory_equal(out, eb, sizeof eb);
+	const float c[5] = {0};
+	denoise_allocate(c, 5, 4, 8, 32, out);
+	for (int i = 0; i < 5; i++)
+		assert_int_equal(out[i], 8);
+	/* a larger map: the total, evenness and the bounds */
+	enum { N = 1000 };
+	static float big[N];
+	static uint16_t nb[N];
+	for (int i = 0; i < N; i++)
+		big[i] = (float)((i * 7919) % 101) * (i % 13 == 0 ? 50.0f : 1.0f);
+	denoise_allocate(big, N, 4, 8, 64, nb);
+	long total = 0;
+	for (int i = 0; i < N; i++) {
+		assert_true(nb[i] >= 4 && nb[i] <= 64 && nb[i] % 2 == 0);
+		total += nb[i];
+	}
+	assert_int_equal(total, 8 * N);
+}
+
+/* The noise that decides a pixel's samples is its 8 neighbours', never its
+ * own: a 3x3 image of 4 samples a pixel, grey 0.5 (brightness 0.5), each
+ * pixel's mean squared brightness 0.25 + v 3/4, so that its unbiased
+ * variance, (mean square - mean^2) 4/3, is v. v = 1..9 row by row: the
+ * centre (v 5) gets the root of the mean of the other eight, sqrt(40 / 8);
+ * the corner (0, 0) of its three neighbours 2, 4, 5: sqrt(11 / 3). Its own
+ * v changed (to 1000) changes neither. */
+static void test_sigma_neighbours(void **state)
+{
+	(void)state;
+	framebuffer *fb = fb_new(3, 3);
+	assert_non_null(fb);
+	assert_true(denoise_prepare(fb));
+	fb->spp = 4;
+	for (int i = 0; i < 9; i++) {
+		for (int k = 0; k < 3; k++) {
+			fb->rgb[i * 3 + k] = 0.5f;
+			fb->feat[i * DENOISE_FEATURES + k] = 0.5f; /* albedo */
+		}
+		fb->feat[i * DENOISE_FEATURES + 6] = 3.0f; /* depth: a surface */
+		fb->feat[i * DENOISE_FEATURES + 7] = 0.25f + (float)(i + 1) * 0.75f;
+	}
+	float sg[9];
+	assert_true(denoise_sigma(fb, sg));
+	assert_near(sg[4], sqrt(40.0 / 8), 1e-5);
+	assert_near(sg[0], sqrt(11.0 / 3), 1e-5);
+	fb->feat[4 * DENOISE_FEATURES + 7] = 0.25f + 1000.0f * 0.75f;
+	float s2[9];
+	assert_true(denoise_sigma(fb, s2));
+	assert_true(s2[4] == sg[4]);
+	fb->feat[4 * DENOISE_FEATURES + 7] = 0.25f + 5.0f * 0.75f;
+	fb->feat[0 * DENOISE_FEATURES + 7] = 0.25f + 1000.0f * 0.75f;
+	assert_true(denoise_sigma(fb, s2));
+	assert_true(s2[0] == sg[0]);
+	/* A pixel that missed the scene (depth 0) or sees a lamp (albedo 2)
+	 * is fixed and its noise counts for none of its neighbours: pixel 1
+	 * (v 2) missing, the corner's neighbours are 4 and 5 (and pixel 1's
+	 * 0): sqrt(9 / 3); pixel 3 (v 4) a lamp too: sqrt(5 / 3); the
+	 * centre's sum 40 - 2 - 4 = 34 over 8. */
+	fb->feat[0 * DENOISE_FEATURES + 7] = 0.25f + 1.0f * 0.75f;
+	fb->feat[1 * DENOISE_FEATURES + 6] = 0.0f;
+	assert_true(denoise_fixed(fb->feat + 1 * DENOISE_FEATURES));
+	assert_false(denoise_fixed(fb->feat + 0 * DENOISE_FEATURES));
+	assert_true(denoise_sigma(fb, s2));
+	assert_near(s2[0], sqrt(9.0 / 3), 1e-5);
+	fb->feat[3 * DENOISE_FEATURES + 1] = 2.0f;
+	assert_true(denoise_fixed(fb->feat + 3 * DENOISE_FEATURES));
+	assert_true(denoise_sigma(fb, s2));
+	assert_near(s2[0], sqrt(5.0 / 3), 1e-5);
+	assert_near(s2[4], sqrt(34.0 / 8), 1e-5);
+	fb_free(fb);
+}
+
+/* The adaptive pass continues each pixel's own sequence: a first pass of 4
+ * samples, then every pixel to 8 through render_job.pixel_end, holds the
+ * bits of 8 samples in one pass (the same sums in the same order); pixels
+ * ended at 4 and 6 keep their 4 or 6 samples' mean (a 4- or 6-sample render's
+ * bits), and their features are still made over the first 8 positions (as
+ * the 8-sample render's, to float rounding), the albedo at their radiance
+ * samples' own positions (15-20) over their own 4 or 6. */
+static void test_adaptive_pass(void **state)
+{
+	(void)state;
+	scene *s = load_text("C 0,1,-4 0,-0.2,1 60\nA 0.5 200,220,255\nL 2,4,-2 0.7 255,255,255\n"
+	                     "pl 0,0,0 0,1,0 200,200,200\nsp 0,1,0 2 220,60,50\nsp -1.2,0.4,-1.5 0.4 40,40,240\n");
+	world *w = world_build(s, NULL);
+	assert_non_null(w);
+	enum { W = 19, H = 13, N = W * H };
+	render_settings set = path_settings(W, H, 8, 3, 11);
+	framebuffer *ref[3];
+	const int spp[3] = {4, 6, 8};
+	for (int k = 0; k < 3; k++) {
+		ref[k] = fb_new(W, H);
+		assert_true(ref[k] && denoise_prepare(ref[k]));
+		render_job job = {.w = w, .set = set, .fb = ref[k], .sample_begin = 0, .sample_end = spp[k]};
+		assert_int_equal(render_run(&job, NULL), RENDER_DONE);
+	}
+	framebuffer *fb = fb_new(W, H);
+	assert_true(fb && denoise_prepare(fb));
+	render_job job = {.w = w, .set = set, .fb = fb, .sample_begin = 0, .sample_end = 4};
+	assert_int_equal(render_run(&job, NULL), RENDER_DONE);
+	uint16_t end[N];
+	for (int i = 0; i < N; i++)
+		end[i] = (uint16_t)spp[i % 3];
+	job.sample_begin = 4;
+	job.sample_end = 8;
+	job.pixel_end = end;
+	assert_int_equal(render_run(&job, NULL), RENDER_DONE);
+	for (int i = 0; i < N; i++) {
+		const framebuffer *r = ref[i % 3], *r8 = ref[2];
+		assert_memory_equal(fb->rgb + i * 3, r->rgb + i * 3, 3 * sizeof *fb->rgb);
+		const float *f = fb->feat + (size_t)i * DENOISE_FEATURES;
+		const float *f8 = r8->feat + (size_t)i * DENOISE_FEATURES, *fr = r->feat + (size_t)i * DENOISE_FEATURES;
+		for (int q = 0; q < DENOISE_FEATURES; q++) {
+			/* the features of the 8 positions; of the radiance, and
+			 * the albedo at its own positions, of the pixel's samples */
+			bool own = q == 7 || (q >= 10 && q <= 13) || (q >= 15 && q <= 20);
+			float e = own ? fr[q] : f8[q];
+			assert_near(f[q], e, 1e-5 * (1 + fabsf(e)));
+		}
+	}
+	for (int k = 0; k < 3; k++)
+		fb_free(ref[k]);
+	fb_free(fb);
+	world_free(w);
+	scene_free(s);
+}
+
+/* A denoised render (render_image, as save and batch output) of 8 samples
+ * spends 8 x W x H in all, but not 8 in each pixel: at least
+ * DENOISE_FIRST(8) = 6, even, at most DENOISE_CAP_TIMES x 8, and 8 where
+ * the pixel is fixed (the background above the horizon); the same counts
+ * and the same picture for 1, 2 and 7 threads. */
+static void test_adaptive_render(void **state)
+{
+	(void)state;
+	scene *s = load_text("C 0,1,-4 0,-0.2,1 60\nA 0.3 200,220,255\nL 2,4,-2 0.7 255,255,255\n"
+	                     "pl 0,0,0 0,1,0 200,200,200\nsp 0,1,0 2 220,60,50\n"
+	                     "sp 1.5,0.5,-1 0,1,0 1,1,1 255,255,255 0 0 1 1\n");
+	world *w = world_build(s, NULL);
+	assert_non_null(w);
+	enum { W = 37, H = 23, N = W * H };
+	render_settings set = path_settings(W, H, 8, 4, 7);
+	set.threads = 1;
+	framebuffer *one = render_with(w, set, DENOISE_ON);
+	assert_non_null(one->pixel_spp);
+	assert_int_equal(one->spp, 8);
+	long total = 0;
+	int low = 0, high = 0, fixed = 0;
+	assert_int_equal(DENOISE_FIRST(8), 6);
+	for (int i = 0; i < N; i++) {
+		int n = one->pixel_spp[i];
+		assert_true(n >= 6 && n <= DENOISE_CAP_TIMES * 8 && n % 2 == 0);
+		if (denoise_fixed(one->feat + (size_t)i * DENOISE_FEATURES)) {
+			assert_int_equal(n, 8);
+			fixed++;
+		}
+		total += n;
+		low += n < 8;
+		high += n > 8;
+	}
+	assert_int_equal(total, 8L * N);
+	assert_true(low > 0 && high > 0 && fixed > 0);
+	const int threads[] = {2, 7};
+	for (int k = 0; k < 2; k++) {
+		set.threads = threads[k];
+		framebuffer *many = render_with(w, set, DENOISE_ON);
+		assert_memory_equal(one->pixel_spp, many->pixel_spp, N * sizeof *one->pixel_spp);
+		assert_memory_equal(one->rgb, many->rgb, N * 3 * sizeof *one->rgb);
+		fb_free(many);
+	}
+	/* raw renders stay one pass of 8 in every pixel */
+	framebuffer *raw = render_with(w, set, DENOISE_OFF);
+	assert_null(raw->pixel_spp);
+	fb_free(raw);
+	fb_free(one);
+	world_free(w);
+	scene_free(s);
+}
+
 /* Whitted images are never touched, whatever the setting; path images only
  * with denoise on (render_image is what save and batch use). */
 static void test_modes(void **state)
@@ -1154,6 +1359,10 @@ int main(void)
 		cmocka_unit_test(test_probe_edge),
 		cmocka_unit_test(test_mixed_pixel_agreeing_samples),
 		cmocka_unit_test(test_features_in_passes),
+		cmocka_unit_test(test_allocate_rule),
+		cmocka_unit_test(test_sigma_neighbours),
+		cmocka_unit_test(test_adaptive_pass),
+		cmocka_unit_test(test_adaptive_render),
 		cmocka_unit_test(test_modes),
 		cmocka_unit_test(test_setting),
 	};
