@@ -34,6 +34,7 @@
 
 #include "core/bvh/bvh.h"
 #include "core/prim_hit.h"
+#include "core/surface.h"
 #include "rtsh/mesh.h"
 
 /* The state of a packet's walk: the rays by component (for the vector
@@ -42,8 +43,8 @@ typedef struct pk_state {
 	int n;
 	_Alignas(16) double ox[PACKET_MAX], oy[PACKET_MAX], oz[PACKET_MAX];
 	_Alignas(16) double dx[PACKET_MAX], dy[PACKET_MAX], dz[PACKET_MAX];
-	_Alignas(16) double dd[PACKET_MAX]; /* d . d, as sphere_hit computes it */
-	double tmax[PACKET_MAX];            /* the nearest hit so far (or the query's tmax) */
+	_Alignas(16) double dd[PACKET_MAX];   /* d . d, as sphere_hit computes it */
+	_Alignas(16) double tmax[PACKET_MAX]; /* the nearest hit so far (or the query's tmax) */
 	const prim *best[PACKET_MAX];
 	vec3 nl[PACKET_MAX];
 	bool tie[PACKET_MAX];
@@ -437,47 +438,95 @@ static bool model_packet(const world *w, int n, const ray *r, double tmin, doubl
 	return true;
 }
 
-void world_trace_packet(const world *w, int n, const ray *r, double tmin, double tmax, trace_hit *th, bool *found)
+/* The planes beside the tree for the rays of s, as trace tests them (the
+ * nearest in the planes' order, each with plane_hit's test): s->tmax[i]
+ * from tmax down to the nearest plane's distance, best_plane[i] that plane
+ * or NULL. Two rays per SSE2 register, each lane plane_hit_o's operations
+ * in its order: dy = h . d, -oy / dy, the strict test against tmin and the
+ * nearest so far (dy == 0 fails as there; a NaN fails every compare, as
+ * there). Rays of one origin share its height over each plane (plane_oy,
+ * once a plane: see world_trace_packet); others each compute their own,
+ * plane_oy's operations in its order. */
+static void packet_planes(const world *w, pk_state *s, double tmin, double tmax, const prim_plane **best_plane)
+{
+	int n = s->n, even = (n + 1) & ~1;
+	for (int i = 0; i < even; i++) {
+		s->tmax[i] = tmax;
+		best_plane[i] = NULL;
+	}
+	/* Origins equal as doubles may differ in the sign of a zero, and so
+	 * may oy, only when it is zero: then -oy / dy is a zero (or NaN) that
+	 * no tmin >= 0 lets through either way. */
+	bool one = s->one_o && tmin >= 0.0;
+	const __m128d sign = _mm_set1_pd(-0.0), zero = _mm_setzero_pd(), t0 = _mm_set1_pd(tmin);
+	for (size_t k = 0; k < w->nplanes; k++) {
+		const prim_plane *pl = &w->planes[k];
+		const __m128d h0 = _mm_set1_pd(pl->h[0]), h1 = _mm_set1_pd(pl->h[1]), h2 = _mm_set1_pd(pl->h[2]);
+		const __m128d h3 = _mm_set1_pd(pl->h[3]);
+		const __m128d oy1 = _mm_set1_pd(one ? plane_oy(pl, (vec3){s->ox[0], s->oy[0], s->oz[0]}) : 0.0);
+		for (int i = 0; i < n; i += 2) {
+			__m128d oy = oy1;
+			if (!one)
+				oy = _mm_add_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(h0, _mm_load_pd(&s->ox[i])),
+				                                      _mm_mul_pd(h1, _mm_load_pd(&s->oy[i]))),
+				                           _mm_mul_pd(h2, _mm_load_pd(&s->oz[i]))),
+				                h3);
+			__m128d dy = _mm_add_pd(_mm_add_pd(_mm_mul_pd(h0, _mm_load_pd(&s->dx[i])),
+			                                   _mm_mul_pd(h1, _mm_load_pd(&s->dy[i]))),
+			                        _mm_mul_pd(h2, _mm_load_pd(&s->dz[i])));
+			__m128d tt = _mm_div_pd(_mm_xor_pd(oy, sign), dy), t = _mm_load_pd(&s->tmax[i]);
+			__m128d m = _mm_and_pd(_mm_cmpneq_pd(dy, zero), _mm_and_pd(_mm_cmpgt_pd(tt, t0), _mm_cmplt_pd(tt, t)));
+			_mm_store_pd(&s->tmax[i], _mm_or_pd(_mm_and_pd(m, tt), _mm_andnot_pd(m, t)));
+			/* (without branches: which rays meet a plane first follows the
+			 * picture, not a pattern the branch predictor learns) */
+			int bits = _mm_movemask_pd(m);
+			best_plane[i] = bits & 1 ? pl : best_plane[i];
+			best_plane[i + 1] = bits & 2 ? pl : best_plane[i + 1]; /* (the pad's entry exists: even <= PACKET_MAX) */
+		}
+	}
+}
+
+/* The packet's walk of rays r[0..n) (n <= PACKET_MAX) into s, the planes'
+ * nearest into best_plane: false when the rays are not traced as a packet
+ * (too few, not coherent, an empty tree), to be traced alone. */
+static bool packet_trace(const world *w, int n, const ray *r, double tmin, double tmax, pk_state *s,
+                         const prim_plane **best_plane)
 {
 	pk_ray q;
-	bool lone_model = w->nprims == 1 && w->prims[0].tag == PRIM_MESH;
-	if (lone_model && n >= 2 && n <= PACKET_MAX && model_packet(w, n, r, tmin, tmax, th, found))
+	if (n < 2 || !w->nprims || !packet_prepare(r, n, &q))
+		return false;
+	world_rays_count(n);
+	s->n = n;
+	s->one_o = q.one_o;
+	for (int i = 0; i < n; i++) {
+		s->best[i] = NULL;
+		s->tie[i] = false;
+		pk_load_ray(s, i, &r[i]);
+	}
+	if (n & 1) /* the vector tests read an even count; the pad is never offered */
+		pk_load_ray(s, n, &r[0]);
+	packet_planes(w, s, tmin, tmax, best_plane);
+	packet_walk(w, s, r, &q, tmin);
+	return true;
+}
+
+static bool lone_model(const world *w)
+{
+	return w->nprims == 1 && w->prims[0].tag == PRIM_MESH;
+}
+
+void world_trace_packet(const world *w, int n, const ray *r, double tmin, double tmax, trace_hit *th, bool *found)
+{
+	pk_state s;
+	const prim_plane *best_plane[PACKET_MAX];
+	bool lone = lone_model(w);
+	if (lone && n >= 2 && n <= PACKET_MAX && model_packet(w, n, r, tmin, tmax, th, found))
 		return;
-	if (n < 2 || n > PACKET_MAX || !w->nprims || lone_model || !packet_prepare(r, n, &q)) {
+	if (n > PACKET_MAX || lone || !packet_trace(w, n, r, tmin, tmax, &s, best_plane)) {
 		for (int i = 0; i < n; i++)
 			found[i] = world_trace_coherent(w, &r[i], tmin, tmax, &th[i]);
 		return;
 	}
-	world_rays_count(n);
-	pk_state s;
-	s.n = n;
-	const prim_plane *best_plane[PACKET_MAX];
-	s.one_o = q.one_o;
-	/* rays of one origin: its height over each of the first planes once
-	 * (plane_oy). Origins equal as doubles may differ in the sign of a
-	 * zero, and so may oy, only when it is zero: then -oy / dy is a zero
-	 * (or NaN) that no tmin >= 0 lets through either way. */
-	double oy[4];
-	size_t noy = s.one_o && tmin >= 0.0 ? (w->nplanes < 4 ? w->nplanes : 4) : 0;
-	for (size_t k = 0; k < noy; k++)
-		oy[k] = plane_oy(&w->planes[k], r[0].o);
-	for (int i = 0; i < n; i++) {
-		double t = tmax, tp;
-		best_plane[i] = NULL;
-		for (size_t k = 0; k < w->nplanes; k++)
-			if (k < noy ? plane_hit_o(&w->planes[k], oy[k], &r[i], tmin, t, &tp)
-			            : plane_hit(&w->planes[k], &r[i], tmin, t, &tp)) {
-				t = tp;
-				best_plane[i] = &w->planes[k];
-			}
-		s.tmax[i] = t;
-		s.best[i] = NULL;
-		s.tie[i] = false;
-		pk_load_ray(&s, i, &r[i]);
-	}
-	if (n & 1) /* the vector pre-test reads an even count; the pad is never offered */
-		pk_load_ray(&s, n, &r[0]);
-	packet_walk(w, &s, r, &q, tmin);
 	for (int i = 0; i < n; i++) {
 		if (s.tie[i]) {
 			world_rays_count(-1);
@@ -492,13 +541,178 @@ void world_trace_packet(const world *w, int n, const ray *r, double tmin, double
 	}
 }
 
+/* Rays a and b of s (lanes 0 and 1) on a point of their hit: o + d t, as
+ * ray_at. */
+static inline void pk_point2(const pk_state *s, int a, int b, __m128d *px, __m128d *py, __m128d *pz)
+{
+	__m128d t = _mm_set_pd(s->tmax[b], s->tmax[a]);
+	*px = _mm_add_pd(_mm_set_pd(s->ox[b], s->ox[a]), _mm_mul_pd(_mm_set_pd(s->dx[b], s->dx[a]), t));
+	*py = _mm_add_pd(_mm_set_pd(s->oy[b], s->oy[a]), _mm_mul_pd(_mm_set_pd(s->dy[b], s->dy[a]), t));
+	*pz = _mm_add_pd(_mm_set_pd(s->oz[b], s->oz[a]), _mm_mul_pd(_mm_set_pd(s->dz[b], s->dz[a]), t));
+}
+
+/* Whether n . d < 0 for rays a and b (bits 0 and 1), as v3_dot(n, d) < 0.0
+ * computes it, n given by component for each lane. */
+static inline int pk_front2(const pk_state *s, int a, int b, __m128d nx, __m128d ny, __m128d nz)
+{
+	__m128d dot = _mm_add_pd(_mm_add_pd(_mm_mul_pd(nx, _mm_set_pd(s->dx[b], s->dx[a])),
+	                                    _mm_mul_pd(ny, _mm_set_pd(s->dy[b], s->dy[a]))),
+	                         _mm_mul_pd(nz, _mm_set_pd(s->dz[b], s->dz[a])));
+	return _mm_movemask_pd(_mm_cmplt_pd(dot, _mm_setzero_pd()));
+}
+
+static inline void store2(__m128d v, double *a, double *b)
+{
+	_mm_storel_pd(a, v);
+	_mm_storeh_pd(b, v);
+}
+
+/* One row of a 3x4 matrix applied to points in lanes: m[0] x + m[1] y +
+ * m[2] z + m[3], in that order (finish_plane's local point). */
+static inline __m128d row2(const double *m, __m128d x, __m128d y, __m128d z)
+{
+	return _mm_add_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(_mm_set1_pd(m[0]), x), _mm_mul_pd(_mm_set1_pd(m[1]), y)),
+	                             _mm_mul_pd(_mm_set1_pd(m[2]), z)),
+	                  _mm_set1_pd(m[3]));
+}
+
+/* The hit records of rays a and b of s on plane pl: world_finish's
+ * (finish_plane, surf_shape_uv), each lane its operations in its order. */
+static void finish_plane2(const world *w, const pk_state *s, const prim_plane *pl, int a, int b, hit *h)
+{
+	const prim_shape *sh = &w->shapes[pl->shape];
+	const double(*m)[4] = sh->inv;
+	__m128d px, py, pz;
+	pk_point2(s, a, b, &px, &py, &pz);
+	int front = pk_front2(s, a, b, _mm_set1_pd(pl->n.x), _mm_set1_pd(pl->n.y), _mm_set1_pd(pl->n.z));
+	__m128d lx = row2(m[0], px, py, pz), ly = row2(m[1], px, py, pz), lz = row2(m[2], px, py, pz);
+	bool uv = surf_wants_uv(w, pl->object);
+	int idx[2] = {a, b};
+	for (int k = 0; k < 2; k++) {
+		hit *o = &h[idx[k]];
+		o->t = s->tmax[idx[k]];
+		o->object = pl->object;
+		o->front = front >> k & 1;
+		o->n = pl->n;
+	}
+	store2(px, &h[a].p.x, &h[b].p.x);
+	store2(py, &h[a].p.y, &h[b].p.y);
+	store2(pz, &h[a].p.z, &h[b].p.z);
+	store2(lx, &h[a].local.x, &h[b].local.x);
+	store2(ly, &h[a].local.y, &h[b].local.y);
+	store2(lz, &h[a].local.z, &h[b].local.z);
+	for (int k = 0; k < 2; k++) {
+		hit *o = &h[idx[k]];
+		if (uv) {
+			surf_shape_uv(w, sh, pl->n, o);
+		} else {
+			o->mat = pl->object;
+			o->has_uv = false;
+		}
+	}
+}
+
+/* The hit records of rays a and b of s on spheres pa and pb: finish_hit's
+ * for a sphere, each lane its operations in its order (the normal
+ * v3_norm(p - c): the squared length, its sqrt, 1 / that, the products). */
+static void finish_sphere2(const pk_state *s, const prim *pa, const prim *pb, int a, int b, hit *h)
+{
+	__m128d px, py, pz;
+	pk_point2(s, a, b, &px, &py, &pz);
+	__m128d vx = _mm_sub_pd(px, _mm_set_pd(pb->u.sph.c.x, pa->u.sph.c.x));
+	__m128d vy = _mm_sub_pd(py, _mm_set_pd(pb->u.sph.c.y, pa->u.sph.c.y));
+	__m128d vz = _mm_sub_pd(pz, _mm_set_pd(pb->u.sph.c.z, pa->u.sph.c.z));
+	__m128d len = _mm_sqrt_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(vx, vx), _mm_mul_pd(vy, vy)), _mm_mul_pd(vz, vz)));
+	__m128d inv = _mm_div_pd(_mm_set1_pd(1.0), len);
+	__m128d nx = _mm_mul_pd(vx, inv), ny = _mm_mul_pd(vy, inv), nz = _mm_mul_pd(vz, inv);
+	int front = pk_front2(s, a, b, nx, ny, nz);
+	const prim *p[2] = {pa, pb};
+	int idx[2] = {a, b};
+	for (int k = 0; k < 2; k++) {
+		hit *o = &h[idx[k]];
+		o->t = s->tmax[idx[k]];
+		o->object = p[k]->object;
+		o->mat = p[k]->object;
+		o->has_uv = false;
+		o->front = front >> k & 1;
+	}
+	store2(px, &h[a].p.x, &h[b].p.x);
+	store2(py, &h[a].p.y, &h[b].p.y);
+	store2(pz, &h[a].p.z, &h[b].p.z);
+	/* (local = n: stored from the registers, not copied from the record,
+	 * whose halves, just stored one by one, a 16-byte load would wait for) */
+	store2(nx, &h[a].n.x, &h[b].n.x);
+	store2(ny, &h[a].n.y, &h[b].n.y);
+	store2(nz, &h[a].n.z, &h[b].n.z);
+	store2(nx, &h[a].local.x, &h[b].local.x);
+	store2(ny, &h[a].local.y, &h[b].local.y);
+	store2(nz, &h[a].local.z, &h[b].local.z);
+}
+
 void world_intersect_packet(const world *w, int n, const ray *r, double tmin, double tmax, hit *h, bool *found)
 {
-	trace_hit th[PACKET_MAX];
-	world_trace_packet(w, n, r, tmin, tmax, th, found);
-	for (int i = 0; i < n; i++)
-		if (found[i])
-			world_finish(w, &r[i], &th[i], &h[i]);
+	pk_state s;
+	const prim_plane *best_plane[PACKET_MAX];
+	bool lone = lone_model(w);
+	if (lone || n > PACKET_MAX || !packet_trace(w, n, r, tmin, tmax, &s, best_plane)) {
+		trace_hit th[PACKET_MAX];
+		if (!lone || n > PACKET_MAX) {
+			for (int i = 0; i < n; i++)
+				found[i] = world_intersect_coherent(w, &r[i], tmin, tmax, &h[i]);
+			return;
+		}
+		world_trace_packet(w, n, r, tmin, tmax, th, found);
+		for (int i = 0; i < n; i++)
+			if (found[i])
+				world_finish(w, &r[i], &th[i], &h[i]);
+		return;
+	}
+	/* the hit records: pairs of rays on one plane, pairs on spheres, the
+	 * rest one by one as world_finish makes them */
+	int on_plane[PACKET_MAX], on_sphere[PACKET_MAX], np = 0, ns = 0;
+	/* sorted without branches (which rays end on a sphere and which on the
+	 * plane follows the picture: a branch on it is mispredicted often);
+	 * ties and other primitives, rare, one by one below */
+	static const prim none = {.tag = PRIM_MESH};
+	unsigned alone = 0;
+	for (int i = 0; i < n; i++) {
+		const prim *p = s.best[i] ? s.best[i] : &none;
+		bool tie = s.tie[i], sphere = p->tag == PRIM_SPHERE && !tie;
+		bool plane = !s.best[i] && best_plane[i] && !tie;
+		found[i] = s.best[i] || best_plane[i];
+		on_plane[np] = i;
+		np += plane;
+		on_sphere[ns] = i;
+		ns += sphere;
+		alone |= (unsigned)(tie || (s.best[i] && !sphere)) << i;
+	}
+	for (; alone; alone &= alone - 1) {
+		int i = __builtin_ctz(alone);
+		if (s.tie[i]) {
+			world_rays_count(-1);
+			found[i] = world_intersect_coherent(w, &r[i], tmin, tmax, &h[i]);
+		} else {
+			trace_hit th = {s.tmax[i], s.best[i], NULL, s.nl[i]};
+			world_finish(w, &r[i], &th, &h[i]);
+		}
+	}
+	for (int k = 0; k < np; k++) {
+		int a = on_plane[k];
+		if (k + 1 < np && best_plane[on_plane[k + 1]] == best_plane[a]) {
+			finish_plane2(w, &s, best_plane[a], a, on_plane[k + 1], h);
+			k++;
+		} else {
+			trace_hit th = {s.tmax[a], NULL, best_plane[a], {0, 0, 0}};
+			world_finish(w, &r[a], &th, &h[a]);
+		}
+	}
+	for (int k = 0; k + 1 < ns; k += 2)
+		finish_sphere2(&s, s.best[on_sphere[k]], s.best[on_sphere[k + 1]], on_sphere[k], on_sphere[k + 1], h);
+	if (ns & 1) {
+		int a = on_sphere[ns - 1];
+		trace_hit th = {s.tmax[a], s.best[a], NULL, s.nl[a]};
+		world_finish(w, &r[a], &th, &h[a]);
+	}
 }
 
 /* --- any hit: shadow rays --- */

@@ -45,6 +45,45 @@ static void same_vec(vec3 a, vec3 b, const char *what)
 	same_double(a.z, b.z, what);
 }
 
+/* Two hit records field by field, to the bit (u, v, dpdu, dpdv where the
+ * single ray's has them). */
+static void same_hit(const hit *hp, const hit *hs)
+{
+	same_double(hp->t, hs->t, "t");
+	same_vec(hp->p, hs->p, "p");
+	same_vec(hp->n, hs->n, "n");
+	same_vec(hp->local, hs->local, "local");
+	assert_int_equal(hp->front, hs->front);
+	assert_int_equal(hp->object, hs->object);
+	assert_int_equal(hp->mat, hs->mat);
+	assert_int_equal(hp->has_uv, hs->has_uv);
+	if (hs->has_uv) {
+		same_double(hp->u, hs->u, "u");
+		same_double(hp->v, hs->v, "v");
+		same_vec(hp->dpdu, hs->dpdu, "dpdu");
+		same_vec(hp->dpdv, hs->dpdv, "dpdv");
+	}
+}
+
+/* world_intersect_packet's hit records (the packet's own, made two rays at
+ * a time on planes and spheres) against world_intersect_coherent's, for
+ * r[0..n) with tmin < t < tmax. */
+static void check_records(const world *w, const ray *r, int n, double tmin, double tmax)
+{
+	hit hp[PACKET_MAX];
+	bool fp[PACKET_MAX];
+	memset(hp, 0, sizeof hp);
+	world_intersect_packet(w, n, r, tmin, tmax, hp, fp);
+	for (int i = 0; i < n; i++) {
+		hit hs;
+		memset(&hs, 0, sizeof hs);
+		bool fs = world_intersect_coherent(w, &r[i], tmin, tmax, &hs);
+		assert_int_equal(fp[i], fs);
+		if (fs)
+			same_hit(&hp[i], &hs);
+	}
+}
+
 /* Packet against single rays for r[0..n): nearest hits, hit records, and
  * shadow queries to a fraction of each hit's distance and to `lamp`. */
 static void check_packet(const world *w, const ray *r, int n, vec3 lamp)
@@ -53,6 +92,7 @@ static void check_packet(const world *w, const ray *r, int n, vec3 lamp)
 	bool fp[PACKET_MAX];
 	world_trace_packet(w, n, r, 0.0, INFINITY, tp, fp);
 	packets++;
+	check_records(w, r, n, 0.0, INFINITY);
 	ray sr[PACKET_MAX];
 	double smax[PACKET_MAX];
 	for (int i = 0; i < n; i++) {
@@ -74,19 +114,7 @@ static void check_packet(const world *w, const ray *r, int n, vec3 lamp)
 		memset(&hs, 0, sizeof hs);
 		world_finish(w, &r[i], &tp[i], &hp);
 		world_finish(w, &r[i], &ts, &hs);
-		same_vec(hp.p, hs.p, "p");
-		same_vec(hp.n, hs.n, "n");
-		same_vec(hp.local, hs.local, "local");
-		assert_int_equal(hp.front, hs.front);
-		assert_int_equal(hp.object, hs.object);
-		assert_int_equal(hp.mat, hs.mat);
-		assert_int_equal(hp.has_uv, hs.has_uv);
-		if (hs.has_uv) {
-			same_double(hp.u, hs.u, "u");
-			same_double(hp.v, hs.v, "v");
-			same_vec(hp.dpdu, hs.dpdu, "dpdu");
-			same_vec(hp.dpdv, hs.dpdv, "dpdv");
-		}
+		same_hit(&hp, &hs);
 		/* a shadow ray from just off the hit toward the light */
 		vec3 p = v3_add(hs.p, v3_scale(hs.n, hs.front ? 1e-6 : -1e-6));
 		vec3 to = v3_sub(lamp, p);
@@ -139,8 +167,11 @@ static void cone_packets(const world *w, vec3 lo, vec3 hi, int count, uint64_t s
 		for (int i = 0; i < n; i++) {
 			vec3 j = v3((trand(&g) - 0.5) * spread, (trand(&g) - 0.5) * spread, (trand(&g) - 0.5) * spread);
 			r[i] = (ray){o, v3_norm(v3_add(v3_norm(v3_sub(at, o)), j))};
+			if (k % 3 == 2) /* origins a little apart: each ray's own height over the planes */
+				r[i].o = v3_add(o, v3_scale(j, 0.1));
 		}
 		check_packet(w, r, n, lamp);
+		check_records(w, r, n, 1e-3, 1e3);
 	}
 }
 
