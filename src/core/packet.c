@@ -51,16 +51,29 @@ typedef struct pk_state {
 	bool one_o; /* every ray's origin is ray 0's, bit for bit (camera rays) */
 } pk_state;
 
-/* Ray i by component, and d . d as sphere_hit computes it. */
-static inline void pk_load_ray(pk_state *s, int i, const ray *r)
+/* Rays r[0..n) by component into s (n <= PACKET_MAX), and d . d as
+ * sphere_hit computes it, two rays per register; an odd count is padded
+ * with ray 0, which the vector tests read and nothing offers. Each double
+ * is read alone: the caller has usually just written the rays a component
+ * at a time (cam_block_rays), and a 16-byte load of two such stores waits
+ * for both to leave the store buffer instead of being forwarded; the pairs
+ * are stored whole, so that the vector tests' loads are forwarded. */
+static void pk_load(pk_state *s, const ray *r, int n)
 {
-	s->ox[i] = r->o.x;
-	s->oy[i] = r->o.y;
-	s->oz[i] = r->o.z;
-	s->dx[i] = r->d.x;
-	s->dy[i] = r->d.y;
-	s->dz[i] = r->d.z;
-	s->dd[i] = v3_dot(r->d, r->d);
+	s->n = n;
+	for (int i = 0; i < n; i += 2) {
+		const ray *a = &r[i], *b = i + 1 < n ? &r[i + 1] : &r[0];
+		__m128d dx = _mm_loadh_pd(_mm_load_sd(&a->d.x), &b->d.x);
+		__m128d dy = _mm_loadh_pd(_mm_load_sd(&a->d.y), &b->d.y);
+		__m128d dz = _mm_loadh_pd(_mm_load_sd(&a->d.z), &b->d.z);
+		_mm_store_pd(&s->ox[i], _mm_loadh_pd(_mm_load_sd(&a->o.x), &b->o.x));
+		_mm_store_pd(&s->oy[i], _mm_loadh_pd(_mm_load_sd(&a->o.y), &b->o.y));
+		_mm_store_pd(&s->oz[i], _mm_loadh_pd(_mm_load_sd(&a->o.z), &b->o.z));
+		_mm_store_pd(&s->dx[i], dx);
+		_mm_store_pd(&s->dy[i], dy);
+		_mm_store_pd(&s->dz[i], dz);
+		_mm_store_pd(&s->dd[i], _mm_add_pd(_mm_add_pd(_mm_mul_pd(dx, dx), _mm_mul_pd(dy, dy)), _mm_mul_pd(dz, dz)));
+	}
 }
 
 /* The interval form of bvh_ray: per axis, the near- and far-plane origins
@@ -85,13 +98,14 @@ static inline double next_up(double t)
 	return t;
 }
 
-/* Fills q for rays r[0..n); false when the packet is not coherent enough
- * for the interval test: a direction component of another sign than the
- * first ray's, a zero or NaN component, an inverse or origin that is not
- * finite. Each ray's origin and inverse direction are rounded as world.c's
- * bvh_ray_prepare rounds them (on and of bracket the origin so that the near
- * plane's distance can only come down and the far plane's go up), three
- * axes in one register, and the packet keeps their lowest and highest.
+/* Fills q for the rays of s (pk_load); false when the packet is not
+ * coherent enough for the interval test: a direction component of another
+ * sign than the first ray's, a zero or NaN component, an inverse or origin
+ * that is not finite. Each ray's origin and inverse direction are rounded
+ * as world.c's bvh_ray_prepare rounds them (on and of bracket the origin so
+ * that the near plane's distance can only come down and the far plane's go
+ * up), three axes in one register, and the packet keeps their lowest and
+ * highest.
  *
  * The inverses are not computed ray by ray: for directions of one sign,
  * 1/d falls as d rises, and both the double division and the rounding to
@@ -99,44 +113,60 @@ static inline double next_up(double t)
  * direction component and the highest that of the lowest: the same floats
  * from two divisions a packet instead of one a ray. Every ray's inverse
  * lies between those two (of one sign), so they are finite and not zero
- * exactly when all the rays' are. An origin equal to the first ray's
- * (camera rays) brackets the same floats and is not rounded again. */
-static bool packet_prepare(const ray *r, int n, pk_ray *q)
+ * exactly when all the rays' are. When every origin equals the first
+ * ray's as doubles (camera rays; a zero of either sign gives the same
+ * floats here), the first ray's bracket is the packet's. The components are
+ * read by pairs from s (the pad, ray 0 again, changes no extreme). */
+static bool packet_prepare(const pk_state *s, pk_ray *q)
 {
+	const int n = s->n;
 	const __m128d one = _mm_set1_pd(1.0);
 	const __m128 sign = _mm_set1_ps(-0.0f), ulp = _mm_set1_ps(0x1p-23f), tiny = _mm_set1_ps(0x1p-149f);
 	const __m128 big = _mm_set1_ps(FLT_MAX);
-	/* the directions' lowest and highest, x and y in one register, z in
-	 * the low lane of another; any NaN among them or the origins */
-	__m128d dlo = _mm_loadu_pd(&r[0].d.x), dhi = dlo, dlo_z = _mm_load_sd(&r[0].d.z), dhi_z = dlo_z;
-	const __m128d o0 = _mm_loadu_pd(&r[0].o.x), o0z = _mm_load_sd(&r[0].o.z);
-	/* the inverses' signs are the directions' (when the packet is used:
-	 * no NaN, every ray's signs the first ray's) */
-	const __m128 isign = _mm_and_ps(_mm_movelh_ps(_mm_cvtpd_ps(dlo), _mm_cvtpd_ps(dlo_z)), sign);
-	__m128d nan = _mm_setzero_pd();
+	/* per axis the directions' lowest and highest and their bits ANDed
+	 * and ORed (the sign bits: all negative, any negative), two lanes
+	 * each; any NaN among directions and origins; whether every origin
+	 * is the first ray's */
+	__m128d lx = _mm_load_pd(&s->dx[0]), ly = _mm_load_pd(&s->dy[0]), lz = _mm_load_pd(&s->dz[0]);
+	__m128d hx = lx, hy = ly, hz = lz, ax = lx, ay = ly, az = lz, bx = lx, by = ly, bz = lz;
+	const __m128d o0x = _mm_set1_pd(s->ox[0]), o0y = _mm_set1_pd(s->oy[0]), o0z = _mm_set1_pd(s->oz[0]);
+	__m128d nan = _mm_setzero_pd(), same = _mm_cmpeq_pd(o0x, o0x);
+	for (int i = 0; i < n; i += 2) {
+		__m128d dx = _mm_load_pd(&s->dx[i]), dy = _mm_load_pd(&s->dy[i]), dz = _mm_load_pd(&s->dz[i]);
+		__m128d ox = _mm_load_pd(&s->ox[i]), oy = _mm_load_pd(&s->oy[i]), oz = _mm_load_pd(&s->oz[i]);
+		nan = _mm_or_pd(nan, _mm_or_pd(_mm_cmpunord_pd(dx, dy), _mm_cmpunord_pd(dz, ox)));
+		nan = _mm_or_pd(nan, _mm_cmpunord_pd(oy, oz));
+		same = _mm_and_pd(same, _mm_and_pd(_mm_cmpeq_pd(ox, o0x), _mm_and_pd(_mm_cmpeq_pd(oy, o0y), _mm_cmpeq_pd(oz, o0z))));
+		lx = _mm_min_pd(lx, dx);
+		ly = _mm_min_pd(ly, dy);
+		lz = _mm_min_pd(lz, dz);
+		hx = _mm_max_pd(hx, dx);
+		hy = _mm_max_pd(hy, dy);
+		hz = _mm_max_pd(hz, dz);
+		ax = _mm_and_pd(ax, dx);
+		ay = _mm_and_pd(ay, dy);
+		az = _mm_and_pd(az, dz);
+		bx = _mm_or_pd(bx, dx);
+		by = _mm_or_pd(by, dy);
+		bz = _mm_or_pd(bz, dz);
+	}
+	int neg_and = (_mm_movemask_pd(ax) == 3) | (_mm_movemask_pd(ay) == 3) << 1 | (_mm_movemask_pd(az) == 3) << 2;
+	int neg_or = (_mm_movemask_pd(bx) != 0) | (_mm_movemask_pd(by) != 0) << 1 | (_mm_movemask_pd(bz) != 0) << 2;
+	if (_mm_movemask_pd(nan) || neg_and != neg_or)
+		return false;
+	/* (the extremes of values of one sign, no NaN, are the same whatever
+	 * the order they are taken in) */
+	__m128d dlo = _mm_unpacklo_pd(_mm_min_pd(lx, _mm_unpackhi_pd(lx, lx)), _mm_min_pd(ly, _mm_unpackhi_pd(ly, ly)));
+	__m128d dhi = _mm_unpacklo_pd(_mm_max_pd(hx, _mm_unpackhi_pd(hx, hx)), _mm_max_pd(hy, _mm_unpackhi_pd(hy, hy)));
+	__m128d dlo_z = _mm_min_pd(lz, _mm_unpackhi_pd(lz, lz)), dhi_z = _mm_max_pd(hz, _mm_unpackhi_pd(hz, hz));
+	/* the inverses' signs are the directions' (every ray's the first's) */
+	const __m128 isign = _mm_and_ps(
+		_mm_movelh_ps(_mm_cvtpd_ps(_mm_set_pd(s->dy[0], s->dx[0])), _mm_cvtpd_ps(_mm_set_sd(s->dz[0]))), sign);
+	bool one_o = _mm_movemask_pd(same) == 3;
 	__m128 on_lo = _mm_set1_ps(INFINITY), on_hi = _mm_set1_ps(-INFINITY), of_lo = on_lo, of_hi = on_hi;
 	__m128 bad = _mm_setzero_ps();
-	int neg_and = 7, neg_or = 0, same_o = 0;
-	for (int i = 0; i < n; i++) {
-		__m128d d = _mm_loadu_pd(&r[i].d.x), dz = _mm_load_sd(&r[i].d.z);
-		__m128d o = _mm_loadu_pd(&r[i].o.x), oz = _mm_load_sd(&r[i].o.z);
-		/* (lane 0: x or z is NaN, lane 1: y; dz's high lane is 0) */
-		nan = _mm_or_pd(nan, _mm_or_pd(_mm_cmpunord_pd(d, dz), _mm_cmpunord_pd(o, oz)));
-		int neg = _mm_movemask_pd(d) | (_mm_movemask_pd(dz) & 1) << 2;
-		neg_and &= neg;
-		neg_or |= neg;
-		dlo = _mm_min_pd(dlo, d);
-		dhi = _mm_max_pd(dhi, d);
-		dlo_z = _mm_min_sd(dlo_z, dz);
-		dhi_z = _mm_max_sd(dhi_z, dz);
-		/* the origin's bracket, unless it is the first ray's (camera
-		 * rays: equal doubles, a zero of either sign giving the same
-		 * floats here) */
-		if (i > 0 && _mm_movemask_pd(_mm_and_pd(_mm_cmpeq_pd(o, o0), _mm_cmpeq_pd(oz, o0z))) == 3) {
-			same_o++;
-			continue;
-		}
-		__m128 f = _mm_movelh_ps(_mm_cvtpd_ps(o), _mm_cvtpd_ps(oz));
+	for (int i = 0; i < (one_o ? 1 : n); i++) {
+		__m128 f = _mm_movelh_ps(_mm_cvtpd_ps(_mm_set_pd(s->oy[i], s->ox[i])), _mm_cvtpd_ps(_mm_set_sd(s->oz[i])));
 		__m128 e = _mm_add_ps(_mm_mul_ps(_mm_andnot_ps(sign, f), ulp), tiny);
 		__m128 es = _mm_xor_ps(e, isign);
 		__m128 on = _mm_add_ps(f, es), of = _mm_sub_ps(f, es);
@@ -148,8 +178,6 @@ static bool packet_prepare(const ray *r, int n, pk_ray *q)
 		of_lo = _mm_min_ps(of_lo, of);
 		of_hi = _mm_max_ps(of_hi, of);
 	}
-	if (_mm_movemask_pd(nan) || neg_and != neg_or)
-		return false;
 	__m128 ilo = _mm_movelh_ps(_mm_cvtpd_ps(_mm_div_pd(one, dhi)), _mm_cvtpd_ps(_mm_div_sd(one, dhi_z)));
 	__m128 ihi = _mm_movelh_ps(_mm_cvtpd_ps(_mm_div_pd(one, dlo)), _mm_cvtpd_ps(_mm_div_sd(one, dlo_z)));
 	/* the inverses must be finite and not zero (a zero direction
@@ -161,7 +189,7 @@ static bool packet_prepare(const ray *r, int n, pk_ray *q)
 	bad = _mm_or_ps(bad, _mm_cmpeq_ps(_mm_andnot_ps(sign, ihi), _mm_setzero_ps()));
 	if (_mm_movemask_ps(bad) & 7)
 		return false;
-	q->one_o = same_o == n - 1;
+	q->one_o = one_o;
 	float a_on_lo[4], a_on_hi[4], a_of_lo[4], a_of_hi[4], a_ilo[4], a_ihi[4];
 	_mm_storeu_ps(a_on_lo, on_lo);
 	_mm_storeu_ps(a_on_hi, on_hi);
@@ -450,9 +478,9 @@ static bool model_packet(const world *w, int n, const ray *r, double tmin, doubl
 static void packet_planes(const world *w, pk_state *s, double tmin, double tmax, const prim_plane **best_plane)
 {
 	int n = s->n, even = (n + 1) & ~1;
-	for (int i = 0; i < even; i++) {
-		s->tmax[i] = tmax;
-		best_plane[i] = NULL;
+	for (int i = 0; i < even; i += 2) {
+		_mm_store_pd(&s->tmax[i], _mm_set1_pd(tmax)); /* (whole: the loads below are forwarded) */
+		best_plane[i] = best_plane[i + 1] = NULL;
 	}
 	/* Origins equal as doubles may differ in the sign of a zero, and so
 	 * may oy, only when it is zero: then -oy / dy is a zero (or NaN) that
@@ -493,18 +521,17 @@ static bool packet_trace(const world *w, int n, const ray *r, double tmin, doubl
                          const prim_plane **best_plane)
 {
 	pk_ray q;
-	if (n < 2 || !w->nprims || !packet_prepare(r, n, &q))
+	if (n < 2 || !w->nprims)
+		return false;
+	pk_load(s, r, n);
+	if (!packet_prepare(s, &q))
 		return false;
 	world_rays_count(n);
-	s->n = n;
 	s->one_o = q.one_o;
 	for (int i = 0; i < n; i++) {
 		s->best[i] = NULL;
 		s->tie[i] = false;
-		pk_load_ray(s, i, &r[i]);
 	}
-	if (n & 1) /* the vector tests read an even count; the pad is never offered */
-		pk_load_ray(s, n, &r[0]);
 	packet_planes(w, s, tmin, tmax, best_plane);
 	packet_walk(w, s, r, &q, tmin);
 	return true;
@@ -790,14 +817,15 @@ void world_occluded_packet(const world *w, int n, const ray *r, double tmin, con
 	bool lone_model = w->nprims == 1 && w->prims[0].tag == PRIM_MESH;
 	if (lone_model && n >= 2 && n <= PACKET_MAX && model_occluded(w, n, r, tmin, tmax, occ))
 		return;
-	if (n < 2 || n > PACKET_MAX || lone_model || !packet_prepare(r, n, &q)) {
+	pk_state s;
+	if (n >= 2 && n <= PACKET_MAX && !lone_model)
+		pk_load(&s, r, n);
+	if (n < 2 || n > PACKET_MAX || lone_model || !packet_prepare(&s, &q)) {
 		for (int i = 0; i < n; i++)
 			occ[i] = world_occluded(w, &r[i], tmin, tmax[i]);
 		return;
 	}
 	world_rays_count(n);
-	pk_state s;
-	s.n = n;
 	s.one_o = false;
 	unsigned live = 0;
 	for (int i = 0; i < n; i++) {
@@ -805,10 +833,7 @@ void world_occluded_packet(const world *w, int n, const ray *r, double tmin, con
 		occ[i] = blocked;
 		live |= (unsigned)!blocked << i;
 		s.tmax[i] = tmax[i];
-		pk_load_ray(&s, i, &r[i]);
 	}
-	if (n & 1) /* the vector pre-test reads an even count; the pad is never offered */
-		pk_load_ray(&s, n, &r[0]);
 	if (w->nprims && live) {
 		const bvh_node *nodes = w->tree->nodes;
 		float ftmin = to_float_down(tmin);
