@@ -287,43 +287,84 @@ static inline unsigned sphere_disc2_o(const pk_state *s, int i, __m128d ocx, __m
 }
 #endif
 
-static void leaf_spheres(pk_state *s, const prim *p, const ray *r, double tmin)
+/* next_up of both lanes: the smallest double above t >= 0, +inf and NaN
+ * kept, the smallest denormal for t <= 0 (next_up's integer steps). */
+static inline __m128d next_up2(__m128d t)
 {
-	vec3 zero = {0, 0, 0};
-#if defined(__SSE2__)
+	__m128d fin = _mm_cmplt_pd(t, _mm_set1_pd(INFINITY)), pos = _mm_cmpgt_pd(t, _mm_setzero_pd());
+	__m128i one = _mm_set1_epi64x(1);
+	__m128d up = _mm_castsi128_pd(_mm_add_epi64(_mm_castpd_si128(t), one));
+	__m128d u = _mm_or_pd(_mm_and_pd(pos, up), _mm_andnot_pd(pos, _mm_castsi128_pd(one)));
+	return _mm_or_pd(_mm_and_pd(fin, u), _mm_andnot_pd(fin, t));
+}
+
+/* The rays of s meet sphere p: first the discriminants of all the pairs
+ * (sphere_disc2), then for the pairs where one is not negative sphere_hit's
+ * remaining steps on both lanes, each lane its operations in its order: q
+ * = -(b + copysign(sqrt(disc), b)), t0 = q / a, t1 = c / q (t0 when q is
+ * 0), the two in order, the nearer above tmin, and its test against tmin
+ * and the next double above the ray's nearest so far (offer). A lane
+ * whose discriminant is negative is dropped, as sphere_hit returns there. */
+static void leaf_spheres(pk_state *s, const prim *p, double tmin)
+{
+	const vec3 zero = {0, 0, 0};
 	const pk_sphere sph = pk_sphere_of(p);
+	const __m128d sign = _mm_set1_pd(-0.0), t0v = _mm_set1_pd(tmin);
+	__m128d ocx = _mm_setzero_pd(), ocy = ocx, ocz = ocx, c1 = ocx;
 	if (s->one_o) {
-		__m128d ocx = _mm_sub_pd(_mm_load_pd(&s->ox[0]), sph.cx), ocy = _mm_sub_pd(_mm_load_pd(&s->oy[0]), sph.cy);
-		__m128d ocz = _mm_sub_pd(_mm_load_pd(&s->oz[0]), sph.cz);
-		__m128d c = _mm_sub_pd(
-			_mm_add_pd(_mm_add_pd(_mm_mul_pd(ocx, ocx), _mm_mul_pd(ocy, ocy)), _mm_mul_pd(ocz, ocz)), sph.rr);
-		for (int i = 0; i < s->n; i += 2) {
-			unsigned m = sphere_disc2_o(s, i, ocx, ocy, ocz, c);
-			for (; m; m &= m - 1) {
-				int j = i + __builtin_ctz(m);
-				double t;
-				if (j < s->n && sphere_hit(p, &r[j], tmin, next_up(s->tmax[j]), &t))
-					offer(s, j, p, t, zero);
-			}
+		ocx = _mm_sub_pd(_mm_load_pd(&s->ox[0]), sph.cx);
+		ocy = _mm_sub_pd(_mm_load_pd(&s->oy[0]), sph.cy);
+		ocz = _mm_sub_pd(_mm_load_pd(&s->oz[0]), sph.cz);
+		c1 = _mm_sub_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(ocx, ocx), _mm_mul_pd(ocy, ocy)), _mm_mul_pd(ocz, ocz)),
+		                sph.rr);
+	}
+	unsigned pass = 0;
+	for (int i = 0; i < s->n; i += 2)
+		pass |= (s->one_o ? sphere_disc2_o(s, i, ocx, ocy, ocz, c1) : sphere_disc2(s, i, &sph)) << i;
+	pass &= (1u << s->n) - 1; /* (not the pad) */
+	for (unsigned pairs = (pass | pass >> 1) & 0x5555u; pairs; pairs &= pairs - 1) {
+		int i = __builtin_ctz(pairs);
+		__m128d dx = _mm_load_pd(&s->dx[i]), dy = _mm_load_pd(&s->dy[i]), dz = _mm_load_pd(&s->dz[i]);
+		__m128d ox = ocx, oy = ocy, oz = ocz, c = c1;
+		if (!s->one_o) {
+			ox = _mm_sub_pd(_mm_load_pd(&s->ox[i]), sph.cx);
+			oy = _mm_sub_pd(_mm_load_pd(&s->oy[i]), sph.cy);
+			oz = _mm_sub_pd(_mm_load_pd(&s->oz[i]), sph.cz);
+			c = _mm_sub_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(ox, ox), _mm_mul_pd(oy, oy)), _mm_mul_pd(oz, oz)), sph.rr);
 		}
-		return;
-	}
-	for (int i = 0; i < s->n; i += 2) {
-		unsigned m = sphere_disc2(s, i, &sph);
-		for (; m; m &= m - 1) {
-			int j = i + __builtin_ctz(m);
-			double t;
-			if (j < s->n && sphere_hit(p, &r[j], tmin, next_up(s->tmax[j]), &t))
-				offer(s, j, p, t, zero);
+		__m128d a = _mm_load_pd(&s->dd[i]);
+		__m128d b = _mm_add_pd(_mm_add_pd(_mm_mul_pd(ox, dx), _mm_mul_pd(oy, dy)), _mm_mul_pd(oz, dz));
+		if (s->one_o && _mm_movemask_pd(_mm_cmpeq_pd(b, _mm_setzero_pd()))) {
+			/* b is a zero: its sign, which q takes, is that of the
+			 * ray's own o - c (origins equal as doubles may differ in
+			 * the sign of a zero; c and the discriminant do not) */
+			ox = _mm_sub_pd(_mm_load_pd(&s->ox[i]), sph.cx);
+			oy = _mm_sub_pd(_mm_load_pd(&s->oy[i]), sph.cy);
+			oz = _mm_sub_pd(_mm_load_pd(&s->oz[i]), sph.cz);
+			b = _mm_add_pd(_mm_add_pd(_mm_mul_pd(ox, dx), _mm_mul_pd(oy, dy)), _mm_mul_pd(oz, dz));
 		}
+		__m128d disc = _mm_sub_pd(_mm_mul_pd(b, b), _mm_mul_pd(a, c));
+		__m128d sq = _mm_sqrt_pd(disc);
+		__m128d q = _mm_xor_pd(_mm_add_pd(b, _mm_or_pd(_mm_andnot_pd(sign, sq), _mm_and_pd(sign, b))), sign);
+		__m128d t0 = _mm_div_pd(q, a), t1 = _mm_div_pd(c, q);
+		__m128d qz = _mm_cmpneq_pd(q, _mm_setzero_pd());
+		t1 = _mm_or_pd(_mm_and_pd(qz, t1), _mm_andnot_pd(qz, t0));
+		__m128d gt = _mm_cmpgt_pd(t0, t1);
+		__m128d lo = _mm_or_pd(_mm_and_pd(gt, t1), _mm_andnot_pd(gt, t0));
+		__m128d hi = _mm_or_pd(_mm_and_pd(gt, t0), _mm_andnot_pd(gt, t1));
+		__m128d above = _mm_cmpgt_pd(lo, t0v);
+		__m128d tt = _mm_or_pd(_mm_and_pd(above, lo), _mm_andnot_pd(above, hi));
+		__m128d ok = _mm_and_pd(_mm_cmpgt_pd(tt, t0v), _mm_cmplt_pd(tt, next_up2(_mm_load_pd(&s->tmax[i]))));
+		unsigned m = (unsigned)_mm_movemask_pd(ok) & pass >> i & 3u;
+		if (!m)
+			continue;
+		double t[2];
+		_mm_storeu_pd(t, tt);
+		if (m & 1)
+			offer(s, i, p, t[0], zero);
+		if (m & 2)
+			offer(s, i + 1, p, t[1], zero);
 	}
-#else
-	for (int i = 0; i < s->n; i++) {
-		double t;
-		if (sphere_hit(p, &r[i], tmin, next_up(s->tmax[i]), &t))
-			offer(s, i, p, t, zero);
-	}
-#endif
 }
 
 /* The rays of s meet a model among the objects (a mesh instance in a leaf)
@@ -380,7 +421,7 @@ static void packet_walk(const world *w, pk_state *s, const ray *r, const pk_ray 
 			uint32_t count = meta & ~BVH_LEAF;
 			for (uint32_t k = 0; k < count; k++) {
 				if (p[k].tag == PRIM_SPHERE) {
-					leaf_spheres(s, &p[k], r, tmin);
+					leaf_spheres(s, &p[k], tmin);
 					continue;
 				}
 				if (p[k].tag == PRIM_MESH && leaf_mesh(w, s, &p[k], r, tmin))

@@ -347,6 +347,37 @@ static void test_ties(void **state)
 	scene_free(s);
 }
 
+/* Rays from a sphere's centre, which lies on zeros: origins equal as
+ * doubles (one origin for the packet) whose zeros differ in sign from ray
+ * to ray. There b = (o - c) . d is a zero whose sign the ray's own origin
+ * gives, and sphere_hit's q takes it: the packet must not use the first
+ * ray's. */
+static void test_signed_zero_origins(void **state)
+{
+	(void)state;
+	scene *s;
+	world *w = world_of_text("C 0,2,-6 0,-0.2,1 60\nL 3,6,-4 0.8 255,255,255\nsp 0,0,0 2 255,0,0\n"
+	                         "sp 0,1,0 1 0,255,0\nsp 3,0,0 1 0,0,255\n",
+	                         "zeros", &s);
+	test_rng g = {41};
+	long before = rays_hit;
+	for (int k = 0; k < 400; k++) {
+		/* one octant a packet; the centre (0,0,0) or (0,1,0) */
+		vec3 sg = v3(k & 1 ? -1 : 1, k & 2 ? -1 : 1, k & 4 ? -1 : 1);
+		double cy = k & 8 ? 1.0 : 0.0;
+		ray r[PACKET_MAX];
+		for (int i = 0; i < PACKET_MAX; i++) {
+			unsigned z = (unsigned)(trand(&g) * 8);
+			r[i].o = v3(z & 1 ? -0.0 : 0.0, cy == 0.0 && z & 2 ? -0.0 : cy, z & 4 ? -0.0 : 0.0);
+			r[i].d = v3_norm(v3(sg.x * (0.1 + trand(&g)), sg.y * (0.1 + trand(&g)), sg.z * (0.1 + trand(&g))));
+		}
+		check_packet(w, r, PACKET_MAX, w->lights[0].pos);
+	}
+	assert_true(rays_hit - before > 5000);
+	world_free(w);
+	scene_free(s);
+}
+
 /* Packets at the edges of the interval set-up (packet_prepare): origins
  * equal to the first ray's (a zero of either sign among them) and one
  * ulp off it; a direction component that is 0, -0, of the other sign, or
@@ -740,6 +771,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_ties),
+		cmocka_unit_test(test_signed_zero_origins),
 		cmocka_unit_test(test_prepare_edges),
 		cmocka_unit_test(test_scenes),
 		cmocka_unit_test(test_split_shadows),
