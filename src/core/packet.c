@@ -47,7 +47,10 @@ typedef struct pk_state {
 	_Alignas(16) double tmax[PACKET_MAX]; /* the nearest hit so far (or the query's tmax) */
 	const prim *best[PACKET_MAX];
 	vec3 nl[PACKET_MAX];
-	bool tie[PACKET_MAX];
+	/* bit i for ray i: a primitive is its best (best[i] set), that
+	 * primitive is a sphere, it has a tie; the planes beside the tree gave
+	 * its tmax (packet_planes) */
+	unsigned got, sph, tie, plane;
 	bool one_o; /* every ray's origin is ray 0's, bit for bit (camera rays) */
 } pk_state;
 
@@ -229,19 +232,22 @@ static inline unsigned packet_slab4(const bvh_node *n, const pk_ray *q, float tm
 	return (unsigned)_mm_movemask_ps(_mm_cmple_ps(t0, _mm_mul_ps(t1, _mm_set1_ps(BVH_SLAB_SLACK))));
 }
 
-/* Ray i meets primitive p: a nearer hit replaces its best, one at the same
- * distance from another primitive is a tie. */
-static inline void offer(pk_state *s, int i, const prim *p, double t, vec3 nl)
+/* Ray i meets primitive p (a sphere or not): a nearer hit replaces its
+ * best, one at the same distance from another primitive is a tie. */
+static inline void offer(pk_state *s, int i, const prim *p, double t, vec3 nl, bool sphere)
 {
+	unsigned bit = 1u << i;
 	if (t < s->tmax[i]) {
 		s->tmax[i] = t;
 		s->best[i] = p;
 		s->nl[i] = nl;
-		s->tie[i] = false;
-	} else if (t == s->tmax[i] && s->best[i] && p != s->best[i]) {
+		s->got |= bit;
+		s->tie &= ~bit;
+		s->sph = sphere ? s->sph | bit : s->sph & ~bit;
+	} else if (t == s->tmax[i] && (s->got & bit) && p != s->best[i]) {
 		/* (at the distance of a plane or of the query's tmax, a single
 		 * ray keeps the plane or nothing: not a tie) */
-		s->tie[i] = true;
+		s->tie |= bit;
 	}
 }
 
@@ -361,9 +367,9 @@ static void leaf_spheres(pk_state *s, const prim *p, double tmin)
 		double t[2];
 		_mm_storeu_pd(t, tt);
 		if (m & 1)
-			offer(s, i, p, t[0], zero);
+			offer(s, i, p, t[0], zero, true);
 		if (m & 2)
-			offer(s, i + 1, p, t[1], zero);
+			offer(s, i + 1, p, t[1], zero, true);
 	}
 }
 
@@ -385,14 +391,14 @@ static bool leaf_mesh(const world *w, pk_state *s, const prim *p, const ray *r, 
 		return false;
 	for (unsigned g = got & ~tie; g; g &= g - 1) {
 		int i = __builtin_ctz(g);
-		offer(s, i, p, t[i], v3((double)slot[i], b[i][1], b[i][2]));
+		offer(s, i, p, t[i], v3((double)slot[i], b[i][1], b[i][2]), false);
 	}
 	for (; tie; tie &= tie - 1) {
 		int i = __builtin_ctz(tie);
 		double tt;
 		vec3 nl;
 		if (world_prim_hit(w, p, &r[i], tmin, tm[i], &tt, &nl, true))
-			offer(s, i, p, tt, nl);
+			offer(s, i, p, tt, nl, false);
 	}
 	return true;
 }
@@ -430,7 +436,7 @@ static void packet_walk(const world *w, pk_state *s, const ray *r, const pk_ray 
 					double t;
 					vec3 nl = {0, 0, 0};
 					if (world_prim_hit(w, &p[k], &r[i], tmin, next_up(s->tmax[i]), &t, &nl, true))
-						offer(s, i, &p[k], t, nl);
+						offer(s, i, &p[k], t, nl, false);
 				}
 			}
 			far = packet_far(s);
@@ -523,6 +529,7 @@ static void packet_planes(const world *w, pk_state *s, double tmin, double tmax,
 		_mm_store_pd(&s->tmax[i], _mm_set1_pd(tmax)); /* (whole: the loads below are forwarded) */
 		best_plane[i] = best_plane[i + 1] = NULL;
 	}
+	unsigned any = 0;
 	/* Origins equal as doubles may differ in the sign of a zero, and so
 	 * may oy, only when it is zero: then -oy / dy is a zero (or NaN) that
 	 * no tmin >= 0 lets through either way. */
@@ -551,8 +558,10 @@ static void packet_planes(const world *w, pk_state *s, double tmin, double tmax,
 			int bits = _mm_movemask_pd(m);
 			best_plane[i] = bits & 1 ? pl : best_plane[i];
 			best_plane[i + 1] = bits & 2 ? pl : best_plane[i + 1]; /* (the pad's entry exists: even <= PACKET_MAX) */
+			any |= (unsigned)bits << i;
 		}
 	}
+	s->plane = any & ((1u << n) - 1);
 }
 
 /* The packet's walk of rays r[0..n) (n <= PACKET_MAX) into s, the planes'
@@ -569,10 +578,7 @@ static bool packet_trace(const world *w, int n, const ray *r, double tmin, doubl
 		return false;
 	world_rays_count(n);
 	s->one_o = q.one_o;
-	for (int i = 0; i < n; i++) {
-		s->best[i] = NULL;
-		s->tie[i] = false;
-	}
+	s->got = s->sph = s->tie = 0;
 	packet_planes(w, s, tmin, tmax, best_plane);
 	packet_walk(w, s, r, &q, tmin);
 	return true;
@@ -596,16 +602,17 @@ void world_trace_packet(const world *w, int n, const ray *r, double tmin, double
 		return;
 	}
 	for (int i = 0; i < n; i++) {
-		if (s.tie[i]) {
+		if (s.tie >> i & 1) {
 			world_rays_count(-1);
 			found[i] = world_trace_coherent(w, &r[i], tmin, tmax, &th[i]);
 			continue;
 		}
+		bool got = s.got >> i & 1;
 		th[i].t = s.tmax[i];
-		th[i].prim = s.best[i];
-		th[i].plane = s.best[i] ? NULL : best_plane[i];
-		th[i].nl = s.best[i] ? s.nl[i] : (vec3){0, 0, 0};
-		found[i] = s.best[i] || best_plane[i];
+		th[i].prim = got ? s.best[i] : NULL;
+		th[i].plane = got ? NULL : best_plane[i];
+		th[i].nl = got ? s.nl[i] : (vec3){0, 0, 0};
+		found[i] = got || best_plane[i];
 	}
 }
 
@@ -635,48 +642,56 @@ static inline void store2(__m128d v, double *a, double *b)
 	_mm_storeh_pd(b, v);
 }
 
-/* One row of a 3x4 matrix applied to points in lanes: m[0] x + m[1] y +
- * m[2] z + m[3], in that order (finish_plane's local point). */
-static inline __m128d row2(const double *m, __m128d x, __m128d y, __m128d z)
-{
-	return _mm_add_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(_mm_set1_pd(m[0]), x), _mm_mul_pd(_mm_set1_pd(m[1]), y)),
-	                             _mm_mul_pd(_mm_set1_pd(m[2]), z)),
-	                  _mm_set1_pd(m[3]));
-}
-
-/* The hit records of rays a and b of s on plane pl: world_finish's
- * (finish_plane, surf_shape_uv), each lane its operations in its order. */
-static void finish_plane2(const world *w, const pk_state *s, const prim_plane *pl, int a, int b, hit *h)
+/* The hit records of the rays of s on plane pl (bits on): world_finish's
+ * (finish_plane, surf_shape_uv), two rays at a time, each lane its
+ * operations in its order; an odd one out through world_finish itself. */
+static void finish_planes(const world *w, const pk_state *s, const ray *r, const prim_plane *pl, unsigned on, hit *h)
 {
 	const prim_shape *sh = &w->shapes[pl->shape];
 	const double(*m)[4] = sh->inv;
-	__m128d px, py, pz;
-	pk_point2(s, a, b, &px, &py, &pz);
-	int front = pk_front2(s, a, b, _mm_set1_pd(pl->n.x), _mm_set1_pd(pl->n.y), _mm_set1_pd(pl->n.z));
-	__m128d lx = row2(m[0], px, py, pz), ly = row2(m[1], px, py, pz), lz = row2(m[2], px, py, pz);
-	bool uv = surf_wants_uv(w, pl->object);
-	int idx[2] = {a, b};
-	for (int k = 0; k < 2; k++) {
-		hit *o = &h[idx[k]];
-		o->t = s->tmax[idx[k]];
-		o->object = pl->object;
-		o->front = front >> k & 1;
-		o->n = pl->n;
-	}
-	store2(px, &h[a].p.x, &h[b].p.x);
-	store2(py, &h[a].p.y, &h[b].p.y);
-	store2(pz, &h[a].p.z, &h[b].p.z);
-	store2(lx, &h[a].local.x, &h[b].local.x);
-	store2(ly, &h[a].local.y, &h[b].local.y);
-	store2(lz, &h[a].local.z, &h[b].local.z);
-	for (int k = 0; k < 2; k++) {
-		hit *o = &h[idx[k]];
+	const __m128d m00 = _mm_set1_pd(m[0][0]), m01 = _mm_set1_pd(m[0][1]), m02 = _mm_set1_pd(m[0][2]);
+	const __m128d m03 = _mm_set1_pd(m[0][3]), m10 = _mm_set1_pd(m[1][0]), m11 = _mm_set1_pd(m[1][1]);
+	const __m128d m12 = _mm_set1_pd(m[1][2]), m13 = _mm_set1_pd(m[1][3]), m20 = _mm_set1_pd(m[2][0]);
+	const __m128d m21 = _mm_set1_pd(m[2][1]), m22 = _mm_set1_pd(m[2][2]), m23 = _mm_set1_pd(m[2][3]);
+	const __m128d nx = _mm_set1_pd(pl->n.x), ny = _mm_set1_pd(pl->n.y), nz = _mm_set1_pd(pl->n.z);
+	const bool uv = surf_wants_uv(w, pl->object);
+	while (on & (on - 1)) {
+		int a = __builtin_ctz(on);
+		on &= on - 1;
+		int b = __builtin_ctz(on);
+		on &= on - 1;
+		__m128d px, py, pz;
+		pk_point2(s, a, b, &px, &py, &pz);
+		int front = pk_front2(s, a, b, nx, ny, nz);
+		/* m[k][0] x + m[k][1] y + m[k][2] z + m[k][3], in that order */
+		__m128d lx = _mm_add_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(m00, px), _mm_mul_pd(m01, py)), _mm_mul_pd(m02, pz)), m03);
+		__m128d ly = _mm_add_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(m10, px), _mm_mul_pd(m11, py)), _mm_mul_pd(m12, pz)), m13);
+		__m128d lz = _mm_add_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(m20, px), _mm_mul_pd(m21, py)), _mm_mul_pd(m22, pz)), m23);
+		hit *ha = &h[a], *hb = &h[b];
+		ha->t = s->tmax[a];
+		hb->t = s->tmax[b];
+		store2(px, &ha->p.x, &hb->p.x);
+		store2(py, &ha->p.y, &hb->p.y);
+		store2(pz, &ha->p.z, &hb->p.z);
+		store2(lx, &ha->local.x, &hb->local.x);
+		store2(ly, &ha->local.y, &hb->local.y);
+		store2(lz, &ha->local.z, &hb->local.z);
+		ha->n = hb->n = pl->n;
+		ha->object = hb->object = pl->object;
+		ha->front = front & 1;
+		hb->front = front >> 1 & 1;
 		if (uv) {
-			surf_shape_uv(w, sh, pl->n, o);
+			surf_shape_uv(w, sh, pl->n, ha);
+			surf_shape_uv(w, sh, pl->n, hb);
 		} else {
-			o->mat = pl->object;
-			o->has_uv = false;
+			ha->mat = hb->mat = pl->object;
+			ha->has_uv = hb->has_uv = false;
 		}
+	}
+	if (on) {
+		int a = __builtin_ctz(on);
+		trace_hit th = {s->tmax[a], NULL, pl, {0, 0, 0}};
+		world_finish(w, &r[a], &th, &h[a]);
 	}
 }
 
@@ -735,28 +750,19 @@ void world_intersect_packet(const world *w, int n, const ray *r, double tmin, do
 				world_finish(w, &r[i], &th[i], &h[i]);
 		return;
 	}
-	/* the hit records: pairs of rays on one plane, pairs on spheres, the
-	 * rest one by one as world_finish makes them */
-	int on_plane[PACKET_MAX], on_sphere[PACKET_MAX], np = 0, ns = 0;
-	/* sorted without branches (which rays end on a sphere and which on the
-	 * plane follows the picture: a branch on it is mispredicted often);
-	 * ties and other primitives, rare, one by one below */
-	static const prim none = {.tag = PRIM_MESH};
-	unsigned alone = 0;
-	for (int i = 0; i < n; i++) {
-		const prim *p = s.best[i] ? s.best[i] : &none;
-		bool tie = s.tie[i], sphere = p->tag == PRIM_SPHERE && !tie;
-		bool plane = !s.best[i] && best_plane[i] && !tie;
-		found[i] = s.best[i] || best_plane[i];
-		on_plane[np] = i;
-		np += plane;
-		on_sphere[ns] = i;
-		ns += sphere;
-		alone |= (unsigned)(tie || (s.best[i] && !sphere)) << i;
-	}
+	/* the hit records: rays on one plane by pairs, rays on spheres by
+	 * pairs, the rest (ties, other primitives) one by one as world_finish
+	 * makes them; sorted by the walk's bits, not by branches on each ray
+	 * (which rays end on a sphere and which on the plane follows the
+	 * picture: a branch on it is mispredicted often) */
+	unsigned tie = s.tie;
+	unsigned sph = s.got & s.sph & ~tie, pln = s.plane & ~s.got & ~tie, alone = tie | (s.got & ~s.sph);
+	unsigned hit_any = s.got | s.plane;
+	for (int i = 0; i < n; i++)
+		found[i] = hit_any >> i & 1;
 	for (; alone; alone &= alone - 1) {
 		int i = __builtin_ctz(alone);
-		if (s.tie[i]) {
+		if (tie >> i & 1) {
 			world_rays_count(-1);
 			found[i] = world_intersect_coherent(w, &r[i], tmin, tmax, &h[i]);
 		} else {
@@ -764,20 +770,26 @@ void world_intersect_packet(const world *w, int n, const ray *r, double tmin, do
 			world_finish(w, &r[i], &th, &h[i]);
 		}
 	}
-	for (int k = 0; k < np; k++) {
-		int a = on_plane[k];
-		if (k + 1 < np && best_plane[on_plane[k + 1]] == best_plane[a]) {
-			finish_plane2(w, &s, best_plane[a], a, on_plane[k + 1], h);
-			k++;
-		} else {
-			trace_hit th = {s.tmax[a], NULL, best_plane[a], {0, 0, 0}};
-			world_finish(w, &r[a], &th, &h[a]);
+	while (pln) {
+		/* the rays on the first ray's plane, then those on the next */
+		const prim_plane *pl = best_plane[__builtin_ctz(pln)];
+		unsigned on = 0;
+		for (unsigned m = pln; m; m &= m - 1) {
+			int i = __builtin_ctz(m);
+			on |= (unsigned)(best_plane[i] == pl) << i;
 		}
+		pln &= ~on;
+		finish_planes(w, &s, r, pl, on, h);
 	}
-	for (int k = 0; k + 1 < ns; k += 2)
-		finish_sphere2(&s, s.best[on_sphere[k]], s.best[on_sphere[k + 1]], on_sphere[k], on_sphere[k + 1], h);
-	if (ns & 1) {
-		int a = on_sphere[ns - 1];
+	while (sph & (sph - 1)) {
+		int a = __builtin_ctz(sph);
+		sph &= sph - 1;
+		int b = __builtin_ctz(sph);
+		sph &= sph - 1;
+		finish_sphere2(&s, s.best[a], s.best[b], a, b, h);
+	}
+	if (sph) {
+		int a = __builtin_ctz(sph);
 		trace_hit th = {s.tmax[a], s.best[a], NULL, s.nl[a]};
 		world_finish(w, &r[a], &th, &h[a]);
 	}
