@@ -54,31 +54,6 @@ typedef struct pk_state {
 	bool one_o; /* every ray's origin is ray 0's, bit for bit (camera rays) */
 } pk_state;
 
-/* Rays r[0..n) by component into s (n <= PACKET_MAX), and d . d as
- * sphere_hit computes it, two rays per register; an odd count is padded
- * with ray 0, which the vector tests read and nothing offers. Each double
- * is read alone: the caller has usually just written the rays a component
- * at a time (cam_block_rays), and a 16-byte load of two such stores waits
- * for both to leave the store buffer instead of being forwarded; the pairs
- * are stored whole, so that the vector tests' loads are forwarded. */
-static void pk_load(pk_state *s, const ray *r, int n)
-{
-	s->n = n;
-	for (int i = 0; i < n; i += 2) {
-		const ray *a = &r[i], *b = i + 1 < n ? &r[i + 1] : &r[0];
-		__m128d dx = _mm_loadh_pd(_mm_load_sd(&a->d.x), &b->d.x);
-		__m128d dy = _mm_loadh_pd(_mm_load_sd(&a->d.y), &b->d.y);
-		__m128d dz = _mm_loadh_pd(_mm_load_sd(&a->d.z), &b->d.z);
-		_mm_store_pd(&s->ox[i], _mm_loadh_pd(_mm_load_sd(&a->o.x), &b->o.x));
-		_mm_store_pd(&s->oy[i], _mm_loadh_pd(_mm_load_sd(&a->o.y), &b->o.y));
-		_mm_store_pd(&s->oz[i], _mm_loadh_pd(_mm_load_sd(&a->o.z), &b->o.z));
-		_mm_store_pd(&s->dx[i], dx);
-		_mm_store_pd(&s->dy[i], dy);
-		_mm_store_pd(&s->dz[i], dz);
-		_mm_store_pd(&s->dd[i], _mm_add_pd(_mm_add_pd(_mm_mul_pd(dx, dx), _mm_mul_pd(dy, dy)), _mm_mul_pd(dz, dz)));
-	}
-}
-
 /* The interval form of bvh_ray: per axis, the near- and far-plane origins
  * that give the lowest near and highest far distances of any ray, the
  * inverse directions' range, and the rows of the node's boxes to read. */
@@ -101,8 +76,8 @@ static inline double next_up(double t)
 	return t;
 }
 
-/* Fills q for the rays of s (pk_load); false when the packet is not
- * coherent enough for the interval test: a direction component of another
+/* Loads rays r[0..n) (2 <= n <= PACKET_MAX) into s and fills q; false
+ * when the packet is not coherent enough for the interval test: a direction component of another
  * sign than the first ray's, a zero or NaN component, an inverse or origin
  * that is not finite. Each ray's origin and inverse direction are rounded
  * as world.c's bvh_ray_prepare rounds them (on and of bracket the origin so
@@ -118,11 +93,18 @@ static inline double next_up(double t)
  * lies between those two (of one sign), so they are finite and not zero
  * exactly when all the rays' are. When every origin equals the first
  * ray's as doubles (camera rays; a zero of either sign gives the same
- * floats here), the first ray's bracket is the packet's. The components are
- * read by pairs from s (the pad, ray 0 again, changes no extreme). */
-static bool packet_prepare(const pk_state *s, pk_ray *q)
+ * floats here), the first ray's bracket is the packet's.
+ *
+ * s gets the rays by component and d . d as sphere_hit computes it, two
+ * rays per register; an odd count is padded with ray 0, which the vector
+ * tests read and nothing offers (nor changes an extreme here). Each double
+ * is read alone: the caller has usually just written the rays a component
+ * at a time (cam_block_rays), and a 16-byte load of two such stores waits
+ * for both to leave the store buffer instead of being forwarded; the pairs
+ * are stored whole, so that the vector tests' loads are forwarded. */
+static bool packet_prepare(pk_state *s, const ray *r, int n, pk_ray *q)
 {
-	const int n = s->n;
+	s->n = n;
 	const __m128d one = _mm_set1_pd(1.0);
 	const __m128 sign = _mm_set1_ps(-0.0f), ulp = _mm_set1_ps(0x1p-23f), tiny = _mm_set1_ps(0x1p-149f);
 	const __m128 big = _mm_set1_ps(FLT_MAX);
@@ -130,13 +112,25 @@ static bool packet_prepare(const pk_state *s, pk_ray *q)
 	 * and ORed (the sign bits: all negative, any negative), two lanes
 	 * each; any NaN among directions and origins; whether every origin
 	 * is the first ray's */
-	__m128d lx = _mm_load_pd(&s->dx[0]), ly = _mm_load_pd(&s->dy[0]), lz = _mm_load_pd(&s->dz[0]);
+	__m128d lx = _mm_set1_pd(r[0].d.x), ly = _mm_set1_pd(r[0].d.y), lz = _mm_set1_pd(r[0].d.z);
 	__m128d hx = lx, hy = ly, hz = lz, ax = lx, ay = ly, az = lz, bx = lx, by = ly, bz = lz;
-	const __m128d o0x = _mm_set1_pd(s->ox[0]), o0y = _mm_set1_pd(s->oy[0]), o0z = _mm_set1_pd(s->oz[0]);
+	const __m128d o0x = _mm_set1_pd(r[0].o.x), o0y = _mm_set1_pd(r[0].o.y), o0z = _mm_set1_pd(r[0].o.z);
 	__m128d nan = _mm_setzero_pd(), same = _mm_cmpeq_pd(o0x, o0x);
 	for (int i = 0; i < n; i += 2) {
-		__m128d dx = _mm_load_pd(&s->dx[i]), dy = _mm_load_pd(&s->dy[i]), dz = _mm_load_pd(&s->dz[i]);
-		__m128d ox = _mm_load_pd(&s->ox[i]), oy = _mm_load_pd(&s->oy[i]), oz = _mm_load_pd(&s->oz[i]);
+		const ray *ra = &r[i], *rb = i + 1 < n ? &r[i + 1] : &r[0];
+		__m128d dx = _mm_loadh_pd(_mm_load_sd(&ra->d.x), &rb->d.x);
+		__m128d dy = _mm_loadh_pd(_mm_load_sd(&ra->d.y), &rb->d.y);
+		__m128d dz = _mm_loadh_pd(_mm_load_sd(&ra->d.z), &rb->d.z);
+		__m128d ox = _mm_loadh_pd(_mm_load_sd(&ra->o.x), &rb->o.x);
+		__m128d oy = _mm_loadh_pd(_mm_load_sd(&ra->o.y), &rb->o.y);
+		__m128d oz = _mm_loadh_pd(_mm_load_sd(&ra->o.z), &rb->o.z);
+		_mm_store_pd(&s->ox[i], ox);
+		_mm_store_pd(&s->oy[i], oy);
+		_mm_store_pd(&s->oz[i], oz);
+		_mm_store_pd(&s->dx[i], dx);
+		_mm_store_pd(&s->dy[i], dy);
+		_mm_store_pd(&s->dz[i], dz);
+		_mm_store_pd(&s->dd[i], _mm_add_pd(_mm_add_pd(_mm_mul_pd(dx, dx), _mm_mul_pd(dy, dy)), _mm_mul_pd(dz, dz)));
 		nan = _mm_or_pd(nan, _mm_or_pd(_mm_cmpunord_pd(dx, dy), _mm_cmpunord_pd(dz, ox)));
 		nan = _mm_or_pd(nan, _mm_cmpunord_pd(oy, oz));
 		same = _mm_and_pd(same, _mm_and_pd(_mm_cmpeq_pd(ox, o0x), _mm_and_pd(_mm_cmpeq_pd(oy, o0y), _mm_cmpeq_pd(oz, o0z))));
@@ -164,12 +158,12 @@ static bool packet_prepare(const pk_state *s, pk_ray *q)
 	__m128d dlo_z = _mm_min_pd(lz, _mm_unpackhi_pd(lz, lz)), dhi_z = _mm_max_pd(hz, _mm_unpackhi_pd(hz, hz));
 	/* the inverses' signs are the directions' (every ray's the first's) */
 	const __m128 isign = _mm_and_ps(
-		_mm_movelh_ps(_mm_cvtpd_ps(_mm_set_pd(s->dy[0], s->dx[0])), _mm_cvtpd_ps(_mm_set_sd(s->dz[0]))), sign);
+		_mm_movelh_ps(_mm_cvtpd_ps(_mm_set_pd(r[0].d.y, r[0].d.x)), _mm_cvtpd_ps(_mm_set_sd(r[0].d.z))), sign);
 	bool one_o = _mm_movemask_pd(same) == 3;
 	__m128 on_lo = _mm_set1_ps(INFINITY), on_hi = _mm_set1_ps(-INFINITY), of_lo = on_lo, of_hi = on_hi;
 	__m128 bad = _mm_setzero_ps();
 	for (int i = 0; i < (one_o ? 1 : n); i++) {
-		__m128 f = _mm_movelh_ps(_mm_cvtpd_ps(_mm_set_pd(s->oy[i], s->ox[i])), _mm_cvtpd_ps(_mm_set_sd(s->oz[i])));
+		__m128 f = _mm_movelh_ps(_mm_cvtpd_ps(_mm_set_pd(r[i].o.y, r[i].o.x)), _mm_cvtpd_ps(_mm_set_sd(r[i].o.z)));
 		__m128 e = _mm_add_ps(_mm_mul_ps(_mm_andnot_ps(sign, f), ulp), tiny);
 		__m128 es = _mm_xor_ps(e, isign);
 		__m128 on = _mm_add_ps(f, es), of = _mm_sub_ps(f, es);
@@ -573,8 +567,7 @@ static bool packet_trace(const world *w, int n, const ray *r, double tmin, doubl
 	pk_ray q;
 	if (n < 2 || !w->nprims)
 		return false;
-	pk_load(s, r, n);
-	if (!packet_prepare(s, &q))
+	if (!packet_prepare(s, r, n, &q))
 		return false;
 	world_rays_count(n);
 	s->one_o = q.one_o;
@@ -773,8 +766,8 @@ void world_intersect_packet(const world *w, int n, const ray *r, double tmin, do
 	while (pln) {
 		/* the rays on the first ray's plane, then those on the next */
 		const prim_plane *pl = best_plane[__builtin_ctz(pln)];
-		unsigned on = 0;
-		for (unsigned m = pln; m; m &= m - 1) {
+		unsigned on = w->nplanes == 1 ? pln : 0;
+		for (unsigned m = on ? 0 : pln; m; m &= m - 1) {
 			int i = __builtin_ctz(m);
 			on |= (unsigned)(best_plane[i] == pl) << i;
 		}
@@ -871,9 +864,7 @@ void world_occluded_packet(const world *w, int n, const ray *r, double tmin, con
 	if (lone_model && n >= 2 && n <= PACKET_MAX && model_occluded(w, n, r, tmin, tmax, occ))
 		return;
 	pk_state s;
-	if (n >= 2 && n <= PACKET_MAX && !lone_model)
-		pk_load(&s, r, n);
-	if (n < 2 || n > PACKET_MAX || lone_model || !packet_prepare(&s, &q)) {
+	if (n < 2 || n > PACKET_MAX || lone_model || !packet_prepare(&s, r, n, &q)) {
 		for (int i = 0; i < n; i++)
 			occ[i] = world_occluded(w, &r[i], tmin, tmax[i]);
 		return;
