@@ -829,6 +829,37 @@ static bool planes_block(const world *w, const ray *r, double tmin, double tmax)
 	return false;
 }
 
+/* The rays of s (bits) that a plane blocks between tmin and tmax[i]:
+ * planes_block's test (plane_hit) two rays per SSE2 register, each lane
+ * its operations in its order (the origin's height h . o + h[3], the
+ * slope h . d, -oy / dy, the strict tests; dy == 0 and NaN fail as
+ * there). */
+static unsigned packet_planes_block(const world *w, const pk_state *s, double tmin, const double *tmax)
+{
+	int n = s->n;
+	unsigned blocked = 0;
+	const __m128d sign = _mm_set1_pd(-0.0), zero = _mm_setzero_pd(), t0 = _mm_set1_pd(tmin);
+	for (size_t k = 0; k < w->nplanes; k++) {
+		const prim_plane *pl = &w->planes[k];
+		const __m128d h0 = _mm_set1_pd(pl->h[0]), h1 = _mm_set1_pd(pl->h[1]), h2 = _mm_set1_pd(pl->h[2]);
+		const __m128d h3 = _mm_set1_pd(pl->h[3]);
+		for (int i = 0; i < n; i += 2) {
+			__m128d oy = _mm_add_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(h0, _mm_load_pd(&s->ox[i])),
+			                                              _mm_mul_pd(h1, _mm_load_pd(&s->oy[i]))),
+			                                   _mm_mul_pd(h2, _mm_load_pd(&s->oz[i]))),
+			                        h3);
+			__m128d dy = _mm_add_pd(_mm_add_pd(_mm_mul_pd(h0, _mm_load_pd(&s->dx[i])),
+			                                   _mm_mul_pd(h1, _mm_load_pd(&s->dy[i]))),
+			                        _mm_mul_pd(h2, _mm_load_pd(&s->dz[i])));
+			__m128d tt = _mm_div_pd(_mm_xor_pd(oy, sign), dy);
+			__m128d tm = _mm_set_pd(i + 1 < n ? tmax[i + 1] : tmax[i], tmax[i]);
+			__m128d m = _mm_and_pd(_mm_cmpneq_pd(dy, zero), _mm_and_pd(_mm_cmpgt_pd(tt, t0), _mm_cmplt_pd(tt, tm)));
+			blocked |= (unsigned)_mm_movemask_pd(m) << i;
+		}
+	}
+	return blocked & ((1u << n) - 1);
+}
+
 /* Shadow rays on a lone model: the planes first for each ray, as
  * world_occluded, then the rays they leave through the model's triangle
  * tree in one packet (mesh_occluded_world_packet). False when that packet
@@ -871,11 +902,9 @@ void world_occluded_packet(const world *w, int n, const ray *r, double tmin, con
 	}
 	world_rays_count(n);
 	s.one_o = false;
-	unsigned live = 0;
+	unsigned live = ((1u << n) - 1) & ~packet_planes_block(w, &s, tmin, tmax);
 	for (int i = 0; i < n; i++) {
-		bool blocked = planes_block(w, &r[i], tmin, tmax[i]);
-		occ[i] = blocked;
-		live |= (unsigned)!blocked << i;
+		occ[i] = !(live >> i & 1u);
 		s.tmax[i] = tmax[i];
 	}
 	if (w->nprims && live) {
