@@ -34,6 +34,7 @@
 
 #include "core/bvh/bvh.h"
 #include "core/prim_hit.h"
+#include "core/surface.h"
 #include "rtsh/mesh.h"
 
 /* The state of a packet's walk: the rays by component (for the vector
@@ -42,25 +43,16 @@ typedef struct pk_state {
 	int n;
 	_Alignas(16) double ox[PACKET_MAX], oy[PACKET_MAX], oz[PACKET_MAX];
 	_Alignas(16) double dx[PACKET_MAX], dy[PACKET_MAX], dz[PACKET_MAX];
-	_Alignas(16) double dd[PACKET_MAX]; /* d . d, as sphere_hit computes it */
-	double tmax[PACKET_MAX];            /* the nearest hit so far (or the query's tmax) */
+	_Alignas(16) double dd[PACKET_MAX];   /* d . d, as sphere_hit computes it */
+	_Alignas(16) double tmax[PACKET_MAX]; /* the nearest hit so far (or the query's tmax) */
 	const prim *best[PACKET_MAX];
 	vec3 nl[PACKET_MAX];
-	bool tie[PACKET_MAX];
+	/* bit i for ray i: a primitive is its best (best[i] set), that
+	 * primitive is a sphere, it has a tie; the planes beside the tree gave
+	 * its tmax (packet_planes) */
+	unsigned got, sph, tie, plane;
 	bool one_o; /* every ray's origin is ray 0's, bit for bit (camera rays) */
 } pk_state;
-
-/* Ray i by component, and d . d as sphere_hit computes it. */
-static inline void pk_load_ray(pk_state *s, int i, const ray *r)
-{
-	s->ox[i] = r->o.x;
-	s->oy[i] = r->o.y;
-	s->oz[i] = r->o.z;
-	s->dx[i] = r->d.x;
-	s->dy[i] = r->d.y;
-	s->dz[i] = r->d.z;
-	s->dd[i] = v3_dot(r->d, r->d);
-}
 
 /* The interval form of bvh_ray: per axis, the near- and far-plane origins
  * that give the lowest near and highest far distances of any ray, the
@@ -84,13 +76,14 @@ static inline double next_up(double t)
 	return t;
 }
 
-/* Fills q for rays r[0..n); false when the packet is not coherent enough
- * for the interval test: a direction component of another sign than the
- * first ray's, a zero or NaN component, an inverse or origin that is not
- * finite. Each ray's origin and inverse direction are rounded as world.c's
- * bvh_ray_prepare rounds them (on and of bracket the origin so that the near
- * plane's distance can only come down and the far plane's go up), three
- * axes in one register, and the packet keeps their lowest and highest.
+/* Loads rays r[0..n) (2 <= n <= PACKET_MAX) into s and fills q; false
+ * when the packet is not coherent enough for the interval test: a direction component of another
+ * sign than the first ray's, a zero or NaN component, an inverse or origin
+ * that is not finite. Each ray's origin and inverse direction are rounded
+ * as world.c's bvh_ray_prepare rounds them (on and of bracket the origin so
+ * that the near plane's distance can only come down and the far plane's go
+ * up), three axes in one register, and the packet keeps their lowest and
+ * highest.
  *
  * The inverses are not computed ray by ray: for directions of one sign,
  * 1/d falls as d rises, and both the double division and the rounding to
@@ -98,44 +91,79 @@ static inline double next_up(double t)
  * direction component and the highest that of the lowest: the same floats
  * from two divisions a packet instead of one a ray. Every ray's inverse
  * lies between those two (of one sign), so they are finite and not zero
- * exactly when all the rays' are. An origin equal to the first ray's
- * (camera rays) brackets the same floats and is not rounded again. */
-static bool packet_prepare(const ray *r, int n, pk_ray *q)
+ * exactly when all the rays' are. When every origin equals the first
+ * ray's as doubles (camera rays; a zero of either sign gives the same
+ * floats here), the first ray's bracket is the packet's.
+ *
+ * s gets the rays by component and d . d as sphere_hit computes it, two
+ * rays per register; an odd count is padded with ray 0, which the vector
+ * tests read and nothing offers (nor changes an extreme here). Each double
+ * is read alone: the caller has usually just written the rays a component
+ * at a time (cam_block_rays), and a 16-byte load of two such stores waits
+ * for both to leave the store buffer instead of being forwarded; the pairs
+ * are stored whole, so that the vector tests' loads are forwarded. */
+static bool packet_prepare(pk_state *s, const ray *r, int n, pk_ray *q)
 {
+	s->n = n;
 	const __m128d one = _mm_set1_pd(1.0);
 	const __m128 sign = _mm_set1_ps(-0.0f), ulp = _mm_set1_ps(0x1p-23f), tiny = _mm_set1_ps(0x1p-149f);
 	const __m128 big = _mm_set1_ps(FLT_MAX);
-	/* the directions' lowest and highest, x and y in one register, z in
-	 * the low lane of another; any NaN among them or the origins */
-	__m128d dlo = _mm_loadu_pd(&r[0].d.x), dhi = dlo, dlo_z = _mm_load_sd(&r[0].d.z), dhi_z = dlo_z;
-	const __m128d o0 = _mm_loadu_pd(&r[0].o.x), o0z = _mm_load_sd(&r[0].o.z);
-	/* the inverses' signs are the directions' (when the packet is used:
-	 * no NaN, every ray's signs the first ray's) */
-	const __m128 isign = _mm_and_ps(_mm_movelh_ps(_mm_cvtpd_ps(dlo), _mm_cvtpd_ps(dlo_z)), sign);
-	__m128d nan = _mm_setzero_pd();
+	/* per axis the directions' lowest and highest and their bits ANDed
+	 * and ORed (the sign bits: all negative, any negative), two lanes
+	 * each; any NaN among directions and origins; whether every origin
+	 * is the first ray's */
+	__m128d lx = _mm_set1_pd(r[0].d.x), ly = _mm_set1_pd(r[0].d.y), lz = _mm_set1_pd(r[0].d.z);
+	__m128d hx = lx, hy = ly, hz = lz, ax = lx, ay = ly, az = lz, bx = lx, by = ly, bz = lz;
+	const __m128d o0x = _mm_set1_pd(r[0].o.x), o0y = _mm_set1_pd(r[0].o.y), o0z = _mm_set1_pd(r[0].o.z);
+	__m128d nan = _mm_setzero_pd(), same = _mm_cmpeq_pd(o0x, o0x);
+	for (int i = 0; i < n; i += 2) {
+		const ray *ra = &r[i], *rb = i + 1 < n ? &r[i + 1] : &r[0];
+		__m128d dx = _mm_loadh_pd(_mm_load_sd(&ra->d.x), &rb->d.x);
+		__m128d dy = _mm_loadh_pd(_mm_load_sd(&ra->d.y), &rb->d.y);
+		__m128d dz = _mm_loadh_pd(_mm_load_sd(&ra->d.z), &rb->d.z);
+		__m128d ox = _mm_loadh_pd(_mm_load_sd(&ra->o.x), &rb->o.x);
+		__m128d oy = _mm_loadh_pd(_mm_load_sd(&ra->o.y), &rb->o.y);
+		__m128d oz = _mm_loadh_pd(_mm_load_sd(&ra->o.z), &rb->o.z);
+		_mm_store_pd(&s->ox[i], ox);
+		_mm_store_pd(&s->oy[i], oy);
+		_mm_store_pd(&s->oz[i], oz);
+		_mm_store_pd(&s->dx[i], dx);
+		_mm_store_pd(&s->dy[i], dy);
+		_mm_store_pd(&s->dz[i], dz);
+		_mm_store_pd(&s->dd[i], _mm_add_pd(_mm_add_pd(_mm_mul_pd(dx, dx), _mm_mul_pd(dy, dy)), _mm_mul_pd(dz, dz)));
+		nan = _mm_or_pd(nan, _mm_or_pd(_mm_cmpunord_pd(dx, dy), _mm_cmpunord_pd(dz, ox)));
+		nan = _mm_or_pd(nan, _mm_cmpunord_pd(oy, oz));
+		same = _mm_and_pd(same, _mm_and_pd(_mm_cmpeq_pd(ox, o0x), _mm_and_pd(_mm_cmpeq_pd(oy, o0y), _mm_cmpeq_pd(oz, o0z))));
+		lx = _mm_min_pd(lx, dx);
+		ly = _mm_min_pd(ly, dy);
+		lz = _mm_min_pd(lz, dz);
+		hx = _mm_max_pd(hx, dx);
+		hy = _mm_max_pd(hy, dy);
+		hz = _mm_max_pd(hz, dz);
+		ax = _mm_and_pd(ax, dx);
+		ay = _mm_and_pd(ay, dy);
+		az = _mm_and_pd(az, dz);
+		bx = _mm_or_pd(bx, dx);
+		by = _mm_or_pd(by, dy);
+		bz = _mm_or_pd(bz, dz);
+	}
+	int neg_and = (_mm_movemask_pd(ax) == 3) | (_mm_movemask_pd(ay) == 3) << 1 | (_mm_movemask_pd(az) == 3) << 2;
+	int neg_or = (_mm_movemask_pd(bx) != 0) | (_mm_movemask_pd(by) != 0) << 1 | (_mm_movemask_pd(bz) != 0) << 2;
+	if (_mm_movemask_pd(nan) || neg_and != neg_or)
+		return false;
+	/* (the extremes of values of one sign, no NaN, are the same whatever
+	 * the order they are taken in) */
+	__m128d dlo = _mm_unpacklo_pd(_mm_min_pd(lx, _mm_unpackhi_pd(lx, lx)), _mm_min_pd(ly, _mm_unpackhi_pd(ly, ly)));
+	__m128d dhi = _mm_unpacklo_pd(_mm_max_pd(hx, _mm_unpackhi_pd(hx, hx)), _mm_max_pd(hy, _mm_unpackhi_pd(hy, hy)));
+	__m128d dlo_z = _mm_min_pd(lz, _mm_unpackhi_pd(lz, lz)), dhi_z = _mm_max_pd(hz, _mm_unpackhi_pd(hz, hz));
+	/* the inverses' signs are the directions' (every ray's the first's) */
+	const __m128 isign = _mm_and_ps(
+		_mm_movelh_ps(_mm_cvtpd_ps(_mm_set_pd(r[0].d.y, r[0].d.x)), _mm_cvtpd_ps(_mm_set_sd(r[0].d.z))), sign);
+	bool one_o = _mm_movemask_pd(same) == 3;
 	__m128 on_lo = _mm_set1_ps(INFINITY), on_hi = _mm_set1_ps(-INFINITY), of_lo = on_lo, of_hi = on_hi;
 	__m128 bad = _mm_setzero_ps();
-	int neg_and = 7, neg_or = 0, same_o = 0;
-	for (int i = 0; i < n; i++) {
-		__m128d d = _mm_loadu_pd(&r[i].d.x), dz = _mm_load_sd(&r[i].d.z);
-		__m128d o = _mm_loadu_pd(&r[i].o.x), oz = _mm_load_sd(&r[i].o.z);
-		/* (lane 0: x or z is NaN, lane 1: y; dz's high lane is 0) */
-		nan = _mm_or_pd(nan, _mm_or_pd(_mm_cmpunord_pd(d, dz), _mm_cmpunord_pd(o, oz)));
-		int neg = _mm_movemask_pd(d) | (_mm_movemask_pd(dz) & 1) << 2;
-		neg_and &= neg;
-		neg_or |= neg;
-		dlo = _mm_min_pd(dlo, d);
-		dhi = _mm_max_pd(dhi, d);
-		dlo_z = _mm_min_sd(dlo_z, dz);
-		dhi_z = _mm_max_sd(dhi_z, dz);
-		/* the origin's bracket, unless it is the first ray's (camera
-		 * rays: equal doubles, a zero of either sign giving the same
-		 * floats here) */
-		if (i > 0 && _mm_movemask_pd(_mm_and_pd(_mm_cmpeq_pd(o, o0), _mm_cmpeq_pd(oz, o0z))) == 3) {
-			same_o++;
-			continue;
-		}
-		__m128 f = _mm_movelh_ps(_mm_cvtpd_ps(o), _mm_cvtpd_ps(oz));
+	for (int i = 0; i < (one_o ? 1 : n); i++) {
+		__m128 f = _mm_movelh_ps(_mm_cvtpd_ps(_mm_set_pd(r[i].o.y, r[i].o.x)), _mm_cvtpd_ps(_mm_set_sd(r[i].o.z)));
 		__m128 e = _mm_add_ps(_mm_mul_ps(_mm_andnot_ps(sign, f), ulp), tiny);
 		__m128 es = _mm_xor_ps(e, isign);
 		__m128 on = _mm_add_ps(f, es), of = _mm_sub_ps(f, es);
@@ -147,8 +175,6 @@ static bool packet_prepare(const ray *r, int n, pk_ray *q)
 		of_lo = _mm_min_ps(of_lo, of);
 		of_hi = _mm_max_ps(of_hi, of);
 	}
-	if (_mm_movemask_pd(nan) || neg_and != neg_or)
-		return false;
 	__m128 ilo = _mm_movelh_ps(_mm_cvtpd_ps(_mm_div_pd(one, dhi)), _mm_cvtpd_ps(_mm_div_sd(one, dhi_z)));
 	__m128 ihi = _mm_movelh_ps(_mm_cvtpd_ps(_mm_div_pd(one, dlo)), _mm_cvtpd_ps(_mm_div_sd(one, dlo_z)));
 	/* the inverses must be finite and not zero (a zero direction
@@ -160,7 +186,7 @@ static bool packet_prepare(const ray *r, int n, pk_ray *q)
 	bad = _mm_or_ps(bad, _mm_cmpeq_ps(_mm_andnot_ps(sign, ihi), _mm_setzero_ps()));
 	if (_mm_movemask_ps(bad) & 7)
 		return false;
-	q->one_o = same_o == n - 1;
+	q->one_o = one_o;
 	float a_on_lo[4], a_on_hi[4], a_of_lo[4], a_of_hi[4], a_ilo[4], a_ihi[4];
 	_mm_storeu_ps(a_on_lo, on_lo);
 	_mm_storeu_ps(a_on_hi, on_hi);
@@ -200,19 +226,22 @@ static inline unsigned packet_slab4(const bvh_node *n, const pk_ray *q, float tm
 	return (unsigned)_mm_movemask_ps(_mm_cmple_ps(t0, _mm_mul_ps(t1, _mm_set1_ps(BVH_SLAB_SLACK))));
 }
 
-/* Ray i meets primitive p: a nearer hit replaces its best, one at the same
- * distance from another primitive is a tie. */
-static inline void offer(pk_state *s, int i, const prim *p, double t, vec3 nl)
+/* Ray i meets primitive p (a sphere or not): a nearer hit replaces its
+ * best, one at the same distance from another primitive is a tie. */
+static inline void offer(pk_state *s, int i, const prim *p, double t, vec3 nl, bool sphere)
 {
+	unsigned bit = 1u << i;
 	if (t < s->tmax[i]) {
 		s->tmax[i] = t;
 		s->best[i] = p;
 		s->nl[i] = nl;
-		s->tie[i] = false;
-	} else if (t == s->tmax[i] && s->best[i] && p != s->best[i]) {
+		s->got |= bit;
+		s->tie &= ~bit;
+		s->sph = sphere ? s->sph | bit : s->sph & ~bit;
+	} else if (t == s->tmax[i] && (s->got & bit) && p != s->best[i]) {
 		/* (at the distance of a plane or of the query's tmax, a single
 		 * ray keeps the plane or nothing: not a tie) */
-		s->tie[i] = true;
+		s->tie |= bit;
 	}
 }
 
@@ -258,43 +287,84 @@ static inline unsigned sphere_disc2_o(const pk_state *s, int i, __m128d ocx, __m
 }
 #endif
 
-static void leaf_spheres(pk_state *s, const prim *p, const ray *r, double tmin)
+/* next_up of both lanes: the smallest double above t >= 0, +inf and NaN
+ * kept, the smallest denormal for t <= 0 (next_up's integer steps). */
+static inline __m128d next_up2(__m128d t)
 {
-	vec3 zero = {0, 0, 0};
-#if defined(__SSE2__)
+	__m128d fin = _mm_cmplt_pd(t, _mm_set1_pd(INFINITY)), pos = _mm_cmpgt_pd(t, _mm_setzero_pd());
+	__m128i one = _mm_set1_epi64x(1);
+	__m128d up = _mm_castsi128_pd(_mm_add_epi64(_mm_castpd_si128(t), one));
+	__m128d u = _mm_or_pd(_mm_and_pd(pos, up), _mm_andnot_pd(pos, _mm_castsi128_pd(one)));
+	return _mm_or_pd(_mm_and_pd(fin, u), _mm_andnot_pd(fin, t));
+}
+
+/* The rays of s meet sphere p: first the discriminants of all the pairs
+ * (sphere_disc2), then for the pairs where one is not negative sphere_hit's
+ * remaining steps on both lanes, each lane its operations in its order: q
+ * = -(b + copysign(sqrt(disc), b)), t0 = q / a, t1 = c / q (t0 when q is
+ * 0), the two in order, the nearer above tmin, and its test against tmin
+ * and the next double above the ray's nearest so far (offer). A lane
+ * whose discriminant is negative is dropped, as sphere_hit returns there. */
+static void leaf_spheres(pk_state *s, const prim *p, double tmin)
+{
+	const vec3 zero = {0, 0, 0};
 	const pk_sphere sph = pk_sphere_of(p);
+	const __m128d sign = _mm_set1_pd(-0.0), t0v = _mm_set1_pd(tmin);
+	__m128d ocx = _mm_setzero_pd(), ocy = ocx, ocz = ocx, c1 = ocx;
 	if (s->one_o) {
-		__m128d ocx = _mm_sub_pd(_mm_load_pd(&s->ox[0]), sph.cx), ocy = _mm_sub_pd(_mm_load_pd(&s->oy[0]), sph.cy);
-		__m128d ocz = _mm_sub_pd(_mm_load_pd(&s->oz[0]), sph.cz);
-		__m128d c = _mm_sub_pd(
-			_mm_add_pd(_mm_add_pd(_mm_mul_pd(ocx, ocx), _mm_mul_pd(ocy, ocy)), _mm_mul_pd(ocz, ocz)), sph.rr);
-		for (int i = 0; i < s->n; i += 2) {
-			unsigned m = sphere_disc2_o(s, i, ocx, ocy, ocz, c);
-			for (; m; m &= m - 1) {
-				int j = i + __builtin_ctz(m);
-				double t;
-				if (j < s->n && sphere_hit(p, &r[j], tmin, next_up(s->tmax[j]), &t))
-					offer(s, j, p, t, zero);
-			}
+		ocx = _mm_sub_pd(_mm_load_pd(&s->ox[0]), sph.cx);
+		ocy = _mm_sub_pd(_mm_load_pd(&s->oy[0]), sph.cy);
+		ocz = _mm_sub_pd(_mm_load_pd(&s->oz[0]), sph.cz);
+		c1 = _mm_sub_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(ocx, ocx), _mm_mul_pd(ocy, ocy)), _mm_mul_pd(ocz, ocz)),
+		                sph.rr);
+	}
+	unsigned pass = 0;
+	for (int i = 0; i < s->n; i += 2)
+		pass |= (s->one_o ? sphere_disc2_o(s, i, ocx, ocy, ocz, c1) : sphere_disc2(s, i, &sph)) << i;
+	pass &= (1u << s->n) - 1; /* (not the pad) */
+	for (unsigned pairs = (pass | pass >> 1) & 0x5555u; pairs; pairs &= pairs - 1) {
+		int i = __builtin_ctz(pairs);
+		__m128d dx = _mm_load_pd(&s->dx[i]), dy = _mm_load_pd(&s->dy[i]), dz = _mm_load_pd(&s->dz[i]);
+		__m128d ox = ocx, oy = ocy, oz = ocz, c = c1;
+		if (!s->one_o) {
+			ox = _mm_sub_pd(_mm_load_pd(&s->ox[i]), sph.cx);
+			oy = _mm_sub_pd(_mm_load_pd(&s->oy[i]), sph.cy);
+			oz = _mm_sub_pd(_mm_load_pd(&s->oz[i]), sph.cz);
+			c = _mm_sub_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(ox, ox), _mm_mul_pd(oy, oy)), _mm_mul_pd(oz, oz)), sph.rr);
 		}
-		return;
-	}
-	for (int i = 0; i < s->n; i += 2) {
-		unsigned m = sphere_disc2(s, i, &sph);
-		for (; m; m &= m - 1) {
-			int j = i + __builtin_ctz(m);
-			double t;
-			if (j < s->n && sphere_hit(p, &r[j], tmin, next_up(s->tmax[j]), &t))
-				offer(s, j, p, t, zero);
+		__m128d a = _mm_load_pd(&s->dd[i]);
+		__m128d b = _mm_add_pd(_mm_add_pd(_mm_mul_pd(ox, dx), _mm_mul_pd(oy, dy)), _mm_mul_pd(oz, dz));
+		if (s->one_o && _mm_movemask_pd(_mm_cmpeq_pd(b, _mm_setzero_pd()))) {
+			/* b is a zero: its sign, which q takes, is that of the
+			 * ray's own o - c (origins equal as doubles may differ in
+			 * the sign of a zero; c and the discriminant do not) */
+			ox = _mm_sub_pd(_mm_load_pd(&s->ox[i]), sph.cx);
+			oy = _mm_sub_pd(_mm_load_pd(&s->oy[i]), sph.cy);
+			oz = _mm_sub_pd(_mm_load_pd(&s->oz[i]), sph.cz);
+			b = _mm_add_pd(_mm_add_pd(_mm_mul_pd(ox, dx), _mm_mul_pd(oy, dy)), _mm_mul_pd(oz, dz));
 		}
+		__m128d disc = _mm_sub_pd(_mm_mul_pd(b, b), _mm_mul_pd(a, c));
+		__m128d sq = _mm_sqrt_pd(disc);
+		__m128d q = _mm_xor_pd(_mm_add_pd(b, _mm_or_pd(_mm_andnot_pd(sign, sq), _mm_and_pd(sign, b))), sign);
+		__m128d t0 = _mm_div_pd(q, a), t1 = _mm_div_pd(c, q);
+		__m128d qz = _mm_cmpneq_pd(q, _mm_setzero_pd());
+		t1 = _mm_or_pd(_mm_and_pd(qz, t1), _mm_andnot_pd(qz, t0));
+		__m128d gt = _mm_cmpgt_pd(t0, t1);
+		__m128d lo = _mm_or_pd(_mm_and_pd(gt, t1), _mm_andnot_pd(gt, t0));
+		__m128d hi = _mm_or_pd(_mm_and_pd(gt, t0), _mm_andnot_pd(gt, t1));
+		__m128d above = _mm_cmpgt_pd(lo, t0v);
+		__m128d tt = _mm_or_pd(_mm_and_pd(above, lo), _mm_andnot_pd(above, hi));
+		__m128d ok = _mm_and_pd(_mm_cmpgt_pd(tt, t0v), _mm_cmplt_pd(tt, next_up2(_mm_load_pd(&s->tmax[i]))));
+		unsigned m = (unsigned)_mm_movemask_pd(ok) & pass >> i & 3u;
+		if (!m)
+			continue;
+		double t[2];
+		_mm_storeu_pd(t, tt);
+		if (m & 1)
+			offer(s, i, p, t[0], zero, true);
+		if (m & 2)
+			offer(s, i + 1, p, t[1], zero, true);
 	}
-#else
-	for (int i = 0; i < s->n; i++) {
-		double t;
-		if (sphere_hit(p, &r[i], tmin, next_up(s->tmax[i]), &t))
-			offer(s, i, p, t, zero);
-	}
-#endif
 }
 
 /* The rays of s meet a model among the objects (a mesh instance in a leaf)
@@ -315,14 +385,14 @@ static bool leaf_mesh(const world *w, pk_state *s, const prim *p, const ray *r, 
 		return false;
 	for (unsigned g = got & ~tie; g; g &= g - 1) {
 		int i = __builtin_ctz(g);
-		offer(s, i, p, t[i], v3((double)slot[i], b[i][1], b[i][2]));
+		offer(s, i, p, t[i], v3((double)slot[i], b[i][1], b[i][2]), false);
 	}
 	for (; tie; tie &= tie - 1) {
 		int i = __builtin_ctz(tie);
 		double tt;
 		vec3 nl;
 		if (world_prim_hit(w, p, &r[i], tmin, tm[i], &tt, &nl, true))
-			offer(s, i, p, tt, nl);
+			offer(s, i, p, tt, nl, false);
 	}
 	return true;
 }
@@ -351,7 +421,7 @@ static void packet_walk(const world *w, pk_state *s, const ray *r, const pk_ray 
 			uint32_t count = meta & ~BVH_LEAF;
 			for (uint32_t k = 0; k < count; k++) {
 				if (p[k].tag == PRIM_SPHERE) {
-					leaf_spheres(s, &p[k], r, tmin);
+					leaf_spheres(s, &p[k], tmin);
 					continue;
 				}
 				if (p[k].tag == PRIM_MESH && leaf_mesh(w, s, &p[k], r, tmin))
@@ -360,7 +430,7 @@ static void packet_walk(const world *w, pk_state *s, const ray *r, const pk_ray 
 					double t;
 					vec3 nl = {0, 0, 0};
 					if (world_prim_hit(w, &p[k], &r[i], tmin, next_up(s->tmax[i]), &t, &nl, true))
-						offer(s, i, &p[k], t, nl);
+						offer(s, i, &p[k], t, nl, false);
 				}
 			}
 			far = packet_far(s);
@@ -437,68 +507,285 @@ static bool model_packet(const world *w, int n, const ray *r, double tmin, doubl
 	return true;
 }
 
-void world_trace_packet(const world *w, int n, const ray *r, double tmin, double tmax, trace_hit *th, bool *found)
+/* The planes beside the tree for the rays of s, as trace tests them (the
+ * nearest in the planes' order, each with plane_hit's test): s->tmax[i]
+ * from tmax down to the nearest plane's distance, best_plane[i] that plane
+ * or NULL. Two rays per SSE2 register, each lane plane_hit_o's operations
+ * in its order: dy = h . d, -oy / dy, the strict test against tmin and the
+ * nearest so far (dy == 0 fails as there; a NaN fails every compare, as
+ * there). Rays of one origin share its height over each plane (plane_oy,
+ * once a plane: see world_trace_packet); others each compute their own,
+ * plane_oy's operations in its order. */
+static void packet_planes(const world *w, pk_state *s, double tmin, double tmax, const prim_plane **best_plane)
+{
+	int n = s->n, even = (n + 1) & ~1;
+	for (int i = 0; i < even; i += 2) {
+		_mm_store_pd(&s->tmax[i], _mm_set1_pd(tmax)); /* (whole: the loads below are forwarded) */
+		best_plane[i] = best_plane[i + 1] = NULL;
+	}
+	unsigned any = 0;
+	/* Origins equal as doubles may differ in the sign of a zero, and so
+	 * may oy, only when it is zero: then -oy / dy is a zero (or NaN) that
+	 * no tmin >= 0 lets through either way. */
+	bool one = s->one_o && tmin >= 0.0;
+	const __m128d sign = _mm_set1_pd(-0.0), zero = _mm_setzero_pd(), t0 = _mm_set1_pd(tmin);
+	for (size_t k = 0; k < w->nplanes; k++) {
+		const prim_plane *pl = &w->planes[k];
+		const __m128d h0 = _mm_set1_pd(pl->h[0]), h1 = _mm_set1_pd(pl->h[1]), h2 = _mm_set1_pd(pl->h[2]);
+		const __m128d h3 = _mm_set1_pd(pl->h[3]);
+		const __m128d oy1 = _mm_set1_pd(one ? plane_oy(pl, (vec3){s->ox[0], s->oy[0], s->oz[0]}) : 0.0);
+		for (int i = 0; i < n; i += 2) {
+			__m128d oy = oy1;
+			if (!one)
+				oy = _mm_add_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(h0, _mm_load_pd(&s->ox[i])),
+				                                      _mm_mul_pd(h1, _mm_load_pd(&s->oy[i]))),
+				                           _mm_mul_pd(h2, _mm_load_pd(&s->oz[i]))),
+				                h3);
+			__m128d dy = _mm_add_pd(_mm_add_pd(_mm_mul_pd(h0, _mm_load_pd(&s->dx[i])),
+			                                   _mm_mul_pd(h1, _mm_load_pd(&s->dy[i]))),
+			                        _mm_mul_pd(h2, _mm_load_pd(&s->dz[i])));
+			__m128d tt = _mm_div_pd(_mm_xor_pd(oy, sign), dy), t = _mm_load_pd(&s->tmax[i]);
+			__m128d m = _mm_and_pd(_mm_cmpneq_pd(dy, zero), _mm_and_pd(_mm_cmpgt_pd(tt, t0), _mm_cmplt_pd(tt, t)));
+			_mm_store_pd(&s->tmax[i], _mm_or_pd(_mm_and_pd(m, tt), _mm_andnot_pd(m, t)));
+			/* (without branches: which rays meet a plane first follows the
+			 * picture, not a pattern the branch predictor learns) */
+			int bits = _mm_movemask_pd(m);
+			best_plane[i] = bits & 1 ? pl : best_plane[i];
+			best_plane[i + 1] = bits & 2 ? pl : best_plane[i + 1]; /* (the pad's entry exists: even <= PACKET_MAX) */
+			any |= (unsigned)bits << i;
+		}
+	}
+	s->plane = any & ((1u << n) - 1);
+}
+
+/* The packet's walk of rays r[0..n) (n <= PACKET_MAX) into s, the planes'
+ * nearest into best_plane: false when the rays are not traced as a packet
+ * (too few, not coherent, an empty tree), to be traced alone. */
+static bool packet_trace(const world *w, int n, const ray *r, double tmin, double tmax, pk_state *s,
+                         const prim_plane **best_plane)
 {
 	pk_ray q;
-	bool lone_model = w->nprims == 1 && w->prims[0].tag == PRIM_MESH;
-	if (lone_model && n >= 2 && n <= PACKET_MAX && model_packet(w, n, r, tmin, tmax, th, found))
+	if (n < 2 || !w->nprims)
+		return false;
+	if (!packet_prepare(s, r, n, &q))
+		return false;
+	world_rays_count(n);
+	s->one_o = q.one_o;
+	s->got = s->sph = s->tie = 0;
+	packet_planes(w, s, tmin, tmax, best_plane);
+	packet_walk(w, s, r, &q, tmin);
+	return true;
+}
+
+static bool lone_model(const world *w)
+{
+	return w->nprims == 1 && w->prims[0].tag == PRIM_MESH;
+}
+
+void world_trace_packet(const world *w, int n, const ray *r, double tmin, double tmax, trace_hit *th, bool *found)
+{
+	pk_state s;
+	const prim_plane *best_plane[PACKET_MAX];
+	bool lone = lone_model(w);
+	if (lone && n >= 2 && n <= PACKET_MAX && model_packet(w, n, r, tmin, tmax, th, found))
 		return;
-	if (n < 2 || n > PACKET_MAX || !w->nprims || lone_model || !packet_prepare(r, n, &q)) {
+	if (n > PACKET_MAX || lone || !packet_trace(w, n, r, tmin, tmax, &s, best_plane)) {
 		for (int i = 0; i < n; i++)
 			found[i] = world_trace_coherent(w, &r[i], tmin, tmax, &th[i]);
 		return;
 	}
-	world_rays_count(n);
-	pk_state s;
-	s.n = n;
-	const prim_plane *best_plane[PACKET_MAX];
-	s.one_o = q.one_o;
-	/* rays of one origin: its height over each of the first planes once
-	 * (plane_oy). Origins equal as doubles may differ in the sign of a
-	 * zero, and so may oy, only when it is zero: then -oy / dy is a zero
-	 * (or NaN) that no tmin >= 0 lets through either way. */
-	double oy[4];
-	size_t noy = s.one_o && tmin >= 0.0 ? (w->nplanes < 4 ? w->nplanes : 4) : 0;
-	for (size_t k = 0; k < noy; k++)
-		oy[k] = plane_oy(&w->planes[k], r[0].o);
 	for (int i = 0; i < n; i++) {
-		double t = tmax, tp;
-		best_plane[i] = NULL;
-		for (size_t k = 0; k < w->nplanes; k++)
-			if (k < noy ? plane_hit_o(&w->planes[k], oy[k], &r[i], tmin, t, &tp)
-			            : plane_hit(&w->planes[k], &r[i], tmin, t, &tp)) {
-				t = tp;
-				best_plane[i] = &w->planes[k];
-			}
-		s.tmax[i] = t;
-		s.best[i] = NULL;
-		s.tie[i] = false;
-		pk_load_ray(&s, i, &r[i]);
-	}
-	if (n & 1) /* the vector pre-test reads an even count; the pad is never offered */
-		pk_load_ray(&s, n, &r[0]);
-	packet_walk(w, &s, r, &q, tmin);
-	for (int i = 0; i < n; i++) {
-		if (s.tie[i]) {
+		if (s.tie >> i & 1) {
 			world_rays_count(-1);
 			found[i] = world_trace_coherent(w, &r[i], tmin, tmax, &th[i]);
 			continue;
 		}
+		bool got = s.got >> i & 1;
 		th[i].t = s.tmax[i];
-		th[i].prim = s.best[i];
-		th[i].plane = s.best[i] ? NULL : best_plane[i];
-		th[i].nl = s.best[i] ? s.nl[i] : (vec3){0, 0, 0};
-		found[i] = s.best[i] || best_plane[i];
+		th[i].prim = got ? s.best[i] : NULL;
+		th[i].plane = got ? NULL : best_plane[i];
+		th[i].nl = got ? s.nl[i] : (vec3){0, 0, 0};
+		found[i] = got || best_plane[i];
 	}
+}
+
+/* Rays a and b of s (lanes 0 and 1) on a point of their hit: o + d t, as
+ * ray_at. */
+static inline void pk_point2(const pk_state *s, int a, int b, __m128d *px, __m128d *py, __m128d *pz)
+{
+	__m128d t = _mm_set_pd(s->tmax[b], s->tmax[a]);
+	*px = _mm_add_pd(_mm_set_pd(s->ox[b], s->ox[a]), _mm_mul_pd(_mm_set_pd(s->dx[b], s->dx[a]), t));
+	*py = _mm_add_pd(_mm_set_pd(s->oy[b], s->oy[a]), _mm_mul_pd(_mm_set_pd(s->dy[b], s->dy[a]), t));
+	*pz = _mm_add_pd(_mm_set_pd(s->oz[b], s->oz[a]), _mm_mul_pd(_mm_set_pd(s->dz[b], s->dz[a]), t));
+}
+
+/* Whether n . d < 0 for rays a and b (bits 0 and 1), as v3_dot(n, d) < 0.0
+ * computes it, n given by component for each lane. */
+static inline int pk_front2(const pk_state *s, int a, int b, __m128d nx, __m128d ny, __m128d nz)
+{
+	__m128d dot = _mm_add_pd(_mm_add_pd(_mm_mul_pd(nx, _mm_set_pd(s->dx[b], s->dx[a])),
+	                                    _mm_mul_pd(ny, _mm_set_pd(s->dy[b], s->dy[a]))),
+	                         _mm_mul_pd(nz, _mm_set_pd(s->dz[b], s->dz[a])));
+	return _mm_movemask_pd(_mm_cmplt_pd(dot, _mm_setzero_pd()));
+}
+
+static inline void store2(__m128d v, double *a, double *b)
+{
+	_mm_storel_pd(a, v);
+	_mm_storeh_pd(b, v);
+}
+
+/* The hit records of the rays of s on plane pl (bits on): world_finish's
+ * (finish_plane, surf_shape_uv), two rays at a time, each lane its
+ * operations in its order; an odd one out through world_finish itself. */
+static void finish_planes(const world *w, const pk_state *s, const ray *r, const prim_plane *pl, unsigned on, hit *h)
+{
+	const prim_shape *sh = &w->shapes[pl->shape];
+	const double(*m)[4] = sh->inv;
+	const __m128d m00 = _mm_set1_pd(m[0][0]), m01 = _mm_set1_pd(m[0][1]), m02 = _mm_set1_pd(m[0][2]);
+	const __m128d m03 = _mm_set1_pd(m[0][3]), m10 = _mm_set1_pd(m[1][0]), m11 = _mm_set1_pd(m[1][1]);
+	const __m128d m12 = _mm_set1_pd(m[1][2]), m13 = _mm_set1_pd(m[1][3]), m20 = _mm_set1_pd(m[2][0]);
+	const __m128d m21 = _mm_set1_pd(m[2][1]), m22 = _mm_set1_pd(m[2][2]), m23 = _mm_set1_pd(m[2][3]);
+	const __m128d nx = _mm_set1_pd(pl->n.x), ny = _mm_set1_pd(pl->n.y), nz = _mm_set1_pd(pl->n.z);
+	const bool uv = surf_wants_uv(w, pl->object);
+	while (on & (on - 1)) {
+		int a = __builtin_ctz(on);
+		on &= on - 1;
+		int b = __builtin_ctz(on);
+		on &= on - 1;
+		__m128d px, py, pz;
+		pk_point2(s, a, b, &px, &py, &pz);
+		int front = pk_front2(s, a, b, nx, ny, nz);
+		/* m[k][0] x + m[k][1] y + m[k][2] z + m[k][3], in that order */
+		__m128d lx = _mm_add_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(m00, px), _mm_mul_pd(m01, py)), _mm_mul_pd(m02, pz)), m03);
+		__m128d ly = _mm_add_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(m10, px), _mm_mul_pd(m11, py)), _mm_mul_pd(m12, pz)), m13);
+		__m128d lz = _mm_add_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(m20, px), _mm_mul_pd(m21, py)), _mm_mul_pd(m22, pz)), m23);
+		hit *ha = &h[a], *hb = &h[b];
+		ha->t = s->tmax[a];
+		hb->t = s->tmax[b];
+		store2(px, &ha->p.x, &hb->p.x);
+		store2(py, &ha->p.y, &hb->p.y);
+		store2(pz, &ha->p.z, &hb->p.z);
+		store2(lx, &ha->local.x, &hb->local.x);
+		store2(ly, &ha->local.y, &hb->local.y);
+		store2(lz, &ha->local.z, &hb->local.z);
+		ha->n = hb->n = pl->n;
+		ha->object = hb->object = pl->object;
+		ha->front = front & 1;
+		hb->front = front >> 1 & 1;
+		if (uv) {
+			surf_shape_uv(w, sh, pl->n, ha);
+			surf_shape_uv(w, sh, pl->n, hb);
+		} else {
+			ha->mat = hb->mat = pl->object;
+			ha->has_uv = hb->has_uv = false;
+		}
+	}
+	if (on) {
+		int a = __builtin_ctz(on);
+		trace_hit th = {s->tmax[a], NULL, pl, {0, 0, 0}};
+		world_finish(w, &r[a], &th, &h[a]);
+	}
+}
+
+/* The hit records of rays a and b of s on spheres pa and pb: finish_hit's
+ * for a sphere, each lane its operations in its order (the normal
+ * v3_norm(p - c): the squared length, its sqrt, 1 / that, the products). */
+static void finish_sphere2(const pk_state *s, const prim *pa, const prim *pb, int a, int b, hit *h)
+{
+	__m128d px, py, pz;
+	pk_point2(s, a, b, &px, &py, &pz);
+	__m128d vx = _mm_sub_pd(px, _mm_set_pd(pb->u.sph.c.x, pa->u.sph.c.x));
+	__m128d vy = _mm_sub_pd(py, _mm_set_pd(pb->u.sph.c.y, pa->u.sph.c.y));
+	__m128d vz = _mm_sub_pd(pz, _mm_set_pd(pb->u.sph.c.z, pa->u.sph.c.z));
+	__m128d len = _mm_sqrt_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(vx, vx), _mm_mul_pd(vy, vy)), _mm_mul_pd(vz, vz)));
+	__m128d inv = _mm_div_pd(_mm_set1_pd(1.0), len);
+	__m128d nx = _mm_mul_pd(vx, inv), ny = _mm_mul_pd(vy, inv), nz = _mm_mul_pd(vz, inv);
+	int front = pk_front2(s, a, b, nx, ny, nz);
+	const prim *p[2] = {pa, pb};
+	int idx[2] = {a, b};
+	for (int k = 0; k < 2; k++) {
+		hit *o = &h[idx[k]];
+		o->t = s->tmax[idx[k]];
+		o->object = p[k]->object;
+		o->mat = p[k]->object;
+		o->has_uv = false;
+		o->front = front >> k & 1;
+	}
+	store2(px, &h[a].p.x, &h[b].p.x);
+	store2(py, &h[a].p.y, &h[b].p.y);
+	store2(pz, &h[a].p.z, &h[b].p.z);
+	/* (local = n: stored from the registers, not copied from the record,
+	 * whose halves, just stored one by one, a 16-byte load would wait for) */
+	store2(nx, &h[a].n.x, &h[b].n.x);
+	store2(ny, &h[a].n.y, &h[b].n.y);
+	store2(nz, &h[a].n.z, &h[b].n.z);
+	store2(nx, &h[a].local.x, &h[b].local.x);
+	store2(ny, &h[a].local.y, &h[b].local.y);
+	store2(nz, &h[a].local.z, &h[b].local.z);
 }
 
 void world_intersect_packet(const world *w, int n, const ray *r, double tmin, double tmax, hit *h, bool *found)
 {
-	trace_hit th[PACKET_MAX];
-	world_trace_packet(w, n, r, tmin, tmax, th, found);
+	pk_state s;
+	const prim_plane *best_plane[PACKET_MAX];
+	bool lone = lone_model(w);
+	if (lone || n > PACKET_MAX || !packet_trace(w, n, r, tmin, tmax, &s, best_plane)) {
+		trace_hit th[PACKET_MAX];
+		if (!lone || n > PACKET_MAX) {
+			for (int i = 0; i < n; i++)
+				found[i] = world_intersect_coherent(w, &r[i], tmin, tmax, &h[i]);
+			return;
+		}
+		world_trace_packet(w, n, r, tmin, tmax, th, found);
+		for (int i = 0; i < n; i++)
+			if (found[i])
+				world_finish(w, &r[i], &th[i], &h[i]);
+		return;
+	}
+	/* the hit records: rays on one plane by pairs, rays on spheres by
+	 * pairs, the rest (ties, other primitives) one by one as world_finish
+	 * makes them; sorted by the walk's bits, not by branches on each ray
+	 * (which rays end on a sphere and which on the plane follows the
+	 * picture: a branch on it is mispredicted often) */
+	unsigned tie = s.tie;
+	unsigned sph = s.got & s.sph & ~tie, pln = s.plane & ~s.got & ~tie, alone = tie | (s.got & ~s.sph);
+	unsigned hit_any = s.got | s.plane;
 	for (int i = 0; i < n; i++)
-		if (found[i])
-			world_finish(w, &r[i], &th[i], &h[i]);
+		found[i] = hit_any >> i & 1;
+	for (; alone; alone &= alone - 1) {
+		int i = __builtin_ctz(alone);
+		if (tie >> i & 1) {
+			world_rays_count(-1);
+			found[i] = world_intersect_coherent(w, &r[i], tmin, tmax, &h[i]);
+		} else {
+			trace_hit th = {s.tmax[i], s.best[i], NULL, s.nl[i]};
+			world_finish(w, &r[i], &th, &h[i]);
+		}
+	}
+	while (pln) {
+		/* the rays on the first ray's plane, then those on the next */
+		const prim_plane *pl = best_plane[__builtin_ctz(pln)];
+		unsigned on = w->nplanes == 1 ? pln : 0;
+		for (unsigned m = on ? 0 : pln; m; m &= m - 1) {
+			int i = __builtin_ctz(m);
+			on |= (unsigned)(best_plane[i] == pl) << i;
+		}
+		pln &= ~on;
+		finish_planes(w, &s, r, pl, on, h);
+	}
+	while (sph & (sph - 1)) {
+		int a = __builtin_ctz(sph);
+		sph &= sph - 1;
+		int b = __builtin_ctz(sph);
+		sph &= sph - 1;
+		finish_sphere2(&s, s.best[a], s.best[b], a, b, h);
+	}
+	if (sph) {
+		int a = __builtin_ctz(sph);
+		trace_hit th = {s.tmax[a], s.best[a], NULL, s.nl[a]};
+		world_finish(w, &r[a], &th, &h[a]);
+	}
 }
 
 /* --- any hit: shadow rays --- */
@@ -542,6 +829,37 @@ static bool planes_block(const world *w, const ray *r, double tmin, double tmax)
 	return false;
 }
 
+/* The rays of s (bits) that a plane blocks between tmin and tmax[i]:
+ * planes_block's test (plane_hit) two rays per SSE2 register, each lane
+ * its operations in its order (the origin's height h . o + h[3], the
+ * slope h . d, -oy / dy, the strict tests; dy == 0 and NaN fail as
+ * there). */
+static unsigned packet_planes_block(const world *w, const pk_state *s, double tmin, const double *tmax)
+{
+	int n = s->n;
+	unsigned blocked = 0;
+	const __m128d sign = _mm_set1_pd(-0.0), zero = _mm_setzero_pd(), t0 = _mm_set1_pd(tmin);
+	for (size_t k = 0; k < w->nplanes; k++) {
+		const prim_plane *pl = &w->planes[k];
+		const __m128d h0 = _mm_set1_pd(pl->h[0]), h1 = _mm_set1_pd(pl->h[1]), h2 = _mm_set1_pd(pl->h[2]);
+		const __m128d h3 = _mm_set1_pd(pl->h[3]);
+		for (int i = 0; i < n; i += 2) {
+			__m128d oy = _mm_add_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(h0, _mm_load_pd(&s->ox[i])),
+			                                              _mm_mul_pd(h1, _mm_load_pd(&s->oy[i]))),
+			                                   _mm_mul_pd(h2, _mm_load_pd(&s->oz[i]))),
+			                        h3);
+			__m128d dy = _mm_add_pd(_mm_add_pd(_mm_mul_pd(h0, _mm_load_pd(&s->dx[i])),
+			                                   _mm_mul_pd(h1, _mm_load_pd(&s->dy[i]))),
+			                        _mm_mul_pd(h2, _mm_load_pd(&s->dz[i])));
+			__m128d tt = _mm_div_pd(_mm_xor_pd(oy, sign), dy);
+			__m128d tm = _mm_set_pd(i + 1 < n ? tmax[i + 1] : tmax[i], tmax[i]);
+			__m128d m = _mm_and_pd(_mm_cmpneq_pd(dy, zero), _mm_and_pd(_mm_cmpgt_pd(tt, t0), _mm_cmplt_pd(tt, tm)));
+			blocked |= (unsigned)_mm_movemask_pd(m) << i;
+		}
+	}
+	return blocked & ((1u << n) - 1);
+}
+
 /* Shadow rays on a lone model: the planes first for each ray, as
  * world_occluded, then the rays they leave through the model's triangle
  * tree in one packet (mesh_occluded_world_packet). False when that packet
@@ -576,25 +894,19 @@ void world_occluded_packet(const world *w, int n, const ray *r, double tmin, con
 	bool lone_model = w->nprims == 1 && w->prims[0].tag == PRIM_MESH;
 	if (lone_model && n >= 2 && n <= PACKET_MAX && model_occluded(w, n, r, tmin, tmax, occ))
 		return;
-	if (n < 2 || n > PACKET_MAX || lone_model || !packet_prepare(r, n, &q)) {
+	pk_state s;
+	if (n < 2 || n > PACKET_MAX || lone_model || !packet_prepare(&s, r, n, &q)) {
 		for (int i = 0; i < n; i++)
 			occ[i] = world_occluded(w, &r[i], tmin, tmax[i]);
 		return;
 	}
 	world_rays_count(n);
-	pk_state s;
-	s.n = n;
 	s.one_o = false;
-	unsigned live = 0;
+	unsigned live = ((1u << n) - 1) & ~packet_planes_block(w, &s, tmin, tmax);
 	for (int i = 0; i < n; i++) {
-		bool blocked = planes_block(w, &r[i], tmin, tmax[i]);
-		occ[i] = blocked;
-		live |= (unsigned)!blocked << i;
+		occ[i] = !(live >> i & 1u);
 		s.tmax[i] = tmax[i];
-		pk_load_ray(&s, i, &r[i]);
 	}
-	if (n & 1) /* the vector pre-test reads an even count; the pad is never offered */
-		pk_load_ray(&s, n, &r[0]);
 	if (w->nprims && live) {
 		const bvh_node *nodes = w->tree->nodes;
 		float ftmin = to_float_down(tmin);

@@ -326,7 +326,7 @@ static void apply_uv(const world *w, hit *h, double u, double v, vec3 dpdu, vec3
 
 static bool wants_uv(const world *w, const hit *h)
 {
-	return w->mats[h->mat].tx != NULL;
+	return surf_wants_uv(w, h->mat);
 }
 
 vec3 surf_inst_ng(const world *w, const prim *p, vec3 nl)

@@ -43,6 +43,13 @@ vec3 surf_inst_ng(const world *w, const prim *p, vec3 nl);
  * of a world-space triangle (its vertex, edges), when h's material has a
  * texture; nl is the object-space normal the shape's intersect gave. */
 void surf_shape_uv(const world *w, const prim_shape *sh, vec3 nl, hit *h);
+/* Whether a hit with material mat needs its texture coordinates (the
+ * material has a texture): surf_shape_uv's test, for callers that fill the
+ * rest of a hit record themselves (packet.c). */
+static inline bool surf_wants_uv(const world *w, uint32_t mat)
+{
+	return w->mats[mat].tx != NULL;
+}
 void surf_triangle_uv(const world *w, vec3 v0, vec3 e1, vec3 e2, hit *h);
 void surf_free(world *w);
 size_t surf_memory(const world *w);

@@ -45,6 +45,45 @@ static void same_vec(vec3 a, vec3 b, const char *what)
 	same_double(a.z, b.z, what);
 }
 
+/* Two hit records field by field, to the bit (u, v, dpdu, dpdv where the
+ * single ray's has them). */
+static void same_hit(const hit *hp, const hit *hs)
+{
+	same_double(hp->t, hs->t, "t");
+	same_vec(hp->p, hs->p, "p");
+	same_vec(hp->n, hs->n, "n");
+	same_vec(hp->local, hs->local, "local");
+	assert_int_equal(hp->front, hs->front);
+	assert_int_equal(hp->object, hs->object);
+	assert_int_equal(hp->mat, hs->mat);
+	assert_int_equal(hp->has_uv, hs->has_uv);
+	if (hs->has_uv) {
+		same_double(hp->u, hs->u, "u");
+		same_double(hp->v, hs->v, "v");
+		same_vec(hp->dpdu, hs->dpdu, "dpdu");
+		same_vec(hp->dpdv, hs->dpdv, "dpdv");
+	}
+}
+
+/* world_intersect_packet's hit records (the packet's own, made two rays at
+ * a time on planes and spheres) against world_intersect_coherent's, for
+ * r[0..n) with tmin < t < tmax. */
+static void check_records(const world *w, const ray *r, int n, double tmin, double tmax)
+{
+	hit hp[PACKET_MAX];
+	bool fp[PACKET_MAX];
+	memset(hp, 0, sizeof hp);
+	world_intersect_packet(w, n, r, tmin, tmax, hp, fp);
+	for (int i = 0; i < n; i++) {
+		hit hs;
+		memset(&hs, 0, sizeof hs);
+		bool fs = world_intersect_coherent(w, &r[i], tmin, tmax, &hs);
+		assert_int_equal(fp[i], fs);
+		if (fs)
+			same_hit(&hp[i], &hs);
+	}
+}
+
 /* Packet against single rays for r[0..n): nearest hits, hit records, and
  * shadow queries to a fraction of each hit's distance and to `lamp`. */
 static void check_packet(const world *w, const ray *r, int n, vec3 lamp)
@@ -53,6 +92,7 @@ static void check_packet(const world *w, const ray *r, int n, vec3 lamp)
 	bool fp[PACKET_MAX];
 	world_trace_packet(w, n, r, 0.0, INFINITY, tp, fp);
 	packets++;
+	check_records(w, r, n, 0.0, INFINITY);
 	ray sr[PACKET_MAX];
 	double smax[PACKET_MAX];
 	for (int i = 0; i < n; i++) {
@@ -74,19 +114,7 @@ static void check_packet(const world *w, const ray *r, int n, vec3 lamp)
 		memset(&hs, 0, sizeof hs);
 		world_finish(w, &r[i], &tp[i], &hp);
 		world_finish(w, &r[i], &ts, &hs);
-		same_vec(hp.p, hs.p, "p");
-		same_vec(hp.n, hs.n, "n");
-		same_vec(hp.local, hs.local, "local");
-		assert_int_equal(hp.front, hs.front);
-		assert_int_equal(hp.object, hs.object);
-		assert_int_equal(hp.mat, hs.mat);
-		assert_int_equal(hp.has_uv, hs.has_uv);
-		if (hs.has_uv) {
-			same_double(hp.u, hs.u, "u");
-			same_double(hp.v, hs.v, "v");
-			same_vec(hp.dpdu, hs.dpdu, "dpdu");
-			same_vec(hp.dpdv, hs.dpdv, "dpdv");
-		}
+		same_hit(&hp, &hs);
 		/* a shadow ray from just off the hit toward the light */
 		vec3 p = v3_add(hs.p, v3_scale(hs.n, hs.front ? 1e-6 : -1e-6));
 		vec3 to = v3_sub(lamp, p);
@@ -139,8 +167,11 @@ static void cone_packets(const world *w, vec3 lo, vec3 hi, int count, uint64_t s
 		for (int i = 0; i < n; i++) {
 			vec3 j = v3((trand(&g) - 0.5) * spread, (trand(&g) - 0.5) * spread, (trand(&g) - 0.5) * spread);
 			r[i] = (ray){o, v3_norm(v3_add(v3_norm(v3_sub(at, o)), j))};
+			if (k % 3 == 2) /* origins a little apart: each ray's own height over the planes */
+				r[i].o = v3_add(o, v3_scale(j, 0.1));
 		}
 		check_packet(w, r, n, lamp);
+		check_records(w, r, n, 1e-3, 1e3);
 	}
 }
 
@@ -312,6 +343,37 @@ static void test_ties(void **state)
 			}
 			check_packet(w, r, PACKET_MAX, lamp);
 		}
+	world_free(w);
+	scene_free(s);
+}
+
+/* Rays from a sphere's centre, which lies on zeros: origins equal as
+ * doubles (one origin for the packet) whose zeros differ in sign from ray
+ * to ray. There b = (o - c) . d is a zero whose sign the ray's own origin
+ * gives, and sphere_hit's q takes it: the packet must not use the first
+ * ray's. */
+static void test_signed_zero_origins(void **state)
+{
+	(void)state;
+	scene *s;
+	world *w = world_of_text("C 0,2,-6 0,-0.2,1 60\nL 3,6,-4 0.8 255,255,255\nsp 0,0,0 2 255,0,0\n"
+	                         "sp 0,1,0 1 0,255,0\nsp 3,0,0 1 0,0,255\n",
+	                         "zeros", &s);
+	test_rng g = {41};
+	long before = rays_hit;
+	for (int k = 0; k < 400; k++) {
+		/* one octant a packet; the centre (0,0,0) or (0,1,0) */
+		vec3 sg = v3(k & 1 ? -1 : 1, k & 2 ? -1 : 1, k & 4 ? -1 : 1);
+		double cy = k & 8 ? 1.0 : 0.0;
+		ray r[PACKET_MAX];
+		for (int i = 0; i < PACKET_MAX; i++) {
+			unsigned z = (unsigned)(trand(&g) * 8);
+			r[i].o = v3(z & 1 ? -0.0 : 0.0, cy == 0.0 && z & 2 ? -0.0 : cy, z & 4 ? -0.0 : 0.0);
+			r[i].d = v3_norm(v3(sg.x * (0.1 + trand(&g)), sg.y * (0.1 + trand(&g)), sg.z * (0.1 + trand(&g))));
+		}
+		check_packet(w, r, PACKET_MAX, w->lights[0].pos);
+	}
+	assert_true(rays_hit - before > 5000);
 	world_free(w);
 	scene_free(s);
 }
@@ -709,6 +771,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_ties),
+		cmocka_unit_test(test_signed_zero_origins),
 		cmocka_unit_test(test_prepare_edges),
 		cmocka_unit_test(test_scenes),
 		cmocka_unit_test(test_split_shadows),
