@@ -644,7 +644,7 @@ static void bench_denoise(const char *only_scene, int only_w, int only_h)
 {
 	printf("\nthe denoiser (issue 27): RMS error of the linear radiance against a reference of another "
 	       "seed (ref: its samples), lamp pixels and their neighbours left out; all threads\n");
-	printf("8 dn: 8 samples a pixel on average, the first 4 everywhere and the rest where the noise is "
+	printf("8 dn: 8 samples a pixel on average, the first 6 everywhere and the rest where the noise is "
 	       "(adaptive); 8 un: 8 in every pixel (uniform); both denoised\n");
 	printf("%-12s %9s %5s %10s %10s %10s %10s %8s %8s %8s\n", "scene", "size", "ref", "8 dn", "8 un",
 	       "64 raw", "8 raw", "dn/64", "un/64", "dn/8");
