@@ -76,6 +76,16 @@ static inline double next_up(double t)
 	return t;
 }
 
+/* One axis's components d of two rays into the packet's lowest, highest,
+ * all its bits ANDed and ORed (packet_prepare). */
+static inline void axis_extremes(__m128d d, __m128d *lo, __m128d *hi, __m128d *all, __m128d *any)
+{
+	*lo = _mm_min_pd(*lo, d);
+	*hi = _mm_max_pd(*hi, d);
+	*all = _mm_and_pd(*all, d);
+	*any = _mm_or_pd(*any, d);
+}
+
 /* Loads rays r[0..n) (2 <= n <= PACKET_MAX) into s and fills q; false
  * when the packet is not coherent enough for the interval test: a direction component of another
  * sign than the first ray's, a zero or NaN component, an inverse or origin
@@ -134,18 +144,9 @@ static bool packet_prepare(pk_state *s, const ray *r, int n, pk_ray *q)
 		nan = _mm_or_pd(nan, _mm_or_pd(_mm_cmpunord_pd(dx, dy), _mm_cmpunord_pd(dz, ox)));
 		nan = _mm_or_pd(nan, _mm_cmpunord_pd(oy, oz));
 		same = _mm_and_pd(same, _mm_and_pd(_mm_cmpeq_pd(ox, o0x), _mm_and_pd(_mm_cmpeq_pd(oy, o0y), _mm_cmpeq_pd(oz, o0z))));
-		lx = _mm_min_pd(lx, dx);
-		ly = _mm_min_pd(ly, dy);
-		lz = _mm_min_pd(lz, dz);
-		hx = _mm_max_pd(hx, dx);
-		hy = _mm_max_pd(hy, dy);
-		hz = _mm_max_pd(hz, dz);
-		ax = _mm_and_pd(ax, dx);
-		ay = _mm_and_pd(ay, dy);
-		az = _mm_and_pd(az, dz);
-		bx = _mm_or_pd(bx, dx);
-		by = _mm_or_pd(by, dy);
-		bz = _mm_or_pd(bz, dz);
+		axis_extremes(dx, &lx, &hx, &ax, &bx);
+		axis_extremes(dy, &ly, &hy, &ay, &by);
+		axis_extremes(dz, &lz, &hz, &az, &bz);
 	}
 	int neg_and = (_mm_movemask_pd(ax) == 3) | (_mm_movemask_pd(ay) == 3) << 1 | (_mm_movemask_pd(az) == 3) << 2;
 	int neg_or = (_mm_movemask_pd(bx) != 0) | (_mm_movemask_pd(by) != 0) << 1 | (_mm_movemask_pd(bz) != 0) << 2;
@@ -507,6 +508,27 @@ static bool model_packet(const world *w, int n, const ray *r, double tmin, doubl
 	return true;
 }
 
+/* plane_hit_o for rays i and i + 1 of s, each lane its operations in its
+ * order: the slope dy = h . d, the distance *tt = -oy / dy, and the lanes
+ * where dy is not 0 and tmin < *tt < tmax (NaN fails every compare, as
+ * there). oy: the origins' height over the plane, plane_oy's operations
+ * on each lane's origin, or *oy1 when given (rays of one origin). */
+static inline __m128d plane_hit2(const prim_plane *pl, const pk_state *s, int i, const __m128d *oy1, double tmin,
+                                 __m128d tmax, __m128d *tt)
+{
+	const __m128d h0 = _mm_set1_pd(pl->h[0]), h1 = _mm_set1_pd(pl->h[1]), h2 = _mm_set1_pd(pl->h[2]);
+	__m128d oy = oy1 ? *oy1
+	                 : _mm_add_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(h0, _mm_load_pd(&s->ox[i])),
+	                                                    _mm_mul_pd(h1, _mm_load_pd(&s->oy[i]))),
+	                                         _mm_mul_pd(h2, _mm_load_pd(&s->oz[i]))),
+	                              _mm_set1_pd(pl->h[3]));
+	__m128d dy = _mm_add_pd(_mm_add_pd(_mm_mul_pd(h0, _mm_load_pd(&s->dx[i])), _mm_mul_pd(h1, _mm_load_pd(&s->dy[i]))),
+	                        _mm_mul_pd(h2, _mm_load_pd(&s->dz[i])));
+	*tt = _mm_div_pd(_mm_xor_pd(oy, _mm_set1_pd(-0.0)), dy);
+	return _mm_and_pd(_mm_cmpneq_pd(dy, _mm_setzero_pd()),
+	                  _mm_and_pd(_mm_cmpgt_pd(*tt, _mm_set1_pd(tmin)), _mm_cmplt_pd(*tt, tmax)));
+}
+
 /* The planes beside the tree for the rays of s, as trace tests them (the
  * nearest in the planes' order, each with plane_hit's test): s->tmax[i]
  * from tmax down to the nearest plane's distance, best_plane[i] that plane
@@ -528,24 +550,12 @@ static void packet_planes(const world *w, pk_state *s, double tmin, double tmax,
 	 * may oy, only when it is zero: then -oy / dy is a zero (or NaN) that
 	 * no tmin >= 0 lets through either way. */
 	bool one = s->one_o && tmin >= 0.0;
-	const __m128d sign = _mm_set1_pd(-0.0), zero = _mm_setzero_pd(), t0 = _mm_set1_pd(tmin);
 	for (size_t k = 0; k < w->nplanes; k++) {
 		const prim_plane *pl = &w->planes[k];
-		const __m128d h0 = _mm_set1_pd(pl->h[0]), h1 = _mm_set1_pd(pl->h[1]), h2 = _mm_set1_pd(pl->h[2]);
-		const __m128d h3 = _mm_set1_pd(pl->h[3]);
 		const __m128d oy1 = _mm_set1_pd(one ? plane_oy(pl, (vec3){s->ox[0], s->oy[0], s->oz[0]}) : 0.0);
 		for (int i = 0; i < n; i += 2) {
-			__m128d oy = oy1;
-			if (!one)
-				oy = _mm_add_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(h0, _mm_load_pd(&s->ox[i])),
-				                                      _mm_mul_pd(h1, _mm_load_pd(&s->oy[i]))),
-				                           _mm_mul_pd(h2, _mm_load_pd(&s->oz[i]))),
-				                h3);
-			__m128d dy = _mm_add_pd(_mm_add_pd(_mm_mul_pd(h0, _mm_load_pd(&s->dx[i])),
-			                                   _mm_mul_pd(h1, _mm_load_pd(&s->dy[i]))),
-			                        _mm_mul_pd(h2, _mm_load_pd(&s->dz[i])));
-			__m128d tt = _mm_div_pd(_mm_xor_pd(oy, sign), dy), t = _mm_load_pd(&s->tmax[i]);
-			__m128d m = _mm_and_pd(_mm_cmpneq_pd(dy, zero), _mm_and_pd(_mm_cmpgt_pd(tt, t0), _mm_cmplt_pd(tt, t)));
+			__m128d tt, t = _mm_load_pd(&s->tmax[i]);
+			__m128d m = plane_hit2(pl, s, i, one ? &oy1 : NULL, tmin, t, &tt);
 			_mm_store_pd(&s->tmax[i], _mm_or_pd(_mm_and_pd(m, tt), _mm_andnot_pd(m, t)));
 			/* (without branches: which rays meet a plane first follows the
 			 * picture, not a pattern the branch predictor learns) */
@@ -838,23 +848,11 @@ static unsigned packet_planes_block(const world *w, const pk_state *s, double tm
 {
 	int n = s->n;
 	unsigned blocked = 0;
-	const __m128d sign = _mm_set1_pd(-0.0), zero = _mm_setzero_pd(), t0 = _mm_set1_pd(tmin);
 	for (size_t k = 0; k < w->nplanes; k++) {
 		const prim_plane *pl = &w->planes[k];
-		const __m128d h0 = _mm_set1_pd(pl->h[0]), h1 = _mm_set1_pd(pl->h[1]), h2 = _mm_set1_pd(pl->h[2]);
-		const __m128d h3 = _mm_set1_pd(pl->h[3]);
 		for (int i = 0; i < n; i += 2) {
-			__m128d oy = _mm_add_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(h0, _mm_load_pd(&s->ox[i])),
-			                                              _mm_mul_pd(h1, _mm_load_pd(&s->oy[i]))),
-			                                   _mm_mul_pd(h2, _mm_load_pd(&s->oz[i]))),
-			                        h3);
-			__m128d dy = _mm_add_pd(_mm_add_pd(_mm_mul_pd(h0, _mm_load_pd(&s->dx[i])),
-			                                   _mm_mul_pd(h1, _mm_load_pd(&s->dy[i]))),
-			                        _mm_mul_pd(h2, _mm_load_pd(&s->dz[i])));
-			__m128d tt = _mm_div_pd(_mm_xor_pd(oy, sign), dy);
-			__m128d tm = _mm_set_pd(i + 1 < n ? tmax[i + 1] : tmax[i], tmax[i]);
-			__m128d m = _mm_and_pd(_mm_cmpneq_pd(dy, zero), _mm_and_pd(_mm_cmpgt_pd(tt, t0), _mm_cmplt_pd(tt, tm)));
-			blocked |= (unsigned)_mm_movemask_pd(m) << i;
+			__m128d tt, tm = _mm_set_pd(i + 1 < n ? tmax[i + 1] : tmax[i], tmax[i]);
+			blocked |= (unsigned)_mm_movemask_pd(plane_hit2(pl, s, i, NULL, tmin, tm, &tt)) << i;
 		}
 	}
 	return blocked & ((1u << n) - 1);
