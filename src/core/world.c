@@ -83,10 +83,14 @@ static bool is_fast_sphere(const object *o)
 {
 	if (o->kind >= OBJ_KIND_COUNT || !shape_kinds[o->kind]->world_sphere || o->scale.x != o->scale.y || o->scale.y != o->scale.z)
 		return false;
-	for (int i = 0; i < 6; i++)
-		if (o->shear[i] != 0.0)
-			return false;
-	return o->mat.checker == 0 && !o->mat.texture && !o->mat.normalmap && !o->mat.bump;
+	/* every shear 0 or -0 (a NaN is not 0): the bits less the sign all 0 */
+	uint64_t bits = 0;
+	for (int i = 0; i < 6; i++) {
+		uint64_t u;
+		memcpy(&u, &o->shear[i], sizeof u);
+		bits |= u << 1;
+	}
+	return bits == 0 && o->mat.checker == 0 && !o->mat.texture && !o->mat.normalmap && !o->mat.bump;
 }
 
 /* Fills p (and the side record it needs) for object o and its world bounds
@@ -297,7 +301,8 @@ world *world_build_cancel(const scene *s, const atomic_bool *cancel, rt_error *e
 		mat_lin_fill(&w->mats[i], &o->mat); /* calloc'ed: zero */
 		unsigned f = kf[i] & ~(unsigned)OBJ_FAST_SPHERE;
 		bool plane = (f & KIND_UNBOUNDED) != 0;
-		if (!surf_material(w, o, (uint32_t)i, err) ||
+		/* (tx is NULL already when surf_material has nothing to do) */
+		if ((surf_material_needed(o) && !surf_material(w, o, (uint32_t)i, err)) ||
 		    (plane ? !make_plane(w, o, (uint32_t)i, &w->planes[w->nplanes], err)
 		           : !make_prim(w, o, f, (kf[i] & OBJ_FAST_SPHERE) != 0, (uint32_t)i, &w->prims[w->nprims],
 		                        &bounds[w->nprims], err))) {
