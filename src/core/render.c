@@ -614,10 +614,22 @@ static void two_passes_progress(void *ctx, long done, long total)
 	tp->progress(tp->ctx, d, total * tp->samples);
 }
 
-/* The adaptive pass of a denoised render (render_image_with): job has
- * rendered its first pass; the samples left, up to job->set.samples in
- * every pixel on average, go where the first pass's noise is
- * (denoise_allocate). */
+/* A denoised image of S samples is made in two passes (render_image_with):
+ * this many samples in every pixel, then render_adaptive; S itself (one
+ * pass) when not denoised, or when S is under 3 or above
+ * RENDER_ADAPTIVE_MAX. */
+static int adaptive_first(int samples, bool denoise)
+{
+	int first = DENOISE_FIRST(samples);
+	return denoise && first >= 2 && samples <= RENDER_ADAPTIVE_MAX ? first : samples;
+}
+
+/* The adaptive pass of a denoised render: job's fb (features, running
+ * sums) holds job->sample_end samples in every pixel, the first pass; the
+ * rest of job->set.samples x W x H paths go where its noise is
+ * (denoise_sigma, denoise_fixed, denoise_allocate) into fb->pixel_spp, and
+ * each pixel's sequence is continued to its count (job->pixel_end); then
+ * fb->spp is job->set.samples, the mean. */
 static render_status render_adaptive(render_job *job, rt_error *err)
 {
 	framebuffer *fb = job->fb;
@@ -654,14 +666,13 @@ static render_status render_adaptive(render_job *job, rt_error *err)
 		most = fb->pixel_spp[i] > most ? fb->pixel_spp[i] : most;
 	render_status st = RENDER_DONE;
 	if (most > first) {
-		if (job->progress)
-			((two_passes *)job->progress_ctx)->second = true;
 		job->sample_begin = first;
 		job->sample_end = most;
 		job->pixel_end = fb->pixel_spp;
 		st = render_run(job, err);
 	}
-	fb->spp = samples; /* on average */
+	if (st == RENDER_DONE)
+		fb->spp = samples; /* on average */
 	return st;
 }
 
@@ -673,8 +684,8 @@ static framebuffer *render_image_with(const world *w, const render_settings *s, 
 	/* A denoised image of 4 samples or more is made in two passes: the
 	 * first DENOISE_FIRST samples everywhere, the rest where the noise is
 	 * (adaptive), and so keeps its running sums between them. */
-	int first = denoise ? DENOISE_FIRST(s->samples) : 0;
-	bool adaptive = first >= 2 && s->samples <= RENDER_ADAPTIVE_MAX;
+	int first = adaptive_first(s->samples, denoise);
+	bool adaptive = first < s->samples;
 	/* One pass makes the whole image: no running sums are needed (nor,
 	 * handing rows over, the floats: the tiles keep theirs). */
 	framebuffer *fb = adaptive ? fb_alloc(s->width, s->height, true, true)
@@ -730,8 +741,10 @@ static framebuffer *render_image_with(const world *w, const render_settings *s, 
 		}
 	}
 	render_status st = render_run(&job, err);
-	if (st == RENDER_DONE && adaptive)
+	if (st == RENDER_DONE && adaptive) {
+		tp.second = true;
 		st = render_adaptive(&job, err);
+	}
 	if (st != RENDER_DONE) {
 		if (st == RENDER_CANCELLED)
 			rt_error_set(err, "render stopped");
