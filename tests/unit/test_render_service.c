@@ -14,7 +14,6 @@
 #include <pthread.h>
 #include <unistd.h>
 
-#include "rtsh/denoise.h"
 #include "rtsh/edit.h"
 #include "rtsh/rtfile.h"
 #include "shell/render_service.h"
@@ -104,18 +103,16 @@ static void assert_equals_direct_render(fixture *f, const rsvc_request *rq, cons
 	assert_int_equal(img->w, fb->w);
 	assert_int_equal(img->h, fb->h);
 	if (img->denoised) {
-		/* A denoised path preview equals the same samples in every
-		 * pixel rendered in one pass and denoised, but for rounding: the
-		 * features of progressive passes are kept as running means in
-		 * floats. (The preview spends its samples uniformly; save and
-		 * batch output adaptively, render_image: not this picture.) */
+		/* A denoised path preview equals a denoised render of the same
+		 * samples (both adaptive: the same counts in every pixel), but
+		 * for rounding: the features of progressive passes are kept as
+		 * running means in floats. */
 		assert_int_equal(s.mode, MODE_PATH);
 		fb_free(fb);
-		fb = fb_new(s.width, s.height);
-		assert_true(fb && denoise_prepare(fb));
-		render_job job = {.w = w, .set = s, .fb = fb, .sample_begin = 0, .sample_end = s.samples};
-		assert_int_equal(render_run(&job, &err), RENDER_DONE);
-		assert_true(denoise_image(fb, fb->rgb, 1));
+		s.denoise = DENOISE_ON;
+		fb = render_image(w, &s, NULL, NULL, NULL, &err);
+		assert_non_null(fb);
+		assert_non_null(fb->pixel_spp);
 		for (size_t i = 0; i < 3 * (size_t)fb->w * fb->h; i++)
 			assert_near(img->rgb[i], fb->rgb[i], 1e-4 + 1e-3 * fabsf(fb->rgb[i]));
 	} else {
