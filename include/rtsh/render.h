@@ -94,6 +94,10 @@ typedef struct framebuffer {
 	int srgb8_ring; /* 0: srgb8 holds every row; k > 0: only a ring of k
 	                 * bands of RENDER_TILE rows, band b in slot b % k, each
 	                 * reused once job->rows has taken it (render_image_rows) */
+	double *sum2;   /* with feat and sum (denoise_prepare): each pixel's
+	                 * running sum of its samples' squared brightness, so
+	                 * that the features' mean of it (denoise.h, 7) is the
+	                 * same for any split of the samples into passes */
 	uint16_t *pixel_spp; /* optional: each pixel's own sample count (a
 	                      * denoised render's adaptive samples, denoise.h);
 	                      * NULL: spp samples in every pixel */
@@ -159,6 +163,22 @@ typedef struct render_job {
  * hold a partial pass (the front end shows or drops it). test_cancel stops
  * a pass in flight and checks the picture rendered again is the same. */
 render_status render_run(render_job *job, rt_error *err);
+
+/* A denoised image of S samples (render_image, the shell's preview) is made
+ * in two passes: render_adaptive_first(S, true) samples in every pixel,
+ * then render_adaptive; S itself (one pass) when not denoised, or when S is
+ * under 3 or above RENDER_ADAPTIVE_MAX. */
+int render_adaptive_first(int samples, bool denoise);
+/* The adaptive pass: job->fb (with features, running sums and sum2)
+ * holds job->sample_end samples in every pixel, the first pass, in one
+ * pass or several; the rest of job->set.samples x W x H paths go where its
+ * noise is (denoise.h: denoise_sigma, denoise_fixed, denoise_allocate) into
+ * fb->pixel_spp, and each pixel's sequence is continued to its count
+ * (job->pixel_end); then fb->spp is job->set.samples, the mean. The
+ * allocation reads only what does not depend on how the first pass was
+ * split (the sums, and feature 7 from sum2), so the image is the same. The
+ * job's other fields (threads, cancel, progress) as render_run's. */
+render_status render_adaptive(render_job *job, rt_error *err);
 
 /* Convenience: a new framebuffer of s->width x s->height with all s->samples
  * samples. NULL (err set) on failure or cancellation. */

@@ -16,9 +16,12 @@
 
 bool denoise_prepare(framebuffer *fb)
 {
+	size_t n = (size_t)fb->w * (size_t)fb->h;
+	if (fb->sum && !fb->sum2 && !(fb->sum2 = calloc(n, sizeof *fb->sum2)))
+		return false;
 	if (fb->feat)
 		return true;
-	fb->feat = calloc((size_t)fb->w * (size_t)fb->h * DENOISE_FEATURES, sizeof *fb->feat);
+	fb->feat = calloc(n * DENOISE_FEATURES, sizeof *fb->feat);
 	return fb->feat != NULL;
 }
 
@@ -1146,7 +1149,16 @@ bool denoise_sigma(const framebuffer *fb, float *sigma)
 		return false;
 	for (size_t i = 0; i < n; i++) {
 		int spp = pixel_spp(fb, i);
+		/* the mean from the sums when there are (the shell's preview
+		 * denoises rgb in place after each pass), as a job writes rgb */
+		float own[3];
 		const float *c = fb->rgb + i * 3;
+		if (fb->sum) {
+			double inv = 1.0 / spp;
+			for (int k = 0; k < 3; k++)
+				own[k] = (float)(fb->sum[i * 3 + k] * inv);
+			c = own;
+		}
 		double m = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
 		double var = spp > 1 ? ((double)fb->feat[i * DENOISE_FEATURES + 7] - m * m) * spp / (spp - 1) : 0.0;
 		v[i] = var > 0 && !denoise_fixed(fb->feat + i * DENOISE_FEATURES) ? (float)var : 0.0f;

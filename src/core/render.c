@@ -51,7 +51,7 @@ framebuffer *fb_new(int w, int h)
 void fb_free(framebuffer *fb)
 {
 	if (fb)
-		mem_free_all(fb->rgb, fb->sum, fb->feat, fb->srgb8, fb->pixel_spp, fb);
+		mem_free_all(fb->rgb, fb->sum, fb->sum2, fb->feat, fb->srgb8, fb->pixel_spp, fb);
 }
 
 void fb_clear(framebuffer *fb)
@@ -62,6 +62,8 @@ void fb_clear(framebuffer *fb)
 		memset(fb->sum, 0, n * sizeof *fb->sum);
 	if (fb->feat)
 		memset(fb->feat, 0, n / 3 * DENOISE_FEATURES * sizeof *fb->feat);
+	if (fb->sum2)
+		memset(fb->sum2, 0, n / 3 * sizeof *fb->sum2);
 	free(fb->pixel_spp);
 	fb->pixel_spp = NULL;
 	fb->spp = 0;
@@ -122,9 +124,10 @@ typedef struct shared {
  * camera rays of one sample are traced together as a packet (packet.h),
  * which finds the same hits as single rays to the bit. feat[i]: pixel i's
  * features for the denoiser (denoise.h), updated with these samples; NULL:
- * none. */
+ * none. sq[i] (with feat[i]; may be NULL): the running sum of the pixel's
+ * squared brightness, continued as acc is (framebuffer.sum2). */
 static void block_add(const world *w, const render_settings *s, int x0, int y0, int x1, int y1, int fw, int fh,
-                      int s0, int s1, double (*acc)[3], float *const *feat)
+                      int s0, int s1, double (*acc)[3], float *const *feat, double *const *sq)
 {
 	double fa[PACKET_MAX][DENOISE_ACC], ra[PACKET_MAX][DENOISE_RACC];
 	int n = (x1 - x0) * (y1 - y0);
@@ -136,6 +139,9 @@ static void block_add(const world *w, const render_settings *s, int x0, int y0, 
 	if (any_feat) {
 		memset(fa, 0, sizeof fa);
 		memset(ra, 0, sizeof ra);
+		for (int i = 0; i < n; i++)
+			if (feat[i] && sq[i] && s0 > 0) /* the squared brightness summed on, as acc */
+				ra[i][0] = *sq[i];
 	}
 	for (int k = s0; k < s1; k++) {
 		ray r[PACKET_MAX];
@@ -169,8 +175,16 @@ static void block_add(const world *w, const render_settings *s, int x0, int y0, 
 	if (any_feat)
 		for (int y = y0, i = 0; y < y1; y++)
 			for (int x = x0; x < x1; x++, i++)
-				if (feat[i])
+				if (feat[i]) {
 					denoise_features(w, s, x, y, fw, fh, s0, s1, ra[i], fa[i], feat[i]);
+					/* ra[i][0] holds all the samples' sum: feature 7
+					 * its mean (for a first pass the value
+					 * denoise_features made of it) */
+					if (sq[i]) {
+						*sq[i] = ra[i][0];
+						feat[i][7] = (float)(ra[i][0] / s1);
+					}
+				}
 	mesh_alpha_hashed(false);
 }
 
@@ -211,8 +225,13 @@ static void render_tile_adaptive(render_job *job, int x0, int y0, int x1, int y1
 			int end = job->pixel_end[p];
 			double acc[1][3] = {{fb->sum[i], fb->sum[i + 1], fb->sum[i + 2]}};
 			float *fp[1] = {feat ? fb->feat + p * DENOISE_FEATURES : NULL};
+			/* feature 7 as a running mean here: the allocation read it
+			 * before, from the sums (framebuffer.sum2), and an adaptive
+			 * image takes no further pass */
+			double *sq[1] = {NULL};
 			if (end > job->sample_begin)
-				block_add(job->w, &job->set, x, y, x + 1, y + 1, fb->w, fb->h, job->sample_begin, end, acc, fp);
+				block_add(job->w, &job->set, x, y, x + 1, y + 1, fb->w, fb->h, job->sample_begin, end, acc, fp,
+				          sq);
 			int from = end > job->sample_begin ? end : job->sample_begin;
 			if (fp[0] && from < DENOISE_FEATURE_SAMPLES)
 				denoise_features_only(job->w, &job->set, x, y, fb->w, fb->h, from, DENOISE_FEATURE_SAMPLES,
@@ -246,9 +265,11 @@ static void render_tile(shared *sh, long t)
 			int ex = bx + BLOCK_SIDE < x1 ? bx + BLOCK_SIDE : x1, ey = by + BLOCK_SIDE < y1 ? by + BLOCK_SIDE : y1;
 			double acc[PACKET_MAX][3];
 			float *fp[PACKET_MAX];
+			double *sq[PACKET_MAX];
 			for (int y = by, k = 0; y < ey; y++)
 				for (int x = bx; x < ex; x++, k++) {
 					size_t i = ((size_t)y * (size_t)fb->w + (size_t)x) * 3;
+					sq[k] = fb->sum2 ? fb->sum2 + i / 3 : NULL;
 					/* A first pass starts from zero whatever the sums hold (a
 					 * cancelled pass leaves them half done). */
 					acc[k][0] = acc[k][1] = acc[k][2] = 0.0;
@@ -259,7 +280,8 @@ static void render_tile(shared *sh, long t)
 					}
 					fp[k] = feat ? fb->feat + i / 3 * DENOISE_FEATURES : NULL;
 				}
-			block_add(job->w, &job->set, bx, by, ex, ey, fb->w, fb->h, job->sample_begin, job->sample_end, acc, fp);
+			block_add(job->w, &job->set, bx, by, ex, ey, fb->w, fb->h, job->sample_begin, job->sample_end, acc, fp,
+			          sq);
 			double *sum = fb->sum;
 			float *rgb = fb->rgb;
 			for (int y = by, k = 0; y < ey; y++) {
@@ -408,6 +430,7 @@ void render_rect_features(const world *w, const render_settings *s, int x0, int 
 			int ex = bx + BLOCK_SIDE < x1 ? bx + BLOCK_SIDE : x1, ey = by + BLOCK_SIDE < y1 ? by + BLOCK_SIDE : y1;
 			double acc[PACKET_MAX][3] = {{0}};
 			float *fp[PACKET_MAX];
+			double *const sq[PACKET_MAX] = {NULL};
 			for (int y = by, k = 0; y < ey; y++)
 				for (int x = bx; x < ex; x++, k++) {
 					size_t i = (size_t)(y - y0) * row + (size_t)(x - x0);
@@ -418,7 +441,7 @@ void render_rect_features(const world *w, const render_settings *s, int x0, int 
 							fp[k] = feat + i * DENOISE_FEATURES;
 					}
 				}
-			block_add(w, s, bx, by, ex, ey, s->width, s->height, 0, s->samples, acc, fp);
+			block_add(w, s, bx, by, ex, ey, s->width, s->height, 0, s->samples, acc, fp, sq);
 			for (int y = by, k = 0; y < ey; y++)
 				for (int x = bx; x < ex; x++, k++) {
 					float *o = out + ((size_t)(y - y0) * row + (size_t)(x - x0)) * 3;
@@ -614,11 +637,13 @@ static void two_passes_progress(void *ctx, long done, long total)
 	tp->progress(tp->ctx, d, total * tp->samples);
 }
 
-/* The adaptive pass of a denoised render (render_image_with): job has
- * rendered its first pass; the samples left, up to job->set.samples in
- * every pixel on average, go where the first pass's noise is
- * (denoise_allocate). */
-static render_status render_adaptive(render_job *job, rt_error *err)
+int render_adaptive_first(int samples, bool denoise)
+{
+	int first = DENOISE_FIRST(samples);
+	return denoise && first >= 2 && samples <= RENDER_ADAPTIVE_MAX ? first : samples;
+}
+
+render_status render_adaptive(render_job *job, rt_error *err)
 {
 	framebuffer *fb = job->fb;
 	size_t n = (size_t)fb->w * (size_t)fb->h;
@@ -654,14 +679,13 @@ static render_status render_adaptive(render_job *job, rt_error *err)
 		most = fb->pixel_spp[i] > most ? fb->pixel_spp[i] : most;
 	render_status st = RENDER_DONE;
 	if (most > first) {
-		if (job->progress)
-			((two_passes *)job->progress_ctx)->second = true;
 		job->sample_begin = first;
 		job->sample_end = most;
 		job->pixel_end = fb->pixel_spp;
 		st = render_run(job, err);
 	}
-	fb->spp = samples; /* on average */
+	if (st == RENDER_DONE)
+		fb->spp = samples; /* on average */
 	return st;
 }
 
@@ -673,8 +697,8 @@ static framebuffer *render_image_with(const world *w, const render_settings *s, 
 	/* A denoised image of 4 samples or more is made in two passes: the
 	 * first DENOISE_FIRST samples everywhere, the rest where the noise is
 	 * (adaptive), and so keeps its running sums between them. */
-	int first = denoise ? DENOISE_FIRST(s->samples) : 0;
-	bool adaptive = first >= 2 && s->samples <= RENDER_ADAPTIVE_MAX;
+	int first = render_adaptive_first(s->samples, denoise);
+	bool adaptive = first < s->samples;
 	/* One pass makes the whole image: no running sums are needed (nor,
 	 * handing rows over, the floats: the tiles keep theirs). */
 	framebuffer *fb = adaptive ? fb_alloc(s->width, s->height, true, true)
@@ -730,8 +754,10 @@ static framebuffer *render_image_with(const world *w, const render_settings *s, 
 		}
 	}
 	render_status st = render_run(&job, err);
-	if (st == RENDER_DONE && adaptive)
+	if (st == RENDER_DONE && adaptive) {
+		tp.second = true;
 		st = render_adaptive(&job, err);
+	}
 	if (st != RENDER_DONE) {
 		if (st == RENDER_CANCELLED)
 			rt_error_set(err, "render stopped");

@@ -269,8 +269,10 @@ static bool run_refine(rsvc *sv, const rsvc_request *req, const world *w, rsvc_i
 {
 	rt_error err;
 	framebuffer *fb = sv->fb;
+	/* an adaptive image (denoised: its pixels' own counts) is continued by
+	 * no pass, only shown again at its own samples */
 	bool cont = req->accumulate && sv->fb_valid && fb && fb->spp > 0 && fb->spp <= req->set.samples &&
-	            continues(&sv->fb_req, req);
+	            (!fb->pixel_spp || fb->spp == req->set.samples) && continues(&sv->fb_req, req);
 	if (!cont)
 		fb = fb_reuse(&sv->fb, req->w, req->h);
 	int qw = req->w / 2 > 0 ? req->w / 2 : 1, qh = req->h / 2 > 0 ? req->h / 2 : 1;
@@ -321,15 +323,24 @@ static bool run_refine(rsvc *sv, const rsvc_request *req, const world *w, rsvc_i
 		publish(sv, fb, req->w, req->h, meta);
 		return true;
 	}
+	/* Denoised: passes up to the adaptive image's first samples, then its
+	 * adaptive pass as the last (render_adaptive: save's image) */
+	int first = render_adaptive_first(target, denoise);
+	if (done > first)
+		first = target; /* (uniform samples beyond it: no adaptive pass) */
 	while (done < target) {
-		if (n > target - done)
+		bool adapt = done == first;
+		if (n > first - done)
+			n = first - done;
+		if (adapt)
 			n = target - done;
 		job.fb = fb;
 		job.sample_begin = done;
-		job.sample_end = done + n;
+		job.sample_end = adapt ? first : done + n;
 		double t1 = now();
-		if (render_run(&job, &err) != RENDER_DONE)
+		if ((adapt ? render_adaptive(&job, &err) : render_run(&job, &err)) != RENDER_DONE)
 			return false;
+		job.pixel_end = NULL;
 		double dt = now() - t1, per = dt / n;
 		meta->denoised = denoise && denoise_image(fb, fb->rgb, threads);
 		done += n;

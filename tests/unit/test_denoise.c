@@ -1145,6 +1145,7 @@ static void test_sigma_neighbours(void **state)
 	for (int i = 0; i < 9; i++) {
 		for (int k = 0; k < 3; k++) {
 			fb->rgb[i * 3 + k] = 0.5f;
+			fb->sum[i * 3 + k] = 2.0; /* 4 samples of 0.5 */
 			fb->feat[i * DENOISE_FEATURES + k] = 0.5f; /* albedo */
 		}
 		fb->feat[i * DENOISE_FEATURES + 6] = 3.0f; /* depth: a surface */
@@ -1232,6 +1233,49 @@ static void test_adaptive_pass(void **state)
 	for (int k = 0; k < 3; k++)
 		fb_free(ref[k]);
 	fb_free(fb);
+	world_free(w);
+	scene_free(s);
+}
+
+/* The adaptive pass after a first pass made in one go or in several (the
+ * shell's preview: passes as its time allows) gives the same counts and
+ * the same raw image: the allocation reads the running sums (rgb and the
+ * squared brightness, framebuffer.sum2), never the features' running
+ * means in floats, nor rgb (the preview denoises it in place between its
+ * passes: done here too). */
+static void test_adaptive_after_passes(void **state)
+{
+	(void)state;
+	scene *s = load_text("C 0,1,-4 0,-0.2,1 60\nA 0.3 200,220,255\nL 2,4,-2 0.7 255,255,255\n"
+	                     "pl 0,0,0 0,1,0 200,200,200\nsp 0,1,0 2 220,60,50\n"
+	                     "sp 1.5,0.5,-1 0,1,0 1,1,1 255,255,255 0 0 1 1\n");
+	world *w = world_build(s, NULL);
+	assert_non_null(w);
+	enum { W = 31, H = 19, N = W * H };
+	render_settings set = path_settings(W, H, 12, 4, 5);
+	int first = render_adaptive_first(12, true);
+	assert_int_equal(first, 8);
+	framebuffer *fb[2];
+	for (int k = 0; k < 2; k++) {
+		fb[k] = fb_new(W, H);
+		assert_true(fb[k] && denoise_prepare(fb[k]));
+		render_job job = {.w = w, .set = set, .fb = fb[k]};
+		const int one[] = {0, 8}, several[] = {0, 1, 3, 8};
+		const int *cut = k ? several : one, ncut = k ? 4 : 2;
+		for (int c = 0; c + 1 < ncut; c++) {
+			job.sample_begin = cut[c];
+			job.sample_end = cut[c + 1];
+			assert_int_equal(render_run(&job, NULL), RENDER_DONE);
+			if (k)
+				assert_true(denoise_image(fb[k], fb[k]->rgb, 2));
+		}
+		assert_int_equal(render_adaptive(&job, NULL), RENDER_DONE);
+		assert_int_equal(fb[k]->spp, 12);
+	}
+	assert_memory_equal(fb[0]->pixel_spp, fb[1]->pixel_spp, N * sizeof *fb[0]->pixel_spp);
+	assert_memory_equal(fb[0]->rgb, fb[1]->rgb, N * 3 * sizeof *fb[0]->rgb);
+	fb_free(fb[0]);
+	fb_free(fb[1]);
 	world_free(w);
 	scene_free(s);
 }
@@ -1363,6 +1407,7 @@ int main(void)
 		cmocka_unit_test(test_sigma_neighbours),
 		cmocka_unit_test(test_adaptive_pass),
 		cmocka_unit_test(test_adaptive_render),
+		cmocka_unit_test(test_adaptive_after_passes),
 		cmocka_unit_test(test_modes),
 		cmocka_unit_test(test_setting),
 	};

@@ -104,13 +104,15 @@ static void assert_equals_direct_render(fixture *f, const rsvc_request *rq, cons
 	assert_int_equal(img->h, fb->h);
 	if (img->denoised) {
 		/* A denoised path preview equals a denoised render of the same
-		 * samples, but for rounding: the features of progressive passes
-		 * are kept as running means in floats. */
+		 * samples (both adaptive: the same counts in every pixel), but
+		 * for rounding: the features of progressive passes are kept as
+		 * running means in floats. */
 		assert_int_equal(s.mode, MODE_PATH);
 		fb_free(fb);
 		s.denoise = DENOISE_ON;
 		fb = render_image(w, &s, NULL, NULL, NULL, &err);
 		assert_non_null(fb);
+		assert_non_null(fb->pixel_spp);
 		for (size_t i = 0; i < 3 * (size_t)fb->w * fb->h; i++)
 			assert_near(img->rgb[i], fb->rgb[i], 1e-4 + 1e-3 * fabsf(fb->rgb[i]));
 	} else {
