@@ -130,7 +130,7 @@ bool surf_material(world *w, const object *o, uint32_t i, rt_error *err)
 	const material *om = &o->mat;
 	m->tx = NULL;
 	/* no texture and no model: nothing to hold (a million spheres) */
-	if (!om->texture && !om->normalmap && !om->bump && !(obj_kind_flags(o->kind) & KIND_MODEL))
+	if (!surf_material_needed(o))
 		return true;
 	mat_tex own = {.tint = true, .bumpscale = om->bumpscale, .uvs = {om->uvscale[0] ? om->uvscale[0] : 1,
 	               om->uvscale[1] ? om->uvscale[1] : 1}, .uvo = {om->uvoffset[0], om->uvoffset[1]}};

@@ -13,6 +13,13 @@ bool surf_begin(world *w, const scene *s, rt_error *err);
 /* After w->mats[i] is set from object i: its textures, and a mesh's own
  * materials (appended to w->mats). */
 bool surf_material(world *w, const object *o, uint32_t i, rt_error *err);
+/* Whether surf_material has anything to do for o (textures, or a model):
+ * when not, it only sets w->mats[i].tx to NULL (a million spheres skip the
+ * call). */
+static inline bool surf_material_needed(const object *o)
+{
+	return o->mat.texture || o->mat.normalmap || o->mat.bump || (obj_kind_flags(o->kind) & KIND_MODEL);
+}
 /* A mesh object's primitive and world bounds. */
 bool surf_make_inst(world *w, const object *o, uint32_t i, prim *p, box *b, rt_error *err);
 /* Instance tests: the nearest hit stores (triangle, b1, b2) in *nl;

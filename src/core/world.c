@@ -19,49 +19,63 @@
 #include "rtsh/memory.h"
 #include "rtsh/shape.h"
 
-mat_lin mat_lin_make(const material *m)
+/* mat_lin_make into *l, whose bytes are zero on entry: world_build fills
+ * its calloc'ed array in place rather than copying a zeroed value in and out
+ * (a million objects). */
+static inline void mat_lin_fill(mat_lin *restrict l, const material *m)
 {
-	mat_lin l = {0};
-	l.albedo = srgb255_to_linear(m->color);
-	l.diffuse = m->diffuse;
-	l.specular = m->specular;
-	l.shininess = m->shininess;
-	l.reflective = m->reflective;
-	l.fuzz = m->fuzz;
-	l.metal = m->metal;
-	l.ior = m->ior;
+	l->albedo = srgb255_to_linear(m->color);
+	l->diffuse = m->diffuse;
+	l->specular = m->specular;
+	l->shininess = m->shininess;
+	l->reflective = m->reflective;
+	l->fuzz = m->fuzz;
+	l->metal = m->metal;
+	l->ior = m->ior;
 	const material_pbr *p = m->pbr;
 	bool own_emit = p && p->emit_color.x >= 0.0 && p->emit_color.y >= 0.0 && p->emit_color.z >= 0.0;
-	l.emission = v3_scale(own_emit ? srgb255_to_linear(p->emit_color) : l.albedo, m->emission);
-	l.checker = m->checker;
-	l.light = -1; /* set by emitters_build */
-	l.tx = NULL;  /* set by surf_material */
+	l->emission = v3_scale(own_emit ? srgb255_to_linear(p->emit_color) : l->albedo, m->emission);
+	l->checker = m->checker;
+	l->light = -1; /* set by emitters_build */
+	l->tx = NULL;  /* set by surf_material */
 	if (!p)
-		return l;
-	l.family = MAT_PBR;
-	l.ior = m->ior >= 1.0 ? m->ior : 1.5;
-	l.pbr.roughness = (float)(p->roughness >= 0.0 ? p->roughness : 1.0);
-	l.pbr.metallic = (float)p->metallic;
-	l.pbr.transmission = (float)p->transmission;
-	l.thin = p->thin != 0;
-	l.pbr.clearcoat = (float)p->clearcoat;
-	l.pbr.clearcoat_roughness = (float)p->clearcoat_roughness;
-	l.pbr.specular_factor = (float)p->specular_factor;
-	l.pbr.single = p->multiscatter == 0;
+		return;
+	l->family = MAT_PBR;
+	l->ior = m->ior >= 1.0 ? m->ior : 1.5;
+	l->pbr.roughness = (float)(p->roughness >= 0.0 ? p->roughness : 1.0);
+	l->pbr.metallic = (float)p->metallic;
+	l->pbr.transmission = (float)p->transmission;
+	l->thin = p->thin != 0;
+	l->pbr.clearcoat = (float)p->clearcoat;
+	l->pbr.clearcoat_roughness = (float)p->clearcoat_roughness;
+	l->pbr.specular_factor = (float)p->specular_factor;
+	l->pbr.single = p->multiscatter == 0;
 	vec3 sc = srgb255_to_linear(p->specular_color);
-	l.pbr.specular_color[0] = (float)sc.x;
-	l.pbr.specular_color[1] = (float)sc.y;
-	l.pbr.specular_color[2] = (float)sc.z;
+	l->pbr.specular_color[0] = (float)sc.x;
+	l->pbr.specular_color[1] = (float)sc.y;
+	l->pbr.specular_color[2] = (float)sc.z;
 	if (p->att_dist > 0.0) {
 		vec3 a = srgb255_to_linear(p->att_color);
 		/* Beer-Lambert: white light keeps a of itself after att_dist */
 		double c[3] = {a.x, a.y, a.z};
 		for (int i = 0; i < 3; i++)
-			l.pbr.sigma_a[i] = (float)(c[i] > 0 ? -log(c[i]) / p->att_dist : 1e30);
+			l->pbr.sigma_a[i] = (float)(c[i] > 0 ? -log(c[i]) / p->att_dist : 1e30);
 	}
-	pbr_lin_finish(&l);
+	pbr_lin_finish(l);
+}
+
+mat_lin mat_lin_make(const material *m)
+{
+	mat_lin l = {0};
+	mat_lin_fill(&l, m);
 	return l;
 }
+
+/* world_build's byte of an object: its kind flags (scene.h, below 16) and
+ * this bit when is_fast_sphere */
+enum { OBJ_FAST_SPHERE = 0x80 };
+_Static_assert((KIND_UNBOUNDED | KIND_VERTICES | KIND_TUBE | KIND_MODEL) < OBJ_FAST_SPHERE,
+               "the kind flags fit below OBJ_FAST_SPHERE");
 
 /* A sphere with a uniform scale, no shear and no texture that its rotation
  * could turn is traced directly in world space. */
@@ -69,21 +83,27 @@ static bool is_fast_sphere(const object *o)
 {
 	if (o->kind >= OBJ_KIND_COUNT || !shape_kinds[o->kind]->world_sphere || o->scale.x != o->scale.y || o->scale.y != o->scale.z)
 		return false;
-	for (int i = 0; i < 6; i++)
-		if (o->shear[i] != 0.0)
-			return false;
-	return o->mat.checker == 0 && !o->mat.texture && !o->mat.normalmap && !o->mat.bump;
+	/* every shear 0 or -0 (a NaN is not 0): the bits less the sign all 0 */
+	uint64_t bits = 0;
+	for (int i = 0; i < 6; i++) {
+		uint64_t u;
+		memcpy(&u, &o->shear[i], sizeof u);
+		bits |= u << 1;
+	}
+	return bits == 0 && o->mat.checker == 0 && !o->mat.texture && !o->mat.normalmap && !o->mat.bump;
 }
 
 /* Fills p (and the side record it needs) for object o and its world bounds
- * *b (planes: see make_plane). */
-static bool make_prim(world *w, const object *o, uint32_t index, prim *p, box *b, rt_error *err)
+ * *b (planes: see make_plane). flags is obj_kind_flags(o->kind) and fast
+ * is_fast_sphere(o): world_build works them out once an object. */
+static bool make_prim(world *w, const object *o, unsigned flags, bool fast, uint32_t index, prim *p, box *b,
+                      rt_error *err)
 {
-	if (obj_kind_flags(o->kind) & KIND_MODEL)
+	if (flags & KIND_MODEL)
 		return surf_make_inst(w, o, index, p, b, err);
 	memset(p, 0, sizeof *p);
 	p->object = index;
-	if (obj_kind_flags(o->kind) & KIND_VERTICES) {
+	if (flags & KIND_VERTICES) {
 		p->tag = PRIM_TRIANGLE;
 		p->u.index = (uint32_t)w->ntris;
 		prim_tri *t = &w->tris[w->ntris++];
@@ -93,7 +113,7 @@ static bool make_prim(world *w, const object *o, uint32_t index, prim *p, box *b
 		*b = object_bounds(o);
 		return true;
 	}
-	if (is_fast_sphere(o)) {
+	if (fast) {
 		double r = o->scale.x * 0.5;
 		p->tag = PRIM_SPHERE;
 		p->u.sph.c = o->pos;
@@ -121,7 +141,7 @@ static bool make_plane(world *w, const object *o, uint32_t index, prim_plane *pl
 {
 	prim p;
 	box b;
-	if (!make_prim(w, o, index, &p, &b, err))
+	if (!make_prim(w, o, obj_kind_flags(o->kind), is_fast_sphere(o), index, &p, &b, err))
 		return false;
 	const prim_shape *sh = &w->shapes[p.u.index];
 	for (int j = 0; j < 4; j++)
@@ -206,13 +226,23 @@ world *world_build_cancel(const scene *s, const atomic_bool *cancel, rt_error *e
 		w->sky_zenith = v3_scale(srgb255_to_linear(s->sky.zenith), s->sky.strength);
 		w->sky_horizon = v3_scale(srgb255_to_linear(s->sky.horizon), s->sky.strength);
 	}
+	/* Each object's kind flags, with OBJ_FAST_SPHERE for is_fast_sphere: the
+	 * counts here and make_prim below read them (one test an object) */
+	uint8_t *kf = malloc(s->nobjs ? s->nobjs : 1);
+	if (!kf) {
+		world_free(w);
+		rt_error_set(err, "out of memory preparing the scene (%zu objects)", s->nobjs);
+		return NULL;
+	}
 	size_t nplanes = 0, ntris = 0, nshapes = 0;
 	for (size_t i = 0; i < s->nobjs; i++) {
 		const object *o = &s->objs[i];
 		unsigned f = obj_kind_flags(o->kind);
+		bool fast = !(f & (KIND_VERTICES | KIND_MODEL)) && is_fast_sphere(o);
+		kf[i] = (uint8_t)(f | (fast ? OBJ_FAST_SPHERE : 0));
 		nplanes += (f & KIND_UNBOUNDED) != 0;
 		ntris += (f & KIND_VERTICES) != 0;
-		nshapes += !(f & (KIND_VERTICES | KIND_MODEL)) && !is_fast_sphere(o);
+		nshapes += !(f & (KIND_VERTICES | KIND_MODEL)) && !fast;
 	}
 	size_t nbounded = s->nobjs - nplanes;
 	w->lights = calloc(s->nlights ? s->nlights : 1, sizeof *w->lights);
@@ -226,6 +256,7 @@ world *world_build_cancel(const scene *s, const atomic_bool *cancel, rt_error *e
 	if (!w->lights || !w->mats || !w->prims || !w->planes || !w->shapes || !w->tris || !bounds || !order) {
 		free(bounds);
 		free(order);
+		free(kf);
 		world_free(w);
 		rt_error_set(err, "out of memory preparing the scene (%zu objects)", s->nobjs);
 		return NULL;
@@ -251,6 +282,7 @@ world *world_build_cancel(const scene *s, const atomic_bool *cancel, rt_error *e
 	if (!surf_begin(w, s, err)) {
 		free(bounds);
 		free(order);
+		free(kf);
 		world_free(w);
 		return NULL;
 	}
@@ -261,17 +293,22 @@ world *world_build_cancel(const scene *s, const atomic_bool *cancel, rt_error *e
 		if ((i & 0xffff) == 0 && cancel && atomic_load(cancel)) {
 			free(bounds);
 			free(order);
+			free(kf);
 			world_free(w);
 			rt_error_set(err, "stopped");
 			return NULL;
 		}
-		w->mats[i] = mat_lin_make(&o->mat);
-		bool plane = (obj_kind_flags(o->kind) & KIND_UNBOUNDED) != 0;
-		if (!surf_material(w, o, (uint32_t)i, err) ||
+		mat_lin_fill(&w->mats[i], &o->mat); /* calloc'ed: zero */
+		unsigned f = kf[i] & ~(unsigned)OBJ_FAST_SPHERE;
+		bool plane = (f & KIND_UNBOUNDED) != 0;
+		/* (tx is NULL already when surf_material has nothing to do) */
+		if ((surf_material_needed(o) && !surf_material(w, o, (uint32_t)i, err)) ||
 		    (plane ? !make_plane(w, o, (uint32_t)i, &w->planes[w->nplanes], err)
-		           : !make_prim(w, o, (uint32_t)i, &w->prims[w->nprims], &bounds[w->nprims], err))) {
+		           : !make_prim(w, o, f, (kf[i] & OBJ_FAST_SPHERE) != 0, (uint32_t)i, &w->prims[w->nprims],
+		                        &bounds[w->nprims], err))) {
 			free(bounds);
 			free(order);
+			free(kf);
 			world_free(w);
 			return NULL;
 		}
@@ -283,6 +320,7 @@ world *world_build_cancel(const scene *s, const atomic_bool *cancel, rt_error *e
 			w->nprims++;
 		}
 	}
+	free(kf);
 	if (!box_is_empty(w->bounds))
 		extent = fmax(extent, fmax(v3_max_abs(w->bounds.lo), v3_max_abs(w->bounds.hi)));
 	for (size_t i = 0; i < s->nlights; i++)

@@ -435,6 +435,202 @@ static void test_float_boxes(void **state)
 		}
 }
 
+/* Which objects are traced as world-space spheres (world_build works it
+ * out once an object): a sphere with a uniform scale and every shear 0 or
+ * -0 is; the least positive or negative shear, a checker, a scale not
+ * uniform make it a transformed shape. Counted by hand: 2 spheres, 8
+ * shapes of which the plane's is one (beside the tree), 1 triangle. */
+static void test_fast_spheres(void **state)
+{
+	(void)state;
+	scene *s = random_scene(5, 0, 1, 1, 0);
+	object o = object_make(OBJ_SPHERE, v3(200, 10, 10));
+	o.scale = v3(2, 2, 2);
+	assert_true(scene_add_object(s, &o, NULL)); /* 0: sphere */
+	object m = o;
+	for (int i = 0; i < 6; i++)
+		m.shear[i] = -0.0;
+	assert_true(scene_add_object(s, &m, NULL)); /* 1: sphere (-0 shears) */
+	for (int i = 0; i < 6; i++) {
+		object t = o;
+		t.pos = v3(3.0 * (i + 1), 0, 0);
+		t.shear[i] = i % 2 ? -0x1p-1074 : 0x1p-1074; /* the least subnormals */
+		assert_true(scene_add_object(s, &t, NULL)); /* 2-7: shapes */
+	}
+	object c = o;
+	c.mat.checker = 2;
+	assert_true(scene_add_object(s, &c, NULL)); /* 8: shape */
+	object e = o;
+	e.scale = v3(2, 2, 2.5);
+	assert_true(scene_add_object(s, &e, NULL)); /* 9: shape */
+	object pl = object_make(OBJ_PLANE, v3(1, 1, 1));
+	pl.pos = v3(0, -10, 0);
+	assert_true(scene_add_object(s, &pl, NULL)); /* 10: plane */
+	object tr = object_make(OBJ_TRIANGLE, v3(1, 1, 1));
+	tr.tri[0] = v3(0, 0, 5);
+	tr.tri[1] = v3(1, 0, 5);
+	tr.tri[2] = v3(0, 1, 5);
+	assert_true(scene_add_object(s, &tr, NULL)); /* 11: triangle */
+	world *w = build(s);
+	assert_int_equal(w->nprims, 11);
+	assert_int_equal(w->nplanes, 1);
+	assert_int_equal(w->nshapes, 9);
+	assert_int_equal(w->ntris, 1);
+	for (size_t i = 0; i < w->nprims; i++) {
+		uint32_t k = w->prims[i].object;
+		uint32_t want = k <= 1 ? PRIM_SPHERE : k == 11 ? PRIM_TRIANGLE : PRIM_SHAPE;
+		if (w->prims[i].tag != want)
+			fail_msg("object %u: tag %u, expected %u", k, (unsigned)w->prims[i].tag, (unsigned)want);
+	}
+	/* the materials as mat_lin_make gives them, filled in place */
+	for (size_t i = 0; i < s->nobjs; i++) {
+		mat_lin ref = mat_lin_make(&s->objs[i].mat);
+		assert_true(v3_eq(w->mats[i].albedo, ref.albedo) && w->mats[i].checker == ref.checker &&
+		            w->mats[i].diffuse == ref.diffuse && w->mats[i].tx == NULL);
+	}
+	world_free(w);
+	scene_free(s);
+}
+
+/* The builder's binning of refs ids[0, n) (float boxes fb, unit costs) by
+ * its definition (bvh.c): doubled centroids lo + hi, min(n, 16) bins
+ * across their bounds per axis, bin (c - lo) * (bins / extent) truncated
+ * and clamped. The cheapest split by the SAH, A_left n_left + A_right
+ * n_right over every axis with an extent and every bin boundary, the first
+ * of equal costs: *axis (-1: none) and the bin each reference falls in. */
+static void brute_split(const bvh_fbox *fb, const uint32_t *ids, size_t n, int *axis, int *at, int *bin)
+{
+	int nbins = n >= 16 ? 16 : (int)n;
+	float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+	for (size_t i = 0; i < n; i++)
+		for (int a = 0; a < 3; a++) {
+			float c = fb[ids[i]].lo[a] + fb[ids[i]].hi[a];
+			lo[a] = c < lo[a] ? c : lo[a];
+			hi[a] = c > hi[a] ? c : hi[a];
+		}
+	double best = INFINITY;
+	*axis = -1;
+	for (int a = 0; a < 3; a++) {
+		float e = hi[a] - lo[a];
+		if (!(e > 0.0f))
+			continue;
+		float scale = (float)nbins / e;
+		for (int k = 1; k < nbins; k++) {
+			bvh_fbox l = {{INFINITY, INFINITY, INFINITY, 0}, {-INFINITY, -INFINITY, -INFINITY, 0}}, r = l;
+			double nl = 0, nr = 0;
+			for (size_t i = 0; i < n; i++) {
+				const bvh_fbox *x = &fb[ids[i]];
+				float v = (x->lo[a] + x->hi[a] - lo[a]) * scale;
+				int b = v > 0.0f ? (v < (float)(nbins - 1) ? (int)v : nbins - 1) : 0;
+				bvh_fbox *side = b < k ? &l : &r;
+				*(b < k ? &nl : &nr) += 1;
+				for (int j = 0; j < 3; j++) {
+					side->lo[j] = x->lo[j] < side->lo[j] ? x->lo[j] : side->lo[j];
+					side->hi[j] = x->hi[j] > side->hi[j] ? x->hi[j] : side->hi[j];
+				}
+			}
+			if (nl == 0 || nr == 0)
+				continue;
+			double cost = bvh_fbox_half_area(&l) * nl + bvh_fbox_half_area(&r) * nr;
+			if (cost < best) {
+				best = cost;
+				*axis = a;
+				*at = k;
+			}
+		}
+	}
+	if (*axis < 0)
+		return;
+	float scale = (float)nbins / (hi[*axis] - lo[*axis]);
+	for (size_t i = 0; i < n; i++) {
+		const bvh_fbox *x = &fb[ids[i]];
+		float v = (x->lo[*axis] + x->hi[*axis] - lo[*axis]) * scale;
+		bin[i] = v > 0.0f ? (v < (float)(nbins - 1) ? (int)v : nbins - 1) : 0;
+	}
+}
+
+/* The references under a child of binary tree t, appended to out. */
+static size_t refs_under(const bvh2 *t, uint32_t child, uint32_t meta, uint32_t *out)
+{
+	if (meta & BVH_LEAF) {
+		uint32_t cnt = meta & ~BVH_LEAF;
+		memcpy(out, &t->ids[child], cnt * sizeof *out);
+		return cnt;
+	}
+	const bvh2_node *nd = &t->nodes[child];
+	size_t k = refs_under(t, nd->child[0], nd->meta[0], out);
+	return k + refs_under(t, nd->child[1], nd->meta[1], out + k);
+}
+
+static int split_nodes_checked;
+
+/* Each node over more than 8 references (more than a leaf may hold) is
+ * split as brute_split says: its left child holds exactly the references
+ * of the bins left of the split. */
+static void check_splits(const bvh2 *t, uint32_t ni, const bvh_fbox *fb, uint32_t *ids, int *bin)
+{
+	const bvh2_node *nd = &t->nodes[ni];
+	size_t nl = refs_under(t, nd->child[0], nd->meta[0], ids);
+	size_t n = nl + refs_under(t, nd->child[1], nd->meta[1], ids + nl);
+	if (n > 8) {
+		int axis, at;
+		brute_split(fb, ids, n, &axis, &at, bin);
+		assert_true(axis >= 0);
+		for (size_t i = 0; i < n; i++)
+			if ((bin[i] < at) != (i < nl))
+				fail_msg("node %u (%zu references): reference %u on the %s, expected the %s (axis %d, bin %d of %d)",
+				         ni, n, ids[i], i < nl ? "left" : "right", bin[i] < at ? "left" : "right", axis, bin[i], at);
+		split_nodes_checked++;
+	}
+	for (int c = 0; c < 2; c++)
+		if (nd->meta[c] == 0)
+			check_splits(t, nd->child[c], fb, ids, bin);
+}
+
+/* The binned SAH's splits, node by node, against brute force: boxes in
+ * clusters, so that many bins are empty (the sweeps skip those), of
+ * coordinates in eighths (floats, so the boxes are not rounded). */
+static void test_sah_splits(void **state)
+{
+	(void)state;
+	for (uint64_t seed = 1; seed <= 6; seed++) {
+		test_rng g = {seed};
+		size_t n = seed <= 3 ? 300 : 3000;
+		box *bx = malloc(n * sizeof *bx);
+		bvh_fbox *fb = malloc(n * sizeof *fb);
+		uint32_t *ids = malloc(n * sizeof *ids);
+		int *bin = malloc(n * sizeof *bin);
+		assert_non_null(bx && fb && ids && bin);
+		int nclusters = 2 + (int)seed;
+		double cc[12][3];
+		for (int c = 0; c < nclusters; c++)
+			for (int a = 0; a < 3; a++)
+				cc[c][a] = floor(urand(&g, -800, 800));
+		for (size_t i = 0; i < n; i++) {
+			int c = (int)(trand(&g) * nclusters) % nclusters;
+			for (int a = 0; a < 3; a++) {
+				double lo = cc[c][a] + floor(urand(&g, -40, 40)) / 8, size = floor(urand(&g, 1, 24)) / 8;
+				(&bx[i].lo.x)[a] = lo;
+				(&bx[i].hi.x)[a] = lo + size;
+				fb[i].lo[a] = (float)lo;
+				fb[i].hi[a] = (float)(lo + size);
+			}
+		}
+		bvh2 t;
+		rt_error err;
+		assert_true(bvh2_build(bx, n, &(bvh_build_opts){.trav = 4}, &t, &err));
+		assert_int_equal(t.root_meta, 0);
+		split_nodes_checked = 0;
+		check_splits(&t, t.root, fb, ids, bin);
+		assert_true(split_nodes_checked >= (int)(n / 16)); /* most inner nodes above the leaves */
+		bvh2_free(&t);
+		free(bx);
+		free(fb);
+		free(ids);
+		free(bin);
+	}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -448,6 +644,8 @@ int main(void)
 		cmocka_unit_test(test_huge_coordinates),
 		cmocka_unit_test(test_half_area),
 		cmocka_unit_test(test_float_boxes),
+		cmocka_unit_test(test_fast_spheres),
+		cmocka_unit_test(test_sah_splits),
 	};
 	return cmocka_run_group_tests_name("bvh", tests, NULL, NULL);
 }
