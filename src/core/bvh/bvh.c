@@ -329,21 +329,11 @@ static inline void sweep_bins(fbox bbox[3][BINS], const binning *bn, unsigned bl
 	for (int a = 0; a < 3; a++) {
 		if (!bn->usable[a])
 			continue;
-		/* right-to-left sweep: the area and cost right of each split.
-		 * An empty bin (cost 0) changes neither sweep's box nor its sum:
-		 * right of it the area is the one before, and the split after it
-		 * costs what the split before it cost, which a strict < never
-		 * prefers (its area is not worked out; about a third of the bins
-		 * of small nodes are empty). */
+		/* right-to-left sweep: the area and cost right of each split */
 		double right_area[BINS], right_cost[BINS];
 		fbox acc = fbox_empty();
 		double sum = 0.0;
 		for (int k = nbins - 1; k > 0; k--) {
-			if (bbox[a][k].hi[3] == 0.0f && k < nbins - 1) {
-				right_area[k] = right_area[k + 1];
-				right_cost[k] = sum;
-				continue;
-			}
 			fbox_union(&acc, &bbox[a][k]);
 			sum += bbox[a][k].hi[3];
 			right_area[k] = sum > 0.0 ? fbox_half_area(&acc) : 0.0;
@@ -352,11 +342,9 @@ static inline void sweep_bins(fbox bbox[3][BINS], const binning *bn, unsigned bl
 		acc = fbox_empty();
 		sum = 0.0;
 		for (int k = 0; k < nbins - 1; k++) {
-			if (bbox[a][k].hi[3] == 0.0f)
-				continue;
 			fbox_union(&acc, &bbox[a][k]);
 			sum += bbox[a][k].hi[3];
-			if (right_cost[k + 1] == 0.0)
+			if (sum == 0.0 || right_cost[k + 1] == 0.0)
 				continue;
 			/* the left term is >= 0: a right term that alone reaches
 			 * the best cost cannot win, and its left area is not needed */
