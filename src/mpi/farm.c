@@ -244,10 +244,23 @@ static void *server_thread(void *arg)
 	return NULL;
 }
 
-/* The progress line (shell/progress.h) on standard error. */
-static void show_progress(const render_settings *s, long done, long total, double elapsed)
+double farm_clock(void)
 {
-	progress_state ps = {s->width, s->height, s->samples, done, total, elapsed};
+	return now();
+}
+
+/* The progress line (shell/progress.h) on standard error: a denoised
+ * image's two passes as one, each tile of the first counting its first
+ * samples, of the second the rest (as rtsh shows them), the time since
+ * o->t0 (the frame's start; 0: this pass's, t0). */
+static void show_progress(const render_settings *s, const farm_opts *o, const tiling *t, long done, double t0)
+{
+	long total = t->count * s->samples, d = done * s->samples;
+	if (t->pass == FARM_FIRST)
+		d = done * t->first;
+	else if (t->pass == FARM_ADAPTIVE)
+		d = t->count * t->first + done * (s->samples - t->first);
+	progress_state ps = {s->width, s->height, s->samples, d, total, now() - (o->t0 > 0 ? o->t0 : t0)};
 	progress_print(stderr, &ps);
 }
 
@@ -409,7 +422,7 @@ bool farm_serve(const world *w, const render_settings *s, const farm_opts *o, fr
 		}
 		if (o->progress && now() - shown >= 0.1) {
 			shown = now();
-			show_progress(s, atomic_load(&sv.done), sv.t.count, shown - t0);
+			show_progress(s, o, &sv.t, atomic_load(&sv.done), t0);
 		}
 		long i = own ? atomic_fetch_add(&sv.next, 1) : sv.t.count;
 		if (i < sv.t.count) {
@@ -449,8 +462,9 @@ bool farm_serve(const world *w, const render_settings *s, const farm_opts *o, fr
 	for (int i = 0; i < started; i++)
 		pthread_join(tid[i], NULL);
 	if (o->progress) {
-		show_progress(s, atomic_load(&sv.done), sv.t.count, now() - t0);
-		fputc('\n', stderr);
+		show_progress(s, o, &sv.t, atomic_load(&sv.done), t0);
+		if (sv.t.pass != FARM_FIRST) /* the line goes on in the second pass */
+			fputc('\n', stderr);
 	}
 	if (started == 0)
 		atomic_fetch_add(&sv.rays, world_rays_traced());

@@ -49,6 +49,7 @@ typedef struct farm_opts {
 	int delay_us;   /* test mode: each result waits this long before it is sent */
 	int threads;    /* render threads on this rank */
 	bool progress;  /* rank 0: a progress line on standard error */
+	double t0;      /* rank 0: the progress line's start (farm_clock), 0: the pass's */
 	/* Rank 0: a worker that holds tiles (or has not asked yet) and has sent
 	 * nothing for max(deadline, FARM_DEADLINE_TILES x the slowest tile or
 	 * gap between results seen so far) seconds is taken for stopped or hung
@@ -76,6 +77,8 @@ typedef struct farm_stats {
 
 /* Both return false (err set) when a message breaks the protocol or memory
  * runs out; the caller then ends the job. */
+/* The clock of farm_opts.t0, in seconds. */
+double farm_clock(void);
 /* Whether the job's image is denoised (path mode, denoise on, as
  * render_image): its tiles then carry the features too. */
 bool farm_denoises(const render_settings *s);

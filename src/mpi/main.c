@@ -294,6 +294,7 @@ static bool render_frame(int rank, const world *w, const render_settings *s, far
 {
 	int first = farm_first(s);
 	fo->first = first;
+	fo->t0 = farm_clock();
 	fo->pass = first < s->samples ? FARM_FIRST : FARM_ONE;
 	if (!farm_pass(rank, w, s, fo, fb, st, true, err))
 		return false;
