@@ -491,9 +491,10 @@ static void print_figures(const farm_stats *st, int size, const job_config *c, d
 		rays += f->rays;
 		bytes += f->bytes;
 	}
-	fprintf(stderr, "all   %d ranks, %.0f tiles of %dx%d%s, %.2f s, %.2f Mrays/s, %.0f bytes sent\n",
-	        size, tiles, c->tile, c->tile, farm_first(&c->set) < c->set.samples ? " in two passes" : "", total,
-	        total > 0 ? rays / total * 1e-6 : 0.0, bytes);
+	/* the tiles' count first (bench/mpi.sh reads the seconds after it) */
+	fprintf(stderr, "all   %d ranks, %.0f tiles of %dx%d, %.2f s, %.2f Mrays/s, %.0f bytes sent%s\n", size, tiles,
+	        c->tile, c->tile, total, total > 0 ? rays / total * 1e-6 : 0.0, bytes,
+	        farm_first(&c->set) < c->set.samples ? " in two passes" : "");
 	double remote = tiles - st[0].tiles;
 	if (remote > 0)
 		fprintf(stderr, "rank 0 served %.0f tiles to the others with %.1f us of CPU each\n", remote,
