@@ -179,6 +179,11 @@ int render_adaptive_first(int samples, bool denoise);
  * split (the sums, and feature 7 from sum2), so the image is the same. The
  * job's other fields (threads, cancel, progress) as render_run's. */
 render_status render_adaptive(render_job *job, rt_error *err);
+/* Its allocation alone: fb (features, running sums and sum2, first
+ * samples in every pixel) gets its pixels' counts of samples in
+ * fb->pixel_spp (replacing any there); returns the largest, or -1 (err set)
+ * when out of memory. rtsh-mpi allocates its image's samples with it. */
+int render_adaptive_counts(framebuffer *fb, int samples, int first, rt_error *err);
 
 /* Convenience: a new framebuffer of s->width x s->height with all s->samples
  * samples. NULL (err set) on failure or cancellation. */
@@ -214,6 +219,19 @@ void render_rect(const world *w, const render_settings *s, int x0, int y0, int x
  * for bit what a render job into a framebuffer with features records. */
 void render_rect_features(const world *w, const render_settings *s, int x0, int y0, int x1, int y1,
                           float *out, float *feat);
+/* The two passes of a denoised render (render_adaptive) on a rectangle, as
+ * rtsh-mpi farms them: render_rect_first renders samples [0, samples) of
+ * each pixel into sum (3 running sums a pixel, doubles) and feat (as
+ * render_rect_features); render_rect_adaptive continues each pixel p of
+ * the rectangle from those sums and features, sum[p] and feat[p], to its
+ * own end[p] (samples [begin, end[p]); at least begin), updating them, and
+ * writes its mean into rgb. Bit for bit the values render_image gives those
+ * pixels when end is its allocation (render_adaptive_counts). Arrays are
+ * the rectangle's, rows top to bottom. */
+void render_rect_first(const world *w, const render_settings *s, int x0, int y0, int x1, int y1, int samples,
+                       double *sum, float *feat);
+void render_rect_adaptive(const world *w, const render_settings *s, int x0, int y0, int x1, int y1, int begin,
+                          const uint16_t *end, double *sum, float *rgb, float *feat);
 
 /* The radiance along one camera sample: the integrators (whitted.c, path.c).
  * px, py: pixel; sample: index; the random stream depends only on these and

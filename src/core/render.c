@@ -211,37 +211,47 @@ static void tile_srgb8(framebuffer *fb, int x0, int y0, int x1, int y1)
 		                  codes_row(fb, y) + (size_t)x0 * 3, (size_t)(x1 - x0) * 3);
 }
 
-/* An adaptive pass (job->pixel_end): each pixel of the tile alone, its
- * samples [sample_begin, its own end) continuing its sums, and its
- * features made up to DENOISE_FEATURE_SAMPLES positions when it has fewer
- * radiance samples than that. */
-static void render_tile_adaptive(render_job *job, int x0, int y0, int x1, int y1)
+/* An adaptive pass over the pixels x0 <= x < x1, y0 <= y < y1 of an fw x fh
+ * image (render_rect_adaptive), its arrays from the rectangle's first pixel,
+ * stride pixels a row: each pixel alone, its samples [begin, its own end)
+ * continuing its sums, and its features made up to DENOISE_FEATURE_SAMPLES
+ * positions when it has fewer radiance samples than that. */
+static void rect_adaptive(const world *w, const render_settings *s, int x0, int y0, int x1, int y1, int fw, int fh,
+                          size_t stride, int begin, const uint16_t *end, double *sum, float *rgb, float *feat)
 {
-	framebuffer *fb = job->fb;
-	bool feat = fb->feat && integrator_of(job->set.mode)->features;
+	bool features = feat && integrator_of(s->mode)->features;
 	for (int y = y0; y < y1; y++)
 		for (int x = x0; x < x1; x++) {
-			size_t p = (size_t)y * (size_t)fb->w + (size_t)x, i = p * 3;
-			int end = job->pixel_end[p];
-			double acc[1][3] = {{fb->sum[i], fb->sum[i + 1], fb->sum[i + 2]}};
-			float *fp[1] = {feat ? fb->feat + p * DENOISE_FEATURES : NULL};
+			size_t p = (size_t)(y - y0) * stride + (size_t)(x - x0), i = p * 3;
+			int e = end[p];
+			double acc[1][3] = {{sum[i], sum[i + 1], sum[i + 2]}};
+			float *fp[1] = {features ? feat + p * DENOISE_FEATURES : NULL};
 			/* feature 7 as a running mean here: the allocation read it
 			 * before, from the sums (framebuffer.sum2), and an adaptive
 			 * image takes no further pass */
 			double *sq[1] = {NULL};
-			if (end > job->sample_begin)
-				block_add(job->w, &job->set, x, y, x + 1, y + 1, fb->w, fb->h, job->sample_begin, end, acc, fp,
-				          sq);
-			int from = end > job->sample_begin ? end : job->sample_begin;
+			if (e > begin)
+				block_add(w, s, x, y, x + 1, y + 1, fw, fh, begin, e, acc, fp, sq);
+			int from = e > begin ? e : begin;
 			if (fp[0] && from < DENOISE_FEATURE_SAMPLES)
-				denoise_features_only(job->w, &job->set, x, y, fb->w, fb->h, from, DENOISE_FEATURE_SAMPLES,
-				                      fp[0]);
-			double inv = 1.0 / (end > job->sample_begin ? end : job->sample_begin);
+				denoise_features_only(w, s, x, y, fw, fh, from, DENOISE_FEATURE_SAMPLES, fp[0]);
+			double inv = 1.0 / from;
 			for (int c = 0; c < 3; c++) {
-				fb->sum[i + c] = acc[0][c];
-				fb->rgb[i + c] = (float)(acc[0][c] * inv);
+				sum[i + c] = acc[0][c];
+				rgb[i + c] = (float)(acc[0][c] * inv);
 			}
 		}
+}
+
+/* An adaptive pass (job->pixel_end): the tile's pixels in the image's
+ * arrays. */
+static void render_tile_adaptive(render_job *job, int x0, int y0, int x1, int y1)
+{
+	framebuffer *fb = job->fb;
+	size_t p = (size_t)y0 * (size_t)fb->w + (size_t)x0;
+	rect_adaptive(job->w, &job->set, x0, y0, x1, y1, fb->w, fb->h, (size_t)fb->w, job->sample_begin,
+	              job->pixel_end + p, fb->sum + p * 3, fb->rgb + p * 3,
+	              fb->feat ? fb->feat + p * DENOISE_FEATURES : NULL);
 }
 
 static void render_tile(shared *sh, long t)
@@ -419,10 +429,12 @@ void render_rect(const world *w, const render_settings *s, int x0, int y0, int x
 	render_rect_features(w, s, x0, y0, x1, y1, out, NULL);
 }
 
-void render_rect_features(const world *w, const render_settings *s, int x0, int y0, int x1, int y1,
-                          float *out, float *feat)
+/* Samples [0, samples) of the rectangle (render_rect_features,
+ * render_rect_first): the mean into out, the sums into sum, when not NULL. */
+static void rect_first(const world *w, const render_settings *s, int x0, int y0, int x1, int y1, int samples,
+                       float *out, double *sum, float *feat)
 {
-	double inv = 1.0 / s->samples;
+	double inv = 1.0 / samples;
 	texture_set_pixel_angle(2.0 * cam_tan_x(&w->cam, s->width, s->height) / s->width); /* as render_tile */
 	size_t row = (size_t)(x1 - x0);
 	for (int by = y0; by < y1; by += BLOCK_SIDE)
@@ -441,15 +453,37 @@ void render_rect_features(const world *w, const render_settings *s, int x0, int 
 							fp[k] = feat + i * DENOISE_FEATURES;
 					}
 				}
-			block_add(w, s, bx, by, ex, ey, s->width, s->height, 0, s->samples, acc, fp, sq);
+			block_add(w, s, bx, by, ex, ey, s->width, s->height, 0, samples, acc, fp, sq);
 			for (int y = by, k = 0; y < ey; y++)
 				for (int x = bx; x < ex; x++, k++) {
-					float *o = out + ((size_t)(y - y0) * row + (size_t)(x - x0)) * 3;
-					o[0] = (float)(acc[k][0] * inv);
-					o[1] = (float)(acc[k][1] * inv);
-					o[2] = (float)(acc[k][2] * inv);
+					size_t i = (size_t)(y - y0) * row + (size_t)(x - x0);
+					for (int c = 0; c < 3; c++) {
+						if (out)
+							out[i * 3 + c] = (float)(acc[k][c] * inv);
+						if (sum)
+							sum[i * 3 + c] = acc[k][c];
+					}
 				}
 		}
+}
+
+void render_rect_features(const world *w, const render_settings *s, int x0, int y0, int x1, int y1,
+                          float *out, float *feat)
+{
+	rect_first(w, s, x0, y0, x1, y1, s->samples, out, NULL, feat);
+}
+
+void render_rect_first(const world *w, const render_settings *s, int x0, int y0, int x1, int y1, int samples,
+                       double *sum, float *feat)
+{
+	rect_first(w, s, x0, y0, x1, y1, samples, NULL, sum, feat);
+}
+
+void render_rect_adaptive(const world *w, const render_settings *s, int x0, int y0, int x1, int y1, int begin,
+                          const uint16_t *end, double *sum, float *rgb, float *feat)
+{
+	texture_set_pixel_angle(2.0 * cam_tan_x(&w->cam, s->width, s->height) / s->width); /* as render_tile */
+	rect_adaptive(w, s, x0, y0, x1, y1, s->width, s->height, (size_t)(x1 - x0), begin, end, sum, rgb, feat);
 }
 
 static void *worker(void *arg)
@@ -643,23 +677,18 @@ int render_adaptive_first(int samples, bool denoise)
 	return denoise && first >= 2 && samples <= RENDER_ADAPTIVE_MAX ? first : samples;
 }
 
-render_status render_adaptive(render_job *job, rt_error *err)
+int render_adaptive_counts(framebuffer *fb, int samples, int first, rt_error *err)
 {
-	framebuffer *fb = job->fb;
 	size_t n = (size_t)fb->w * (size_t)fb->h;
 	float *sigma = malloc(n * sizeof *sigma);
 	uint16_t *spp = malloc(n * sizeof *spp);
-	if (!sigma || !spp) {
-		mem_free_all(sigma, spp);
-		rt_error_set(err, "out of memory for the adaptive samples of a %dx%d image", fb->w, fb->h);
-		return RENDER_FAILED;
-	}
-	int samples = job->set.samples, first = job->sample_end;
 	/* of the first pass, the same count in every pixel */
-	if (!denoise_sigma(fb, sigma)) {
+	free(fb->pixel_spp);
+	fb->pixel_spp = NULL;
+	if (!sigma || !spp || !denoise_sigma(fb, sigma)) {
 		mem_free_all(sigma, spp);
 		rt_error_set(err, "out of memory for the adaptive samples of a %dx%d image", fb->w, fb->h);
-		return RENDER_FAILED;
+		return -1;
 	}
 	fb->pixel_spp = spp;
 	/* A pixel that missed the scene or sees a lamp (denoise_fixed) keeps
@@ -676,7 +705,17 @@ render_status render_adaptive(render_job *job, rt_error *err)
 	free(sigma);
 	int most = first;
 	for (size_t i = 0; i < n; i++)
-		most = fb->pixel_spp[i] > most ? fb->pixel_spp[i] : most;
+		most = spp[i] > most ? spp[i] : most;
+	return most;
+}
+
+render_status render_adaptive(render_job *job, rt_error *err)
+{
+	framebuffer *fb = job->fb;
+	int samples = job->set.samples, first = job->sample_end;
+	int most = render_adaptive_counts(fb, samples, first, err);
+	if (most < 0)
+		return RENDER_FAILED;
 	render_status st = RENDER_DONE;
 	if (most > first) {
 		job->sample_begin = first;

@@ -36,27 +36,47 @@ static void sleep_us(long us)
 	nanosleep(&t, NULL);
 }
 
-/* The tiles of the image, row by row. A tile's floats are its pixels'
- * radiance (3 a pixel), then, when the image is to be denoised, their
- * features (DENOISE_FEATURES a pixel): rank 0 denoises the whole image. */
+/* The tiles of the image, row by row, in one of the passes (farm_opts.pass).
+ * A tile's result (out bytes a pixel) is, in one pass, its pixels'
+ * radiance (3 floats a pixel), then, when the image is to be denoised,
+ * their features (DENOISE_FEATURES floats a pixel): rank 0 denoises the
+ * whole image. A denoised image's first pass sends its running sums (3
+ * doubles a pixel) and the features; its adaptive pass is handed each
+ * tile's state (in bytes a pixel: the sums, the features, each pixel's own
+ * count of samples, uint16) and sends the radiance and features as one
+ * pass does. */
 typedef struct tiling {
 	int w, h, side, across;
 	long count;
-	int per; /* floats a pixel */
+	int pass, first;
+	size_t out, in; /* bytes a pixel: of a result, of a tile's state */
 } tiling;
 
-static tiling tiling_of(const render_settings *s, int side)
+#define SUMS_BYTES (3 * sizeof(double))
+#define FEAT_BYTES (DENOISE_FEATURES * sizeof(float))
+
+static tiling tiling_of(const render_settings *s, const farm_opts *o)
 {
-	tiling t = {s->width, s->height, side, (s->width + side - 1) / side, 0, 3};
-	t.count = (long)t.across * ((s->height + side - 1) / side);
+	tiling t = {s->width, s->height, o->tile, (s->width + o->tile - 1) / o->tile, 0, o->pass, o->first,
+	            3 * sizeof(float), 0};
+	t.count = (long)t.across * ((s->height + o->tile - 1) / o->tile);
 	if (farm_denoises(s))
-		t.per += DENOISE_FEATURES;
+		t.out += FEAT_BYTES;
+	if (t.pass == FARM_FIRST)
+		t.out = SUMS_BYTES + FEAT_BYTES;
+	if (t.pass == FARM_ADAPTIVE)
+		t.in = SUMS_BYTES + FEAT_BYTES + sizeof(uint16_t);
 	return t;
 }
 
 bool farm_denoises(const render_settings *s)
 {
 	return render_mode_denoises(s->mode) && s->denoise == DENOISE_ON;
+}
+
+int farm_first(const render_settings *s)
+{
+	return render_adaptive_first(s->samples, farm_denoises(s));
 }
 
 static void tile_rect(const tiling *t, long i, int r[4])
@@ -67,37 +87,98 @@ static void tile_rect(const tiling *t, long i, int r[4])
 	r[3] = r[1] + t->side < t->h ? r[1] + t->side : t->h;
 }
 
-static size_t tile_floats(const tiling *t, long i)
+static size_t tile_pixels(const tiling *t, long i)
 {
 	int r[4];
 	tile_rect(t, i, r);
-	return (size_t)(r[2] - r[0]) * (size_t)(r[3] - r[1]) * (size_t)t->per;
+	return (size_t)(r[2] - r[0]) * (size_t)(r[3] - r[1]);
 }
 
-/* Renders tile i into px (tile_floats floats). */
-static void render_tile_px(const world *w, const render_settings *s, const tiling *t, long i, float *px)
+/* Bytes up to a multiple of 8: a tile's doubles stay aligned after it. */
+static size_t round8(size_t n)
 {
-	int r[4];
-	tile_rect(t, i, r);
-	size_t n = (size_t)(r[2] - r[0]) * (size_t)(r[3] - r[1]);
-	render_rect_features(w, s, r[0], r[1], r[2], r[3], px, t->per > 3 ? px + n * 3 : NULL);
+	return (n + 7) & ~(size_t)7;
 }
 
-/* Copies a tile's floats into the image (and its features, when it has
- * them, into fb->feat). */
-static void place(const tiling *t, long i, const float *px, framebuffer *fb)
+/* The most bytes of a tile's result, of its state (room for either and
+ * what follows aligned). */
+static size_t most_out(const tiling *t)
+{
+	return round8((size_t)t->side * (size_t)t->side * t->out);
+}
+
+static size_t most_in(const tiling *t)
+{
+	return round8((size_t)t->side * (size_t)t->side * t->in);
+}
+
+/* Renders tile i into out (its result); in: its state in the adaptive pass
+ * (8-byte aligned; its sums and features are used up). */
+static void render_tile_px(const world *w, const render_settings *s, const tiling *t, long i, unsigned char *in,
+                           unsigned char *out)
 {
 	int r[4];
 	tile_rect(t, i, r);
-	size_t row = (size_t)(r[2] - r[0]) * 3;
-	for (int y = r[1]; y < r[3]; y++, px += row)
-		memcpy(fb->rgb + ((size_t)y * (size_t)fb->w + (size_t)r[0]) * 3, px, row * sizeof *px);
-	if (t->per > 3 && fb->feat) {
-		row = (size_t)(r[2] - r[0]) * DENOISE_FEATURES;
-		for (int y = r[1]; y < r[3]; y++, px += row)
-			memcpy(fb->feat + ((size_t)y * (size_t)fb->w + (size_t)r[0]) * DENOISE_FEATURES, px,
-			       row * sizeof *px);
+	size_t n = tile_pixels(t, i);
+	if (t->pass == FARM_FIRST) {
+		render_rect_first(w, s, r[0], r[1], r[2], r[3], t->first, (double *)(void *)out,
+		                  (float *)(void *)(out + n * SUMS_BYTES));
+	} else if (t->pass == FARM_ADAPTIVE) {
+		float *feat = (float *)(void *)(out + n * 3 * sizeof(float));
+		memcpy(feat, in + n * SUMS_BYTES, n * FEAT_BYTES);
+		render_rect_adaptive(w, s, r[0], r[1], r[2], r[3], t->first,
+		                     (const uint16_t *)(void *)(in + n * (SUMS_BYTES + FEAT_BYTES)),
+		                     (double *)(void *)in, (float *)(void *)out, feat);
+	} else {
+		float *px = (float *)(void *)out;
+		render_rect_features(w, s, r[0], r[1], r[2], r[3], px, t->out > 3 * sizeof(float) ? px + n * 3 : NULL);
 	}
+}
+
+/* Copies a tile's per-pixel block (size bytes a pixel, rows top to
+ * bottom) from src into the rows of tile r in the image's array img (w
+ * pixels a row); returns what follows it in src. */
+static const unsigned char *rows_in(const int r[4], int w, size_t size, const unsigned char *src, void *img)
+{
+	size_t row = (size_t)(r[2] - r[0]) * size;
+	for (int y = r[1]; y < r[3]; y++, src += row)
+		memcpy((unsigned char *)img + ((size_t)y * (size_t)w + (size_t)r[0]) * size, src, row);
+	return src;
+}
+
+/* The other way: the rows of tile r of img into dst; returns its end. */
+static unsigned char *rows_out(const int r[4], int w, size_t size, const void *img, unsigned char *dst)
+{
+	size_t row = (size_t)(r[2] - r[0]) * size;
+	for (int y = r[1]; y < r[3]; y++, dst += row)
+		memcpy(dst, (const unsigned char *)img + ((size_t)y * (size_t)w + (size_t)r[0]) * size, row);
+	return dst;
+}
+
+/* Copies a tile's result into the image: its radiance into fb->rgb, or
+ * its first pass's sums into fb->sum; its features, when it has them,
+ * into fb->feat. */
+static void place(const tiling *t, long i, const unsigned char *px, framebuffer *fb)
+{
+	int r[4];
+	tile_rect(t, i, r);
+	if (t->pass == FARM_FIRST)
+		px = rows_in(r, fb->w, SUMS_BYTES, px, fb->sum);
+	else
+		px = rows_in(r, fb->w, 3 * sizeof(float), px, fb->rgb);
+	if (t->out > 3 * sizeof(float) && fb->feat)
+		rows_in(r, fb->w, FEAT_BYTES, px, fb->feat);
+}
+
+/* The state of tile i for the adaptive pass, from the image (its first
+ * pass and counts), into in (t->in bytes a pixel). */
+static void pack(const tiling *t, long i, const framebuffer *fb, unsigned char *in)
+{
+	int r[4];
+	tile_rect(t, i, r);
+	in = rows_out(r, fb->w, SUMS_BYTES, fb->sum, in);
+	in = rows_out(r, fb->w, FEAT_BYTES, fb->feat, in);
+	rows_out(r, fb->w, sizeof(uint16_t), fb->pixel_spp, in);
 }
 
 /* ---------------------------------------------------------------- rank 0 */
@@ -124,13 +205,24 @@ static void add_double(_Atomic double *a, double v)
 
 typedef struct server_arg {
 	server *sv;
-	float *buf; /* one tile */
+	unsigned char *buf; /* one tile: its result, then its state */
 } server_arg;
+
+/* Renders tile i with buf (server_arg) and places it in the image. */
+static void serve_tile(const world *w, const render_settings *s, const tiling *t, long i, framebuffer *fb,
+                       unsigned char *buf)
+{
+	unsigned char *in = buf + most_out(t);
+	if (t->pass == FARM_ADAPTIVE)
+		pack(t, i, fb, in);
+	render_tile_px(w, s, t, i, in, buf);
+	place(t, i, buf, fb);
+}
 
 static void *server_thread(void *arg)
 {
 	server *sv = ((server_arg *)arg)->sv;
-	float *buf = ((server_arg *)arg)->buf;
+	unsigned char *buf = ((server_arg *)arg)->buf;
 	world_rays_reset();
 	double busy = 0.0;
 	for (;;) {
@@ -138,13 +230,12 @@ static void *server_thread(void *arg)
 		if (i >= sv->t.count)
 			break;
 		double t0 = now();
-		render_tile_px(sv->w, sv->s, &sv->t, i, buf);
+		serve_tile(sv->w, sv->s, &sv->t, i, sv->fb, buf);
 		double took = now() - t0;
 		busy += took;
 		for (double old = atomic_load(&sv->slowest); took > old;)
 			if (atomic_compare_exchange_weak(&sv->slowest, &old, took))
 				break;
-		place(&sv->t, i, buf, sv->fb);
 		atomic_fetch_add(&sv->local, 1);
 		atomic_fetch_add(&sv->done, 1);
 	}
@@ -153,10 +244,23 @@ static void *server_thread(void *arg)
 	return NULL;
 }
 
-/* The progress line (shell/progress.h) on standard error. */
-static void show_progress(const render_settings *s, long done, long total, double elapsed)
+double farm_clock(void)
 {
-	progress_state ps = {s->width, s->height, s->samples, done, total, elapsed};
+	return now();
+}
+
+/* The progress line (shell/progress.h) on standard error: a denoised
+ * image's two passes as one, each tile of the first counting its first
+ * samples, of the second the rest (as rtsh shows them), the time since
+ * o->t0 (the frame's start; 0: this pass's, t0). */
+static void show_progress(const render_settings *s, const farm_opts *o, const tiling *t, long done, double t0)
+{
+	long total = t->count * s->samples, d = done * s->samples;
+	if (t->pass == FARM_FIRST)
+		d = done * t->first;
+	else if (t->pass == FARM_ADAPTIVE)
+		d = t->count * t->first + done * (s->samples - t->first);
+	progress_state ps = {s->width, s->height, s->samples, d, total, now() - (o->t0 > 0 ? o->t0 : t0)};
 	progress_print(stderr, &ps);
 }
 
@@ -167,36 +271,49 @@ typedef struct pace {
 	double slowest;  /* the longest wait between two of its messages, while it held tiles */
 } pace;
 
-/* Sends a worker up to k tile numbers (list has room for k + 1), with -1
- * after them when none are left; then the worker is told. */
-static void hand_out(server *sv, int worker, int64_t k, int64_t *list, bool *told, int *active,
+/* Room for a hand_out of k tiles. */
+static size_t hand_bytes(const tiling *t, int64_t k)
+{
+	return ((size_t)k + 1) * sizeof(int64_t) + (size_t)k * most_in(t);
+}
+
+/* Sends a worker up to k tile numbers, each followed by its state in the
+ * adaptive pass (list has hand_bytes(k)), with -1 after them when none are
+ * left; then the worker is told. */
+static void hand_out(server *sv, int worker, int64_t k, unsigned char *list, bool *told, int *active,
                      double *bytes, pace *pc)
 {
-	int n = 0;
-	while (n < k) {
-		long i = atomic_fetch_add(&sv->next, 1);
+	size_t at = 0;
+	for (int n = 0; n < k; n++) {
+		int64_t i = atomic_fetch_add(&sv->next, 1);
 		if (i >= sv->t.count) {
-			list[n++] = -1;
+			i = -1;
+			memcpy(list + at, &i, sizeof i);
+			at += sizeof i;
 			*told = true;
 			(*active)--;
 			break;
 		}
-		list[n++] = i;
+		memcpy(list + at, &i, sizeof i);
+		at += sizeof i;
+		if (sv->t.pass == FARM_ADAPTIVE) {
+			pack(&sv->t, i, sv->fb, list + at);
+			at += tile_pixels(&sv->t, i) * sv->t.in;
+		}
 		pc[worker].held++;
 	}
-	MPI_Send(list, n, MPI_INT64_T, worker, FARM_TILES, MPI_COMM_WORLD);
-	*bytes += (double)n * sizeof *list;
+	MPI_Send(list, (int)at, MPI_BYTE, worker, FARM_TILES, MPI_COMM_WORLD);
+	*bytes += (double)at;
 }
 
 #define FARM_MAX_ASK 65536
 
 /* Takes one waiting message from a worker and answers it; false (err set)
  * when the message breaks the protocol. */
-static bool serve_one(server *sv, MPI_Status *ms, char *msg, size_t most, bool *told, int *active,
+static bool serve_one(server *sv, MPI_Status *ms, char *msg, unsigned char *one, bool *told, int *active,
                       double *bytes, pace *pc, rt_error *err)
 {
 	int src = ms->MPI_SOURCE, count;
-	int64_t one[2];
 	double t = now();
 	if (pc[src].held > 0 && t - pc[src].last > pc[src].slowest)
 		pc[src].slowest = t - pc[src].last;
@@ -207,9 +324,9 @@ static bool serve_one(server *sv, MPI_Status *ms, char *msg, size_t most, bool *
 		if (k < 1 || k > FARM_MAX_ASK || told[src])
 			return rt_error_set(err, "rank %d asked for %lld tiles; expected one ask of 1..%d",
 			                    src, (long long)k, FARM_MAX_ASK);
-		int64_t *list = malloc(((size_t)k + 1) * sizeof *list);
+		unsigned char *list = malloc(hand_bytes(&sv->t, k));
 		if (!list)
-			return rt_error_set(err, "out of memory");
+			return rt_error_set(err, "out of memory for %lld tiles", (long long)k);
 		hand_out(sv, src, k, list, &told[src], active, bytes, pc);
 		free(list);
 		return true;
@@ -217,7 +334,7 @@ static bool serve_one(server *sv, MPI_Status *ms, char *msg, size_t most, bool *
 	if (ms->MPI_TAG != FARM_RESULT)
 		return rt_error_set(err, "rank %d sent message kind %d; expected a tile", src, ms->MPI_TAG);
 	MPI_Get_count(ms, MPI_BYTE, &count);
-	size_t cap = sizeof(int64_t) + most * sizeof(float);
+	size_t cap = sizeof(int64_t) + most_out(&sv->t);
 	if (count < (int)sizeof(int64_t) || (size_t)count > cap)
 		return rt_error_set(err, "rank %d sent a tile of %d bytes; expected at most %zu", src,
 		                    count, cap);
@@ -225,11 +342,11 @@ static bool serve_one(server *sv, MPI_Status *ms, char *msg, size_t most, bool *
 	int64_t i;
 	memcpy(&i, msg, sizeof i);
 	if (i < 0 || i >= sv->t.count ||
-	    (size_t)count != sizeof i + tile_floats(&sv->t, i) * sizeof(float))
+	    (size_t)count != sizeof i + tile_pixels(&sv->t, i) * sv->t.out)
 		return rt_error_set(err, "rank %d sent tile %lld in %d bytes; expected one of the %ld tiles, whole",
 		                    src, (long long)i, count, sv->t.count);
-	/* msg is malloc'd and the floats start 8 bytes in: aligned */
-	place(&sv->t, i, (const float *)(void *)(msg + sizeof i), sv->fb);
+	/* msg is malloc'd and the floats and doubles start 8 bytes in: aligned */
+	place(&sv->t, i, (const unsigned char *)msg + sizeof i, sv->fb);
 	atomic_fetch_add(&sv->done, 1);
 	if (pc[src].held > 0)
 		pc[src].held--;
@@ -243,24 +360,26 @@ bool farm_serve(const world *w, const render_settings *s, const farm_opts *o, fr
 {
 	int size;
 	MPI_Comm_size(MPI_COMM_WORLD, &size);
-	server sv = {.w = w, .s = s, .t = tiling_of(s, o->tile), .fb = fb};
+	server sv = {.w = w, .s = s, .t = tiling_of(s, o), .fb = fb};
 	atomic_init(&sv.next, 0);
 	atomic_init(&sv.done, 0);
 	atomic_init(&sv.rays, 0);
 	atomic_init(&sv.local, 0);
 	atomic_init(&sv.busy, 0.0);
 	atomic_init(&sv.slowest, 0.0);
-	size_t most = (size_t)o->tile * (size_t)o->tile * (size_t)sv.t.per;
+	size_t most = most_out(&sv.t) + most_in(&sv.t); /* a tile's buffer */
 	int n = o->threads;
-	char *msg = malloc(sizeof(int64_t) + most * sizeof(float));
+	char *msg = malloc(sizeof(int64_t) + most_out(&sv.t));
+	unsigned char *one = malloc(hand_bytes(&sv.t, 1));
 	bool *told = calloc((size_t)size, sizeof *told);
 	pace *pc = calloc((size_t)size, sizeof *pc);
 	pthread_t *tid = calloc((size_t)n, sizeof *tid);
 	server_arg *args = calloc((size_t)n, sizeof *args);
 	/* one tile for each thread, and one for this thread if none starts */
-	float *bufs = malloc(((size_t)n + 1) * most * sizeof *bufs);
-	if (!msg || !told || !pc || !tid || !args || !bufs) {
+	unsigned char *bufs = malloc(((size_t)n + 1) * most);
+	if (!msg || !one || !told || !pc || !tid || !args || !bufs) {
 		free(msg);
+		free(one);
 		free(told);
 		free(pc);
 		free(tid);
@@ -285,7 +404,7 @@ bool farm_serve(const world *w, const render_settings *s, const farm_opts *o, fr
 	int active = size - 1;
 	long nap = 50;
 	bool ok = true;
-	float *own = started == 0 ? bufs + (size_t)n * most : NULL;
+	unsigned char *own = started == 0 ? bufs + (size_t)n * most : NULL;
 	double own_busy = 0.0, checked = t0;
 	long own_tiles = 0;
 	if (started == 0)
@@ -295,7 +414,7 @@ bool farm_serve(const world *w, const render_settings *s, const farm_opts *o, fr
 		MPI_Status ms;
 		MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &ms);
 		if (flag) {
-			ok = serve_one(&sv, &ms, msg, most, told, &active, &bytes, pc, err);
+			ok = serve_one(&sv, &ms, msg, one, told, &active, &bytes, pc, err);
 			if (!ok) /* the threads stop after their tile; the caller aborts */
 				atomic_store(&sv.next, sv.t.count);
 			nap = 50;
@@ -303,16 +422,15 @@ bool farm_serve(const world *w, const render_settings *s, const farm_opts *o, fr
 		}
 		if (o->progress && now() - shown >= 0.1) {
 			shown = now();
-			show_progress(s, atomic_load(&sv.done), sv.t.count, shown - t0);
+			show_progress(s, o, &sv.t, atomic_load(&sv.done), t0);
 		}
 		long i = own ? atomic_fetch_add(&sv.next, 1) : sv.t.count;
 		if (i < sv.t.count) {
 			double b0 = now();
-			render_tile_px(w, s, &sv.t, i, own);
+			serve_tile(w, s, &sv.t, i, fb, own);
 			own_busy += now() - b0;
 			if (now() - b0 > atomic_load(&sv.slowest))
 				atomic_store(&sv.slowest, now() - b0);
-			place(&sv.t, i, own, fb);
 			own_tiles++;
 			atomic_fetch_add(&sv.done, 1);
 			continue;
@@ -344,8 +462,9 @@ bool farm_serve(const world *w, const render_settings *s, const farm_opts *o, fr
 	for (int i = 0; i < started; i++)
 		pthread_join(tid[i], NULL);
 	if (o->progress) {
-		show_progress(s, atomic_load(&sv.done), sv.t.count, now() - t0);
-		fputc('\n', stderr);
+		show_progress(s, o, &sv.t, atomic_load(&sv.done), t0);
+		if (sv.t.pass != FARM_FIRST) /* the line goes on in the second pass */
+			fputc('\n', stderr);
 	}
 	if (started == 0)
 		atomic_fetch_add(&sv.rays, world_rays_traced());
@@ -361,6 +480,7 @@ bool farm_serve(const world *w, const render_settings *s, const farm_opts *o, fr
 	free(bufs);
 	free(args);
 	free(msg);
+	free(one);
 	free(told);
 	free(pc);
 	free(tid);
@@ -386,6 +506,7 @@ typedef struct crew {
 	pthread_cond_t comm; /* a tile is ready to send */
 	/* all below under lock */
 	int64_t *queue;      /* tiles to render (ring) */
+	unsigned char *state; /* the adaptive pass: queue[j]'s state at j x most_in */
 	int qhead, qlen, cap;
 	char **spare;        /* free message buffers (2 k: k tiles, and sends in flight) */
 	int nspare;
@@ -409,19 +530,23 @@ static void *crew_thread(void *arg)
 		if (c->qlen == 0)
 			break;
 		int64_t i = c->queue[c->qhead];
+		char *msg = c->spare[--c->nspare];
+		/* the state after the result's room (8 + most_out: aligned) */
+		unsigned char *in = (unsigned char *)msg + sizeof i + most_out(&c->t);
+		if (c->t.in)
+			memcpy(in, c->state + (size_t)c->qhead * most_in(&c->t), tile_pixels(&c->t, i) * c->t.in);
 		c->qhead = (c->qhead + 1) % c->cap;
 		c->qlen--;
-		char *msg = c->spare[--c->nspare];
 		pthread_mutex_unlock(&c->lock);
 
 		memcpy(msg, &i, sizeof i);
 		double t0 = now();
-		render_tile_px(c->w, c->s, &c->t, i, (float *)(void *)(msg + sizeof i));
+		render_tile_px(c->w, c->s, &c->t, i, in, (unsigned char *)msg + sizeof i);
 		double t1 = now();
 
 		pthread_mutex_lock(&c->lock);
 		c->out[(c->ohead + c->olen++) % c->cap] =
-			(outgoing){msg, sizeof i + tile_floats(&c->t, i) * sizeof(float), t1 + c->delay};
+			(outgoing){msg, sizeof i + tile_pixels(&c->t, i) * c->t.out, t1 + c->delay};
 		c->tiles++;
 		c->busy += t1 - t0;
 		pthread_cond_signal(&c->comm);
@@ -446,21 +571,23 @@ bool farm_work(const world *w, const render_settings *s, const farm_opts *o, far
                rt_error *err)
 {
 	int n = o->threads, k = o->threads + o->prefetch;
-	crew c = {.w = w, .s = s, .t = tiling_of(s, o->tile), .delay = o->delay_us * 1e-6, .cap = k};
-	size_t most = (size_t)o->tile * (size_t)o->tile * (size_t)c.t.per;
-	size_t msgsize = sizeof(int64_t) + most * sizeof(float);
+	crew c = {.w = w, .s = s, .t = tiling_of(s, o), .delay = o->delay_us * 1e-6, .cap = k};
+	/* a message: the tile number, its result, then its state */
+	size_t msgsize = sizeof(int64_t) + most_out(&c.t) + most_in(&c.t);
+	size_t replysize = hand_bytes(&c.t, k);
 	c.queue = calloc((size_t)k, sizeof *c.queue);
+	c.state = malloc((size_t)k * most_in(&c.t) + 1);
 	int nbuf = 2 * k;
 	c.spare = calloc((size_t)nbuf, sizeof *c.spare);
 	MPI_Request *sreq = calloc((size_t)nbuf, sizeof *sreq);
 	char **smsg = calloc((size_t)nbuf, sizeof *smsg);
 	int nsend = 0; /* results on their way (MPI_Isend: no core spins while rank 0 takes them) */
 	c.out = calloc((size_t)k, sizeof *c.out);
-	int64_t *reply = calloc((size_t)k + 1, sizeof *reply);
+	unsigned char *reply = malloc(replysize);
 	double *sent_at = calloc((size_t)k + 1, sizeof *sent_at);
 	pthread_t *tid = calloc((size_t)n, sizeof *tid);
 	char *slab = malloc((size_t)nbuf * msgsize);
-	bool ok = c.queue && c.spare && c.out && reply && sent_at && tid && slab && sreq && smsg;
+	bool ok = c.queue && c.state && c.spare && c.out && reply && sent_at && tid && slab && sreq && smsg;
 	if (!ok)
 		rt_error_set(err, "out of memory for %d tiles of %dx%d", nbuf, o->tile, o->tile);
 	for (int i = 0; ok && i < nbuf; i++)
@@ -491,14 +618,14 @@ bool farm_work(const world *w, const render_settings *s, const farm_opts *o, far
 		bool event = false;
 		/* a reply: queue its tiles */
 		if (expect > 0 && req == MPI_REQUEST_NULL)
-			MPI_Irecv(reply, k + 1, MPI_INT64_T, 0, FARM_TILES, MPI_COMM_WORLD, &req);
+			MPI_Irecv(reply, (int)replysize, MPI_BYTE, 0, FARM_TILES, MPI_COMM_WORLD, &req);
 		if (req != MPI_REQUEST_NULL) {
 			int flag = 0, count = 0;
 			MPI_Status ms;
 			MPI_Test(&req, &flag, &ms);
 			if (flag) {
 				event = true;
-				MPI_Get_count(&ms, MPI_INT64_T, &count);
+				MPI_Get_count(&ms, MPI_BYTE, &count);
 				int slot = (sq - expect + (k + 1)) % (k + 1);
 				if (sent_at[slot] >= 0.0) {
 					rtt += now() - sent_at[slot];
@@ -506,16 +633,31 @@ bool farm_work(const world *w, const render_settings *s, const farm_opts *o, far
 				}
 				expect--;
 				pthread_mutex_lock(&c.lock);
-				for (int j = 0; j < count; j++) {
-					if (reply[j] < 0) {
+				/* tile numbers, each with its state (the adaptive pass) */
+				for (size_t at = 0; ok && at < (size_t)count;) {
+					int64_t j;
+					if ((size_t)count - at < sizeof j) {
+						ok = rt_error_set(err, "rank 0 sent %d bytes of tiles; expected whole tiles", count);
+						break;
+					}
+					memcpy(&j, reply + at, sizeof j);
+					at += sizeof j;
+					size_t sb = j >= 0 && j < c.t.count ? tile_pixels(&c.t, j) * c.t.in : 0;
+					if (j < 0) {
 						c.no_more = true;
 						expect = 0;
-					} else if (reply[j] < c.t.count && c.qlen < c.cap) {
-						c.queue[(c.qhead + c.qlen++) % c.cap] = reply[j];
+					} else if (j < c.t.count && c.qlen < c.cap && (size_t)count - at >= sb) {
+						int q = (c.qhead + c.qlen++) % c.cap;
+						c.queue[q] = j;
+						if (sb)
+							memcpy(c.state + (size_t)q * most_in(&c.t), reply + at, sb);
+						at += sb;
 						assigned++;
 					} else {
-						ok = rt_error_set(err, "rank 0 sent tile %lld; expected one of %ld, at most %d at once",
-						                  (long long)reply[j], c.t.count, c.cap);
+						ok = rt_error_set(err,
+						                  "rank 0 sent tile %lld; expected one of %ld with its state, at most %d "
+						                  "at once",
+						                  (long long)j, c.t.count, c.cap);
 					}
 				}
 				pthread_cond_broadcast(&c.work);
@@ -608,6 +750,7 @@ bool farm_work(const world *w, const render_settings *s, const farm_opts *o, far
 	pthread_cond_destroy(&c.work);
 	pthread_cond_destroy(&c.comm);
 	free(c.queue);
+	free(c.state);
 	free(c.spare);
 	free(c.out);
 	free(reply);

@@ -10,6 +10,7 @@
  * atomically. Every rank ends with the same exit status.
  */
 #include <errno.h>
+#include <math.h>
 #include <mpi.h>
 #include <signal.h>
 #include <stdatomic.h>
@@ -224,8 +225,10 @@ static void setup(int argc, char **argv, job_config *c, fileset *files, world **
 		        o.scene, c->set.width, c->set.height, RENDER_MAX_DIM);
 		goto out;
 	}
-	free((*fb)->sum); /* one pass: no running sums, as render_image */
-	(*fb)->sum = NULL;
+	if (farm_first(&c->set) == c->set.samples) {
+		free((*fb)->sum); /* one pass: no running sums, as render_image */
+		(*fb)->sum = NULL;
+	}
 	if (farm_denoises(&c->set) && !denoise_prepare(*fb)) {
 		fprintf(stderr, "%s: out of memory for the denoiser's features of a %dx%d image\n", o.scene,
 		        c->set.width, c->set.height);
@@ -233,6 +236,8 @@ static void setup(int argc, char **argv, job_config *c, fileset *files, world **
 		*fb = NULL;
 		goto out;
 	}
+	free((*fb)->sum2); /* the first pass's sums of squares: in its features */
+	(*fb)->sum2 = NULL;
 	c->progress = !o.quiet && watched();
 	*output = o.output;
 	c->status = -1;
@@ -257,6 +262,66 @@ static void wait_for(MPI_Request *req)
 		if (nap < 2000)
 			nap *= 2;
 	}
+}
+
+/* One farmed pass (fo->pass); its figures added to *st (first: set). */
+static bool farm_pass(int rank, const world *w, const render_settings *s, const farm_opts *fo, framebuffer *fb,
+                      farm_stats *st, bool first, rt_error *err)
+{
+	farm_stats f;
+	bool ok = rank == 0 ? farm_serve(w, s, fo, fb, &f, err) : farm_work(w, s, fo, &f, err);
+	if (first) {
+		*st = f;
+	} else {
+		st->rtt = (st->rtt * st->tiles + f.rtt * f.tiles) / fmax(st->tiles + f.tiles, 1.0);
+		st->tiles += f.tiles;
+		st->seconds += f.seconds;
+		st->busy += f.busy;
+		st->rays += f.rays;
+		st->bytes += f.bytes;
+		st->serve += f.serve;
+	}
+	return ok;
+}
+
+/* Renders a frame into fb on rank 0 with every rank: one pass of the farm,
+ * or a denoised image's two (farm.h), as render_image makes it, to the
+ * same bits: the first samples in every pixel, rank 0's allocation of the
+ * rest from the whole image (render_adaptive_counts), told to every rank
+ * (its most: whether there is a second pass), and the adaptive pass. */
+static bool render_frame(int rank, const world *w, const render_settings *s, farm_opts *fo, framebuffer *fb,
+                         farm_stats *st, rt_error *err)
+{
+	int first = farm_first(s);
+	fo->first = first;
+	fo->t0 = farm_clock();
+	fo->pass = first < s->samples ? FARM_FIRST : FARM_ONE;
+	if (!farm_pass(rank, w, s, fo, fb, st, true, err))
+		return false;
+	if (fo->pass == FARM_ONE)
+		return true;
+	int most = 0;
+	if (rank == 0) {
+		fb->spp = first;
+		most = render_adaptive_counts(fb, s->samples, first, err);
+		if (most < 0)
+			return false;
+	}
+	/* every rank done with the first pass before any asks for a tile of
+	 * the second */
+	MPI_Request b;
+	MPI_Ibcast(&most, 1, MPI_INT, 0, MPI_COMM_WORLD, &b);
+	wait_for(&b);
+	if (most > first) {
+		fo->pass = FARM_ADAPTIVE;
+		return farm_pass(rank, w, s, fo, fb, st, false, err);
+	}
+	/* no pixel takes more (render_adaptive: no second pass): the first
+	 * pass's means, as a render job writes them */
+	if (rank == 0)
+		for (size_t i = 0; i < (size_t)fb->w * (size_t)fb->h * 3; i++)
+			fb->rgb[i] = (float)(fb->sum[i] * (1.0 / first));
+	return true;
 }
 
 static void bcast(void *buf, int count, MPI_Datatype type)
@@ -583,9 +648,7 @@ int main(int argc, char **argv)
 			camera ck = orbit_turntable(cam0, pivot, k, frames);
 			w->cam = cam_view_make(&ck);
 		}
-		bool ok = rank == 0 ? farm_serve(w, &c.set, &fo, fb, &st, &err)
-		                    : farm_work(w, &c.set, &fo, &st, &err);
-		if (!ok)
+		if (!render_frame(rank, w, &c.set, &fo, fb, &st, &err))
 			die(rank, host, "", &err);
 		if (rank == 0 && fb->feat) {
 			/* --denoise: the whole frame, as rtsh denoises its image */

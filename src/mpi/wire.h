@@ -5,7 +5,8 @@
  * version of rtsh-mpi read the same values or refuse with a message; no
  * padding, pointer or struct layout is ever sent.
  *
- * Layout (version 4), WIRE_CONFIG_SIZE bytes, zeros after the fields:
+ * Layout (version 5; version 4's, the farm's messages since changed:
+ * farm.h), WIRE_CONFIG_SIZE bytes, zeros after the fields:
  *   "RTSHMPI\0"  u32 version  u32 length of what follows
  *   i32 status verbose progress strict tile prefetch delay_us
  *   render_settings: every row of the settings table (settings.h) but the
@@ -26,7 +27,7 @@
 
 #include "rtsh/render.h"
 
-#define WIRE_VERSION 4
+#define WIRE_VERSION 5
 /* Every rank receives this many bytes: more than version 1 needs, so that a
  * newer version can add fields and still be told apart. */
 #define WIRE_CONFIG_SIZE 256

@@ -214,6 +214,18 @@ static scene *load_text(const char *text)
 	return s;
 }
 
+/* The adaptive tests' world (a light, a floor and two objects), its scene
+ * in *s. */
+static world *adaptive_world(scene **s)
+{
+	*s = load_text("C 0,1,-4 0,-0.2,1 60\nA 0.3 200,220,255\nL 2,4,-2 0.7 255,255,255\n"
+	               "pl 0,0,0 0,1,0 200,200,200\nsp 0,1,0 2 220,60,50\n"
+	               "sp 1.5,0.5,-1 0,1,0 1,1,1 255,255,255 0 0 1 1\n");
+	world *w = world_build(*s, NULL);
+	assert_non_null(w);
+	return w;
+}
+
 /* The features of the centre pixel of a 9x9 picture of the scene of text,
  * summed over its samples 0 .. n - 1 (denoise_sample's accumulator). */
 static void centre_features(const char *text, int n, double f[DENOISE_ACC])
@@ -1246,11 +1258,8 @@ static void test_adaptive_pass(void **state)
 static void test_adaptive_after_passes(void **state)
 {
 	(void)state;
-	scene *s = load_text("C 0,1,-4 0,-0.2,1 60\nA 0.3 200,220,255\nL 2,4,-2 0.7 255,255,255\n"
-	                     "pl 0,0,0 0,1,0 200,200,200\nsp 0,1,0 2 220,60,50\n"
-	                     "sp 1.5,0.5,-1 0,1,0 1,1,1 255,255,255 0 0 1 1\n");
-	world *w = world_build(s, NULL);
-	assert_non_null(w);
+	scene *s;
+	world *w = adaptive_world(&s);
 	enum { W = 31, H = 19, N = W * H };
 	render_settings set = path_settings(W, H, 12, 4, 5);
 	int first = render_adaptive_first(12, true);
@@ -1280,6 +1289,86 @@ static void test_adaptive_after_passes(void **state)
 	scene_free(s);
 }
 
+/* rtsh-mpi's two passes on rectangles (render_rect_first, the counts from
+ * the whole image's first pass, render_rect_adaptive) give each pixel the
+ * bits a render job's two passes (render_run, render_adaptive) give it:
+ * its mean, sums and features, rectangles of 1 pixel and of sides that do
+ * not divide the image included (a pixel with fewer samples than
+ * DENOISE_FEATURE_SAMPLES too: 3 samples, 2 first). */
+static void test_adaptive_rects(void **state)
+{
+	(void)state;
+	scene *s;
+	world *w = adaptive_world(&s);
+	enum { W = 29, H = 17, N = W * H };
+	const int budgets[] = {3, 12};
+	for (int b = 0; b < 2; b++) {
+		render_settings set = path_settings(W, H, budgets[b], 4, 3);
+		int first = render_adaptive_first(set.samples, true);
+		assert_true(first < set.samples);
+		framebuffer *job_fb = fb_new(W, H), *rect_fb = fb_new(W, H);
+		assert_true(job_fb && rect_fb && denoise_prepare(job_fb) && denoise_prepare(rect_fb));
+		render_job job = {.w = w, .set = set, .fb = job_fb, .sample_end = first};
+		assert_int_equal(render_run(&job, NULL), RENDER_DONE);
+		assert_int_equal(render_adaptive(&job, NULL), RENDER_DONE);
+		/* the rectangles cover the image once: 1 x 1, 6 x 5 (not
+		 * dividing 29 x 17), and what is left of each row band */
+		const int rects[][4] = {{0, 0, 1, 1}, {1, 0, 7, 5}, {7, 0, 29, 5}, {0, 5, 6, 10}, {6, 5, 29, 10},
+		                        {0, 10, 29, 17}, {0, 1, 1, 5}};
+		enum { NR = sizeof rects / sizeof rects[0] };
+		size_t covered = 0;
+		for (int pass = 0; pass < 2; pass++) {
+			if (pass == 1) {
+				rect_fb->spp = first;
+				assert_int_equal(render_adaptive_counts(rect_fb, set.samples, first, NULL) >= first, true);
+				assert_memory_equal(rect_fb->pixel_spp, job_fb->pixel_spp, N * sizeof *rect_fb->pixel_spp);
+			}
+			for (int r = 0; r < NR; r++) {
+				const int *q = rects[r];
+				size_t rw = (size_t)(q[2] - q[0]), n = rw * (size_t)(q[3] - q[1]);
+				double *sum = malloc(n * 3 * sizeof *sum);
+				float *feat = malloc(n * DENOISE_FEATURES * sizeof *feat), *rgb = malloc(n * 3 * sizeof *rgb);
+				uint16_t *end = malloc(n * sizeof *end);
+				assert_true(sum && feat && rgb && end);
+				for (size_t i = 0; i < n; i++) {
+					size_t p = (size_t)(q[1] + (int)(i / rw)) * W + (size_t)q[0] + i % rw;
+					if (pass == 1) {
+						memcpy(sum + i * 3, rect_fb->sum + p * 3, 3 * sizeof *sum);
+						memcpy(feat + i * DENOISE_FEATURES, rect_fb->feat + p * DENOISE_FEATURES,
+						       DENOISE_FEATURES * sizeof *feat);
+						end[i] = rect_fb->pixel_spp[p];
+					}
+				}
+				if (pass == 0)
+					render_rect_first(w, &set, q[0], q[1], q[2], q[3], first, sum, feat);
+				else
+					render_rect_adaptive(w, &set, q[0], q[1], q[2], q[3], first, end, sum, rgb, feat);
+				for (size_t i = 0; i < n; i++) {
+					size_t p = (size_t)(q[1] + (int)(i / rw)) * W + (size_t)q[0] + i % rw;
+					memcpy(rect_fb->sum + p * 3, sum + i * 3, 3 * sizeof *sum);
+					memcpy(rect_fb->feat + p * DENOISE_FEATURES, feat + i * DENOISE_FEATURES,
+					       DENOISE_FEATURES * sizeof *feat);
+					if (pass == 1)
+						memcpy(rect_fb->rgb + p * 3, rgb + i * 3, 3 * sizeof *rgb);
+					covered += pass == 0;
+				}
+				free(sum);
+				free(feat);
+				free(rgb);
+				free(end);
+			}
+		}
+		assert_int_equal(covered, N);
+		assert_memory_equal(rect_fb->sum, job_fb->sum, N * 3 * sizeof *rect_fb->sum);
+		assert_memory_equal(rect_fb->feat, job_fb->feat, N * DENOISE_FEATURES * sizeof *rect_fb->feat);
+		assert_memory_equal(rect_fb->rgb, job_fb->rgb, N * 3 * sizeof *rect_fb->rgb);
+		fb_free(job_fb);
+		fb_free(rect_fb);
+	}
+	world_free(w);
+	scene_free(s);
+}
+
 /* A denoised render (render_image, as save and batch output) of 8 samples
  * spends 8 x W x H in all, but not 8 in each pixel: at least
  * DENOISE_FIRST(8) = 6, even, at most DENOISE_CAP_TIMES x 8, and 8 where
@@ -1288,11 +1377,8 @@ static void test_adaptive_after_passes(void **state)
 static void test_adaptive_render(void **state)
 {
 	(void)state;
-	scene *s = load_text("C 0,1,-4 0,-0.2,1 60\nA 0.3 200,220,255\nL 2,4,-2 0.7 255,255,255\n"
-	                     "pl 0,0,0 0,1,0 200,200,200\nsp 0,1,0 2 220,60,50\n"
-	                     "sp 1.5,0.5,-1 0,1,0 1,1,1 255,255,255 0 0 1 1\n");
-	world *w = world_build(s, NULL);
-	assert_non_null(w);
+	scene *s;
+	world *w = adaptive_world(&s);
 	enum { W = 37, H = 23, N = W * H };
 	render_settings set = path_settings(W, H, 8, 4, 7);
 	set.threads = 1;
@@ -1408,6 +1494,7 @@ int main(void)
 		cmocka_unit_test(test_adaptive_pass),
 		cmocka_unit_test(test_adaptive_render),
 		cmocka_unit_test(test_adaptive_after_passes),
+		cmocka_unit_test(test_adaptive_rects),
 		cmocka_unit_test(test_modes),
 		cmocka_unit_test(test_setting),
 	};

@@ -110,7 +110,7 @@ static void test_layout(void **state)
 	unsigned char buf[WIRE_CONFIG_SIZE];
 	memset(buf, 0xee, sizeof buf);
 	wire_put_config(&a, buf);
-	static const unsigned char head[16] = {'R', 'T', 'S', 'H', 'M', 'P', 'I', 0, 4, 0, 0, 0, 80, 0, 0, 0};
+	static const unsigned char head[16] = {'R', 'T', 'S', 'H', 'M', 'P', 'I', 0, 5, 0, 0, 0, 80, 0, 0, 0};
 	assert_memory_equal(buf, head, 16);
 	static const unsigned char status[4] = {0xff, 0xff, 0xff, 0xff}, tile[4] = {0x0d, 0x0c, 0x0b, 0x0a},
 	                           prefetch[4] = {0xfe, 0xff, 0xff, 0xff}, width[4] = {0x34, 0x12, 0, 0},
@@ -164,6 +164,9 @@ static void test_refused(void **state)
 	memcpy(buf, good, sizeof buf);
 	buf[8] = 3; /* version 3 (with the terminal's pixels and symbols) */
 	expect_refused(buf, "version 3");
+	memcpy(buf, good, sizeof buf);
+	buf[8] = 4; /* version 4 (the farm's one pass of a denoised image) */
+	expect_refused(buf, "version 4");
 	memcpy(buf, good, sizeof buf);
 	buf[60] = 7; /* mode */
 	expect_refused(buf, "mode = 7");
