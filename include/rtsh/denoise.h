@@ -163,13 +163,17 @@ bool denoise_image(const framebuffer *fb, float *out, int threads);
  * spends S x W x H camera paths, DENOISE_FIRST(S) (3/4 of S, even) in
  * every pixel first, then the rest where the noise is (render_image). */
 #define DENOISE_FIRST(S) ((3 * (S) / 4) & ~1)
-/* ...each pixel at most this many times the mean. */
-#define DENOISE_CAP_TIMES 8
+/* ...each pixel at most 16 times the mean (8: metal-fuzz 1-2% worse, its
+ * highlights' pixels held at 64 of 8), and below 65535 (a pixel's count is
+ * 16 bits, framebuffer.pixel_spp; RENDER_ADAPTIVE_MAX x 16 is 65536). */
+#define DENOISE_CAP_TIMES 16
+#define DENOISE_CAP(S) (DENOISE_CAP_TIMES * (S) < 65534 ? DENOISE_CAP_TIMES * (S) : 65534)
 
 /* The noise about each pixel of fb (features and at least 2 samples a
  * pixel) into sigma (w*h): the standard deviation of one sample's
  * brightness over its 8 neighbours, the root of the mean of their
- * variances, the pixel's own samples left out (so that its count does not
+ * variances (those of fixed neighbours, denoise_fixed, left out: their
+ * noise is not known), the pixel's own samples left out (so that its count does not
  * depend on them: a pixel whose first samples happened to miss a bright
  * path would keep few, and its mean would be low on average). False when
  * out of memory. */

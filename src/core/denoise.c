@@ -1134,7 +1134,7 @@ bool denoise_image(const framebuffer *fb, float *out, int threads)
  * so far, at least two; features 7): the variance in each pixel from the
  * mean of the squared brightness and the mean's square, n / (n - 1)
  * unbiased; then each pixel the root of the mean of its 8 neighbours'
- * (those inside the image), its own left out. */
+ * (those inside the image and not fixed), its own left out. */
 bool denoise_fixed(const float *f)
 {
 	return !(f[6] > 0.0f) || f[0] > 1.0f || f[1] > 1.0f || f[2] > 1.0f;
@@ -1170,7 +1170,10 @@ bool denoise_sigma(const framebuffer *fb, float *sigma)
 			for (int dy = -1; dy <= 1; dy++)
 				for (int dx = -1; dx <= 1; dx++) {
 					int qx = x + dx, qy = y + dy;
-					if (qx < 0 || qy < 0 || qx >= w || qy >= h || (dx == 0 && dy == 0))
+					/* a fixed neighbour's noise is not known (its
+					 * variance was set to 0): it does not count */
+					if (qx < 0 || qy < 0 || qx >= w || qy >= h || (dx == 0 && dy == 0) ||
+					    denoise_fixed(fb->feat + ((size_t)qy * w + qx) * DENOISE_FEATURES))
 						continue;
 					s += v[(size_t)qy * w + qx];
 					k++;

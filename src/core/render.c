@@ -699,7 +699,7 @@ int render_adaptive_counts(framebuffer *fb, int samples, int first, rt_error *er
 	for (size_t i = 0; i < n; i++)
 		if (!denoise_fixed(fb->feat + i * DENOISE_FEATURES))
 			sigma[m++] = sigma[i];
-	denoise_allocate(sigma, m, first, samples, DENOISE_CAP_TIMES * samples, spp + (n - m));
+	denoise_allocate(sigma, m, first, samples, DENOISE_CAP(samples), spp + (n - m));
 	for (size_t i = 0, k = n - m; i < n; i++)
 		spp[i] = !denoise_fixed(fb->feat + i * DENOISE_FEATURES) ? spp[k++] : (uint16_t)samples;
 	free(sigma);

@@ -1176,21 +1176,25 @@ static void test_sigma_neighbours(void **state)
 	assert_true(denoise_sigma(fb, s2));
 	assert_true(s2[0] == sg[0]);
 	/* A pixel that missed the scene (depth 0) or sees a lamp (albedo 2)
-	 * is fixed and its noise counts for none of its neighbours: pixel 1
-	 * (v 2) missing, the corner's neighbours are 4 and 5 (and pixel 1's
-	 * 0): sqrt(9 / 3); pixel 3 (v 4) a lamp too: sqrt(5 / 3); the
-	 * centre's sum 40 - 2 - 4 = 34 over 8. */
+	 * is fixed and its noise, not known, counts for none of its
+	 * neighbours, not even as 0: pixel 1 (v 2) missing, the corner's
+	 * neighbours are 4 and 5: sqrt(9 / 2); pixel 3 (v 4) a lamp too, 5
+	 * alone: sqrt(5 / 1); the centre's 40 - 2 - 4 = 34 over 6. */
 	fb->feat[0 * DENOISE_FEATURES + 7] = 0.25f + 1.0f * 0.75f;
 	fb->feat[1 * DENOISE_FEATURES + 6] = 0.0f;
 	assert_true(denoise_fixed(fb->feat + 1 * DENOISE_FEATURES));
 	assert_false(denoise_fixed(fb->feat + 0 * DENOISE_FEATURES));
 	assert_true(denoise_sigma(fb, s2));
-	assert_near(s2[0], sqrt(9.0 / 3), 1e-5);
+	assert_near(s2[0], sqrt(9.0 / 2), 1e-5);
 	fb->feat[3 * DENOISE_FEATURES + 1] = 2.0f;
 	assert_true(denoise_fixed(fb->feat + 3 * DENOISE_FEATURES));
 	assert_true(denoise_sigma(fb, s2));
-	assert_near(s2[0], sqrt(5.0 / 3), 1e-5);
-	assert_near(s2[4], sqrt(34.0 / 8), 1e-5);
+	assert_near(s2[0], sqrt(5.0 / 1), 1e-5);
+	assert_near(s2[4], sqrt(34.0 / 6), 1e-5);
+	/* pixel 4 a lamp too: the corner has no neighbour left, sigma 0 */
+	fb->feat[4 * DENOISE_FEATURES + 1] = 2.0f;
+	assert_true(denoise_sigma(fb, s2));
+	assert_true(s2[0] == 0.0f);
 	fb_free(fb);
 }
 
@@ -1371,7 +1375,7 @@ static void test_adaptive_rects(void **state)
 
 /* A denoised render (render_image, as save and batch output) of 8 samples
  * spends 8 x W x H in all, but not 8 in each pixel: at least
- * DENOISE_FIRST(8) = 6, even, at most DENOISE_CAP_TIMES x 8, and 8 where
+ * DENOISE_FIRST(8) = 6, even, at most DENOISE_CAP(8) = 128, and 8 where
  * the pixel is fixed (the background above the horizon); the same counts
  * and the same picture for 1, 2 and 7 threads. */
 static void test_adaptive_render(void **state)
@@ -1388,9 +1392,13 @@ static void test_adaptive_render(void **state)
 	long total = 0;
 	int low = 0, high = 0, fixed = 0;
 	assert_int_equal(DENOISE_FIRST(8), 6);
+	/* the cap: 16 x 8 = 128; at the most samples an adaptive render
+	 * takes, 16 x 4096 = 65536 would not fit a pixel's 16-bit count */
+	assert_int_equal(DENOISE_CAP(8), 128);
+	assert_int_equal(DENOISE_CAP(RENDER_ADAPTIVE_MAX), 65534);
 	for (int i = 0; i < N; i++) {
 		int n = one->pixel_spp[i];
-		assert_true(n >= 6 && n <= DENOISE_CAP_TIMES * 8 && n % 2 == 0);
+		assert_true(n >= 6 && n <= 128 && n % 2 == 0);
 		if (denoise_fixed(one->feat + (size_t)i * DENOISE_FEATURES)) {
 			assert_int_equal(n, 8);
 			fixed++;
