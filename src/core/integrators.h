@@ -229,6 +229,21 @@ static inline vec3 offset_point(const world *w, vec3 p, vec3 n)
 	return v3_madd(p, n, e);
 }
 
+/* Whether adding the Phong highlight lr (s rv^e) to c (rv > 0) leaves every
+ * component of c as it is, told without pow: only when it does. With
+ * 0 < rv <= 0.5 and e >= 64, or rv <= 0.8 and e >= 200, rv^e <= 2^-64 (pow
+ * is within an ulp of it); then each product the shading rounds is below
+ * c_k 2^-54 when lr_k s <= 512 c_k (three roundings and pow's error fit in
+ * the spare factor 2), and a c_k > 0 is moved by nothing below half its
+ * ulp, which is above c_k 2^-54. NaN and infinite lr or c fail a test. */
+static inline bool phong_specular_negligible(vec3 c, vec3 lr, double s, double rv, double e)
+{
+	if (!(rv <= 0.5 ? e >= 64.0 : rv <= 0.8 && e >= 200.0))
+		return false;
+	return c.x > 0.0 && c.y > 0.0 && c.z > 0.0 && c.x < INFINITY && c.y < INFINITY && c.z < INFINITY &&
+	       fabs(lr.x * s) <= 512.0 * c.x && fabs(lr.y * s) <= 512.0 * c.y && fabs(lr.z * s) <= 512.0 * c.z;
+}
+
 /* The shading point and normal of the Phong family's Whitted shading at
  * h, and the shadow ray toward light l from there: false when the light
  * sends nothing to p or is behind the surface (no ray is traced); else *sr,

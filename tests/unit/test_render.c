@@ -790,6 +790,43 @@ static void test_write_rendered(void **state)
 }
 
 
+
+/* phong_specular_negligible says yes only when the highlight, computed as
+ * the shading computes it (pow), leaves c's bits as they are; and it does
+ * say yes for dim highlights on a lit surface (else it saves nothing). By
+ * hand: rv = 0.5, e = 64 gives 2^-64: on c = 1 a highlight of lr s = 1 adds
+ * 2^-64, far below 1's half ulp 2^-53 (yes); on c = 0 anything shows (no);
+ * rv = 0.9 at e = 200 is 7e-10 (no). */
+static void test_specular_negligible(void **state)
+{
+	(void)state;
+	assert_true(phong_specular_negligible(v3(1, 1, 1), v3(1, 1, 1), 1, 0.5, 64));
+	assert_false(phong_specular_negligible(v3(0, 1, 1), v3(1, 1, 1), 1, 0.5, 64));
+	assert_false(phong_specular_negligible(v3(1, 1, 1), v3(1, 1, 1), 1, 0.9, 200));
+	assert_false(phong_specular_negligible(v3(1, NAN, 1), v3(1, 1, 1), 1, 0.5, 64));
+	assert_false(phong_specular_negligible(v3(1, 1, 1), v3(INFINITY, 1, 1), 0, 0.5, 64));
+	test_rng r = {29};
+	int yes = 0;
+	for (int k = 0; k < 200000; k++) {
+		/* c and lr over many magnitudes, rv and e around the thresholds */
+		vec3 c = v3(pow(2, trange(&r, -40, 10)), pow(2, trange(&r, -40, 10)), pow(2, trange(&r, -40, 10)));
+		vec3 lr = v3(pow(2, trange(&r, -30, 20)), pow(2, trange(&r, -30, 20)), pow(2, trange(&r, -30, 20)));
+		double sp = trange(&r, 0, 1), rv = trange(&r, 1e-6, 1), e = trange(&r, 1, 500);
+		if (k % 4 == 0)
+			rv = k % 8 == 0 ? 0.5 : 0.8;
+		if (k % 3 == 0)
+			e = k % 9 == 0 ? 64 : 200;
+		if (!phong_specular_negligible(c, lr, sp, rv, e))
+			continue;
+		yes++;
+		vec3 t = v3_scale(lr, sp * pow(rv, e)), sum = v3_add(c, t);
+		if (!v3_eq(sum, c))
+			fail_msg("c %.17g,%.17g,%.17g + highlight %.17g,%.17g,%.17g (rv %.17g, e %.17g) is not c", c.x, c.y, c.z,
+			         t.x, t.y, t.z, rv, e);
+	}
+	assert_true(yes > 10000);
+}
+
 /* Whitted's packets (render_image: camera rays, then each light's shadow
  * rays, in packets, and shading with what the packets worked out:
  * whitted_pre) give each pixel the bits that the single ray's shading,
@@ -935,6 +972,7 @@ int main(void)
 		cmocka_unit_test(test_srgb8_in_tiles),
 		cmocka_unit_test(test_block_rays_bits),
 		cmocka_unit_test(test_packets_equal_single),
+		cmocka_unit_test(test_specular_negligible),
 		cmocka_unit_test(test_rows_while_rendering),
 		cmocka_unit_test(test_rows_ring),
 		cmocka_unit_test(test_write_rendered),
