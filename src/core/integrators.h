@@ -58,17 +58,38 @@ vec3 whitted_radiance_first(const world *w, const render_settings *s, ray r, boo
                             uint32_t known, uint32_t blocked);
 /* Whitted's shadow rays from the first hits of a packet's camera rays,
  * traced as packets, one per light (whitted.c): bit l of known[i] says
- * that ray i's shading will ask about light l (l < 32, a Phong surface),
- * bit l of blocked[i] the answer world_occluded would give. */
+ * that ray i's shading will ask about light l (l < WHITTED_PACKET_LIGHTS,
+ * a Phong surface), bit l of blocked[i] the answer world_occluded would
+ * give. Bit WHITTED_KNOWN_PRE of known[i]: what the rays were made from is
+ * kept too (whitted_pre, this thread's, until its next call), for the
+ * whitted_radiance_first of h[i] that follows. */
 void whitted_shadow_packets(const world *w, int n, const hit *h, const bool *found, uint32_t *known,
                             uint32_t *blocked);
+#define WHITTED_PACKET_LIGHTS 31
+#define WHITTED_KNOWN_PRE 31
+/* What whitted_shadow_packets worked out for a first hit on the way to its
+ * shadow rays: the shading frame (phong_whitted_frame: n, p) and, for the
+ * lights l < WHITTED_PRE_LIGHTS, whether phong_light_ray gave a ray (bit l
+ * of lit), and then the radiance lr arriving, the direction ld and n . l.
+ * The Phong family's Whitted shading takes them instead of working them
+ * out again: the same doubles (the same functions of the same values),
+ * without light_at's square root and division a second time. */
+#define WHITTED_PRE_LIGHTS 4
+typedef struct whitted_pre {
+	vec3 n, p;
+	uint32_t lit;
+	vec3 lr[WHITTED_PRE_LIGHTS], ld[WHITTED_PRE_LIGHTS];
+	double ndl[WHITTED_PRE_LIGHTS];
+} whitted_pre;
 /* What the Phong family's Whitted shading (bsdf_phong.c) is told of its
  * shadow rays: when `h` is the hit it shades, the answers for the lights of
- * `known` (whitted_shadow_packets). Set by whitted_radiance_first around
- * the first hit's shading only; per thread (defined in bsdf_phong.c). */
+ * `known` (whitted_shadow_packets), and pre (or NULL) what they were made
+ * from. Set by whitted_radiance_first around the first hit's shading only;
+ * per thread (defined in bsdf_phong.c). */
 typedef struct whitted_shadows {
 	const hit *h;
 	uint32_t known, blocked;
+	const whitted_pre *pre;
 } whitted_shadows;
 extern _Thread_local whitted_shadows whitted_shadow_hint;
 vec3 path_radiance_first(const world *w, const render_settings *s, ray r, sampler *g, bool found, const hit *h);
@@ -206,6 +227,21 @@ static inline vec3 offset_point(const world *w, vec3 p, vec3 n)
 	double m = ax > ay ? ax : ay;
 	double e = w->eps + 1e-12 * (m > az ? m : az);
 	return v3_madd(p, n, e);
+}
+
+/* Whether adding the Phong highlight lr (s rv^e) to c (rv > 0) leaves every
+ * component of c as it is, told without pow: only when it does. With
+ * 0 < rv <= 0.5 and e >= 64, or rv <= 0.8 and e >= 200, rv^e <= 2^-64 (pow
+ * is within an ulp of it); then each product the shading rounds is below
+ * c_k 2^-54 when lr_k s <= 512 c_k (three roundings and pow's error fit in
+ * the spare factor 2), and a c_k > 0 is moved by nothing below half its
+ * ulp, which is above c_k 2^-54. NaN and infinite lr or c fail a test. */
+static inline bool phong_specular_negligible(vec3 c, vec3 lr, double s, double rv, double e)
+{
+	if (!(rv <= 0.5 ? e >= 64.0 : rv <= 0.8 && e >= 200.0))
+		return false;
+	return c.x > 0.0 && c.y > 0.0 && c.z > 0.0 && c.x < INFINITY && c.y < INFINITY && c.z < INFINITY &&
+	       fabs(lr.x * s) <= 512.0 * c.x && fabs(lr.y * s) <= 512.0 * c.y && fabs(lr.z * s) <= 512.0 * c.z;
 }
 
 /* The shading point and normal of the Phong family's Whitted shading at

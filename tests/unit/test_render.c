@@ -789,6 +789,110 @@ static void test_write_rendered(void **state)
 	world_free(wd);
 }
 
+
+
+/* phong_specular_negligible says yes only when the highlight, computed as
+ * the shading computes it (pow), leaves c's bits as they are; and it does
+ * say yes for dim highlights on a lit surface (else it saves nothing). By
+ * hand: rv = 0.5, e = 64 gives 2^-64: on c = 1 a highlight of lr s = 1 adds
+ * 2^-64, far below 1's half ulp 2^-53 (yes); on c = 0 anything shows (no);
+ * rv = 0.9 at e = 200 is 7e-10 (no). */
+static void test_specular_negligible(void **state)
+{
+	(void)state;
+	assert_true(phong_specular_negligible(v3(1, 1, 1), v3(1, 1, 1), 1, 0.5, 64));
+	assert_false(phong_specular_negligible(v3(0, 1, 1), v3(1, 1, 1), 1, 0.5, 64));
+	assert_false(phong_specular_negligible(v3(1, 1, 1), v3(1, 1, 1), 1, 0.9, 200));
+	assert_false(phong_specular_negligible(v3(1, NAN, 1), v3(1, 1, 1), 1, 0.5, 64));
+	assert_false(phong_specular_negligible(v3(1, 1, 1), v3(INFINITY, 1, 1), 0, 0.5, 64));
+	test_rng r = {29};
+	int yes = 0;
+	for (int k = 0; k < 200000; k++) {
+		/* c and lr over many magnitudes, rv and e around the thresholds */
+		vec3 c = v3(pow(2, trange(&r, -40, 10)), pow(2, trange(&r, -40, 10)), pow(2, trange(&r, -40, 10)));
+		vec3 lr = v3(pow(2, trange(&r, -30, 20)), pow(2, trange(&r, -30, 20)), pow(2, trange(&r, -30, 20)));
+		double sp = trange(&r, 0, 1), rv = trange(&r, 1e-6, 1), e = trange(&r, 1, 500);
+		if (k % 4 == 0)
+			rv = k % 8 == 0 ? 0.5 : 0.8;
+		if (k % 3 == 0)
+			e = k % 9 == 0 ? 64 : 200;
+		if (!phong_specular_negligible(c, lr, sp, rv, e))
+			continue;
+		yes++;
+		vec3 t = v3_scale(lr, sp * pow(rv, e)), sum = v3_add(c, t);
+		if (!v3_eq(sum, c))
+			fail_msg("c %.17g,%.17g,%.17g + highlight %.17g,%.17g,%.17g (rv %.17g, e %.17g) is not c", c.x, c.y, c.z,
+			         t.x, t.y, t.z, rv, e);
+	}
+	assert_true(yes > 10000);
+}
+
+/* Whitted's packets (render_image: camera rays, then each light's shadow
+ * rays, in packets, and shading with what the packets worked out:
+ * whitted_pre) give each pixel the bits that the single ray's shading,
+ * which works out everything itself (render_sample), gives. Seven lights,
+ * more than the WHITTED_PRE_LIGHTS kept a hit: a sun, a spot, one behind
+ * the floor, one of ratio 0 (no ray), one inside a sphere (blocked), first,
+ * so that lights that reach the picture come past WHITTED_PRE_LIGHTS; and
+ * shiny, mirror and glass spheres, whose second hits are single rays. */
+static void test_packets_equal_single(void **state)
+{
+	(void)state;
+	scene *s = base_scene(v3(0, 3, -8), v3(0, -0.35, 1), 60);
+	s->has_ambient = true;
+	s->amb = (ambient){0.15, v3(255, 230, 200)};
+	light ls[7] = {
+		{.pos = v3(0, -3, 0), .ratio = 0.8, .color = v3(255, 255, 255)}, /* below the floor */
+		{.pos = v3(2, 5, 3), .ratio = 0.0, .color = v3(255, 255, 255)},  /* sends nothing */
+		{.pos = v3(1.5, 0.8, 1), .ratio = 0.5, .color = v3(60, 255, 60)}, /* inside a sphere */
+		{.pos = v3(-5, 6, -4), .ratio = 0.6, .color = v3(255, 255, 255)},
+		{.pos = v3(4, 3, -2), .ratio = 0.4, .color = v3(255, 120, 60)},
+		{.pos = v3(0, 0, 0), .color = v3(200, 200, 255), .kind = LIGHT_SUN, .intensity = 0.3, .dir = v3(1, -2, 1)},
+		{.pos = v3(-2, 6, 0), .color = v3(255, 255, 255), .kind = LIGHT_SPOT, .intensity = 20, .dir = v3(0.2, -1, 0),
+		 .inner = 20, .outer = 35},
+	};
+	for (int i = 0; i < 7; i++)
+		assert_true(scene_add_light(s, &ls[i], NULL));
+	object p = object_make(OBJ_PLANE, v3(200, 200, 200));
+	p.mat.checker = 2;
+	assert_true(scene_add_object(s, &p, NULL));
+	for (int k = 0; k < 9; k++) {
+		object o = sphere(v3(-3 + 1.5 * (k % 5), 0.5 + 0.3 * (k / 5), -1 + 1.5 * (k / 5)), k == 8 ? 2.5 : 1,
+		                  v3(50 + 20 * k, 200 - 15 * k, 120));
+		o.mat.specular = k % 3 == 0 ? 0.8 : 0;
+		o.mat.shininess = 20 + 40 * k;
+		o.mat.reflective = k % 4 == 1 ? 0.6 : 0;
+		o.mat.ior = k == 6 ? 1.5 : 0;
+		if (k == 8)
+			o.pos = v3(1.5, 0.8, 1); /* around light 4 */
+		assert_true(scene_add_object(s, &o, NULL));
+	}
+	world *wd = world_build(s, NULL);
+	assert_non_null(wd);
+	render_settings set = render_settings_default();
+	set.width = 67; /* not a multiple of 4: partial blocks too */
+	set.height = 41;
+	set.samples = 1;
+	set.depth = 3;
+	set.threads = 1;
+	set.mode = MODE_WHITTED;
+	framebuffer *fb = render_image(wd, &set, NULL, NULL, NULL, NULL);
+	assert_non_null(fb);
+	int lit = 0;
+	for (int y = 0; y < set.height; y++)
+		for (int x = 0; x < set.width; x++) {
+			vec3 want = render_sample(wd, &set, x, y, set.width, set.height, 0), got = pixel(fb, x, y);
+			if (got.x != (float)want.x || got.y != (float)want.y || got.z != (float)want.z)
+				fail_msg("pixel %d,%d: packets %.9g,%.9g,%.9g, single ray %.9g,%.9g,%.9g", x, y, got.x, got.y,
+				         got.z, want.x, want.y, want.z);
+			lit += want.x > 0.3;
+		}
+	assert_true(lit > set.width * set.height / 4); /* the lights reach the picture */
+	fb_free(fb);
+	world_free(wd);
+	scene_free(s);
+}
+
 /* A block's camera rays (camera_block_rays, which shares each column's and
  * row's terms for one centred sample through a pinhole) are the rays
  * camera_sample_ray gives pixel by pixel, to the bit: cameras with
@@ -867,6 +971,8 @@ int main(void)
 		cmocka_unit_test(test_image_files),
 		cmocka_unit_test(test_srgb8_in_tiles),
 		cmocka_unit_test(test_block_rays_bits),
+		cmocka_unit_test(test_packets_equal_single),
+		cmocka_unit_test(test_specular_negligible),
 		cmocka_unit_test(test_rows_while_rendering),
 		cmocka_unit_test(test_rows_ring),
 		cmocka_unit_test(test_write_rendered),
