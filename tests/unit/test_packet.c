@@ -24,6 +24,7 @@
 #include <unistd.h>
 
 #include "core/bvh/bvh.h"
+#include "core/prim_hit.h"
 #include "rtsh/generate.h"
 #include "rtsh/mesh.h"
 #include "rtsh/packet.h"
@@ -343,6 +344,111 @@ static void test_ties(void **state)
 			}
 			check_packet(w, r, PACKET_MAX, lamp);
 		}
+	world_free(w);
+	scene_free(s);
+}
+
+/* The leaf of w's tree that holds primitive p: the index of its first
+ * primitive, or -1 when no leaf holds it. */
+static long leaf_of(const world *w, const prim *p)
+{
+	size_t k = (size_t)(p - w->prims);
+	const bvh *t = w->tree;
+	if (t->root_meta & BVH_LEAF)
+		return k < (t->root_meta & ~BVH_LEAF) ? (long)t->root : -1;
+	for (size_t n = 0; n < t->nnodes; n++)
+		for (int c = 0; c < BVH_WIDTH; c++) {
+			uint32_t m = t->nodes[n].meta[c], first = t->nodes[n].child[c];
+			if ((m & BVH_LEAF) && k >= first && k < first + (m & ~BVH_LEAF))
+				return (long)first;
+		}
+	return -1;
+}
+
+/* The world's sphere of centre c and radius r (the test fails when there
+ * is none). */
+static const prim *sphere_at(const world *w, vec3 c, double r)
+{
+	for (size_t i = 0; i < w->nprims; i++)
+		if (w->prims[i].tag == PRIM_SPHERE && v3_len(v3_sub(w->prims[i].u.sph.c, c)) == 0.0 && w->prims[i].u.sph.r == r)
+			return &w->prims[i];
+	fail_msg("no sphere at %g,%g,%g of radius %g", c.x, c.y, c.z, r);
+	return NULL;
+}
+
+/* A tie that the packet meets in the other order than the single ray: the
+ * packet must still keep the single ray's primitive. test_ties' ties lie in
+ * one leaf, which both walks read in the same order; here they lie in two.
+ *
+ * Ray 0 goes from o0 = (-9,-18,18) along d = (1,2,-2) to P = (0,0,0) at
+ * t = 9. Both spheres pass through P, and their centres lie ahead of it:
+ * X at (4,0,-3), radius 5 (|(4,0,-3)| = 5, (4,0,-3) . d = 10 > 0) and Y at
+ * (1,2,-2), radius 3 (|(1,2,-2)| = 3, . d = 9 > 0). With oc = o0 - c, every
+ * step of sphere_hit is exact in integers:
+ *   X: oc = (-13,-18,21), b = -91, c = 934 - 25 = 909, a = 9,
+ *      disc = 8281 - 8181 = 100, q = 101, t = c / q = 909 / 101 = 9;
+ *   Y: oc = (-10,-20,20), b = -90, c = 900 - 9 = 891,
+ *      disc = 8100 - 8019 = 81, q = 99, t = 891 / 99 = 9.
+ * The boxes: X's [-1,9] x [-5,5] x [-8,2], Y's [-2,4] x [-1,5] x [-5,1].
+ * Ray 0 enters X's box at t = max(-1+9, (-5+18)/2, (2-18)/-2) = 8 and Y's at
+ * max(-2+9, (-1+18)/2, (1-18)/-2) = 8.5: alone it meets X first and keeps
+ * it (Y at the same t is not nearer).
+ * The other rays of the packet start inside Y's box with x <= -1.25, before
+ * X's box's low x, and d.x <= 1.5: the packet's interval bound is 0 for Y's
+ * box (on every axis some ray starts past its near plane) and about
+ * 0.25 / 1.5 for X's (on x every origin is before -1), so the packet meets
+ * Y first. Without the test at the next double above ray 0's distance
+ * (next_up2 in leaf_spheres) it would not offer X at all, and without the
+ * tie flag (offer) it would keep Y: both give ray 0 Y's hit record instead
+ * of X's (both checked to fail so). */
+static void test_ties_across_leaves(void **state)
+{
+	(void)state;
+	scene *s;
+	/* Y first, so that the scene's order does not favour X; four smaller
+	 * spheres inside each, of its centre, so that the tree splits the two
+	 * apart (a node of more than 4 spheres is split, and each sphere's
+	 * centroid goes with its own) */
+	world *w = world_of_text("C 0,0,30 0,0,-1 60\nL 3,6,20 0.8 255,255,255\n"
+	                         "sp 1,2,-2 6 255,0,0\nsp 4,0,-3 10 0,0,255\n"
+	                         "sp 1,2,-2 1 255,255,0\nsp 1,2,-2 2 255,255,0\nsp 1,2,-2 3 255,255,0\n"
+	                         "sp 1,2,-2 4 255,255,0\n"
+	                         "sp 4,0,-3 2 0,255,255\nsp 4,0,-3 4 0,255,255\nsp 4,0,-3 6 0,255,255\n"
+	                         "sp 4,0,-3 8 0,255,255\n",
+	                         "ties across leaves", &s);
+	const vec3 o0 = v3(-9, -18, 18), d = v3(1, 2, -2);
+	const ray r0 = {o0, d};
+	const prim *px = sphere_at(w, v3(4, 0, -3), 5), *py = sphere_at(w, v3(1, 2, -2), 3);
+	/* the tie itself: each sphere alone at exactly t = 9 */
+	double t = 0;
+	assert_true(sphere_hit(px, &r0, 0.0, INFINITY, &t));
+	same_double(t, 9.0, "X alone");
+	assert_true(sphere_hit(py, &r0, 0.0, INFINITY, &t));
+	same_double(t, 9.0, "Y alone");
+	/* in two leaves (in one, both walks would read them in one order) */
+	long lx = leaf_of(w, px), ly = leaf_of(w, py);
+	assert_true(lx >= 0 && ly >= 0);
+	assert_true(lx != ly);
+	/* the single ray keeps X, whose box it enters first */
+	trace_hit ts;
+	assert_true(world_trace_coherent(w, &r0, 0.0, INFINITY, &ts));
+	same_double(ts.t, 9.0, "single t");
+	assert_ptr_equal(ts.prim, px);
+	test_rng g = {71};
+	long before = packets;
+	for (int n = 2; n <= PACKET_MAX; n++)
+		for (int j = 0; j < n; j++) {
+			ray r[PACKET_MAX];
+			for (int i = 0; i < n; i++) {
+				/* inside Y's box, x in [-2, -1.25] */
+				vec3 o = v3(-2 + 0.75 * trand(&g), -1 + 6 * trand(&g), -5 + 6 * trand(&g));
+				vec3 di = v3(0.5 + trand(&g), 1 + 2 * trand(&g), -1 - 2 * trand(&g));
+				r[i] = i == j ? r0 : (ray){o, i % 2 ? d : di};
+			}
+			check_packet(w, r, n, w->lights[0].pos);
+			check_records(w, r, n, 1.0, 100.0);
+		}
+	assert_true(packets - before == PACKET_MAX * (PACKET_MAX + 1) / 2 - 1);
 	world_free(w);
 	scene_free(s);
 }
@@ -771,6 +877,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_ties),
+		cmocka_unit_test(test_ties_across_leaves),
 		cmocka_unit_test(test_signed_zero_origins),
 		cmocka_unit_test(test_prepare_edges),
 		cmocka_unit_test(test_scenes),
