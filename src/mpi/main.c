@@ -12,6 +12,7 @@
 #include <errno.h>
 #include <math.h>
 #include <mpi.h>
+#include <pthread.h>
 #include <signal.h>
 #include <stdatomic.h>
 #include <stdint.h>
@@ -376,6 +377,7 @@ static const char *stop_output;
 static rank_id *stop_ids;
 static _Atomic int stop_nids;
 static _Atomic int stop_progress; /* a progress line is open: end it first */
+static _Atomic int stop_written;  /* the image (every frame) is on disk, complete */
 
 static void put(char *buf, size_t *n, size_t cap, const char *s)
 {
@@ -440,7 +442,7 @@ static void on_stop(int sig)
 		                                  "(interrupted, or a rank on another host ended)\n");
 	put(buf, &n, cap, "rtsh-mpi: ");
 	put(buf, &n, cap, stop_output ? stop_output : "the image");
-	put(buf, &n, cap, " not written\n");
+	put(buf, &n, cap, atomic_load(&stop_written) ? " was written and is complete\n" : " not written\n");
 	ssize_t wr = write(STDERR_FILENO, buf, n);
 	(void)wr;
 	signal(sig, SIG_DFL);
@@ -451,6 +453,119 @@ static void on_stop(int sig)
 static const char *host_of(int rank)
 {
 	return stop_ids && rank >= 0 && rank < atomic_load(&stop_nids) ? stop_ids[rank].host : "?";
+}
+
+/* Rank 0: what is on disk so far, for the message when a wait expires
+ * ("" until something is written). */
+static char end_written[4200];
+
+/* The end of a frame and of the job, as messages between rank 0 and each
+ * worker on a communicator of their own (farm_serve's probe never sees
+ * them), so that rank 0 can wait for each with a time limit and name the
+ * rank it waits for: a rank stopped once it has no tile left (SIGSTOP, a
+ * frozen host) is beyond the farm's deadline, and a collective (gather,
+ * broadcast, barrier, MPI_Finalize) would wait for it for ever.
+ *   worker -> 0   END_DONE     int32 frame: done with that frame (turntable)
+ *   0 -> worker   END_GO       int32 frame: the next frame may be asked for
+ *   worker -> 0   END_STATS    its farm_stats, as bytes
+ *   0 -> worker   END_STATUS   int32 the job's exit status
+ *   worker -> 0   END_FIN      int32 0: about to call MPI_Finalize */
+enum { END_DONE = 1, END_GO, END_STATS, END_STATUS, END_FIN };
+static MPI_Comm end_comm = MPI_COMM_NULL;
+static double end_deadline = 30; /* rank 0: RTSH_MPI_DEADLINE */
+
+/* Rank 0: says that a rank did not answer and what was written, and ends
+ * the job with status 1. */
+static void end_late(const char *host, int r, const char *what, double waited)
+{
+	fprintf(stderr,
+	        "rtsh-mpi: rank 0 on %s: rank %d on %s did not %s within %.0f s (stopped, or its host hangs; "
+	        "RTSH_MPI_DEADLINE=%g); %s\n",
+	        host, r, host_of(r), what, waited, end_deadline,
+	        end_written[0] ? end_written : "the image was not written");
+	fflush(stderr);
+	atomic_store(&stop_rank, -1); /* all said: the launcher's SIGTERM ends us quietly */
+	MPI_Abort(MPI_COMM_WORLD, 1);
+}
+
+/* Rank 0: waits for reqs[0..n-1], one for each of the ranks 1..n, sleeping
+ * between tests as wait_for; after end_deadline seconds, names the first
+ * rank whose request is not done (end_late). */
+static void end_wait(MPI_Request *reqs, int n, const char *host, const char *what)
+{
+	double t0 = MPI_Wtime();
+	long nap = 50;
+	int *done = malloc((size_t)(n > 0 ? n : 1) * sizeof *done);
+	for (;;) {
+		int k = 0;
+		MPI_Testsome(n, reqs, &k, done, MPI_STATUSES_IGNORE);
+		if (k == MPI_UNDEFINED) /* every request done (MPI_REQUEST_NULL) */
+			break;
+		if (MPI_Wtime() - t0 > end_deadline) {
+			int r = 1;
+			while (r < n && reqs[r - 1] == MPI_REQUEST_NULL)
+				r++;
+			end_late(host, r, what, MPI_Wtime() - t0);
+		}
+		struct timespec t = {0, nap * 1000};
+		nanosleep(&t, NULL);
+		if (nap < 2000)
+			nap *= 2;
+	}
+	free(done);
+}
+
+/* Rank 0: receives (recv) or sends count bytes at buf + r * stride with
+ * tag from or to every rank r in 1..size-1, within end_deadline. */
+static void end_each(bool recv, char *buf, size_t stride, int count, int tag, int size, const char *host,
+                     const char *what)
+{
+	if (size < 2)
+		return;
+	MPI_Request *reqs = malloc((size_t)(size - 1) * sizeof *reqs);
+	if (!reqs) {
+		fputs("rtsh-mpi: out of memory\n", stderr);
+		MPI_Abort(MPI_COMM_WORLD, 1);
+	}
+	for (int r = 1; r < size; r++) {
+		char *p = buf + (size_t)r * stride;
+		if (recv)
+			MPI_Irecv(p, count, MPI_BYTE, r, tag, end_comm, &reqs[r - 1]);
+		else
+			MPI_Isend(p, count, MPI_BYTE, r, tag, end_comm, &reqs[r - 1]);
+	}
+	end_wait(reqs, size - 1, host, what);
+	free(reqs);
+}
+
+/* A worker: sends or receives count bytes with tag to or from rank 0 (no
+ * time limit: rank 0 has one, and ends the job). */
+static void end_one(bool recv, void *buf, int count, int tag)
+{
+	MPI_Request r;
+	if (recv)
+		MPI_Irecv(buf, count, MPI_BYTE, 0, tag, end_comm, &r);
+	else
+		MPI_Isend(buf, count, MPI_BYTE, 0, tag, end_comm, &r);
+	wait_for(&r);
+}
+
+/* Rank 0, around MPI_Finalize: every rank has said it is about to call it
+ * (END_FIN), but one stopped in between would hold it for ever. This
+ * thread ends the process (status 1; the launcher then ends the rest) if
+ * MPI_Finalize has not returned within the deadline. */
+static char finalize_msg[4400];
+
+static void *finalize_watch(void *arg)
+{
+	(void)arg;
+	struct timespec t = {(time_t)end_deadline, 0};
+	while (nanosleep(&t, &t) != 0 && errno == EINTR)
+		;
+	ssize_t wr = write(STDERR_FILENO, finalize_msg, strlen(finalize_msg));
+	(void)wr;
+	_exit(1);
+	return NULL;
 }
 
 /* The tile side when RTSH_MPI_TILE does not set one: 32 pixels, halved
@@ -471,6 +586,13 @@ static void die(int rank, const char *host, const char *what, const rt_error *er
 	char msg[MSG_MAX];
 	rt_error_format(err, msg, sizeof msg);
 	fprintf(stderr, "rtsh-mpi: rank %d on %s: %s%s%s\n", rank, host, what, *what ? ": " : "", msg);
+	if (rank == 0) {
+		/* --turntable: the frames kept so far; then all is said, and the
+		 * launcher's SIGTERM ends rank 0 quietly */
+		if (end_written[0])
+			fprintf(stderr, "rtsh-mpi: %s\n", end_written);
+		atomic_store(&stop_rank, -1);
+	}
 	fflush(stderr);
 	MPI_Abort(MPI_COMM_WORLD, 1);
 }
@@ -514,6 +636,7 @@ int main(int argc, char **argv)
 	MPI_Comm_rank(MPI_COMM_WORLD, &rank);
 	atomic_store(&stop_rank, rank);
 	MPI_Comm_size(MPI_COMM_WORLD, &size);
+	MPI_Comm_dup(MPI_COMM_WORLD, &end_comm);
 	char host[64] = "?";
 	int hl;
 	char name[MPI_MAX_PROCESSOR_NAME];
@@ -623,6 +746,7 @@ int main(int argc, char **argv)
 		rt_error_set(&err, "RTSH_MPI_DEADLINE is not valid");
 		die(rank, host, "", &err);
 	}
+	end_deadline = (double)deadline;
 	farm_opts fo = {
 		.deadline = (double)deadline,
 		.host = host_of,
@@ -660,26 +784,48 @@ int main(int argc, char **argv)
 				die(rank, host, "", &err);
 			}
 		}
-		if (frames > 1) {
-			/* every rank done with this frame before any asks for tiles
-			 * of the next: rank 0 serves one frame at a time */
-			MPI_Request b;
-			MPI_Ibarrier(MPI_COMM_WORLD, &b);
-			wait_for(&b);
-		}
 		if (rank == 0 && frames > 0 && status == 0) {
+			/* the frame is kept before any wait for the others */
 			char fname[4096];
 			if (g) {
 				if (!gif_add_linear(g, fb->rgb, c.set.exposure)) {
 					fputs("rtsh-mpi: out of memory for the GIF\n", stderr);
 					status = 1;
 				}
-			} else if (turntable_name(output, k, fname, sizeof fname) &&
-			           !image_write(fname, fb, c.set.exposure, &err)) {
-				char msg[MSG_MAX];
-				rt_error_format(&err, msg, sizeof msg);
-				fprintf(stderr, "%s\n", msg);
-				status = 1;
+			} else if (turntable_name(output, k, fname, sizeof fname)) {
+				if (!image_write(fname, fb, c.set.exposure, &err)) {
+					char msg[MSG_MAX];
+					rt_error_format(&err, msg, sizeof msg);
+					fprintf(stderr, "%s\n", msg);
+					status = 1;
+				} else {
+					snprintf(end_written, sizeof end_written,
+					         "%d of %d frames were written (the last %s), the others not", k + 1,
+					         frames, fname);
+				}
+			}
+		}
+		if (frames > 1 && k + 1 < frames) {
+			/* every rank done with this frame before any asks for tiles
+			 * of the next: rank 0 serves one frame at a time */
+			int32_t fk = k;
+			if (rank == 0) {
+				int32_t *each = calloc((size_t)size, sizeof *each);
+				if (!each) {
+					rt_error_set(&err, "out of memory");
+					die(rank, host, "", &err);
+				}
+				char what[64];
+				snprintf(what, sizeof what, "end frame %d of %d", k + 1, frames);
+				end_each(true, (char *)each, sizeof *each, (int)sizeof *each, END_DONE, size, host, what);
+				for (int r = 0; r < size; r++)
+					each[r] = fk;
+				end_each(false, (char *)each, sizeof *each, (int)sizeof *each, END_GO, size, host,
+				         "take the next frame");
+				free(each);
+			} else {
+				end_one(false, &fk, (int)sizeof fk, END_DONE);
+				end_one(true, &fk, (int)sizeof fk, END_GO);
 			}
 		}
 	}
@@ -691,9 +837,10 @@ int main(int argc, char **argv)
 	if (rank == 0)
 		st.bytes += (double)c.files * (size > 1);
 	world_free(w);
-	farm_stats *all = rank == 0 ? calloc((size_t)size, sizeof *all) : NULL;
-	gather(&st, all, (int)sizeof st);
-
+	/* The end of the job: rank 0 writes the image first, then waits, each
+	 * wait with a time limit (end_each), for every rank's figures, gives
+	 * the exit status and hears that each rank is about to end. */
+	farm_stats *all = NULL;
 	if (rank == 0) {
 		double rendered = MPI_Wtime() - t0;
 		if (status == 0 && g && !gif_save(g, output, &err)) {
@@ -701,26 +848,76 @@ int main(int argc, char **argv)
 			rt_error_format(&err, msg, sizeof msg);
 			fprintf(stderr, "%s\n", msg);
 			status = 1;
+		} else if (status == 0 && g) {
+			snprintf(end_written, sizeof end_written, "%s was written and is complete, but the job did "
+			         "not end cleanly", output);
+			atomic_store(&stop_written, 1);
 		}
 		if (frames == 0 && !image_write(output, fb, c.set.exposure, &err)) {
 			char msg[MSG_MAX];
 			rt_error_format(&err, msg, sizeof msg);
 			fprintf(stderr, "%s\n", msg);
 			status = 1;
+		} else if (frames == 0) {
+			snprintf(end_written, sizeof end_written, "%s was written and is complete, but the job did "
+			         "not end cleanly", output);
+			atomic_store(&stop_written, 1);
+		} else if (!g && status == 0) {
+			snprintf(end_written, sizeof end_written, "all %d frames were written (%s...) and are "
+			         "complete, but the job did not end cleanly", frames, output);
+			atomic_store(&stop_written, 1);
 		}
-		if (c.verbose && all)
+		all = calloc((size_t)size, sizeof *all);
+		if (!all) {
+			fputs("rtsh-mpi: out of memory\n", stderr);
+			MPI_Abort(MPI_COMM_WORLD, 1);
+		}
+		all[0] = st;
+		end_each(true, (char *)all, sizeof *all, (int)sizeof *all, END_STATS, size, host,
+		         "send its figures at the end of the job");
+		if (c.verbose)
 			print_figures(all, size, &c, rendered);
+		int32_t *each = calloc((size_t)size, sizeof *each);
+		if (!each) {
+			fputs("rtsh-mpi: out of memory\n", stderr);
+			MPI_Abort(MPI_COMM_WORLD, 1);
+		}
+		for (int r = 0; r < size; r++)
+			each[r] = status;
+		end_each(false, (char *)each, sizeof *each, (int)sizeof *each, END_STATUS, size, host,
+		         "take the exit status");
+		end_each(true, (char *)each, sizeof *each, (int)sizeof *each, END_FIN, size, host,
+		         "end (after the exit status)");
+		free(each);
+		/* said once every rank has said it ends */
 		if (status == 0 && c.progress)
 			fprintf(stderr, "wrote %s (%dx%d, %d samples, %s) on %d ranks in %.2fs\n", output,
 			        c.set.width, c.set.height, c.set.samples, render_mode_name(c.set.mode), size,
 			        MPI_Wtime() - t0);
+	} else {
+		end_one(false, &st, (int)sizeof st, END_STATS);
+		int32_t s32 = 0;
+		end_one(true, &s32, (int)sizeof s32, END_STATUS);
+		status = s32;
+		int32_t fin = 0;
+		end_one(false, &fin, (int)sizeof fin, END_FIN);
 	}
 	free(all);
 	gif_free(g);
 	atomic_store(&stop_nids, 0);
-	free(ids);
 	fb_free(fb);
-	bcast(&status, 1, MPI_INT);
+	if (rank == 0) {
+		/* every rank is about to end; one stopped before MPI_Finalize
+		 * would still hold it: finalize_watch */
+		snprintf(finalize_msg, sizeof finalize_msg,
+		         "rtsh-mpi: rank 0 on %s: a rank did not end within %.0f s (stopped, or its host hangs; "
+		         "RTSH_MPI_DEADLINE=%g); %s\n",
+		         host, end_deadline, end_deadline, end_written[0] ? end_written : "the image was not written");
+		pthread_t tid;
+		if (pthread_create(&tid, NULL, finalize_watch, NULL) == 0)
+			pthread_detach(tid);
+	}
+	free(ids);
 	atomic_store(&stop_rank, -1); /* all said: the launcher may stop us quietly */
 	MPI_Finalize();
 	return status;
