@@ -10,6 +10,9 @@
  *   - a scene of ties: two spheres in one place, cubes sharing a face, two
  *     triangles sharing an edge, a sphere resting on a plane, with rays aimed
  *     exactly at the shared edge, the corners and the point of contact;
+ *   - ties that the packet meets in the other order than the single ray:
+ *     a sphere and another sphere or a model in two leaves, both at exactly
+ *     t = 9 on one ray, whose packets start inside the second one's box;
  *   - a lone model's own packets (mesh_intersect_world_packet) against
  *     its single rays, the slot and barycentrics too, each ray to its own
  *     tmax: the bunny, the fence's cut-outs, spot turned over two planes,
