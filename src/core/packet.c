@@ -80,14 +80,14 @@ static inline double next_up(double t)
  * hit so far is at t: that walk tests its float distances strictly against
  * its bound rounded to a float, so next_up(t) rounds back to t where t is a
  * float (another model's distance, or a sphere's that is one) and a
- * triangle at exactly t is not seen. The float above a float >= t lets it
- * through; what else it lets through, beyond t, offer drops. */
+ * triangle at exactly t is not seen. t (1 + 2^-23) is not: for a normal
+ * float F <= t, F 2^-23 is at least F's step to the next float, so the
+ * bound, rounded to a float or not, lies above every float <= t (exact
+ * when t is a float; rounding is monotonic otherwise). What else it lets
+ * through, beyond t, offer drops. (+inf stays +inf.) */
 static inline double model_bound(double t)
 {
-	if (!(t < INFINITY))
-		return t;
-	float f = to_float_up(t);
-	return (double)(f + (fabsf(f) * 0x1p-23f + 0x1p-149f)); /* (FLT_MAX: inf) */
+	return t * (1.0 + 0x1p-23);
 }
 
 /* One axis's components d of two rays into the packet's lowest, highest,
