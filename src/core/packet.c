@@ -76,6 +76,20 @@ static inline double next_up(double t)
 	return t;
 }
 
+/* The bound to give a model's walk (mesh_trace.c) for a ray whose nearest
+ * hit so far is at t: that walk tests its float distances strictly against
+ * its bound rounded to a float, so next_up(t) rounds back to t where t is a
+ * float (another model's distance, or a sphere's that is one) and a
+ * triangle at exactly t is not seen. t (1 + 2^-23) is not: for a normal
+ * float F <= t, F 2^-23 is at least F's step to the next float, so the
+ * bound, rounded to a float or not, lies above every float <= t (exact
+ * when t is a float; rounding is monotonic otherwise). What else it lets
+ * through, beyond t, offer drops. (+inf stays +inf.) */
+static inline double model_bound(double t)
+{
+	return t * (1.0 + 0x1p-23);
+}
+
 /* One axis's components d of two rays into the packet's lowest, highest,
  * all its bits ANDed and ORed (packet_prepare). */
 static inline void axis_extremes(__m128d d, __m128d *lo, __m128d *hi, __m128d *all, __m128d *any)
@@ -369,10 +383,10 @@ static void leaf_spheres(pk_state *s, const prim *p, double tmin)
 }
 
 /* The rays of s meet a model among the objects (a mesh instance in a leaf)
- * as a packet through its own triangle tree: each ray to the next double
- * above its nearest so far, as offer expects, and a ray the model's packet
- * found a tie for meets it again alone. False when the model's packet is
- * not traced (the caller tests ray by ray). */
+ * as a packet through its own triangle tree: each ray to model_bound of its
+ * nearest so far, so that offer sees a triangle at exactly that distance,
+ * and a ray the model's packet found a tie for meets it again alone. False
+ * when the model's packet is not traced (the caller tests ray by ray). */
 static bool leaf_mesh(const world *w, pk_state *s, const prim *p, const ray *r, double tmin)
 {
 	const prim_inst *in = &w->insts[p->u.index];
@@ -381,7 +395,7 @@ static bool leaf_mesh(const world *w, pk_state *s, const prim *p, const ray *r, 
 	float b[PACKET_MAX][3];
 	unsigned got, tie;
 	for (int i = 0; i < s->n; i++)
-		tm[i] = next_up(s->tmax[i]);
+		tm[i] = model_bound(s->tmax[i]);
 	if (!mesh_intersect_world_packet(in->mesh, in->inv, s->n, r, tmin, 0.0, tm, t, slot, b, &got, &tie))
 		return false;
 	for (unsigned g = got & ~tie; g; g &= g - 1) {
@@ -435,7 +449,8 @@ static void packet_walk(const world *w, pk_state *s, const ray *r, const pk_ray 
 				for (int i = 0; i < s->n; i++) {
 					double t;
 					vec3 nl = {0, 0, 0};
-					if (world_prim_hit(w, &p[k], &r[i], tmin, next_up(s->tmax[i]), &t, &nl, true))
+					double tm = p[k].tag == PRIM_MESH ? model_bound(s->tmax[i]) : next_up(s->tmax[i]);
+					if (world_prim_hit(w, &p[k], &r[i], tmin, tm, &t, &nl, true))
 						offer(s, i, &p[k], t, nl, false);
 				}
 			}

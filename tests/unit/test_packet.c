@@ -10,6 +10,9 @@
  *   - a scene of ties: two spheres in one place, cubes sharing a face, two
  *     triangles sharing an edge, a sphere resting on a plane, with rays aimed
  *     exactly at the shared edge, the corners and the point of contact;
+ *   - ties that the packet meets in the other order than the single ray:
+ *     a sphere and another sphere or a model in two leaves, both at exactly
+ *     t = 9 on one ray, whose packets start inside the second one's box;
  *   - a lone model's own packets (mesh_intersect_world_packet) against
  *     its single rays, the slot and barycentrics too, each ray to its own
  *     tmax: the bunny, the fence's cut-outs, spot turned over two planes,
@@ -788,6 +791,92 @@ static void test_model_ties(void **state)
 	}
 }
 
+/* test_ties_across_leaves with a model for X: the packet meets the model
+ * as a packet of its own (leaf_mesh), each ray up to the next double above
+ * its distance so far, where the model's triangle at exactly that distance
+ * is a tie. The model is two triangles, T1 (-1,-2,0) (3,-2,0) (-1,2,0),
+ * which holds P = (0,0,0) inside (x + y < 1), and T2 (3,2,2) (2,2,2)
+ * (3,1,2), off every ray 0 reaches, that makes its box [-1,3] x [-2,2] x
+ * [0,2]: longest side 4, centre (1,0,1), so that placed there at size 4
+ * its coordinates are the world's. Ray 0 (from (-9,-18,18) along (1,2,-2))
+ * runs down z, the largest |d| (z before y on a tie): the shear
+ * constants -1/2, -1 and 1/2 in magnitude are exact, T1's sheared corners
+ * are its own x and y (az = -18 cancels o's x and y), its edge functions
+ * integers summing to 2 x its area, 16, and t = (9 x 16) / 16 = 9 exactly in
+ * float. Ray 0 enters the model's box at t = max(-1+9, (-2+18)/2,
+ * (2-18)/-2) = 8, Y's at 8.5: alone it keeps the model. The others start in
+ * Y's box with x <= -1.25, before the model's low x: the packet meets Y
+ * first. On every vector unit (the model's own packets where there are
+ * some, the generic leaf loop elsewhere): with next_up(9) for bound, which
+ * the model's walk rounds back to 9.0f and tests strictly, both missed the
+ * tie and gave ray 0 Y (packet.c's model_bound). */
+static void test_mesh_tie_across_leaves(void **state)
+{
+	(void)state;
+	char path[] = "/tmp/rtsh-test-packet-XXXXXX.obj";
+	int fd = mkstemps(path, 4);
+	assert_true(fd >= 0);
+	FILE *f = fdopen(fd, "w");
+	assert_non_null(f);
+	/* (x mirrored: model files are right-handed, the scene left-handed) */
+	fprintf(f, "v 1 -2 0\nv -3 -2 0\nv 1 2 0\nv -3 2 2\nv -2 2 2\nv -3 1 2\nf 1 2 3\nf 4 5 6\n");
+	assert_int_equal(fclose(f), 0);
+	char text[512];
+	/* Y and four spheres inside it, of its centre: the tree puts the model
+	 * in a leaf of its own */
+	snprintf(text, sizeof text,
+	         "C 0,0,30 0,0,-1 60\nL 3,6,20 0.8 255,255,255\n"
+	         "sp 1,2,-2 6 255,0,0\nmesh %s 1,0,1 0,1,0 4 0,0,255\n"
+	         "sp 1,2,-2 1 255,255,0\nsp 1,2,-2 2 255,255,0\nsp 1,2,-2 3 255,255,0\nsp 1,2,-2 4 255,255,0\n",
+	         path);
+	scene *s;
+	world *w = world_of_text(text, "mesh tie across leaves", &s);
+	unlink(path);
+	const vec3 o0 = v3(-9, -18, 18), d = v3(1, 2, -2);
+	const ray r0 = {o0, d};
+	const prim *py = sphere_at(w, v3(1, 2, -2), 3), *pm = NULL;
+	for (size_t i = 0; i < w->nprims; i++)
+		if (w->prims[i].tag == PRIM_MESH)
+			pm = &w->prims[i];
+	assert_non_null(pm);
+	const prim_inst *in = &w->insts[pm->u.index];
+	long lm = leaf_of(w, pm), ly = leaf_of(w, py);
+	assert_true(lm >= 0 && ly >= 0);
+	assert_true(lm != ly);
+	for (int isa = MESH_ISA_SCALAR; isa <= MESH_ISA_BEST; isa++) {
+		if (!mesh_isa_force((mesh_isa)isa))
+			continue;
+		/* the tie itself: each alone at exactly t = 9 */
+		double t = 0;
+		uint32_t slot;
+		float b[3];
+		assert_true(sphere_hit(py, &r0, 0.0, INFINITY, &t));
+		same_double(t, 9.0, "Y alone");
+		assert_true(mesh_intersect_world_coherent(in->mesh, in->inv, &r0, 0.0, INFINITY, &t, &slot, b));
+		same_double(t, 9.0, "the model alone");
+		/* the single ray keeps the model, whose box it enters first */
+		trace_hit ts;
+		assert_true(world_trace_coherent(w, &r0, 0.0, INFINITY, &ts));
+		same_double(ts.t, 9.0, "single t");
+		assert_ptr_equal(ts.prim, pm);
+		test_rng g = {73 + (uint64_t)isa};
+		for (int n = 2; n <= PACKET_MAX; n++)
+			for (int j = 0; j < n; j++) {
+				ray r[PACKET_MAX];
+				for (int i = 0; i < n; i++) {
+					vec3 o = v3(-2 + 0.75 * trand(&g), -1 + 6 * trand(&g), -5 + 6 * trand(&g));
+					vec3 di = v3(0.5 + trand(&g), 1 + 2 * trand(&g), -1 - 2 * trand(&g));
+					r[i] = i == j ? r0 : (ray){o, i % 2 ? d : di};
+				}
+				check_packet(w, r, n, w->lights[0].pos);
+				check_records(w, r, n, 1.0, 100.0);
+			}
+	}
+	assert_true(mesh_isa_force(MESH_ISA_BEST));
+	world_free(w);
+	scene_free(s);
+}
+
 /* Packets of which every ray but one passes far from the model (beside
  * the sphere about its box, which lets a packet skip the walk when all its
  * rays pass outside) and the one, in each lane in turn, meets it: the
@@ -884,6 +973,7 @@ int main(void)
 		cmocka_unit_test(test_split_shadows),
 		cmocka_unit_test(test_bunny),
 		cmocka_unit_test(test_model_ties),
+		cmocka_unit_test(test_mesh_tie_across_leaves),
 		cmocka_unit_test(test_model_packets),
 		cmocka_unit_test(test_model_cull),
 	};
