@@ -496,6 +496,10 @@ static void end_wait(MPI_Request *reqs, int n, const char *host, const char *wha
 	double t0 = MPI_Wtime();
 	long nap = 50;
 	int *done = malloc((size_t)(n > 0 ? n : 1) * sizeof *done);
+	if (!done) {
+		fputs("rtsh-mpi: out of memory\n", stderr);
+		MPI_Abort(MPI_COMM_WORLD, 1);
+	}
 	for (;;) {
 		int k = 0;
 		MPI_Testsome(n, reqs, &k, done, MPI_STATUSES_IGNORE);
