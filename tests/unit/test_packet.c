@@ -379,6 +379,25 @@ static const prim *sphere_at(const world *w, vec3 c, double r)
 	return NULL;
 }
 
+/* Packets of 2 to PACKET_MAX rays with the tie ray r0 in each lane in
+ * turn; the others start inside Y's box (x in [-2, -1.25]), every other one
+ * along d: the packet reaches Y's leaf before X's, where the single ray
+ * meets X first. Each against the single rays (hits and records). */
+static void tie_packets(const world *w, ray r0, vec3 d, test_rng *g)
+{
+	for (int n = 2; n <= PACKET_MAX; n++)
+		for (int j = 0; j < n; j++) {
+			ray r[PACKET_MAX];
+			for (int i = 0; i < n; i++) {
+				vec3 o = v3(-2 + 0.75 * trand(g), -1 + 6 * trand(g), -5 + 6 * trand(g));
+				vec3 di = v3(0.5 + trand(g), 1 + 2 * trand(g), -1 - 2 * trand(g));
+				r[i] = i == j ? r0 : (ray){o, i % 2 ? d : di};
+			}
+			check_packet(w, r, n, w->lights[0].pos);
+			check_records(w, r, n, 1.0, 100.0);
+		}
+}
+
 /* A tie that the packet meets in the other order than the single ray: the
  * packet must still keep the single ray's primitive. test_ties' ties lie in
  * one leaf, which both walks read in the same order; here they lie in two.
@@ -439,18 +458,7 @@ static void test_ties_across_leaves(void **state)
 	assert_ptr_equal(ts.prim, px);
 	test_rng g = {71};
 	long before = packets;
-	for (int n = 2; n <= PACKET_MAX; n++)
-		for (int j = 0; j < n; j++) {
-			ray r[PACKET_MAX];
-			for (int i = 0; i < n; i++) {
-				/* inside Y's box, x in [-2, -1.25] */
-				vec3 o = v3(-2 + 0.75 * trand(&g), -1 + 6 * trand(&g), -5 + 6 * trand(&g));
-				vec3 di = v3(0.5 + trand(&g), 1 + 2 * trand(&g), -1 - 2 * trand(&g));
-				r[i] = i == j ? r0 : (ray){o, i % 2 ? d : di};
-			}
-			check_packet(w, r, n, w->lights[0].pos);
-			check_records(w, r, n, 1.0, 100.0);
-		}
+	tie_packets(w, r0, d, &g);
 	assert_true(packets - before == PACKET_MAX * (PACKET_MAX + 1) / 2 - 1);
 	world_free(w);
 	scene_free(s);
@@ -860,17 +868,7 @@ static void test_mesh_tie_across_leaves(void **state)
 		same_double(ts.t, 9.0, "single t");
 		assert_ptr_equal(ts.prim, pm);
 		test_rng g = {73 + (uint64_t)isa};
-		for (int n = 2; n <= PACKET_MAX; n++)
-			for (int j = 0; j < n; j++) {
-				ray r[PACKET_MAX];
-				for (int i = 0; i < n; i++) {
-					vec3 o = v3(-2 + 0.75 * trand(&g), -1 + 6 * trand(&g), -5 + 6 * trand(&g));
-					vec3 di = v3(0.5 + trand(&g), 1 + 2 * trand(&g), -1 - 2 * trand(&g));
-					r[i] = i == j ? r0 : (ray){o, i % 2 ? d : di};
-				}
-				check_packet(w, r, n, w->lights[0].pos);
-				check_records(w, r, n, 1.0, 100.0);
-			}
+		tie_packets(w, r0, d, &g);
 	}
 	assert_true(mesh_isa_force(MESH_ISA_BEST));
 	world_free(w);
