@@ -580,6 +580,17 @@ static void bench_packets(void)
 	scene_free(s);
 }
 
+/* The spheres-N rows' scene: scene_generate(n, 1) with spheres only. */
+static scene *gen_spheres(size_t n)
+{
+	gen_opts o = {.spheres_only = true};
+	rt_error err;
+	scene *s = scene_generate(n, 1, &o, &err);
+	if (!s)
+		fail("generate", &err);
+	return s;
+}
+
 /* Embree 3's build of the spheres-N scene (bench/embree_build): seconds, or
  * < 0 when the harness is absent or fails; its bytes in *bytes. */
 static double run_embree_build(size_t n, double *bytes)
@@ -615,11 +626,7 @@ static void bench_spheres(void)
 	double base = -1;
 	for (int k = 0; k < nsizes; k++) {
 		size_t n = sizes[k];
-		gen_opts o = {.spheres_only = true};
-		rt_error err;
-		scene *s = scene_generate(n, 1, &o, &err);
-		if (!s)
-			fail("generate", &err);
+		scene *s = gen_spheres(n);
 		char name[48];
 		snprintf(name, sizeof name, "spheres-%zu", n);
 		/* world_build: the BVH rebuild after an edit, on one core */
@@ -712,11 +719,7 @@ static void bench_sphere_rays(void)
 	double cam[2], sh[2], ecam[2] = {-1, -1}, esh1[2] = {-1, -1}, esh[2] = {-1, -1};
 	for (int k = 0; k < 2; k++) {
 		size_t n = sizes[k];
-		gen_opts o = {.spheres_only = true};
-		rt_error err;
-		scene *s = scene_generate(n, 1, &o, &err);
-		if (!s)
-			fail("generate", &err);
+		scene *s = gen_spheres(n);
 		world *wd = build(s);
 		double tc[MAX_RUNS], ts[MAX_RUNS];
 		long ns = 0;
@@ -731,6 +734,7 @@ static void bench_sphere_rays(void)
 		int fd = quick ? -1 : mkstemp(path);
 		if (fd >= 0) {
 			close(fd);
+			rt_error err;
 			if (!rt_save(s, path, &err))
 				fail("save", &err);
 			if (!run_embree_rays(path, w, h, &ecam[k], &esh1[k], &esh[k], &eblocked))
@@ -752,7 +756,7 @@ static void bench_sphere_rays(void)
 		world_free(wd);
 		scene_free(s);
 	}
-	row *r = add_row("spheres 1M/1k", "rays-ratio", w, h, 1, 1, runs, -1, -1);
+	row *r = add_row(quick ? "spheres 1k/10" : "spheres 1M/1k", "rays-ratio", w, h, 1, 1, runs, -1, -1);
 	snprintf(r->note, sizeof r->note, "time a ray at %zu over %zu spheres: rtsh camera %.2fx, shadow %.2fx", sizes[1],
 	         sizes[0], cam[0] / cam[1], sh[0] / sh[1]);
 	if (ecam[0] > 0 && ecam[1] > 0)
@@ -765,11 +769,8 @@ static void bench_sphere_rays(void)
 static void bench_load(void)
 {
 	size_t n = quick ? 10000 : 1000000;
-	gen_opts o = {.spheres_only = true};
 	rt_error err;
-	scene *s = scene_generate(n, 1, &o, &err);
-	if (!s)
-		fail("generate", &err);
+	scene *s = gen_spheres(n);
 	char path[] = "/tmp/rtsh-bench-XXXXXX";
 	int fd = mkstemp(path);
 	if (fd < 0)
