@@ -11,7 +11,8 @@
  *     same rays when bench/embree_primary was built;
  *   generated spheres-only scenes of 10, 1k, 100k and 1M spheres at one view,
  *     1 and 2 threads; their world_build time and memory per object; the
- *     load time of the 1M scene saved as .rt;
+ *     rays alone at 1k and 1M (camera and shadow packets) beside Embree's;
+ *     the load time of the 1M scene saved as .rt;
  *   the Whitted preview frame (160x96 pixels, showcase.rt) and the bytes of
  *     the terminal frame that shows it;
  *   key mode (`view`): the time from a key to the first updated frame on
@@ -476,11 +477,13 @@ static void bench_primary(void)
  * answers. Returns the seconds of the camera rays; *shadow_sec those of
  * the shadow rays (the camera rays' time for them not counted), *nshadow
  * their count. */
+static long packet_blocked; /* packet_pass's last count of blocked shadow rays */
+
 static double packet_pass(const world *wd, int w, int h, bool packet, int bw, int bh, double *shadow_sec,
                           long *nshadow)
 {
 	double tc = 0, ts = 0;
-	long ns = 0;
+	long ns = 0, nblocked = 0;
 	vec3 lamp = wd->nlights ? wd->lights[0].pos : v3(0, 10, 0);
 	int nb = (w + bw - 1) / bw;
 	ray *sr = malloc((size_t)nb * PACKET_MAX * sizeof *sr);
@@ -527,6 +530,8 @@ static double packet_pass(const world *wd, int w, int h, bool packet, int bw, in
 			else
 				for (int i = 0; i < cnt[b]; i++)
 					occ[i] = world_occluded(wd, &q[i], 0.0, d[i]);
+			for (int i = 0; i < cnt[b]; i++)
+				nblocked += occ[i];
 		}
 		ts += now() - t1;
 		tc += t1 - t0;
@@ -536,6 +541,7 @@ static double packet_pass(const world *wd, int w, int h, bool packet, int bw, in
 	free(cnt);
 	*shadow_sec = ts;
 	*nshadow = ns;
+	packet_blocked = nblocked;
 	return tc;
 }
 
@@ -574,6 +580,17 @@ static void bench_packets(void)
 	scene_free(s);
 }
 
+/* The spheres-N rows' scene: scene_generate(n, 1) with spheres only. */
+static scene *gen_spheres(size_t n)
+{
+	gen_opts o = {.spheres_only = true};
+	rt_error err;
+	scene *s = scene_generate(n, 1, &o, &err);
+	if (!s)
+		fail("generate", &err);
+	return s;
+}
+
 /* Embree 3's build of the spheres-N scene (bench/embree_build): seconds, or
  * < 0 when the harness is absent or fails; its bytes in *bytes. */
 static double run_embree_build(size_t n, double *bytes)
@@ -609,11 +626,7 @@ static void bench_spheres(void)
 	double base = -1;
 	for (int k = 0; k < nsizes; k++) {
 		size_t n = sizes[k];
-		gen_opts o = {.spheres_only = true};
-		rt_error err;
-		scene *s = scene_generate(n, 1, &o, &err);
-		if (!s)
-			fail("generate", &err);
+		scene *s = gen_spheres(n);
 		char name[48];
 		snprintf(name, sizeof name, "spheres-%zu", n);
 		/* world_build: the BVH rebuild after an edit, on one core */
@@ -664,15 +677,100 @@ static void bench_spheres(void)
 	fb_free(fb);
 }
 
+/* Embree's lines "packet 16 mrays M", "shadow mrays M" and "shadow-packet
+ * 16 mrays M ... blocked B" for the scene at path (bench/embree_primary):
+ * false when the harness is absent or fails. */
+static bool run_embree_rays(const char *path, int w, int h, double *cam16, double *shadow1, double *shadow16,
+                            long *blocked)
+{
+	char exe[512], cmd[1200];
+	snprintf(exe, sizeof exe, "%s/embree_primary", bench_dir);
+	if (access(exe, X_OK) != 0)
+		return false;
+	snprintf(cmd, sizeof cmd, "%s %s %d %d 2>&1", exe, path, w, h);
+	FILE *p = popen(cmd, "r");
+	if (!p)
+		return false;
+	char line[256];
+	*cam16 = *shadow1 = *shadow16 = -1;
+	while (fgets(line, sizeof line, p)) {
+		double m, sec;
+		if (sscanf(line, "packet 16 mrays %lf", &m) == 1)
+			*cam16 = m;
+		else if (sscanf(line, "shadow mrays %lf", &m) == 1)
+			*shadow1 = m;
+		else if (sscanf(line, "shadow-packet 16 mrays %lf seconds %lf blocked %ld", &m, &sec, blocked) == 3)
+			*shadow16 = m;
+	}
+	return pclose(p) == 0 && *cam16 > 0 && *shadow1 > 0 && *shadow16 > 0;
+}
+
+/* The rays alone at 1k and 1M spheres (the spheres-N scenes, 1 thread):
+ * camera rays in 4x4 packets and shadow rays from their hits toward the
+ * first light (packet_pass), beside Embree's rtcIntersect16 and
+ * rtcOccluded1/16 on the same rays (embree_primary, from the scene saved
+ * as .rt), so that the spheres rows' "Nx the 1k time" can be read against
+ * what the 1M tree costs Embree's walks too. */
+static void bench_sphere_rays(void)
+{
+	static const size_t full[] = {1000, 1000000}, small[] = {10, 1000};
+	const size_t *sizes = quick ? small : full;
+	int w = quick ? 320 : 1920, h = quick ? 180 : 1080;
+	double cam[2], sh[2], ecam[2] = {-1, -1}, esh1[2] = {-1, -1}, esh[2] = {-1, -1};
+	for (int k = 0; k < 2; k++) {
+		size_t n = sizes[k];
+		scene *s = gen_spheres(n);
+		world *wd = build(s);
+		double tc[MAX_RUNS], ts[MAX_RUNS];
+		long ns = 0;
+		packet_pass(wd, w, h, true, 4, 4, &ts[0], &ns); /* warm up */
+		for (int i = 0; i < runs; i++)
+			tc[i] = packet_pass(wd, w, h, true, 4, 4, &ts[i], &ns);
+		long blocked = packet_blocked, eblocked = -1;
+		cam[k] = (double)w * h * 1e-6 / median(tc, runs);
+		sh[k] = (double)ns * 1e-6 / median(ts, runs);
+		char name[48], path[] = "/tmp/rtsh-bench-XXXXXX";
+		snprintf(name, sizeof name, "spheres-%zu", n);
+		int fd = quick ? -1 : mkstemp(path);
+		if (fd >= 0) {
+			close(fd);
+			rt_error err;
+			if (!rt_save(s, path, &err))
+				fail("save", &err);
+			if (!run_embree_rays(path, w, h, &ecam[k], &esh1[k], &esh[k], &eblocked))
+				ecam[k] = esh1[k] = esh[k] = -1;
+			unlink(path);
+		}
+		row *r = add_row(name, "primary-packet16", w, h, 1, 1, runs, median(tc, runs), cam[k]);
+		snprintf(r->note, sizeof r->note, "camera rays alone, 4x4 packets");
+		if (ecam[k] > 0)
+			snprintf(r->note + strlen(r->note), sizeof r->note - strlen(r->note),
+			         "; Embree rtcIntersect16 %.2f Mrays/s: rtsh %.2fx", ecam[k], cam[k] / ecam[k]);
+		r = add_row(name, "shadow-packet", w, h, 1, 1, runs, median(ts, runs), sh[k]);
+		snprintf(r->note, sizeof r->note, "%ld rays to light 1, %.0f%% blocked", ns,
+		         100.0 * (double)blocked / (double)(ns > 0 ? ns : 1));
+		if (esh[k] > 0)
+			snprintf(r->note + strlen(r->note), sizeof r->note - strlen(r->note),
+			         "; Embree rtcOccluded16 %.2f, rtcOccluded1 %.2f Mrays/s (%ld blocked)", esh[k], esh1[k],
+			         eblocked);
+		world_free(wd);
+		scene_free(s);
+	}
+	row *r = add_row(quick ? "spheres 1k/10" : "spheres 1M/1k", "rays-ratio", w, h, 1, 1, runs, -1, -1);
+	snprintf(r->note, sizeof r->note, "time a ray at %zu over %zu spheres: rtsh camera %.2fx, shadow %.2fx", sizes[1],
+	         sizes[0], cam[0] / cam[1], sh[0] / sh[1]);
+	if (ecam[0] > 0 && ecam[1] > 0)
+		snprintf(r->note + strlen(r->note), sizeof r->note - strlen(r->note),
+		         "; Embree camera (16) %.2fx, shadow (16) %.2fx, shadow (1) %.2fx", ecam[0] / ecam[1],
+		         esh[0] / esh[1], esh1[0] / esh1[1]);
+}
+
 /* The 1M-sphere scene saved as .rt and loaded back. */
 static void bench_load(void)
 {
 	size_t n = quick ? 10000 : 1000000;
-	gen_opts o = {.spheres_only = true};
 	rt_error err;
-	scene *s = scene_generate(n, 1, &o, &err);
-	if (!s)
-		fail("generate", &err);
+	scene *s = gen_spheres(n);
 	char path[] = "/tmp/rtsh-bench-XXXXXX";
 	int fd = mkstemp(path);
 	if (fd < 0)
@@ -1656,7 +1754,7 @@ static void print_table(FILE *f, bool tsv)
 
 static void usage(void)
 {
-	fputs("usage: bench [--quick] [--runs N] [--out FILE.tsv] [--only grid|primary|spheres|load|path|preview|denoise|pixels|keymode|mesh|symbols]\n",
+	fputs("usage: bench [--quick] [--runs N] [--out FILE.tsv] [--only grid|primary|packets|spheres|sphere-rays|load|path|preview|denoise|pixels|keymode|mesh|symbols]\n",
 	      stderr);
 	exit(2);
 }
@@ -1711,6 +1809,8 @@ int main(int argc, char **argv)
 		bench_packets();
 	if (!only || strcmp(only, "spheres") == 0)
 		bench_spheres();
+	if (!only || strcmp(only, "sphere-rays") == 0)
+		bench_sphere_rays();
 	if (!only || strcmp(only, "load") == 0)
 		bench_load();
 	if (!only || strcmp(only, "path") == 0)

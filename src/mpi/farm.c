@@ -463,7 +463,9 @@ bool farm_serve(const world *w, const render_settings *s, const farm_opts *o, fr
 		pthread_join(tid[i], NULL);
 	if (o->progress) {
 		show_progress(s, o, &sv.t, atomic_load(&sv.done), t0);
-		if (sv.t.pass != FARM_FIRST) /* the line goes on in the second pass */
+		/* the line goes on in the second pass, unless the farm failed:
+		 * then the message that follows must start a line of its own */
+		if (sv.t.pass != FARM_FIRST || !ok)
 			fputc('\n', stderr);
 	}
 	if (started == 0)

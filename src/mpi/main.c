@@ -289,15 +289,17 @@ static bool farm_pass(int rank, const world *w, const render_settings *s, const 
  * or a denoised image's two (farm.h), as render_image makes it, to the
  * same bits: the first samples in every pixel, rank 0's allocation of the
  * rest from the whole image (render_adaptive_counts), told to every rank
- * (its most: whether there is a second pass), and the adaptive pass. */
+ * (its most: whether there is a second pass), and the adaptive pass.
+ * The figures are added to *st (set by a turntable's first frame), so that
+ * -v reports the whole job. */
 static bool render_frame(int rank, const world *w, const render_settings *s, farm_opts *fo, framebuffer *fb,
-                         farm_stats *st, rt_error *err)
+                         farm_stats *st, bool first_frame, rt_error *err)
 {
 	int first = farm_first(s);
 	fo->first = first;
 	fo->t0 = farm_clock();
 	fo->pass = first < s->samples ? FARM_FIRST : FARM_ONE;
-	if (!farm_pass(rank, w, s, fo, fb, st, true, err))
+	if (!farm_pass(rank, w, s, fo, fb, st, first_frame, err))
 		return false;
 	if (fo->pass == FARM_ONE)
 		return true;
@@ -778,7 +780,7 @@ int main(int argc, char **argv)
 			camera ck = orbit_turntable(cam0, pivot, k, frames);
 			w->cam = cam_view_make(&ck);
 		}
-		if (!render_frame(rank, w, &c.set, &fo, fb, &st, &err))
+		if (!render_frame(rank, w, &c.set, &fo, fb, &st, k == 0, &err))
 			die(rank, host, "", &err);
 		if (rank == 0 && fb->feat) {
 			/* --denoise: the whole frame, as rtsh denoises its image */
