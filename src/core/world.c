@@ -261,12 +261,6 @@ world *world_build_cancel(const scene *s, const atomic_bool *cancel, rt_error *e
 		rt_error_set(err, "out of memory preparing the scene (%zu objects)", s->nobjs);
 		return NULL;
 	}
-	/* 2 MB pages, one page fault each instead of 512 (a million objects:
-	 * 128 MB of materials, read at random by every hit; 40 MB of
-	 * primitives; 48 MB of bounds) */
-	mem_huge_pages(w->mats, s->nobjs * sizeof *w->mats);
-	mem_huge_pages(w->prims, nbounded * sizeof *w->prims);
-	mem_huge_pages(bounds, nbounded * sizeof *bounds);
 	w->nlights = s->nlights;
 	for (size_t i = 0; i < s->nlights; i++) {
 		const light *sl = &s->lights[i];

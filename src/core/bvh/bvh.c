@@ -906,10 +906,6 @@ bool bvh2_build(const box *bounds, size_t n, const bvh_build_opts *o, bvh2 *t, r
 		free(b.tmp_ids);
 		return rt_error_set(err, "out of memory building the BVH (%zu objects)", n);
 	}
-	/* 2 MB pages: a million references are 32 MB and their nodes up to
-	 * 80 MB, one page fault each 2 MB instead of each 4 KB */
-	mem_huge_pages(b.refs, cap * sizeof *b.refs);
-	mem_huge_pages(b.nodes, cap * sizeof *b.nodes);
 	fbox bb = fbox_empty(), cb = fbox_empty();
 	for (size_t i = 0; i < n; i++) {
 		fbox *r = &b.refs[i];
@@ -1064,7 +1060,6 @@ bvh *bvh_build(const box *bounds, const float *costs, size_t n, uint32_t *order,
 		rt_error_set(err, "out of memory building the BVH (%zu objects)", n);
 		return NULL;
 	}
-	mem_huge_pages(wide, bytes); /* written once, copied out below */
 	size_t used = 0;
 	t->root = collapse(&b, b.root, wide, &used);
 	t->root_meta = 0;
