@@ -168,6 +168,17 @@ bool denoise_image(const framebuffer *fb, float *out, int threads);
  * 16 bits, framebuffer.pixel_spp; RENDER_ADAPTIVE_MAX x 16 is 65536). */
 #define DENOISE_CAP_TIMES 16
 #define DENOISE_CAP(S) (DENOISE_CAP_TIMES * (S) < 65534 ? DENOISE_CAP_TIMES * (S) : 65534)
+/* A pixel that got at least this many times the mean (framebuffer.spp,
+ * with pixel_spp set) chooses among the denoiser's candidates (its raw
+ * mean, the two regressions) by its own cross-half error estimates, not
+ * by those averaged over its window, and no mixed pixel's step moves it.
+ * The allocation gives so many where the neighbours are the noisiest, a
+ * glossy highlight's: there the window's pixels have few samples, their
+ * estimates say the fits beat the raw pixel, and the fits are biased;
+ * with 4 x 8 samples and more the pixel's own halves tell (metal-fuzz
+ * 160x96, 4 seeds: 1.755 -> 1.57 times the 64 samples' squared error;
+ * 2 x: cornell 25% worse; bench/README, the denoise7 session). */
+#define DENOISE_OWN_TIMES 4
 
 /* The noise about each pixel of fb (features and at least 2 samples a
  * pixel) into sigma (w*h): the standard deviation of one sample's

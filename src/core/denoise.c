@@ -608,6 +608,14 @@ static inline int pixel_spp(const framebuffer *fb, size_t i)
 	return fb->pixel_spp ? fb->pixel_spp[i] : fb->spp;
 }
 
+/* Whether pixel i has so many samples (DENOISE_OWN_TIMES the mean) that
+ * its own error estimates choose its candidate, and no mixed pixel's step
+ * moves it. */
+static inline bool trusts_own(const framebuffer *fb, size_t i)
+{
+	return fb->pixel_spp && fb->pixel_spp[i] >= DENOISE_OWN_TIMES * fb->spp;
+}
+
 /* The samples in each chain of a pixel of spp samples. */
 static inline void chain_n(int spp, float n[NCH])
 {
@@ -947,7 +955,7 @@ static void mix_rows(job *j, int y0, int y1)
 		for (int x = 0; x < w; x++) {
 			size_t i = (size_t)y * w + x;
 			float *o = j->out + i * 3;
-			if (!j->mixed[i] || !mix_pixel(j, x, y, o))
+			if (!j->mixed[i] || trusts_own(j->fb, i) || !mix_pixel(j, x, y, o))
 				for (int k = 0; k < 3; k++)
 					o[k] = j->t[i].h[CH_ALL].c[k];
 		}

@@ -363,7 +363,10 @@ LANES_INLINE void regression_body(job *j, int y0, int y1)
  * wall's behind an edge) count less than the pixel's own surface's. The
  * sums are left undivided by the weights' sum: it is the same for every
  * candidate of the pixel, and neither the choice nor the blend's shares
- * change with it. */
+ * change with it. A pixel of DENOISE_OWN_TIMES the mean samples or
+ * more chooses by its own estimates alone (its halves are long enough:
+ * the window's pixels have far fewer samples and their estimates favour
+ * fits that are biased there, a glossy highlight's). */
 LANES_INLINE void pick_body(job *j, int y0, int y1)
 {
 	int w = j->fb->w, h = j->fb->h;
@@ -410,6 +413,9 @@ LANES_INLINE void pick_body(job *j, int y0, int y1)
 				float s[NCAND];
 				for (int c = 0; c < NCAND; c++)
 					s[c] = sv[c][ln];
+				if (trusts_own(j->fb, i))
+					for (int c = 0; c < NCAND; c++)
+						s[c] = perr[c][i];
 				int best = CAND_RAW;
 				for (int c = 1; c < NCAND; c++)
 					if (s[c] < s[best])

@@ -1140,6 +1140,57 @@ static void test_allocate_rule(void **state)
 	assert_int_equal(total, 8 * N);
 }
 
+/* A pixel of DENOISE_OWN_TIMES (4) times the mean samples or more chooses
+ * by its own error estimates. A flat grey surface (radiance 0.4, 8 samples
+ * of noise 0.2 a pixel, mean 8) holds three pixels of brightness 0.7 whose
+ * halves agree (samples of variance 0.01): P1 and P2 (P2's features vary:
+ * a mixed pixel) of 32 samples, P3 of 30. At each, the fit is about the
+ * window's mean, 0.4 + 0.3 / 81, off by 0.3: its own cross-half estimate
+ * about 0.3^2 = 0.09; the raw pixel's about -0.01 / 16 (its halves agree;
+ * less their noise). So P1 and P2 keep 0.7 (the albedo 0.5 divided out
+ * and in again: exactly), and no mixed step moves P2. Averaged over the
+ * window, as P3's (30 < 32) still are, 80 raw estimates of about
+ * 0.2^2 / 8 (sum 0.4) lose to the fit's (0.09 and 80 of about
+ * 0.2^2 / 8 / 81): P3 comes out near 0.4. Before the rule P1 and P2 did
+ * too. */
+static void test_own_estimates(void **state)
+{
+	(void)state;
+	const int W = 48, H = 24, SPP = 8, Y = 12;
+	const int px[3] = {8, 24, 40}, own[3] = {32, 32, 30};
+	framebuffer *fb = flat_fb(W, H, SPP);
+	fb->pixel_spp = malloc((size_t)W * H * sizeof *fb->pixel_spp);
+	assert_non_null(fb->pixel_spp);
+	test_rng r = {11};
+	for (int i = 0; i < W * H; i++) {
+		fb->pixel_spp[i] = SPP;
+		noisy_pixel(fb, i, 0.4, 0.2, &r);
+	}
+	for (int k = 0; k < 3; k++) {
+		int i = Y * W + px[k];
+		fb->pixel_spp[i] = (uint16_t)own[k];
+		set_pixel(fb, i, 0.7f, 0.7f, 0.7f);
+		float *f = fb->feat + (size_t)i * DENOISE_FEATURES;
+		f[7] = f[13] = 0.49f + 0.01f;
+		if (k == 1) { /* mixed: its albedo varies inside it */
+			f[8] = 3 * 0.25f + 0.1f;
+			f[9] = f[6] * f[6];
+		}
+	}
+	float *out = malloc(sizeof(float) * W * H * 3);
+	assert_non_null(out);
+	assert_true(denoise_image(fb, out, 2));
+	for (int k = 0; k < 3; k++)
+		print_message("pixel %d, %d samples: %.5f\n", k + 1, own[k], out[(Y * W + px[k]) * 3]);
+	for (int c = 0; c < 3; c++) {
+		assert_float_equal(out[(Y * W + px[0]) * 3 + c], 0.7f, 1e-6);
+		assert_float_equal(out[(Y * W + px[1]) * 3 + c], 0.7f, 1e-6);
+		assert_true(fabs(out[(Y * W + px[2]) * 3 + c] - (0.4 + 0.3 / 81)) < 0.05);
+	}
+	free(out);
+	fb_free(fb);
+}
+
 /* The noise that decides a pixel's samples is its 8 neighbours', never its
  * own: a 3x3 image of 4 samples a pixel, grey 0.5 (brightness 0.5), each
  * pixel's mean squared brightness 0.25 + v 3/4, so that its unbiased
@@ -1499,6 +1550,7 @@ int main(void)
 		cmocka_unit_test(test_features_in_passes),
 		cmocka_unit_test(test_allocate_rule),
 		cmocka_unit_test(test_sigma_neighbours),
+		cmocka_unit_test(test_own_estimates),
 		cmocka_unit_test(test_adaptive_pass),
 		cmocka_unit_test(test_adaptive_render),
 		cmocka_unit_test(test_adaptive_after_passes),
