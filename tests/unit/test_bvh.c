@@ -631,6 +631,95 @@ static void test_sah_splits(void **state)
 	}
 }
 
+/* The leaves of binary tree t under child, depth first, left first: each
+ * leaf's ids must be in ascending order; the ids of group (ids[i] % 7 == 0
+ * below) are appended to seq in tree order. */
+static void leaf_walk(const bvh2 *t, uint32_t child, uint32_t meta, uint32_t *seq, size_t *nseq, size_t *leaves)
+{
+	if (meta & BVH_LEAF) {
+		uint32_t cnt = meta & ~BVH_LEAF;
+		const uint32_t *id = &t->ids[child];
+		for (uint32_t i = 0; i < cnt; i++) {
+			if (i > 0 && id[i - 1] >= id[i])
+				fail_msg("leaf at %u: ids %u then %u, expected ascending", child, id[i - 1], id[i]);
+			if (id[i] % 7 == 0)
+				seq[(*nseq)++] = id[i];
+		}
+		(*leaves)++;
+		return;
+	}
+	const bvh2_node *nd = &t->nodes[child];
+	leaf_walk(t, nd->child[0], nd->meta[0], seq, nseq, leaves);
+	leaf_walk(t, nd->child[1], nd->meta[1], seq, nseq, leaves);
+}
+
+/* The order of references the partitions leave is not the tree's: each
+ * leaf holds its primitives in ascending index order, and a node whose
+ * centroids are all one point is halved with the lower indices on the
+ * left. Boxes at random, and every seventh (0, 7, 14, ...) the same box:
+ * that group gathers in one subtree (one centroid: one bin on every axis)
+ * that can only be halved, so in tree order its indices ascend. Then the
+ * same through world_intersect: of two coincident spheres in one leaf the
+ * ray meets the lower index first (the walk keeps the first of equal t). */
+static void test_leaf_order(void **state)
+{
+	(void)state;
+	for (uint64_t seed = 1; seed <= 3; seed++) {
+		test_rng g = {seed};
+		size_t n = 700 * seed;
+		box *bx = malloc(n * sizeof *bx);
+		uint32_t *seq = malloc(n * sizeof *seq);
+		assert_non_null(bx && seq);
+		for (size_t i = 0; i < n; i++) {
+			vec3 c = i % 7 == 0 ? v3(1.5, -2.25, 3) : vrand(&g, -50, 50);
+			double r = i % 7 == 0 ? 0.5 : urand(&g, 0.1, 2);
+			bx[i] = (box){v3_sub(c, v3(r, r, r)), v3_add(c, v3(r, r, r))};
+		}
+		bvh2 t;
+		rt_error err;
+		assert_true(bvh2_build(bx, n, &(bvh_build_opts){.trav = 4}, &t, &err));
+		size_t nseq = 0, leaves = 0;
+		leaf_walk(&t, t.root, t.root_meta, seq, &nseq, &leaves);
+		assert_int_equal(nseq, (n + 6) / 7);
+		for (size_t i = 0; i < nseq; i++)
+			if (seq[i] != 7 * i)
+				fail_msg("seed %llu: the coincident group's %zu-th id in tree order is %u, expected %zu",
+				         (unsigned long long)seed, i, seq[i], 7 * i);
+		assert_true(leaves > n / 8);
+		bvh2_free(&t);
+		free(bx);
+		free(seq);
+	}
+	/* pairs of coincident spheres, the twin of object i at index i + 300,
+	 * in another colour; rays at each pair from outside */
+	test_rng g = {99};
+	scene *s = random_scene(5, 0, 1, 1, 0);
+	vec3 at[300];
+	for (int i = 0; i < 600; i++) {
+		object o = object_make(OBJ_SPHERE, v3(i < 300 ? 200 : 10, 20, 30));
+		if (i < 300)
+			at[i] = vrand(&g, -40, 40);
+		o.pos = at[i % 300];
+		o.scale = v3(0.25, 0.25, 0.25);
+		assert_true(scene_add_object(s, &o, NULL));
+	}
+	world *w = build(s);
+	int pairs = 0;
+	for (int i = 0; i < 300; i++) {
+		ray r = {v3_add(at[i], v3(0.01, -0.02, -100)), v3(0, 0, 1)};
+		hit h;
+		assert_true(world_intersect(w, &r, 0, INFINITY, &h));
+		if (h.object != (uint32_t)i && h.object != (uint32_t)i + 300)
+			continue; /* another sphere in front */
+		if (h.object != (uint32_t)i)
+			fail_msg("pair %d: the ray met object %u first, expected %d (the lower index)", i, h.object, i);
+		pairs++;
+	}
+	assert_true(pairs > 250); /* few hidden behind another sphere */
+	world_free(w);
+	scene_free(s);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -646,6 +735,7 @@ int main(void)
 		cmocka_unit_test(test_float_boxes),
 		cmocka_unit_test(test_fast_spheres),
 		cmocka_unit_test(test_sah_splits),
+		cmocka_unit_test(test_leaf_order),
 	};
 	return cmocka_run_group_tests_name("bvh", tests, NULL, NULL);
 }

@@ -527,9 +527,25 @@ static inline void swap_refs(builder *b, size_t i, size_t j)
 	b->ids[j] = id;
 }
 
+#if defined(__SSE2__)
+/* The bin on axis a of doubled centroid c, as bin_refs computes it. */
+static inline int bin_on_axis(__m128 c, __m128 blo, __m128 bsc, __m128 zero, __m128 top, int a)
+{
+	int k[4];
+	_mm_storeu_si128((__m128i *)k, _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(_mm_mul_ps(_mm_sub_ps(c, blo), bsc), zero), top)));
+	return k[a];
+}
+#endif
+
 /* Partitions by an object split, returning the middle; *lcb, *rcb: the
  * children's centroid bounds. The bins are computed exactly as find_split
- * did. */
+ * did. Two-pointer (Hoare): the scan from the left stops at a reference
+ * that goes right, the scan from the right at one that goes left, and the
+ * two swap, so only misplaced references move (about a quarter of a node's
+ * instead of every right one). Each side gets the same references in
+ * another order than a one-sided partition: the children's bins, centroid
+ * bounds and whole-number cost sums do not depend on the order, and the
+ * order within a leaf is set when the leaf is made (sort_ids). */
 static size_t partition(builder *b, size_t begin, size_t end, const fbox *cb, const split *s, fbox *lcb,
                         fbox *rcb)
 {
@@ -539,42 +555,76 @@ static size_t partition(builder *b, size_t begin, size_t end, const fbox *cb, co
 	*lcb = *rcb = fbox_empty();
 	size_t i = begin, j = end;
 #if defined(__SSE2__)
-	/* the loop below with the bounds in registers */
+	/* the bounds in registers; the axis's bin of a centroid in lane a */
 	__m128 blo = _mm_loadu_ps(bn.lo), bsc = _mm_loadu_ps(bn.scale), zero = _mm_setzero_ps(),
 	       top = _mm_set1_ps((float)(bn.nbins - 1));
 	__m128 llo = _mm_loadu_ps(lcb->lo), lhi = _mm_loadu_ps(lcb->hi), rlo = llo, rhi = lhi;
-	while (i < j) {
-		__m128 c = _mm_add_ps(_mm_loadu_ps(b->refs[i].lo), _mm_loadu_ps(b->refs[i].hi));
-		__m128 v = _mm_mul_ps(_mm_sub_ps(c, blo), bsc);
-		int k[4];
-		_mm_storeu_si128((__m128i *)k, _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(v, zero), top)));
-		if (k[a] < s->at) {
-			llo = _mm_min_ps(llo, c);
-			lhi = _mm_max_ps(lhi, c);
+	int at = s->at;
+	for (;;) {
+		__m128 ci = zero, cj = zero;
+		while (i < j) {
+			ci = _mm_add_ps(_mm_loadu_ps(b->refs[i].lo), _mm_loadu_ps(b->refs[i].hi));
+			if (bin_on_axis(ci, blo, bsc, zero, top, a) >= at)
+				break;
+			llo = _mm_min_ps(llo, ci);
+			lhi = _mm_max_ps(lhi, ci);
 			i++;
-		} else {
-			rlo = _mm_min_ps(rlo, c);
-			rhi = _mm_max_ps(rhi, c);
-			swap_refs(b, i, --j);
 		}
+		if (i == j)
+			break;
+		/* refs[i] goes right */
+		rlo = _mm_min_ps(rlo, ci);
+		rhi = _mm_max_ps(rhi, ci);
+		j--;
+		while (i < j) {
+			cj = _mm_add_ps(_mm_loadu_ps(b->refs[j].lo), _mm_loadu_ps(b->refs[j].hi));
+			if (bin_on_axis(cj, blo, bsc, zero, top, a) < at)
+				break;
+			rlo = _mm_min_ps(rlo, cj);
+			rhi = _mm_max_ps(rhi, cj);
+			j--;
+		}
+		if (i == j)
+			break;
+		/* refs[j] goes left */
+		llo = _mm_min_ps(llo, cj);
+		lhi = _mm_max_ps(lhi, cj);
+		swap_refs(b, i, j);
+		i++;
 	}
 	_mm_storeu_ps(lcb->lo, llo);
 	_mm_storeu_ps(lcb->hi, lhi);
 	_mm_storeu_ps(rcb->lo, rlo);
 	_mm_storeu_ps(rcb->hi, rhi);
 #else
-	while (i < j) {
+	for (;;) {
 		float c[4];
 		int k[4];
-		centroid2(&b->refs[i], c);
-		bin_index(c, bn.lo, bn.scale, bn.nbins, k);
-		if (k[a] < s->at) {
+		while (i < j) {
+			centroid2(&b->refs[i], c);
+			bin_index(c, bn.lo, bn.scale, bn.nbins, k);
+			if (k[a] >= s->at)
+				break;
 			fbox_add_point(lcb, c);
 			i++;
-		} else {
-			fbox_add_point(rcb, c);
-			swap_refs(b, i, --j);
 		}
+		if (i == j)
+			break;
+		fbox_add_point(rcb, c);
+		j--;
+		while (i < j) {
+			centroid2(&b->refs[j], c);
+			bin_index(c, bn.lo, bn.scale, bn.nbins, k);
+			if (k[a] < s->at)
+				break;
+			fbox_add_point(rcb, c);
+			j--;
+		}
+		if (i == j)
+			break;
+		fbox_add_point(lcb, c);
+		swap_refs(b, i, j);
+		i++;
 	}
 #endif
 	return i;
@@ -655,6 +705,54 @@ static void partition_spatial(builder *b, size_t begin, size_t end, size_t room,
 	*nr = room - r;
 }
 
+/* Puts refs[begin, end) in ascending order of primitive index, unless
+ * they are already (a heap sort: no memory, n log n at worst). The halving
+ * below sorts first, so that which references go to which half does not
+ * depend on the order the partitions above left them in. */
+static void sort_refs(builder *b, size_t begin, size_t end)
+{
+	uint32_t *id = b->ids + begin;
+	size_t n = end - begin, i = 1;
+	while (i < n && id[i - 1] < id[i])
+		i++;
+	if (i >= n)
+		return;
+	/* sift down from the root r of the heap over [0, m), 0-based in the range */
+	for (size_t k = n / 2; k-- > 0;)
+		for (size_t r = k, c; (c = 2 * r + 1) < n; r = c) {
+			if (c + 1 < n && id[c + 1] > id[c])
+				c++;
+			if (id[r] >= id[c])
+				break;
+			swap_refs(b, begin + r, begin + c);
+		}
+	for (size_t m = n - 1; m > 0; m--) {
+		swap_refs(b, begin, begin + m);
+		for (size_t r = 0, c; (c = 2 * r + 1) < m; r = c) {
+			if (c + 1 < m && id[c + 1] > id[c])
+				c++;
+			if (id[r] >= id[c])
+				break;
+			swap_refs(b, begin + r, begin + c);
+		}
+	}
+}
+
+/* A leaf's primitive indices in ascending order (insertion sort: a leaf
+ * holds at most leaf_max): the walks keep the first of equal distances in
+ * leaf order, so coincident primitives in one leaf resolve to the lower
+ * index, whatever order the partitions left them in. */
+static void sort_leaf(uint32_t *id, size_t n)
+{
+	for (size_t i = 1; i < n; i++) {
+		uint32_t x = id[i];
+		size_t j = i;
+		for (; j > 0 && id[j - 1] > x; j--)
+			id[j] = id[j - 1];
+		id[j] = x;
+	}
+}
+
 /* Builds the subtree over refs[begin, end) (box bb, centroid bounds cb),
  * with refs[end, cap_end) free for its spatial splits, and returns its
  * reference in *child, *meta. */
@@ -698,6 +796,8 @@ static void build(builder *b, size_t begin, size_t end, size_t cap_end, const fb
 		leaf = s.total <= split_cost;
 	}
 	if (leaf) {
+		if (!b->stopped) /* (a stopped build's tree is thrown away) */
+			sort_leaf(b->ids + begin, n);
 		*child = (uint32_t)begin;
 		*meta = BVH_LEAF | (uint32_t)n;
 		b->leaves++;
@@ -734,7 +834,9 @@ static void build(builder *b, size_t begin, size_t end, size_t cap_end, const fb
 			rb = s.rb;
 		}
 		if (mid == begin || mid == end) {
-			/* no useful split (equal centroids, or past BALANCED_DEPTH): halve */
+			/* no useful split (equal centroids, or past BALANCED_DEPTH):
+			 * halve, the lower primitive indices to the left */
+			sort_refs(b, begin, end);
 			mid = begin + n / 2;
 			bounds_of(b, begin, mid, &lb, &lcb);
 			bounds_of(b, mid, end, &rb, &rcb);
