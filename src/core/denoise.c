@@ -1145,7 +1145,10 @@ bool denoise_image(const framebuffer *fb, float *out, int threads)
  * (those inside the image and not fixed), its own left out. */
 bool denoise_fixed(const float *f)
 {
-	return !(f[6] > 0.0f) || f[0] > 1.0f || f[1] > 1.0f || f[2] > 1.0f;
+	/* the sky or background: depth 0 and no direct light (a glossy
+	 * metal's lobe that the sky is seen through brings its lamps) */
+	bool background = !(f[6] > 0.0f) && !(f[14] > 0.0f);
+	return background || f[0] > 1.0f || f[1] > 1.0f || f[2] > 1.0f;
 }
 
 bool denoise_sigma(const framebuffer *fb, float *sigma)

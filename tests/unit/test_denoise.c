@@ -1246,6 +1246,13 @@ static void test_sigma_neighbours(void **state)
 	fb->feat[4 * DENOISE_FEATURES + 1] = 2.0f;
 	assert_true(denoise_sigma(fb, s2));
 	assert_true(s2[0] == 0.0f);
+	/* The sky seen in a glossy metal: depth 0, but a direct light (the
+	 * lamps the lobe sees, feature 14): not fixed, and pixel 1's v 2
+	 * counts for the corner again, its one neighbour left: sqrt(2 / 1). */
+	fb->feat[1 * DENOISE_FEATURES + 14] = 2.0f;
+	assert_false(denoise_fixed(fb->feat + 1 * DENOISE_FEATURES));
+	assert_true(denoise_sigma(fb, s2));
+	assert_near(s2[0], sqrt(2.0), 1e-5);
 	fb_free(fb);
 }
 
