@@ -218,6 +218,25 @@ static inline __m128 float_round3(const vec3 *v, bool down)
 }
 #endif
 
+/* A reference: box x rounded outward to floats, the cost in lane 3 of
+ * the lower corner. */
+static inline void ref_set(fbox *r, const box *x, float cost)
+{
+#if defined(__SSE2__)
+	/* lane 3 of the lower corner: the cost (its bits or'ed onto 0) */
+	_mm_storeu_ps(r->lo, _mm_or_ps(float_round3(&x->lo, true), _mm_set_ps(cost, 0, 0, 0)));
+	_mm_storeu_ps(r->hi, float_round3(&x->hi, false));
+#else
+	*r = (fbox){{float_down(x->lo.x), float_down(x->lo.y), float_down(x->lo.z), cost},
+	            {float_up(x->hi.x), float_up(x->hi.y), float_up(x->hi.z), 0}};
+#endif
+}
+
+void bvh_ref_set(bvh_fbox *r, const box *x, float cost)
+{
+	ref_set(r, x, cost);
+}
+
 /* Fewer bins for small nodes: most nodes are small, and 16 bins on three
  * axes would cost more to set up and sweep than the binning itself. */
 static int bins_for(size_t n)
@@ -876,20 +895,23 @@ void bvh2_free(bvh2 *t)
 	memset(t, 0, sizeof *t);
 }
 
-bool bvh2_build(const box *bounds, size_t n, const bvh_build_opts *o, bvh2 *t, rt_error *err)
+/* bvh2_build, from the boxes `bounds` or, when refs is not NULL, from the
+ * references refs[0, n) made by bvh_ref_set (used in place: the caller's
+ * to free; no spatial splits). */
+static bool build_from(const box *bounds, fbox *refs, size_t n, const bvh_build_opts *o, bvh2 *t, rt_error *err)
 {
 	memset(t, 0, sizeof *t);
 	t->root_meta = BVH_LEAF; /* an empty leaf */
 	t->bounds = fbox_empty();
 	if (n == 0)
 		return true;
-	double budget = o->chop && o->split_budget > 0 ? o->split_budget : 0;
+	double budget = o->chop && o->split_budget > 0 && !refs ? o->split_budget : 0;
 	size_t cap = n + (size_t)((double)n * budget);
 	if (n > BVH_MAX_PRIMS || cap > BVH_MAX_PRIMS)
 		return rt_error_set(err, "too many objects (%zu); expected at most %u", n, BVH_MAX_PRIMS);
 	builder b = {.o = o, .trav = o->trav, .block = o->block ? o->block : 1,
 	             .leaf_max = o->leaf_max ? o->leaf_max : LEAF_MAX};
-	b.refs = malloc(cap * sizeof *b.refs);
+	b.refs = refs ? refs : malloc(cap * sizeof *b.refs);
 	b.ids = malloc(cap * sizeof *b.ids);
 	/* a binary tree with leaves folded in has fewer inner nodes than leaves,
 	 * and a leaf holds at least one reference */
@@ -899,7 +921,8 @@ bool bvh2_build(const box *bounds, size_t n, const bvh_build_opts *o, bvh2 *t, r
 		b.tmp_ids = malloc(cap * sizeof *b.tmp_ids);
 	}
 	if (!b.refs || !b.ids || !b.nodes || (cap > n && (!b.tmp || !b.tmp_ids))) {
-		free(b.refs);
+		if (!refs)
+			free(b.refs);
 		free(b.ids);
 		free(b.nodes);
 		free(b.tmp);
@@ -909,16 +932,8 @@ bool bvh2_build(const box *bounds, size_t n, const bvh_build_opts *o, bvh2 *t, r
 	fbox bb = fbox_empty(), cb = fbox_empty();
 	for (size_t i = 0; i < n; i++) {
 		fbox *r = &b.refs[i];
-		const box *x = &bounds[i];
-		float cost = o->costs ? o->costs[i] : 1.0f;
-#if defined(__SSE2__)
-		/* lane 3 of the lower corner: the cost (its bits or'ed onto 0) */
-		_mm_storeu_ps(r->lo, _mm_or_ps(float_round3(&x->lo, true), _mm_set_ps(cost, 0, 0, 0)));
-		_mm_storeu_ps(r->hi, float_round3(&x->hi, false));
-#else
-		*r = (fbox){{float_down(x->lo.x), float_down(x->lo.y), float_down(x->lo.z), cost},
-		            {float_up(x->hi.x), float_up(x->hi.y), float_up(x->hi.z), 0}};
-#endif
+		if (!refs)
+			ref_set(r, &bounds[i], o->costs ? o->costs[i] : 1.0f);
 		b.ids[i] = (uint32_t)i;
 		float c[4];
 		centroid2(r, c);
@@ -927,15 +942,15 @@ bool bvh2_build(const box *bounds, size_t n, const bvh_build_opts *o, bvh2 *t, r
 	}
 	b.root_area = fbox_half_area(&bb);
 	build(&b, 0, n, cap, &bb, &cb, 0, &t->root, &t->root_meta);
-	if (b.stopped) {
+	if (!refs)
 		free(b.refs);
+	if (b.stopped) {
 		free(b.tmp);
 		free(b.tmp_ids);
 		free(b.nodes);
 		free(b.ids);
 		return rt_error_set(err, "stopped");
 	}
-	free(b.refs);
 	free(b.tmp);
 	free(b.tmp_ids);
 	t->nodes = b.nodes;
@@ -952,6 +967,11 @@ bool bvh2_build(const box *bounds, size_t n, const bvh_build_opts *o, bvh2 *t, r
 			t->nodes = fit;
 	}
 	return true;
+}
+
+bool bvh2_build(const box *bounds, size_t n, const bvh_build_opts *o, bvh2 *t, rt_error *err)
+{
+	return build_from(bounds, NULL, n, o, t, err);
 }
 
 int bvh2_gather(const bvh2 *t, uint32_t n2, int width, bvh_slot *s)
@@ -1002,17 +1022,16 @@ static uint32_t collapse(const bvh2 *t, uint32_t n2, bvh_node *out, size_t *used
 	return ni;
 }
 
-bvh *bvh_build(const box *bounds, const float *costs, size_t n, uint32_t *order, const atomic_bool *cancel,
-               rt_error *err)
+bvh *bvh_build(bvh_fbox *refs, size_t n, uint32_t *order, const atomic_bool *cancel, rt_error *err)
 {
 	bvh *t = calloc(1, sizeof *t);
 	if (!t) {
 		rt_error_set(err, "out of memory building the BVH");
 		return NULL;
 	}
-	bvh_build_opts o = {.costs = costs, .block = 1, .trav = COST_TRAVERSE, .cancel = cancel};
+	bvh_build_opts o = {.block = 1, .trav = COST_TRAVERSE, .cancel = cancel};
 	bvh2 b;
-	if (!bvh2_build(bounds, n, &o, &b, err)) {
+	if (!build_from(NULL, refs, n, &o, &b, err)) {
 		free(t);
 		return NULL;
 	}

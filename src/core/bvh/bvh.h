@@ -292,14 +292,17 @@ int bvh2_gather(const bvh2 *t, uint32_t n, int width, bvh_slot *out);
 /* Half the surface area of a float box, in double; 0 when empty. */
 double bvh_fbox_half_area(const bvh_fbox *b);
 
-/* Builds the tree over n primitives with world bounds bounds[0..n) and
- * intersection costs costs[0..n) (relative to a world-space sphere; NULL:
- * all 1): binned SAH (Wald, "On fast construction of SAH-based bounding
- * volume hierarchies", 2007). order[i] receives the primitive that goes to
- * place i of tree order (leaves index primitives in that order). NULL (err
- * set) when out of memory or n is too large. */
-bvh *bvh_build(const box *bounds, const float *costs, size_t n, uint32_t *order, const atomic_bool *cancel,
-               rt_error *err);
+/* A reference for bvh_build: primitive box x rounded outward to floats,
+ * and its intersection cost relative to a world-space sphere. */
+void bvh_ref_set(bvh_fbox *r, const box *x, float cost);
+
+/* Builds the tree over the n primitives of references refs[0, n) (made by
+ * bvh_ref_set; reordered by the build, the caller's to free): binned SAH
+ * (Wald, "On fast construction of SAH-based bounding volume hierarchies",
+ * 2007). order[i] receives the primitive that goes to place i of tree
+ * order (leaves index primitives in that order). NULL (err set) when out
+ * of memory or n is too large. */
+bvh *bvh_build(bvh_fbox *refs, size_t n, uint32_t *order, const atomic_bool *cancel, rt_error *err);
 void bvh_free(bvh *t);
 
 #endif
