@@ -523,16 +523,6 @@ void denoise_features_only(const world *w, const render_settings *s, int px, int
 /* Its unknowns: a constant, the slopes along x and y, along the normal's
  * three components, along the depth and along the direct light. */
 #define NU 8
-/* The taps are also weighted by how alike their direct light is (in the
- * regression's own scale of it, the slope's regressor): exp(-DIRECT_W
- * dd^2). A rough metal's reflection of the horizon is a dark band a pixel
- * or two wide that the normals and depth do not tell from the bright
- * pixels beside it; its direct light (the sky its lobe sees) does. Over
- * 4 seeds, with the sky's depth behind glass and mirrors: 0.2 and 0.5
- * took the geomean of metal-fuzz, final, cornell, spot, sky-spheres at
- * 128x96 and 200x120 to 0.9882 and 0.9853 of before (bench/README, the
- * denoise8 session). */
-#define DIRECT_W 0.5f
 /* The slopes are held back by a ridge of this share of the weights; the
  * direct light's own fit's slope by more (1e-3 there: metal-fuzz, final
  * and sky-spheres at 200x120 1.529, 1.730, 0.988 times the 64 samples'

@@ -259,8 +259,6 @@ LANES_INLINE void regression_body(job *j, int y0, int y1)
 					vf e = feat_dist2(gf, pf, q);
 					vf qz = vf_load(pz + q);
 					e += vf_abs(qz - (gz + ggx * off[dx + WIN] + ggy * off[dy + WIN])) * inv_z;
-					vf dd = (vf_load(pd + q) - gd) * dscale;
-					e += vf_splat(DIRECT_W) * dd * dd;
 					vf wt = vf_exp_fast(&e);
 					vi m = in & (wt > vf_splat(0.0f));
 					if (!vf_any(&m))
@@ -273,7 +271,7 @@ LANES_INLINE void regression_body(job *j, int y0, int y1)
 					for (int k = 3; k < 6; k++)
 						v[k] = vf_and(vf_load(pf[k] + q) - gf[k], m);
 					v[6] = vf_and((qz - gz) * inv_z, m);
-					v[7] = vf_and(dd, m);
+					v[7] = vf_and((vf_load(pd + q) - gd) * dscale, m);
 					tw[nt] = tww;
 					tm[nt] = m;
 					tq[nt] = q;

@@ -736,22 +736,26 @@ static void test_features_through_glass(void **state)
 /* The sky's albedo feature is its colour in that direction: a uniform sky
  * of radiance 0.5 seen directly gives 0.5; through the clear glass plane
  * of test_features_through_glass, with nothing behind, 0.96 x 0.5 of the
- * sky and 0.04 of a white reflection: 0.52. Depth 0 (the sky's, even
- * through the glass). */
+ * sky and 0.04 of a white reflection: 0.52; in a white mirror plane at
+ * z = 2 (the ray comes back along -z to the open sky) 0.5. Its depth: 0
+ * seen directly; through the glass or in the mirror the distance to the
+ * last surface the ray left, the plane's 2 (the sky there is that
+ * surface's light, not the open sky's: the filter must not mix them). */
 static void test_sky_feature(void **state)
 {
 	(void)state;
-	const char *texts[2] = {
+	const char *texts[3] = {
 		"C 0,0,0 0,0,1 10\nsky 255,255,255 255,255,255 0.5\n",
 		"C 0,0,0 0,0,1 10\nsky 255,255,255 255,255,255 0.5\npl 0,0,2 0,0,-1 1,1,1 255,255,255 0 0 1 0 ior=1.5\n",
+		"C 0,0,0 0,0,1 10\nsky 255,255,255 255,255,255 0.5\npl 0,0,2 0,0,-1 1,1,1 255,255,255 0 0 1 1\n",
 	};
-	const double want[2] = {0.5, 0.96 * 0.5 + 0.04};
-	for (int c = 0; c < 2; c++) {
+	const double want[3] = {0.5, 0.96 * 0.5 + 0.04, 0.5}, depth[3] = {0.0, 2.0, 2.0};
+	for (int c = 0; c < 3; c++) {
 		double f[DENOISE_ACC];
 		centre_features(texts[c], 1, f);
 		for (int k = 0; k < 3; k++)
 			assert_near(f[k], want[c], 1e-4);
-		assert_near(f[6], 0.0, 1e-9); /* the sky has no depth, through glass too */
+		assert_near(f[6], depth[c], 1e-6);
 	}
 }
 
