@@ -176,7 +176,7 @@ bool denoise_image(const framebuffer *fb, float *out, int threads);
  * glossy highlight's: there the window's pixels have few samples, their
  * estimates say the fits beat the raw pixel, and the fits are biased;
  * with 4 x 8 samples and more the pixel's own halves tell (metal-fuzz
- * 160x96, 4 seeds: 1.755 -> 1.57 times the 64 samples' squared error;
+ * 160x96, 4 seeds: 1.755 -> 1.580 times the 64 samples' squared error;
  * 2 x: cornell 25% worse; bench/README, the denoise7 session). */
 #define DENOISE_OWN_TIMES 4
 
