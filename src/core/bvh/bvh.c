@@ -547,12 +547,16 @@ static inline void swap_refs(builder *b, size_t i, size_t j)
 }
 
 #if defined(__SSE2__)
-/* The bin on axis a of doubled centroid c, as bin_refs computes it. */
-static inline int bin_on_axis(__m128 c, __m128 blo, __m128 bsc, __m128 zero, __m128 top, int a)
+/* Whether doubled centroid c goes right of split bin `at` (1 <= at <
+ * nbins) on the axis of bit abit: whether its bin as bin_refs computes it,
+ * trunc(clamp((c - lo) x scale, 0, nbins - 1)), is at or more. That is
+ * (c - lo) x scale >= at, the same float product compared: below 0 and
+ * NaN (bin 0) are left, at nbins - 1 or more (the last bin) right, and in
+ * between trunc(v) >= at exactly when v >= at. No bin index is stored
+ * and loaded back before the branch. */
+static inline bool goes_right(__m128 c, __m128 blo, __m128 bsc, __m128 at, int abit)
 {
-	int k[4];
-	_mm_storeu_si128((__m128i *)k, _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(_mm_mul_ps(_mm_sub_ps(c, blo), bsc), zero), top)));
-	return k[a];
+	return (_mm_movemask_ps(_mm_cmpge_ps(_mm_mul_ps(_mm_sub_ps(c, blo), bsc), at)) & abit) != 0;
 }
 #endif
 
@@ -576,14 +580,14 @@ static size_t partition(builder *b, size_t begin, size_t end, const fbox *cb, co
 #if defined(__SSE2__)
 	/* the bounds in registers; the axis's bin of a centroid in lane a */
 	__m128 blo = _mm_loadu_ps(bn.lo), bsc = _mm_loadu_ps(bn.scale), zero = _mm_setzero_ps(),
-	       top = _mm_set1_ps((float)(bn.nbins - 1));
+	       at = _mm_set1_ps((float)s->at);
 	__m128 llo = _mm_loadu_ps(lcb->lo), lhi = _mm_loadu_ps(lcb->hi), rlo = llo, rhi = lhi;
-	int at = s->at;
+	int abit = 1 << a;
 	for (;;) {
 		__m128 ci = zero, cj = zero;
 		while (i < j) {
 			ci = _mm_add_ps(_mm_loadu_ps(b->refs[i].lo), _mm_loadu_ps(b->refs[i].hi));
-			if (bin_on_axis(ci, blo, bsc, zero, top, a) >= at)
+			if (goes_right(ci, blo, bsc, at, abit))
 				break;
 			llo = _mm_min_ps(llo, ci);
 			lhi = _mm_max_ps(lhi, ci);
@@ -597,7 +601,7 @@ static size_t partition(builder *b, size_t begin, size_t end, const fbox *cb, co
 		j--;
 		while (i < j) {
 			cj = _mm_add_ps(_mm_loadu_ps(b->refs[j].lo), _mm_loadu_ps(b->refs[j].hi));
-			if (bin_on_axis(cj, blo, bsc, zero, top, a) < at)
+			if (!goes_right(cj, blo, bsc, at, abit))
 				break;
 			rlo = _mm_min_ps(rlo, cj);
 			rhi = _mm_max_ps(rhi, cj);
