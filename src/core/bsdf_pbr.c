@@ -459,8 +459,8 @@ static int pbr_features(const bsdf *b, vec3 *albedo, vec3 *tint, vec3 *dir)
 /* Whitted: ambient x base colour, the point lights through the same BRDF
  * as in path mode, and below WHITTED_MIRROR_ROUGHNESS the mirror (and
  * refracted) rays weighted by the lobes' Fresnel at cos_o. */
-static vec3 pbr_whitted(const world *w, const mat_lin *m, const hit *h, ray r, int depth,
-                        vec3 (*trace)(const world *w, ray r, int depth))
+static vec3 pbr_whitted(const world *w, const mat_lin *m, const hit *h, ray r, int depth, vec3 weight,
+                        whitted_trace_fn trace)
 {
 	bsdf b = {0};
 	b.n = h->front ? h->n : v3_neg(h->n);
@@ -512,9 +512,10 @@ static vec3 pbr_whitted(const world *w, const mat_lin *m, const hit *h, ray r, i
 	if (clampd(m->pbr.clearcoat_roughness, 0, 1) < WHITTED_MIRROR_ROUGHNESS)
 		kr = v3_add(kr, v3_splat(p->cc * schlick1(0.04, co)));
 	if (max3(kr) > 0.0)
-		c = v3_add(c, v3_mul(kr, trace(w, (ray){pt, mirror}, depth - 1)));
+		c = v3_add(c, v3_mul(kr, trace(w, (ray){pt, mirror}, depth - 1, v3_mul(weight, kr))));
 	if (max3(kt) > 0.0)
-		c = v3_add(c, v3_mul(kt, trace(w, (ray){offset_point(w, h->p, v3_neg(b.n)), tdir}, depth - 1)));
+		c = v3_add(c, v3_mul(kt, trace(w, (ray){offset_point(w, h->p, v3_neg(b.n)), tdir}, depth - 1,
+		                               v3_mul(weight, kt))));
 	return c;
 }
 

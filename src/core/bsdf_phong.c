@@ -194,8 +194,8 @@ _Thread_local whitted_shadows whitted_shadow_hint;
 
 /* Whitted shading: ambient x colour + emission, diffuse and Phong per
  * visible point light, then the mirror or the glass rays. */
-static vec3 phong_whitted(const world *w, const mat_lin *m, const hit *hp, ray r, int depth,
-                          vec3 (*trace)(const world *w, ray r, int depth))
+static vec3 phong_whitted(const world *w, const mat_lin *m, const hit *hp, ray r, int depth, vec3 weight,
+                          whitted_trace_fn trace)
 {
 	const hit *h = hp; /* read in place: a copy cost 3% of a grid render's instructions */
 	/* the first hit's shadow rays may have been traced as packets, and
@@ -253,19 +253,20 @@ static vec3 phong_whitted(const world *w, const mat_lin *m, const hit *hp, ray r
 		double cos_i = fmin(v3_dot(v, n), 1.0);
 		double sin2_t = eta * eta * (1.0 - cos_i * cos_i);
 		vec3 refl_dir = v3_reflect(r.d, n);
-		vec3 refl = trace(w, (ray){p, refl_dir}, depth - 1);
-		if (sin2_t >= 1.0)
-			return v3_add(c, refl); /* total internal reflection */
+		if (sin2_t >= 1.0) /* total internal reflection */
+			return v3_add(c, trace(w, (ray){p, refl_dir}, depth - 1, weight));
 		double kr = schlick(cos_i, h->front ? 1.0 / m->ior : m->ior);
+		vec3 refl = trace(w, (ray){p, refl_dir}, depth - 1, v3_scale(weight, kr));
 		vec3 tdir = v3_add(v3_scale(r.d, eta), v3_scale(n, eta * cos_i - sqrt(1.0 - sin2_t)));
 		vec3 q = offset_point(w, h->p, v3_neg(n));
-		vec3 trans = trace(w, (ray){q, v3_norm(tdir)}, depth - 1);
+		vec3 trans = trace(w, (ray){q, v3_norm(tdir)}, depth - 1, v3_mul(weight, v3_scale(albedo, 1.0 - kr)));
 		return v3_add(c, v3_add(v3_scale(refl, kr), v3_scale(v3_mul(trans, albedo), 1.0 - kr)));
 	}
 	if (m->reflective > 0.0) {
-		vec3 refl = trace(w, (ray){p, v3_reflect(r.d, n)}, depth - 1);
+		vec3 tint = m->metal > 0.0 ? v3_lerp(v3(1, 1, 1), albedo, m->metal) : v3(1, 1, 1);
+		vec3 refl = trace(w, (ray){p, v3_reflect(r.d, n)}, depth - 1, v3_mul(weight, v3_scale(tint, m->reflective)));
 		if (m->metal > 0.0)
-			refl = v3_mul(refl, v3_lerp(v3(1, 1, 1), albedo, m->metal));
+			refl = v3_mul(refl, tint);
 		c = v3_lerp(c, refl, m->reflective);
 	}
 	return c;

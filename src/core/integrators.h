@@ -170,6 +170,10 @@ int bsdf_features(const bsdf *b, vec3 *albedo, vec3 *tint, vec3 *dir);
 /* The Phong exponent of a mirror lobe of roughness fuzz in (0,1]. */
 double fuzz_exponent(double fuzz);
 
+/* Whitted's recursive ray (whitted.c): the radiance along r, followed to
+ * depth more bounces; weight as in mat_family.whitted. */
+typedef vec3 (*whitted_trace_fn)(const world *w, ray r, int depth, vec3 weight);
+
 /* One material family (material.c's table, indexed by mat_lin.family). */
 typedef struct mat_family {
 	const char *name;
@@ -181,9 +185,13 @@ typedef struct mat_family {
 	int (*features)(const bsdf *b, vec3 *albedo, vec3 *tint, vec3 *dir);
 	/* Whitted shading (whitted.c): what the material sends back along r
 	 * at h from the point lights and ambient, and the mirror / glass rays
-	 * it follows (trace), up to depth. */
-	vec3 (*whitted)(const world *w, const mat_lin *m, const hit *h, ray r, int depth,
-	                vec3 (*trace)(const world *w, ray r, int depth));
+	 * it follows (trace), up to depth. weight is what r's radiance is
+	 * multiplied by on its way to the camera (1,1,1 for a camera ray); a
+	 * ray the material follows is given weight times its own factor
+	 * (kr, kt, reflective...), and trace does not follow it when that is
+	 * negligible (whitted.c, WHITTED_MIN_WEIGHT). */
+	vec3 (*whitted)(const world *w, const mat_lin *m, const hit *h, ray r, int depth, vec3 weight,
+	                whitted_trace_fn trace);
 } mat_family;
 extern const mat_family mat_phong_family, mat_pbr_family;
 /* By mat_lin.family (material.c). */
