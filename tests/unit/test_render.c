@@ -163,6 +163,88 @@ static void test_reflection(void **state)
 		}
 }
 
+/* The rays (world_rays_traced: camera, mirror, glass and shadow rays) that
+ * Whitted traces for the one camera ray r of s at depth. */
+static uint64_t whitted_rays(const scene *s, ray r, int depth)
+{
+	world *w = world_build(s, NULL);
+	assert_non_null(w);
+	render_settings set = render_settings_default();
+	set.depth = depth;
+	set.mode = MODE_WHITTED;
+	world_rays_reset();
+	vec3 c = whitted_radiance(w, &set, r);
+	uint64_t n = world_rays_traced();
+	assert_true(c.x == 0.0 && c.y == 0.0 && c.z == 0.0); /* no light, no ambient */
+	world_free(w);
+	return n;
+}
+
+static object mirror_object(obj_kind k, vec3 pos, vec3 dir, double diameter, double reflective)
+{
+	object o = object_make(k, v3(255, 255, 255));
+	o.pos = pos;
+	o.dir = dir;
+	o.scale = v3_splat(diameter);
+	o.mat.diffuse = 0;
+	o.mat.specular = 0;
+	o.mat.reflective = reflective;
+	return o;
+}
+
+/* Adaptive tree depth control (whitted.c): between two parallel mirrors of
+ * reflective 0.5 a ray shot along their normal bounces back and forth, the
+ * k-th mirror ray carrying weight 0.5^k to the camera. Rays of weight below
+ * 2^-24 are not traced, so mirror rays k = 1..24 are: 25 rays with the
+ * camera's, whatever the depth beyond 24 (the old code traced 1 + depth). No
+ * light: no shadow rays. */
+static void test_whitted_weight_cutoff(void **state)
+{
+	(void)state;
+	scene *s = base_scene(v3(0, 0, -5), v3(0, 0, 1), 60);
+	object a = mirror_object(OBJ_PLANE, v3(0, 0, 1), v3(0, 0, -1), 1, 0.5);
+	object b = mirror_object(OBJ_PLANE, v3(0, 0, -1), v3(0, 0, 1), 1, 0.5);
+	assert_true(scene_add_object(s, &a, NULL));
+	assert_true(scene_add_object(s, &b, NULL));
+	ray r = {v3(0, 0, 0), v3(0, 0, 1)};
+	assert_int_equal(whitted_rays(s, r, 10), 11);
+	assert_int_equal(whitted_rays(s, r, 24), 25);
+	assert_int_equal(whitted_rays(s, r, 100), 25);
+	assert_int_equal(whitted_rays(s, r, 1000), 25);
+	scene_free(s);
+}
+
+/* The hard bound (whitted.c, WHITTED_MAX_RAYS 4096): a camera ray at the
+ * centre of a glass sphere (diameter 2) inside a mirror sphere (diameter 4,
+ * reflective 1) along a diameter. Every ray hits a surface head-on: glass
+ * sends a mirror and a refracted ray, each of weight 1/2 (an ior of
+ * (1 + sqrt .5) / (1 - sqrt .5) makes Schlick's r0 = 1/2), the mirror one
+ * ray of weight 1; none escapes. A ray arriving at the glass with depth d
+ * left traces G(d) rays with its own, one arriving at the mirror M(d):
+ * G(0) = M(0) = 1, G(d) = 1 + G(d-1) + M(d-1) (inside: back to the glass;
+ * outside: on to the mirror), M(d) = 1 + G(d-1); so G(d) = Fib(d+4) - 2:
+ * 2582 at depth 14, 4179 at 15, 46366 at 20. Up to depth 20 no ray's weight
+ * (at least 2^-20, roughly) is below 2^-24, so the weight rule cuts
+ * nothing: the counts are G(d) up to 1 + 4096, then 1 + 4096. */
+static void test_whitted_ray_bound(void **state)
+{
+	(void)state;
+	scene *s = base_scene(v3(0, 0, -5), v3(0, 0, 1), 60);
+	object g = mirror_object(OBJ_SPHERE, v3(0, 0, 0), v3(0, 1, 0), 2, 0);
+	g.mat.ior = (1 + sqrt(0.5)) / (1 - sqrt(0.5));
+	object m = mirror_object(OBJ_SPHERE, v3(0, 0, 0), v3(0, 1, 0), 4, 1);
+	assert_true(scene_add_object(s, &g, NULL));
+	assert_true(scene_add_object(s, &m, NULL));
+	ray r = {v3(0, 0, 0), v3(1, 0, 0)};
+	assert_int_equal(whitted_rays(s, r, 1), 3);
+	assert_int_equal(whitted_rays(s, r, 2), 6);
+	assert_int_equal(whitted_rays(s, r, 14), 2582);
+	assert_int_equal(whitted_rays(s, r, 15), 1 + 4096);
+	assert_int_equal(whitted_rays(s, r, 20), 1 + 4096);
+	assert_int_equal(whitted_rays(s, r, 1000), 1 + 4096);
+	scene_free(s);
+}
+
 /* A scene with every kind of shape, for the invariance tests. */
 static scene *busy_scene(void)
 {
@@ -963,6 +1045,8 @@ int main(void)
 		cmocka_unit_test(test_phong_by_hand),
 		cmocka_unit_test(test_shadow),
 		cmocka_unit_test(test_reflection),
+		cmocka_unit_test(test_whitted_weight_cutoff),
+		cmocka_unit_test(test_whitted_ray_bound),
 		cmocka_unit_test(test_threads_identical),
 		cmocka_unit_test(test_progressive_equals_batch),
 		cmocka_unit_test(test_rect_equals_image),
