@@ -26,7 +26,7 @@ const setting_def settings_table[] = {
 #define AT(field) offsetof(render_settings, field)
 	{"resolution", SETTING_RESOLUTION, 1, RENDER_MAX_DIM, AT(width), "full-resolution image size, WxH", "1280x720", NULL, SETTING_SCENE},
 	{"samples", SETTING_INT, 1, 1000000, AT(samples), "samples (rays or paths) per pixel", "1", NULL, SETTING_SCENE},
-	{"depth", SETTING_INT, 0, 1000, AT(depth), "reflection depth (whitted) or bounces (path)", "5", NULL, SETTING_SCENE},
+	{"depth", SETTING_INT, 0, 1000, AT(depth), "reflection depth (whitted, faint rays cut) or bounces (path)", "5", NULL, SETTING_SCENE},
 	{"mode", SETTING_ENUM, 0, 0, AT(mode), "render mode: whitted or path", "whitted", render_mode_names, SETTING_SCENE},
 	{"threads", SETTING_INT, 0, 256, AT(threads), "render threads; 0 = one per online CPU", "0", NULL, 0},
 	{"seed", SETTING_U64, 0, 0, AT(seed), "random seed of the sampler", "1", NULL, SETTING_SCENE},
