@@ -28,9 +28,11 @@
  * scenes-wild, and costs final.rt no more rays than 2^-16 to speak of. */
 #define WHITTED_MIN_WEIGHT (1.0 / (1 << 24))
 /* ...and a hard bound for files made to defeat the weight rule (glass of
- * ior 5.8 reflects half and passes half, so 2^24 branches stay above it;
- * PBR's clear coat can push a hit's weights a little over 1): a camera ray
- * traces at most this many mirror and glass rays; past it, none more (they
+ * ior 5.8 reflects half and passes half, so a full tree 24 levels deep,
+ * 2^25 rays, stays above it; a hit's weights sum to at most 1 in both
+ * families, so the rule alone bounds a level to 2^24 rays, no more): a
+ * camera ray traces at most this many mirror and glass rays, so at most
+ * 1 + 4096 rays and their shadow rays in all; past it, none more (they
  * bring back black, in the order they come: such a file's picture is cut,
  * its time bounded). It is above what a chain of depth 1000 mirrors (the
  * setting's largest depth) traces, so no weight-1 chain is ever cut, and
