@@ -263,11 +263,10 @@ static vec3 phong_whitted(const world *w, const mat_lin *m, const hit *hp, ray r
 		return v3_add(c, v3_add(v3_scale(refl, kr), v3_scale(v3_mul(trans, albedo), 1.0 - kr)));
 	}
 	if (m->reflective > 0.0) {
+		/* (a tint of 1 changes no bit: x * 1.0 is x) */
 		vec3 tint = m->metal > 0.0 ? v3_lerp(v3(1, 1, 1), albedo, m->metal) : v3(1, 1, 1);
 		vec3 refl = trace(w, (ray){p, v3_reflect(r.d, n)}, depth - 1, v3_mul(weight, v3_scale(tint, m->reflective)));
-		if (m->metal > 0.0)
-			refl = v3_mul(refl, tint);
-		c = v3_lerp(c, refl, m->reflective);
+		c = v3_lerp(c, v3_mul(refl, tint), m->reflective);
 	}
 	return c;
 }

@@ -694,6 +694,17 @@ static bool have_model_packets(void)
 	return yes;
 }
 
+/* A new temporary model file named by path (a mkstemps template ending in
+ * ".obj"), open for writing. */
+static FILE *open_temp_obj(char *path)
+{
+	int fd = mkstemps(path, 4);
+	assert_true(fd >= 0);
+	FILE *f = fdopen(fd, "w");
+	assert_non_null(f);
+	return f;
+}
+
 /* Triangles at exactly the same distance in different blocks and leaves:
  * twelve copies of one triangle, six of another with its corners turned,
  * a grid of quads behind them whose rays meet shared edges and corners, a
@@ -703,10 +714,7 @@ static void test_model_ties(void **state)
 {
 	(void)state;
 	char path[] = "/tmp/rtsh-test-packet-XXXXXX.obj";
-	int fd = mkstemps(path, 4);
-	assert_true(fd >= 0);
-	FILE *f = fdopen(fd, "w");
-	assert_non_null(f);
+	FILE *f = open_temp_obj(path);
 	int nv = 0;
 	for (int c = 0; c < 12; c++) { /* the same triangle twelve times */
 		fprintf(f, "v -2 -2 0\nv 2 -2 0\nv 0 2 0\nf %d %d %d\n", nv + 1, nv + 2, nv + 3);
@@ -822,10 +830,7 @@ static void test_mesh_tie_across_leaves(void **state)
 {
 	(void)state;
 	char path[] = "/tmp/rtsh-test-packet-XXXXXX.obj";
-	int fd = mkstemps(path, 4);
-	assert_true(fd >= 0);
-	FILE *f = fdopen(fd, "w");
-	assert_non_null(f);
+	FILE *f = open_temp_obj(path);
 	/* (x mirrored: model files are right-handed, the scene left-handed) */
 	fprintf(f, "v 1 -2 0\nv -3 -2 0\nv 1 2 0\nv -3 2 2\nv -2 2 2\nv -3 1 2\nf 1 2 3\nf 4 5 6\n");
 	assert_int_equal(fclose(f), 0);

@@ -728,36 +728,37 @@ static void partition_spatial(builder *b, size_t begin, size_t end, size_t room,
 	*nr = room - r;
 }
 
+/* Sifts place r of the max-heap over refs[begin, begin + m) (by primitive
+ * index, places 0-based from begin) down to where it belongs. */
+static void sift_down(builder *b, size_t begin, size_t r, size_t m)
+{
+	const uint32_t *id = b->ids + begin;
+	for (size_t c; (c = 2 * r + 1) < m; r = c) {
+		if (c + 1 < m && id[c + 1] > id[c])
+			c++;
+		if (id[r] >= id[c])
+			break;
+		swap_refs(b, begin + r, begin + c);
+	}
+}
+
 /* Puts refs[begin, end) in ascending order of primitive index, unless
  * they are already (a heap sort: no memory, n log n at worst). The halving
  * below sorts first, so that which references go to which half does not
  * depend on the order the partitions above left them in. */
 static void sort_refs(builder *b, size_t begin, size_t end)
 {
-	uint32_t *id = b->ids + begin;
+	const uint32_t *id = b->ids + begin;
 	size_t n = end - begin, i = 1;
 	while (i < n && id[i - 1] < id[i])
 		i++;
 	if (i >= n)
 		return;
-	/* sift down from the root r of the heap over [0, m), 0-based in the range */
 	for (size_t k = n / 2; k-- > 0;)
-		for (size_t r = k, c; (c = 2 * r + 1) < n; r = c) {
-			if (c + 1 < n && id[c + 1] > id[c])
-				c++;
-			if (id[r] >= id[c])
-				break;
-			swap_refs(b, begin + r, begin + c);
-		}
+		sift_down(b, begin, k, n);
 	for (size_t m = n - 1; m > 0; m--) {
 		swap_refs(b, begin, begin + m);
-		for (size_t r = 0, c; (c = 2 * r + 1) < m; r = c) {
-			if (c + 1 < m && id[c + 1] > id[c])
-				c++;
-			if (id[r] >= id[c])
-				break;
-			swap_refs(b, begin + r, begin + c);
-		}
+		sift_down(b, begin, 0, m);
 	}
 }
 
