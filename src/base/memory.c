@@ -131,6 +131,21 @@ void mem_huge_pages(void *p, size_t bytes)
 #endif
 }
 
+void mem_prefault(void *p, size_t bytes)
+{
+#ifdef MADV_POPULATE_WRITE
+	const uintptr_t page = 4096;
+	if (!p || bytes < ((size_t)4 << 20))
+		return;
+	uintptr_t lo = ((uintptr_t)p + page - 1) & ~(page - 1), hi = ((uintptr_t)p + bytes) & ~(page - 1);
+	if (hi > lo)
+		(void)madvise((void *)lo, hi - lo, MADV_POPULATE_WRITE);
+#else
+	(void)p;
+	(void)bytes;
+#endif
+}
+
 char *mem_dupz(const void *p, size_t n)
 {
 	char *d = malloc(n + 1);

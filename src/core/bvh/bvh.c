@@ -934,6 +934,7 @@ static bool build_from(const box *bounds, fbox *refs, size_t n, const bvh_build_
 		free(b.tmp_ids);
 		return rt_error_set(err, "out of memory building the BVH (%zu objects)", n);
 	}
+	mem_prefault(b.ids, cap * sizeof *b.ids); /* written whole below */
 	fbox bb = fbox_empty(), cb = fbox_empty();
 	for (size_t i = 0; i < n; i++) {
 		fbox *r = &b.refs[i];
