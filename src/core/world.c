@@ -229,10 +229,15 @@ static bool reorder(world *w, const scene *s, const uint8_t *kf, const uint32_t 
 
 world *world_build(const scene *s, rt_error *err)
 {
-	return world_build_cancel(s, NULL, err);
+	return world_build_threads(s, 1, NULL, err);
 }
 
 world *world_build_cancel(const scene *s, const atomic_bool *cancel, rt_error *err)
+{
+	return world_build_threads(s, 1, cancel, err);
+}
+
+world *world_build_threads(const scene *s, int threads, const atomic_bool *cancel, rt_error *err)
 {
 	world *w = calloc(1, sizeof *w);
 	if (!w) {
@@ -368,7 +373,7 @@ world *world_build_cancel(const scene *s, const atomic_bool *cancel, rt_error *e
 	for (size_t i = 0; i < s->nlights; i++)
 		extent = fmax(extent, v3_max_abs(s->lights[i].pos));
 	w->eps = 1e-9 * fmax(1.0, extent);
-	w->tree = bvh_build(refs, w->nprims, order, cancel, err);
+	w->tree = bvh_build(refs, w->nprims, order, threads, cancel, err);
 	free(refs);
 	bool ok = w->tree && reorder(w, s, kf, pobj, order);
 	mem_free_all(order, pobj, kf);

@@ -559,6 +559,40 @@ static void test_sphere_prims(void **state)
 	scene_free(s);
 }
 
+/* The tree built by 2, 3 and 4 threads is the 1-thread tree to the byte
+ * (bvh.h): 30000 objects of every kind at random (a subtree goes to
+ * another thread from 4096 references on both sides), the wide nodes,
+ * the primitives in tree order and the counts compared. */
+static void test_threaded_build(void **state)
+{
+	(void)state;
+	scene *s = random_scene(29, 30000, 100, 1.0, 1);
+	rt_error err;
+	world *one = world_build_threads(s, 1, NULL, &err);
+	assert_non_null(one);
+	for (int t = 2; t <= 4; t++) {
+		world *w = world_build_threads(s, t, NULL, &err);
+		assert_non_null(w);
+		assert_int_equal(w->tree->nnodes, one->tree->nnodes);
+		assert_int_equal(w->tree->depth, one->tree->depth);
+		assert_int_equal(w->tree->leaves, one->tree->leaves);
+		assert_int_equal(w->tree->root, one->tree->root);
+		assert_memory_equal(w->tree->nodes, one->tree->nodes, one->tree->nnodes * sizeof *one->tree->nodes);
+		assert_int_equal(w->nprims, one->nprims);
+		for (size_t i = 0; i < w->nprims; i++) {
+			const prim *a = &w->prims[i], *b = &one->prims[i];
+			assert_true(a->tag == b->tag && a->object == b->object);
+			if (a->tag == PRIM_SPHERE)
+				assert_memory_equal(&a->u.sph, &b->u.sph, sizeof a->u.sph);
+			else
+				assert_int_equal(a->u.index, b->u.index);
+		}
+		world_free(w);
+	}
+	world_free(one);
+	scene_free(s);
+}
+
 /* The builder's binning of refs ids[0, n) (float boxes fb, unit costs) by
  * its definition (bvh.c): doubled centroids lo + hi, min(n, 16) bins
  * across their bounds per axis, bin (c - lo) * (bins / extent) truncated
@@ -802,6 +836,7 @@ int main(void)
 		cmocka_unit_test(test_float_boxes),
 		cmocka_unit_test(test_fast_spheres),
 		cmocka_unit_test(test_sphere_prims),
+		cmocka_unit_test(test_threaded_build),
 		cmocka_unit_test(test_sah_splits),
 		cmocka_unit_test(test_leaf_order),
 	};
