@@ -39,6 +39,12 @@ double mem_held(long *scenes);
  * before the memory is first written; a no-op below 4 MB or where the call
  * is refused. */
 void mem_huge_pages(void *p, size_t bytes);
+/* bytes (at least 1) for an array walked at random, 64-byte aligned; from
+ * 4 MB on, 2 MB-aligned and a whole number of 2 MB pages long, with
+ * mem_huge_pages, so that every page of it can be a huge one (an array
+ * placed at random leaves up to its first and last 2 MB in 4 KB pages).
+ * Freed with free; NULL when out of memory. */
+void *mem_alloc_huge(size_t bytes);
 /* Makes the pages of [p, p + bytes) at once (madvise MADV_POPULATE_WRITE,
  * Linux 5.14) rather than at a fault each on first write: for a large
  * array about to be written whole (world_build's materials, references and

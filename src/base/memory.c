@@ -131,6 +131,19 @@ void mem_huge_pages(void *p, size_t bytes)
 #endif
 }
 
+void *mem_alloc_huge(size_t bytes)
+{
+	const size_t huge = (size_t)2 << 20;
+	if (bytes > SIZE_MAX - huge)
+		return NULL;
+	if (bytes < 2 * huge)
+		return aligned_alloc(64, bytes ? (bytes + 63) & ~(size_t)63 : 64);
+	size_t whole = (bytes + huge - 1) & ~(huge - 1);
+	void *p = aligned_alloc(huge, whole);
+	mem_huge_pages(p, whole);
+	return p;
+}
+
 void mem_prefault(void *p, size_t bytes)
 {
 #ifdef MADV_POPULATE_WRITE

@@ -176,19 +176,16 @@ static bool make_plane(world *w, const object *o, uint32_t index, prim_plane *pl
  * j is object pobj[j], or object j when pobj is NULL (no planes). */
 static bool reorder(world *w, const scene *s, const uint8_t *kf, const uint32_t *pobj, const uint32_t *order)
 {
-	prim *prims = malloc((w->nprims ? w->nprims : 1) * sizeof *prims);
-	prim_shape *shapes = malloc((w->nshapes ? w->nshapes : 1) * sizeof *shapes);
-	prim_tri *tris = malloc((w->ntris ? w->ntris : 1) * sizeof *tris);
+	/* walked in tree order by every ray: huge pages spare the TLB */
+	prim *prims = mem_alloc_huge(w->nprims * sizeof *prims);
+	prim_shape *shapes = mem_alloc_huge(w->nshapes * sizeof *shapes);
+	prim_tri *tris = mem_alloc_huge(w->ntris * sizeof *tris);
 	if (!prims || !shapes || !tris) {
 		free(prims);
 		free(shapes);
 		free(tris);
 		return false;
 	}
-	/* walked in tree order by every ray: huge pages spare the TLB */
-	mem_huge_pages(prims, w->nprims * sizeof *prims);
-	mem_huge_pages(shapes, w->nshapes * sizeof *shapes);
-	mem_huge_pages(tris, w->ntris * sizeof *tris);
 	enum { AHEAD = 16 }; /* the objects are read at random: fetched ahead */
 	for (size_t i = 0; i < w->nprims; i++) {
 		if (i + AHEAD < w->nprims) {

@@ -1146,9 +1146,8 @@ bvh *bvh_build(bvh_fbox *refs, size_t n, uint32_t *order, int threads, const ato
 	t->root_meta = 0;
 	bvh2_free(&b);
 	bytes = (used * sizeof(bvh_node) + 63) / 64 * 64;
-	bvh_node *fit = aligned_alloc(64, bytes);
+	bvh_node *fit = mem_alloc_huge(bytes); /* every ray's walk: huge pages spare the TLB */
 	if (fit) {
-		mem_huge_pages(fit, bytes); /* every ray's walk: huge pages spare the TLB */
 		memcpy(fit, wide, used * sizeof *fit);
 		free(wide);
 		wide = fit;
