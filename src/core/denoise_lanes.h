@@ -197,10 +197,10 @@ LANES_INLINE vi solve_lanes(const vf *a, vf zv[NU])
  * colour weights) of the radiance over albedo on the screen position, the
  * normal and the depth, over the window around each pixel of rows
  * [y0, y1), evaluated at the pixel. The taps are weighted by how alike
- * their features are (albedo, normal, depth off the pixel's plane) and by
- * nothing else: no weight depends on the noise, so the fit of each half's
- * brightness depends on that half's samples only, and cross_error
- * estimates the fit's error honestly.
+ * their features are (albedo, normal, depth off the pixel's plane, direct
+ * light: DIRECT_W) and by nothing else: no weight depends on the noise,
+ * so the fit of each half's brightness depends on that half's samples
+ * only, and cross_error estimates the fit's error honestly.
  *
  * VL neighbouring pixels of a row at a time, one in each SIMD lane
  * (their planes: one load for them all): each lane does the one pixel's
@@ -259,6 +259,8 @@ LANES_INLINE void regression_body(job *j, int y0, int y1)
 					vf e = feat_dist2(gf, pf, q);
 					vf qz = vf_load(pz + q);
 					e += vf_abs(qz - (gz + ggx * off[dx + WIN] + ggy * off[dy + WIN])) * inv_z;
+					vf dd = (vf_load(pd + q) - gd) * dscale;
+					e += vf_splat(DIRECT_W) * dd * dd;
 					vf wt = vf_exp_fast(&e);
 					vi m = in & (wt > vf_splat(0.0f));
 					if (!vf_any(&m))
@@ -271,7 +273,7 @@ LANES_INLINE void regression_body(job *j, int y0, int y1)
 					for (int k = 3; k < 6; k++)
 						v[k] = vf_and(vf_load(pf[k] + q) - gf[k], m);
 					v[6] = vf_and((qz - gz) * inv_z, m);
-					v[7] = vf_and((vf_load(pd + q) - gd) * dscale, m);
+					v[7] = vf_and(dd, m);
 					tw[nt] = tww;
 					tm[nt] = m;
 					tq[nt] = q;
