@@ -359,9 +359,9 @@ LANES_INLINE void regression_body(job *j, int y0, int y1)
  * both regressions are estimated to beat the raw pixel their blend by
  * those estimates; times the albedo again, into the all-samples chain
  * (radiance, and the noise variance of the mean's brightness). The
- * average is weighted by how alike the pixels' albedo and normal are
- * (exp(-PICK_SCALE d^2), d their distance as the regression's weights
- * measure it), so that the estimates of another surface (a highlight's, a
+ * average is weighted by how alike the pixels' albedo, normal and direct
+ * light are (exp(-PICK_SCALE d^2), d their distance as the regression's
+ * weights measure it, but for the depth), so that the estimates of another surface (a highlight's, a
  * wall's behind an edge) count less than the pixel's own surface's. The
  * sums are left undivided by the weights' sum: it is the same for every
  * candidate of the pixel, and neither the choice nor the blend's shares
@@ -377,6 +377,7 @@ LANES_INLINE void pick_body(job *j, int y0, int y1)
 		perr[c] = plane(j, PL_ERR + c);
 	for (int k = 0; k < 6; k++)
 		pf[k] = plane(j, PL_F0 + k);
+	const float *pd = plane(j, PL_D);
 	for (int y = y0; y < y1; y++)
 		for (int x0 = 0; x0 < w; x0 += VL) {
 			/* VL pixels' sums, one in each lane, each over its window
@@ -391,6 +392,8 @@ LANES_INLINE void pick_body(job *j, int y0, int y1)
 			vf gf[6];
 			for (int k = 0; k < 6; k++)
 				gf[k] = vf_load(pf[k] + (ptrdiff_t)y * w + x0);
+			vf gd = vf_load(pd + (ptrdiff_t)y * w + x0);
+			vf dscale = vf_splat(1.0f) / (vf_splat(0.5f) * vf_abs(gd) + vf_splat(0.05f));
 			vf sv[NCAND] = {{0}};
 			for (int qy = y - PICK_R; qy <= y + PICK_R; qy++) {
 				if (qy < 0 || qy >= h)
@@ -399,6 +402,8 @@ LANES_INLINE void pick_body(job *j, int y0, int y1)
 				for (int dx = -PICK_R; dx <= PICK_R; dx++) {
 					ptrdiff_t q = (ptrdiff_t)qy * w + x0 + dx;
 					vf e = feat_dist2(gf, pf, q);
+					vf dd = (vf_load(pd + q) - gd) * dscale;
+					e += vf_splat(DIRECT_W) * dd * dd;
 					e *= vf_splat(PICK_SCALE);
 					vf wt = vf_exp_fast(&e);
 					/* no weight: skipped (an infinite estimate times 0

@@ -551,7 +551,10 @@ static void test_feature_edge(void **state)
  * is 2 / sqrt(8) x sqrt(2 / 25) = 0.200, and the regression on all the
  * features, a constant, x, y and the direct light, 0.283 then, 0.407
  * now); the raw pixels 0.707. The choice among the candidates by their
- * noisy error estimates adds a little: within 20% of the line. */
+ * noisy error estimates adds to it (the blend with the whole fit; and
+ * averaged over the pixels of alike direct light, fewer, the estimates
+ * are noisier): within 20% of the line (0.324 with the direct light in
+ * the regression's weights alone, 0.348 in the choice's too). */
 static double exp_fast_def(double x)
 {
 	double t = 1.0 - x / 16.0;
@@ -724,6 +727,51 @@ static void test_pick_own_surface(void **state)
 	int c = Y * W + X;
 	print_message("the block's centre: %.4f (its samples 1; the block's mean %.4f)\n", out[c * 3],
 	              2.6 / 9);
+	for (int k = 0; k < 3; k++)
+		assert_near(out[c * 3 + k], 1.0, 1e-5);
+	free(out);
+	fb_free(fb);
+}
+
+/* The same peak told apart by its direct light alone: a 3x3 block of the
+ * surface's albedo (0.5) and direct light 0.1 (over the albedo) in a
+ * surface of direct light 1, whose samples all agree, 1 at the centre
+ * and 0.2 around it (radiance); the surface 1 with noise 0.5 a sample, 8
+ * samples. From the block's pixels a surface pixel is (1 - 0.1) / (0.5 x
+ * 0.1 + 0.05) = 9 off in the direct-light regressor: in the regression
+ * DIRECT_W x 81 >= 16 and in the choice's average PICK_SCALE x DIRECT_W x
+ * 81 = 20.25 >= 16, no weight in either (exp_fast). So at the centre the
+ * fits are the block's 9 taps' mean, (1 + 8 x 0.2) / 9 = 0.2889, their
+ * estimated error 0.711^2, and only the block's estimates are averaged:
+ * the raw pixels' are 0 (their halves agree, no noise), and it keeps its
+ * value, 1. Without the direct light in the choice's weights all 81
+ * estimates count alike, the surface's 72 raw ones (0.5^2 / 8 each on
+ * average, 2.25) outweigh the fits' (0.57 of the block's, about 0.22 of
+ * the surface's: test_pick_own_surface), and the centre took 0.2889. */
+static void test_pick_direct_light(void **state)
+{
+	(void)state;
+	const int W = 40, H = 32, X = 20, Y = 16, SPP = 8;
+	framebuffer *fb = flat_fb(W, H, SPP);
+	test_rng r = {37};
+	for (int y = 0; y < H; y++)
+		for (int x = 0; x < W; x++) {
+			int i = y * W + x;
+			float *f = fb->feat + (size_t)i * DENOISE_FEATURES;
+			bool block = abs(x - X) <= 1 && abs(y - Y) <= 1;
+			f[14] = block ? 0.05f : 0.5f; /* over the albedo 0.5: 0.1 and 1 */
+			if (block) {
+				float v = x == X && y == Y ? 1.0f : 0.2f;
+				set_pixel(fb, i, v, v, v);
+			} else {
+				noisy_pixel(fb, i, 1.0, 0.5, &r);
+			}
+		}
+	float *out = malloc(sizeof(float) * W * H * 3);
+	assert_non_null(out);
+	assert_true(denoise_image(fb, out, 2));
+	int c = Y * W + X;
+	print_message("the block's centre: %.4f (its samples 1; the block's mean %.4f)\n", out[c * 3], 2.6 / 9);
 	for (int k = 0; k < 3; k++)
 		assert_near(out[c * 3 + k], 1.0, 1e-5);
 	free(out);
@@ -1640,6 +1688,7 @@ int main(void)
 		cmocka_unit_test(test_highlight_blocks),
 		cmocka_unit_test(test_direct_weight_band),
 		cmocka_unit_test(test_pick_own_surface),
+		cmocka_unit_test(test_pick_direct_light),
 		cmocka_unit_test(test_threads),
 		cmocka_unit_test(test_features_through_mirror),
 		cmocka_unit_test(test_features_through_glass),
