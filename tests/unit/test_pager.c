@@ -141,7 +141,7 @@ static void test_typing_leaves(void **state)
 	 * at 2 x 3 bytes), then 'e' leaves and is kept */
 	char longt[128] = "";
 	for (int i = 0; i < 30; i++) {
-		char r[8];
+		char r[16];
 		snprintf(r, sizeof r, "r%d\n", i);
 		strcat(longt, r);
 	}
