@@ -539,6 +539,22 @@ void denoise_features_only(const world *w, const render_settings *s, int px, int
  * estimates are noisier than the radiance). */
 #define PICK_R 4
 #define PICK_SCALE 0.25f
+/* The regression's taps, and the pixels in the choice's average, are
+ * also weighted by how alike their direct light is: DIRECT_W dd^2 more in
+ * the weight's exponent (before PICK_SCALE in the choice's), dd the
+ * regression's direct-light regressor (the tap's direct light less the
+ * pixel's, over 0.5 |d| + 0.05 of the pixel's). Where a rough metal
+ * reflects the horizon, the dark band and the bright sky beside it have
+ * the same albedo, normal and depth, and the fits flattened the band; the
+ * direct light (the sky through the metal's lobe) tells them apart, and
+ * the radiance need not be linear in it across the window. 4 seeds (1,
+ * 7920, 15839, 23758), RMS new/old of metal-fuzz, final, cornell, spot,
+ * sky-spheres: 128x96 0.955 0.991 1.004 0.987 1.007, 200x120 0.957 0.984
+ * 1.002 0.980 1.003, 640x360 0.984 0.984 1.000 0.990 1.002; in the
+ * regression alone geomean 0.9887 (128x96, 200x120; 0.9867 both),
+ * DIRECT_W 0.5 and 2 there 0.9894 and 0.9929 (bench/README, the denoise9
+ * session). */
+#define DIRECT_W 1.0f
 /* A mixed pixel's regression may move it by at most this many standard
  * deviations of its noise. */
 #define MIX_K 3.0f

@@ -197,10 +197,10 @@ LANES_INLINE vi solve_lanes(const vf *a, vf zv[NU])
  * colour weights) of the radiance over albedo on the screen position, the
  * normal and the depth, over the window around each pixel of rows
  * [y0, y1), evaluated at the pixel. The taps are weighted by how alike
- * their features are (albedo, normal, depth off the pixel's plane) and by
- * nothing else: no weight depends on the noise, so the fit of each half's
- * brightness depends on that half's samples only, and cross_error
- * estimates the fit's error honestly.
+ * their features are (albedo, normal, depth off the pixel's plane, direct
+ * light: DIRECT_W) and by nothing else: no weight depends on the noise,
+ * so the fit of each half's brightness depends on that half's samples
+ * only, and cross_error estimates the fit's error honestly.
  *
  * VL neighbouring pixels of a row at a time, one in each SIMD lane
  * (their planes: one load for them all): each lane does the one pixel's
@@ -259,6 +259,8 @@ LANES_INLINE void regression_body(job *j, int y0, int y1)
 					vf e = feat_dist2(gf, pf, q);
 					vf qz = vf_load(pz + q);
 					e += vf_abs(qz - (gz + ggx * off[dx + WIN] + ggy * off[dy + WIN])) * inv_z;
+					vf dd = (vf_load(pd + q) - gd) * dscale;
+					e += vf_splat(DIRECT_W) * dd * dd;
 					vf wt = vf_exp_fast(&e);
 					vi m = in & (wt > vf_splat(0.0f));
 					if (!vf_any(&m))
@@ -271,7 +273,7 @@ LANES_INLINE void regression_body(job *j, int y0, int y1)
 					for (int k = 3; k < 6; k++)
 						v[k] = vf_and(vf_load(pf[k] + q) - gf[k], m);
 					v[6] = vf_and((qz - gz) * inv_z, m);
-					v[7] = vf_and((vf_load(pd + q) - gd) * dscale, m);
+					v[7] = vf_and(dd, m);
 					tw[nt] = tww;
 					tm[nt] = m;
 					tq[nt] = q;
@@ -357,9 +359,9 @@ LANES_INLINE void regression_body(job *j, int y0, int y1)
  * both regressions are estimated to beat the raw pixel their blend by
  * those estimates; times the albedo again, into the all-samples chain
  * (radiance, and the noise variance of the mean's brightness). The
- * average is weighted by how alike the pixels' albedo and normal are
- * (exp(-PICK_SCALE d^2), d their distance as the regression's weights
- * measure it), so that the estimates of another surface (a highlight's, a
+ * average is weighted by how alike the pixels' albedo, normal and direct
+ * light are (exp(-PICK_SCALE d^2), d their distance as the regression's
+ * weights measure it, but for the depth), so that the estimates of another surface (a highlight's, a
  * wall's behind an edge) count less than the pixel's own surface's. The
  * sums are left undivided by the weights' sum: it is the same for every
  * candidate of the pixel, and neither the choice nor the blend's shares
@@ -375,6 +377,7 @@ LANES_INLINE void pick_body(job *j, int y0, int y1)
 		perr[c] = plane(j, PL_ERR + c);
 	for (int k = 0; k < 6; k++)
 		pf[k] = plane(j, PL_F0 + k);
+	const float *pd = plane(j, PL_D);
 	for (int y = y0; y < y1; y++)
 		for (int x0 = 0; x0 < w; x0 += VL) {
 			/* VL pixels' sums, one in each lane, each over its window
@@ -389,6 +392,8 @@ LANES_INLINE void pick_body(job *j, int y0, int y1)
 			vf gf[6];
 			for (int k = 0; k < 6; k++)
 				gf[k] = vf_load(pf[k] + (ptrdiff_t)y * w + x0);
+			vf gd = vf_load(pd + (ptrdiff_t)y * w + x0);
+			vf dscale = vf_splat(1.0f) / (vf_splat(0.5f) * vf_abs(gd) + vf_splat(0.05f));
 			vf sv[NCAND] = {{0}};
 			for (int qy = y - PICK_R; qy <= y + PICK_R; qy++) {
 				if (qy < 0 || qy >= h)
@@ -397,6 +402,8 @@ LANES_INLINE void pick_body(job *j, int y0, int y1)
 				for (int dx = -PICK_R; dx <= PICK_R; dx++) {
 					ptrdiff_t q = (ptrdiff_t)qy * w + x0 + dx;
 					vf e = feat_dist2(gf, pf, q);
+					vf dd = (vf_load(pd + q) - gd) * dscale;
+					e += vf_splat(DIRECT_W) * dd * dd;
 					e *= vf_splat(PICK_SCALE);
 					vf wt = vf_exp_fast(&e);
 					/* no weight: skipped (an infinite estimate times 0

@@ -64,6 +64,13 @@ void evloop_set_interrupt(evloop *l, bool (*interrupted)(void *ctx), void *ctx)
 	l->ctx = ctx;
 }
 
+void evloop_unread(evloop *l, size_t n)
+{
+	/* Nothing compacts the buffer between evloop_key's return and this:
+	 * its bytes are still at pos - n. */
+	l->pos -= n <= l->pos ? n : l->pos;
+}
+
 bool evloop_has_keys(const evloop *l)
 {
 	return l->pos < l->keys.len;

@@ -91,6 +91,10 @@ int evloop_getc_wait(evloop *l);
  * Returns its length; 0 at the end of the input or when the interrupt hook
  * said so. */
 size_t evloop_key(evloop *l, char *seq, size_t size, double esc_wait);
+/* Gives back the last n bytes evloop_key returned, to be read again (by
+ * the next reader: readline after the pager). Only right after that
+ * evloop_key, with n at most its length. */
+void evloop_unread(evloop *l, size_t n);
 /* True while key bytes wait. */
 bool evloop_has_keys(const evloop *l);
 /* True once the input ended (and every key byte was read). */

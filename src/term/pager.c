@@ -178,7 +178,8 @@ static void draw(evloop *l, int fd, const slice *rows, int nrows, int top, int p
 	}
 	int last = top + page < nrows ? top + page : nrows;
 	char keys[160];
-	snprintf(keys, sizeof keys, " lines %d-%d of %d%s  Space next page  b back  Up/Down a line  q quit ",
+	snprintf(keys, sizeof keys, " lines %d-%d of %d%s  Space next page  b back  Up/Down a line  q quit  "
+	         "typing starts a command ",
 	         top + 1, last, nrows, last == nrows ? " (end)" : "");
 	abuf_printf(&a, "\x1b[%d;1H\x1b[m\x1b[7m", page + 1);
 	int w = 0;
@@ -194,6 +195,20 @@ static void draw(evloop *l, int fd, const slice *rows, int nrows, int top, int p
 			write_all(fd, a.b, a.len);
 	}
 	abuf_free(&a);
+}
+
+/* Whether key k (evloop_key's) is typed text rather than a key of the
+ * pager: a printable character that is not Space or q, nor, while the
+ * text is longer than a page (`fits` false), one of the moving letters
+ * f b j k g G. */
+static bool starts_command(const char *k, bool fits)
+{
+	unsigned char c = (unsigned char)k[0];
+	if (c < 0x20 || c == 0x7f || c == ' ' || c == 'q' || c == 'Q')
+		return false;
+	if (c >= 0x80)
+		return c >= 0xc0; /* a UTF-8 character's first byte */
+	return fits || !strchr("fbjkgG", c);
 }
 
 bool pager_show(evloop *l, int fd_out, const char *text, size_t len, int cols, int rows, size_t *at)
@@ -218,10 +233,19 @@ bool pager_show(evloop *l, int fd_out, const char *text, size_t len, int cols, i
 				*at = (size_t)(sl[top].p - text);
 			draw(l, fd_out, sl, nrows, top, page, cols);
 			char k[16];
-			if (!evloop_key(l, k, sizeof k, PAGER_ESC_WAIT)) {
+			size_t kn = evloop_key(l, k, sizeof k, PAGER_ESC_WAIT);
+			if (!kn) {
 				left = evloop_eof(l);
 				break;
 			}
+			bool fits = nrows <= page;
+			if (starts_command(k, fits)) {
+				/* The user began the next command: it is kept whole. */
+				evloop_unread(l, kn);
+				break;
+			}
+			if (fits && (strcmp(k, "\r") == 0 || strcmp(k, "\n") == 0))
+				break;
 			if (strcmp(k, " ") == 0 || strcmp(k, "f") == 0 || strcmp(k, "\x1b[6~") == 0) {
 				if (top >= max_top && k[0] == ' ')
 					break;

@@ -33,7 +33,10 @@ char *pager_wrap(const char *text, size_t len, int cols, size_t *out_len);
  * terminal, is put in non-canonical mode for the while): Space / PgDn / f a page on,
  * b / PgUp a page back, Enter / Down / j a line on, Up / k a line back,
  * g / Home the top, G / End the end, q / Esc leave; Space on the last page
- * leaves too. *at is the offset in text of the first row to show (0: the
+ * leaves too, and Enter when the text fits one page. Any other printable
+ * key (the moving letters too when the text fits one page) leaves and is
+ * given back to the loop, to begin the next command line: what the user
+ * typed is not lost. *at is the offset in text of the first row to show (0: the
  * top), and on return that of the first row shown. Returns true when the
  * user leaves or the input ends, false when the loop's interrupt hook
  * stopped it (a signal): the caller may show it again from *at, as it was

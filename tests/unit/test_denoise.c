@@ -531,22 +531,65 @@ static void test_feature_edge(void **state)
 	fb_free(fb);
 }
 
-/* Highlights a few pixels wide: a flat surface of albedo 0.5 with 3x3
+/* Highlights a few pixels wide: a flat surface of albedo 0.5 with 12 5x5
  * blocks of albedo 1 (a glossy metal's highlight: so unlike their
- * surroundings that no tap crosses, SIGMA_A2), 12 pixels apart, whose
- * direct light peaks as a highlight does: 8 at the centre, 4 at the
- * edges' middles, 2 at the corners; the radiance is the direct light,
- * with noise 2 a sample, 8 samples. Each block's pixel then has the 9
- * taps of its block, all of weight one. A least-squares fit with p
- * unknowns over n equally weighted taps has at its taps a variance of
- * trace(hat) / n = p / n of the noise on average: a line in the direct
- * light (2 unknowns) 2 / 9 of the raw pixel's, RMS 2 / sqrt(8) x
- * sqrt(2 / 9) = 0.333; the regression on all the features (a constant,
- * x, y and the direct light; the normal and depth are alike) 4 / 9, RMS
- * 0.471; the raw pixels 0.707. 15 blocks, 30 degrees of freedom: the RMS
- * is within 20% of 0.333 but for a chance of a few in 100 (chi-square),
- * and the choice among candidates by their noisy error estimates adds
- * a little. */
+ * surroundings that a tap across has a weight of (1 - 9.375 / 16)^16 =
+ * 7e-7, none to speak of; SIGMA_A2), 14 pixels apart, whose direct light
+ * peaks as a highlight does: 8 at the centre, halved at each step out (4,
+ * 2, 1, 0.5 at city-block distance 1 to 4); the radiance is the direct
+ * light, with noise 2 a sample (variance 4 / 8 of a pixel's mean), 8
+ * samples. Each block's pixel p then has the 25 taps t of its block, of
+ * weight w_t = exp_fast(DIRECT_W dd_t^2), dd_t = (d_t - d_p) / (0.5 d_p +
+ * 0.05) (the direct light's weight; 1 for every tap before it). A
+ * weighted least-squares line in the direct light (what the direct
+ * light's fit is: a constant and dd's slope, held back by DIRECT_RIDGE x
+ * sum w) gives sum_t h_t y_t at p, h_t = w_t (z0 + z1 dd_t), (z0, z1) =
+ * M^-1 (1, 0), M = sum_t w_t (1, dd_t)^T (1, dd_t) plus the ridge; its
+ * expected squared error is (sum h_t d_t - d_p)^2 + 4 / 8 sum h_t^2
+ * (the radiance is linear in the direct light: the bias is the ridge's).
+ * Computed below for the 25 pixels: RMS 0.2925 (with equal weights it
+ * is 2 / sqrt(8) x sqrt(2 / 25) = 0.200, and the regression on all the
+ * features, a constant, x, y and the direct light, 0.283 then, 0.407
+ * now); the raw pixels 0.707. The choice among the candidates by their
+ * noisy error estimates adds to it (the blend with the whole fit; and
+ * averaged over the pixels of alike direct light, fewer, the estimates
+ * are noisier): within 20% of the line (0.324 with the direct light in
+ * the regression's weights alone, 0.348 in the choice's too). */
+static double exp_fast_def(double x)
+{
+	double t = 1.0 - x / 16.0;
+	t = t > 0 ? t : 0;
+	return pow(t, 16);
+}
+
+static double highlight_line_rms(int B)
+{
+	const double W = 1.0, RIDGE_D = 1e-2, VAR = 4.0 / 8.0; /* DIRECT_W, DIRECT_RIDGE, the pixel's noise */
+	double se = 0;
+	for (int p = 0; p < B * B; p++) {
+		double dp = 8.0 / (1 << (abs(p % B - B / 2) + abs(p / B - B / 2)));
+		double sc = 1.0 / (0.5 * dp + 0.05), m00 = 0, m01 = 0, m11 = 0;
+		for (int t = 0; t < B * B; t++) {
+			double dd = (8.0 / (1 << (abs(t % B - B / 2) + abs(t / B - B / 2))) - dp) * sc;
+			double w = exp_fast_def(W * dd * dd);
+			m00 += w;
+			m01 += w * dd;
+			m11 += w * dd * dd;
+		}
+		m11 += RIDGE_D * m00;
+		double det = m00 * m11 - m01 * m01, z0 = m11 / det, z1 = -m01 / det;
+		double fit = 0, var = 0;
+		for (int t = 0; t < B * B; t++) {
+			double dt = 8.0 / (1 << (abs(t % B - B / 2) + abs(t / B - B / 2))), dd = (dt - dp) * sc;
+			double h = exp_fast_def(W * dd * dd) * (z0 + z1 * dd);
+			fit += h * dt;
+			var += h * h * VAR;
+		}
+		se += (fit - dp) * (fit - dp) + var;
+	}
+	return sqrt(se / (B * B));
+}
+
 static void test_highlight_blocks(void **state)
 {
 	(void)state;
@@ -584,11 +627,62 @@ static void test_highlight_blocks(void **state)
 		n++;
 	}
 	assert_int_equal(n, NB * B * B);
-	double dn = sqrt(se_dn / n), raw = sqrt(se_raw / n), want = SIG / sqrt(SPP) * sqrt(2.0 / (B * B));
-	print_message("highlight blocks: RMS error raw %.4f (expected %.4f), denoised %.4f (expected %.4f; all "
-	              "the features' regression %.4f)\n",
-	              raw, SIG / sqrt(SPP), dn, want, SIG / sqrt(SPP) * sqrt(4.0 / (B * B)));
+	double dn = sqrt(se_dn / n), raw = sqrt(se_raw / n), want = highlight_line_rms(B);
+	print_message("highlight blocks: RMS error raw %.4f (expected %.4f), denoised %.4f (expected %.4f, "
+	              "the weighted line in the direct light)\n",
+	              raw, SIG / sqrt(SPP), dn, want);
+	assert_near(want, 0.2925, 1e-4);
 	assert_true(dn < 1.2 * want);
+	free(out);
+	fb_free(fb);
+}
+
+/* A rough metal reflecting the horizon: one surface (albedo 0.5, the same
+ * normal and depth everywhere), vertical stripes every 12 columns of a
+ * dark band 3 wide (direct light over albedo 0.1, radiance 0.3), with 2
+ * columns each side of a mid tone (0.55, 0.9), in a bright rest (1, 1):
+ * the radiance is no line in the direct light. Noise 0.5 a sample, 8
+ * samples. At a band pixel a tap of the mid tone is 0.45 / (0.5 x 0.1 +
+ * 0.05) = 4.5 off in the direct-light regressor, of the rest 9: DIRECT_W
+ * x 4.5^2 = 20.25 >= 16, so exp_fast gives them no weight at all, the
+ * fits are over the band's own taps, whose radiance is a constant plus
+ * noise: every candidate is unbiased, and the band's mean comes out 0.3
+ * but for noise (the band's 288 pixels' mean of 8 samples each: 0.5 /
+ * sqrt(8 x 288) = 0.010). Without that weight all 81 taps count alike: at
+ * the band's centre 18 of the rest, 36 of the mid tone, 27 of the band,
+ * whose least-squares line in the direct light (mean direct light 40.5 /
+ * 81 = 0.5, radiance 58.5 / 81 = 0.7222, slope 7.38 / 8.91 = 0.8283) is
+ * 0.7222 - 0.4 x 0.8283 = 0.391 at the band: 0.09 too bright, and the
+ * fits' estimated error (0.09^2 + a little noise) beats the raw pixel's
+ * (0.5^2 / 8), so the fits were taken (the old code: 0.359). */
+static void test_direct_weight_band(void **state)
+{
+	(void)state;
+	const int W = 48, H = 24, SPP = 8;
+	framebuffer *fb = flat_fb(W, H, SPP);
+	test_rng r = {11};
+	for (int y = 0; y < H; y++)
+		for (int x = 0; x < W; x++) {
+			int i = y * W + x, o = abs(x % 12 - 6);
+			float *f = fb->feat + (size_t)i * DENOISE_FEATURES;
+			double d = o <= 1 ? 0.1 : o <= 3 ? 0.55 : 1.0, v = o <= 1 ? 0.3 : o <= 3 ? 0.9 : 1.0;
+			f[14] = (float)(d * 0.5); /* over the albedo 0.5: d */
+			noisy_pixel(fb, i, v, 0.5, &r);
+		}
+	float *out = malloc(sizeof(float) * W * H * 3);
+	assert_non_null(out);
+	assert_true(denoise_image(fb, out, 2));
+	double s = 0;
+	int n = 0;
+	for (int y = 0; y < H; y++)
+		for (int x = 0; x < W; x++)
+			if (abs(x % 12 - 6) <= 1) {
+				s += out[(y * W + x) * 3];
+				n++;
+			}
+	assert_int_equal(n, 288);
+	print_message("the dark band's mean: %.4f (true 0.3; one line over all the taps 0.391)\n", s / n);
+	assert_true(fabs(s / n - 0.3) < 0.03);
 	free(out);
 	fb_free(fb);
 }
@@ -633,6 +727,51 @@ static void test_pick_own_surface(void **state)
 	int c = Y * W + X;
 	print_message("the block's centre: %.4f (its samples 1; the block's mean %.4f)\n", out[c * 3],
 	              2.6 / 9);
+	for (int k = 0; k < 3; k++)
+		assert_near(out[c * 3 + k], 1.0, 1e-5);
+	free(out);
+	fb_free(fb);
+}
+
+/* The same peak told apart by its direct light alone: a 3x3 block of the
+ * surface's albedo (0.5) and direct light 0.1 (over the albedo) in a
+ * surface of direct light 1, whose samples all agree, 1 at the centre
+ * and 0.2 around it (radiance); the surface 1 with noise 0.5 a sample, 8
+ * samples. From the block's pixels a surface pixel is (1 - 0.1) / (0.5 x
+ * 0.1 + 0.05) = 9 off in the direct-light regressor: in the regression
+ * DIRECT_W x 81 >= 16 and in the choice's average PICK_SCALE x DIRECT_W x
+ * 81 = 20.25 >= 16, no weight in either (exp_fast). So at the centre the
+ * fits are the block's 9 taps' mean, (1 + 8 x 0.2) / 9 = 0.2889, their
+ * estimated error 0.711^2, and only the block's estimates are averaged:
+ * the raw pixels' are 0 (their halves agree, no noise), and it keeps its
+ * value, 1. Without the direct light in the choice's weights all 81
+ * estimates count alike, the surface's 72 raw ones (0.5^2 / 8 each on
+ * average, 2.25) outweigh the fits' (0.57 of the block's, about 0.22 of
+ * the surface's: test_pick_own_surface), and the centre took 0.2889. */
+static void test_pick_direct_light(void **state)
+{
+	(void)state;
+	const int W = 40, H = 32, X = 20, Y = 16, SPP = 8;
+	framebuffer *fb = flat_fb(W, H, SPP);
+	test_rng r = {37};
+	for (int y = 0; y < H; y++)
+		for (int x = 0; x < W; x++) {
+			int i = y * W + x;
+			float *f = fb->feat + (size_t)i * DENOISE_FEATURES;
+			bool block = abs(x - X) <= 1 && abs(y - Y) <= 1;
+			f[14] = block ? 0.05f : 0.5f; /* over the albedo 0.5: 0.1 and 1 */
+			if (block) {
+				float v = x == X && y == Y ? 1.0f : 0.2f;
+				set_pixel(fb, i, v, v, v);
+			} else {
+				noisy_pixel(fb, i, 1.0, 0.5, &r);
+			}
+		}
+	float *out = malloc(sizeof(float) * W * H * 3);
+	assert_non_null(out);
+	assert_true(denoise_image(fb, out, 2));
+	int c = Y * W + X;
+	print_message("the block's centre: %.4f (its samples 1; the block's mean %.4f)\n", out[c * 3], 2.6 / 9);
 	for (int k = 0; k < 3; k++)
 		assert_near(out[c * 3 + k], 1.0, 1e-5);
 	free(out);
@@ -1547,7 +1686,9 @@ int main(void)
 		cmocka_unit_test(test_flat_noise),
 		cmocka_unit_test(test_feature_edge),
 		cmocka_unit_test(test_highlight_blocks),
+		cmocka_unit_test(test_direct_weight_band),
 		cmocka_unit_test(test_pick_own_surface),
+		cmocka_unit_test(test_pick_direct_light),
 		cmocka_unit_test(test_threads),
 		cmocka_unit_test(test_features_through_mirror),
 		cmocka_unit_test(test_features_through_glass),

@@ -2,7 +2,9 @@
  * escape sequences take no room, a code point takes one column. */
 #include "testutil.h"
 
+#include <fcntl.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "term/pager.h"
 
@@ -90,12 +92,81 @@ static void test_hanging_indent(void **state)
 	free(w);
 }
 
+/* The pager on keys from a pipe (written before it reads), its screen to
+ * /dev/null: returns whether it left; *next the first key byte left for
+ * the command line (-1: none). */
+static bool page_keys(const char *text, int rows, const char *keys, size_t *at, int *next)
+{
+	int p[2];
+	assert_int_equal(pipe(p), 0);
+	assert_int_equal(write(p[1], keys, strlen(keys)), (ssize_t)strlen(keys));
+	close(p[1]);
+	int out = open("/dev/null", O_WRONLY);
+	assert_true(out >= 0);
+	evloop *l = evloop_new(p[0], -1);
+	assert_non_null(l);
+	bool left = pager_show(l, out, text, strlen(text), 40, rows, at);
+	*next = evloop_getc(l);
+	evloop_free(l);
+	close(out);
+	close(p[0]);
+	return left;
+}
+
+/* Typing while the pager shows `help set` (issue: a command typed before q
+ * lost its first letters): a key that is not the pager's leaves it and
+ * starts the command line, whole. */
+static void test_typing_leaves(void **state)
+{
+	(void)state;
+	const char *shortt = "one\ntwo\nthree\n"; /* 3 rows: fits a page of 9 */
+	size_t at = 0;
+	int next;
+	/* "set" typed: 's' is not a pager key, the pager leaves, s comes next */
+	assert_true(page_keys(shortt, 10, "set", &at, &next));
+	assert_int_equal(next, 's');
+	/* fitting text: the moving letters are typed text too ("keys") */
+	at = 0;
+	assert_true(page_keys(shortt, 10, "keys", &at, &next));
+	assert_int_equal(next, 'k');
+	/* q leaves and is the pager's: the next key is what follows it */
+	at = 0;
+	assert_true(page_keys(shortt, 10, "qab", &at, &next));
+	assert_int_equal(next, 'a');
+	/* Enter leaves a text that fits, taken by the pager */
+	at = 0;
+	assert_true(page_keys(shortt, 10, "\rz", &at, &next));
+	assert_int_equal(next, 'z');
+	/* 30 rows, a page of 9: j moves a line on (twice: row 3, "r2\n" begins
+	 * at 2 x 3 bytes), then 'e' leaves and is kept */
+	char longt[128] = "";
+	for (int i = 0; i < 30; i++) {
+		char r[16];
+		snprintf(r, sizeof r, "r%d\n", i);
+		strcat(longt, r);
+	}
+	at = 0;
+	assert_true(page_keys(longt, 10, "jje", &at, &next));
+	assert_int_equal(at, 6);
+	assert_int_equal(next, 'e');
+	/* a UTF-8 letter is typed text, all its bytes kept */
+	at = 0;
+	assert_true(page_keys(longt, 10, "\xc3\xa9", &at, &next));
+	assert_int_equal(next, 0xc3);
+	/* the input ends in the pager: it leaves, nothing is left */
+	at = 0;
+	assert_true(page_keys(longt, 10, "j", &at, &next));
+	assert_int_equal(next, -1);
+	assert_int_equal(at, 3);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_rows),
 		cmocka_unit_test(test_word_wrap),
 		cmocka_unit_test(test_hanging_indent),
+		cmocka_unit_test(test_typing_leaves),
 	};
 	return cmocka_run_group_tests_name("pager", tests, NULL, NULL);
 }
