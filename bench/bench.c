@@ -147,13 +147,18 @@ static scene *load(const char *path)
 	return s;
 }
 
-static world *build(const scene *s)
+static world *build_threads(const scene *s, int threads)
 {
 	rt_error err;
-	world *w = world_build(s, &err);
+	world *w = world_build_threads(s, threads, NULL, &err);
 	if (!w)
 		fail("world_build", &err);
 	return w;
+}
+
+static world *build(const scene *s)
+{
+	return build_threads(s, 1);
 }
 
 static render_settings settings(int w, int h, int threads)
@@ -593,13 +598,13 @@ static scene *gen_spheres(size_t n)
 
 /* Embree 3's build of the spheres-N scene (bench/embree_build): seconds, or
  * < 0 when the harness is absent or fails; its bytes in *bytes. */
-static double run_embree_build(size_t n, double *bytes)
+static double run_embree_build(size_t n, int threads, double *bytes)
 {
 	char exe[512], cmd[1200];
 	snprintf(exe, sizeof exe, "%s/embree_build", bench_dir);
 	if (access(exe, X_OK) != 0)
 		return -1;
-	snprintf(cmd, sizeof cmd, "%s %zu 2>&1", exe, n);
+	snprintf(cmd, sizeof cmd, "%s %zu %d 2>&1", exe, n, threads);
 	FILE *p = popen(cmd, "r");
 	if (!p)
 		return -1;
@@ -645,13 +650,31 @@ static void bench_spheres(void)
 		         world_memory(wd) / s->nobjs, wd->tree->nnodes);
 		/* Embree's build of the same spheres, right after rtsh's (the
 		 * harness takes the median of its own three builds) */
-		double ebytes = 0, eb = quick ? -1 : run_embree_build(n, &ebytes);
+		double ebytes = 0, eb = quick ? -1 : run_embree_build(n, 1, &ebytes);
 		if (eb > 0) {
 			r = add_row(name, "embree-build", -1, -1, 0, 1, 3, eb, -1);
 			snprintf(r->note, sizeof r->note,
 			         "Embree 3 spheres, default (medium) quality, 1 thread: rtsh world_build %.2fx its time; "
 			         "%.0f B/sphere",
 			         median(tb, bruns) / eb, ebytes / (double)n);
+		}
+		/* the same at 2 threads, like with like (world_build_threads:
+		 * the same tree; Embree's device given threads=2) */
+		double tb2[MAX_RUNS];
+		for (int i = 0; i < bruns; i++) {
+			world_free(wd);
+			double t0 = now();
+			wd = build_threads(s, 2);
+			tb2[i] = now() - t0;
+		}
+		r = add_row(name, "world_build", -1, -1, 0, 2, bruns, median(tb2, bruns), -1);
+		snprintf(r->note, sizeof r->note, "%.2fx one thread", median(tb, bruns) / median(tb2, bruns));
+		double eb2 = quick ? -1 : run_embree_build(n, 2, &ebytes);
+		if (eb2 > 0) {
+			r = add_row(name, "embree-build", -1, -1, 0, 2, 3, eb2, -1);
+			snprintf(r->note, sizeof r->note,
+			         "Embree 3 spheres, 2 threads: rtsh world_build at 2 threads %.2fx its time; %.2fx its 1 thread",
+			         median(tb2, bruns) / eb2, eb > 0 ? eb / eb2 : 0.0);
 		}
 		render_settings set1 = settings(w, h, 1), set2 = settings(w, h, 2);
 		uint64_t rays = count_rays(wd, set1, fb);

@@ -90,11 +90,16 @@ static RTCScene build(RTCDevice dev, const scene *s, size_t nsph)
 
 int main(int argc, char **argv)
 {
-	if (argc != 2) {
-		fputs("usage: embree_build N\n", stderr);
+	if (argc != 2 && argc != 3) {
+		fputs("usage: embree_build N [THREADS]\n", stderr);
 		return 2;
 	}
 	size_t n = strtoul(argv[1], NULL, 10);
+	int threads = argc == 3 ? atoi(argv[2]) : 1;
+	if (threads < 1 || threads > 64) {
+		fprintf(stderr, "embree_build: %s threads; expected 1..64\n", argv[2]);
+		return 2;
+	}
 	gen_opts o = {.spheres_only = true};
 	rt_error err;
 	scene *s = scene_generate(n, 1, &o, &err);
@@ -105,7 +110,9 @@ int main(int argc, char **argv)
 	size_t nsph = 0;
 	for (size_t i = 0; i < s->nobjs; i++)
 		nsph += s->objs[i].kind == OBJ_SPHERE;
-	RTCDevice dev = rtcNewDevice("threads=1");
+	char config[32];
+	snprintf(config, sizeof config, "threads=%d", threads);
+	RTCDevice dev = rtcNewDevice(config);
 	rtcSetDeviceMemoryMonitorFunction(dev, monitor, NULL);
 	double t[3];
 	long long scene_bytes = 0;

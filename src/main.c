@@ -126,7 +126,8 @@ static int batch_render(const rtsh_options *o)
 	if (clamped && set.width == cw && set.height == ch && !o->quiet)
 		fprintf(stderr, "%s: resolution %dx%d is too large; rendering %dx%d (use -r to choose)\n",
 		        o->scene, s->hints.width, s->hints.height, set.width, set.height);
-	world *w = world_build(s, &err);
+	/* the tree built by the render's threads too (the same world) */
+	world *w = world_build_threads(s, render_threads(&set), NULL, &err);
 	scene_free(s);
 	if (!w) {
 		rt_error_format(&err, msg, sizeof msg);

@@ -259,6 +259,10 @@ world *world_build(const scene *s, rt_error *err);
  * (NULL: never): between objects, in a model's normals and tree, in the
  * BVH (Ctrl-C in the shell). */
 world *world_build_cancel(const scene *s, const atomic_bool *cancel, rt_error *err);
+/* world_build_cancel whose tree is built by up to `threads` threads (the
+ * two halves below its top nodes at once: the same world, to the byte, for
+ * any count; 1 or less: the calling thread alone). */
+world *world_build_threads(const scene *s, int threads, const atomic_bool *cancel, rt_error *err);
 /* Worlds are reference-counted, so that no thread renders from a world
  * another may free: whoever keeps a world beyond a call (a render thread, a
  * cache, key mode) holds a reference. world_retain takes one more and

@@ -131,6 +131,34 @@ void mem_huge_pages(void *p, size_t bytes)
 #endif
 }
 
+void *mem_alloc_huge(size_t bytes)
+{
+	const size_t huge = (size_t)2 << 20;
+	if (bytes > SIZE_MAX - huge)
+		return NULL;
+	if (bytes < 2 * huge)
+		return aligned_alloc(64, bytes ? (bytes + 63) & ~(size_t)63 : 64);
+	size_t whole = (bytes + huge - 1) & ~(huge - 1);
+	void *p = aligned_alloc(huge, whole);
+	mem_huge_pages(p, whole);
+	return p;
+}
+
+void mem_prefault(void *p, size_t bytes)
+{
+#ifdef MADV_POPULATE_WRITE
+	const uintptr_t page = 4096;
+	if (!p || bytes < ((size_t)4 << 20))
+		return;
+	uintptr_t lo = ((uintptr_t)p + page - 1) & ~(page - 1), hi = ((uintptr_t)p + bytes) & ~(page - 1);
+	if (hi > lo)
+		(void)madvise((void *)lo, hi - lo, MADV_POPULATE_WRITE);
+#else
+	(void)p;
+	(void)bytes;
+#endif
+}
+
 char *mem_dupz(const void *p, size_t n)
 {
 	char *d = malloc(n + 1);

@@ -93,6 +93,25 @@ static bool is_fast_sphere(const object *o)
 	return bits == 0 && o->mat.checker == 0 && !o->mat.texture && !o->mat.normalmap && !o->mat.bump;
 }
 
+/* The primitive of object `index`, o, a fast sphere (is_fast_sphere), and
+ * its world bounds. world_build makes these twice, the box in its object
+ * loop and the primitive in tree order (reorder), so that a million spheres
+ * are written once, where they end. */
+static inline void fast_sphere_prim(const object *o, uint32_t index, prim *p)
+{
+	memset(p, 0, sizeof *p);
+	p->object = index;
+	p->tag = PRIM_SPHERE;
+	p->u.sph.c = o->pos;
+	p->u.sph.r = o->scale.x * 0.5;
+}
+
+static inline box fast_sphere_box(const object *o)
+{
+	double r = o->scale.x * 0.5;
+	return (box){v3_sub(o->pos, v3_splat(r)), v3_add(o->pos, v3_splat(r))};
+}
+
 /* Fills p (and the side record it needs) for object o and its world bounds
  * *b (planes: see make_plane). flags is obj_kind_flags(o->kind) and fast
  * is_fast_sphere(o): world_build works them out once an object. */
@@ -114,11 +133,8 @@ static bool make_prim(world *w, const object *o, unsigned flags, bool fast, uint
 		return true;
 	}
 	if (fast) {
-		double r = o->scale.x * 0.5;
-		p->tag = PRIM_SPHERE;
-		p->u.sph.c = o->pos;
-		p->u.sph.r = r;
-		*b = (box){v3_sub(o->pos, v3_splat(r)), v3_add(o->pos, v3_splat(r))};
+		fast_sphere_prim(o, index, p);
+		*b = fast_sphere_box(o);
 		return true;
 	}
 	xform x;
@@ -154,24 +170,36 @@ static bool make_plane(world *w, const object *o, uint32_t index, prim_plane *pl
 
 /* Puts the primitives in tree order, and the side records in the order of
  * the primitives that use them (planes first), so that a leaf's data is
- * contiguous in memory. */
-static bool reorder(world *w, const uint32_t *order)
+ * contiguous in memory. A fast sphere (OBJ_FAST_SPHERE in kf, by object)
+ * is made here from its object, once: w->prims holds only the others (a
+ * scene of spheres leaves that array's pages untouched). Bounded primitive
+ * j is object pobj[j], or object j when pobj is NULL (no planes). */
+static bool reorder(world *w, const scene *s, const uint8_t *kf, const uint32_t *pobj, const uint32_t *order)
 {
-	prim *prims = malloc((w->nprims ? w->nprims : 1) * sizeof *prims);
-	prim_shape *shapes = malloc((w->nshapes ? w->nshapes : 1) * sizeof *shapes);
-	prim_tri *tris = malloc((w->ntris ? w->ntris : 1) * sizeof *tris);
+	/* walked in tree order by every ray: huge pages spare the TLB */
+	prim *prims = mem_alloc_huge(w->nprims * sizeof *prims);
+	prim_shape *shapes = mem_alloc_huge(w->nshapes * sizeof *shapes);
+	prim_tri *tris = mem_alloc_huge(w->ntris * sizeof *tris);
 	if (!prims || !shapes || !tris) {
 		free(prims);
 		free(shapes);
 		free(tris);
 		return false;
 	}
-	/* walked in tree order by every ray: huge pages spare the TLB */
-	mem_huge_pages(prims, w->nprims * sizeof *prims);
-	mem_huge_pages(shapes, w->nshapes * sizeof *shapes);
-	mem_huge_pages(tris, w->ntris * sizeof *tris);
-	for (size_t i = 0; i < w->nprims; i++)
-		prims[i] = w->prims[order[i]];
+	enum { AHEAD = 16 }; /* the objects are read at random: fetched ahead */
+	for (size_t i = 0; i < w->nprims; i++) {
+		if (i + AHEAD < w->nprims) {
+			uint32_t ja = order[i + AHEAD];
+			const object *oa = &s->objs[pobj ? pobj[ja] : ja];
+			__builtin_prefetch(&oa->pos);
+			__builtin_prefetch(&oa->scale);
+		}
+		uint32_t j = order[i], ob = pobj ? pobj[j] : j;
+		if (kf[ob] & OBJ_FAST_SPHERE)
+			fast_sphere_prim(&s->objs[ob], ob, &prims[i]);
+		else
+			prims[i] = w->prims[j];
+	}
 	size_t ns = 0, nt = 0;
 	for (size_t i = 0; i < w->nplanes; i++) {
 		shapes[ns] = w->shapes[w->planes[i].shape];
@@ -198,10 +226,15 @@ static bool reorder(world *w, const uint32_t *order)
 
 world *world_build(const scene *s, rt_error *err)
 {
-	return world_build_cancel(s, NULL, err);
+	return world_build_threads(s, 1, NULL, err);
 }
 
 world *world_build_cancel(const scene *s, const atomic_bool *cancel, rt_error *err)
+{
+	return world_build_threads(s, 1, cancel, err);
+}
+
+world *world_build_threads(const scene *s, int threads, const atomic_bool *cancel, rt_error *err)
 {
 	world *w = calloc(1, sizeof *w);
 	if (!w) {
@@ -254,14 +287,19 @@ world *world_build_cancel(const scene *s, const atomic_bool *cancel, rt_error *e
 	/* each primitive's box as the tree builder takes it (floats, 32 bytes) */
 	bvh_fbox *refs = malloc((nbounded ? nbounded : 1) * sizeof *refs);
 	uint32_t *order = malloc((nbounded ? nbounded : 1) * sizeof *order);
-	if (!w->lights || !w->mats || !w->prims || !w->planes || !w->shapes || !w->tris || !refs || !order) {
-		free(refs);
-		free(order);
-		free(kf);
+	/* the object of each bounded primitive, when planes make them differ */
+	uint32_t *pobj = nplanes ? malloc((nbounded ? nbounded : 1) * sizeof *pobj) : NULL;
+	if (!w->lights || !w->mats || !w->prims || !w->planes || !w->shapes || !w->tris || !refs || !order ||
+	    (nplanes && !pobj)) {
+		mem_free_all(refs, order, pobj, kf);
 		world_free(w);
 		rt_error_set(err, "out of memory preparing the scene (%zu objects)", s->nobjs);
 		return NULL;
 	}
+	/* written whole below: their pages made at once, not a fault each */
+	mem_prefault(w->mats, s->nobjs * sizeof *w->mats);
+	mem_prefault(refs, nbounded * sizeof *refs);
+	mem_prefault(order, nbounded * sizeof *order);
 	w->nlights = s->nlights;
 	for (size_t i = 0; i < s->nlights; i++) {
 		const light *sl = &s->lights[i];
@@ -281,9 +319,7 @@ world *world_build_cancel(const scene *s, const atomic_bool *cancel, rt_error *e
 	}
 	w->nmats = s->nobjs;
 	if (!surf_begin(w, s, err)) {
-		free(refs);
-		free(order);
-		free(kf);
+		mem_free_all(refs, order, pobj, kf);
 		world_free(w);
 		return NULL;
 	}
@@ -292,9 +328,7 @@ world *world_build_cancel(const scene *s, const atomic_bool *cancel, rt_error *e
 	for (size_t i = 0; i < s->nobjs; i++) {
 		const object *o = &s->objs[i];
 		if ((i & 0xffff) == 0 && cancel && atomic_load(cancel)) {
-			free(refs);
-			free(order);
-			free(kf);
+			mem_free_all(refs, order, pobj, kf);
 			world_free(w);
 			rt_error_set(err, "stopped");
 			return NULL;
@@ -302,15 +336,14 @@ world *world_build_cancel(const scene *s, const atomic_bool *cancel, rt_error *e
 		mat_lin_fill(&w->mats[i], &o->mat); /* calloc'ed: zero */
 		box bx;
 		unsigned f = kf[i] & ~(unsigned)OBJ_FAST_SPHERE;
-		bool plane = (f & KIND_UNBOUNDED) != 0;
-		/* (tx is NULL already when surf_material has nothing to do) */
+		bool plane = (f & KIND_UNBOUNDED) != 0, fast = (kf[i] & OBJ_FAST_SPHERE) != 0;
+		/* (tx is NULL already when surf_material has nothing to do; a
+		 * fast sphere's primitive is made by reorder) */
 		if ((surf_material_needed(o) && !surf_material(w, o, (uint32_t)i, err)) ||
-		    (plane ? !make_plane(w, o, (uint32_t)i, &w->planes[w->nplanes], err)
-		           : !make_prim(w, o, f, (kf[i] & OBJ_FAST_SPHERE) != 0, (uint32_t)i, &w->prims[w->nprims],
-		                        &bx, err))) {
-			free(refs);
-			free(order);
-			free(kf);
+		    (plane  ? !make_plane(w, o, (uint32_t)i, &w->planes[w->nplanes], err)
+		     : fast ? (bx = fast_sphere_box(o), false)
+		            : !make_prim(w, o, f, false, (uint32_t)i, &w->prims[w->nprims], &bx, err))) {
+			mem_free_all(refs, order, pobj, kf);
 			world_free(w);
 			return NULL;
 		}
@@ -324,22 +357,23 @@ world *world_build_cancel(const scene *s, const atomic_bool *cancel, rt_error *e
 			 * slabs (8 gave the fastest mixed scenes: 3000 generated shapes
 			 * render 15% faster than with 4, and 40% faster than with every
 			 * cost 1) */
-			uint32_t tag = w->prims[w->nprims].tag;
-			float cost = tag == PRIM_SPHERE ? 1.0f : tag == PRIM_TRIANGLE ? 2.0f : shape_kinds[o->kind]->cost;
+			bool tri = (f & (KIND_VERTICES | KIND_MODEL)) == KIND_VERTICES;
+			float cost = fast ? 1.0f : tri ? 2.0f : shape_kinds[o->kind]->cost;
 			bvh_ref_set(&refs[w->nprims], &bx, cost);
+			if (pobj)
+				pobj[w->nprims] = (uint32_t)i;
 			w->nprims++;
 		}
 	}
-	free(kf);
 	if (!box_is_empty(w->bounds))
 		extent = fmax(extent, fmax(v3_max_abs(w->bounds.lo), v3_max_abs(w->bounds.hi)));
 	for (size_t i = 0; i < s->nlights; i++)
 		extent = fmax(extent, v3_max_abs(s->lights[i].pos));
 	w->eps = 1e-9 * fmax(1.0, extent);
-	w->tree = bvh_build(refs, w->nprims, order, cancel, err);
+	w->tree = bvh_build(refs, w->nprims, order, threads, cancel, err);
 	free(refs);
-	bool ok = w->tree && reorder(w, order);
-	free(order);
+	bool ok = w->tree && reorder(w, s, kf, pobj, order);
+	mem_free_all(order, pobj, kf);
 	if (w->tree && !ok)
 		rt_error_set(err, "out of memory preparing the scene (%zu objects)", s->nobjs);
 	if (!ok || !emitters_build(w, s, err)) {

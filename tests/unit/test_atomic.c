@@ -469,6 +469,41 @@ static void test_xattrs_and_acls_are_kept(void **state)
 		skip();
 }
 
+/* mem_alloc_huge's alignment by its definition (memory.h): 64 bytes below
+ * 4 MB, 2 MB from 4 MB on; every byte asked for writable (ASan checks the
+ * ends); mem_prefault leaves the contents as they were. */
+static void test_memory_huge_arrays(void **state)
+{
+	(void)state;
+	static const size_t sizes[] = {0, 1, 63, 65, 4095, ((size_t)4 << 20) - 1, (size_t)4 << 20,
+	                               ((size_t)5 << 20) + 3};
+	for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) {
+		size_t n = sizes[k];
+		unsigned char *p = mem_alloc_huge(n);
+		assert_non_null(p);
+		uintptr_t align = n >= ((size_t)4 << 20) ? (uintptr_t)2 << 20 : 64;
+		assert_int_equal((uintptr_t)p % align, 0);
+		for (size_t i = 0; i < n; i += 4093)
+			p[i] = (unsigned char)(i * 7 + 1);
+		if (n) {
+			p[n - 1] = 0xa5;
+			mem_prefault(p, n);
+			for (size_t i = 0; i + 1 < n; i += 4093)
+				assert_int_equal(p[i], (unsigned char)(i * 7 + 1));
+			assert_int_equal(p[n - 1], 0xa5);
+		}
+		free(p);
+	}
+	/* a calloc'ed array prefaulted is still zero */
+	size_t n = (size_t)6 << 20;
+	unsigned char *z = calloc(n, 1);
+	assert_non_null(z);
+	mem_prefault(z, n);
+	for (size_t i = 0; i < n; i += 509)
+		assert_int_equal(z[i], 0);
+	free(z);
+}
+
 static void test_memory_check(void **state)
 {
 	(void)state;
@@ -602,6 +637,7 @@ int main(void)
 		cmocka_unit_test(test_mode_is_kept),
 		cmocka_unit_test(test_stale_temporary_files),
 		cmocka_unit_test(test_xattrs_and_acls_are_kept),
+		cmocka_unit_test(test_memory_huge_arrays),
 		cmocka_unit_test(test_memory_check),
 		cmocka_unit_test(test_memory_counts_the_undo_scenes),
 	};

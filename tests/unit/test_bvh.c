@@ -492,6 +492,107 @@ static void test_fast_spheres(void **state)
 	scene_free(s);
 }
 
+/* A fast sphere's primitive is made in tree order from its object
+ * (world.c reorder), by the map from bounded primitive to object when
+ * planes sit between the objects. Spheres on the x axis at x = 10 k, of
+ * diameter 1 + k / 8 (radius its half), with a plane first and a plane,
+ * a cube and a triangle among them: every primitive's object is a bounded
+ * object met once, each sphere's record is its object's centre and half
+ * its diameter, and a ray down the y axis onto x = 10 k hits object k's
+ * sphere at t = 100 - radius. */
+static void test_sphere_prims(void **state)
+{
+	(void)state;
+	scene *s = scene_new();
+	camera cam = {v3(0, 0, -50), v3(0, 0, 1), 60, false, 0, 0};
+	assert_true(scene_add_camera(s, &cam, NULL));
+	enum { N = 40 };
+	for (int k = 0; k < N; k++) {
+		object o;
+		if (k == 0 || k == 17) {
+			o = object_make(OBJ_PLANE, v3(1, 1, 1));
+			o.pos = v3(0, -1000 - k, 0);
+		} else if (k == 23) {
+			o = object_make(OBJ_CUBE, v3(1, 1, 1));
+			o.pos = v3(10.0 * k, 0, 0);
+		} else if (k == 31) {
+			o = object_make(OBJ_TRIANGLE, v3(1, 1, 1));
+			o.tri[0] = v3(10.0 * k, 0, -1);
+			o.tri[1] = v3(10.0 * k + 1, 0, 1);
+			o.tri[2] = v3(10.0 * k - 1, 0, 1);
+		} else {
+			o = object_make(OBJ_SPHERE, v3(1, 1, 1));
+			o.pos = v3(10.0 * k, 0, 0);
+			double d = 1.0 + k / 8.0;
+			o.scale = v3(d, d, d);
+		}
+		assert_true(scene_add_object(s, &o, NULL));
+	}
+	world *w = build(s);
+	assert_int_equal(w->nprims, N - 2);
+	assert_int_equal(w->nplanes, 2);
+	int seen[N] = {0};
+	for (size_t i = 0; i < w->nprims; i++) {
+		const prim *p = &w->prims[i];
+		uint32_t k = p->object;
+		assert_true(k < N && k != 0 && k != 17);
+		seen[k]++;
+		bool sphere = k != 23 && k != 31;
+		assert_int_equal(p->tag, sphere ? PRIM_SPHERE : k == 23 ? PRIM_SHAPE : PRIM_TRIANGLE);
+		if (sphere) {
+			assert_true(p->u.sph.c.x == 10.0 * k && p->u.sph.c.y == 0 && p->u.sph.c.z == 0);
+			assert_true(p->u.sph.r == (1.0 + k / 8.0) / 2);
+		}
+	}
+	for (int k = 1; k < N; k++)
+		assert_int_equal(seen[k], k == 17 ? 0 : 1);
+	for (int k = 1; k < N; k++) {
+		if (k == 17 || k == 23 || k == 31)
+			continue;
+		ray r = {v3(10.0 * k, 100, 0), v3(0, -1, 0)};
+		hit h;
+		assert_true(world_intersect(w, &r, 1e-9, INFINITY, &h));
+		assert_int_equal(h.object, k);
+		assert_true(fabs(h.t - (100 - (1.0 + k / 8.0) / 2)) < 1e-9);
+	}
+	world_free(w);
+	scene_free(s);
+}
+
+/* The tree built by 2, 3 and 4 threads is the 1-thread tree to the byte
+ * (bvh.h): 30000 objects of every kind at random (a subtree goes to
+ * another thread from 4096 references on both sides), the wide nodes,
+ * the primitives in tree order and the counts compared. */
+static void test_threaded_build(void **state)
+{
+	(void)state;
+	scene *s = random_scene(29, 30000, 100, 1.0, 1);
+	rt_error err;
+	world *one = world_build_threads(s, 1, NULL, &err);
+	assert_non_null(one);
+	for (int t = 2; t <= 4; t++) {
+		world *w = world_build_threads(s, t, NULL, &err);
+		assert_non_null(w);
+		assert_int_equal(w->tree->nnodes, one->tree->nnodes);
+		assert_int_equal(w->tree->depth, one->tree->depth);
+		assert_int_equal(w->tree->leaves, one->tree->leaves);
+		assert_int_equal(w->tree->root, one->tree->root);
+		assert_memory_equal(w->tree->nodes, one->tree->nodes, one->tree->nnodes * sizeof *one->tree->nodes);
+		assert_int_equal(w->nprims, one->nprims);
+		for (size_t i = 0; i < w->nprims; i++) {
+			const prim *a = &w->prims[i], *b = &one->prims[i];
+			assert_true(a->tag == b->tag && a->object == b->object);
+			if (a->tag == PRIM_SPHERE)
+				assert_memory_equal(&a->u.sph, &b->u.sph, sizeof a->u.sph);
+			else
+				assert_int_equal(a->u.index, b->u.index);
+		}
+		world_free(w);
+	}
+	world_free(one);
+	scene_free(s);
+}
+
 /* The builder's binning of refs ids[0, n) (float boxes fb, unit costs) by
  * its definition (bvh.c): doubled centroids lo + hi, min(n, 16) bins
  * across their bounds per axis, bin (c - lo) * (bins / extent) truncated
@@ -734,6 +835,8 @@ int main(void)
 		cmocka_unit_test(test_half_area),
 		cmocka_unit_test(test_float_boxes),
 		cmocka_unit_test(test_fast_spheres),
+		cmocka_unit_test(test_sphere_prims),
+		cmocka_unit_test(test_threaded_build),
 		cmocka_unit_test(test_sah_splits),
 		cmocka_unit_test(test_leaf_order),
 	};

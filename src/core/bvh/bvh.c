@@ -30,6 +30,7 @@
 #include "core/bvh/bvh.h"
 #include "rtsh/memory.h"
 
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -68,6 +69,7 @@ typedef struct builder {
 	unsigned leaf_max;
 	double root_area; /* for the spatial splits' overlap test */
 	bool stopped;     /* o->cancel was set: the rest became leaves */
+	int threads;      /* threads this subtree may use (no spatial splits) */
 } builder;
 
 /* The SAH cost of testing primitives of summed cost `sum` in a leaf: the
@@ -781,6 +783,29 @@ static void sort_leaf(uint32_t *id, size_t n)
  * with refs[end, cap_end) free for its spatial splits, and returns its
  * reference in *child, *meta. */
 static void build(builder *b, size_t begin, size_t end, size_t cap_end, const fbox *bb, const fbox *cb, int depth,
+                  uint32_t *child, uint32_t *meta);
+
+/* A node's left subtree built by another thread: the same calls with a
+ * builder of its own, whose nodes go to a range of the array set apart. */
+typedef struct sub_build {
+	builder b;
+	size_t begin, end, cap_end;
+	fbox bb, cb;
+	int depth;
+	uint32_t child, meta;
+} sub_build;
+
+static void *sub_build_run(void *arg)
+{
+	sub_build *s = arg;
+	build(&s->b, s->begin, s->end, s->cap_end, &s->bb, &s->cb, s->depth, &s->child, &s->meta);
+	return NULL;
+}
+
+/* Below this many references a subtree is not given to another thread. */
+#define PARALLEL_MIN 4096
+
+static void build(builder *b, size_t begin, size_t end, size_t cap_end, const fbox *bb, const fbox *cb, int depth,
                   uint32_t *child, uint32_t *meta)
 {
 	size_t n = end - begin;
@@ -882,8 +907,39 @@ static void build(builder *b, size_t begin, size_t end, size_t cap_end, const fb
 	node->box[0] = lb;
 	node->box[1] = rb;
 	uint32_t c0, m0, c1, m1;
-	build(b, begin, lend, lcap, &lb, &lcb, depth + 1, &c0, &m0);
-	build(b, rbegin, rend, cap_end, &rb, &rcb, depth + 1, &c1, &m1);
+	if (b->threads > 1 && !b->o->chop && lend - begin >= PARALLEL_MIN && rend - rbegin >= PARALLEL_MIN) {
+		/* The left subtree in another thread. Its nodes take the range
+		 * after this one, the right subtree's follow it: a subtree over
+		 * m references has at most m - 1 nodes (every node splits its
+		 * range in two non-empty ones), so the ranges cannot meet. The
+		 * references are partitioned in place within each child's range,
+		 * as one thread would: the same tree (node indices aside, which
+		 * the wide tree does not keep). */
+		sub_build sb = {.b = *b, .begin = begin, .end = lend, .cap_end = lcap, .bb = lb, .cb = lcb,
+		                .depth = depth + 1};
+		sb.b.threads = b->threads / 2;
+		sb.b.depth = 0;
+		sb.b.leaves = sb.b.nrefs = 0;
+		b->threads -= sb.b.threads;
+		b->used = ni + (lend - begin);
+		pthread_t th;
+		bool spawned = pthread_create(&th, NULL, sub_build_run, &sb) == 0;
+		if (!spawned)
+			sub_build_run(&sb);
+		build(b, rbegin, rend, cap_end, &rb, &rcb, depth + 1, &c1, &m1);
+		if (spawned)
+			pthread_join(th, NULL);
+		b->threads += sb.b.threads;
+		c0 = sb.child;
+		m0 = sb.meta;
+		b->depth = b->depth > sb.b.depth ? b->depth : sb.b.depth;
+		b->leaves += sb.b.leaves;
+		b->nrefs += sb.b.nrefs;
+		b->stopped = b->stopped || sb.b.stopped;
+	} else {
+		build(b, begin, lend, lcap, &lb, &lcb, depth + 1, &c0, &m0);
+		build(b, rbegin, rend, cap_end, &rb, &rcb, depth + 1, &c1, &m1);
+	}
 	node = &b->nodes[ni];
 	node->child[0] = c0;
 	node->meta[0] = m0;
@@ -915,7 +971,7 @@ static bool build_from(const box *bounds, fbox *refs, size_t n, const bvh_build_
 	if (n > BVH_MAX_PRIMS || cap > BVH_MAX_PRIMS)
 		return rt_error_set(err, "too many objects (%zu); expected at most %u", n, BVH_MAX_PRIMS);
 	builder b = {.o = o, .trav = o->trav, .block = o->block ? o->block : 1,
-	             .leaf_max = o->leaf_max ? o->leaf_max : LEAF_MAX};
+	             .leaf_max = o->leaf_max ? o->leaf_max : LEAF_MAX, .threads = o->threads > 1 ? o->threads : 1};
 	b.refs = refs ? refs : malloc(cap * sizeof *b.refs);
 	b.ids = malloc(cap * sizeof *b.ids);
 	/* a binary tree with leaves folded in has fewer inner nodes than leaves,
@@ -934,6 +990,7 @@ static bool build_from(const box *bounds, fbox *refs, size_t n, const bvh_build_
 		free(b.tmp_ids);
 		return rt_error_set(err, "out of memory building the BVH (%zu objects)", n);
 	}
+	mem_prefault(b.ids, cap * sizeof *b.ids); /* written whole below */
 	fbox bb = fbox_empty(), cb = fbox_empty();
 	for (size_t i = 0; i < n; i++) {
 		fbox *r = &b.refs[i];
@@ -1027,14 +1084,14 @@ static uint32_t collapse(const bvh2 *t, uint32_t n2, bvh_node *out, size_t *used
 	return ni;
 }
 
-bvh *bvh_build(bvh_fbox *refs, size_t n, uint32_t *order, const atomic_bool *cancel, rt_error *err)
+bvh *bvh_build(bvh_fbox *refs, size_t n, uint32_t *order, int threads, const atomic_bool *cancel, rt_error *err)
 {
 	bvh *t = calloc(1, sizeof *t);
 	if (!t) {
 		rt_error_set(err, "out of memory building the BVH");
 		return NULL;
 	}
-	bvh_build_opts o = {.block = 1, .trav = COST_TRAVERSE, .cancel = cancel};
+	bvh_build_opts o = {.block = 1, .trav = COST_TRAVERSE, .cancel = cancel, .threads = threads};
 	bvh2 b;
 	if (!build_from(NULL, refs, n, &o, &b, err)) {
 		free(t);
@@ -1089,9 +1146,8 @@ bvh *bvh_build(bvh_fbox *refs, size_t n, uint32_t *order, const atomic_bool *can
 	t->root_meta = 0;
 	bvh2_free(&b);
 	bytes = (used * sizeof(bvh_node) + 63) / 64 * 64;
-	bvh_node *fit = aligned_alloc(64, bytes);
+	bvh_node *fit = mem_alloc_huge(bytes); /* every ray's walk: huge pages spare the TLB */
 	if (fit) {
-		mem_huge_pages(fit, bytes); /* every ray's walk: huge pages spare the TLB */
 		memcpy(fit, wide, used * sizeof *fit);
 		free(wide);
 		wide = fit;

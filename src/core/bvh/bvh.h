@@ -268,6 +268,7 @@ typedef struct bvh_build_opts {
 	const void *ctx;
 	double split_budget; /* references allowed beyond n, a fraction of n */
 	const atomic_bool *cancel; /* when set, the build stops (NULL: never) */
+	int threads;        /* > 1: up to that many threads (bvh_build; not with chop) */
 } bvh_build_opts;
 
 /* Builds the binary tree over n primitives of world bounds bounds[0..n)
@@ -300,9 +301,11 @@ void bvh_ref_set(bvh_fbox *r, const box *x, float cost);
  * bvh_ref_set; reordered by the build, the caller's to free): binned SAH
  * (Wald, "On fast construction of SAH-based bounding volume hierarchies",
  * 2007). order[i] receives the primitive that goes to place i of tree
- * order (leaves index primitives in that order). NULL (err set) when out
- * of memory or n is too large. */
-bvh *bvh_build(bvh_fbox *refs, size_t n, uint32_t *order, const atomic_bool *cancel, rt_error *err);
+ * order (leaves index primitives in that order). threads > 1: the two
+ * subtrees below a node built at once when each has 4096 references or
+ * more (the same tree, to the byte, for any count). NULL (err set) when
+ * out of memory or n is too large. */
+bvh *bvh_build(bvh_fbox *refs, size_t n, uint32_t *order, int threads, const atomic_bool *cancel, rt_error *err);
 void bvh_free(bvh *t);
 
 #endif
