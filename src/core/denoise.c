@@ -171,10 +171,17 @@ static bool env_lit(const world *w)
  * (bsdf_sample_u: about the normal, cosine-distributed, for a Lambertian
  * surface; a glossy lobe's own directions for a rough metal) with the
  * numbers of one fixed Hammersley set of ENV_SET, sample k taking the
- * points k, k + DENOISE_FEATURE_SAMPLES, ...; each weighed by f cos / pdf
- * and shadowed. The same numbers for every pixel: a function of the
- * position and normal, smooth wherever what blocks the sky changes slowly,
- * and no noise between neighbours. */
+ * points k, k + DENOISE_FEATURE_SAMPLES, ...; each weighed by f cos / pdf.
+ * A direction that meets a surface (not a lamp: the lamps are
+ * direct_feature's) brings that surface's sky once more: its albedo times
+ * the sky along its normal (turned toward p) where that ray is free, a
+ * surface of albedo a lit by a sky of radiance L, unshadowed, sending a L
+ * back; else nothing. That is the sky a rough metal shows in its lobe
+ * below the horizon, the floor and the shadows on it (final.rt's rough
+ * spheres: the fits flattened the dark band of a shadow seen in them), and
+ * the light a sky-lit surface gets from its neighbours. The same numbers
+ * for every pixel: a function of the position and normal, smooth wherever
+ * what blocks the sky changes slowly, and no noise between neighbours. */
 static double env_feature(const world *w, const bsdf *b, vec3 p, int k)
 {
 	if (!b->smooth || !env_lit(w))
@@ -188,8 +195,18 @@ static double env_feature(const world *w, const bsdf *b, vec3 p, int k)
 		if (!bsdf_sample_u(b, u, &sm) || sm.transmit)
 			continue;
 		ray sr = {p, sm.wi};
-		if (world_occluded(w, &sr, 0.0, INFINITY))
+		hit h;
+		if (world_intersect(w, &sr, 0.0, INFINITY, &h)) {
+			const mat_lin *m = &w->mats[h.mat];
+			if (m->emission.x + m->emission.y + m->emission.z > 0.0)
+				continue;
+			vec3 n = v3_dot(h.n, sm.wi) > 0.0 ? v3_neg(h.n) : h.n;
+			ray up = {offset_point(w, h.p, n), n};
+			if (world_occluded(w, &up, 0.0, INFINITY))
+				continue;
+			sum += lum_d(v3_mul(sm.weight, v3_mul(hit_albedo(m, &h), world_background(w, n, MODE_PATH))));
 			continue;
+		}
 		sum += lum_d(v3_mul(sm.weight, world_background(w, sm.wi, MODE_PATH)));
 	}
 	return sum / nq;

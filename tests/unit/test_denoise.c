@@ -937,8 +937,10 @@ static void test_direct_feature(void **state)
  *   about -z is half the mean of |y| over the unit disc (Malley's method:
  *   the tangent coordinates are uniform on the disc), 1/2 x 4 / (3 pi) =
  *   2 / (3 pi), to the set's quadrature error (32 points: 0.01);
- * - the uniform sky with an infinite floor at y = -0.5: the directions
- *   below the horizon are blocked, half of them, 0.25 to 0.01;
+ * - the uniform sky with an infinite white floor at y = -0.5: the
+ *   directions below the horizon (half of them) meet the floor, which sees
+ *   the sky along its normal (+y): albedo 1 x 0.5 each, and the sky 0.5
+ *   in the others: 0.5 in all, exactly (blocked and nothing more: 0.25);
  * - no sky and no ambient: 0, and no shadow ray is traced;
  * - a white metal of fuzz 0.3 instead of the wall (Phong exponent
  *   5 / 0.3^2 - 2 = 53.6: not looked through) under the uniform sky: the
@@ -947,27 +949,40 @@ static void test_direct_feature(void **state)
  *   mean over the lobe is 1 (the lobe's mean cosine is (n + 1) / (n + 2)),
  *   times the tint 1 (white): 0.5, to the set's quadrature (0.01). Fixed
  *   cosine-distributed directions would put one or two of the 32 in a lobe
- *   some 10 degrees wide. */
+ *   some 10 degrees wide;
+ * - the zenith sky max(0, d.y) with the white floor: 2 / (3 pi) from the
+ *   directions above the horizon as without it, and the half below (the
+ *   cosine-weighted share of the directions with y < 0 is 1/2) meets the
+ *   floor, which sees radiance 1 along +y: 2 / (3 pi) + 0.5, to 0.01;
+ * - the uniform sky, the floor and a white roof at y = 0.5: every
+ *   direction meets the floor or the roof, and each of those sees the
+ *   other along its normal, no sky: 0, exactly (without the normal's
+ *   shadow ray: 0.5). */
 static void test_env_feature(void **state)
 {
 	(void)state;
 	const char *cam = "C 0,0,0 0,0,1 10\n", *lambert = "pl 0,0,2 0,0,-1 1,1,1 255,255,255 1 0 1 0\n";
-	const char *surface[5] = {lambert, lambert, lambert, lambert,
-	                          "pl 0,0,2 0,0,-1 1,1,1 255,255,255 0 0 1 1 metal=1 fuzz=0.3\n"};
-	const char *extra[5] = {
+	const char *ground = "pl 0,-0.5,0 0,1,0 1,1,1 255,255,255 1 0 1 0\n";
+	const char *surface[7] = {lambert, lambert, lambert, lambert,
+	                          "pl 0,0,2 0,0,-1 1,1,1 255,255,255 0 0 1 1 metal=1 fuzz=0.3\n", lambert, lambert};
+	const char *extra[7] = {
 		"sky 255,255,255 255,255,255 0.5\n",
 		"sky 255,255,255 0,0,0 1\n",
-		"sky 255,255,255 255,255,255 0.5\npl 0,-0.5,0 0,1,0 1,1,1 255,255,255 1 0 1 0\n",
+		"sky 255,255,255 255,255,255 0.5\n",
 		"A 0 255,255,255\n",
 		"sky 255,255,255 255,255,255 0.5\n",
+		"sky 255,255,255 0,0,0 1\n",
+		"sky 255,255,255 255,255,255 0.5\npl 0,0.5,0 0,-1,0 1,1,1 255,255,255 1 0 1 0\n",
 	};
-	const double want[5] = {0.5, 2.0 / (3.0 * M_PI), 0.25, 0.0, 0.5};
-	const double tol[5] = {1e-9, 0.01, 0.01, 0.0, 0.01};
-	for (int c = 0; c < 5; c++) {
+	const bool floored[7] = {false, false, true, false, false, true, true};
+	const double want[7] = {0.5, 2.0 / (3.0 * M_PI), 0.5, 0.0, 0.5, 2.0 / (3.0 * M_PI) + 0.5, 0.0};
+	const double tol[7] = {1e-9, 0.01, 1e-9, 0.0, 0.01, 0.01, 0.0};
+	for (int c = 0; c < 7; c++) {
 		char text[512];
-		snprintf(text, sizeof text, "%s%s%s", cam, surface[c], extra[c]);
+		snprintf(text, sizeof text, "%s%s%s%s", cam, surface[c], extra[c], floored[c] ? ground : "");
 		double f[DENOISE_ACC];
 		centre_features(text, DENOISE_FEATURE_SAMPLES, f);
+		print_message("sky feature, case %d: %.6f (want %.6f)\n", c, f[7] / DENOISE_FEATURE_SAMPLES, want[c]);
 		assert_near(f[7] / DENOISE_FEATURE_SAMPLES, want[c], tol[c]);
 		assert_near(f[6] / DENOISE_FEATURE_SAMPLES, 2.0, 1e-9);
 	}
