@@ -28,7 +28,7 @@ const setting_def settings_table[] = {
 	{"samples", SETTING_INT, 1, 1000000, AT(samples), "samples (rays or paths) per pixel", "1", NULL, SETTING_SCENE},
 	{"depth", SETTING_INT, 0, 1000, AT(depth), "reflection depth (whitted, faint rays cut) or bounces (path)", "5", NULL, SETTING_SCENE},
 	{"mode", SETTING_ENUM, 0, 0, AT(mode), "render mode: whitted or path", "whitted", render_mode_names, SETTING_SCENE},
-	{"threads", SETTING_INT, 0, 256, AT(threads), "render threads; 0 = one per online CPU", "0", NULL, 0},
+	{"threads", SETTING_INT, 0, 256, AT(threads), "render and tree-build threads; 0 = one per online CPU", "0", NULL, 0},
 	{"seed", SETTING_U64, 0, 0, AT(seed), "random seed of the sampler", "1", NULL, SETTING_SCENE},
 	{"exposure", SETTING_DOUBLE, -20, 20, AT(exposure), "exposure in stops: output = radiance x 2^exposure", "0", NULL, SETTING_SCENE},
 	{"denoise", SETTING_ENUM, 0, 0, AT(denoise),

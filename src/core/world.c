@@ -224,6 +224,38 @@ static bool reorder(world *w, const scene *s, const uint8_t *kf, const uint32_t 
 	return true;
 }
 
+/* A world's materials made by a second thread (world_build_threads, a
+ * scene without models, whose instances read their object's material):
+ * prefaulted and filled while the calling thread makes the primitives and
+ * references; the textures (surf_material) follow in object order once it
+ * is done, so that the world and any error are the one thread's. */
+typedef struct mats_job {
+	mat_lin *mats;
+	const object *objs;
+	size_t n;
+} mats_job;
+
+static void *mats_fill_run(void *arg)
+{
+	mats_job *j = arg;
+	mem_prefault(j->mats, j->n * sizeof *j->mats);
+	for (size_t i = 0; i < j->n; i++)
+		mat_lin_fill(&j->mats[i], &j->objs[i].mat); /* calloc'ed: zero */
+	return NULL;
+}
+
+/* surf_material for the objects [0, n) that need it, in order. */
+static bool mats_textures(world *w, const scene *s, size_t n, rt_error *err)
+{
+	for (size_t i = 0; i < n; i++)
+		if (surf_material_needed(&s->objs[i]) && !surf_material(w, &s->objs[i], (uint32_t)i, err))
+			return false;
+	return true;
+}
+
+/* Fewer objects than this fill their materials in the calling thread. */
+#define MATS_APART_MIN 4096
+
 world *world_build(const scene *s, rt_error *err)
 {
 	return world_build_threads(s, 1, NULL, err);
@@ -267,7 +299,7 @@ world *world_build_threads(const scene *s, int threads, const atomic_bool *cance
 		rt_error_set(err, "out of memory preparing the scene (%zu objects)", s->nobjs);
 		return NULL;
 	}
-	size_t nplanes = 0, ntris = 0, nshapes = 0;
+	size_t nplanes = 0, ntris = 0, nshapes = 0, nmodels = 0;
 	for (size_t i = 0; i < s->nobjs; i++) {
 		const object *o = &s->objs[i];
 		unsigned f = obj_kind_flags(o->kind);
@@ -276,7 +308,9 @@ world *world_build_threads(const scene *s, int threads, const atomic_bool *cance
 		nplanes += (f & KIND_UNBOUNDED) != 0;
 		ntris += (f & KIND_VERTICES) != 0;
 		nshapes += !(f & (KIND_VERTICES | KIND_MODEL)) && !fast;
+		nmodels += (f & KIND_MODEL) != 0;
 	}
+	bool mats_apart = threads > 1 && nmodels == 0 && s->nobjs >= MATS_APART_MIN;
 	size_t nbounded = s->nobjs - nplanes;
 	w->lights = calloc(s->nlights ? s->nlights : 1, sizeof *w->lights);
 	w->mats = calloc(s->nobjs ? s->nobjs : 1, sizeof *w->mats);
@@ -297,7 +331,8 @@ world *world_build_threads(const scene *s, int threads, const atomic_bool *cance
 		return NULL;
 	}
 	/* written whole below: their pages made at once, not a fault each */
-	mem_prefault(w->mats, s->nobjs * sizeof *w->mats);
+	if (!mats_apart)
+		mem_prefault(w->mats, s->nobjs * sizeof *w->mats);
 	mem_prefault(refs, nbounded * sizeof *refs);
 	mem_prefault(order, nbounded * sizeof *order);
 	w->nlights = s->nlights;
@@ -323,26 +358,41 @@ world *world_build_threads(const scene *s, int threads, const atomic_bool *cance
 		world_free(w);
 		return NULL;
 	}
+	mats_job mj = {w->mats, s->objs, s->nobjs};
+	pthread_t mt;
+	if (mats_apart && pthread_create(&mt, NULL, mats_fill_run, &mj) != 0) {
+		mats_apart = false; /* filled below, unprefaulted */
+	}
 	w->bounds = box_empty();
 	double extent = v3_max_abs(c.pos);
 	for (size_t i = 0; i < s->nobjs; i++) {
 		const object *o = &s->objs[i];
 		if ((i & 0xffff) == 0 && cancel && atomic_load(cancel)) {
+			if (mats_apart)
+				pthread_join(mt, NULL);
 			mem_free_all(refs, order, pobj, kf);
 			world_free(w);
 			rt_error_set(err, "stopped");
 			return NULL;
 		}
-		mat_lin_fill(&w->mats[i], &o->mat); /* calloc'ed: zero */
+		if (!mats_apart)
+			mat_lin_fill(&w->mats[i], &o->mat); /* calloc'ed: zero */
 		box bx;
 		unsigned f = kf[i] & ~(unsigned)OBJ_FAST_SPHERE;
 		bool plane = (f & KIND_UNBOUNDED) != 0, fast = (kf[i] & OBJ_FAST_SPHERE) != 0;
 		/* (tx is NULL already when surf_material has nothing to do; a
 		 * fast sphere's primitive is made by reorder) */
-		if ((surf_material_needed(o) && !surf_material(w, o, (uint32_t)i, err)) ||
+		if ((!mats_apart && surf_material_needed(o) && !surf_material(w, o, (uint32_t)i, err)) ||
 		    (plane  ? !make_plane(w, o, (uint32_t)i, &w->planes[w->nplanes], err)
 		     : fast ? (bx = fast_sphere_box(o), false)
 		            : !make_prim(w, o, f, false, (uint32_t)i, &w->prims[w->nprims], &bx, err))) {
+			if (mats_apart) {
+				/* one thread would have met a texture's error first */
+				pthread_join(mt, NULL);
+				rt_error first;
+				if (!mats_textures(w, s, i + 1, &first) && err)
+					*err = first;
+			}
 			mem_free_all(refs, order, pobj, kf);
 			world_free(w);
 			return NULL;
@@ -363,6 +413,14 @@ world *world_build_threads(const scene *s, int threads, const atomic_bool *cance
 			if (pobj)
 				pobj[w->nprims] = (uint32_t)i;
 			w->nprims++;
+		}
+	}
+	if (mats_apart) {
+		pthread_join(mt, NULL);
+		if (!mats_textures(w, s, s->nobjs, err)) {
+			mem_free_all(refs, order, pobj, kf);
+			world_free(w);
+			return NULL;
 		}
 	}
 	if (!box_is_empty(w->bounds))

@@ -168,7 +168,7 @@ static const world *km_world(keymode *km)
 	world_release(km->w);
 	rt_error err;
 	rt_error_clear(&err);
-	km->w = rsvc_world(km->rs, editor_scene(km->sh->ed), gen, NULL, &err);
+	km->w = rsvc_world(km->rs, editor_scene(km->sh->ed), gen, render_threads(&km->sh->set), NULL, &err);
 	km->wgen = gen;
 	if (!km->w)
 		km_message(km, "the scene cannot be shown: %s", err.msg);

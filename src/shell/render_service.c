@@ -369,7 +369,8 @@ static bool run(rsvc *sv, const rsvc_request *req, uint64_t seq)
 	meta.gen = req->gen;
 	rt_error err;
 	rt_error_clear(&err);
-	const world *w = req->world ? world_retain(req->world) : rsvc_world(sv, req->s, req->gen, &sv->cancel, &err);
+	const world *w = req->world ? world_retain(req->world)
+	                            : rsvc_world(sv, req->s, req->gen, render_threads(&req->set), &sv->cancel, &err);
 	if (!w && atomic_load(&sv->cancel))
 		return false; /* a hold stopped the build: as a stopped render, nothing to show */
 	if (!w) {
@@ -443,12 +444,13 @@ void rsvc_hold(rsvc *sv)
 	pthread_mutex_unlock(&sv->m);
 }
 
-const world *rsvc_world(rsvc *sv, const scene *s, uint64_t gen, const atomic_bool *cancel, rt_error *err)
+const world *rsvc_world(rsvc *sv, const scene *s, uint64_t gen, int threads, const atomic_bool *cancel,
+                        rt_error *err)
 {
 	pthread_mutex_lock(&sv->wm);
 	if (!sv->w || sv->wgen != gen) {
 		world_release(sv->w);
-		sv->w = world_build_cancel(s, cancel, err); /* stopped: NULL, built again next time */
+		sv->w = world_build_threads(s, threads, cancel, err); /* stopped: NULL, built again next time */
 		sv->wgen = gen;
 	}
 	const world *w = world_retain(sv->w);

@@ -102,10 +102,12 @@ void rsvc_free(rsvc *sv);
  * the thread is idle: the scene may change after. */
 void rsvc_hold(rsvc *sv);
 /* A reference to the world of scene s at generation gen (the caller
- * releases it), built now if the one kept is older; NULL (err set) when it
- * cannot be built, or "stopped" when *cancel (NULL: never) was set during
- * the build (the next call builds it again). */
-const world *rsvc_world(rsvc *sv, const scene *s, uint64_t gen, const atomic_bool *cancel, rt_error *err);
+ * releases it), built now by up to `threads` threads if the one kept is
+ * older (world_build_threads: the same world for any count); NULL (err
+ * set) when it cannot be built, or "stopped" when *cancel (NULL: never) was
+ * set during the build (the next call builds it again). */
+const world *rsvc_world(rsvc *sv, const scene *s, uint64_t gen, int threads, const atomic_bool *cancel,
+                        rt_error *err);
 /* Ends a hold and renders req in the background (starting the thread on
  * first use); an image taken later answers it when its seq is the number
  * returned (0: the thread could not start). A request equal to the last one completed renders nothing and

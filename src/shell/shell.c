@@ -411,7 +411,8 @@ const framebuffer *shell_full_image(shell *sh, bool force)
 	rt_error err;
 	rt_error_clear(&err);
 	atomic_store(&sh->cancel, false);
-	const world *w = rsvc_world(sh->rs, editor_scene(sh->ed), gen, &sh->cancel, &err);
+	const world *w =
+	    rsvc_world(sh->rs, editor_scene(sh->ed), gen, render_threads(&sh->set), &sh->cancel, &err);
 	if (!w) {
 		shell_refresh(sh);
 		if (atomic_load(&sh->cancel)) {
@@ -473,7 +474,8 @@ frame *shell_picture_frame(shell *sh, frame_palette pal, int cols)
 		rt_error err;
 		rt_error_clear(&err);
 		atomic_store(&sh->cancel, false);
-		const world *wd = rsvc_world(sh->rs, editor_scene(sh->ed), editor_generation(sh->ed), &sh->cancel, &err);
+		const world *wd = rsvc_world(sh->rs, editor_scene(sh->ed), editor_generation(sh->ed), render_threads(&sh->set),
+		                              &sh->cancel, &err);
 		render_settings s = sh->set;
 		s.width = w;
 		s.height = h;

@@ -587,10 +587,55 @@ static void test_threaded_build(void **state)
 			else
 				assert_int_equal(a->u.index, b->u.index);
 		}
+		/* the materials, filled by another thread from 4096 objects on */
+		assert_int_equal(w->nmats, one->nmats);
+		assert_memory_equal(w->mats, one->mats, one->nmats * sizeof *one->mats);
 		world_free(w);
 	}
 	world_free(one);
 	scene_free(s);
+}
+
+/* With the materials made by another thread, the textures follow once it
+ * is done (world.c mats_textures), in object order: a world of 5000
+ * spheres whose objects 3000 and 4000 name missing textures fails at any
+ * thread count with the one thread's error, object 3001's; and so does
+ * one whose object 4999 cannot be placed (a zero scale) after them. */
+static void test_threaded_textures(void **state)
+{
+	(void)state;
+	for (int bad_shape = 0; bad_shape < 2; bad_shape++) {
+		scene *s = random_scene(31, 0, 1, 1, 0);
+		for (int k = 0; k < 5000; k++) {
+			object o = object_make(OBJ_SPHERE, v3(200, 10, 10));
+			o.pos = v3(k % 70, k / 70, 0);
+			o.mat.texture = k == 3000 ? "no-such-texture-3000.ppm" : k == 4000 ? "no-such-texture-4000.ppm" : NULL;
+			if (bad_shape && k == 4999) {
+				o.kind = OBJ_CUBE;
+				o.scale = v3(1, 0, 1);
+			}
+			assert_true(scene_add_object(s, &o, NULL));
+		}
+		rt_error e1, e2;
+		assert_null(world_build_threads(s, 1, NULL, &e1));
+		assert_non_null(strstr(e1.msg, "no-such-texture-3000"));
+		for (int t = 2; t <= 3; t++) {
+			assert_null(world_build_threads(s, t, NULL, &e2));
+			assert_string_equal(e2.msg, e1.msg);
+		}
+		/* the texture cleared: the build goes through with the same materials */
+		s->objs[3000].mat.texture = NULL;
+		s->objs[4000].mat.texture = NULL;
+		if (!bad_shape) {
+			world *a = world_build_threads(s, 1, NULL, &e1), *b = world_build_threads(s, 2, NULL, &e2);
+			assert_non_null(a);
+			assert_non_null(b);
+			assert_memory_equal(a->mats, b->mats, a->nmats * sizeof *a->mats);
+			world_free(a);
+			world_free(b);
+		}
+		scene_free(s);
+	}
 }
 
 /* The builder's binning of refs ids[0, n) (float boxes fb, unit costs) by
@@ -837,6 +882,7 @@ int main(void)
 		cmocka_unit_test(test_fast_spheres),
 		cmocka_unit_test(test_sphere_prims),
 		cmocka_unit_test(test_threaded_build),
+		cmocka_unit_test(test_threaded_textures),
 		cmocka_unit_test(test_sah_splits),
 		cmocka_unit_test(test_leaf_order),
 	};

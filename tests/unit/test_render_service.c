@@ -181,7 +181,7 @@ static void test_edits_cancel_and_restart(void **state)
 	assert_equals_direct_render(&f, &last, &img);
 	/* A full render takes a reference to the world kept. */
 	rsvc_hold(f.rs);
-	const world *w = rsvc_world(f.rs, editor_scene(f.ed), editor_generation(f.ed), NULL, &err);
+	const world *w = rsvc_world(f.rs, editor_scene(f.ed), editor_generation(f.ed), 1, NULL, &err);
 	assert_non_null(w);
 	render_settings s = render_settings_default();
 	s.width = 32;
@@ -363,7 +363,7 @@ static void test_world_outlives_the_service(void **state)
 	rt_error err;
 	render_settings one = render_settings_default();
 	framebuffer *before = direct(&f, one, 32, 18);
-	const world *held = rsvc_world(f.rs, editor_scene(f.ed), editor_generation(f.ed), NULL, &err);
+	const world *held = rsvc_world(f.rs, editor_scene(f.ed), editor_generation(f.ed), 1, NULL, &err);
 	assert_non_null(held);
 	rsvc_hold(f.rs);
 	assert_true(editor_object_move(f.ed, 0, v3(1, 0, 0), &err));
