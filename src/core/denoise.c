@@ -166,17 +166,36 @@ static bool env_lit(const world *w)
 	return w->env || w->has_sky || w->ambient.x > 0.0 || w->ambient.y > 0.0 || w->ambient.z > 0.0;
 }
 
+/* What the sky sends along sr for the features: the sky where sr meets
+ * nothing; where it meets a surface (not a lamp: the lamps are
+ * direct_feature's), that surface's albedo times the sky along its normal
+ * (turned toward sr's origin) where that ray is free, a surface of albedo
+ * a lit by a sky of radiance L, unshadowed, sending a L back; else
+ * nothing. */
+static vec3 sky_along(const world *w, const ray *sr)
+{
+	hit h;
+	if (world_intersect(w, sr, 0.0, INFINITY, &h)) {
+		const mat_lin *m = &w->mats[h.mat];
+		if (m->emission.x + m->emission.y + m->emission.z > 0.0)
+			return v3(0, 0, 0);
+		vec3 n = v3_dot(h.n, sr->d) > 0.0 ? v3_neg(h.n) : h.n;
+		ray up = {offset_point(w, h.p, n), n};
+		if (world_occluded(w, &up, 0.0, INFINITY))
+			return v3(0, 0, 0);
+		return v3_mul(hit_albedo(m, &h), world_background(w, n, MODE_PATH));
+	}
+	return world_background(w, sr->d, MODE_PATH);
+}
+
 /* The light of the background (the sky) that b at p sends toward the eye,
  * as brightness: ENV_DIRS directions drawn from the bsdf itself
  * (bsdf_sample_u: about the normal, cosine-distributed, for a Lambertian
  * surface; a glossy lobe's own directions for a rough metal) with the
  * numbers of one fixed Hammersley set of ENV_SET, sample k taking the
  * points k, k + DENOISE_FEATURE_SAMPLES, ...; each weighed by f cos / pdf.
- * A direction that meets a surface (not a lamp: the lamps are
- * direct_feature's) brings that surface's sky once more: its albedo times
- * the sky along its normal (turned toward p) where that ray is free, a
- * surface of albedo a lit by a sky of radiance L, unshadowed, sending a L
- * back; else nothing. That is the sky a rough metal shows in its lobe
+ * A direction that meets a surface brings that surface's sky once more
+ * (sky_along). That is the sky a rough metal shows in its lobe
  * below the horizon, the floor and the shadows on it (final.rt's rough
  * spheres: the fits flattened the dark band of a shadow seen in them), and
  * the light a sky-lit surface gets from its neighbours. The same numbers
@@ -195,19 +214,7 @@ static double env_feature(const world *w, const bsdf *b, vec3 p, int k)
 		if (!bsdf_sample_u(b, u, &sm) || sm.transmit)
 			continue;
 		ray sr = {p, sm.wi};
-		hit h;
-		if (world_intersect(w, &sr, 0.0, INFINITY, &h)) {
-			const mat_lin *m = &w->mats[h.mat];
-			if (m->emission.x + m->emission.y + m->emission.z > 0.0)
-				continue;
-			vec3 n = v3_dot(h.n, sm.wi) > 0.0 ? v3_neg(h.n) : h.n;
-			ray up = {offset_point(w, h.p, n), n};
-			if (world_occluded(w, &up, 0.0, INFINITY))
-				continue;
-			sum += lum_d(v3_mul(sm.weight, v3_mul(hit_albedo(m, &h), world_background(w, n, MODE_PATH))));
-			continue;
-		}
-		sum += lum_d(v3_mul(sm.weight, world_background(w, sm.wi, MODE_PATH)));
+		sum += lum_d(v3_mul(sm.weight, sky_along(w, &sr)));
 	}
 	return sum / nq;
 }
@@ -359,6 +366,14 @@ static void first_surface(const world *w, ray r, int ks, double f[9])
 			double eta = b.front ? b.ior : 1.0 / b.ior, cos_t;
 			double fr = fresnel_dielectric(b.cos_o, eta, &cos_t);
 			refl = v3_add(refl, v3_scale(tint, b.wg * fr));
+			if (ks >= 0 && ks < DENOISE_FEATURE_SAMPLES && env_lit(w)) {
+				/* and that share of the sky in the mirror direction
+				 * (or of a surface's there, env_feature's rule) joins
+				 * the direct light: the glass's reflection, brighter
+				 * toward its rim, is no noise of the lighting behind */
+				ray mr = {offset_point(w, h.p, b.n), v3_sub(v3_scale(b.n, 2.0 * b.cos_o), b.wo)};
+				f[7] += lum_d(v3_mul(v3_scale(tint, b.wg * fr), sky_along(w, &mr)));
+			}
 			tt = v3_scale(tt, 1.0 - fr);
 		}
 		tint = v3_mul(tint, tt);

@@ -898,6 +898,32 @@ static void test_sky_feature(void **state)
 	}
 }
 
+/* Glass's reflection in the direct-light feature: the clear glass plane of
+ * test_features_through_glass (ior 1.5, at z = 2 facing the camera) under a
+ * uniform sky of radiance 0.5, nothing behind it. The refracted ray meets
+ * only the sky (no direct light there); the glass reflects F = 0.04 at
+ * normal incidence, and its mirror direction (-z, back past the camera)
+ * sees the open sky: 0.04 x 0.5 = 0.02 a sample (the old code: 0). No sky
+ * and no ambient: 0. A white wall behind the camera at z = -1 facing it:
+ * the reflection meets the wall, which sees along its normal (+z) only the
+ * glass, no sky: 0. */
+static void test_glass_reflection_feature(void **state)
+{
+	(void)state;
+	const char *glass = "C 0,0,0 0,0,1 10\npl 0,0,2 0,0,-1 1,1,1 255,255,255 0 0 1 0 ior=1.5\n";
+	const char *extra[3] = {"sky 255,255,255 255,255,255 0.5\n", "A 0 255,255,255\n",
+	                        "sky 255,255,255 255,255,255 0.5\npl 0,0,-1 0,0,1 1,1,1 255,255,255 1 0 1 0\n"};
+	const double want[3] = {0.02, 0.0, 0.0};
+	for (int c = 0; c < 3; c++) {
+		char text[512];
+		snprintf(text, sizeof text, "%s%s", glass, extra[c]);
+		double f[DENOISE_ACC];
+		centre_features(text, DENOISE_FEATURE_SAMPLES, f);
+		print_message("glass reflection, case %d: %.6f (want %.6f)\n", c, f[7] / DENOISE_FEATURE_SAMPLES, want[c]);
+		assert_near(f[7] / DENOISE_FEATURE_SAMPLES, want[c], 1e-6);
+	}
+}
+
 /* The direct-light feature (acc[7]): a white Lambertian wall at z = 2
  * facing the camera at the origin, a point light of ratio 0.5 at (0, 1, 0).
  * The centre pixel's ray meets the wall at (0, 0, 2); the light is seen
@@ -1708,6 +1734,7 @@ int main(void)
 		cmocka_unit_test(test_features_through_mirror),
 		cmocka_unit_test(test_features_through_glass),
 		cmocka_unit_test(test_sky_feature),
+		cmocka_unit_test(test_glass_reflection_feature),
 		cmocka_unit_test(test_direct_feature),
 		cmocka_unit_test(test_env_feature),
 		cmocka_unit_test(test_lamp_through_glossy),
