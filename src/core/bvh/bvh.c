@@ -392,20 +392,23 @@ typedef struct node_bins node_bins;
 
 /* A node's bins made before it is reached, by its parent's partition or
  * by itself for its own partition (bin_refs_cen): the bins of bin_refs
- * (box, cost sum in lane 3 of the upper corner) and, per bin, the bounds
- * of its (doubled) centroids with their count in lane 3 of the upper
- * corner, from which the children's centroid bounds and sizes follow
- * before the partition. */
+ * (box, cost sum in lane 3 of the upper corner) and, per bin of axis cax
+ * (the longest of the centroid bounds, where the split is most likely),
+ * the bounds of its (doubled) centroids with their count in lane 3 of the
+ * upper corner, from which the children's centroid bounds and sizes
+ * follow before the partition when the split is on that axis. */
 struct node_bins {
 	binning bn;
+	int cax;
 	fbox box[3][BINS];
-	fbox cen[3][BINS];
+	fbox cen[BINS];
 };
 
 /* One reference (corners lo, hi, doubled centroid c) into the bins of
  * binning (blo, bsc, top): bin_refs's operations, and the bin's centroid
  * bounds and count. */
-static inline void bin_one(node_bins *x, __m128 lo, __m128 hi, __m128 c, __m128 blo, __m128 bsc, __m128 top)
+static inline void bin_one(fbox bx3[3][BINS], fbox cen[BINS], int cax, __m128 lo, __m128 hi, __m128 c, __m128 blo,
+                           __m128 bsc, __m128 top)
 {
 	const __m128 zero = _mm_setzero_ps(), lane3 = _mm_castsi128_ps(_mm_set_epi32(-1, 0, 0, 0)),
 	             low3 = _mm_castsi128_ps(_mm_set_epi32(0, -1, -1, -1)), negz = _mm_set_ps(0.0f, -0.0f, -0.0f, -0.0f),
@@ -416,8 +419,8 @@ static inline void bin_one(node_bins *x, __m128 lo, __m128 hi, __m128 c, __m128 
 	__m128i k = _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(v, zero), top));
 	int k0 = _mm_cvtsi128_si32(k), k1 = _mm_cvtsi128_si32(_mm_shuffle_epi32(k, 1)),
 	    k2 = _mm_cvtsi128_si32(_mm_shuffle_epi32(k, 2));
-	fbox *bx = &x->box[0][k0], *by = &x->box[1][k1], *bz = &x->box[2][k2];
-	fbox *cx = &x->cen[0][k0], *cy = &x->cen[1][k1], *cz = &x->cen[2][k2];
+	fbox *bx = &bx3[0][k0], *by = &bx3[1][k1], *bz = &bx3[2][k2];
+	fbox *cx = &cen[cax == 0 ? k0 : cax == 1 ? k1 : k2];
 	_mm_storeu_ps(bx->lo, _mm_min_ps(_mm_loadu_ps(bx->lo), lo));
 	_mm_storeu_ps(bx->hi, _mm_add_ps(_mm_max_ps(_mm_loadu_ps(bx->hi), hi), cost));
 	_mm_storeu_ps(by->lo, _mm_min_ps(_mm_loadu_ps(by->lo), lo));
@@ -426,31 +429,38 @@ static inline void bin_one(node_bins *x, __m128 lo, __m128 hi, __m128 c, __m128 
 	_mm_storeu_ps(bz->hi, _mm_add_ps(_mm_max_ps(_mm_loadu_ps(bz->hi), hi), cost));
 	_mm_storeu_ps(cx->lo, _mm_min_ps(_mm_loadu_ps(cx->lo), c3));
 	_mm_storeu_ps(cx->hi, _mm_add_ps(_mm_max_ps(_mm_loadu_ps(cx->hi), c3), one));
-	_mm_storeu_ps(cy->lo, _mm_min_ps(_mm_loadu_ps(cy->lo), c3));
-	_mm_storeu_ps(cy->hi, _mm_add_ps(_mm_max_ps(_mm_loadu_ps(cy->hi), c3), one));
-	_mm_storeu_ps(cz->lo, _mm_min_ps(_mm_loadu_ps(cz->lo), c3));
-	_mm_storeu_ps(cz->hi, _mm_add_ps(_mm_max_ps(_mm_loadu_ps(cz->hi), c3), one));
 }
 
 /* Empties x's bins for binning of centroid bounds cb over n references. */
 static void bins_init(node_bins *x, const fbox *cb, size_t n)
 {
 	binning_make(cb, n, &x->bn);
-	for (int a = 0; a < 3; a++)
-		for (int k = 0; k < x->bn.nbins; k++)
-			x->box[a][k] = x->cen[a][k] = fbox_empty();
+	x->cax = 0;
+	for (int a = 1; a < 3; a++)
+		if (cb->hi[a] - cb->lo[a] > cb->hi[x->cax] - cb->lo[x->cax])
+			x->cax = a;
+	for (int k = 0; k < x->bn.nbins; k++) {
+		x->box[0][k] = x->box[1][k] = x->box[2][k] = x->cen[k] = fbox_empty();
+	}
 }
 
 /* bin_refs with the bins' centroid bounds, for a node of FUSE_MIN
  * references or more whose parent did not bin it. */
 static void bin_refs_cen(const fbox *refs, size_t n, node_bins *x)
 {
+	/* the bins on the stack while they are made (fixed addresses) */
+	fbox bx3[3][BINS], cen[BINS];
+	memcpy(bx3, x->box, sizeof bx3);
+	memcpy(cen, x->cen, sizeof cen);
 	__m128 blo = _mm_loadu_ps(x->bn.lo), bsc = _mm_loadu_ps(x->bn.scale),
 	       top = _mm_set1_ps((float)(x->bn.nbins - 1));
+	int cax = x->cax;
 	for (size_t i = 0; i < n; i++) {
 		__m128 lo = _mm_loadu_ps(refs[i].lo), hi = _mm_loadu_ps(refs[i].hi);
-		bin_one(x, lo, hi, _mm_add_ps(lo, hi), blo, bsc, top);
+		bin_one(bx3, cen, cax, lo, hi, _mm_add_ps(lo, hi), blo, bsc, top);
 	}
+	memcpy(x->box, bx3, sizeof bx3);
+	memcpy(x->cen, cen, sizeof cen);
 }
 #endif
 
@@ -750,7 +760,7 @@ static size_t partition_binning(builder *b, size_t begin, size_t end, const node
 	*lcb = *rcb = fbox_empty();
 	float nl = 0.0f, nr = 0.0f;
 	for (int k = 0; k < x->bn.nbins; k++) {
-		const fbox *c = &x->cen[a][k];
+		const fbox *c = &x->cen[k];
 		if (k < s->at) {
 			fbox_union(lcb, c);
 			nl += c->hi[3];
@@ -769,7 +779,13 @@ static size_t partition_binning(builder *b, size_t begin, size_t end, const node
 	       ltop = _mm_set1_ps((float)(kid[0].bn.nbins - 1));
 	__m128 rlo = _mm_loadu_ps(kid[1].bn.lo), rsc = _mm_loadu_ps(kid[1].bn.scale),
 	       rtop = _mm_set1_ps((float)(kid[1].bn.nbins - 1));
-	int abit = 1 << a;
+	int abit = 1 << a, lax = kid[0].cax, rax = kid[1].cax;
+	/* the children's bins on the stack while they are made */
+	fbox lbox[3][BINS], rbox[3][BINS], lcen[BINS], rcen[BINS];
+	memcpy(lbox, kid[0].box, sizeof lbox);
+	memcpy(lcen, kid[0].cen, sizeof lcen);
+	memcpy(rbox, kid[1].box, sizeof rbox);
+	memcpy(rcen, kid[1].cen, sizeof rcen);
 	for (;;) {
 		__m128 lo = zero, hi = zero, c = zero;
 		while (i < j) {
@@ -778,12 +794,12 @@ static size_t partition_binning(builder *b, size_t begin, size_t end, const node
 			c = _mm_add_ps(lo, hi);
 			if (goes_right(c, blo, bsc, at, abit))
 				break;
-			bin_one(&kid[0], lo, hi, c, llo, lsc, ltop);
+			bin_one(lbox, lcen, lax, lo, hi, c, llo, lsc, ltop);
 			i++;
 		}
 		if (i == j)
 			break;
-		bin_one(&kid[1], lo, hi, c, rlo, rsc, rtop); /* refs[i] goes right */
+		bin_one(rbox, rcen, rax, lo, hi, c, rlo, rsc, rtop); /* refs[i] goes right */
 		j--;
 		while (i < j) {
 			lo = _mm_loadu_ps(b->refs[j].lo);
@@ -791,15 +807,19 @@ static size_t partition_binning(builder *b, size_t begin, size_t end, const node
 			c = _mm_add_ps(lo, hi);
 			if (!goes_right(c, blo, bsc, at, abit))
 				break;
-			bin_one(&kid[1], lo, hi, c, rlo, rsc, rtop);
+			bin_one(rbox, rcen, rax, lo, hi, c, rlo, rsc, rtop);
 			j--;
 		}
 		if (i == j)
 			break;
-		bin_one(&kid[0], lo, hi, c, llo, lsc, ltop); /* refs[j] goes left */
+		bin_one(lbox, lcen, lax, lo, hi, c, llo, lsc, ltop); /* refs[j] goes left */
 		swap_refs(b, i, j);
 		i++;
 	}
+	memcpy(kid[0].box, lbox, sizeof lbox);
+	memcpy(kid[0].cen, lcen, sizeof lcen);
+	memcpy(kid[1].box, rbox, sizeof rbox);
+	memcpy(kid[1].cen, rcen, sizeof rcen);
 	*counted = i - begin == (size_t)nl && end - i == (size_t)nr;
 	return i;
 }
@@ -1041,7 +1061,7 @@ static void build(builder *b, size_t begin, size_t end, size_t cap_end, const fb
 		bounds_of(b, rbegin, rend, &rb, &rcb);
 	} else {
 #if defined(__SSE2__)
-		if (s.axis >= 0 && pre && n >= FUSE_MIN && (kids = malloc(2 * sizeof *kids))) {
+		if (s.axis >= 0 && pre && n >= FUSE_MIN && pre->cax == s.axis && (kids = malloc(2 * sizeof *kids))) {
 			bool counted;
 			mid = partition_binning(b, begin, end, pre, &s, kids, &lcb, &rcb, &counted);
 			if (!counted) {
