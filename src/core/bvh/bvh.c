@@ -382,93 +382,9 @@ static inline void sweep_bins(fbox bbox[3][BINS], const binning *bn, unsigned bl
 	}
 }
 
-typedef struct node_bins node_bins;
-
-#if defined(__SSE2__)
-/* Nodes of this many references or more make their children's bins in
- * their partition (partition_binning): the references are read once a
- * level instead of twice where they come from memory, not the caches. */
-#define FUSE_MIN 262144
-
-/* A node's bins made before it is reached, by its parent's partition or
- * by itself for its own partition (bin_refs_cen): the bins of bin_refs
- * (box, cost sum in lane 3 of the upper corner) and, per bin of axis cax
- * (the longest of the centroid bounds, where the split is most likely),
- * the bounds of its (doubled) centroids with their count in lane 3 of the
- * upper corner, from which the children's centroid bounds and sizes
- * follow before the partition when the split is on that axis. */
-struct node_bins {
-	binning bn;
-	int cax;
-	fbox box[3][BINS];
-	fbox cen[BINS];
-};
-
-/* One reference (corners lo, hi, doubled centroid c) into the bins of
- * binning (blo, bsc, top): bin_refs's operations, and the bin's centroid
- * bounds and count. */
-static inline void bin_one(fbox bx3[3][BINS], fbox cen[BINS], int cax, __m128 lo, __m128 hi, __m128 c, __m128 blo,
-                           __m128 bsc, __m128 top)
-{
-	const __m128 zero = _mm_setzero_ps(), lane3 = _mm_castsi128_ps(_mm_set_epi32(-1, 0, 0, 0)),
-	             low3 = _mm_castsi128_ps(_mm_set_epi32(0, -1, -1, -1)), negz = _mm_set_ps(0.0f, -0.0f, -0.0f, -0.0f),
-	             one = _mm_set_ps(1.0f, -0.0f, -0.0f, -0.0f);
-	__m128 cost = _mm_or_ps(_mm_and_ps(lo, lane3), negz); /* (-0, -0, -0, cost) */
-	__m128 c3 = _mm_and_ps(c, low3);                       /* (c0, c1, c2, 0) */
-	__m128 v = _mm_mul_ps(_mm_sub_ps(c, blo), bsc);
-	__m128i k = _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(v, zero), top));
-	int k0 = _mm_cvtsi128_si32(k), k1 = _mm_cvtsi128_si32(_mm_shuffle_epi32(k, 1)),
-	    k2 = _mm_cvtsi128_si32(_mm_shuffle_epi32(k, 2));
-	fbox *bx = &bx3[0][k0], *by = &bx3[1][k1], *bz = &bx3[2][k2];
-	fbox *cx = &cen[cax == 0 ? k0 : cax == 1 ? k1 : k2];
-	_mm_storeu_ps(bx->lo, _mm_min_ps(_mm_loadu_ps(bx->lo), lo));
-	_mm_storeu_ps(bx->hi, _mm_add_ps(_mm_max_ps(_mm_loadu_ps(bx->hi), hi), cost));
-	_mm_storeu_ps(by->lo, _mm_min_ps(_mm_loadu_ps(by->lo), lo));
-	_mm_storeu_ps(by->hi, _mm_add_ps(_mm_max_ps(_mm_loadu_ps(by->hi), hi), cost));
-	_mm_storeu_ps(bz->lo, _mm_min_ps(_mm_loadu_ps(bz->lo), lo));
-	_mm_storeu_ps(bz->hi, _mm_add_ps(_mm_max_ps(_mm_loadu_ps(bz->hi), hi), cost));
-	_mm_storeu_ps(cx->lo, _mm_min_ps(_mm_loadu_ps(cx->lo), c3));
-	_mm_storeu_ps(cx->hi, _mm_add_ps(_mm_max_ps(_mm_loadu_ps(cx->hi), c3), one));
-}
-
-/* Empties x's bins for binning of centroid bounds cb over n references. */
-static void bins_init(node_bins *x, const fbox *cb, size_t n)
-{
-	binning_make(cb, n, &x->bn);
-	x->cax = 0;
-	for (int a = 1; a < 3; a++)
-		if (cb->hi[a] - cb->lo[a] > cb->hi[x->cax] - cb->lo[x->cax])
-			x->cax = a;
-	for (int k = 0; k < x->bn.nbins; k++) {
-		x->box[0][k] = x->box[1][k] = x->box[2][k] = x->cen[k] = fbox_empty();
-	}
-}
-
-/* bin_refs with the bins' centroid bounds, for a node of FUSE_MIN
- * references or more whose parent did not bin it. */
-static void bin_refs_cen(const fbox *refs, size_t n, node_bins *x)
-{
-	/* the bins on the stack while they are made (fixed addresses) */
-	fbox bx3[3][BINS], cen[BINS];
-	memcpy(bx3, x->box, sizeof bx3);
-	memcpy(cen, x->cen, sizeof cen);
-	__m128 blo = _mm_loadu_ps(x->bn.lo), bsc = _mm_loadu_ps(x->bn.scale),
-	       top = _mm_set1_ps((float)(x->bn.nbins - 1));
-	int cax = x->cax;
-	for (size_t i = 0; i < n; i++) {
-		__m128 lo = _mm_loadu_ps(refs[i].lo), hi = _mm_loadu_ps(refs[i].hi);
-		bin_one(bx3, cen, cax, lo, hi, _mm_add_ps(lo, hi), blo, bsc, top);
-	}
-	memcpy(x->box, bx3, sizeof bx3);
-	memcpy(x->cen, cen, sizeof cen);
-}
-#endif
-
 /* The cheapest binned split of refs[begin, end) with centroid bounds cb;
- * axis -1 when every centroid is the same point. `pre`: the node's bins
- * made already (its binning is binning_make's of cb and the node's size,
- * so the same bins), or NULL. */
-static split find_split(const builder *b, size_t begin, size_t end, const fbox *cb, const fbox (*pre)[BINS])
+ * axis -1 when every centroid is the same point. */
+static split find_split(const builder *b, size_t begin, size_t end, const fbox *cb)
 {
 	split best = {.axis = -1, .cost = INFINITY};
 	binning bn;
@@ -485,14 +401,10 @@ static split find_split(const builder *b, size_t begin, size_t end, const fbox *
 	/* per bin: the box and the summed cost in hi[3] (every cost is >= 1,
 	 * so a bin is empty when its cost is 0; float sums are exact to 2^24) */
 	fbox bbox[3][BINS];
-	if (pre)
-		memcpy(bbox, pre, sizeof bbox);
-	else {
-		for (int a = 0; a < 3; a++)
-			for (int k = 0; k < nbins; k++)
-				bbox[a][k] = fbox_empty();
-		bin_refs(b->refs + begin, end - begin, &bn, bbox);
-	}
+	for (int a = 0; a < 3; a++)
+		for (int k = 0; k < nbins; k++)
+			bbox[a][k] = fbox_empty();
+	bin_refs(b->refs + begin, end - begin, &bn, bbox);
 	/* the sweeps, made twice: for unit costs leaf_cost is the sum itself */
 	if (b->block > 1)
 		sweep_bins(bbox, &bn, b->block, &best);
@@ -743,88 +655,6 @@ static size_t partition(builder *b, size_t begin, size_t end, const fbox *cb, co
 	return i;
 }
 
-#if defined(__SSE2__)
-/* partition for a node binned with its centroids (x, from bin_refs_cen
- * or its parent's partition): the children's centroid bounds *lcb, *rcb
- * and sizes are the unions and sums of x's bins on the split axis, known
- * before the partition (min and max do not depend on the order; the counts
- * are whole numbers, exact in floats below 2^24), so the partition bins
- * each reference into its child's bins kid[0] or kid[1] as it passes:
- * the same bins as the children's own bin_refs would make (the same float
- * operations; the boxes' and costs' unions and sums do not depend on the
- * order), without a second pass over the references. */
-static size_t partition_binning(builder *b, size_t begin, size_t end, const node_bins *x, const split *s,
-                                node_bins kid[2], fbox *lcb, fbox *rcb, bool *counted)
-{
-	int a = s->axis;
-	*lcb = *rcb = fbox_empty();
-	float nl = 0.0f, nr = 0.0f;
-	for (int k = 0; k < x->bn.nbins; k++) {
-		const fbox *c = &x->cen[k];
-		if (k < s->at) {
-			fbox_union(lcb, c);
-			nl += c->hi[3];
-		} else {
-			fbox_union(rcb, c);
-			nr += c->hi[3];
-		}
-	}
-	lcb->hi[3] = rcb->hi[3] = 0.0f; /* (the counts) */
-	bins_init(&kid[0], lcb, (size_t)nl);
-	bins_init(&kid[1], rcb, (size_t)nr);
-	size_t i = begin, j = end;
-	__m128 blo = _mm_loadu_ps(x->bn.lo), bsc = _mm_loadu_ps(x->bn.scale), zero = _mm_setzero_ps(),
-	       at = _mm_set1_ps((float)s->at);
-	__m128 llo = _mm_loadu_ps(kid[0].bn.lo), lsc = _mm_loadu_ps(kid[0].bn.scale),
-	       ltop = _mm_set1_ps((float)(kid[0].bn.nbins - 1));
-	__m128 rlo = _mm_loadu_ps(kid[1].bn.lo), rsc = _mm_loadu_ps(kid[1].bn.scale),
-	       rtop = _mm_set1_ps((float)(kid[1].bn.nbins - 1));
-	int abit = 1 << a, lax = kid[0].cax, rax = kid[1].cax;
-	/* the children's bins on the stack while they are made */
-	fbox lbox[3][BINS], rbox[3][BINS], lcen[BINS], rcen[BINS];
-	memcpy(lbox, kid[0].box, sizeof lbox);
-	memcpy(lcen, kid[0].cen, sizeof lcen);
-	memcpy(rbox, kid[1].box, sizeof rbox);
-	memcpy(rcen, kid[1].cen, sizeof rcen);
-	for (;;) {
-		__m128 lo = zero, hi = zero, c = zero;
-		while (i < j) {
-			lo = _mm_loadu_ps(b->refs[i].lo);
-			hi = _mm_loadu_ps(b->refs[i].hi);
-			c = _mm_add_ps(lo, hi);
-			if (goes_right(c, blo, bsc, at, abit))
-				break;
-			bin_one(lbox, lcen, lax, lo, hi, c, llo, lsc, ltop);
-			i++;
-		}
-		if (i == j)
-			break;
-		bin_one(rbox, rcen, rax, lo, hi, c, rlo, rsc, rtop); /* refs[i] goes right */
-		j--;
-		while (i < j) {
-			lo = _mm_loadu_ps(b->refs[j].lo);
-			hi = _mm_loadu_ps(b->refs[j].hi);
-			c = _mm_add_ps(lo, hi);
-			if (!goes_right(c, blo, bsc, at, abit))
-				break;
-			bin_one(rbox, rcen, rax, lo, hi, c, rlo, rsc, rtop);
-			j--;
-		}
-		if (i == j)
-			break;
-		bin_one(lbox, lcen, lax, lo, hi, c, llo, lsc, ltop); /* refs[j] goes left */
-		swap_refs(b, i, j);
-		i++;
-	}
-	memcpy(kid[0].box, lbox, sizeof lbox);
-	memcpy(kid[0].cen, lcen, sizeof lcen);
-	memcpy(kid[1].box, rbox, sizeof rbox);
-	memcpy(kid[1].cen, rcen, sizeof rcen);
-	*counted = i - begin == (size_t)nl && end - i == (size_t)nr;
-	return i;
-}
-#endif
-
 /* The box and centroid bounds of refs[begin, end). */
 static void bounds_of(const builder *b, size_t begin, size_t end, fbox *bb, fbox *cb)
 {
@@ -952,8 +782,8 @@ static void sort_leaf(uint32_t *id, size_t n)
 /* Builds the subtree over refs[begin, end) (box bb, centroid bounds cb),
  * with refs[end, cap_end) free for its spatial splits, and returns its
  * reference in *child, *meta. */
-static void build(builder *b, size_t begin, size_t end, size_t cap_end, const fbox *bb, const fbox *cb,
-                  const node_bins *pre, int depth, uint32_t *child, uint32_t *meta);
+static void build(builder *b, size_t begin, size_t end, size_t cap_end, const fbox *bb, const fbox *cb, int depth,
+                  uint32_t *child, uint32_t *meta);
 
 /* A node's left subtree built by another thread: the same calls with a
  * builder of its own, whose nodes go to a range of the array set apart. */
@@ -961,7 +791,6 @@ typedef struct sub_build {
 	builder b;
 	size_t begin, end, cap_end;
 	fbox bb, cb;
-	const node_bins *pre;
 	int depth;
 	uint32_t child, meta;
 } sub_build;
@@ -969,17 +798,15 @@ typedef struct sub_build {
 static void *sub_build_run(void *arg)
 {
 	sub_build *s = arg;
-	build(&s->b, s->begin, s->end, s->cap_end, &s->bb, &s->cb, s->pre, s->depth, &s->child, &s->meta);
+	build(&s->b, s->begin, s->end, s->cap_end, &s->bb, &s->cb, s->depth, &s->child, &s->meta);
 	return NULL;
 }
 
 /* Below this many references a subtree is not given to another thread. */
 #define PARALLEL_MIN 4096
 
-/* pre: the node's bins with their centroids (made by its parent's
- * partition), or NULL. */
-static void build(builder *b, size_t begin, size_t end, size_t cap_end, const fbox *bb, const fbox *cb,
-                  const node_bins *pre, int depth, uint32_t *child, uint32_t *meta)
+static void build(builder *b, size_t begin, size_t end, size_t cap_end, const fbox *bb, const fbox *cb, int depth,
+                  uint32_t *child, uint32_t *meta)
 {
 	size_t n = end - begin;
 	if (depth > b->depth)
@@ -999,17 +826,8 @@ static void build(builder *b, size_t begin, size_t end, size_t cap_end, const fb
 		leaf = leaf_cost(b, total) <= b->trav;
 	}
 	split s = {.axis = -1}, obj = s;
-	node_bins *own = NULL, *kids = NULL; /* this node's bins, its children's */
 	if (!leaf && depth < BALANCED_DEPTH) {
-#if defined(__SSE2__)
-		/* a large node bins with its centroids, for partition_binning */
-		if (!pre && n >= FUSE_MIN && n < (1u << 24) && !b->o->chop && (own = malloc(sizeof *own))) {
-			bins_init(own, cb, n);
-			bin_refs_cen(b->refs + begin, n, own);
-			pre = own;
-		}
-#endif
-		s = obj = find_split(b, begin, end, cb, pre ? (const fbox(*)[BINS])pre->box : NULL);
+		s = obj = find_split(b, begin, end, cb);
 		if (b->o->chop && cap_end > end) {
 			/* a spatial split where the object split's children overlap */
 			fbox ov = s.lb;
@@ -1027,7 +845,6 @@ static void build(builder *b, size_t begin, size_t end, size_t cap_end, const fb
 		leaf = s.total <= split_cost;
 	}
 	if (leaf) {
-		free(own);
 		if (!b->stopped) /* (a stopped build's tree is thrown away) */
 			sort_leaf(b->ids + begin, n);
 		*child = (uint32_t)begin;
@@ -1060,19 +877,6 @@ static void build(builder *b, size_t begin, size_t end, size_t cap_end, const fb
 		bounds_of(b, begin, lend, &lb, &lcb);
 		bounds_of(b, rbegin, rend, &rb, &rcb);
 	} else {
-#if defined(__SSE2__)
-		if (s.axis >= 0 && pre && n >= FUSE_MIN && pre->cax == s.axis && (kids = malloc(2 * sizeof *kids))) {
-			bool counted;
-			mid = partition_binning(b, begin, end, pre, &s, kids, &lcb, &rcb, &counted);
-			if (!counted) {
-				/* (a NaN centroid: the children bin themselves) */
-				free(kids);
-				kids = NULL;
-			}
-			lb = s.lb;
-			rb = s.rb;
-		} else
-#endif
 		if (s.axis >= 0) {
 			mid = partition(b, begin, end, cb, &s, &lcb, &rcb);
 			lb = s.lb;
@@ -1081,8 +885,6 @@ static void build(builder *b, size_t begin, size_t end, size_t cap_end, const fb
 		if (mid == begin || mid == end) {
 			/* no useful split (equal centroids, or past BALANCED_DEPTH):
 			 * halve, the lower primitive indices to the left */
-			free(kids);
-			kids = NULL;
 			sort_refs(b, begin, end);
 			mid = begin + n / 2;
 			bounds_of(b, begin, mid, &lb, &lcb);
@@ -1100,7 +902,6 @@ static void build(builder *b, size_t begin, size_t end, size_t cap_end, const fb
 			memmove(&b->ids[rbegin], &b->ids[mid], (end - mid) * sizeof *b->ids);
 		}
 	}
-	free(own); /* (its bins are the children's now) */
 	size_t ni = b->used++;
 	node2 *node = &b->nodes[ni];
 	node->box[0] = lb;
@@ -1115,7 +916,7 @@ static void build(builder *b, size_t begin, size_t end, size_t cap_end, const fb
 		 * as one thread would: the same tree (node indices aside, which
 		 * the wide tree does not keep). */
 		sub_build sb = {.b = *b, .begin = begin, .end = lend, .cap_end = lcap, .bb = lb, .cb = lcb,
-		                .pre = kids ? &kids[0] : NULL, .depth = depth + 1};
+		                .depth = depth + 1};
 		sb.b.threads = b->threads / 2;
 		sb.b.depth = 0;
 		sb.b.leaves = sb.b.nrefs = 0;
@@ -1125,7 +926,7 @@ static void build(builder *b, size_t begin, size_t end, size_t cap_end, const fb
 		bool spawned = pthread_create(&th, NULL, sub_build_run, &sb) == 0;
 		if (!spawned)
 			sub_build_run(&sb);
-		build(b, rbegin, rend, cap_end, &rb, &rcb, kids ? &kids[1] : NULL, depth + 1, &c1, &m1);
+		build(b, rbegin, rend, cap_end, &rb, &rcb, depth + 1, &c1, &m1);
 		if (spawned)
 			pthread_join(th, NULL);
 		b->threads += sb.b.threads;
@@ -1136,10 +937,9 @@ static void build(builder *b, size_t begin, size_t end, size_t cap_end, const fb
 		b->nrefs += sb.b.nrefs;
 		b->stopped = b->stopped || sb.b.stopped;
 	} else {
-		build(b, begin, lend, lcap, &lb, &lcb, kids ? &kids[0] : NULL, depth + 1, &c0, &m0);
-		build(b, rbegin, rend, cap_end, &rb, &rcb, kids ? &kids[1] : NULL, depth + 1, &c1, &m1);
+		build(b, begin, lend, lcap, &lb, &lcb, depth + 1, &c0, &m0);
+		build(b, rbegin, rend, cap_end, &rb, &rcb, depth + 1, &c1, &m1);
 	}
-	free(kids);
 	node = &b->nodes[ni];
 	node->child[0] = c0;
 	node->meta[0] = m0;
@@ -1203,7 +1003,7 @@ static bool build_from(const box *bounds, fbox *refs, size_t n, const bvh_build_
 		fbox_add_point(&cb, c);
 	}
 	b.root_area = fbox_half_area(&bb);
-	build(&b, 0, n, cap, &bb, &cb, NULL, 0, &t->root, &t->root_meta);
+	build(&b, 0, n, cap, &bb, &cb, 0, &t->root, &t->root_meta);
 	if (!refs)
 		free(b.refs);
 	if (b.stopped) {
