@@ -687,6 +687,38 @@ static void test_direct_weight_band(void **state)
 	fb_free(fb);
 }
 
+/* A 3x3 block whose samples all agree, 1 at the centre and 0.2 around it,
+ * in a surface of radiance 1 with noise 0.5 a sample, 8 samples; `mark`
+ * sets a pixel's features (in the block or not). Asserts the denoised
+ * centre keeps its value, 1. */
+static void check_peak_kept(unsigned seed, void (*mark)(float *f, bool block))
+{
+	const int W = 40, H = 32, X = 20, Y = 16, SPP = 8;
+	framebuffer *fb = flat_fb(W, H, SPP);
+	test_rng r = {seed};
+	for (int y = 0; y < H; y++)
+		for (int x = 0; x < W; x++) {
+			int i = y * W + x;
+			bool block = abs(x - X) <= 1 && abs(y - Y) <= 1;
+			mark(fb->feat + (size_t)i * DENOISE_FEATURES, block);
+			if (block) {
+				float v = x == X && y == Y ? 1.0f : 0.2f;
+				set_pixel(fb, i, v, v, v);
+			} else {
+				noisy_pixel(fb, i, 1.0, 0.5, &r);
+			}
+		}
+	float *out = malloc(sizeof(float) * W * H * 3);
+	assert_non_null(out);
+	assert_true(denoise_image(fb, out, 2));
+	int c = Y * W + X;
+	print_message("the block's centre: %.4f (its samples 1; the block's mean %.4f)\n", out[c * 3], 2.6 / 9);
+	for (int k = 0; k < 3; k++)
+		assert_near(out[c * 3 + k], 1.0, 1e-5);
+	free(out);
+	fb_free(fb);
+}
+
 /* A highlight's peak that no feature explains, in a noisy surface: a 3x3
  * block of albedo 1 (so unlike the surface's 0.2 that no regression tap
  * crosses) whose samples all agree, 1 at its centre and 0.2 around it, in
@@ -701,36 +733,15 @@ static void test_direct_weight_band(void **state)
  * the fits' 0.2889; weighted by how alike the albedo is (the surface's by
  * exp(-0.25 x 3 x 0.8^2 / 0.08) = exp(-6), as exp_fast has it (1 - 6/16)^16
  * = 5.4e-4), they count for 0.001, and it keeps its value, 1. */
+static void albedo_mark(float *f, bool block)
+{
+	f[0] = f[1] = f[2] = block ? 1.0f : 0.2f;
+}
+
 static void test_pick_own_surface(void **state)
 {
 	(void)state;
-	const int W = 40, H = 32, X = 20, Y = 16, SPP = 8;
-	framebuffer *fb = flat_fb(W, H, SPP);
-	test_rng r = {31};
-	for (int y = 0; y < H; y++)
-		for (int x = 0; x < W; x++) {
-			int i = y * W + x;
-			float *f = fb->feat + (size_t)i * DENOISE_FEATURES;
-			bool block = abs(x - X) <= 1 && abs(y - Y) <= 1;
-			float a = block ? 1.0f : 0.2f;
-			f[0] = f[1] = f[2] = a;
-			if (block) {
-				float v = x == X && y == Y ? 1.0f : 0.2f;
-				set_pixel(fb, i, v, v, v);
-			} else {
-				noisy_pixel(fb, i, 1.0, 0.5, &r);
-			}
-		}
-	float *out = malloc(sizeof(float) * W * H * 3);
-	assert_non_null(out);
-	assert_true(denoise_image(fb, out, 2));
-	int c = Y * W + X;
-	print_message("the block's centre: %.4f (its samples 1; the block's mean %.4f)\n", out[c * 3],
-	              2.6 / 9);
-	for (int k = 0; k < 3; k++)
-		assert_near(out[c * 3 + k], 1.0, 1e-5);
-	free(out);
-	fb_free(fb);
+	check_peak_kept(31, albedo_mark);
 }
 
 /* The same peak told apart by its direct light alone: a 3x3 block of the
@@ -748,34 +759,15 @@ static void test_pick_own_surface(void **state)
  * estimates count alike, the surface's 72 raw ones (0.5^2 / 8 each on
  * average, 2.25) outweigh the fits' (0.57 of the block's, about 0.22 of
  * the surface's: test_pick_own_surface), and the centre took 0.2889. */
+static void direct_mark(float *f, bool block)
+{
+	f[14] = block ? 0.05f : 0.5f; /* over the albedo 0.5: 0.1 and 1 */
+}
+
 static void test_pick_direct_light(void **state)
 {
 	(void)state;
-	const int W = 40, H = 32, X = 20, Y = 16, SPP = 8;
-	framebuffer *fb = flat_fb(W, H, SPP);
-	test_rng r = {37};
-	for (int y = 0; y < H; y++)
-		for (int x = 0; x < W; x++) {
-			int i = y * W + x;
-			float *f = fb->feat + (size_t)i * DENOISE_FEATURES;
-			bool block = abs(x - X) <= 1 && abs(y - Y) <= 1;
-			f[14] = block ? 0.05f : 0.5f; /* over the albedo 0.5: 0.1 and 1 */
-			if (block) {
-				float v = x == X && y == Y ? 1.0f : 0.2f;
-				set_pixel(fb, i, v, v, v);
-			} else {
-				noisy_pixel(fb, i, 1.0, 0.5, &r);
-			}
-		}
-	float *out = malloc(sizeof(float) * W * H * 3);
-	assert_non_null(out);
-	assert_true(denoise_image(fb, out, 2));
-	int c = Y * W + X;
-	print_message("the block's centre: %.4f (its samples 1; the block's mean %.4f)\n", out[c * 3], 2.6 / 9);
-	for (int k = 0; k < 3; k++)
-		assert_near(out[c * 3 + k], 1.0, 1e-5);
-	free(out);
-	fb_free(fb);
+	check_peak_kept(37, direct_mark);
 }
 
 /* The same picture for 1, 2, 3 and 7 threads, byte for byte, with 1, 3
