@@ -263,7 +263,8 @@ static double lobe_feature(const world *w, const bsdf *b, vec3 p, int ks)
  * surface seen in it, the albedo tinted by the mirror's or the glass's
  * colour, the depth the length of the whole path. Glass is followed along the refracted ray unless the
  * reflection is total, the albedo tinted by its transmitted share 1 - F
- * and its reflected share F added as white (the Phong family's glass). */
+ * and, where the ray enters it, its reflected share F added as white (the
+ * Phong family's glass). */
 static void first_surface(const world *w, ray r, int ks, double f[9])
 {
 	vec3 tint = v3(1, 1, 1);
@@ -362,10 +363,23 @@ static void first_surface(const world *w, ray r, int ks, double f[9])
 			 * the surface behind is tinted by 1 - F, and F joins the
 			 * albedo as a white reflection's, so that dividing the
 			 * radiance by the albedo does not blow the reflection up
-			 * where what lies behind is dark. */
+			 * where what lies behind is dark. Where the ray leaves the
+			 * glass (its back face) F is the share reflected back
+			 * inside it, to leave it elsewhere after more bounces
+			 * and see something else, mostly darker than a white
+			 * surface would be: it is left out of the albedo (in the
+			 * lighting, as the 1 - F tint already says). Counted
+			 * white, it made the albedo of pixels near the rim of
+			 * what a sphere shows (F large, up to total reflection)
+			 * as bright as their neighbours' while their radiance is
+			 * 0.1 to 0.15 darker, and the filter brought them up to
+			 * their neighbours (final.rt's big glass sphere, 4 seeds:
+			 * 128x96 0.987, 200x120 0.990 of the error before;
+			 * bench/README, the denoise10 session). */
 			double eta = b.front ? b.ior : 1.0 / b.ior, cos_t;
 			double fr = fresnel_dielectric(b.cos_o, eta, &cos_t);
-			refl = v3_add(refl, v3_scale(tint, b.wg * fr));
+			if (b.front)
+				refl = v3_add(refl, v3_scale(tint, b.wg * fr));
 			if (ks >= 0 && ks < DENOISE_FEATURE_SAMPLES && env_lit(w)) {
 				/* and that share of the sky in the mirror direction
 				 * (or of a surface's there, env_feature's rule) joins

@@ -864,6 +864,34 @@ static void test_features_through_glass(void **state)
 	assert_near(f[6], 4.0, 1e-3);
 }
 
+/* A clear glass sphere (ior 1.5, radius 1, centre (0, 0, 4)) in front of
+ * the wall of test_features_through_glass, now at z = 8: the centre ray
+ * enters it at z = 3 and leaves at z = 5, both at normal incidence, where
+ * F = ((1.5 - 1) / (1.5 + 1))^2 = 0.04 either way. Entering, F joins the
+ * albedo as a white reflection's (0.04) and the rest goes on tinted 0.96;
+ * leaving, F is reflected back inside the sphere and is no surface's
+ * albedo: the wall's tint is 0.96 x 0.96 = 0.9216 and the albedo
+ * 0.9216 x the wall's + 0.04 (the old code added the inner reflection as
+ * white too: + 0.96 x 0.04 = 0.0384 more). The normal and depth are the
+ * wall's: -z and 8. */
+static void test_features_through_glass_sphere(void **state)
+{
+	(void)state;
+	double f[DENOISE_ACC];
+	centre_features("C 0,0,0 0,0,1 10\nsp 0,0,4 0,1,0 1,1,1 255,255,255 0 0 1 0 ior=1.5\n"
+	                "pl 0,0,8 0,0,-1 1,1,1 180,100,50 1 0 1 0\n",
+	                1, f);
+	vec3 wall = srgb255_to_linear(v3(180, 100, 50));
+	const double F = 0.04, T = (1 - F) * (1 - F);
+	print_message("through the sphere: %.6f %.6f %.6f (want %.6f %.6f %.6f)\n", f[0], f[1], f[2], T * wall.x + F,
+	              T * wall.y + F, T * wall.z + F);
+	assert_near(f[0], T * wall.x + F, 1e-4);
+	assert_near(f[1], T * wall.y + F, 1e-4);
+	assert_near(f[2], T * wall.z + F, 1e-4);
+	assert_near(f[5], -1.0, 1e-3);
+	assert_near(f[6], 8.0, 1e-3);
+}
+
 /* The sky's albedo feature is its colour in that direction: a uniform sky
  * of radiance 0.5 seen directly gives 0.5; through the clear glass plane
  * of test_features_through_glass, with nothing behind, 0.96 x 0.5 of the
@@ -1726,6 +1754,7 @@ int main(void)
 		cmocka_unit_test(test_features_through_mirror),
 		cmocka_unit_test(test_features_through_glass),
 		cmocka_unit_test(test_sky_feature),
+		cmocka_unit_test(test_features_through_glass_sphere),
 		cmocka_unit_test(test_glass_reflection_feature),
 		cmocka_unit_test(test_direct_feature),
 		cmocka_unit_test(test_env_feature),
