@@ -117,6 +117,14 @@ typedef struct shared {
 	atomic_bool stop;
 } shared;
 
+/* Ctrl-C within a tile: the cancel flag of the render this thread's
+ * tiles belong to (NULL: none), polled by block_add every 16 samples, and
+ * whether it stopped a block short. A tile of many samples (set samples
+ * 100000: seconds of work) then stops within a fraction of a second; a
+ * tile stopped short is not counted done, so the pass is cancelled. */
+static _Thread_local const atomic_bool *tile_cancel;
+static _Thread_local bool tile_stopped;
+
 /* Adds samples [s0, s1) of the pixels of block [x0, x1) x [y0, y1) (at
  * most PACKET_MAX of them, row by row) of an fw x fh image to acc[i], each
  * pixel's in sample order: render_tile and render_rect share it, so a tile
@@ -144,6 +152,10 @@ static void block_add(const world *w, const render_settings *s, int x0, int y0, 
 				ra[i][0] = *sq[i];
 	}
 	for (int k = s0; k < s1; k++) {
+		if (((k - s0) & 15) == 15 && tile_cancel && atomic_load_explicit(tile_cancel, memory_order_relaxed)) {
+			tile_stopped = true;
+			break;
+		}
 		ray r[PACKET_MAX];
 		sampler sp[PACKET_MAX];
 		hit h[PACKET_MAX];
@@ -254,7 +266,8 @@ static void render_tile_adaptive(render_job *job, int x0, int y0, int x1, int y1
 	              fb->feat ? fb->feat + p * DENOISE_FEATURES : NULL);
 }
 
-static void render_tile(shared *sh, long t)
+/* False when the render's cancel flag stopped the tile short. */
+static bool render_tile(shared *sh, long t)
 {
 	render_job *job = sh->job;
 	framebuffer *fb = job->fb;
@@ -265,9 +278,10 @@ static void render_tile(shared *sh, long t)
 	int y1 = y0 + RENDER_TILE < fb->h ? y0 + RENDER_TILE : fb->h;
 	double inv = 1.0 / job->sample_end;
 	texture_set_pixel_angle(2.0 * cam_tan_x(&job->w->cam, fb->w, fb->h) / fb->w); /* texture footprints */
+	tile_stopped = false;
 	if (job->pixel_end) {
 		render_tile_adaptive(job, x0, y0, x1, y1);
-		return;
+		return !tile_stopped;
 	}
 	bool feat = fb->feat && integrator_of(job->set.mode)->features;
 	for (int by = y0; by < y1; by += BLOCK_SIDE)
@@ -292,6 +306,8 @@ static void render_tile(shared *sh, long t)
 				}
 			block_add(job->w, &job->set, bx, by, ex, ey, fb->w, fb->h, job->sample_begin, job->sample_end, acc, fp,
 			          sq);
+			if (tile_stopped)
+				return false;
 			double *sum = fb->sum;
 			float *rgb = fb->rgb;
 			for (int y = by, k = 0; y < ey; y++) {
@@ -317,6 +333,7 @@ static void render_tile(shared *sh, long t)
 		for (int y = y0; y < y1; y++) /* the same expression on the same floats */
 			linear_to_srgb8_n(own + (size_t)(y - y0) * RENDER_TILE * 3, fb->srgb8_gain,
 			                  codes_row(fb, y) + (size_t)x0 * 3, (size_t)(x1 - x0) * 3);
+	return true;
 }
 
 /* A tile is finished: the last of its band wakes the thread that hands the
@@ -489,6 +506,7 @@ void render_rect_adaptive(const world *w, const render_settings *s, int x0, int 
 static void *worker(void *arg)
 {
 	shared *sh = arg;
+	tile_cancel = sh->job->cancel;
 	for (;;) {
 		if ((sh->job->cancel && atomic_load_explicit(sh->job->cancel, memory_order_relaxed)) ||
 		    atomic_load_explicit(&sh->stop, memory_order_relaxed))
@@ -496,10 +514,12 @@ static void *worker(void *arg)
 		long t = atomic_fetch_add(&sh->next, 1);
 		if (t >= sh->tiles || !slot_ready(sh, t, false))
 			break;
-		render_tile(sh, t);
+		if (!render_tile(sh, t))
+			break; /* stopped short: not done */
 		atomic_fetch_add(&sh->done, 1);
 		tile_finished(sh, t);
 	}
+	tile_cancel = NULL;
 	pthread_mutex_lock(&sh->lock);
 	if (atomic_fetch_sub(&sh->running, 1) == 1)
 		pthread_cond_signal(&sh->finished);
@@ -583,13 +603,15 @@ render_status render_run(render_job *job, rt_error *err)
 	 * them (no third thread to wake on two cores), reporting about every
 	 * 100 ms. */
 	double last = now_seconds();
+	tile_cancel = job->cancel;
 	for (;;) {
 		if ((job->cancel && atomic_load(job->cancel)) || atomic_load(&sh.stop))
 			break;
 		long t = atomic_fetch_add(&sh.next, 1);
 		if (t >= sh.tiles || !slot_ready(&sh, t, true))
 			break;
-		render_tile(&sh, t);
+		if (!render_tile(&sh, t))
+			break; /* stopped short: not done */
 		atomic_fetch_add(&sh.done, 1);
 		if (sh.band_left) {
 			atomic_fetch_sub(&sh.band_left[t / sh.tiles_x], 1);
@@ -600,6 +622,7 @@ render_status render_run(render_job *job, rt_error *err)
 			report(job, &sh);
 		}
 	}
+	tile_cancel = NULL; /* this thread's other renders (render_rect) have none */
 	if (started > 0) {
 		/* The workers' last tiles: their bands are handed over as they
 		 * finish; progress every 100 ms (a band that wakes this thread

@@ -381,6 +381,59 @@ static void test_render_stops_in_flight(void **state)
 	scene_free(s);
 }
 
+/* A tile of many samples (set samples 100000 in the shell: seconds of
+ * work a tile) stops when the flag is set, not when the tile is done: a
+ * one-tile image of 16x16 pixels at 100000 samples (25.6 million, many
+ * seconds), the flag set 50 ms in from another thread. The old renderer
+ * looked at the flag between tiles only: it finished the tile and said
+ * RENDER_DONE. Rendering again after the stop gives the bytes of a render
+ * never stopped (at fewer samples, not to wait). */
+static void test_render_stops_within_a_tile(void **state)
+{
+	(void)state;
+	rt_error err;
+	scene *s = scene_generate(5, 3, NULL, &err);
+	assert_non_null(s);
+	world *w = world_build(s, &err);
+	assert_non_null(w);
+	render_settings set = render_settings_default();
+	set.width = set.height = RENDER_TILE; /* one tile */
+	set.threads = 1;
+	framebuffer *fb = fb_new(set.width, set.height), *ref = fb_new(set.width, set.height);
+	assert_non_null(fb);
+	assert_non_null(ref);
+	for (int mode = 0; mode < 2; mode++) {
+		set.mode = mode ? MODE_PATH : MODE_WHITTED;
+		set.samples = 100000;
+		atomic_bool cancel;
+		atomic_init(&cancel, false);
+		later l = {&cancel, 50};
+		pthread_t th;
+		assert_int_equal(pthread_create(&th, NULL, set_later, &l), 0);
+		render_job job = {.w = w, .set = set, .fb = fb, .sample_begin = 0, .sample_end = set.samples,
+		                  .cancel = &cancel};
+		render_status got = render_run(&job, &err);
+		pthread_join(th, NULL);
+		assert_int_equal(got, RENDER_CANCELLED);
+		assert_int_equal(fb->spp, 0);
+		/* again without the flag, and a render never stopped */
+		atomic_store(&cancel, false);
+		set.samples = 64;
+		job.set = set;
+		job.sample_end = set.samples;
+		assert_int_equal(render_run(&job, &err), RENDER_DONE);
+		render_job fresh = {.w = w, .set = set, .fb = ref, .sample_begin = 0, .sample_end = set.samples};
+		assert_int_equal(render_run(&fresh, &err), RENDER_DONE);
+		size_t n = (size_t)set.width * set.height * 3;
+		assert_memory_equal(fb->rgb, ref->rgb, n * sizeof *fb->rgb);
+		assert_memory_equal(fb->sum, ref->sum, n * sizeof *fb->sum);
+	}
+	fb_free(fb);
+	fb_free(ref);
+	world_release(w);
+	scene_free(s);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -389,6 +442,7 @@ int main(void)
 	    cmocka_unit_test(test_world_build_stops),
 	    cmocka_unit_test(test_readers_stop),
 	    cmocka_unit_test(test_render_stops_in_flight),
+	    cmocka_unit_test(test_render_stops_within_a_tile),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
 }
