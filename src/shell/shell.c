@@ -290,7 +290,7 @@ void shell_refresh(shell *sh)
 		.denoise = render_mode_denoises(sh->set.mode) && sh->set.denoise != DENOISE_OFF,
 		.pass_seconds = PREVIEW_PASS_SECONDS,
 	};
-	rsvc_start(sh->rs, &req);
+	sh->preview_seq = rsvc_start(sh->rs, &req);
 	sh->redraw = true;
 	if (sh->status_hook)
 		sh->status_hook(sh);
@@ -462,7 +462,14 @@ frame *shell_picture_frame(shell *sh, frame_palette pal, int cols)
 	if (pal == PALETTE_NONE)
 		k = SYMBOLS_HALF;
 	int sx = k == SYMBOLS_HALF ? 1 : SYMBOLS_SAMPLE_W, sy = k == SYMBOLS_HALF ? 2 : SYMBOLS_SAMPLE_H;
-	if (sh->scr && sh->img.w > 0 && sh->img.rgb && !sh->scr->pix_ops && sh->scr->sym == k) {
+	/* The preview's picture when it shows the scene and settings as they
+	 * are: the newest image taken, of the preview asked for last (an edit
+	 * or a `set` earlier on the same line asked for a new one), past its
+	 * quick pass. Else the picture is rendered here. */
+	if (sh->scr && rsvc_take(sh->rs, &sh->img))
+		sh->redraw = true;
+	bool current = sh->img.seq == sh->preview_seq && sh->img.spp > 0 && !sh->img.error[0];
+	if (sh->scr && current && sh->img.w > 0 && sh->img.rgb && !sh->scr->pix_ops && sh->scr->sym == k) {
 		rgb = sh->img.rgb;
 		w = sh->img.w;
 		h = sh->img.h;

@@ -61,6 +61,7 @@ typedef struct shell {
 	abuf *notes;           /* when set, shell_note and load warnings append here (key mode) */
 	rsvc *rs;              /* the render service: the preview, key mode, the world cache */
 	rsvc_image img;        /* the newest preview image shown */
+	uint64_t preview_seq;  /* rsvc_start's number of the preview asked for last */
 	uint8_t *srgb;         /* img as sRGB bytes */
 	size_t srgb_cap;
 	double last_draw;      /* when the picture was last sent */

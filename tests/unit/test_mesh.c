@@ -119,6 +119,12 @@ static void test_obj_bad_input(void **state)
 	rt_error err = {0};
 	expect_error(mesh_load("/nonexistent/x.obj", &err), &err, "/nonexistent/x.obj", "cannot read");
 	expect_error(mesh_load(tmp_text("m.xyz", "hello"), &err), &err, "m.xyz", "unknown model format");
+	/* no extension (a model saved as "cube", a device): no format ".", but
+	 * what is missing */
+	expect_error(mesh_load(tmp_text("cube", "hello"), &err), &err, "the name has no extension", ".obj, .ply");
+	expect_error(mesh_load(tmp_text("cube.", "hello"), &err), &err, "the name has no extension", ".obj, .ply");
+	expect_error(mesh_load("/dev/null", &err), &err, "the name has no extension", ".obj, .ply");
+	expect_error(mesh_load(tmp_text("m.xyz", "hello"), &err), &err, "m.xyz", "\".xyz\"; expected .obj");
 }
 
 /* PLY: ascii faces, and a binary strip with a -1 restart. */
@@ -180,6 +186,21 @@ static void test_ply_faces_and_strips(void **state)
 	                  "0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n";
 	expect_error(mesh_parse_ply("oob.ply", oob, strlen(oob), &err), &err, "oob.ply:13", "index 7 is out of range");
 	expect_error(mesh_parse_ply("x.ply", "plx\n", 4, &err), &err, "x.ply:1", "not a PLY file");
+	/* list lengths: negative, fractional and beyond the reader's bound of
+	 * 1e9 are refused, each with the range it takes (4000000000 is a whole
+	 * number >= 0: the old message said that was what it expected) */
+	static const char *const lens[] = {"-1", "2.5", "4000000000"};
+	for (size_t i = 0; i < sizeof lens / sizeof lens[0]; i++) {
+		char text[512];
+		snprintf(text, sizeof text,
+		         "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+		         "property float z\nelement face 1\nproperty list uint int vertex_indices\nend_header\n"
+		         "0 0 0\n1 0 0\n0 1 0\n%s 0 1 2\n", lens[i]);
+		char want[64];
+		snprintf(want, sizeof want, "list length %s;", lens[i]);
+		expect_error(mesh_parse_ply("len.ply", text, strlen(text), &err), &err, want,
+		             "expected a whole number in 0..1000000000");
+	}
 }
 
 /* glTF 2.0 (our reader) and STL (assimp): a square of two triangles under a node

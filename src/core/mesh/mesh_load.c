@@ -65,7 +65,10 @@ static mesh *load_node(const char *path, long node, rt_error *err)
 	if (!f) {
 		char list[128];
 		mesh_format_list(list, sizeof list);
-		rt_error_set(err, "%s: unknown model format \".%s\"; expected %s", path, ext_of(path), list);
+		if (!*ext_of(path)) /* "." would name no format: say what is missing */
+			rt_error_set(err, "%s: the name has no extension; expected %s", path, list);
+		else
+			rt_error_set(err, "%s: unknown model format \".%s\"; expected %s", path, ext_of(path), list);
 		return NULL;
 	}
 	if (node >= 0 && f->read != mesh_read_gltf) {

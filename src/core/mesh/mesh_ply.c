@@ -241,7 +241,8 @@ static bool read_elem(ply_reader *r, const elem *e)
 				if (!value(r, pr->count_type, &v, e->name, i))
 					return false;
 				if (!(v >= 0) || v > 1e9 || v != floor(v))
-					return fail(r, "%s %zu: list length %.15g; expected a whole number >= 0", e->name, i, v);
+					return fail(r, "%s %zu: list length %.15g; expected a whole number in 0..1000000000",
+					            e->name, i, v);
 				size_t n = (size_t)v;
 				size_t min = r->format == 0 ? 2 : (size_t)type_size[pr->type];
 				if (n > (size_t)(r->end - r->s) / min + 1)
