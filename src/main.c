@@ -6,6 +6,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "base/visible.h"
 #include "rtsh/image.h"
 #include "rtsh/render.h"
 #include "rtsh/rtfile.h"
@@ -110,6 +111,10 @@ static int batch_render(const rtsh_options *o)
 	}
 	if (!o->scene)
 		return usage_error("-o needs a scene file%s", "");
+	/* the names as messages show them: escape sequences visible, not run */
+	char scene_name[4096], output_name[4096];
+	text_visible(scene_name, sizeof scene_name, o->scene, false);
+	text_visible(output_name, sizeof output_name, o->output, false);
 	rt_warnings warn = {print_warning, NULL};
 	rt_load_opts lo = {.strict = o->strict, .warn = o->quiet ? NULL : &warn};
 	scene *s = rt_load_file(o->scene, &lo, &err);
@@ -125,13 +130,13 @@ static int batch_render(const rtsh_options *o)
 	/* Said only when the clamped size is the one rendered (not -r's). */
 	if (clamped && set.width == cw && set.height == ch && !o->quiet)
 		fprintf(stderr, "%s: resolution %dx%d is too large; rendering %dx%d (use -r to choose)\n",
-		        o->scene, s->hints.width, s->hints.height, set.width, set.height);
+		        scene_name, s->hints.width, s->hints.height, set.width, set.height);
 	/* the tree built by the render's threads too (the same world) */
 	world *w = world_build_threads(s, render_threads(&set), NULL, &err);
 	scene_free(s);
 	if (!w) {
 		rt_error_format(&err, msg, sizeof msg);
-		fprintf(stderr, "%s: %s\n", o->scene, msg);
+		fprintf(stderr, "%s: %s\n", scene_name, msg);
 		return 1;
 	}
 	batch_progress ps = {.w = set.width, .h = set.height, .samples = set.samples, .shown = false};
@@ -144,7 +149,7 @@ static int batch_render(const rtsh_options *o)
 	world_free(w);
 	if (!ok && bm.failed) {
 		rt_error_format(&bm.err, msg, sizeof msg);
-		fprintf(stderr, "%s: %s\n", o->scene, msg);
+		fprintf(stderr, "%s: %s\n", scene_name, msg);
 		return 1;
 	}
 	if (!ok) {
@@ -155,7 +160,7 @@ static int batch_render(const rtsh_options *o)
 	if (*file_write_note())
 		fprintf(stderr, "rtsh: %s\n", file_write_note());
 	if (!o->quiet && isatty(STDERR_FILENO))
-		fprintf(stderr, "wrote %s (%dx%d, %d samples, %s) in %.2fs\n", o->output, set.width,
+		fprintf(stderr, "wrote %s (%dx%d, %d samples, %s) in %.2fs\n", output_name, set.width,
 		        set.height, set.samples, render_mode_name(set.mode), since(&ps.start));
 	return 0;
 }

@@ -5,14 +5,32 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "base/visible.h"
+
+/* A message's text made safe for a terminal (visible.h): file names and
+ * strings read from files (a glTF image's uri) may hold escape sequences,
+ * and errors are printed where a file manager's preview pane or the shell
+ * shows them. */
+static void make_visible(char *msg)
+{
+	if (!text_has_controls(msg, false))
+		return;
+	char tmp[RT_ERROR_MSG_MAX];
+	text_visible(tmp, sizeof tmp, msg, false);
+	memcpy(msg, tmp, strlen(tmp) + 1);
+}
+
 static void set_file(rt_error *err, const char *file)
 {
-	if (!file)
-		file = "";
+	/* visible first, so that a long name keeps its end */
+	char vis[4 * RT_ERROR_FILE_MAX + 4096];
+	file = text_visible(vis, sizeof vis, file ? file : "", false);
 	size_t n = strlen(file);
 	if (n >= sizeof err->file) {
 		/* Keep the end of a long path: the file name matters most. */
 		file += n - (sizeof err->file - 4);
+		while ((*file & 0xc0) == 0x80) /* at a whole character */
+			file++;
 		snprintf(err->file, sizeof err->file, "...%s", file);
 	} else {
 		memcpy(err->file, file, n + 1);
@@ -29,6 +47,7 @@ bool rt_error_set(rt_error *err, const char *fmt, ...)
 	va_start(ap, fmt);
 	vsnprintf(err->msg, sizeof err->msg, fmt, ap);
 	va_end(ap);
+	make_visible(err->msg);
 	return false;
 }
 
@@ -43,6 +62,7 @@ bool rt_error_at(rt_error *err, const char *file, int line, int col, const char 
 	va_start(ap, fmt);
 	vsnprintf(err->msg, sizeof err->msg, fmt, ap);
 	va_end(ap);
+	make_visible(err->msg);
 	return false;
 }
 
@@ -81,5 +101,6 @@ void rt_warn(const rt_warnings *w, const char *file, int line, int col, const ch
 	va_start(ap, fmt);
 	vsnprintf(e.msg, sizeof e.msg, fmt, ap);
 	va_end(ap);
+	make_visible(e.msg);
 	w->emit(w->ctx, &e);
 }

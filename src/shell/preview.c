@@ -20,6 +20,7 @@
 #include "rtsh/world.h"
 #include "shell/args.h"
 #include "base/abuf.h"
+#include "base/visible.h"
 #include "term/caps.h"
 #include "term/frame.h"
 #include "term/encoder.h"
@@ -40,9 +41,17 @@ static void watchdog(int sig)
 	_exit(1);
 }
 
+/* The file's name with its control characters made visible: a file
+ * manager shows this message, and a name may hold escape sequences. */
+static const char *shown(const char *file, char *buf, size_t size)
+{
+	return text_visible(buf, size, file, false);
+}
+
 static int fail(const char *file, const char *what)
 {
-	fprintf(stderr, "rtsh: %s: %s\n", file, what);
+	char name[4096];
+	fprintf(stderr, "rtsh: %s: %s\n", shown(file, name, sizeof name), what);
 	return 1;
 }
 
@@ -137,7 +146,9 @@ int preview_main(const rtsh_options *o)
 		pm = isatty(STDOUT_FILENO) ? ask_terminal(&cw, &ch) : PIXELS_OFF;
 	char why[400];
 	if (pm == PIXELS_SIXEL && !pixels_sixel_available(why, sizeof why)) {
-		fprintf(stderr, "rtsh: %s: sixel images cannot be drawn: %s: half blocks\n", file, why);
+		char name[4096];
+		fprintf(stderr, "rtsh: %s: sixel images cannot be drawn: %s: half blocks\n", shown(file, name, sizeof name),
+		        why);
 		pm = PIXELS_OFF;
 	}
 	/* The symbol set asked for (--symbols); auto: what the terminal is

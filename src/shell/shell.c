@@ -12,6 +12,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "base/visible.h"
 #include "rtsh/settings.h"
 #include "shell/builtin_scene.h"
 #include "shell/progress.h"
@@ -26,18 +27,39 @@ bool shell_fail(shell *sh, const char *fmt, ...)
 	va_start(ap, fmt);
 	vsnprintf(buf, sizeof buf, fmt, ap);
 	va_end(ap);
-	memcpy(sh->err, buf, sizeof buf);
+	/* a file name with escape sequences shows them, never runs them */
+	text_visible(sh->err, sizeof sh->err, buf, true);
 	return false;
 }
 
 /* Command output goes to standard output, or to the pager's buffer while
  * an interactive command runs. */
-static void out_v(shell *sh, const char *fmt, va_list ap)
+static void out_text(shell *sh, const char *text)
 {
-	if (!sh->capture) {
-		vprintf(fmt, ap);
+	if (sh->capture)
+		abuf_add(sh->capture, text, strlen(text));
+	else
+		fputs(text, stdout);
+}
+
+/* The text with its control characters made visible (visible.h): names
+ * of files and of a model's parts, which may hold escape sequences, are
+ * printed by many commands. */
+static void out_visible(shell *sh, const char *text, size_t n)
+{
+	if (!text_has_controls(text, true)) {
+		out_text(sh, text);
 		return;
 	}
+	size_t size = 4 * n + 1; /* ^X for one byte, M-^X for two */
+	char *vis = malloc(size);
+	if (vis)
+		out_text(sh, text_visible(vis, size, text, true));
+	free(vis);
+}
+
+static void out_v(shell *sh, const char *fmt, va_list ap)
+{
 	char small[512];
 	va_list copy;
 	va_copy(copy, ap);
@@ -46,14 +68,14 @@ static void out_v(shell *sh, const char *fmt, va_list ap)
 	if (n < 0)
 		return;
 	if ((size_t)n < sizeof small) {
-		abuf_add(sh->capture, small, (size_t)n);
+		out_visible(sh, small, (size_t)n);
 		return;
 	}
 	char *big = malloc((size_t)n + 1);
 	if (!big)
 		return;
 	vsnprintf(big, (size_t)n + 1, fmt, ap);
-	abuf_add(sh->capture, big, (size_t)n);
+	out_visible(sh, big, (size_t)n);
 	free(big);
 }
 
@@ -79,15 +101,24 @@ void shell_note(shell *sh, const char *fmt, ...)
 {
 	va_list ap;
 	va_start(ap, fmt);
-	if (sh && sh->notes) {
-		char buf[1024];
-		int n = vsnprintf(buf, sizeof buf, fmt, ap);
-		if (n > 0)
-			abuf_add(sh->notes, buf, (size_t)n < sizeof buf ? (size_t)n : sizeof buf - 1);
-	} else {
-		fflush(stdout);
-		vfprintf(stderr, fmt, ap);
+	va_list copy;
+	va_copy(copy, ap);
+	int n = vsnprintf(NULL, 0, fmt, copy);
+	va_end(copy);
+	char *buf = n >= 0 ? malloc((size_t)n + 1) : NULL, *vis = n >= 0 ? malloc(4 * (size_t)n + 1) : NULL;
+	if (buf && vis) {
+		vsnprintf(buf, (size_t)n + 1, fmt, ap);
+		/* escape sequences in a name shown, not run (visible.h) */
+		text_visible(vis, 4 * (size_t)n + 1, buf, true);
+		if (sh && sh->notes) {
+			abuf_add(sh->notes, vis, strlen(vis));
+		} else {
+			fflush(stdout);
+			fputs(vis, stderr);
+		}
 	}
+	free(buf);
+	free(vis);
 	va_end(ap);
 }
 
@@ -193,7 +224,8 @@ static void name_from_label(shell *sh)
 		return;
 	}
 	const char *slash = strrchr(l, '/');
-	snprintf(sh->name, sizeof sh->name, "%s", slash ? slash + 1 : l);
+	/* the status line's name: escape sequences in it shown, not run */
+	text_visible(sh->name, sizeof sh->name, slash ? slash + 1 : l, false);
 	free(sh->dir);
 	sh->dir = slash ? strndup(l, slash == l ? 1 : (size_t)(slash - l)) : strdup(".");
 }
