@@ -15,6 +15,8 @@
  *     matrix), not the eight-unknown one's;
  *   - an edge pixel's highlight in a glossy metal: 5 x the mean albedo over
  *     the same 64 positions as the albedo;
+ *   - a mixed pixel moves towards its window's line by at most 1.345
+ *     standard deviations of a pixel mean's noise (Huber's clip);
  *   - the features seen through a mirror are the reflected wall's, at the
  *     distance of the whole path; through glass 1 - F of the wall's albedo
  *     and F of white (Fresnel at normal incidence); the sky's, its colour;
@@ -1125,11 +1127,19 @@ static void test_edge_direct_feature(void **state)
  * (which the step leaves as they are) and the pixel's own value before the
  * step (the same picture with its albedo's spread taken away, so that it
  * is no mixed pixel). With a variance of 0 the old limit kept that value. */
-static void test_mixed_pixel_agreeing_samples(void **state)
+/* The picture of test_mixed_pixel_agreeing_samples, its neighbours'
+ * samples of standard deviation sigma: the output (red) of the mixed pixel
+ * (16, 12) with the mixed-pixel step (*after), without it (*before: its
+ * albedo's spread taken away), the window's least-squares line at its
+ * albedo 0.5 (*line), and the step's floor of the noise, the mean over the
+ * 3x3 window of each pixel's variance of its mean in radiance (*var):
+ * (mean of the squares - square of the mean) / (n - 1) a pixel, from the
+ * picture's own sums (the centre's 0). */
+static void mixed_pixel_case(double sigma, double *after, double *before, double *line, double *var)
 {
-	(void)state;
 	const int W = 32, H = 24, X = 16, Y = 12, SPP = 8;
 	float *out[2];
+	double vsum = 0;
 	for (int pass = 0; pass < 2; pass++) {
 		framebuffer *fb = flat_fb(W, H, SPP);
 		test_rng r = {7};
@@ -1142,13 +1152,17 @@ static void test_mixed_pixel_agreeing_samples(void **state)
 					a = 0.5f;
 					set_pixel(fb, i, 0.4f, 0.4f, 0.4f);
 				} else {
-					noisy_pixel(fb, i, 0.5 * a, 0.3, &r);
+					noisy_pixel(fb, i, 0.5 * a, sigma, &r);
 				}
 				f[0] = f[1] = f[2] = a;
 				/* the mean squared albedo: the mixed pixel's of half 0.8,
 				 * half 0.2 (features_vary), unless taken away */
 				f[8] = x == X && y == Y && pass == 0 ? 1.5f * (0.64f + 0.04f) : 3 * a * a;
 				f[9] = f[6] * f[6];
+				if (pass == 0 && abs(x - X) <= 1 && abs(y - Y) <= 1) {
+					double m = fb->rgb[i * 3], q = (double)f[7] - m * m;
+					vsum += (q > 0 ? q : 0) / (SPP - 1);
+				}
 			}
 		out[pass] = malloc(sizeof(float) * W * H * 3);
 		assert_non_null(out[pass]);
@@ -1169,15 +1183,47 @@ static void test_mixed_pixel_agreeing_samples(void **state)
 			sar += a * v;
 			n++;
 		}
-	double slope = (sar - sa * sr / n) / (saa - sa * sa / n), expect = sr / n + slope * (0.5 - sa / n);
+	double slope = (sar - sa * sr / n) / (saa - sa * sa / n);
 	int c = Y * W + X;
-	print_message("mixed pixel, samples all 0.4: before the step %.4f, after %.4f (the window's line at 0.5: "
-	              "%.4f)\n",
-	              out[1][c * 3], out[0][c * 3], expect);
-	assert_true(fabs(out[1][c * 3] - expect) > 0.05);
-	assert_near(out[0][c * 3], expect, 0.01);
+	*line = sr / n + slope * (0.5 - sa / n);
+	*after = out[0][c * 3];
+	*before = out[1][c * 3];
+	*var = vsum / 9;
 	free(out[0]);
 	free(out[1]);
+}
+
+static void test_mixed_pixel_agreeing_samples(void **state)
+{
+	(void)state;
+	double after, before, line, var;
+	mixed_pixel_case(0.3, &after, &before, &line, &var);
+	print_message("mixed pixel, samples all 0.4: before the step %.4f, after %.4f (the window's line at 0.5: "
+	              "%.4f)\n",
+	              before, after, line);
+	assert_true(fabs(before - line) > 0.05);
+	assert_near(after, line, 0.01);
+}
+
+/* The same picture with quieter neighbours (sd 0.09 a sample): the line
+ * now lies further from the pixel than 1.345 standard deviations of the
+ * noise of a pixel's mean (the window's, the pixel's own being 0), and the
+ * step moves it by exactly that much towards the line, Huber's clip; the
+ * old limit, 3 standard deviations, let it go all the way. */
+static void test_mixed_pixel_huber_clip(void **state)
+{
+	(void)state;
+	double after, before, line, var;
+	mixed_pixel_case(0.09, &after, &before, &line, &var);
+	double sd = sqrt(var), lim = 1.345 * sd;
+	double expect = before + (line < before ? -lim : lim);
+	print_message("mixed pixel, neighbours sd 0.09: before the step %.4f, after %.4f; the line at 0.5 %.4f, "
+	              "the noise's sd %.4f: clipped at %.4f\n",
+	              before, after, line, sd, expect);
+	/* the clip acts under the rule, and would not at 3 sd */
+	assert_true(fabs(line - before) > lim + 0.005);
+	assert_true(fabs(line - before) < 3 * sd - 0.005);
+	assert_near(after, expect, 1e-4);
 }
 
 /* An edge that none of the first DENOISE_FEATURE_SAMPLES camera positions
@@ -1762,6 +1808,7 @@ int main(void)
 		cmocka_unit_test(test_edge_direct_feature),
 		cmocka_unit_test(test_probe_edge),
 		cmocka_unit_test(test_mixed_pixel_agreeing_samples),
+		cmocka_unit_test(test_mixed_pixel_huber_clip),
 		cmocka_unit_test(test_features_in_passes),
 		cmocka_unit_test(test_allocate_rule),
 		cmocka_unit_test(test_sigma_neighbours),
