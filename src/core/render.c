@@ -604,6 +604,11 @@ render_status render_run(render_job *job, rt_error *err)
 	 * 100 ms. */
 	double last = now_seconds();
 	tile_cancel = job->cancel;
+	/* At once, not after this thread's first tile: a tile of many samples
+	 * takes seconds, and the shell's status line says "rendering ...
+	 * (Ctrl-C stops)" from this report on. */
+	if (job->progress)
+		report(job, &sh);
 	for (;;) {
 		if ((job->cancel && atomic_load(job->cancel)) || atomic_load(&sh.stop))
 			break;

@@ -434,6 +434,51 @@ static void test_render_stops_within_a_tile(void **state)
 	scene_free(s);
 }
 
+/* The first progress report comes before any tile is done (done 0 of
+ * all), so that a render of many samples says it is rendering at once; the
+ * old renderer's first came after the calling thread's first tile. */
+typedef struct first_report {
+	long calls, first_done, first_total;
+} first_report;
+
+static void record_first(void *ctx, long done, long total)
+{
+	first_report *f = ctx;
+	if (f->calls++ == 0) {
+		f->first_done = done;
+		f->first_total = total;
+	}
+}
+
+static void test_progress_reported_at_once(void **state)
+{
+	(void)state;
+	rt_error err;
+	scene *s = scene_generate(5, 3, NULL, &err);
+	assert_non_null(s);
+	world *w = world_build(s, &err);
+	assert_non_null(w);
+	render_settings set = render_settings_default();
+	set.width = 4 * RENDER_TILE;
+	set.height = 2 * RENDER_TILE; /* 8 tiles */
+	set.samples = 2;
+	for (int threads = 1; threads <= 2; threads++) {
+		set.threads = threads;
+		framebuffer *fb = fb_new(set.width, set.height);
+		assert_non_null(fb);
+		first_report f = {0, -1, -1};
+		render_job job = {.w = w, .set = set, .fb = fb, .sample_begin = 0, .sample_end = set.samples,
+		                  .progress = record_first, .progress_ctx = &f};
+		assert_int_equal(render_run(&job, &err), RENDER_DONE);
+		assert_true(f.calls >= 2); /* the first, and the last (8 of 8) */
+		assert_int_equal(f.first_done, 0);
+		assert_int_equal(f.first_total, 8);
+		fb_free(fb);
+	}
+	world_release(w);
+	scene_free(s);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -443,6 +488,7 @@ int main(void)
 	    cmocka_unit_test(test_readers_stop),
 	    cmocka_unit_test(test_render_stops_in_flight),
 	    cmocka_unit_test(test_render_stops_within_a_tile),
+	    cmocka_unit_test(test_progress_reported_at_once),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
 }
