@@ -110,8 +110,11 @@ int preview_main(const rtsh_options *o)
 	/* Only regular files: a FIFO would block the open, a device or a
 	 * folder means nothing. */
 	struct stat st;
-	if (stat(file, &st) != 0)
-		return fail(file, strerror(errno));
+	if (stat(file, &st) != 0) {
+		char msg[160];
+		snprintf(msg, sizeof msg, "cannot open: %s; expected a readable scene (.rt) or model file", strerror(errno));
+		return fail(file, msg);
+	}
 	const char *kind = rt_file_kind(st.st_mode);
 	if (kind) {
 		char msg[160];
