@@ -112,6 +112,50 @@ static void test_headers_that_promise_too_much(void **state)
 		fail_msg("message \"%s\"", err.msg);
 }
 
+/* An image over the size limit says its size and the limit, in every
+ * format: stb_image alone called a 30000 x 30000 RGB PNG or JPEG an
+ * "unknown image type" (its own limits are 2^30 and 2^31 decoded bytes).
+ * Each header is written here from its format's layout. */
+static void test_too_large_says_so(void **state)
+{
+	(void)state;
+	/* 30000 = 0x7530 */
+	static const unsigned char png[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R',
+	                                    0, 0, 0x75, 0x30, 0, 0, 0x75, 0x30, 8, 2, 0, 0, 0, 0, 0, 0, 0};
+	/* SOI, then SOF0: length 17, 8 bits, height, width, 3 components */
+	static const unsigned char jpg[] = {0xff, 0xd8, 0xff, 0xc0, 0, 17, 8, 0x75, 0x30, 0x75, 0x30, 3,
+	                                    1, 0x11, 0, 2, 0x11, 0, 3, 0x11, 0, 0xff, 0xd9};
+	/* BITMAPFILEHEADER, then a 40-byte BITMAPINFOHEADER, 24 bits */
+	unsigned char bmp[54] = {'B', 'M'};
+	bmp[10] = 54;
+	bmp[14] = 40;
+	bmp[18] = 0x30, bmp[19] = 0x75, bmp[22] = 0x30, bmp[23] = 0x75;
+	bmp[26] = 1;
+	bmp[28] = 24;
+	static const char hdr[] = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 30000 +X 30000\n";
+	static const char ppm[] = "P6\n30000 30000\n255\n";
+	static const char pfm[] = "PF\n30000 30000\n-1.0\n";
+	const struct {
+		const char *name;
+		const void *b;
+		size_t len;
+	} c[] = {{"x.png", png, sizeof png}, {"x.jpg", jpg, sizeof jpg}, {"x.bmp", bmp, sizeof bmp},
+	         {"x.hdr", hdr, sizeof hdr - 1}, {"x.ppm", ppm, sizeof ppm - 1}, {"x.pfm", pfm, sizeof pfm - 1}};
+	for (size_t i = 0; i < sizeof c / sizeof c[0]; i++) {
+		rt_error err = {0};
+		int w, h;
+		float *p = image_decode_rgb(c[i].name, c[i].b, c[i].len, true, &w, &h, &err);
+		assert_null(p);
+		if (!strstr(err.msg, "image too large: 30000x30000 pixels; expected at most 268435456"))
+			fail_msg("%s: message \"%s\"", c[i].name, err.msg);
+		unsigned char *a = NULL;
+		bool ok = image_decode_alpha(c[i].name, c[i].b, c[i].len, &a, &w, &h, &err);
+		assert_null(a);
+		if (!ok && !strstr(err.msg, "image too large: 30000x30000 pixels"))
+			fail_msg("%s: the alpha reader's message \"%s\"", c[i].name, err.msg);
+	}
+}
+
 static void test_mipmap_average(void **state)
 {
 	(void)state;
@@ -339,6 +383,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_ppm_pfm_xpm),
 		cmocka_unit_test(test_headers_that_promise_too_much),
+		cmocka_unit_test(test_too_large_says_so),
 		cmocka_unit_test(test_mipmap_average),
 		cmocka_unit_test(test_corner_lands_where_documented),
 		cmocka_unit_test(test_flat_normal_map_changes_nothing),
