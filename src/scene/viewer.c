@@ -104,6 +104,48 @@ static bool node_bounds(const char *path, const gltf_info *gi, const rt_load_opt
 	return true;
 }
 
+/* The model's own image files (an MTL's maps, a glTF's images beside it),
+ * read at load as a .rt's texture= is (rtfile_read.c): a missing or bad one
+ * makes the load fail with the model's name and the image's, rather than
+ * every render after it (rtsh(5), "Meshes"). They stay in the texture cache
+ * for the render. */
+static bool model_images_ok(const char *path, const mesh *m, const rt_load_opts *opts, rt_error *err)
+{
+	for (uint32_t k = 0; k < m->nmats; k++) {
+		const mesh_mat *mm = &m->mats[k];
+		/* the colour spaces surface.c asks for (the cache keys on them) */
+		const struct {
+			const char *file, *what;
+			bool srgb;
+		} f[] = {{mm->map_kd, "colour texture", true},
+		         {mm->map_norm, "normal map", false},
+		         {mm->map_bump, "bump map", false},
+		         {mm->gltf ? mm->map_mr : NULL, "metallic-roughness texture", false},
+		         {mm->gltf ? mm->map_emit : NULL, "emissive texture", true}};
+		for (size_t i = 0; i < sizeof f / sizeof f[0]; i++) {
+			if (!f[i].file)
+				continue;
+			rt_error e;
+			rt_error_clear(&e);
+			texture *t = texture_cache_get(f[i].file, f[i].srgb, opts ? opts->cancel : NULL, &e);
+			if (!t) {
+				char why[RT_ERROR_MSG_MAX];
+				rt_error_format(&e, why, sizeof why);
+				if (strcmp(why, "stopped") == 0)
+					return rt_error_set(err, "stopped");
+				char mat[96];
+				if (mm->name && mm->name[0])
+					snprintf(mat, sizeof mat, "\"%.80s\"", mm->name);
+				else
+					snprintf(mat, sizeof mat, "%u", k + 1);
+				return rt_error_set(err, "%s: the %s of material %s: %s", path, f[i].what, mat, why);
+			}
+			texture_cache_put(t);
+		}
+	}
+	return true;
+}
+
 static char *gltf_text(const char *path, const rt_load_opts *opts, size_t *len, bool *stage_lit, rt_error *err)
 {
 	gltf_info gi;
@@ -120,7 +162,23 @@ static char *gltf_text(const char *path, const rt_load_opts *opts, size_t *len, 
 			return NULL;
 		}
 		bb = m->bounds;
+		bool images = model_images_ok(path, m, opts, err);
 		mesh_cache_put(m);
+		if (!images) {
+			free(nb);
+			gltf_info_free(&gi);
+			return NULL;
+		}
+	} else {
+		/* a node's mesh holds all the file's materials */
+		mesh *m = mesh_cache_get_node(path, gi.mesh_nodes[0], true, 60, opts ? opts->cancel : NULL, err);
+		bool images = m && model_images_ok(path, m, opts, err);
+		mesh_cache_put(m);
+		if (!images) {
+			free(nb);
+			gltf_info_free(&gi);
+			return NULL;
+		}
 	}
 	vec3 ext = v3_sub(bb.hi, bb.lo), mid = box_center(bb);
 	double longest = v3_max_comp(ext);
@@ -322,6 +380,10 @@ static char *model_text(const char *path, const rt_load_opts *opts, size_t *len,
 		return NULL;
 	if (m->warning) /* a missing material library, say */
 		rt_warn(opts ? opts->warn : NULL, NULL, 0, 0, "%s", m->warning);
+	if (!model_images_ok(path, m, opts, err)) {
+		mesh_cache_put(m);
+		return NULL;
+	}
 	vec3 ext = v3_sub(m->bounds.hi, m->bounds.lo);
 	bool turned = faces_back(m);
 	bool textured = beside_texture(path, m, opts, tex, tex_size);
