@@ -34,7 +34,7 @@ static bool hold_texture(world *w, const char *path, bool srgb, const struct tex
 	w->texs = t;
 	texture *tx = texture_cache_get(path, srgb, w->cancel, err);
 	if (!tx)
-		return false;
+		return image_budget_refused(err); /* the previewer's budget: untextured */
 	w->texs[w->ntexs++] = tx;
 	*out = tx;
 	return true;

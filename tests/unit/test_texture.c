@@ -156,6 +156,52 @@ static void test_too_large_says_so(void **state)
 	}
 }
 
+/* The previewer's budget: an image of more pixels than it is refused
+ * before decoding, the refusal is known as the budget's (image_budget_refused)
+ * and counted once per image; the sky is exempt; at or under the budget,
+ * and with none, the image is read. */
+static void test_preview_budget(void **state)
+{
+	(void)state;
+	unsigned char a[16 + 110];
+	int n = sprintf((char *)a, "P5\n10 10\n255\n");
+	memset(a + n, 128, 100);
+	size_t len100 = (size_t)n + 100;
+	unsigned char b[16 + 110];
+	int m = sprintf((char *)b, "P5\n10 11\n255\n");
+	memset(b + m, 128, 110);
+	size_t len110 = (size_t)m + 110;
+	rt_error err = {0};
+	int w, h;
+	image_budget_set(100);
+	float *px = image_decode_rgb("a.pgm", a, len100, true, &w, &h, &err);
+	assert_non_null(px); /* 100 pixels: at the budget */
+	free(px);
+	assert_null(image_decode_rgb("b.pgm", b, len110, true, &w, &h, &err));
+	assert_true(image_budget_refused(&err));
+	if (!strstr(err.msg, "b.pgm: 10x11 pixels, over the preview's 100 for an image"))
+		fail_msg("message \"%s\"", err.msg);
+	assert_null(image_decode_rgb("b.pgm", b, len110, true, &w, &h, &err)); /* the same image again */
+	char first[RT_ERROR_MSG_MAX];
+	assert_int_equal(image_budget_report(first, sizeof first), 1);
+	assert_string_equal(first, err.msg);
+	/* another failure is not the budget's */
+	rt_error other = {0};
+	assert_null(image_decode_rgb("c.pgm", (const unsigned char *)"P5\n0 1\n255\n", 12, true, &w, &h, &other));
+	assert_false(image_budget_refused(&other));
+	/* the sky is not held to it */
+	image_budget_exempt(true);
+	px = image_decode_rgb("b.pgm", b, len110, true, &w, &h, &err);
+	image_budget_exempt(false);
+	assert_non_null(px);
+	free(px);
+	/* no budget: read */
+	image_budget_set(0);
+	px = image_decode_rgb("b.pgm", b, len110, true, &w, &h, &err);
+	assert_non_null(px);
+	free(px);
+}
+
 static void test_mipmap_average(void **state)
 {
 	(void)state;
@@ -384,6 +430,7 @@ int main(void)
 		cmocka_unit_test(test_ppm_pfm_xpm),
 		cmocka_unit_test(test_headers_that_promise_too_much),
 		cmocka_unit_test(test_too_large_says_so),
+		cmocka_unit_test(test_preview_budget),
 		cmocka_unit_test(test_mipmap_average),
 		cmocka_unit_test(test_corner_lands_where_documented),
 		cmocka_unit_test(test_flat_normal_map_changes_nothing),

@@ -1116,6 +1116,8 @@ static bool alpha_info(gl *g, const cJSON *ti, const char *where, mesh_mat *m)
 	bool ok = image_decode_alpha(ib.name, ib.data, ib.len, &m->alpha_map, &w, &h, g->err);
 	free(ib.own);
 	free(disk);
+	if (!ok && image_budget_refused(g->err)) /* the previewer's budget: no cut-outs */
+		return true;
 	m->alpha_w = w;
 	m->alpha_h = h;
 	return ok;
@@ -1154,7 +1156,7 @@ static bool tex_info(gl *g, mesh_builder *b, texture **cache, const cJSON *ti, c
 	float *rgb = image_decode_rgb(ib.name, ib.data, ib.len, srgb, &w, &h, g->err);
 	free(ib.own);
 	if (!rgb)
-		return false;
+		return image_budget_refused(g->err); /* the previewer's budget: untextured */
 	texture *x = texture_make(rgb, w, h, ib.name, srgb, g->err);
 	if (!x)
 		return false;

@@ -73,6 +73,62 @@ static void codes_to_float(const unsigned char *in, size_t n, int comp, bool srg
  * ours). */
 #define IMAGE_BYTES_PER_PIXEL (12.0 + 12.0 + 4.0)
 
+/* --- the previewer's budget (texture.h) --- */
+
+static size_t budget;                       /* 0: none */
+static _Thread_local bool budget_off;        /* image_budget_exempt */
+static _Thread_local char budget_last[RT_ERROR_MSG_MAX];
+static pthread_mutex_t budget_lock = PTHREAD_MUTEX_INITIALIZER;
+#define BUDGET_KEEP 32
+static char *budget_paths[BUDGET_KEEP];     /* the refused images, to count each once */
+static size_t budget_count;
+static char budget_first[RT_ERROR_MSG_MAX];
+
+void image_budget_set(size_t pixels)
+{
+	budget = pixels;
+}
+
+void image_budget_exempt(bool on)
+{
+	budget_off = on;
+}
+
+bool image_budget_refused(const rt_error *err)
+{
+	return err && budget_last[0] && strcmp(err->msg, budget_last) == 0;
+}
+
+size_t image_budget_report(char *first, size_t size)
+{
+	pthread_mutex_lock(&budget_lock);
+	size_t n = budget_count;
+	if (size)
+		snprintf(first, size, "%s", budget_first);
+	pthread_mutex_unlock(&budget_lock);
+	return n;
+}
+
+static bool over_budget(const char *path, long w, long h, rt_error *err)
+{
+	rt_error_set(err, "%s: %ldx%ld pixels, over the preview's %zu for an image; drawn untextured", path, w, h,
+	             budget);
+	snprintf(budget_last, sizeof budget_last, "%s", err ? err->msg : "");
+	pthread_mutex_lock(&budget_lock);
+	bool seen = false;
+	for (size_t i = 0; i < BUDGET_KEEP && budget_paths[i] && !seen; i++)
+		seen = strcmp(budget_paths[i], path) == 0;
+	if (!seen) {
+		if (budget_count == 0)
+			snprintf(budget_first, sizeof budget_first, "%s", budget_last);
+		if (budget_count < BUDGET_KEEP)
+			budget_paths[budget_count] = strdup(path); /* NULL: counted again, no harm */
+		budget_count++;
+	}
+	pthread_mutex_unlock(&budget_lock);
+	return false;
+}
+
 static bool size_ok(const char *path, long w, long h, rt_error *err)
 {
 	if (w <= 0 || h <= 0)
@@ -80,6 +136,8 @@ static bool size_ok(const char *path, long w, long h, rt_error *err)
 	if ((size_t)w * (size_t)h > IMAGE_MAX_PIXELS || w > 1 << 20 || h > 1 << 20)
 		return rt_error_set(err, "%s: image too large: %ldx%ld pixels; expected at most 268435456 (2^28, "
 		                    "16384x16384) pixels and 1048576 a side", path, w, h);
+	if (budget && !budget_off && (size_t)w * (size_t)h > budget)
+		return over_budget(path, w, h, err);
 	/* the decoder's pixels (floats for HDR), ours, and the mip chain's
 	 * third more (texture.c) */
 	char what[300];
