@@ -560,13 +560,15 @@ static void test_sphere_prims(void **state)
 }
 
 /* The tree built by 2, 3 and 4 threads is the 1-thread tree to the byte
- * (bvh.h): 30000 objects of every kind at random (a subtree goes to
- * another thread from 4096 references on both sides), the wide nodes,
- * the primitives in tree order and the counts compared. */
+ * (bvh.h): 70000 objects of every kind at random (a subtree goes to
+ * another thread from 4096 references on both sides, and the primitives'
+ * first half in tree order from 65536 on: world.c reorder), the wide
+ * nodes, the primitives in tree order and the counts compared; and each
+ * fast sphere's record is its object's centre and half its scale. */
 static void test_threaded_build(void **state)
 {
 	(void)state;
-	scene *s = random_scene(29, 30000, 100, 1.0, 1);
+	scene *s = random_scene(29, 70000, 100, 1.0, 1);
 	rt_error err;
 	world *one = world_build_threads(s, 1, NULL, &err);
 	assert_non_null(one);
@@ -582,9 +584,11 @@ static void test_threaded_build(void **state)
 		for (size_t i = 0; i < w->nprims; i++) {
 			const prim *a = &w->prims[i], *b = &one->prims[i];
 			assert_true(a->tag == b->tag && a->object == b->object);
-			if (a->tag == PRIM_SPHERE)
+			if (a->tag == PRIM_SPHERE) {
 				assert_memory_equal(&a->u.sph, &b->u.sph, sizeof a->u.sph);
-			else
+				const object *o = &s->objs[a->object];
+				assert_true(v3_eq(a->u.sph.c, o->pos) && a->u.sph.r == o->scale.x * 0.5);
+			} else
 				assert_int_equal(a->u.index, b->u.index);
 		}
 		/* the materials, filled by another thread from 4096 objects on */
