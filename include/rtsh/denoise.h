@@ -182,12 +182,18 @@ bool denoise_image(const framebuffer *fb, float *out, int threads);
 
 /* The noise about each pixel of fb (features and at least 2 samples a
  * pixel) into sigma (w*h): the standard deviation of one sample's
- * brightness over its 8 neighbours, the root of the mean of their
- * variances (those of fixed neighbours, denoise_fixed, left out: their
- * noise is not known), the pixel's own samples left out (so that its count does not
- * depend on them: a pixel whose first samples happened to miss a bright
- * path would keep few, and its mean would be low on average). False when
- * out of memory. */
+ * brightness over its 3x3 window, the root of the mean of the nine
+ * variances (those of fixed pixels, denoise_fixed, left out: their noise
+ * is not known), its own included. Until the denoise12 session its own was
+ * left out, so that its count would not depend on its samples (a pixel
+ * whose first samples happened to miss a bright path keeps fewer, and its
+ * mean is low on average); but then a pixel whose first samples met one,
+ * a firefly, gave more samples to its neighbours and kept its firefly at
+ * 6 of 8 samples, which cost more: with its own included, 4 seeds,
+ * metal-fuzz, final, cornell, spot, sky-spheres, RMS new/old: 128x96
+ * 1.006 0.992 0.991 0.962 0.990, 200x120 0.989 0.991 0.981 0.964 0.987,
+ * 640x360 0.979 0.995 1.011 0.948 0.997 (bench/README). False when out of
+ * memory. */
 bool denoise_sigma(const framebuffer *fb, float *sigma);
 /* Whether a pixel of features f keeps the samples a uniform render gives it
  * and its noise counts for none of its neighbours: its first positions all

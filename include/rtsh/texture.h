@@ -52,6 +52,20 @@ float *image_decode_rgb(const char *path, const unsigned char *buf, size_t len, 
  * when the image cannot be decoded. */
 bool image_decode_alpha(const char *path, const unsigned char *buf, size_t len, unsigned char **alpha, int *w, int *h,
                         rt_error *err);
+/* The previewer's budget for textures (rtsh(1), --preview): an image of
+ * more pixels than this is not decoded; its reader fails, and the callers
+ * that can go on without it (texture=, normalmap=, bump=, a model's own
+ * images) see image_budget_refused and leave the surface untextured. 0 (the
+ * default): no budget. Set before any thread reads images. */
+void image_budget_set(size_t pixels);
+/* On this thread, images read until it is called again with false are not
+ * held to the budget (the sky: without it there is no picture). */
+void image_budget_exempt(bool on);
+/* True when err is this thread's last refusal by the budget. */
+bool image_budget_refused(const rt_error *err);
+/* How many different images the budget refused, and the first one's
+ * message in first (size bytes). */
+size_t image_budget_report(char *first, size_t size);
 /* The one netpbm and PFM reader, for a file on disk whatever its name:
  * pfm false, PPM/PGM (P2 P3 P5 P6, 8 or 16 bits, sRGB-decoded); pfm true,
  * PFM (PF colour, Pf grey, linear; non-finite values read as 0). image.c's

@@ -1217,8 +1217,8 @@ bool denoise_image(const framebuffer *fb, float *out, int threads)
 /* The noise of one sample's brightness about each pixel of fb (its samples
  * so far, at least two; features 7): the variance in each pixel from the
  * mean of the squared brightness and the mean's square, n / (n - 1)
- * unbiased; then each pixel the root of the mean of its 8 neighbours'
- * (those inside the image and not fixed), its own left out. */
+ * unbiased; then each pixel the root of the mean over its 3x3 window (the
+ * pixels inside the image and not fixed), its own included. */
 bool denoise_fixed(const float *f)
 {
 	/* the sky or background: depth 0 and no direct light (a glossy
@@ -1258,9 +1258,9 @@ bool denoise_sigma(const framebuffer *fb, float *sigma)
 			for (int dy = -1; dy <= 1; dy++)
 				for (int dx = -1; dx <= 1; dx++) {
 					int qx = x + dx, qy = y + dy;
-					/* a fixed neighbour's noise is not known (its
+					/* a fixed pixel's noise is not known (its
 					 * variance was set to 0): it does not count */
-					if (qx < 0 || qy < 0 || qx >= w || qy >= h || (dx == 0 && dy == 0) ||
+					if (qx < 0 || qy < 0 || qx >= w || qy >= h ||
 					    denoise_fixed(fb->feat + ((size_t)qy * w + qx) * DENOISE_FEATURES))
 						continue;
 					s += v[(size_t)qy * w + qx];

@@ -38,7 +38,9 @@ envmap *envmap_new(const char *path, double strength, double rotation_deg, const
 		rt_error_set(err, "out of memory loading the sky");
 		return NULL;
 	}
+	image_budget_exempt(true); /* the previewer's budget is for textures */
 	e->tex = texture_cache_get(path, false, cancel, err);
+	image_budget_exempt(false);
 	if (!e->tex) {
 		free(e);
 		return NULL;

@@ -15,6 +15,7 @@
 #include "surface.h"
 #include "ggx.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -33,10 +34,29 @@ static bool hold_texture(world *w, const char *path, bool srgb, const struct tex
 	w->texs = t;
 	texture *tx = texture_cache_get(path, srgb, w->cancel, err);
 	if (!tx)
-		return false;
+		return image_budget_refused(err); /* the previewer's budget: untextured */
 	w->texs[w->ntexs++] = tx;
 	*out = tx;
 	return true;
+}
+
+/* hold_texture for a model's own material k: a failure names the model
+ * and the material (rtsh(5), "Meshes"). */
+static bool hold_model_texture(world *w, const mesh *me, uint32_t k, const char *what, const char *path, bool srgb,
+                               const struct texture **out, rt_error *err)
+{
+	if (hold_texture(w, path, srgb, out, err))
+		return true;
+	char why[RT_ERROR_MSG_MAX], mat[96];
+	rt_error_format(err, why, sizeof why);
+	if (strcmp(why, "stopped") == 0)
+		return false;
+	const char *name = me->mats[k].name;
+	if (name && name[0])
+		snprintf(mat, sizeof mat, "\"%.80s\"", name);
+	else
+		snprintf(mat, sizeof mat, "%u", k + 1);
+	return rt_error_set(err, "%s: the %s of material %s: %s", me->path ? me->path : "the model", what, mat, why);
 }
 
 bool surf_begin(world *w, const scene *s, rt_error *err)
@@ -161,7 +181,7 @@ bool surf_material(world *w, const object *o, uint32_t i, rt_error *err)
 		l.light = -1;
 		mat_tex t = own;
 		if (mm->map_kd) {
-			if (!hold_texture(w, mm->map_kd, true, &t.tex, err))
+			if (!hold_model_texture(w, me, k, "colour texture", mm->map_kd, true, &t.tex, err))
 				return false;
 			t.tint = mm->gltf; /* glTF: texture x baseColorFactor */
 		} else if (mm->tex_kd) { /* embedded in the model: the mesh holds it */
@@ -174,20 +194,21 @@ bool surf_material(world *w, const object *o, uint32_t i, rt_error *err)
 				t.uvx[a] = mm->uvx[a] * t.uvs[a];
 				t.uvs[a] *= mm->uvs[a];
 			}
-		if (mm->map_norm && !hold_texture(w, mm->map_norm, false, &t.nmap, err))
+		if (mm->map_norm && !hold_model_texture(w, me, k, "normal map", mm->map_norm, false, &t.nmap, err))
 			return false;
 		if (!mm->map_norm && mm->tex_norm)
 			t.nmap = mm->tex_norm;
-		if (mm->gltf && mm->map_mr && !hold_texture(w, mm->map_mr, false, &t.mr, err))
+		if (mm->gltf && mm->map_mr &&
+		    !hold_model_texture(w, me, k, "metallic-roughness texture", mm->map_mr, false, &t.mr, err))
 			return false;
 		if (mm->gltf && !mm->map_mr && mm->tex_mr)
 			t.mr = mm->tex_mr;
-		if (mm->gltf && mm->map_emit && !hold_texture(w, mm->map_emit, true, &t.emit, err))
+		if (mm->gltf && mm->map_emit && !hold_model_texture(w, me, k, "emissive texture", mm->map_emit, true, &t.emit, err))
 			return false;
 		if (mm->gltf && !mm->map_emit && mm->tex_emit)
 			t.emit = mm->tex_emit;
 		if (mm->map_bump) {
-			if (!hold_texture(w, mm->map_bump, false, &t.bump, err))
+			if (!hold_model_texture(w, me, k, "bump map", mm->map_bump, false, &t.bump, err))
 				return false;
 			/* an MTL -bm is in model units: roughly right for scenes */
 			t.bumpscale = mm->bump_scale * 0.01;

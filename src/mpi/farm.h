@@ -7,7 +7,7 @@
  * as render_image makes it (render.h: render_adaptive): FARM_FIRST renders
  * farm_first(S) samples in every pixel; rank 0 allocates the rest from the
  * whole image's sums (render_adaptive_counts: a pixel's count depends on
- * its 8 neighbours, across tiles); FARM_ADAPTIVE hands every tile out with
+ * its 3x3 window, across tiles); FARM_ADAPTIVE hands every tile out with
  * its pixels' sums, features and counts, and each pixel's sequence is
  * continued to its count. Any other image is one pass, FARM_ONE.
  *

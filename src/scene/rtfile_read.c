@@ -918,9 +918,15 @@ static bool get_file(parser *p, const tok *t, const char *name, size_t n, const 
 	bool ok = true;
 	bool image = key || strcmp(p->toks[0].s, "sky") == 0;
 	if (image) {
+		image_budget_exempt(!key); /* the sky: no picture without it */
 		texture *tx = texture_cache_get(full, key && strcmp(key->name, "texture") == 0, p->cancel, &ferr);
+		image_budget_exempt(false);
 		ok = tx != NULL;
 		texture_cache_put(tx);
+		if (!ok && key && image_budget_refused(&ferr)) { /* the previewer's budget: untextured */
+			*out = NULL;
+			return true;
+		}
 	} else if (!mesh_format_known(full)) {
 		ok = mesh_load(full, &ferr) != NULL; /* gives the message */
 	}

@@ -17,6 +17,7 @@
  * spot_triangulated.obj), which the status line names.
  */
 #include <dirent.h>
+#include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -104,6 +105,47 @@ static bool node_bounds(const char *path, const gltf_info *gi, const rt_load_opt
 	return true;
 }
 
+/* The model's own image files (an MTL's maps, a glTF's images beside it)
+ * are there, as a .rt's texture= is checked (rtfile_read.c): a missing one
+ * makes the load fail with the model's name, the material's and the
+ * image's, rather than every render after it (rtsh(5), "Meshes"). Only
+ * looked up (stat), not decoded: a scene of a hundred images is not read
+ * twice; a corrupt one is the render's error, in the same words
+ * (surface.c). */
+static bool model_images_ok(const char *path, const mesh *m, rt_error *err)
+{
+	for (uint32_t k = 0; k < m->nmats; k++) {
+		const mesh_mat *mm = &m->mats[k];
+		const struct {
+			const char *file, *what;
+		} f[] = {{mm->map_kd, "colour texture"},
+		         {mm->map_norm, "normal map"},
+		         {mm->map_bump, "bump map"},
+		         {mm->gltf ? mm->map_mr : NULL, "metallic-roughness texture"},
+		         {mm->gltf ? mm->map_emit : NULL, "emissive texture"}};
+		for (size_t i = 0; i < sizeof f / sizeof f[0]; i++) {
+			struct stat st;
+			if (!f[i].file)
+				continue;
+			const char *why = NULL, *kind = NULL;
+			if (rt_file_stat(f[i].file, &st) != 0)
+				why = strerror(errno);
+			else if ((kind = rt_file_kind(st.st_mode)) != NULL)
+				why = "not a regular file";
+			if (!why)
+				continue;
+			char mat[96];
+			if (mm->name && mm->name[0])
+				snprintf(mat, sizeof mat, "\"%.80s\"", mm->name);
+			else
+				snprintf(mat, sizeof mat, "%u", k + 1);
+			return rt_error_set(err, "%s: the %s of material %s: %s: cannot read the image: %s%s%s", path,
+			                    f[i].what, mat, f[i].file, why, kind ? " but " : "", kind ? kind : "");
+		}
+	}
+	return true;
+}
+
 static char *gltf_text(const char *path, const rt_load_opts *opts, size_t *len, bool *stage_lit, rt_error *err)
 {
 	gltf_info gi;
@@ -120,7 +162,23 @@ static char *gltf_text(const char *path, const rt_load_opts *opts, size_t *len, 
 			return NULL;
 		}
 		bb = m->bounds;
+		bool images = model_images_ok(path, m, err);
 		mesh_cache_put(m);
+		if (!images) {
+			free(nb);
+			gltf_info_free(&gi);
+			return NULL;
+		}
+	} else {
+		/* a node's mesh holds all the file's materials */
+		mesh *m = mesh_cache_get_node(path, gi.mesh_nodes[0], true, 60, opts ? opts->cancel : NULL, err);
+		bool images = m && model_images_ok(path, m, err);
+		mesh_cache_put(m);
+		if (!images) {
+			free(nb);
+			gltf_info_free(&gi);
+			return NULL;
+		}
 	}
 	vec3 ext = v3_sub(bb.hi, bb.lo), mid = box_center(bb);
 	double longest = v3_max_comp(ext);
@@ -322,6 +380,10 @@ static char *model_text(const char *path, const rt_load_opts *opts, size_t *len,
 		return NULL;
 	if (m->warning) /* a missing material library, say */
 		rt_warn(opts ? opts->warn : NULL, NULL, 0, 0, "%s", m->warning);
+	if (!model_images_ok(path, m, err)) {
+		mesh_cache_put(m);
+		return NULL;
+	}
 	vec3 ext = v3_sub(m->bounds.hi, m->bounds.lo);
 	bool turned = faces_back(m);
 	bool textured = beside_texture(path, m, opts, tex, tex_size);

@@ -17,6 +17,7 @@
 #include "rtsh/render.h"
 #include "rtsh/rtfile.h"
 #include "rtsh/settings.h"
+#include "rtsh/texture.h"
 #include "rtsh/world.h"
 #include "shell/args.h"
 #include "base/abuf.h"
@@ -122,6 +123,7 @@ int preview_main(const rtsh_options *o)
 		return fail(file, msg);
 	}
 	rt_error err;
+	image_budget_set(PREVIEW_TEXTURE_PIXELS);
 	rt_load_opts lo = {.strict = false, .warn = NULL};
 	scene *s = rt_load_file(file, &lo, &err);
 	if (!s) {
@@ -193,6 +195,16 @@ int preview_main(const rtsh_options *o)
 	world_free(wd);
 	if (!fb)
 		return fail(file, err.msg);
+	/* the textures the budget left out: one line, the picture still drawn */
+	char first[RT_ERROR_MSG_MAX];
+	size_t skipped = image_budget_report(first, sizeof first);
+	if (skipped) {
+		char name[4096], more[64] = "", shown_first[RT_ERROR_MSG_MAX];
+		if (skipped > 1)
+			snprintf(more, sizeof more, " (and %zu more images)", skipped - 1);
+		fprintf(stderr, "rtsh: %s: %s%s\n", shown(file, name, sizeof name),
+		        text_visible(shown_first, sizeof shown_first, first, false), more);
+	}
 	uint8_t *rgb = malloc((size_t)w * h * 3);
 	if (!rgb) {
 		fb_free(fb);

@@ -1441,13 +1441,17 @@ static void test_own_estimates(void **state)
 	fb_free(fb);
 }
 
-/* The noise that decides a pixel's samples is its 8 neighbours', never its
- * own: a 3x3 image of 4 samples a pixel, grey 0.5 (brightness 0.5), each
- * pixel's mean squared brightness 0.25 + v 3/4, so that its unbiased
- * variance, (mean square - mean^2) 4/3, is v. v = 1..9 row by row: the
- * centre (v 5) gets the root of the mean of the other eight, sqrt(40 / 8);
- * the corner (0, 0) of its three neighbours 2, 4, 5: sqrt(11 / 3). Its own
- * v changed (to 1000) changes neither. */
+/* The noise that decides a pixel's samples is the mean over its 3x3
+ * window, its own included: a 3x3 image of 4 samples a pixel, grey 0.5
+ * (brightness 0.5), each pixel's mean squared brightness 0.25 + v 3/4, so
+ * that its unbiased variance, (mean square - mean^2) 4/3, is v. v = 1..9
+ * row by row: the centre (v 5) gets the root of the mean of all nine,
+ * sqrt(45 / 9); the corner (0, 0) of itself and its three neighbours 1, 2,
+ * 4, 5: sqrt(12 / 4) (the old rule, its neighbours alone, gave sqrt(11 /
+ * 3)). Its own v raised to 1000 raises it: sqrt((40 + 1000) / 9) for the
+ * centre, and the corner, a neighbour of it, sqrt((1 + 2 + 4 + 1000) / 4).
+ * (A pixel whose first samples met a rare bright path, a firefly, had
+ * none of its own: its neighbours got them, and it kept the firefly.) */
 static void test_sigma_neighbours(void **state)
 {
 	(void)state;
@@ -1466,43 +1470,40 @@ static void test_sigma_neighbours(void **state)
 	}
 	float sg[9];
 	assert_true(denoise_sigma(fb, sg));
-	assert_near(sg[4], sqrt(40.0 / 8), 1e-5);
-	assert_near(sg[0], sqrt(11.0 / 3), 1e-5);
+	assert_near(sg[4], sqrt(45.0 / 9), 1e-5);
+	assert_near(sg[0], sqrt(12.0 / 4), 1e-5);
 	fb->feat[4 * DENOISE_FEATURES + 7] = 0.25f + 1000.0f * 0.75f;
 	float s2[9];
 	assert_true(denoise_sigma(fb, s2));
-	assert_true(s2[4] == sg[4]);
-	fb->feat[4 * DENOISE_FEATURES + 7] = 0.25f + 5.0f * 0.75f;
-	fb->feat[0 * DENOISE_FEATURES + 7] = 0.25f + 1000.0f * 0.75f;
-	assert_true(denoise_sigma(fb, s2));
-	assert_true(s2[0] == sg[0]);
+	assert_near(s2[4], sqrt(1040.0 / 9), 1e-4);
+	assert_near(s2[0], sqrt(1007.0 / 4), 1e-4);
 	/* A pixel that missed the scene (depth 0) or sees a lamp (albedo 2)
-	 * is fixed and its noise, not known, counts for none of its
-	 * neighbours, not even as 0: pixel 1 (v 2) missing, the corner's
-	 * neighbours are 4 and 5: sqrt(9 / 2); pixel 3 (v 4) a lamp too, 5
-	 * alone: sqrt(5 / 1); the centre's 40 - 2 - 4 = 34 over 6. */
-	fb->feat[0 * DENOISE_FEATURES + 7] = 0.25f + 1.0f * 0.75f;
+	 * is fixed and its noise, not known, counts for no pixel, not even as
+	 * 0: pixel 1 (v 2) missing, the corner's window holds 1, 4 and 5:
+	 * sqrt(10 / 3); pixel 3 (v 4) a lamp too, 1 and 5: sqrt(6 / 2); the
+	 * centre's 45 - 2 - 4 = 39 over 7. */
+	fb->feat[4 * DENOISE_FEATURES + 7] = 0.25f + 5.0f * 0.75f;
 	fb->feat[1 * DENOISE_FEATURES + 6] = 0.0f;
 	assert_true(denoise_fixed(fb->feat + 1 * DENOISE_FEATURES));
 	assert_false(denoise_fixed(fb->feat + 0 * DENOISE_FEATURES));
 	assert_true(denoise_sigma(fb, s2));
-	assert_near(s2[0], sqrt(9.0 / 2), 1e-5);
+	assert_near(s2[0], sqrt(10.0 / 3), 1e-5);
 	fb->feat[3 * DENOISE_FEATURES + 1] = 2.0f;
 	assert_true(denoise_fixed(fb->feat + 3 * DENOISE_FEATURES));
 	assert_true(denoise_sigma(fb, s2));
-	assert_near(s2[0], sqrt(5.0 / 1), 1e-5);
-	assert_near(s2[4], sqrt(34.0 / 6), 1e-5);
-	/* pixel 4 a lamp too: the corner has no neighbour left, sigma 0 */
+	assert_near(s2[0], sqrt(6.0 / 2), 1e-5);
+	assert_near(s2[4], sqrt(39.0 / 7), 1e-5);
+	/* pixel 4 a lamp too: the corner has its own noise left, sqrt(1) */
 	fb->feat[4 * DENOISE_FEATURES + 1] = 2.0f;
 	assert_true(denoise_sigma(fb, s2));
-	assert_true(s2[0] == 0.0f);
+	assert_near(s2[0], 1.0, 1e-5);
 	/* The sky seen in a glossy metal: depth 0, but a direct light (the
 	 * lamps the lobe sees, feature 14): not fixed, and pixel 1's v 2
-	 * counts for the corner again, its one neighbour left: sqrt(2 / 1). */
+	 * counts for the corner again: sqrt((1 + 2) / 2). */
 	fb->feat[1 * DENOISE_FEATURES + 14] = 2.0f;
 	assert_false(denoise_fixed(fb->feat + 1 * DENOISE_FEATURES));
 	assert_true(denoise_sigma(fb, s2));
-	assert_near(s2[0], sqrt(2.0), 1e-5);
+	assert_near(s2[0], sqrt(3.0 / 2), 1e-5);
 	fb_free(fb);
 }
 

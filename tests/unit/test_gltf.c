@@ -333,6 +333,50 @@ static void test_bad_files(void **state)
 	assert_non_null(strstr(err.msg, "cut.glb: byte 12: a .glb chunk of 4294967288 bytes, 4 left"));
 }
 
+/* A buffer's or an image's file that cannot be read is named after the
+ * .gltf and the buffer or image that points to it (the file reader alone
+ * said "nothere.bin: cannot read the glTF buffer: ..." without the model);
+ * a %00 in a uri is refused, not read as a shorter name. */
+static void expect_file_fail(const char *name, const char *text, const char *want1, const char *want2)
+{
+	rt_error err = {0};
+	const char *path = tmp_text(name, text);
+	mesh *m = mesh_read_gltf(path, &err);
+	if (m)
+		fail_msg("%s was read; expected the error \"%s\"", name, want1);
+	if (!strstr(err.msg, want1) || !strstr(err.msg, want2))
+		fail_msg("message \"%s\" lacks \"%s\" / \"%s\"", err.msg, want1, want2);
+}
+
+static void test_buffer_files_named(void **state)
+{
+	(void)state;
+	char *t = tri_gltf(unit_tri, "\"nodes\":[{\"mesh\":0}],");
+	char *at = strstr(t, "data:application/octet-stream;base64,");
+	assert_non_null(at);
+	char *end = strchr(at, '"');
+	char text[4096];
+	snprintf(text, sizeof text, "%.*snothere.bin%s", (int)(at - t), t, end);
+	expect_file_fail("miss.gltf", text, "miss.gltf: buffers[0]: ", "nothere.bin: cannot read the glTF buffer");
+	snprintf(text, sizeof text, "%.*s%%00x.bin%s", (int)(at - t), t, end);
+	expect_file_fail("nul.gltf", text, "nul.gltf: buffers[0]: uri: \"%00x.bin\" holds %00", "expected a file name");
+	/* a short buffer file: named already, its size and the expected one */
+	tmp_write("short.bin", "abc", 3);
+	snprintf(text, sizeof text, "%.*sshort.bin%s", (int)(at - t), t, end);
+	expect_file_fail("short.gltf", text, "short.gltf: buffers[0]: byteLength 44, the data has 3 bytes",
+	                 "expected at most 3");
+	free(t);
+	/* an alpha-masked material's image file, read with the model */
+	t = tri_gltf(unit_tri, "\"nodes\":[{\"mesh\":0}],\"images\":[{\"uri\":\"gone.png\"}],"
+	                       "\"textures\":[{\"source\":0}],\"materials\":[{\"alphaMode\":\"MASK\","
+	                       "\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}}}],");
+	at = strstr(t, "\"attributes\"");
+	assert_non_null(at);
+	snprintf(text, sizeof text, "%.*s\"material\":0,%s", (int)(at - t), t, at);
+	expect_file_fail("mask.gltf", text, "mask.gltf: images[0]: ", "gone.png: cannot read the image");
+	free(t);
+}
+
 /* A small file whose nodes place one mesh many times makes more triangles
  * than its bytes: the triangles the nodes place are checked against the
  * memory limit before any is built. 1,000 nodes naming a one-triangle mesh
@@ -365,7 +409,11 @@ static void test_hostile_instancing(void **state)
 	m = mesh_parse_gltf("many.gltf", NULL, text, strlen(text), &err);
 	if (!m)
 		fail_msg("%s", err.msg);
-	assert_int_equal(m->ntris, 1000);
+	/* without the limit: the 1,000 placed copies coincide (every node the
+	 * same identity transform), so all but one are dropped as duplicates */
+	assert_int_equal(m->ntris, 1);
+	assert_non_null(m->warning);
+	assert_non_null(strstr(m->warning, "many.gltf: 999 duplicate triangles dropped"));
 	mesh_free(m);
 	free(text);
 	free(t);
@@ -1474,6 +1522,7 @@ int main(void)
 	    cmocka_unit_test(test_material_extensions),
 	    cmocka_unit_test(test_cameras_and_lights),
 	    cmocka_unit_test(test_bad_files),
+	    cmocka_unit_test(test_buffer_files_named),
 	    cmocka_unit_test(test_hostile_instancing),
 	    cmocka_unit_test(test_directional_light_lux),
 	    cmocka_unit_test(test_point_light_candela),

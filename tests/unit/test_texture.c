@@ -112,6 +112,96 @@ static void test_headers_that_promise_too_much(void **state)
 		fail_msg("message \"%s\"", err.msg);
 }
 
+/* An image over the size limit says its size and the limit, in every
+ * format: stb_image alone called a 30000 x 30000 RGB PNG or JPEG an
+ * "unknown image type" (its own limits are 2^30 and 2^31 decoded bytes).
+ * Each header is written here from its format's layout. */
+static void test_too_large_says_so(void **state)
+{
+	(void)state;
+	/* 30000 = 0x7530 */
+	static const unsigned char png[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R',
+	                                    0, 0, 0x75, 0x30, 0, 0, 0x75, 0x30, 8, 2, 0, 0, 0, 0, 0, 0, 0};
+	/* SOI, then SOF0: length 17, 8 bits, height, width, 3 components */
+	static const unsigned char jpg[] = {0xff, 0xd8, 0xff, 0xc0, 0, 17, 8, 0x75, 0x30, 0x75, 0x30, 3,
+	                                    1, 0x11, 0, 2, 0x11, 0, 3, 0x11, 0, 0xff, 0xd9};
+	/* BITMAPFILEHEADER, then a 40-byte BITMAPINFOHEADER, 24 bits */
+	unsigned char bmp[54] = {'B', 'M'};
+	bmp[10] = 54;
+	bmp[14] = 40;
+	bmp[18] = 0x30, bmp[19] = 0x75, bmp[22] = 0x30, bmp[23] = 0x75;
+	bmp[26] = 1;
+	bmp[28] = 24;
+	static const char hdr[] = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 30000 +X 30000\n";
+	static const char ppm[] = "P6\n30000 30000\n255\n";
+	static const char pfm[] = "PF\n30000 30000\n-1.0\n";
+	const struct {
+		const char *name;
+		const void *b;
+		size_t len;
+	} c[] = {{"x.png", png, sizeof png}, {"x.jpg", jpg, sizeof jpg}, {"x.bmp", bmp, sizeof bmp},
+	         {"x.hdr", hdr, sizeof hdr - 1}, {"x.ppm", ppm, sizeof ppm - 1}, {"x.pfm", pfm, sizeof pfm - 1}};
+	for (size_t i = 0; i < sizeof c / sizeof c[0]; i++) {
+		rt_error err = {0};
+		int w, h;
+		float *p = image_decode_rgb(c[i].name, c[i].b, c[i].len, true, &w, &h, &err);
+		assert_null(p);
+		if (!strstr(err.msg, "image too large: 30000x30000 pixels; expected at most 268435456"))
+			fail_msg("%s: message \"%s\"", c[i].name, err.msg);
+		unsigned char *a = NULL;
+		bool ok = image_decode_alpha(c[i].name, c[i].b, c[i].len, &a, &w, &h, &err);
+		assert_null(a);
+		if (!ok && !strstr(err.msg, "image too large: 30000x30000 pixels"))
+			fail_msg("%s: the alpha reader's message \"%s\"", c[i].name, err.msg);
+	}
+}
+
+/* The previewer's budget: an image of more pixels than it is refused
+ * before decoding, the refusal is known as the budget's (image_budget_refused)
+ * and counted once per image; the sky is exempt; at or under the budget,
+ * and with none, the image is read. */
+static void test_preview_budget(void **state)
+{
+	(void)state;
+	unsigned char a[16 + 110];
+	int n = sprintf((char *)a, "P5\n10 10\n255\n");
+	memset(a + n, 128, 100);
+	size_t len100 = (size_t)n + 100;
+	unsigned char b[16 + 110];
+	int m = sprintf((char *)b, "P5\n10 11\n255\n");
+	memset(b + m, 128, 110);
+	size_t len110 = (size_t)m + 110;
+	rt_error err = {0};
+	int w, h;
+	image_budget_set(100);
+	float *px = image_decode_rgb("a.pgm", a, len100, true, &w, &h, &err);
+	assert_non_null(px); /* 100 pixels: at the budget */
+	free(px);
+	assert_null(image_decode_rgb("b.pgm", b, len110, true, &w, &h, &err));
+	assert_true(image_budget_refused(&err));
+	if (!strstr(err.msg, "b.pgm: 10x11 pixels, over the preview's 100 for an image"))
+		fail_msg("message \"%s\"", err.msg);
+	assert_null(image_decode_rgb("b.pgm", b, len110, true, &w, &h, &err)); /* the same image again */
+	char first[RT_ERROR_MSG_MAX];
+	assert_int_equal(image_budget_report(first, sizeof first), 1);
+	assert_string_equal(first, err.msg);
+	/* another failure is not the budget's */
+	rt_error other = {0};
+	assert_null(image_decode_rgb("c.pgm", (const unsigned char *)"P5\n0 1\n255\n", 12, true, &w, &h, &other));
+	assert_false(image_budget_refused(&other));
+	/* the sky is not held to it */
+	image_budget_exempt(true);
+	px = image_decode_rgb("b.pgm", b, len110, true, &w, &h, &err);
+	image_budget_exempt(false);
+	assert_non_null(px);
+	free(px);
+	/* no budget: read */
+	image_budget_set(0);
+	px = image_decode_rgb("b.pgm", b, len110, true, &w, &h, &err);
+	assert_non_null(px);
+	free(px);
+}
+
 static void test_mipmap_average(void **state)
 {
 	(void)state;
@@ -339,6 +429,8 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_ppm_pfm_xpm),
 		cmocka_unit_test(test_headers_that_promise_too_much),
+		cmocka_unit_test(test_too_large_says_so),
+		cmocka_unit_test(test_preview_budget),
 		cmocka_unit_test(test_mipmap_average),
 		cmocka_unit_test(test_corner_lands_where_documented),
 		cmocka_unit_test(test_flat_normal_map_changes_nothing),

@@ -134,6 +134,115 @@ static bool tri_ok(const float *a, const float *b, const float *c)
 	return x * x + y * y + z * z > 0.0;
 }
 
+/* --- exact duplicates --- */
+
+/* Two vertices with the same position, uv and normal, bit for bit. */
+static bool corner_eq(const mesh *m, uint32_t va, uint32_t vb)
+{
+	return va == vb || (memcmp(m->p[va], m->p[vb], sizeof *m->p) == 0 &&
+	                    (!m->uv || memcmp(m->uv[va], m->uv[vb], sizeof *m->uv) == 0) &&
+	                    (!m->n || memcmp(m->n[va], m->n[vb], sizeof *m->n) == 0));
+}
+
+static uint64_t bits2(const float *a, const float *b)
+{
+	uint32_t x, y;
+	memcpy(&x, a, 4);
+	memcpy(&y, b, 4);
+	return (uint64_t)x | (uint64_t)y << 32;
+}
+
+static uint64_t fold(uint64_t h)
+{
+	h ^= h >> 31;
+	h *= 0xBF58476D1CE4E5B9ull;
+	return h ^ h >> 29;
+}
+
+/* A vertex's hash, from its values (two vertices of the same values, as
+ * an STL's corners are, hash alike). */
+static uint64_t vertex_hash(const mesh *m, uint32_t v)
+{
+	static const float zero[3] = {0, 0, 0};
+	const float *p = m->p[v], *t = m->uv ? m->uv[v] : zero, *n = m->n ? m->n[v] : zero;
+	return fold(bits2(p, p + 1) * 0x9E3779B97F4A7C15ull + bits2(p + 2, t) * 0xC2B2AE3D27D4EB4Full +
+	            bits2(t + 1, n) * 0x165667B19E3779F9ull + bits2(n + 1, n + 2) * 0xD6E8FEB86659FD93ull);
+}
+
+/* Drops the triangles equal to an earlier one: the same three corners
+ * (position, uv and normal) in the same turn, from any corner, and the
+ * same material. A ray meets a duplicate at the same distance as the one
+ * kept, with the same surface, so the picture cannot change; N copies of
+ * one face would otherwise make every ray that passes test all N (no tree
+ * separates them). A triangle's hash is the sum over its three directed
+ * edges of a hash of the edge's two vertices' hashes: the same from any
+ * corner, another for the mirror-image winding (another triangle). One
+ * pass with a hash table (1.5 to 3 slots a triangle, each its index and 32
+ * bits of its hash, so that only a matching hash compares corners), the
+ * slots fetched ahead. Returns how many were dropped; none when the memory
+ * cannot be had. */
+static uint64_t tri_hash(const mesh *m, const uint32_t t[3], uint16_t mat)
+{
+	uint64_t a = vertex_hash(m, t[0]), b = vertex_hash(m, t[1]), c = vertex_hash(m, t[2]);
+	uint64_t e = (a + (b << 17 | b >> 47)) * 0x9E3779B97F4A7C15ull + (b + (c << 17 | c >> 47)) * 0x9E3779B97F4A7C15ull +
+	             (c + (a << 17 | a >> 47)) * 0x9E3779B97F4A7C15ull;
+	return fold(e + mat);
+}
+
+static size_t drop_duplicates(mesh *m, uint16_t *fm)
+{
+	size_t n = m->ntris, cap = 16;
+	if (n < 2)
+		return 0;
+	while (cap < n + n / 2)
+		cap *= 2;
+	uint64_t *slot = malloc(cap * sizeof *slot);
+	if (!slot)
+		return 0;
+	memset(slot, 0xff, cap * sizeof *slot);
+	enum { AHEAD = 16 };
+	uint64_t ring[AHEAD]; /* the hashes of triangles t .. t + AHEAD - 1 */
+	for (size_t t = 0; t < AHEAD && t < n; t++)
+		ring[t] = tri_hash(m, m->tri[t], fm[t]);
+	size_t kept = 0;
+	for (size_t t = 0; t < n; t++) {
+		uint64_t ht = ring[t % AHEAD];
+		if (t + AHEAD < n) {
+			/* made before this triangle may move: t + AHEAD is not moved yet */
+			uint64_t ha = tri_hash(m, m->tri[t + AHEAD], fm[t + AHEAD]);
+			ring[t % AHEAD] = ha;
+			__builtin_prefetch(&slot[ha & (cap - 1)]);
+		}
+		const uint32_t *tt = m->tri[t];
+		uint32_t tag = (uint32_t)(ht >> 32);
+		size_t h = (size_t)ht & (cap - 1);
+		bool dup = false;
+		while (slot[h] != UINT64_MAX && !dup) {
+			uint32_t o = (uint32_t)slot[h];
+			if ((uint32_t)(slot[h] >> 32) == tag && fm[o] == fm[t]) {
+				const uint32_t *ot = m->tri[o];
+				for (int j = 0; j < 3 && !dup; j++)
+					dup = corner_eq(m, tt[0], ot[j]) && corner_eq(m, tt[1], ot[(j + 1) % 3]) &&
+					      corner_eq(m, tt[2], ot[(j + 2) % 3]);
+			}
+			if (!dup)
+				h = (h + 1) & (cap - 1);
+		}
+		if (dup)
+			continue;
+		/* kept: moved down to its place, and found there from now on */
+		if (kept != t) {
+			memmove(m->tri[kept], tt, sizeof *m->tri);
+			fm[kept] = fm[t];
+		}
+		slot[h] = (uint64_t)tag << 32 | kept++;
+	}
+	free(slot);
+	size_t dropped = n - kept;
+	m->ntris = (uint32_t)kept;
+	return dropped;
+}
+
 mesh *mb_finish(mesh_builder *b, rt_error *err)
 {
 	mesh *m = calloc(1, sizeof *m);
@@ -227,6 +336,13 @@ mesh *mb_finish(mesh_builder *b, rt_error *err)
 		m->nverts = nv;
 		free(slot);
 		slot = NULL;
+	}
+	size_t dups = drop_duplicates(m, b->fm);
+	if (dups && !b->warning) {
+		char msg[RT_ERROR_FILE_MAX + 128];
+		snprintf(msg, sizeof msg, "%s: %zu duplicate triangle%s dropped (the same corners and material as another)",
+		         b->name, dups, dups == 1 ? "" : "s");
+		b->warning = strdup(msg); /* NULL: not said, no harm */
 	}
 	m->nmats = (uint32_t)b->nmats;
 	m->mats = b->mats;

@@ -451,6 +451,26 @@ static char *uri_file(const char *dir, const char *uri)
 	return p;
 }
 
+/* A file uri that %00 would cut short (the file read would be another). */
+static bool uri_name_ok(gl *g, const char *uri, const char *where)
+{
+	if (!*uri)
+		return fail(g, where, "uri: empty; expected a data: URI or a file name");
+	for (const char *p = uri; (p = strchr(p, '%')) != NULL; p++)
+		if (p[1] == '0' && p[2] == '0')
+			return fail(g, where, "uri: \"%.80s\" holds %%00 (a NUL byte); expected a file name", uri);
+	return true;
+}
+
+/* g->err, set by a reader that does not know the model (a file's "PATH:
+ * cannot read ..."), again after the model's name and where. */
+static bool fail_again(gl *g, const char *where)
+{
+	char why[RT_ERROR_MSG_MAX];
+	rt_error_format(g->err, why, sizeof why);
+	return fail(g, where, "%s", why);
+}
+
 /* Buffer i's bytes, read on first use. */
 static bool buffer(gl *g, size_t i, const unsigned char **p, size_t *len)
 {
@@ -479,14 +499,16 @@ static bool buffer(gl *g, size_t i, const unsigned char **p, size_t *len)
 			if (!g->dir)
 				return fail(g, where, "uri: the file \"%.80s\" is not read here; expected the data in the file",
 				            uri->valuestring);
+			if (!uri_name_ok(g, uri->valuestring, where))
+				return false;
 			char *path = uri_file(g->dir, uri->valuestring);
 			if (!path)
 				return fail(g, where, "out of memory");
 			size_t n = 0;
 			char *data = rt_file_read(path, "glTF buffer", &n, g->err);
 			free(path);
-			if (!data)
-				return false;
+			if (!data) /* the reader's words, after the model's name */
+				return fail_again(g, where);
 			g->buf[i] = (unsigned char *)data;
 			g->buflen[i] = n;
 			g->bufown[i] = true;
@@ -1034,6 +1056,8 @@ static bool image_bytes(gl *g, long im, img_bytes *ib)
 		ib->data = ib->own;
 		return true;
 	} else if (cj.is_string(uri)) {
+		if (!uri_name_ok(g, uri->valuestring, iw))
+			return false;
 		ib->file = uri_file(g->dir ? g->dir : "", uri->valuestring);
 		return ib->file ? true : fail(g, iw, "out of memory");
 	}
@@ -1085,13 +1109,15 @@ static bool alpha_info(gl *g, const cJSON *ti, const char *where, mesh_mat *m)
 		snprintf(ib.name, sizeof ib.name, "%s", ib.file);
 		free(ib.file);
 		if (!disk)
-			return false;
+			return fail_again(g, ib.where);
 		ib.data = (const unsigned char *)disk;
 	}
 	int w = 0, h = 0;
 	bool ok = image_decode_alpha(ib.name, ib.data, ib.len, &m->alpha_map, &w, &h, g->err);
 	free(ib.own);
 	free(disk);
+	if (!ok && image_budget_refused(g->err)) /* the previewer's budget: no cut-outs */
+		return true;
 	m->alpha_w = w;
 	m->alpha_h = h;
 	return ok;
@@ -1130,7 +1156,7 @@ static bool tex_info(gl *g, mesh_builder *b, texture **cache, const cJSON *ti, c
 	float *rgb = image_decode_rgb(ib.name, ib.data, ib.len, srgb, &w, &h, g->err);
 	free(ib.own);
 	if (!rgb)
-		return false;
+		return image_budget_refused(g->err); /* the previewer's budget: untextured */
 	texture *x = texture_make(rgb, w, h, ib.name, srgb, g->err);
 	if (!x)
 		return false;

@@ -73,17 +73,141 @@ static void codes_to_float(const unsigned char *in, size_t n, int comp, bool srg
  * ours). */
 #define IMAGE_BYTES_PER_PIXEL (12.0 + 12.0 + 4.0)
 
+/* --- the previewer's budget (texture.h) --- */
+
+static size_t budget;                       /* 0: none */
+static _Thread_local bool budget_off;        /* image_budget_exempt */
+static _Thread_local char budget_last[RT_ERROR_MSG_MAX];
+static pthread_mutex_t budget_lock = PTHREAD_MUTEX_INITIALIZER;
+#define BUDGET_KEEP 32
+static char *budget_paths[BUDGET_KEEP];     /* the refused images, to count each once */
+static size_t budget_count;
+static char budget_first[RT_ERROR_MSG_MAX];
+
+void image_budget_set(size_t pixels)
+{
+	budget = pixels;
+}
+
+void image_budget_exempt(bool on)
+{
+	budget_off = on;
+}
+
+bool image_budget_refused(const rt_error *err)
+{
+	return err && budget_last[0] && strcmp(err->msg, budget_last) == 0;
+}
+
+size_t image_budget_report(char *first, size_t size)
+{
+	pthread_mutex_lock(&budget_lock);
+	size_t n = budget_count;
+	if (size)
+		snprintf(first, size, "%s", budget_first);
+	pthread_mutex_unlock(&budget_lock);
+	return n;
+}
+
+static bool over_budget(const char *path, long w, long h, rt_error *err)
+{
+	rt_error_set(err, "%s: %ldx%ld pixels, over the preview's %zu for an image; drawn untextured", path, w, h,
+	             budget);
+	snprintf(budget_last, sizeof budget_last, "%s", err ? err->msg : "");
+	pthread_mutex_lock(&budget_lock);
+	bool seen = false;
+	for (size_t i = 0; i < BUDGET_KEEP && budget_paths[i] && !seen; i++)
+		seen = strcmp(budget_paths[i], path) == 0;
+	if (!seen) {
+		if (budget_count == 0)
+			snprintf(budget_first, sizeof budget_first, "%s", budget_last);
+		if (budget_count < BUDGET_KEEP)
+			budget_paths[budget_count] = strdup(path); /* NULL: counted again, no harm */
+		budget_count++;
+	}
+	pthread_mutex_unlock(&budget_lock);
+	return false;
+}
+
 static bool size_ok(const char *path, long w, long h, rt_error *err)
 {
 	if (w <= 0 || h <= 0)
 		return rt_error_set(err, "%s: the image is %ldx%ld pixels; expected a size of at least 1x1", path, w, h);
 	if ((size_t)w * (size_t)h > IMAGE_MAX_PIXELS || w > 1 << 20 || h > 1 << 20)
-		return rt_error_set(err, "%s: the image is %ldx%ld pixels; expected at most 2^28 pixels", path, w, h);
+		return rt_error_set(err, "%s: image too large: %ldx%ld pixels; expected at most 268435456 (2^28, "
+		                    "16384x16384) pixels and 1048576 a side", path, w, h);
+	if (budget && !budget_off && (size_t)w * (size_t)h > budget)
+		return over_budget(path, w, h, err);
 	/* the decoder's pixels (floats for HDR), ours, and the mip chain's
 	 * third more (texture.c) */
 	char what[300];
 	snprintf(what, sizeof what, "the image %s (%ldx%ld pixels)", path, w, h);
 	return mem_check((double)w * (double)h * IMAGE_BYTES_PER_PIXEL, what, err);
+}
+
+/* The size a PNG, JPEG, BMP or Radiance HDR header gives, read here: for an
+ * image over its own limits stb_image says only "unknown image type" (its
+ * PNG reader refuses more than 2^30 decoded bytes, its JPEG reader more
+ * than 2^31), and the user needs the size and ours. False when the bytes
+ * are none of these or the header is cut short. After the PNG and JFIF
+ * specifications and Ward's RGBE format note. */
+static uint32_t be16(const unsigned char *p) { return (uint32_t)p[0] << 8 | p[1]; }
+static uint32_t be32(const unsigned char *p) { return be16(p) << 16 | be16(p + 2); }
+static uint32_t le32(const unsigned char *p) { return (uint32_t)p[3] << 24 | (uint32_t)p[2] << 16 | (uint32_t)p[1] << 8 | p[0]; }
+
+static bool header_size(const unsigned char *b, size_t len, long *w, long *h)
+{
+	if (len >= 24 && memcmp(b, "\x89PNG\r\n\x1a\n", 8) == 0 && memcmp(b + 12, "IHDR", 4) == 0) {
+		*w = (long)be32(b + 16);
+		*h = (long)be32(b + 20);
+		return true;
+	}
+	if (len >= 26 && b[0] == 'B' && b[1] == 'M' && le32(b + 14) >= 40) {
+		*w = (long)(int32_t)le32(b + 18);
+		*h = labs((long)(int32_t)le32(b + 22));
+		return true;
+	}
+	if (len >= 4 && b[0] == 0xff && b[1] == 0xd8) { /* JPEG: the segments up to a frame header */
+		size_t i = 2;
+		while (i + 4 <= len && b[i] == 0xff) {
+			unsigned m = b[i + 1];
+			if (m == 0xff) { /* fill byte */
+				i++;
+				continue;
+			}
+			size_t seg = be16(b + i + 2);
+			if (m >= 0xc0 && m <= 0xcf && m != 0xc4 && m != 0xc8 && m != 0xcc) {
+				if (i + 9 > len)
+					return false;
+				*h = (long)be16(b + i + 5);
+				*w = (long)be16(b + i + 7);
+				return true;
+			}
+			i += 2 + seg;
+		}
+		return false;
+	}
+	if (len >= 2 && b[0] == '#' && b[1] == '?') { /* Radiance: after the blank line, "-Y H +X W" */
+		const unsigned char *e = b + len, *s = b;
+		while (s + 1 < e && !(s[0] == '\n' && s[1] == '\n'))
+			s++;
+		char axis[2][3];
+		long a, c;
+		char line[96];
+		size_t n = s + 2 < e ? (size_t)(e - s - 2) : 0;
+		if (n == 0)
+			return false;
+		n = n < sizeof line - 1 ? n : sizeof line - 1;
+		memcpy(line, s + 2, n);
+		line[n] = '\0';
+		if (sscanf(line, "%2s %ld %2s %ld", axis[0], &a, axis[1], &c) != 4)
+			return false;
+		bool y_first = axis[0][1] == 'Y';
+		*h = y_first ? a : c;
+		*w = y_first ? c : a;
+		return true;
+	}
+	return false;
 }
 
 /* Pixel bytes a file byte may hold, at most (read_stb). */
@@ -97,8 +221,10 @@ static float *read_stb(const char *path, const unsigned char *buf, size_t len, b
 		return NULL;
 	}
 	int x = 0, y = 0, comp = 0;
+	long hw, hh;
 	if (!stbi_info_from_memory(buf, (int)len, &x, &y, &comp)) {
-		rt_error_set(err, "%s: cannot decode the image: %s", path, stbi_failure_reason());
+		if (!header_size(buf, len, &hw, &hh) || size_ok(path, hw, hh, err))
+			rt_error_set(err, "%s: cannot decode the image: %s", path, stbi_failure_reason());
 		return NULL;
 	}
 	if (!size_ok(path, x, y, err))
@@ -154,6 +280,10 @@ static bool read_stb_alpha(const char *path, const unsigned char *buf, size_t le
                            int *h, rt_error *err)
 {
 	int x = 0, y = 0, comp = 0;
+	long hw, hh;
+	if (len <= INT32_MAX && !stbi_info_from_memory(buf, (int)len, &x, &y, &comp) &&
+	    header_size(buf, len, &hw, &hh) && !size_ok(path, hw, hh, err))
+		return false;
 	if (len > INT32_MAX || !stbi_info_from_memory(buf, (int)len, &x, &y, &comp))
 		return rt_error_set(err, "%s: cannot decode the image: %s", path,
 		                    len > INT32_MAX ? "too large" : stbi_failure_reason());
