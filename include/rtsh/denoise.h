@@ -161,7 +161,8 @@ bool denoise_image(const framebuffer *fb, float *out, int threads);
 
 /* Adaptive sampling at the same budget: a denoised render of S samples
  * spends S x W x H camera paths, DENOISE_FIRST(S) (3/4 of S, even) in
- * every pixel first, then the rest where the noise is (render_image). */
+ * every pixel first, then the rest where the noise the filter leaves is
+ * (render_image: denoise_sigma times a power of denoise_reach). */
 #define DENOISE_FIRST(S) ((3 * (S) / 4) & ~1)
 /* ...each pixel at most 16 times the mean (8: metal-fuzz 1-2% worse, its
  * highlights' pixels held at 64 of 8), and below 65535 (a pixel's count is
