@@ -196,6 +196,7 @@ typedef struct mesh_builder {
 	/* corners: index triples (position, uv or -1, normal or -1) */
 	int32_t (*c)[3]; size_t nc, cc;
 	uint16_t *fm;  size_t nf, cf;    /* material per triangle */
+	uint64_t *th;  size_t cth;       /* hash per triangle (its corners' values), nf of them */
 	mesh_mat *mats; size_t nmats, cmats;
 	struct texture **texs; size_t ntexs, ctexs; /* embedded images (mb_texture) */
 	uint16_t cur_mat;
@@ -203,6 +204,11 @@ typedef struct mesh_builder {
 	bool over;         /* a growth was refused by the memory limit */
 	char *warning;     /* the first warning, handed to the mesh (owned) */
 	rt_error limit;    /* ... and how (memory.h) */
+	/* the last triangles kept, by hash (tag << 32 | index + 1; 0: none):
+	 * a copy of one of them is dropped as it comes (mb_triangle), so that
+	 * N copies of a face cost no memory; mb_finish drops the rest */
+	uint64_t recent[1024];
+	size_t ndup;       /* copies dropped so */
 } mesh_builder;
 
 /* Why an mb_ call failed: the memory limit's message ("the model X needs

@@ -174,7 +174,44 @@ static bool make_plane(world *w, const object *o, uint32_t index, prim_plane *pl
  * is made here from its object, once: w->prims holds only the others (a
  * scene of spheres leaves that array's pages untouched). Bounded primitive
  * j is object pobj[j], or object j when pobj is NULL (no planes). */
-static bool reorder(world *w, const scene *s, const uint8_t *kf, const uint32_t *pobj, const uint32_t *order)
+/* The primitives of tree places [begin, end) made or copied into prims
+ * (reorder's first loop; halves of it run in two threads). */
+typedef struct reorder_job {
+	const world *w;
+	const scene *s;
+	const uint8_t *kf;
+	const uint32_t *pobj, *order;
+	prim *prims;
+	size_t begin, end;
+} reorder_job;
+
+static void *reorder_run(void *arg)
+{
+	const reorder_job *j = arg;
+	const object *objs = j->s->objs;
+	const uint32_t *order = j->order, *pobj = j->pobj;
+	enum { AHEAD = 16 }; /* the objects are read at random: fetched ahead */
+	for (size_t i = j->begin; i < j->end; i++) {
+		if (i + AHEAD < j->end) {
+			uint32_t ja = order[i + AHEAD];
+			const object *oa = &objs[pobj ? pobj[ja] : ja];
+			__builtin_prefetch(&oa->pos);
+			__builtin_prefetch(&oa->scale);
+		}
+		uint32_t k = order[i], ob = pobj ? pobj[k] : k;
+		if (j->kf[ob] & OBJ_FAST_SPHERE)
+			fast_sphere_prim(&objs[ob], ob, &j->prims[i]);
+		else
+			j->prims[i] = j->w->prims[k];
+	}
+	return NULL;
+}
+
+/* Below this many primitives reorder's first loop stays in one thread. */
+#define REORDER_APART_MIN 65536
+
+static bool reorder(world *w, const scene *s, const uint8_t *kf, const uint32_t *pobj, const uint32_t *order,
+                    int threads)
 {
 	/* walked in tree order by every ray: huge pages spare the TLB */
 	prim *prims = mem_alloc_huge(w->nprims * sizeof *prims);
@@ -186,26 +223,28 @@ static bool reorder(world *w, const scene *s, const uint8_t *kf, const uint32_t 
 		free(tris);
 		return false;
 	}
-	enum { AHEAD = 16 }; /* the objects are read at random: fetched ahead */
-	for (size_t i = 0; i < w->nprims; i++) {
-		if (i + AHEAD < w->nprims) {
-			uint32_t ja = order[i + AHEAD];
-			const object *oa = &s->objs[pobj ? pobj[ja] : ja];
-			__builtin_prefetch(&oa->pos);
-			__builtin_prefetch(&oa->scale);
-		}
-		uint32_t j = order[i], ob = pobj ? pobj[j] : j;
-		if (kf[ob] & OBJ_FAST_SPHERE)
-			fast_sphere_prim(&s->objs[ob], ob, &prims[i]);
-		else
-			prims[i] = w->prims[j];
+	/* with 2 threads the first half by another one: each place is
+	 * written from its own object, the same bytes either way */
+	reorder_job all = {w, s, kf, pobj, order, prims, 0, w->nprims}, first = all;
+	pthread_t th;
+	bool apart = threads > 1 && w->nprims >= REORDER_APART_MIN;
+	if (apart) {
+		first.end = all.begin = w->nprims / 2;
+		apart = pthread_create(&th, NULL, reorder_run, &first) == 0;
+		if (!apart)
+			all.begin = 0;
 	}
+	reorder_run(&all);
+	if (apart)
+		pthread_join(th, NULL);
 	size_t ns = 0, nt = 0;
 	for (size_t i = 0; i < w->nplanes; i++) {
 		shapes[ns] = w->shapes[w->planes[i].shape];
 		w->planes[i].shape = (uint32_t)ns++;
 	}
-	for (size_t i = 0; i < w->nprims; i++) {
+	/* (each plane has one shape: without bounded shapes or triangles
+	 * there is nothing to renumber) */
+	for (size_t i = 0; (w->nshapes > w->nplanes || w->ntris) && i < w->nprims; i++) {
 		prim *p = &prims[i];
 		if (p->tag == PRIM_SHAPE) {
 			shapes[ns] = w->shapes[p->u.index];
@@ -430,7 +469,7 @@ world *world_build_threads(const scene *s, int threads, const atomic_bool *cance
 	w->eps = 1e-9 * fmax(1.0, extent);
 	w->tree = bvh_build(refs, w->nprims, order, threads, cancel, err);
 	free(refs);
-	bool ok = w->tree && reorder(w, s, kf, pobj, order);
+	bool ok = w->tree && reorder(w, s, kf, pobj, order, threads);
 	mem_free_all(order, pobj, kf);
 	if (w->tree && !ok)
 		rt_error_set(err, "out of memory preparing the scene (%zu objects)", s->nobjs);

@@ -560,13 +560,15 @@ static void test_sphere_prims(void **state)
 }
 
 /* The tree built by 2, 3 and 4 threads is the 1-thread tree to the byte
- * (bvh.h): 30000 objects of every kind at random (a subtree goes to
- * another thread from 4096 references on both sides), the wide nodes,
- * the primitives in tree order and the counts compared. */
+ * (bvh.h): 70000 objects of every kind at random (a subtree goes to
+ * another thread from 4096 references on both sides, and the primitives'
+ * first half in tree order from 65536 on: world.c reorder), the wide
+ * nodes, the primitives in tree order and the counts compared; and each
+ * fast sphere's record is its object's centre and half its scale. */
 static void test_threaded_build(void **state)
 {
 	(void)state;
-	scene *s = random_scene(29, 30000, 100, 1.0, 1);
+	scene *s = random_scene(29, 70000, 100, 1.0, 1);
 	rt_error err;
 	world *one = world_build_threads(s, 1, NULL, &err);
 	assert_non_null(one);
@@ -582,9 +584,11 @@ static void test_threaded_build(void **state)
 		for (size_t i = 0; i < w->nprims; i++) {
 			const prim *a = &w->prims[i], *b = &one->prims[i];
 			assert_true(a->tag == b->tag && a->object == b->object);
-			if (a->tag == PRIM_SPHERE)
+			if (a->tag == PRIM_SPHERE) {
 				assert_memory_equal(&a->u.sph, &b->u.sph, sizeof a->u.sph);
-			else
+				const object *o = &s->objs[a->object];
+				assert_true(v3_eq(a->u.sph.c, o->pos) && a->u.sph.r == o->scale.x * 0.5);
+			} else
 				assert_int_equal(a->u.index, b->u.index);
 		}
 		/* the materials, filled by another thread from 4096 objects on */
@@ -866,6 +870,104 @@ static void test_leaf_order(void **state)
 	scene_free(s);
 }
 
+/* The union of the boxes of the references under a child of binary tree t
+ * (float boxes fb by primitive); every inner node's two boxes must be
+ * exactly those unions (checked on the way). */
+static bvh_fbox box_under(const bvh2 *t, uint32_t child, uint32_t meta, const bvh_fbox *fb)
+{
+	bvh_fbox u = {{INFINITY, INFINITY, INFINITY, 0}, {-INFINITY, -INFINITY, -INFINITY, 0}};
+	if (meta & BVH_LEAF) {
+		for (uint32_t i = 0; i < (meta & ~BVH_LEAF); i++)
+			for (int a = 0; a < 3; a++) {
+				const bvh_fbox *x = &fb[t->ids[child + i]];
+				u.lo[a] = x->lo[a] < u.lo[a] ? x->lo[a] : u.lo[a];
+				u.hi[a] = x->hi[a] > u.hi[a] ? x->hi[a] : u.hi[a];
+			}
+		return u;
+	}
+	const bvh2_node *nd = &t->nodes[child];
+	for (int c = 0; c < 2; c++) {
+		bvh_fbox x = box_under(t, nd->child[c], nd->meta[c], fb);
+		for (int a = 0; a < 3; a++) {
+			if (nd->box[c].lo[a] != x.lo[a] || nd->box[c].hi[a] != x.hi[a])
+				fail_msg("node %u child %d axis %d: box [%g, %g], its references' [%g, %g]", child, c, a,
+				         (double)nd->box[c].lo[a], (double)nd->box[c].hi[a], (double)x.lo[a], (double)x.hi[a]);
+			u.lo[a] = x.lo[a] < u.lo[a] ? x.lo[a] : u.lo[a];
+			u.hi[a] = x.hi[a] > u.hi[a] ? x.hi[a] : u.hi[a];
+		}
+	}
+	return u;
+}
+
+/* A node of 4096 references or more takes the split of a sample: every
+ * k-th reference in its order, k = n / 1024. 4096 unit cubes at y = z = 0
+ * (only x can split): the sample, references 0, 4, 8, ..., holds cluster A
+ * at x = 0 (i % 8 == 0) and C at x = 100 (i % 8 == 4); the other 3072 are
+ * cluster B at x = 10. Doubled centroids 1 (A), 21 (B), 201 (C): 16 bins
+ * of 12.5, so A is in bin 0, B in bin 1 and C in bin 15. The sample has
+ * A and C only: every split between them costs 3 x 512 + 3 x 512, and the
+ * first, after bin 0, is taken: A on the left, B and C on the right, whose
+ * box is x in [10, 101]. The whole node would put A and B left (after bin
+ * 1: 23 x 3584 + 3 x 512 against 3 x 512 + 183 x 3584 after bin 0). Then
+ * boxes at random, 20000 and 4095: every node's boxes are the unions of
+ * its references' (the sample's bins hold only the sample's). */
+static void test_sampled_split(void **state)
+{
+	(void)state;
+	size_t n = 4096;
+	box *bx = malloc(n * sizeof *bx);
+	bvh_fbox *fb = malloc(20000 * sizeof *fb);
+	uint32_t *ids = malloc(n * sizeof *ids);
+	assert_non_null(bx && fb && ids);
+	for (size_t i = 0; i < n; i++) {
+		double x = i % 8 == 0 ? 0 : i % 8 == 4 ? 100 : 10;
+		bx[i] = (box){v3(x, 0, 0), v3(x + 1, 1, 1)};
+	}
+	bvh2 t;
+	rt_error err;
+	assert_true(bvh2_build(bx, n, &(bvh_build_opts){.trav = 4}, &t, &err));
+	assert_int_equal(t.root_meta, 0);
+	const bvh2_node *root = &t.nodes[t.root];
+	size_t nl = refs_under(&t, root->child[0], root->meta[0], ids);
+	assert_int_equal(nl, 512);
+	for (size_t i = 0; i < nl; i++)
+		if (ids[i] % 8 != 0)
+			fail_msg("reference %u on the root's left, expected only cluster A (i %% 8 == 0)", ids[i]);
+	const float want[2][2][3] = {{{0, 0, 0}, {1, 1, 1}}, {{10, 0, 0}, {101, 1, 1}}};
+	for (int c = 0; c < 2; c++)
+		for (int a = 0; a < 3; a++) {
+			assert_true(root->box[c].lo[a] == want[c][0][a]);
+			assert_true(root->box[c].hi[a] == want[c][1][a]);
+		}
+	bvh2_free(&t);
+	free(bx);
+	for (uint64_t seed = 1; seed <= 2; seed++) {
+		test_rng g = {seed};
+		n = seed == 1 ? 20000 : 4095;
+		bx = malloc(n * sizeof *bx);
+		assert_non_null(bx);
+		for (size_t i = 0; i < n; i++) {
+			/* eighths, and every fifth box long: floats, not rounded */
+			vec3 lo = v3(floor(urand(&g, -800, 800)) / 8, floor(urand(&g, -800, 800)) / 8,
+			             floor(urand(&g, -800, 800)) / 8);
+			double len = i % 5 == 0 ? 40 : floor(urand(&g, 1, 16)) / 8;
+			bx[i] = (box){lo, v3_add(lo, v3(len, len / 2, len / 4))};
+			for (int a = 0; a < 3; a++) {
+				fb[i].lo[a] = (float)(&bx[i].lo.x)[a];
+				fb[i].hi[a] = (float)(&bx[i].hi.x)[a];
+			}
+		}
+		assert_true(bvh2_build(bx, n, &(bvh_build_opts){.trav = 4}, &t, &err));
+		bvh_fbox all = box_under(&t, t.root, t.root_meta, fb);
+		for (int a = 0; a < 3; a++)
+			assert_true(all.lo[a] == t.bounds.lo[a] && all.hi[a] == t.bounds.hi[a]);
+		bvh2_free(&t);
+		free(bx);
+	}
+	free(fb);
+	free(ids);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -885,6 +987,7 @@ int main(void)
 		cmocka_unit_test(test_threaded_textures),
 		cmocka_unit_test(test_sah_splits),
 		cmocka_unit_test(test_leaf_order),
+		cmocka_unit_test(test_sampled_split),
 	};
 	return cmocka_run_group_tests_name("bvh", tests, NULL, NULL);
 }

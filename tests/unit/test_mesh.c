@@ -84,6 +84,57 @@ static void test_obj_welds_uv_corners(void **state)
 	mesh_free(m);
 }
 
+/* Exact duplicate triangles are dropped at load and counted once in the
+ * warning: the same corners in the same turn from any corner (1 2 3, 2 3 1,
+ * 3 1 2), or another vertex of the same values (4 is 1's position); a
+ * mirror-image winding (1 3 2), another corner, uv or material is another
+ * triangle. 2,000 copies of one face leave one. Counts by hand. */
+static void test_duplicates_dropped(void **state)
+{
+	(void)state;
+	const char *obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 0\nv 0 0 1\n"
+	                  "f 1 2 3\nf 2 3 1\nf 3 1 2\nf 4 2 3\nf 1 3 2\nf 1 2 5\n";
+	rt_error err = {0};
+	mesh *m = mesh_parse_obj("a.obj", "", obj, strlen(obj), &err);
+	assert_non_null(m);
+	assert_int_equal(m->ntris, 3);
+	assert_non_null(m->warning);
+	assert_string_equal(m->warning, "a.obj: 3 duplicate triangles dropped (the same corners and material as another)");
+	mesh_free(m);
+	/* uv: the same positions with another uv stay */
+	obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
+	      "f 1/1 2/2 3/3\nf 2/2 3/3 1/1\nf 1/2 2/2 3/3\n";
+	m = mesh_parse_obj("b.obj", "", obj, strlen(obj), &err);
+	assert_non_null(m);
+	assert_int_equal(m->ntris, 2);
+	mesh_free(m);
+	/* materials: the same face in two materials stays twice */
+	obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\nf 1 2 3\nusemtl b\nf 1 2 3\n";
+	m = mesh_parse_obj("c.obj", "", obj, strlen(obj), &err);
+	assert_non_null(m);
+	assert_int_equal(m->nmats, 2);
+	assert_int_equal(m->ntris, 2);
+	mesh_free(m);
+	/* many copies, and no warning without duplicates */
+	char *big = malloc(64 + 2000 * 8);
+	assert_non_null(big);
+	size_t n = (size_t)sprintf(big, "v 0 0 0\nv 1 0 0\nv 0 1 0\n");
+	for (int i = 0; i < 2000; i++)
+		n += (size_t)sprintf(big + n, "f 1 2 3\n");
+	m = mesh_parse_obj("d.obj", "", big, n, &err);
+	free(big);
+	assert_non_null(m);
+	assert_int_equal(m->ntris, 1);
+	assert_non_null(strstr(m->warning, "d.obj: 1999 duplicate triangles dropped"));
+	mesh_free(m);
+	obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 3 2\n";
+	m = mesh_parse_obj("e.obj", "", obj, strlen(obj), &err);
+	assert_non_null(m);
+	assert_int_equal(m->ntris, 2);
+	assert_null(m->warning);
+	mesh_free(m);
+}
+
 /* A message must name the file and the place. */
 static void expect_error(mesh *m, const rt_error *err, const char *want1, const char *want2)
 {
@@ -1230,6 +1281,7 @@ int main(void)
 		cmocka_unit_test(test_instances_share_one_mesh),
 		cmocka_unit_test(test_bunny_counts),
 		cmocka_unit_test(test_igea_strips),
+		cmocka_unit_test(test_duplicates_dropped),
 		cmocka_unit_test(test_memory_limit),
 		cmocka_unit_test(test_shadow_terminator),
 	};

@@ -293,10 +293,10 @@ static bool binning_make(const fbox *cb, size_t n, binning *bn)
 	return any;
 }
 
-/* Adds refs[0, n) to the bins of binning bn on each axis: the box, and
- * the summed cost in lane 3 of its upper corner (the references' is 0; the
- * sums are made in the references' order). */
-static void bin_refs(const fbox *refs, size_t n, const binning *bn, fbox bbox[3][BINS])
+/* Adds refs[0], refs[step], ... (n of them) to the bins of binning bn on
+ * each axis: the box, and the summed cost in lane 3 of its upper corner
+ * (the references' is 0; the sums are made in the references' order). */
+static void bin_refs(const fbox *refs, size_t n, size_t step, const binning *bn, fbox bbox[3][BINS])
 {
 #if defined(__SSE2__)
 	/* the same operations as the loop below, the reference and its bins
@@ -305,8 +305,8 @@ static void bin_refs(const fbox *refs, size_t n, const binning *bn, fbox bbox[3]
 	       top = _mm_set1_ps((float)(bn->nbins - 1));
 	/* lane 3 only, and -0 in lanes 0-2: x + -0 is x, -0 and NaN included */
 	__m128 lane3 = _mm_castsi128_ps(_mm_set_epi32(-1, 0, 0, 0)), negz = _mm_set_ps(0.0f, -0.0f, -0.0f, -0.0f);
-	for (size_t i = 0; i < n; i++) {
-		__m128 lo = _mm_loadu_ps(refs[i].lo), hi = _mm_loadu_ps(refs[i].hi);
+	for (size_t i = 0; i < n; i++, refs += step) {
+		__m128 lo = _mm_loadu_ps(refs->lo), hi = _mm_loadu_ps(refs->hi);
 		__m128 cost = _mm_or_ps(_mm_and_ps(lo, lane3), negz); /* (-0, -0, -0, cost) */
 		__m128 v = _mm_mul_ps(_mm_sub_ps(_mm_add_ps(lo, hi), blo), bsc);
 		__m128i k = _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(v, zero), top));
@@ -322,7 +322,7 @@ static void bin_refs(const fbox *refs, size_t n, const binning *bn, fbox bbox[3]
 	}
 #else
 	for (size_t i = 0; i < n; i++) {
-		const fbox *r = &refs[i];
+		const fbox *r = &refs[i * step];
 		float c[4];
 		int k[4];
 		centroid2(r, c);
@@ -383,8 +383,11 @@ static inline void sweep_bins(fbox bbox[3][BINS], const binning *bn, unsigned bl
 }
 
 /* The cheapest binned split of refs[begin, end) with centroid bounds cb;
- * axis -1 when every centroid is the same point. */
-static split find_split(const builder *b, size_t begin, size_t end, const fbox *cb)
+ * axis -1 when every centroid is the same point. With step > 1 only
+ * refs[begin], refs[begin + step], ... are binned (a large node's sample,
+ * build): the split is the sample's, and lb and rb are the sample's boxes,
+ * not the children's (the partition gathers those). */
+static split find_split(const builder *b, size_t begin, size_t end, const fbox *cb, size_t step)
 {
 	split best = {.axis = -1, .cost = INFINITY};
 	binning bn;
@@ -404,7 +407,7 @@ static split find_split(const builder *b, size_t begin, size_t end, const fbox *
 	for (int a = 0; a < 3; a++)
 		for (int k = 0; k < nbins; k++)
 			bbox[a][k] = fbox_empty();
-	bin_refs(b->refs + begin, end - begin, &bn, bbox);
+	bin_refs(b->refs + begin, (end - begin + step - 1) / step, step, &bn, bbox);
 	/* the sweeps, made twice: for unit costs leaf_cost is the sum itself */
 	if (b->block > 1)
 		sweep_bins(bbox, &bn, b->block, &best);
@@ -563,36 +566,50 @@ static inline bool goes_right(__m128 c, __m128 blo, __m128 bsc, __m128 at, int a
 #endif
 
 /* Partitions by an object split, returning the middle; *lcb, *rcb: the
- * children's centroid bounds. The bins are computed exactly as find_split
- * did. Two-pointer (Hoare): the scan from the left stops at a reference
- * that goes right, the scan from the right at one that goes left, and the
- * two swap, so only misplaced references move (about a quarter of a node's
- * instead of every right one). Each side gets the same references in
- * another order than a one-sided partition: the children's bins, centroid
- * bounds and whole-number cost sums do not depend on the order, and the
- * order within a leaf is set when the leaf is made (sort_ids). */
-static size_t partition(builder *b, size_t begin, size_t end, const fbox *cb, const split *s, fbox *lcb,
-                        fbox *rcb)
+ * children's centroid bounds, and with `boxes` *lb, *rb their boxes (a
+ * split found on a sample, whose bins hold the sample's boxes only). The
+ * bins are computed exactly as find_split did. Two-pointer (Hoare): the
+ * scan from the left stops at a reference that goes right, the scan from
+ * the right at one that goes left, and the two swap, so only misplaced
+ * references move (about a quarter of a node's instead of every right
+ * one). Each side gets the same references in another order than a
+ * one-sided partition: the children's bins, centroid bounds and
+ * whole-number cost sums do not depend on the order, and the order within
+ * a leaf is set when the leaf is made (sort_ids). Inline with a constant
+ * `boxes`: partition and partition_boxes below. */
+static inline __attribute__((always_inline)) size_t partition_with(builder *b, size_t begin, size_t end,
+                                                                   const fbox *cb, const split *s, fbox *lcb,
+                                                                   fbox *rcb, bool boxes, fbox *lb, fbox *rb)
 {
 	binning bn;
 	binning_make(cb, end - begin, &bn);
 	int a = s->axis;
 	*lcb = *rcb = fbox_empty();
+	if (boxes)
+		*lb = *rb = fbox_empty();
 	size_t i = begin, j = end;
 #if defined(__SSE2__)
 	/* the bounds in registers; the axis's bin of a centroid in lane a */
 	__m128 blo = _mm_loadu_ps(bn.lo), bsc = _mm_loadu_ps(bn.scale), zero = _mm_setzero_ps(),
 	       at = _mm_set1_ps((float)s->at);
 	__m128 llo = _mm_loadu_ps(lcb->lo), lhi = _mm_loadu_ps(lcb->hi), rlo = llo, rhi = lhi;
+	/* the children's boxes (with `boxes`) */
+	__m128 blol = llo, bhil = lhi, blor = llo, bhir = lhi;
 	int abit = 1 << a;
 	for (;;) {
-		__m128 ci = zero, cj = zero;
+		__m128 ci = zero, cj = zero, loi = zero, hii = zero, loj = zero, hij = zero;
 		while (i < j) {
-			ci = _mm_add_ps(_mm_loadu_ps(b->refs[i].lo), _mm_loadu_ps(b->refs[i].hi));
+			loi = _mm_loadu_ps(b->refs[i].lo);
+			hii = _mm_loadu_ps(b->refs[i].hi);
+			ci = _mm_add_ps(loi, hii);
 			if (goes_right(ci, blo, bsc, at, abit))
 				break;
 			llo = _mm_min_ps(llo, ci);
 			lhi = _mm_max_ps(lhi, ci);
+			if (boxes) {
+				blol = _mm_min_ps(blol, loi);
+				bhil = _mm_max_ps(bhil, hii);
+			}
 			i++;
 		}
 		if (i == j)
@@ -600,13 +617,23 @@ static size_t partition(builder *b, size_t begin, size_t end, const fbox *cb, co
 		/* refs[i] goes right */
 		rlo = _mm_min_ps(rlo, ci);
 		rhi = _mm_max_ps(rhi, ci);
+		if (boxes) {
+			blor = _mm_min_ps(blor, loi);
+			bhir = _mm_max_ps(bhir, hii);
+		}
 		j--;
 		while (i < j) {
-			cj = _mm_add_ps(_mm_loadu_ps(b->refs[j].lo), _mm_loadu_ps(b->refs[j].hi));
+			loj = _mm_loadu_ps(b->refs[j].lo);
+			hij = _mm_loadu_ps(b->refs[j].hi);
+			cj = _mm_add_ps(loj, hij);
 			if (!goes_right(cj, blo, bsc, at, abit))
 				break;
 			rlo = _mm_min_ps(rlo, cj);
 			rhi = _mm_max_ps(rhi, cj);
+			if (boxes) {
+				blor = _mm_min_ps(blor, loj);
+				bhir = _mm_max_ps(bhir, hij);
+			}
 			j--;
 		}
 		if (i == j)
@@ -614,6 +641,10 @@ static size_t partition(builder *b, size_t begin, size_t end, const fbox *cb, co
 		/* refs[j] goes left */
 		llo = _mm_min_ps(llo, cj);
 		lhi = _mm_max_ps(lhi, cj);
+		if (boxes) {
+			blol = _mm_min_ps(blol, loj);
+			bhil = _mm_max_ps(bhil, hij);
+		}
 		swap_refs(b, i, j);
 		i++;
 	}
@@ -621,6 +652,12 @@ static size_t partition(builder *b, size_t begin, size_t end, const fbox *cb, co
 	_mm_storeu_ps(lcb->hi, lhi);
 	_mm_storeu_ps(rcb->lo, rlo);
 	_mm_storeu_ps(rcb->hi, rhi);
+	if (boxes) {
+		_mm_storeu_ps(lb->lo, blol);
+		_mm_storeu_ps(lb->hi, bhil);
+		_mm_storeu_ps(rb->lo, blor);
+		_mm_storeu_ps(rb->hi, bhir);
+	}
 #else
 	for (;;) {
 		float c[4];
@@ -631,11 +668,15 @@ static size_t partition(builder *b, size_t begin, size_t end, const fbox *cb, co
 			if (k[a] >= s->at)
 				break;
 			fbox_add_point(lcb, c);
+			if (boxes)
+				fbox_union(lb, &b->refs[i]);
 			i++;
 		}
 		if (i == j)
 			break;
 		fbox_add_point(rcb, c);
+		if (boxes)
+			fbox_union(rb, &b->refs[i]);
 		j--;
 		while (i < j) {
 			centroid2(&b->refs[j], c);
@@ -643,16 +684,34 @@ static size_t partition(builder *b, size_t begin, size_t end, const fbox *cb, co
 			if (k[a] < s->at)
 				break;
 			fbox_add_point(rcb, c);
+			if (boxes)
+				fbox_union(rb, &b->refs[j]);
 			j--;
 		}
 		if (i == j)
 			break;
 		fbox_add_point(lcb, c);
+		if (boxes)
+			fbox_union(lb, &b->refs[j]);
 		swap_refs(b, i, j);
 		i++;
 	}
 #endif
+	if (boxes) /* boxes, not costs: lane 3 as find_split leaves it */
+		lb->hi[3] = rb->hi[3] = 0.0f;
 	return i;
+}
+
+static size_t partition(builder *b, size_t begin, size_t end, const fbox *cb, const split *s, fbox *lcb,
+                        fbox *rcb)
+{
+	return partition_with(b, begin, end, cb, s, lcb, rcb, false, NULL, NULL);
+}
+
+static size_t partition_boxes(builder *b, size_t begin, size_t end, const fbox *cb, const split *s, fbox *lcb,
+                              fbox *rcb, fbox *lb, fbox *rb)
+{
+	return partition_with(b, begin, end, cb, s, lcb, rcb, true, lb, rb);
 }
 
 /* The box and centroid bounds of refs[begin, end). */
@@ -802,6 +861,19 @@ static void *sub_build_run(void *arg)
 	return NULL;
 }
 
+/* A node of SAMPLE_MIN references or more (and no spatial splits) finds
+ * its split by binning every k-th reference, k = n / SAMPLE_N (about
+ * SAMPLE_N of them, fixed by the order the partitions above left: the
+ * same for any thread count), and the partition gathers the children's
+ * boxes. The top levels' binning passes over every reference are what it
+ * saves; the split is the sample's, not the whole node's. */
+#ifndef SAMPLE_MIN
+#define SAMPLE_MIN 4096
+#endif
+#ifndef SAMPLE_N
+#define SAMPLE_N 1024
+#endif
+
 /* Below this many references a subtree is not given to another thread. */
 #define PARALLEL_MIN 4096
 
@@ -826,8 +898,15 @@ static void build(builder *b, size_t begin, size_t end, size_t cap_end, const fb
 		leaf = leaf_cost(b, total) <= b->trav;
 	}
 	split s = {.axis = -1}, obj = s;
+	/* a large node's split from a sample (SAMPLE_MIN) */
+	size_t step = !b->o->chop && n >= SAMPLE_MIN ? n / SAMPLE_N : 1;
 	if (!leaf && depth < BALANCED_DEPTH) {
-		s = obj = find_split(b, begin, end, cb);
+		s = obj = find_split(b, begin, end, cb, step);
+		if (step > 1 && s.axis < 0) {
+			/* the sample's centroids in one bin an axis: all of them */
+			step = 1;
+			s = obj = find_split(b, begin, end, cb, step);
+		}
 		if (b->o->chop && cap_end > end) {
 			/* a spatial split where the object split's children overlap */
 			fbox ov = s.lb;
@@ -877,7 +956,9 @@ static void build(builder *b, size_t begin, size_t end, size_t cap_end, const fb
 		bounds_of(b, begin, lend, &lb, &lcb);
 		bounds_of(b, rbegin, rend, &rb, &rcb);
 	} else {
-		if (s.axis >= 0) {
+		if (s.axis >= 0 && step > 1) {
+			mid = partition_boxes(b, begin, end, cb, &s, &lcb, &rcb, &lb, &rb);
+		} else if (s.axis >= 0) {
 			mid = partition(b, begin, end, cb, &s, &lcb, &rcb);
 			lb = s.lb;
 			rb = s.rb;

@@ -68,11 +68,20 @@ bool mb_normal(mesh_builder *b, const float n[3])
 	return true;
 }
 
+static bool recent_copy(mesh_builder *b, int32_t c[3][3], uint64_t *hash);
+
 bool mb_triangle(mesh_builder *b, int32_t c[3][3])
 {
+	uint64_t h;
+	if (recent_copy(b, c, &h)) {
+		b->ndup++;
+		return !read_poll();
+	}
 	if (read_poll() || !bgrow(b, (void **)&b->c, &b->cc, b->nc + 3, sizeof *b->c) ||
-	    !bgrow(b, (void **)&b->fm, &b->cf, b->nf + 1, sizeof *b->fm))
+	    !bgrow(b, (void **)&b->fm, &b->cf, b->nf + 1, sizeof *b->fm) ||
+	    !bgrow(b, (void **)&b->th, &b->cth, b->nf + 1, sizeof *b->th))
 		return false;
+	b->th[b->nf] = h;
 	memcpy(b->c[b->nc], c, 3 * sizeof *b->c);
 	b->nc += 3;
 	b->fm[b->nf++] = b->cur_mat;
@@ -109,7 +118,7 @@ static void mats_texs_free(mesh_mat *mats, size_t nmats, texture **texs, size_t 
 void mb_free(mesh_builder *b)
 {
 	mats_texs_free(b->mats, b->nmats, b->texs, b->ntexs);
-	mem_free_all(b->v, b->vt, b->vn, b->c, b->fm, b->warning);
+	mem_free_all(b->v, b->vt, b->vn, b->c, b->fm, b->th, b->warning);
 	memset(b, 0, sizeof *b);
 }
 
@@ -118,7 +127,14 @@ static uint64_t hash3(const int32_t k[3])
 	uint64_t h = (uint32_t)k[0] * 0x9E3779B97F4A7C15ull;
 	h ^= ((uint64_t)(uint32_t)k[1] + 0x632BE59BD9B4E019ull) * 0xC2B2AE3D27D4EB4Full;
 	h ^= ((uint64_t)(uint32_t)k[2] + 0x85EBCA77C2B2AE63ull) * 0x165667B19E3779F9ull;
-	return h ^ (h >> 29);
+	/* the whole word into the low bits the table uses (splitmix64's
+	 * finaliser): keys that step together, as an STL's corners (k, -1, k)
+	 * do, made runs of neighbouring slots and long probes */
+	h ^= h >> 30;
+	h *= 0xBF58476D1CE4E5B9ull;
+	h ^= h >> 27;
+	h *= 0x94D049BB133111EBull;
+	return h ^ (h >> 31);
 }
 
 /* Is the triangle of positions a, b, c of non-zero area? */
@@ -132,6 +148,158 @@ static bool tri_ok(const float *a, const float *b, const float *c)
 	double x = e1[1] * e2[2] - e1[2] * e2[1], y = e1[2] * e2[0] - e1[0] * e2[2],
 	       z = e1[0] * e2[1] - e1[1] * e2[0];
 	return x * x + y * y + z * z > 0.0;
+}
+
+/* --- exact duplicates --- */
+
+/* The corners as the builder holds them: index triples (position, uv,
+ * normal) into its arrays; uv and normals count only when every corner
+ * has them (has_uv, has_n), as the welding below decides. */
+typedef struct corners {
+	const mesh_builder *b;
+	bool uv, n;
+} corners;
+
+/* Two corners with the same position, uv and normal, bit for bit. */
+static bool corner_eq(const corners *k, const int32_t *ca, const int32_t *cb)
+{
+	const mesh_builder *b = k->b;
+	return (ca[0] == cb[0] || memcmp(b->v[ca[0]], b->v[cb[0]], sizeof *b->v) == 0) &&
+	       (!k->uv || ca[1] == cb[1] || memcmp(b->vt[ca[1]], b->vt[cb[1]], sizeof *b->vt) == 0) &&
+	       (!k->n || ca[2] == cb[2] || memcmp(b->vn[ca[2]], b->vn[cb[2]], sizeof *b->vn) == 0);
+}
+
+static uint64_t bits2(const float *a, const float *b)
+{
+	uint32_t x, y;
+	memcpy(&x, a, 4);
+	memcpy(&y, b, 4);
+	return (uint64_t)x | (uint64_t)y << 32;
+}
+
+static uint64_t fold(uint64_t h)
+{
+	h ^= h >> 31;
+	h *= 0xBF58476D1CE4E5B9ull;
+	return h ^ h >> 29;
+}
+
+/* A corner's hash, from its values (two corners of the same values, as
+ * an STL's are, hash alike). */
+static uint64_t corner_hash(const corners *k, const int32_t *c)
+{
+	static const float zero[3] = {0, 0, 0};
+	const float *p = k->b->v[c[0]], *t = k->uv ? k->b->vt[c[1]] : zero, *n = k->n ? k->b->vn[c[2]] : zero;
+	return fold(bits2(p, p + 1) * 0x9E3779B97F4A7C15ull + bits2(p + 2, t) * 0xC2B2AE3D27D4EB4Full +
+	            bits2(t + 1, n) * 0x165667B19E3779F9ull + bits2(n + 1, n + 2) * 0xD6E8FEB86659FD93ull);
+}
+
+/* A triangle's hash: the sum over its three directed edges of a hash of
+ * the edge's two corners' hashes, the same from any corner, another for
+ * the mirror-image winding. */
+static uint64_t tri_hash(const corners *k, int32_t (*c)[3], uint16_t mat)
+{
+	uint64_t a = corner_hash(k, c[0]), b = corner_hash(k, c[1]), d = corner_hash(k, c[2]);
+	uint64_t e = (a + (b << 17 | b >> 47)) * 0x9E3779B97F4A7C15ull + (b + (d << 17 | d >> 47)) * 0x9E3779B97F4A7C15ull +
+	             (d + (a << 17 | a >> 47)) * 0x9E3779B97F4A7C15ull;
+	return fold(e + mat);
+}
+
+/* Drops the triangles equal to an earlier one: the same three corners
+ * (position, uv and normal) in the same turn, from any corner, and the
+ * same material. A ray meets a duplicate at the same distance as the one
+ * kept, with the same surface, so the picture cannot change; N copies of
+ * one face would otherwise make every ray that passes test all N (no tree
+ * separates them). A mirror-image winding is another triangle. Done on the
+ * builder's corners (ntri triangles, b->c and b->fm compacted), before
+ * they are welded, so that the copies cost no vertices. One pass with a
+ * hash table (1.5 to 3 slots a triangle, each its index and 32 bits of its
+ * hash, so that only a matching hash compares corners), the slots fetched
+ * ahead. Returns how many were dropped; none when the memory cannot be
+ * had. */
+static size_t drop_duplicates(mesh_builder *b, size_t ntri, bool has_uv, bool has_n)
+{
+	size_t cap = 16;
+	if (ntri < 2)
+		return 0;
+	while (cap < ntri + ntri / 2)
+		cap *= 2;
+	uint64_t *slot = malloc(cap * sizeof *slot);
+	if (!slot)
+		return 0;
+	memset(slot, 0xff, cap * sizeof *slot);
+	const corners k = {b, has_uv, has_n};
+	enum { AHEAD = 16 };
+	size_t kept = 0;
+	for (size_t t = 0; t < ntri; t++) {
+		/* the hash mb_triangle made (positions and material: equal
+		 * triangles hash alike whatever has_uv and has_n say) */
+		uint64_t ht = b->th[t];
+		if (t + AHEAD < ntri) /* not moved yet: only up to t are */
+			__builtin_prefetch(&slot[b->th[t + AHEAD] & (cap - 1)]);
+		int32_t(*tt)[3] = &b->c[3 * t];
+		uint32_t tag = (uint32_t)(ht >> 32);
+		size_t h = (size_t)ht & (cap - 1);
+		bool dup = false;
+		while (slot[h] != UINT64_MAX && !dup) {
+			uint32_t o = (uint32_t)slot[h];
+			if ((uint32_t)(slot[h] >> 32) == tag && b->fm[o] == b->fm[t]) {
+				int32_t(*ot)[3] = &b->c[3 * (size_t)o];
+				for (int j = 0; j < 3 && !dup; j++)
+					dup = corner_eq(&k, tt[0], ot[j]) && corner_eq(&k, tt[1], ot[(j + 1) % 3]) &&
+					      corner_eq(&k, tt[2], ot[(j + 2) % 3]);
+			}
+			if (!dup)
+				h = (h + 1) & (cap - 1);
+		}
+		if (dup)
+			continue;
+		/* kept: moved down to its place, and found there from now on */
+		if (kept != t) {
+			memmove(&b->c[3 * kept], tt, 3 * sizeof *tt);
+			b->fm[kept] = b->fm[t];
+			b->th[kept] = b->th[t];
+		}
+		slot[h] = (uint64_t)tag << 32 | kept++;
+	}
+	free(slot);
+	return ntri - kept;
+}
+
+/* Is triangle c a copy of one of the last triangles kept (b->recent), in
+ * the current material? Corners compare by value; a uv or a normal only
+ * when both corners have one (the finish compares more loosely, when the
+ * mesh keeps none). Else c becomes the one its hash's slot remembers. */
+static bool recent_copy(mesh_builder *b, int32_t c[3][3], uint64_t *hash)
+{
+	*hash = 0; /* out-of-range indices: one hash, the finish compares */
+	for (int k = 0; k < 3; k++)
+		if (c[k][0] < 0 || (size_t)c[k][0] >= b->nv || c[k][1] >= (int32_t)b->nvt || c[k][2] >= (int32_t)b->nvn)
+			return false; /* the reader checks its indices; nothing is assumed here */
+	const corners k = {b, false, false};
+	uint64_t h = tri_hash(&k, c, b->cur_mat);
+	*hash = h;
+	uint64_t *slot = &b->recent[h & (sizeof b->recent / sizeof b->recent[0] - 1)];
+	uint32_t tag = (uint32_t)(h >> 32);
+	if (*slot && (uint32_t)(*slot >> 32) == tag) {
+		size_t o = (uint32_t)*slot - 1;
+		int32_t(*ot)[3] = &b->c[3 * o];
+		if (b->fm[o] == b->cur_mat)
+			for (int j = 0; j < 3; j++) {
+				bool same = true;
+				for (int i = 0; i < 3 && same; i++) {
+					const int32_t *x = c[i], *y = ot[(j + i) % 3];
+					same = (x[0] == y[0] || memcmp(b->v[x[0]], b->v[y[0]], sizeof *b->v) == 0) &&
+					       (x[1] == y[1] || (x[1] >= 0 && y[1] >= 0 && memcmp(b->vt[x[1]], b->vt[y[1]], sizeof *b->vt) == 0)) &&
+					       (x[2] == y[2] || (x[2] >= 0 && y[2] >= 0 && memcmp(b->vn[x[2]], b->vn[y[2]], sizeof *b->vn) == 0));
+				}
+				if (same)
+					return true;
+			}
+	}
+	if (b->nf < UINT32_MAX - 1)
+		*slot = (uint64_t)tag << 32 | (b->nf + 1);
+	return false;
 }
 
 mesh *mb_finish(mesh_builder *b, rt_error *err)
@@ -153,6 +321,7 @@ mesh *mb_finish(mesh_builder *b, rt_error *err)
 		if (!tri_ok(b->v[c[0][0]], b->v[c[1][0]], b->v[c[2][0]]))
 			continue;
 		memmove(&b->c[3 * kept], c, 3 * sizeof *c);
+		b->th[kept] = b->th[t];
 		b->fm[kept++] = b->fm[t];
 	}
 	ntri = kept;
@@ -169,6 +338,8 @@ mesh *mb_finish(mesh_builder *b, rt_error *err)
 			has_n = false;
 	}
 	plain = !has_uv && !has_n;
+	size_t dups = drop_duplicates(b, ntri, has_uv, has_n), dropped = b->ndup + dups;
+	ntri -= dups;
 	m->ntris = (uint32_t)ntri;
 	m->tri = malloc(ntri * sizeof *m->tri);
 	if (!m->tri)
@@ -184,7 +355,7 @@ mesh *mb_finish(mesh_builder *b, rt_error *err)
 	} else {
 		/* weld equal (position, uv, normal) triples into one vertex */
 		size_t cap = 16;
-		while (cap < 6 * ntri)
+		while (cap < 4 * ntri)
 			cap *= 2;
 		slot = malloc(cap * sizeof *slot);
 		m->p = malloc(3 * ntri * sizeof *m->p);
@@ -196,7 +367,16 @@ mesh *mb_finish(mesh_builder *b, rt_error *err)
 			goto oom;
 		memset(slot, 0xff, cap * sizeof *slot);
 		uint32_t nv = 0;
+		/* the slot of the corner WELD_AHEAD on is fetched now: the table
+		 * (4 to 8 slots a triangle) outgrows the caches, and the walk
+		 * would otherwise wait on memory at every corner */
+		enum { WELD_AHEAD = 32 };
 		for (size_t i = 0; i < 3 * ntri; i++) {
+			if (i + WELD_AHEAD < 3 * ntri) {
+				const int32_t *a = b->c[i + WELD_AHEAD];
+				int32_t ka[3] = {a[0], has_uv ? a[1] : -1, has_n ? a[2] : -1};
+				__builtin_prefetch(&slot[(size_t)hash3(ka) & (cap - 1)]);
+			}
 			int32_t key[3] = {b->c[i][0], has_uv ? b->c[i][1] : -1, has_n ? b->c[i][2] : -1};
 			size_t h = (size_t)hash3(key) & (cap - 1);
 			uint32_t found = UINT32_MAX;
@@ -227,6 +407,12 @@ mesh *mb_finish(mesh_builder *b, rt_error *err)
 		m->nverts = nv;
 		free(slot);
 		slot = NULL;
+	}
+	if (dropped && !b->warning) {
+		char msg[RT_ERROR_FILE_MAX + 128];
+		snprintf(msg, sizeof msg, "%s: %zu duplicate triangle%s dropped (the same corners and material as another)",
+		         b->name, dropped, dropped == 1 ? "" : "s");
+		b->warning = strdup(msg); /* NULL: not said, no harm */
 	}
 	m->nmats = (uint32_t)b->nmats;
 	m->mats = b->mats;
