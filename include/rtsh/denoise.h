@@ -161,7 +161,8 @@ bool denoise_image(const framebuffer *fb, float *out, int threads);
 
 /* Adaptive sampling at the same budget: a denoised render of S samples
  * spends S x W x H camera paths, DENOISE_FIRST(S) (3/4 of S, even) in
- * every pixel first, then the rest where the noise is (render_image). */
+ * every pixel first, then the rest where the noise the filter leaves is
+ * (render_image: denoise_sigma times a power of denoise_reach). */
 #define DENOISE_FIRST(S) ((3 * (S) / 4) & ~1)
 /* ...each pixel at most 16 times the mean (8: metal-fuzz 1-2% worse, its
  * highlights' pixels held at 64 of 8), and below 65535 (a pixel's count is
@@ -195,6 +196,26 @@ bool denoise_image(const framebuffer *fb, float *out, int threads);
  * 640x360 0.979 0.995 1.011 0.948 0.997 (bench/README). False when out of
  * memory. */
 bool denoise_sigma(const framebuffer *fb, float *sigma);
+/* How much of each pixel's noise the filter passes on, from the features
+ * alone (no sample's radiance) into reach (w*h): the sum, over the pixels
+ * whose 9x9 window holds it, of its share of that pixel's fit squared,
+ * (w_pt / sum_q w_pq)^2, w the regression's weight of the tap (albedo,
+ * normal, depth off the pixel's plane and direct light, as denoise_image
+ * weighs its taps). The filtered image's variance is then about
+ * sum_t reach_t sigma_t^2 / n_t: 1/K in a surface of K alike pixels
+ * around, 1 for a pixel like none of its window (a highlight a pixel
+ * wide, a sliver of a small sphere), whose noise the fit keeps. False
+ * when out of memory. */
+bool denoise_reach(const framebuffer *fb, float *reach);
+/* The adaptive samples go where sigma_p reach_p^DENOISE_REACH_POW is: the
+ * n_p that minimise sum_p reach_p sigma_p^2 / n_p are proportional to
+ * sigma_p reach_p^0.5; less than that hedges for the pixels where the
+ * filter keeps the raw mean (its reach is 1 there, whatever the features
+ * say). 4 seeds, metal-fuzz, final, cornell, spot, sky-spheres, RMS
+ * new/old: 128x96 0.975 0.962 0.984 1.010 1.002, 200x120 0.980 0.957
+ * 0.993 1.007 0.989 (bench/README, the denoise12 session; 0.5: geomean
+ * 0.9907, 0.25: 0.9877). */
+#define DENOISE_REACH_POW 0.375
 /* Whether a pixel of features f keeps the samples a uniform render gives it
  * and its noise counts for none of its neighbours: its first positions all
  * missed the scene (the background or the sky: a path there is one ray,

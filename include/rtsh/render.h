@@ -172,7 +172,8 @@ int render_adaptive_first(int samples, bool denoise);
 /* The adaptive pass: job->fb (with features, running sums and sum2)
  * holds job->sample_end samples in every pixel, the first pass, in one
  * pass or several; the rest of job->set.samples x W x H paths go where its
- * noise is (denoise.h: denoise_sigma, denoise_fixed, denoise_allocate) into
+ * noise is, as the filter will pass it on (denoise.h: denoise_sigma,
+ * denoise_reach, denoise_fixed, denoise_allocate) into
  * fb->pixel_spp, and each pixel's sequence is continued to its count
  * (job->pixel_end); then fb->spp is job->set.samples, the mean. The
  * allocation reads only what does not depend on how the first pass was

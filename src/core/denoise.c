@@ -1214,6 +1214,117 @@ bool denoise_image(const framebuffer *fb, float *out, int threads)
 
 /* --- adaptive sampling ------------------------------------------------------ */
 
+/* Four floats, four lanes (SSE2 and NEON have them; GCC and clang both
+ * take the element-wise operators). */
+typedef float v4f __attribute__((vector_size(16)));
+typedef int v4i __attribute__((vector_size(16)));
+
+static inline v4f v4_load(const float *p)
+{
+	v4f v;
+	memcpy(&v, p, sizeof v);
+	return v;
+}
+
+static inline void v4_store(float *p, v4f v)
+{
+	memcpy(p, &v, sizeof v);
+}
+
+bool denoise_reach(const framebuffer *fb, float *reach)
+{
+	int w = fb->w, h = fb->h;
+	int wr = (w + 3) & ~3, S = wr + 2 * WIN; /* a padded row */
+	size_t np = (size_t)h * S;
+	/* the planes (pixel (x, y) at y S + x + WIN): the six scaled
+	 * features, depth, its slopes, the direct light over the albedo; the
+	 * pads' albedo far from any pixel's, so that their weight is 0 */
+	enum { R_Z = 6, R_GX, R_GY, R_D, R_HS, R_N };
+	float *pl = malloc(np * R_N * sizeof *pl), *wt = malloc((size_t)TAPS * wr * sizeof *wt);
+	if (!pl || !wt) {
+		mem_free_all(pl, wt);
+		return false;
+	}
+	for (size_t i = 0; i < np * R_N; i++)
+		pl[i] = i < np ? 1e4f : 0.0f;
+	for (int y = 0; y < h; y++)
+		for (int x = 0; x < w; x++) {
+			size_t i = (size_t)y * w + x, o = (size_t)y * S + x + WIN;
+			const float *f = fb->feat + i * DENOISE_FEATURES;
+			float am[3];
+			for (int k = 0; k < 3; k++) {
+				pl[k * np + o] = f[k] * (1.0f / sqrtf(SIGMA_A2));
+				pl[(3 + k) * np + o] = f[3 + k] * (1.0f / sqrtf(SIGMA_N2));
+				am[k] = (float)albedo_divisor(f[k]);
+			}
+			pl[R_Z * np + o] = f[6];
+			pl[R_GX * np + o] = depth_slope(f + 6, x, w, DENOISE_FEATURES);
+			pl[R_GY * np + o] = depth_slope(f + 6, y, h, DENOISE_FEATURES * w);
+			pl[R_D * np + o] = f[14] / lum(am);
+		}
+	float *hs = pl + R_HS * np;
+	for (int y = 0; y < h; y++)
+		for (int xb = 0; xb < wr; xb += 4) {
+			size_t o = (size_t)y * S + xb + WIN;
+			v4f g[6];
+			for (int k = 0; k < 6; k++)
+				g[k] = v4_load(pl + k * np + o);
+			v4f gz = v4_load(pl + R_Z * np + o), gx = v4_load(pl + R_GX * np + o),
+			    gy = v4_load(pl + R_GY * np + o), gd = v4_load(pl + R_D * np + o);
+			v4f one = {1, 1, 1, 1}, zero = {0, 0, 0, 0};
+			v4f inv_z = one / ((v4f){SIGMA_Z, SIGMA_Z, SIGMA_Z, SIGMA_Z} * gz + 1e-6f);
+			v4f ad = (v4f)((v4i)gd & 0x7fffffff);
+			v4f dscale = one / (0.5f * ad + 0.05f);
+			v4i xs = {xb, xb + 1, xb + 2, xb + 3};
+			v4i in = xs < w;
+			v4f sw = zero;
+			int t = 0;
+			for (int dy = -WIN; dy <= WIN; dy++)
+				for (int dx = -WIN; dx <= WIN; dx++, t++) {
+					int qy = y + dy;
+					v4f u = zero;
+					if (qy >= 0 && qy < h) {
+						size_t q = (size_t)qy * S + xb + dx + WIN;
+						v4f e = zero;
+						for (int k = 0; k < 6; k++) {
+							v4f d = g[k] - v4_load(pl + k * np + q);
+							e += d * d;
+						}
+						v4f dz = v4_load(pl + R_Z * np + q) - (gz + gx * (float)dx + gy * (float)dy);
+						e += (v4f)((v4i)dz & 0x7fffffff) * inv_z;
+						v4f dd = (v4_load(pl + R_D * np + q) - gd) * dscale;
+						e += DIRECT_W * dd * dd;
+						u = one - e * (1.0f / 16);
+						u = (v4f)((v4i)u & ((u > zero) & in));
+						u *= u;
+						u *= u;
+						u *= u;
+						u *= u;
+					}
+					v4_store(wt + (size_t)t * wr + xb, u);
+					sw += u;
+				}
+			/* each tap's share of the pixel's fit, squared, to the tap */
+			v4f inv = one / (sw * sw + 1e-30f);
+			t = 0;
+			for (int dy = -WIN; dy <= WIN; dy++)
+				for (int dx = -WIN; dx <= WIN; dx++, t++) {
+					int qy = y + dy;
+					if (qy < 0 || qy >= h)
+						continue;
+					v4f u = v4_load(wt + (size_t)t * wr + xb);
+					float *dst = hs + (size_t)qy * S + xb + dx + WIN;
+					v4_store(dst, v4_load(dst) + u * u * inv);
+				}
+		}
+	for (int y = 0; y < h; y++)
+		for (int x = 0; x < w; x++)
+			reach[(size_t)y * w + x] = hs[(size_t)y * S + x + WIN];
+	mem_free_all(pl, wt);
+	return true;
+}
+
+
 /* The noise of one sample's brightness about each pixel of fb (its samples
  * so far, at least two; features 7): the variance in each pixel from the
  * mean of the squared brightness and the mean's square, n / (n - 1)

@@ -2,6 +2,7 @@
  * pthreads; each pixel's samples are summed in sample order (render.h). */
 #include "rtsh/render.h"
 
+#include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
@@ -720,12 +721,18 @@ int render_adaptive_counts(framebuffer *fb, int samples, int first, rt_error *er
 	/* of the first pass, the same count in every pixel */
 	free(fb->pixel_spp);
 	fb->pixel_spp = NULL;
-	if (!sigma || !spp || !denoise_sigma(fb, sigma)) {
-		mem_free_all(sigma, spp);
+	float *reach = malloc(n * sizeof *reach);
+	if (!sigma || !spp || !reach || !denoise_sigma(fb, sigma) || !denoise_reach(fb, reach)) {
+		mem_free_all(sigma, spp, reach);
 		rt_error_set(err, "out of memory for the adaptive samples of a %dx%d image", fb->w, fb->h);
 		return -1;
 	}
 	fb->pixel_spp = spp;
+	/* The noise the filtered pixel keeps, not the raw one: a pixel the
+	 * fit averages with many alike ones needs fewer of its own. */
+	for (size_t i = 0; i < n; i++)
+		sigma[i] *= (float)pow(reach[i], DENOISE_REACH_POW);
+	free(reach);
 	/* A pixel that missed the scene or sees a lamp (denoise_fixed) keeps
 	 * the samples a uniform render gives it (spent on surfaces, the
 	 * background's one-ray paths cost cornell.rt's render 29% more

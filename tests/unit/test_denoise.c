@@ -1507,6 +1507,99 @@ static void test_sigma_neighbours(void **state)
 	fb_free(fb);
 }
 
+/* A small image of surface pixels (depth 3), albedo a[i] in every channel,
+ * direct light 0 and 6 samples of grey 0.5 whose variance is 1. */
+static framebuffer *reach_image(int w, int h, const float *a)
+{
+	framebuffer *fb = fb_new(w, h);
+	assert_non_null(fb);
+	assert_true(denoise_prepare(fb));
+	fb->spp = 6;
+	for (int i = 0; i < w * h; i++) {
+		float *f = fb->feat + i * DENOISE_FEATURES;
+		for (int k = 0; k < 3; k++) {
+			fb->rgb[i * 3 + k] = 0.5f;
+			fb->sum[i * 3 + k] = 3.0; /* 6 samples of 0.5 */
+			f[k] = a[i];
+			f[3 + k] = k == 2 ? 1.0f : 0.0f; /* normal +z */
+		}
+		f[6] = 3.0f;
+		/* mean square 0.25 + 5/6: variance (0.25 + 5/6 - 0.25) 6/5 = 1 */
+		f[7] = 0.25f + 5.0f / 6.0f;
+	}
+	return fb;
+}
+
+/* How much of a pixel's noise the filter passes on (denoise_reach), by
+ * hand: the sum over the pixels whose window holds it of its share of
+ * their fit, squared.
+ * (a) 3x3 alike pixels: every window holds all nine at weight 1, so each
+ *     pixel is 1/9 of nine fits: 9 / 81 = 1/9.
+ * (b) the centre's albedo 0.9 among 0.1: its squared distance 3 x 0.8^2 /
+ *     0.08 = 24 is past the weight's end (16): its fit is itself alone
+ *     (reach 1), each other pixel 1/8 of eight fits (8 / 64).
+ * (c) 2x1, albedo 0.5, direct light 0.1 and 0.2 (over the albedo d 0.2
+ *     and 0.4): pixel 0 weighs pixel 1 by (1 - dd^2 / 16)^16 with dd =
+ *     0.2 / (0.5 x 0.2 + 0.05) = 4/3: u = (1 - 1/9)^16 = 0.151901; pixel
+ *     1 weighs pixel 0 with dd = 0.2 / 0.25 = 0.8: v = 0.96^16 = 0.520403.
+ *     reach 0 = (1 / (1 + u))^2 + (v / (1 + v))^2 = 0.870806, reach 1 =
+ *     (u / (1 + u))^2 + (1 / (1 + v))^2 = 0.449986. */
+static void test_reach(void **state)
+{
+	(void)state;
+	float r[9];
+	const float flat[9] = {0.1f, 0.1f, 0.1f, 0.1f, 0.1f, 0.1f, 0.1f, 0.1f, 0.1f};
+	framebuffer *fb = reach_image(3, 3, flat);
+	assert_true(denoise_reach(fb, r));
+	for (int i = 0; i < 9; i++)
+		assert_near(r[i], 1.0 / 9, 1e-6);
+	fb_free(fb);
+	const float spot[9] = {0.1f, 0.1f, 0.1f, 0.1f, 0.9f, 0.1f, 0.1f, 0.1f, 0.1f};
+	fb = reach_image(3, 3, spot);
+	assert_true(denoise_reach(fb, r));
+	for (int i = 0; i < 9; i++)
+		assert_near(r[i], i == 4 ? 1.0 : 1.0 / 8, 1e-6);
+	fb_free(fb);
+	const float two[2] = {0.5f, 0.5f};
+	fb = reach_image(2, 1, two);
+	fb->feat[14] = 0.1f;
+	fb->feat[DENOISE_FEATURES + 14] = 0.2f;
+	assert_true(denoise_reach(fb, r));
+	double u = pow(1 - 1.0 / 9, 16), v = pow(0.96, 16);
+	assert_near(u, 0.151901, 1e-6);
+	assert_near(v, 0.520403, 1e-6);
+	assert_near(r[0], 1 / ((1 + u) * (1 + u)) + v * v / ((1 + v) * (1 + v)), 1e-5);
+	assert_near(r[1], u * u / ((1 + u) * (1 + u)) + 1 / ((1 + v) * (1 + v)), 1e-5);
+	assert_near(r[0], 0.870806, 1e-5);
+	assert_near(r[1], 0.449986, 1e-5);
+	fb_free(fb);
+}
+
+/* The allocation takes the filtered noise: (b)'s image above, every
+ * pixel's noise 1 (its 3x3 window's mean variance), 6 samples each and 8
+ * on average (72 in all). The eight alike pixels' reach is 1/8, their
+ * weight 8^-DENOISE_REACH_POW = 8^-0.375 = 0.45850, the centre's 1: l (1
+ * + 8 x 0.45850) = 72 (the thousandth of the mean added is below the
+ * rounding), l = 15.424: the centre 15.42 samples, 4.71 pairs above 6,
+ * the others 7.07, 0.536 pairs; their running sums 0.536, 1.073, 1.609,
+ * 2.146, 6.856, 7.392, 7.928, 8.464, 9 round to 1, 1, 2, 2, 7, 7, 8, 8,
+ * 9 pairs: 8 6 8 6 16 6 8 6 8. (Without the reach every pixel got 8.) */
+static void test_reach_allocation(void **state)
+{
+	(void)state;
+	assert_true(DENOISE_REACH_POW == 0.375);
+	const float spot[9] = {0.1f, 0.1f, 0.1f, 0.1f, 0.9f, 0.1f, 0.1f, 0.1f, 0.1f};
+	framebuffer *fb = reach_image(3, 3, spot);
+	float sg[9];
+	assert_true(denoise_sigma(fb, sg));
+	for (int i = 0; i < 9; i++)
+		assert_near(sg[i], 1.0, 1e-5);
+	assert_int_equal(render_adaptive_counts(fb, 8, 6, NULL), 16);
+	const uint16_t want[9] = {8, 6, 8, 6, 16, 6, 8, 6, 8};
+	assert_memory_equal(fb->pixel_spp, want, sizeof want);
+	fb_free(fb);
+}
+
 /* The adaptive pass continues each pixel's own sequence: a first pass of 4
  * samples, then every pixel to 8 through render_job.pixel_end, holds the
  * bits of 8 samples in one pass (the same sums in the same order); pixels
@@ -1813,6 +1906,8 @@ int main(void)
 		cmocka_unit_test(test_features_in_passes),
 		cmocka_unit_test(test_allocate_rule),
 		cmocka_unit_test(test_sigma_neighbours),
+		cmocka_unit_test(test_reach),
+		cmocka_unit_test(test_reach_allocation),
 		cmocka_unit_test(test_own_estimates),
 		cmocka_unit_test(test_adaptive_pass),
 		cmocka_unit_test(test_adaptive_render),
