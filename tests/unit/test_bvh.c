@@ -968,6 +968,35 @@ static void test_sampled_split(void **state)
 	free(ids);
 }
 
+/* The world's bounds are the union of its bounded primitives' boxes
+ * (world.c makes them in line): three spheres by hand, centres and
+ * diameters (-7, 2, 1) 2, (5, -4, 20) 4 and (1, 9, -3) 1, give lo (-8, -6,
+ * -3.5) and hi (7, 9.5, 22); a plane far out adds nothing; and eps is
+ * 1e-9 x the largest coordinate of the camera (-3 x region 1 = -3), the
+ * bounds (22) and the plane's point (40): 4e-8. */
+static void test_world_bounds(void **state)
+{
+	(void)state;
+	scene *s = random_scene(1, 0, 1, 1, 0);
+	const double at[3][4] = {{-7, 2, 1, 2}, {5, -4, 20, 4}, {1, 9, -3, 1}};
+	for (int i = 0; i < 3; i++) {
+		object o = object_make(OBJ_SPHERE, v3(200, 10, 10));
+		o.pos = v3(at[i][0], at[i][1], at[i][2]);
+		o.scale = v3(at[i][3], at[i][3], at[i][3]);
+		assert_true(scene_add_object(s, &o, NULL));
+	}
+	object p = object_make(OBJ_PLANE, v3(1, 1, 1));
+	p.pos = v3(0, -40, 0);
+	p.dir = v3(0, 1, 0);
+	assert_true(scene_add_object(s, &p, NULL));
+	world *w = build(s);
+	assert_true(v3_eq(w->bounds.lo, v3(-8, -6, -3.5)));
+	assert_true(v3_eq(w->bounds.hi, v3(7, 9.5, 22)));
+	assert_true(w->eps == 1e-9 * 40);
+	world_free(w);
+	scene_free(s);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -988,6 +1017,7 @@ int main(void)
 		cmocka_unit_test(test_sah_splits),
 		cmocka_unit_test(test_leaf_order),
 		cmocka_unit_test(test_sampled_split),
+		cmocka_unit_test(test_world_bounds),
 	};
 	return cmocka_run_group_tests_name("bvh", tests, NULL, NULL);
 }
