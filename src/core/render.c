@@ -119,8 +119,8 @@ typedef struct shared {
 } shared;
 
 /* Ctrl-C within a tile: the cancel flag of the render this thread's
- * tiles belong to (NULL: none), polled by block_add every 16 samples, and
- * whether it stopped a block short. A tile of many samples (set samples
+ * tiles belong to (NULL: none), polled by block_add every 16 samples and by
+ * render_tile before each block, and whether it stopped a block short. A tile of many samples (set samples
  * 100000: seconds of work) then stops within a fraction of a second; a
  * tile stopped short is not counted done, so the pass is cancelled. */
 static _Thread_local const atomic_bool *tile_cancel;
@@ -288,6 +288,13 @@ static bool render_tile(shared *sh, long t)
 	for (int by = y0; by < y1; by += BLOCK_SIDE)
 		for (int bx = x0; bx < x1; bx += BLOCK_SIDE) {
 			int ex = bx + BLOCK_SIDE < x1 ? bx + BLOCK_SIDE : x1, ey = by + BLOCK_SIDE < y1 ? by + BLOCK_SIDE : y1;
+			/* and before each block: a pass of fewer than 16 samples (a
+			 * preview's 1) is stopped here, where every ray of a block may
+			 * meet thousands of overlapping triangles */
+			if (tile_cancel && atomic_load_explicit(tile_cancel, memory_order_relaxed)) {
+				tile_stopped = true;
+				return false;
+			}
 			double acc[PACKET_MAX][3];
 			float *fp[PACKET_MAX];
 			double *sq[PACKET_MAX];

@@ -3,12 +3,15 @@
 
 #include <errno.h>
 #include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/ioctl.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "rtsh/filesrc.h"
@@ -99,8 +102,161 @@ static frame_palette preview_palette(color_mode m)
 	return nc && *nc ? PALETTE_NONE : PALETTE_TRUECOLOR;
 }
 
+/* --- the time budget --- */
+
+/* A thread that sets *cancel at `at` (CLOCK_MONOTONIC) unless told to stop
+ * first. */
+typedef struct alarm_clock {
+	pthread_mutex_t m;
+	pthread_cond_t c;
+	bool stop;
+	struct timespec at;
+	atomic_bool *cancel;
+	pthread_t th;
+	bool running;
+} alarm_clock;
+
+static void *alarm_run(void *arg)
+{
+	alarm_clock *a = arg;
+	pthread_mutex_lock(&a->m);
+	while (!a->stop)
+		if (pthread_cond_timedwait(&a->c, &a->m, &a->at) == ETIMEDOUT) {
+			atomic_store(a->cancel, true);
+			break;
+		}
+	pthread_mutex_unlock(&a->m);
+	return NULL;
+}
+
+static struct timespec after(double s)
+{
+	struct timespec t;
+	clock_gettime(CLOCK_MONOTONIC, &t);
+	if (!(s > 0))
+		s = 0;
+	double whole = floor(s);
+	t.tv_sec += (time_t)whole;
+	t.tv_nsec += (long)((s - whole) * 1e9);
+	if (t.tv_nsec >= 1000000000L) {
+		t.tv_sec++;
+		t.tv_nsec -= 1000000000L;
+	}
+	return t;
+}
+
+/* Starts the clock; false (and *cancel set: no render) when the budget is
+ * spent already or no thread can be had. */
+static bool alarm_start(alarm_clock *a, atomic_bool *cancel, double s)
+{
+	atomic_store(cancel, !(s > 0));
+	a->running = false;
+	if (!(s > 0))
+		return false;
+	pthread_condattr_t ca;
+	pthread_condattr_init(&ca);
+	pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
+	pthread_mutex_init(&a->m, NULL);
+	pthread_cond_init(&a->c, &ca);
+	pthread_condattr_destroy(&ca);
+	a->stop = false;
+	a->at = after(s);
+	a->cancel = cancel;
+	a->running = pthread_create(&a->th, NULL, alarm_run, a) == 0;
+	if (!a->running) {
+		pthread_cond_destroy(&a->c);
+		pthread_mutex_destroy(&a->m);
+	}
+	return a->running;
+}
+
+static void alarm_stop(alarm_clock *a)
+{
+	if (!a->running)
+		return;
+	pthread_mutex_lock(&a->m);
+	a->stop = true;
+	pthread_cond_signal(&a->c);
+	pthread_mutex_unlock(&a->m);
+	pthread_join(a->th, NULL);
+	pthread_cond_destroy(&a->c);
+	pthread_mutex_destroy(&a->m);
+	a->running = false;
+}
+
+/* A render stopped at s seconds from now; NULL (err set) when stopped
+ * (*stopped set) or failed. Without a clock thread the render runs
+ * unstopped (the watchdog is still there). */
+static framebuffer *render_within(const world *wd, const render_settings *set, double s, bool *stopped,
+                                  rt_error *err)
+{
+	atomic_bool cancel;
+	alarm_clock a;
+	*stopped = false;
+	if (!alarm_start(&a, &cancel, s) && atomic_load(&cancel)) {
+		*stopped = true;
+		rt_error_set(err, "render stopped");
+		return NULL;
+	}
+	framebuffer *fb = render_image(wd, set, &cancel, NULL, NULL, err);
+	alarm_stop(&a);
+	*stopped = !fb && atomic_load(&cancel);
+	return fb;
+}
+
+framebuffer *preview_render(const world *wd, const render_settings *set, double full_s, double coarse_s, bool *coarse,
+                            rt_error *err)
+{
+	*coarse = false;
+	render_settings cs = *set;
+	cs.width = (set->width + 3) / 4;
+	cs.height = (set->height + 3) / 4;
+	cs.samples = 1;
+	cs.denoise = DENOISE_OFF;
+	struct timespec t0;
+	clock_gettime(CLOCK_MONOTONIC, &t0);
+	bool stopped;
+	framebuffer *small = render_within(wd, &cs, coarse_s, &stopped, err);
+	if (!small) {
+		if (stopped)
+			rt_error_set(err, "stopped");
+		return NULL;
+	}
+	struct timespec t1;
+	clock_gettime(CLOCK_MONOTONIC, &t1);
+	double spent = (double)(t1.tv_sec - t0.tv_sec) + (double)(t1.tv_nsec - t0.tv_nsec) * 1e-9;
+	rt_error ferr;
+	rt_error_clear(&ferr);
+	framebuffer *fb = render_within(wd, set, full_s - spent, &stopped, &ferr);
+	if (fb) {
+		fb_free(small);
+		return fb;
+	}
+	if (!stopped) { /* failed */
+		fb_free(small);
+		*err = ferr;
+		return NULL;
+	}
+	fb = fb_new(set->width, set->height);
+	if (!fb) {
+		fb_free(small);
+		rt_error_set(err, "out of memory");
+		return NULL;
+	}
+	for (int y = 0; y < fb->h; y++)
+		for (int x = 0; x < fb->w; x++)
+			memcpy(&fb->rgb[3 * ((size_t)y * fb->w + x)], &small->rgb[3 * ((size_t)(y / 4) * small->w + x / 4)],
+			       3 * sizeof *fb->rgb);
+	fb->spp = small->spp;
+	fb_free(small);
+	*coarse = true;
+	return fb;
+}
+
 int preview_main(const rtsh_options *o)
 {
+	struct timespec start;
+	clock_gettime(CLOCK_MONOTONIC, &start);
 	const char *file = o->scene;
 	if (!file) {
 		fprintf(stderr, "rtsh: --preview needs a file\nTry 'rtsh --help' for more information.\n");
@@ -191,10 +347,22 @@ int preview_main(const rtsh_options *o)
 	scene_free(s);
 	if (!wd)
 		return fail(file, err.msg);
-	framebuffer *fb = render_image(wd, &set, NULL, NULL, NULL, &err);
+	/* the budget counts from the start: the load and the tree took some */
+	struct timespec now;
+	clock_gettime(CLOCK_MONOTONIC, &now);
+	double spent = (double)(now.tv_sec - start.tv_sec) + (double)(now.tv_nsec - start.tv_nsec) * 1e-9;
+	bool coarse = false;
+	framebuffer *fb = preview_render(wd, &set, PREVIEW_FULL_BUDGET - spent, PREVIEW_COARSE_BUDGET - spent, &coarse, &err);
 	world_free(wd);
+	if (!fb && strcmp(err.msg, "stopped") == 0)
+		return fail(file, "gave up: not even a coarse picture after " XSTR(PREVIEW_COARSE_BUDGET) " seconds");
 	if (!fb)
 		return fail(file, err.msg);
+	if (coarse) {
+		char name[4096];
+		fprintf(stderr, "rtsh: %s: the full picture was not ready after %g seconds: shown at a quarter of its "
+		        "resolution\n", shown(file, name, sizeof name), PREVIEW_FULL_BUDGET);
+	}
 	/* the textures the budget left out: one line, the picture still drawn */
 	char first[RT_ERROR_MSG_MAX];
 	size_t skipped = image_budget_report(first, sizeof first);

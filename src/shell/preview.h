@@ -20,6 +20,8 @@
 
 #include <stdbool.h>
 
+#include "rtsh/render.h"
+#include "rtsh/world.h"
 #include "shell/options.h"
 
 /* Seconds before a preview gives up (exit status 1). */
@@ -29,6 +31,22 @@
  * says so (image_budget_set; the sky is not held to it). A 12000 x 12000
  * PNG of 420 KB cost 2.9 s and 2.2 GB. */
 #define PREVIEW_TEXTURE_PIXELS ((size_t)4096 * 4096)
+/* Seconds from the start a preview's full picture may take; past them the
+ * coarse picture is shown (preview_render). */
+#define PREVIEW_FULL_BUDGET 10.0
+/* ... and the coarse picture: past them the preview gives up (status 1),
+ * before the watchdog. */
+#define PREVIEW_COARSE_BUDGET 16.0
+/* The picture of a preview in a time budget: first a coarse pass (a
+ * quarter of the width and of the height, 1 sample, not denoised: 1/16 of
+ * the pixels), stopped coarse_s seconds from now; then the picture of set,
+ * stopped full_s seconds from now (both from the call). When the full picture is stopped, the
+ * coarse one is returned, each of its pixels 4 x 4 (*coarse set true);
+ * otherwise the full one, the same bits as render_image's. NULL (err set;
+ * "stopped" when the coarse pass is stopped too) on failure. Both passes are stopped
+ * between blocks of 4 x 4 pixels (render.c's polls). */
+framebuffer *preview_render(const world *wd, const render_settings *set, double full_s, double coarse_s, bool *coarse,
+                            rt_error *err);
 /* Runs the preview of o->scene at o->preview_cols x o->preview_rows;
  * returns the exit status (0, or 1 after a message on standard error). */
 int preview_main(const rtsh_options *o);
