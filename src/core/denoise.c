@@ -1231,41 +1231,67 @@ static inline void v4_store(float *p, v4f v)
 	memcpy(p, &v, sizeof v);
 }
 
+/* The rows of the planes denoise_reach keeps at a time: a window's. */
+#define REACH_ROWS (2 * WIN + 1)
+enum { R_Z = 6, R_GX, R_GY, R_D, R_HS, R_N };
+
+/* Image row y of fb into its slot of the planes (rows of S floats, pixel
+ * x at x + WIN, np floats a plane): the six scaled features, depth, its
+ * slopes, the direct light over the albedo; the reach's sums cleared. */
+static void reach_row(const framebuffer *fb, int y, float *pl, size_t np, int S)
+{
+	int w = fb->w, h = fb->h;
+	size_t o0 = (size_t)(y % REACH_ROWS) * S;
+	for (int k = 0; k < R_N; k++)
+		for (int x = 0; x < S; x++)
+			pl[k * np + o0 + x] = k < 3 ? 1e4f : 0.0f; /* pads: far from any pixel */
+	for (int x = 0; x < w; x++) {
+		size_t i = (size_t)y * w + x, o = o0 + x + WIN;
+		const float *f = fb->feat + i * DENOISE_FEATURES;
+		float am[3];
+		for (int k = 0; k < 3; k++) {
+			pl[k * np + o] = f[k] * (1.0f / sqrtf(SIGMA_A2));
+			pl[(3 + k) * np + o] = f[3 + k] * (1.0f / sqrtf(SIGMA_N2));
+			am[k] = (float)albedo_divisor(f[k]);
+		}
+		pl[R_Z * np + o] = f[6];
+		pl[R_GX * np + o] = depth_slope(f + 6, x, w, DENOISE_FEATURES);
+		pl[R_GY * np + o] = depth_slope(f + 6, y, h, DENOISE_FEATURES * w);
+		pl[R_D * np + o] = f[14] / lum(am);
+	}
+}
+
+/* Row y of the reach's sums, complete, out of its slot. */
+static void reach_out(const framebuffer *fb, int y, const float *hs, int S, float *reach)
+{
+	const float *r = hs + (size_t)(y % REACH_ROWS) * S + WIN;
+	memcpy(reach + (size_t)y * fb->w, r, (size_t)fb->w * sizeof *reach);
+}
+
 bool denoise_reach(const framebuffer *fb, float *reach)
 {
 	int w = fb->w, h = fb->h;
 	int wr = (w + 3) & ~3, S = wr + 2 * WIN; /* a padded row */
-	size_t np = (size_t)h * S;
-	/* the planes (pixel (x, y) at y S + x + WIN): the six scaled
-	 * features, depth, its slopes, the direct light over the albedo; the
-	 * pads' albedo far from any pixel's, so that their weight is 0 */
-	enum { R_Z = 6, R_GX, R_GY, R_D, R_HS, R_N };
+	/* a window's rows of each plane, a ring: row y in slot y % REACH_ROWS */
+	size_t np = (size_t)REACH_ROWS * S;
 	float *pl = malloc(np * R_N * sizeof *pl), *wt = malloc((size_t)TAPS * wr * sizeof *wt);
 	if (!pl || !wt) {
 		mem_free_all(pl, wt);
 		return false;
 	}
-	for (size_t i = 0; i < np * R_N; i++)
-		pl[i] = i < np ? 1e4f : 0.0f;
-	for (int y = 0; y < h; y++)
-		for (int x = 0; x < w; x++) {
-			size_t i = (size_t)y * w + x, o = (size_t)y * S + x + WIN;
-			const float *f = fb->feat + i * DENOISE_FEATURES;
-			float am[3];
-			for (int k = 0; k < 3; k++) {
-				pl[k * np + o] = f[k] * (1.0f / sqrtf(SIGMA_A2));
-				pl[(3 + k) * np + o] = f[3 + k] * (1.0f / sqrtf(SIGMA_N2));
-				am[k] = (float)albedo_divisor(f[k]);
-			}
-			pl[R_Z * np + o] = f[6];
-			pl[R_GX * np + o] = depth_slope(f + 6, x, w, DENOISE_FEATURES);
-			pl[R_GY * np + o] = depth_slope(f + 6, y, h, DENOISE_FEATURES * w);
-			pl[R_D * np + o] = f[14] / lum(am);
-		}
 	float *hs = pl + R_HS * np;
-	for (int y = 0; y < h; y++)
+	for (int y = 0; y < WIN && y < h; y++)
+		reach_row(fb, y, pl, np, S);
+	for (int y = 0; y < h; y++) {
+		/* row y - WIN - 1 has had all its sums (the last from centre y -
+		 * 1); row y + WIN takes its slot */
+		if (y - WIN - 1 >= 0)
+			reach_out(fb, y - WIN - 1, hs, S, reach);
+		if (y + WIN < h)
+			reach_row(fb, y + WIN, pl, np, S);
+		size_t orow = (size_t)(y % REACH_ROWS) * S;
 		for (int xb = 0; xb < wr; xb += 4) {
-			size_t o = (size_t)y * S + xb + WIN;
+			size_t o = orow + xb + WIN;
 			v4f g[6];
 			for (int k = 0; k < 6; k++)
 				g[k] = v4_load(pl + k * np + o);
@@ -1284,7 +1310,7 @@ bool denoise_reach(const framebuffer *fb, float *reach)
 					int qy = y + dy;
 					v4f u = zero;
 					if (qy >= 0 && qy < h) {
-						size_t q = (size_t)qy * S + xb + dx + WIN;
+						size_t q = (size_t)(qy % REACH_ROWS) * S + xb + dx + WIN;
 						v4f e = zero;
 						for (int k = 0; k < 6; k++) {
 							v4f d = g[k] - v4_load(pl + k * np + q);
@@ -1294,6 +1320,7 @@ bool denoise_reach(const framebuffer *fb, float *reach)
 						e += (v4f)((v4i)dz & 0x7fffffff) * inv_z;
 						v4f dd = (v4_load(pl + R_D * np + q) - gd) * dscale;
 						e += DIRECT_W * dd * dd;
+						/* the regression's weight, exp(-e) as (1 - e / 16)^16 */
 						u = one - e * (1.0f / 16);
 						u = (v4f)((v4i)u & ((u > zero) & in));
 						u *= u;
@@ -1313,13 +1340,13 @@ bool denoise_reach(const framebuffer *fb, float *reach)
 					if (qy < 0 || qy >= h)
 						continue;
 					v4f u = v4_load(wt + (size_t)t * wr + xb);
-					float *dst = hs + (size_t)qy * S + xb + dx + WIN;
+					float *dst = hs + (size_t)(qy % REACH_ROWS) * S + xb + dx + WIN;
 					v4_store(dst, v4_load(dst) + u * u * inv);
 				}
 		}
-	for (int y = 0; y < h; y++)
-		for (int x = 0; x < w; x++)
-			reach[(size_t)y * w + x] = hs[(size_t)y * S + x + WIN];
+	}
+	for (int y = h - WIN - 1 < 0 ? 0 : h - WIN - 1; y < h; y++)
+		reach_out(fb, y, hs, S, reach);
 	mem_free_all(pl, wt);
 	return true;
 }
