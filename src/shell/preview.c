@@ -191,6 +191,7 @@ static framebuffer *render_within(const world *wd, const render_settings *set, d
                                   rt_error *err)
 {
 	atomic_bool cancel;
+	atomic_init(&cancel, false);
 	alarm_clock a;
 	*stopped = false;
 	if (!alarm_start(&a, &cancel, s) && atomic_load(&cancel)) {
