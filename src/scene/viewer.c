@@ -162,6 +162,8 @@ static char *gltf_text(const char *path, const rt_load_opts *opts, size_t *len, 
 			return NULL;
 		}
 		bb = m->bounds;
+		if (m->warning) /* duplicate triangles dropped, say */
+			rt_warn(opts ? opts->warn : NULL, NULL, 0, 0, "%s", m->warning);
 		bool images = model_images_ok(path, m, err);
 		mesh_cache_put(m);
 		if (!images) {

@@ -189,6 +189,12 @@ static void test_preview_budget(void **state)
 	rt_error other = {0};
 	assert_null(image_decode_rgb("c.pgm", (const unsigned char *)"P5\n0 1\n255\n", 12, true, &w, &h, &other));
 	assert_false(image_budget_refused(&other));
+	/* an image over the size limit too: the budget's (a preview skips it) */
+	static const unsigned char png[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R',
+	                                    0, 0, 0x75, 0x30, 0, 0, 0x75, 0x30, 8, 2, 0, 0, 0, 0, 0, 0, 0};
+	assert_null(image_decode_rgb("huge.png", png, sizeof png, true, &w, &h, &err));
+	assert_true(image_budget_refused(&err));
+	assert_int_equal(image_budget_report(first, sizeof first), 2);
 	/* the sky is not held to it */
 	image_budget_exempt(true);
 	px = image_decode_rgb("b.pgm", b, len110, true, &w, &h, &err);

@@ -184,14 +184,17 @@ static uint64_t fold(uint64_t h)
 	return h ^ h >> 29;
 }
 
-/* A corner's hash, from its values (two corners of the same values, as
- * an STL's are, hash alike). */
+/* A corner's hash, from its position's values (two corners at the same
+ * place, as an STL's are, hash alike; uv and normals are compared, not
+ * hashed: a copy has them equal, and a triangle seldom differs from
+ * another in them alone). */
 static uint64_t corner_hash(const corners *k, const int32_t *c)
 {
-	static const float zero[3] = {0, 0, 0};
-	const float *p = k->b->v[c[0]], *t = k->uv ? k->b->vt[c[1]] : zero, *n = k->n ? k->b->vn[c[2]] : zero;
-	return fold(bits2(p, p + 1) * 0x9E3779B97F4A7C15ull + bits2(p + 2, t) * 0xC2B2AE3D27D4EB4Full +
-	            bits2(t + 1, n) * 0x165667B19E3779F9ull + bits2(n + 1, n + 2) * 0xD6E8FEB86659FD93ull);
+	const float *p = k->b->v[c[0]];
+	uint32_t z;
+	memcpy(&z, p + 2, 4);
+	uint64_t h = bits2(p, p + 1) * 0x9E3779B97F4A7C15ull + (uint64_t)z * 0xC2B2AE3D27D4EB4Full;
+	return h ^ h >> 32;
 }
 
 /* A triangle's hash: the sum over its three directed edges of a hash of

@@ -133,11 +133,13 @@ static bool size_ok(const char *path, long w, long h, rt_error *err)
 {
 	if (w <= 0 || h <= 0)
 		return rt_error_set(err, "%s: the image is %ldx%ld pixels; expected a size of at least 1x1", path, w, h);
+	/* the previewer's budget first: an image too large for any use is
+	 * skipped by a preview as one over the budget */
+	if (budget && !budget_off && (double)w * (double)h > (double)budget)
+		return over_budget(path, w, h, err);
 	if ((size_t)w * (size_t)h > IMAGE_MAX_PIXELS || w > 1 << 20 || h > 1 << 20)
 		return rt_error_set(err, "%s: image too large: %ldx%ld pixels; expected at most 268435456 (2^28, "
 		                    "16384x16384) pixels and 1048576 a side", path, w, h);
-	if (budget && !budget_off && (size_t)w * (size_t)h > budget)
-		return over_budget(path, w, h, err);
 	/* the decoder's pixels (floats for HDR), ours, and the mip chain's
 	 * third more (texture.c) */
 	char what[300];
