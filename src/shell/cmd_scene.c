@@ -218,7 +218,7 @@ static void list_items(shell *sh, const scene *s, int which)
 			mesh *m = o->kind == OBJ_MESH && o->file ? mesh_cache_get(o->file, o->smooth != 0, o->crease, NULL, NULL)
 			                                         : NULL;
 			if (m)
-				snprintf(note, sizeof note, "  # %u triangles", m->ntris);
+				snprintf(note, sizeof note, "  # %u triangle%s", m->ntris, m->ntris == 1 ? "" : "s");
 			mesh_cache_put(m);
 		}
 		shell_out(sh, "%s %zu%s: %s%s\n", name[which], i + 1, which == 0 && i == s->cam ? " (active)" : "", line,
