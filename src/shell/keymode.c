@@ -506,10 +506,8 @@ static void km_home(keymode *km)
 	km->model = label && mesh_format_known(label);
 	km->home = scene_camera(editor_scene(km->sh->ed));
 	/* The help bar says what the arrows do here. */
-	size_t n = keymode_help_bar(km->bar, sizeof km->bar / sizeof km->bar[0]);
-	for (size_t i = 0; km->model && i < n; i++)
-		if (strcmp(km->bar[i].what, "move") == 0)
-			km->bar[i] = (keyview_item){"←↑↓→", "orbit  wasd move  f frame"};
+	size_t n = km->model ? keymode_help_bar_model(km->bar, sizeof km->bar / sizeof km->bar[0])
+	                     : keymode_help_bar(km->bar, sizeof km->bar / sizeof km->bar[0]);
 	km->kv.bar = km->bar;
 	km->kv.nbar = n;
 	keyview_repaint(&km->kv);

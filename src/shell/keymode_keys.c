@@ -73,7 +73,7 @@ const char *keymode_help_text(void)
 		return text;
 	abuf a;
 	abuf_init(&a);
-	abuf_str(&a, "keys in view (key mode; letters in either case but u and U):\n");
+	abuf_str(&a, "keys in view (key mode; letters in either case but u and U, and f and F in the model viewer):\n");
 	for (size_t i = 0; i < keymode_nkeys; i++) {
 		const km_keyrow *r = &keymode_keys[i];
 		abuf_printf(&a, "  %-*s", HELP_COLUMN - 2, r->names);
@@ -112,6 +112,17 @@ size_t keymode_help_bar(keyview_item *items, size_t max)
 		if (!found && !more)
 			break;
 	}
+	return n;
+}
+
+size_t keymode_help_bar_model(keyview_item *items, size_t max)
+{
+	size_t n = keymode_help_bar(items, max);
+	for (size_t i = 0; i < n; i++)
+		if (strcmp(items[i].what, "move") == 0)
+			items[i] = (keyview_item){"←↑↓→", "orbit  wasd move  f frame"};
+		else if (strcmp(items[i].what, "up/down") == 0) /* f frames here: F is down */
+			items[i] = (keyview_item){"r F", "up/down"};
 	return n;
 }
 
