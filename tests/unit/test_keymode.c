@@ -262,6 +262,28 @@ static void test_apply(void **state)
 	a = keymode_map('+', editor_scene(ed), camera_sel, 0.5);
 	assert_true(keymode_apply(ed, &a, &err));
 	assert_near(scene_camera(editor_scene(ed)).fov, 65, 1e-12);
+	/* An orthographic camera has no field of view (the fov would change and
+	 * the picture not): + shows a height 1.1 times smaller, - 1.1 larger,
+	 * and its fov stays as written. */
+	{
+		editor *oe = editor_new(load("A 0.3 255,255,255\nC 0,0,-10 0,0,1 70 ortho=2\nsp 0,0,0 1 255,0,0\n"), "o.rt");
+		assert_non_null(oe);
+		km_action z = keymode_map('+', editor_scene(oe), camera_sel, 0.5);
+		assert_true(keymode_apply(oe, &z, &err));
+		assert_near(scene_camera(editor_scene(oe)).ortho, 2 / 1.1, 1e-12);
+		assert_near(scene_camera(editor_scene(oe)).fov, 70, 0);
+		z = keymode_map('-', editor_scene(oe), camera_sel, 0.5);
+		assert_true(keymode_apply(oe, &z, &err));
+		z = keymode_map('-', editor_scene(oe), camera_sel, 0.5);
+		assert_true(keymode_apply(oe, &z, &err));
+		assert_near(scene_camera(editor_scene(oe)).ortho, 2 * 1.1, 1e-12);
+		assert_near(scene_camera(editor_scene(oe)).fov, 70, 0);
+		/* the shell's camera fov is refused there, and says why */
+		assert_false(editor_camera_fov(oe, 30, &err));
+		assert_non_null(strstr(err.msg, "orthographic"));
+		assert_near(scene_camera(editor_scene(oe)).fov, 70, 0);
+		editor_free(oe);
+	}
 	/* ] turns the cube's front to the right: -15 degrees about Y, a twist
 	 * for an upright cube. */
 	a = keymode_map(']', editor_scene(ed), cube, 0.5);
