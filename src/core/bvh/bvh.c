@@ -52,6 +52,7 @@
 #define SPATIAL_ALPHA 1e-2
 
 typedef bvh_fbox fbox;
+_Static_assert(sizeof(fbox) == 32, "bin_refs finds a bin by its byte offset: 32 x its index");
 typedef bvh2_node node2;
 
 typedef struct builder {
@@ -312,10 +313,12 @@ static void bin_refs(const fbox *refs, size_t n, size_t step, const binning *bn,
 		__m128 lo = _mm_loadu_ps(refs->lo), hi = _mm_loadu_ps(refs->hi);
 		__m128 cost = _mm_or_ps(_mm_and_ps(lo, lane3), negz); /* (-0, -0, -0, cost) */
 		__m128 v = _mm_mul_ps(_mm_sub_ps(_mm_add_ps(lo, hi), blo), bsc);
-		__m128i k = _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(v, zero), top));
-		int k0 = _mm_cvtsi128_si32(k), k1 = _mm_cvtsi128_si32(_mm_shuffle_epi32(k, 1)),
-		    k2 = _mm_cvtsi128_si32(_mm_shuffle_epi32(k, 2));
-		fbox *x = &bbox[0][k0], *y = &bbox[1][k1], *z = &bbox[2][k2];
+		/* the bins' byte offsets: the indices times sizeof (fbox), 32 */
+		__m128i k = _mm_slli_epi32(_mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(v, zero), top)), 5);
+		size_t k0 = (uint32_t)_mm_cvtsi128_si32(k), k1 = (uint32_t)_mm_cvtsi128_si32(_mm_shuffle_epi32(k, 1)),
+		       k2 = (uint32_t)_mm_cvtsi128_si32(_mm_shuffle_epi32(k, 2));
+		fbox *x = (fbox *)((char *)bbox[0] + k0), *y = (fbox *)((char *)bbox[1] + k1),
+		     *z = (fbox *)((char *)bbox[2] + k2);
 		_mm_storeu_ps(x->lo, _mm_min_ps(_mm_loadu_ps(x->lo), lo));
 		_mm_storeu_ps(x->hi, _mm_add_ps(_mm_max_ps(_mm_loadu_ps(x->hi), hi), cost));
 		_mm_storeu_ps(y->lo, _mm_min_ps(_mm_loadu_ps(y->lo), lo));
