@@ -352,7 +352,7 @@ static inline double sweep_cost(unsigned block, double sum)
  * cheapest split into *best (axis and bin; best->cost is the cost to beat). */
 static inline void sweep_bins(fbox bbox[3][BINS], const binning *bn, unsigned block, split *best)
 {
-	int nbins = bn->nbins;
+	size_t nbins = (size_t)bn->nbins;
 	for (int a = 0; a < 3; a++) {
 		if (!bn->usable[a])
 			continue;
@@ -363,7 +363,7 @@ static inline void sweep_bins(fbox bbox[3][BINS], const binning *bn, unsigned bl
 		 * sums and boxes are the ones sweeps over every bin make. A whole
 		 * node's centroid bounds put references in its first and last
 		 * bins: the loops below usually stop at once. */
-		int first = 0, last = nbins - 1;
+		size_t first = 0, last = nbins - 1;
 		while (first < last && bbox[a][first].hi[3] == 0.0f)
 			first++;
 		while (last > first && bbox[a][last].hi[3] == 0.0f)
@@ -372,7 +372,7 @@ static inline void sweep_bins(fbox bbox[3][BINS], const binning *bn, unsigned bl
 		double right_area[BINS], right_cost[BINS];
 		fbox acc = fbox_empty();
 		double sum = 0.0;
-		for (int k = last; k > first; k--) {
+		for (size_t k = last; k > first; k--) {
 			fbox_union(&acc, &bbox[a][k]);
 			sum += bbox[a][k].hi[3];
 			right_area[k] = fbox_half_area(&acc);
@@ -380,7 +380,7 @@ static inline void sweep_bins(fbox bbox[3][BINS], const binning *bn, unsigned bl
 		}
 		acc = fbox_empty();
 		sum = 0.0;
-		for (int k = first; k < last; k++) {
+		for (size_t k = first; k < last; k++) {
 			fbox_union(&acc, &bbox[a][k]);
 			sum += bbox[a][k].hi[3];
 			/* the left term is >= 0: a right term that alone reaches
@@ -392,7 +392,7 @@ static inline void sweep_bins(fbox bbox[3][BINS], const binning *bn, unsigned bl
 			if (cost < best->cost) {
 				best->cost = cost;
 				best->axis = a;
-				best->at = k + 1;
+				best->at = (int)k + 1;
 			}
 		}
 	}
