@@ -149,7 +149,10 @@ void answer_camera_fields(shell *sh, size_t i)
 	shell_out(sh, "camera %zu%s: %s\n", i + 1, i == s->cam ? " (active)" : "", line);
 	field_vec(sh, "position", c->pos);
 	field_vec(sh, "direction", c->dir);
-	field_num(sh, "fov", c->fov);
+	if (c->ortho > 0)
+		field_num(sh, "ortho", c->ortho); /* the half height; its fov is unused */
+	else
+		field_num(sh, c->vertical ? "vertical fov" : "fov", c->fov);
 	if (s->ncams > 1)
 		shell_out(sh, "  (%zu cameras: camera N makes camera N active, list cameras shows them)\n",
 		          s->ncams);
