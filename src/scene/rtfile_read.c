@@ -1367,8 +1367,8 @@ static bool parse_tokens(parser *p)
 		            p->strict ? " (strict mode)" : "");
 	}
 	p->np = p->ntoks - 1;
-	for (size_t i = 1; i < p->ntoks; i++)
-		if (memchr(p->toks[i].s, '=', p->toks[i].len)) {
+	for (size_t i = 1; i < p->ntoks; i++) /* a quoted file name with '=' in it is no key */
+		if (!p->toks[i].quoted && memchr(p->toks[i].s, '=', p->toks[i].len)) {
 			p->np = i - 1;
 			break;
 		}
