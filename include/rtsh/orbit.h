@@ -30,11 +30,14 @@ vec3 orbit_scene_centre(const scene *s);
 camera orbit_camera(camera c, vec3 pivot, double yaw_deg, double pitch_deg);
 /* c moved along the line to pivot by factor of its distance (0.1: a tenth
  * nearer; -0.1: a tenth farther); never nearer than a thousandth of the
- * distance. Its direction stays. */
+ * distance. Its direction stays. An orthographic camera stays where it is
+ * and its half height is multiplied by 1 - factor instead. */
 camera orbit_dolly(camera c, vec3 pivot, double factor);
 /* c keeping its direction, moved so that box b fills an image of aspect
  * (width / height): b's bounding sphere within the narrower field of view,
- * (the sphere around the box is margin enough). An empty box leaves c as it is. */
+ * (the sphere around the box is margin enough). An empty box leaves c as it is.
+ * A vertical=1 camera's fov is the height's; an orthographic camera gets the
+ * half height that holds the sphere, from two radii in front of it. */
 camera orbit_frame(camera c, box b, double aspect);
 /* The frame'th of frames views of a full turn of c about pivot (frame 0 is
  * c itself; frame k is turned by 360 k / frames degrees). */

@@ -73,8 +73,15 @@ camera orbit_dolly(camera c, vec3 pivot, double factor)
 {
 	if (!isfinite(factor))
 		return c;
-	vec3 off = v3_sub(c.pos, pivot);
 	double keep = clampd(1.0 - factor, 0.001, 1000.0);
+	if (c.ortho > 0) {
+		/* an orthographic view does not grow nearer: it shows less */
+		double h = c.ortho * keep;
+		if (h >= 1e-9 && h <= 1e9)
+			c.ortho = h;
+		return c;
+	}
+	vec3 off = v3_sub(c.pos, pivot);
 	c.pos = v3_add(pivot, v3_scale(off, keep));
 	return c;
 }
@@ -87,13 +94,21 @@ camera orbit_frame(camera c, box b, double aspect)
 	double radius = 0.5 * v3_len(v3_sub(b.hi, b.lo));
 	if (!(radius > 0))
 		radius = 0.5;
-	double th = tan(deg_to_rad(c.fov) * 0.5); /* horizontal half angle */
-	double tv = th / aspect;
+	vec3 d = v3_norm(c.dir);
+	c.dir = d;
+	if (c.ortho > 0) {
+		/* the sphere within the rectangle, h high and h x aspect wide
+		 * either side, from in front of it */
+		c.ortho = radius / fmin(1.0, aspect);
+		c.pos = v3_sub(centre, v3_scale(d, 2 * radius));
+		return c;
+	}
+	/* the half angles' tangents; vertical=1 (glTF's yfov) gives the height's */
+	double t = tan(deg_to_rad(c.fov) * 0.5);
+	double th = c.vertical ? t * aspect : t, tv = c.vertical ? t : t / aspect;
 	double half = atan(fmin(th, tv));
 	double dist = radius / sin(half);
-	vec3 d = v3_norm(c.dir);
 	c.pos = v3_sub(centre, v3_scale(d, dist));
-	c.dir = d;
 	return c;
 }
 

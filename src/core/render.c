@@ -595,6 +595,13 @@ render_status render_run(render_job *job, rt_error *err)
 	pthread_cond_init(&sh.finished, NULL);
 	pthread_cond_init(&sh.slot_free, NULL);
 
+	/* At once, not after this thread's first tile: a tile of many samples
+	 * takes seconds, and the shell's status line says "rendering ...
+	 * (Ctrl-C stops)" from this report on. Before the workers start, so
+	 * that it says 0 done: a worker's first tile could otherwise end
+	 * before this thread got here. */
+	if (job->progress)
+		report(job, &sh);
 	pthread_t *tid = n > 1 ? calloc((size_t)(n - 1), sizeof *tid) : NULL;
 	int started = 0;
 	if (tid)
@@ -612,11 +619,6 @@ render_status render_run(render_job *job, rt_error *err)
 	 * 100 ms. */
 	double last = now_seconds();
 	tile_cancel = job->cancel;
-	/* At once, not after this thread's first tile: a tile of many samples
-	 * takes seconds, and the shell's status line says "rendering ...
-	 * (Ctrl-C stops)" from this report on. */
-	if (job->progress)
-		report(job, &sh);
 	for (;;) {
 		if ((job->cancel && atomic_load(job->cancel)) || atomic_load(&sh.stop))
 			break;

@@ -848,6 +848,10 @@ bool editor_camera_fov(editor *ed, double deg, rt_error *err)
 {
 	camera c;
 	size_t i = active_camera(ed, &c);
+	if (c.ortho > 0) /* its fov is unused: a change would not show */
+		return rt_error_set(err, "camera %zu is orthographic (ortho=%g, its half height): it has no field of view; "
+		                         "expected a perspective camera (key mode's - and + zoom it)",
+		                    i + 1, c.ortho);
 	bool clamped; /* 0 and 180 as in files: clamped to the renderable ends */
 	if (!fov_rule(&deg, &clamped, err))
 		return false;

@@ -1233,7 +1233,15 @@ static bool parse_mesh(parser *p, const elem_def *e)
 	 * model viewer's own scene (named after the model) says it itself */
 	if (m->warning && strcmp(p->name, o.file) != 0)
 		rt_warn(p->warn, p->name, p->line, t[1].col, "mesh file \"%s\": %s", quoted(p, &t[1]), m->warning);
+	/* its own images too: a missing one failed every render after the
+	 * load (the shell's load and add took the scene without a word) */
+	bool images = rt_model_images_ok(o.file, m, &merr);
 	mesh_cache_put(m);
+	if (!images) {
+		char msg[RT_ERROR_MSG_MAX];
+		rt_error_format(&merr, msg, sizeof msg);
+		return fail(p, t[1].col, "mesh file \"%s\": %s", quoted(p, &t[1]), msg);
+	}
 	return add_object(p, e, &o, NULL);
 }
 
@@ -1359,8 +1367,8 @@ static bool parse_tokens(parser *p)
 		            p->strict ? " (strict mode)" : "");
 	}
 	p->np = p->ntoks - 1;
-	for (size_t i = 1; i < p->ntoks; i++)
-		if (memchr(p->toks[i].s, '=', p->toks[i].len)) {
+	for (size_t i = 1; i < p->ntoks; i++) /* a quoted file name with '=' in it is no key */
+		if (!p->toks[i].quoted && memchr(p->toks[i].s, '=', p->toks[i].len)) {
 			p->np = i - 1;
 			break;
 		}

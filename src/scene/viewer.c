@@ -32,6 +32,7 @@
 #include "rtsh/rtfile.h"
 #include "rtsh/texture.h"
 #include "rtsh/world.h"
+#include "scene/rtfile_priv.h"
 
 /* --- glTF 2.0 scenes --- */
 
@@ -112,7 +113,7 @@ static bool node_bounds(const char *path, const gltf_info *gi, const rt_load_opt
  * looked up (stat), not decoded: a scene of a hundred images is not read
  * twice; a corrupt one is the render's error, in the same words
  * (surface.c). */
-static bool model_images_ok(const char *path, const mesh *m, rt_error *err)
+bool rt_model_images_ok(const char *path, const mesh *m, rt_error *err)
 {
 	for (uint32_t k = 0; k < m->nmats; k++) {
 		const mesh_mat *mm = &m->mats[k];
@@ -164,7 +165,7 @@ static char *gltf_text(const char *path, const rt_load_opts *opts, size_t *len, 
 		bb = m->bounds;
 		if (m->warning) /* duplicate triangles dropped, say */
 			rt_warn(opts ? opts->warn : NULL, NULL, 0, 0, "%s", m->warning);
-		bool images = model_images_ok(path, m, err);
+		bool images = rt_model_images_ok(path, m, err);
 		mesh_cache_put(m);
 		if (!images) {
 			free(nb);
@@ -174,7 +175,7 @@ static char *gltf_text(const char *path, const rt_load_opts *opts, size_t *len, 
 	} else {
 		/* a node's mesh holds all the file's materials */
 		mesh *m = mesh_cache_get_node(path, gi.mesh_nodes[0], true, 60, opts ? opts->cancel : NULL, err);
-		bool images = m && model_images_ok(path, m, err);
+		bool images = m && rt_model_images_ok(path, m, err);
 		mesh_cache_put(m);
 		if (!images) {
 			free(nb);
@@ -382,7 +383,7 @@ static char *model_text(const char *path, const rt_load_opts *opts, size_t *len,
 		return NULL;
 	if (m->warning) /* a missing material library, say */
 		rt_warn(opts ? opts->warn : NULL, NULL, 0, 0, "%s", m->warning);
-	if (!model_images_ok(path, m, err)) {
+	if (!rt_model_images_ok(path, m, err)) {
 		mesh_cache_put(m);
 		return NULL;
 	}

@@ -59,21 +59,6 @@ static const struct {
 };
 #define NFIXED (sizeof fixed / sizeof fixed[0])
 
-/* Keeps a plain option's value (fixed[].field); false when c is not one. */
-static bool keep_plain(int c, rtsh_options *o)
-{
-	for (size_t i = 0; i < NFIXED; i++)
-		if (fixed[i].opt.val == c && fixed[i].field) {
-			char *at = (char *)o + fixed[i].field;
-			if (fixed[i].opt.has_arg == required_argument)
-				*(const char **)(void *)at = optarg;
-			else
-				*(bool *)(void *)at = true;
-			return true;
-		}
-	return false;
-}
-
 static int usage_error(const char *prog, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 static int usage_error(const char *prog, const char *fmt, ...)
 {
@@ -84,6 +69,28 @@ static int usage_error(const char *prog, const char *fmt, ...)
 	va_end(ap);
 	fprintf(stderr, "\nTry '%s --help' for more information.\n", prog);
 	return 2;
+}
+
+/* Keeps a plain option's value (fixed[].field): 0 when kept, -1 when c is
+ * not one, 2 (a usage error, said) when an option with a value comes twice:
+ * the first value would be lost without a word (-c A -c B ran only B). */
+static int keep_plain(int c, const char *prog, rtsh_options *o)
+{
+	for (size_t i = 0; i < NFIXED; i++)
+		if (fixed[i].opt.val == c && fixed[i].field) {
+			char *at = (char *)o + fixed[i].field;
+			if (fixed[i].opt.has_arg == required_argument) {
+				const char **v = (const char **)(void *)at;
+				if (*v)
+					return usage_error(prog, "option -%c (--%s) given twice (\"%s\" and \"%s\"); expected it once%s",
+					                   c, fixed[i].opt.name, *v, optarg, c == 'c' ? " (join commands with ;: -c 'CMD; CMD')" : "");
+				*v = optarg;
+			} else {
+				*(bool *)(void *)at = true;
+			}
+			return 0;
+		}
+	return -1;
 }
 
 static char short_of(const char *setting)
@@ -253,8 +260,13 @@ int args_parse(int argc, char **argv, args_kind kind, const char *prog, rtsh_opt
 	while (rc < 0 && (c = getopt_long(argc, argv, shorts, longs, NULL)) != -1) {
 		char name[64];
 		const setting_def *def = NULL;
-		if (keep_plain(c, o))
+		int kept = keep_plain(c, prog, o);
+		if (kept == 0)
 			continue;
+		if (kept > 0) {
+			rc = kept;
+			break;
+		}
 		switch (c) {
 		case 1: /* an operand: the scene */
 			if (o->scene)

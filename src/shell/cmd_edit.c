@@ -207,7 +207,8 @@ bool cmd_object(shell *sh, int argc, char **argv, const char *rest)
 {
 	(void)rest;
 	static const char *const names[] = {"move", "rotate", "scale", "color", "set"};
-	static const item_cmd c = {"object", "objects", "an object command", "object N move|rotate|scale|color VALUE",
+	static const item_cmd c = {"object", "objects", "an object command",
+	                           "object N move|rotate|scale|color VALUE | object N set KEY=VALUE",
 	                           SUBS_OBJECT, names, answer_object_fields};
 	size_t i;
 	char what[32];

@@ -82,6 +82,13 @@ bool cmd_save(shell *sh, int argc, char **argv, const char *rest)
 		} else {
 			sh->saved_gen = editor_generation(sh->ed);
 			shell_info(sh, "saved the scene to %s\n", path);
+			/* The file says which cameras, not which one is active. */
+			const scene *s = editor_scene(sh->ed);
+			if (s->cam > 0 && s->cam < s->ncams)
+				shell_note(sh,
+				           "save: %s opens with camera 1, not camera %zu, the active one (a .rt file opens "
+				           "with its first camera) (warning)\n",
+				           path, s->cam + 1);
 		}
 	} else if (has_ext(path, ".ans")) {
 		frame *f = shell_picture_frame(sh, PALETTE_TRUECOLOR, picture_columns());
@@ -218,7 +225,7 @@ static void list_items(shell *sh, const scene *s, int which)
 			mesh *m = o->kind == OBJ_MESH && o->file ? mesh_cache_get(o->file, o->smooth != 0, o->crease, NULL, NULL)
 			                                         : NULL;
 			if (m)
-				snprintf(note, sizeof note, "  # %u triangles", m->ntris);
+				snprintf(note, sizeof note, "  # %u triangle%s", m->ntris, m->ntris == 1 ? "" : "s");
 			mesh_cache_put(m);
 		}
 		shell_out(sh, "%s %zu%s: %s%s\n", name[which], i + 1, which == 0 && i == s->cam ? " (active)" : "", line,

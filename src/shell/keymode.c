@@ -506,10 +506,8 @@ static void km_home(keymode *km)
 	km->model = label && mesh_format_known(label);
 	km->home = scene_camera(editor_scene(km->sh->ed));
 	/* The help bar says what the arrows do here. */
-	size_t n = keymode_help_bar(km->bar, sizeof km->bar / sizeof km->bar[0]);
-	for (size_t i = 0; km->model && i < n; i++)
-		if (strcmp(km->bar[i].what, "move") == 0)
-			km->bar[i] = (keyview_item){"←↑↓→", "orbit  wasd move  f frame"};
+	size_t n = km->model ? keymode_help_bar_model(km->bar, sizeof km->bar / sizeof km->bar[0])
+	                     : keymode_help_bar(km->bar, sizeof km->bar / sizeof km->bar[0]);
 	km->kv.bar = km->bar;
 	km->kv.nbar = n;
 	keyview_repaint(&km->kv);
@@ -1108,15 +1106,16 @@ bool keymode_turntable(shell *sh, double seconds)
 {
 	screen *scr = sh->scr;
 	evloop *ev = sh->ev;
+	const char *cmd = seconds > 0 ? "turntable" : "view"; /* the command's name for its errors */
 	if (!sh->interactive || !scr || !scr->active || !scr->out || !ev || evloop_out(ev) != scr->out ||
 	    !isatty(evloop_in_fd(ev)))
-		return shell_fail(sh, "view: key mode needs the full-screen shell on a terminal");
+		return shell_fail(sh, "%s: key mode needs the full-screen shell on a terminal", cmd);
 	int in = evloop_in_fd(ev), fd = scr->fd;
 	termout *out = scr->out;
 	fflush(stdout);
 	struct termios saved;
 	if (tcgetattr(in, &saved) != 0)
-		return shell_fail(sh, "view: cannot read the terminal's modes: %s", strerror(errno));
+		return shell_fail(sh, "%s: cannot read the terminal's modes: %s", cmd, strerror(errno));
 	/* The answers the terminal owes the output scheduler come in before
 	 * key mode starts (keys typed meanwhile are dropped). */
 	evloop_settle(ev, 5.0);
@@ -1130,7 +1129,7 @@ bool keymode_turntable(shell *sh, double seconds)
 	keys *k = keys_open_fed(25);
 	if (!k) {
 		abuf_free(&pend);
-		return shell_fail(sh, "view: ncurses cannot read the keys of this terminal (TERM=%s)",
+		return shell_fail(sh, "%s: ncurses cannot read the keys of this terminal (TERM=%s)", cmd,
 		                  getenv("TERM") ? getenv("TERM") : "");
 	}
 	/* kitty images float over text: none may stay under key mode's. */

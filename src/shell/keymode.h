@@ -131,6 +131,8 @@ extern const size_t keymode_nkeys;
 const char *keymode_help_text(void);
 /* The help bar's items in their order (at most max); returns how many. */
 size_t keymode_help_bar(keyview_item *items, size_t max);
+/* The model viewer's help bar: the arrows orbit, f frames, F moves down. */
+size_t keymode_help_bar_model(keyview_item *items, size_t max);
 
 typedef struct km_action {
 	km_op op;

@@ -40,7 +40,7 @@ const km_keyrow keymode_keys[] = {
 	{"{ }", "roll it about the line of sight by 15 degrees", NULL, NULL, 0,
 	 {{'{', KM_ROTATE, 2}, {'}', KM_ROTATE, -2}}},
 	{"- +", "shrink / grow it (x1.1); a light: dimmer / brighter;\n"
-	        "the camera: zoom out / in (field of view)",
+	        "the camera: zoom out / in (field of view; orthographic: height)",
 	 "- +", "size", 7,
 	 {{'-', KM_SCALE, -1}, {'_', KM_SCALE, -1}, {'+', KM_SCALE, 1}, {'=', KM_SCALE, 1}}},
 	{", .", "halve / double the samples per pixel", ", .", "spp", 10,
@@ -73,7 +73,7 @@ const char *keymode_help_text(void)
 		return text;
 	abuf a;
 	abuf_init(&a);
-	abuf_str(&a, "keys in view (key mode; letters in either case but u and U):\n");
+	abuf_str(&a, "keys in view (key mode; letters in either case but u and U, and f and F in the model viewer):\n");
 	for (size_t i = 0; i < keymode_nkeys; i++) {
 		const km_keyrow *r = &keymode_keys[i];
 		abuf_printf(&a, "  %-*s", HELP_COLUMN - 2, r->names);
@@ -112,6 +112,17 @@ size_t keymode_help_bar(keyview_item *items, size_t max)
 		if (!found && !more)
 			break;
 	}
+	return n;
+}
+
+size_t keymode_help_bar_model(keyview_item *items, size_t max)
+{
+	size_t n = keymode_help_bar(items, max);
+	for (size_t i = 0; i < n; i++)
+		if (strcmp(items[i].what, "move") == 0)
+			items[i] = (keyview_item){"←↑↓→", "orbit  wasd move  f frame"};
+		else if (strcmp(items[i].what, "up/down") == 0) /* f frames here: F is down */
+			items[i] = (keyview_item){"r F", "up/down"};
 	return n;
 }
 
@@ -325,6 +336,14 @@ bool keymode_apply(editor *ed, const km_action *a, rt_error *err)
 			double r = s->lights[i].ratio + (a->a > 1 ? KEYMODE_BRIGHTNESS : -KEYMODE_BRIGHTNESS);
 			r = clampd(round(r * 1000.0) / 1000.0, 0.0, 1.0);
 			return r == s->lights[i].ratio ? true : editor_light_brightness(ed, i, r, err);
+		} else if (scene_camera(s).ortho > 0) {
+			/* an orthographic camera: its height, by the objects' factor */
+			camera c = scene_camera(s);
+			double h = c.ortho / a->a; /* + (1.1) shows less: zooms in */
+			if (!(h >= 1e-6 && h <= 1e6))
+				return true;
+			c.ortho = h;
+			return editor_set_camera(ed, s->cam, &c, err);
 		} else {
 			double fov = scene_camera(s).fov + (a->a > 1 ? -KEYMODE_FOV_DEG : KEYMODE_FOV_DEG);
 			fov = clampd(fov, 5.0, 170.0);

@@ -191,6 +191,7 @@ static framebuffer *render_within(const world *wd, const render_settings *set, d
                                   rt_error *err)
 {
 	atomic_bool cancel;
+	atomic_init(&cancel, false);
 	alarm_clock a;
 	*stopped = false;
 	if (!alarm_start(&a, &cancel, s) && atomic_load(&cancel)) {
@@ -251,6 +252,21 @@ framebuffer *preview_render(const world *wd, const render_settings *set, double 
 	fb_free(small);
 	*coarse = true;
 	return fb;
+}
+
+void preview_camera(camera *c, bool model, box bounds, int w, int h)
+{
+	double aspect = (double)w / h;
+	if (model) {
+		*c = orbit_frame(*c, bounds, aspect);
+	} else if (!c->vertical && !(c->ortho > 0)) {
+		/* a vertical fov keeps the height already, and an orthographic
+		 * camera has none: widening it zoomed a glTF's camera out */
+		double th = tan(deg_to_rad(c->fov) * 0.5);
+		double need = th * 9.0 / 16.0 * aspect;
+		if (need > th)
+			c->fov = fmin(2.0 * rad_to_deg(atan(need)), 150.0);
+	}
 }
 
 int preview_main(const rtsh_options *o)
@@ -328,19 +344,8 @@ int preview_main(const rtsh_options *o)
 		w = cols * cw;
 		h = rows * ch;
 	}
-	/* A model fills the pane (the viewer frames it for 16:9); a scene
-	 * keeps its view, at least as high as in a 16:9 picture: a wide pane
-	 * widens the field of view rather than cutting the top off. */
-	if (s->ncams > 0 && mesh_format_known(file)) {
-		camera *c = &s->cams[s->cam];
-		*c = orbit_frame(*c, orbit_scene_bounds(s), (double)w / h);
-	} else if (s->ncams > 0) {
-		camera *c = &s->cams[s->cam];
-		double th = tan(deg_to_rad(c->fov) * 0.5), aspect = (double)w / h;
-		double need = th * 9.0 / 16.0 * aspect;
-		if (need > th)
-			c->fov = fmin(2.0 * rad_to_deg(atan(need)), 150.0);
-	}
+	if (s->ncams > 0)
+		preview_camera(&s->cams[s->cam], mesh_format_known(file), orbit_scene_bounds(s), w, h);
 	set.width = w;
 	set.height = h;
 	world *wd = world_build(s, &err);

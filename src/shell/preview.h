@@ -47,6 +47,12 @@
  * between blocks of 4 x 4 pixels (render.c's polls). */
 framebuffer *preview_render(const world *wd, const render_settings *set, double full_s, double coarse_s, bool *coarse,
                             rt_error *err);
+/* The preview's camera on a w x h picture: a model (model true) framed to
+ * fill it (orbit_frame of the objects' bounds); a scene's kept, at least as
+ * high as in a 16:9 picture: a wide pane widens the horizontal field of view
+ * rather than cutting the top off (a vertical=1 fov keeps the height
+ * already; an orthographic camera is left as it is). */
+void preview_camera(camera *c, bool model, box bounds, int w, int h);
 /* Runs the preview of o->scene at o->preview_cols x o->preview_rows;
  * returns the exit status (0, or 1 after a message on standard error). */
 int preview_main(const rtsh_options *o);

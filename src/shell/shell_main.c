@@ -21,6 +21,16 @@ int shell_main(const rtsh_options *o)
 	bool script = o->commands || o->file || !tty_in;
 	bool then_interactive = !script || (o->interactive && tty_in);
 	bool screen_ok = then_interactive && caps_screen_ok(STDOUT_FILENO);
+	/* --turntable without -o turns the scene in the full screen: with no
+	 * terminal to show it, it was dropped without a word (status 0). */
+	if (o->turntable && !screen_ok) {
+		fprintf(stderr,
+		        "rtsh: --turntable turns the scene on the terminal's full screen, and %s; expected the "
+		        "interactive shell on a terminal, or --turntable FRAMES -o OUT for files\n",
+		        !then_interactive ? (tty_in ? "-c or -f without -i never opens it" : "standard input is not a terminal")
+		                          : "standard output is not a terminal that shows pictures");
+		return 2;
+	}
 	int wake[2] = {-1, -1};
 	if (then_interactive) {
 		if (pipe(wake) != 0) {

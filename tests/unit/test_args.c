@@ -127,6 +127,10 @@ static void test_usage_errors(void **state)
 		"a.rt -o x.png -c list",
 		"-i",              /* -i without -c or -f */
 		"-c list -f x",
+		"-c list -c help",  /* the first -c was dropped without a word */
+		"-f a -f b",
+		"a.rt -o x.png -o y.png",
+		"a.rt --output=x.png -o y.png",
 	};
 	for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
 		if (parse(ARGS_RTSH, bad[i], &o) != 2)
@@ -139,6 +143,7 @@ static void test_usage_errors(void **state)
 	assert_int_equal(parse(ARGS_BATCH, "a.rt -o x.png -c list", &o), 2);
 	assert_int_equal(parse(ARGS_BATCH, "a.rt", &o), 2);
 	assert_int_equal(parse(ARGS_BATCH, "-o x.png", &o), 2);
+	assert_int_equal(parse(ARGS_BATCH, "a.rt -o x.png -o y.png", &o), 2);
 }
 
 int main(void)

@@ -5,6 +5,7 @@
  * world_occluded_brute. Also: an edit followed by world_build sees the new
  * geometry, and the degenerate trees (no object, one object, every centroid
  * in one point, huge coordinates, rays in the planes of the boxes). */
+#include <float.h>
 #include "testutil.h"
 
 #include "core/bvh/bvh.h"
@@ -392,7 +393,30 @@ static void test_half_area(void **state)
 		e.lo[a] = INFINITY; /* the empty box's corner */
 		e.hi[a] = -INFINITY;
 		assert_true(bvh_fbox_half_area(&e) == 0.0);
+		/* an extent of inf - inf is NaN, not >= 0: empty (the test is
+		 * on the extents, not on hi >= lo) */
+		e = b;
+		e.lo[a] = e.hi[a] = INFINITY;
+		assert_true(bvh_fbox_half_area(&e) == 0.0);
+		/* hi below lo by the least subnormal: the extent -2^-149 < 0 */
+		e = b;
+		e.lo[a] = 0x1p-149f;
+		e.hi[a] = 0.0f;
+		assert_true(bvh_fbox_half_area(&e) == 0.0);
+		/* and above it by that much: the extent is 2^-149 > 0, so the
+		 * area is the other two axes' product plus two tiny terms */
+		e = b;
+		e.lo[a] = 0.0f;
+		e.hi[a] = 0x1p-149f;
+		double ex[3] = {1, 2, 3};
+		ex[a] = 0x1p-149;
+		assert_true(bvh_fbox_half_area(&e) == ex[0] * ex[1] + ex[1] * ex[2] + ex[2] * ex[0]);
 	}
+	/* extents 2 FLT_MAX: infinite as a float difference, finite in doubles */
+	bvh_fbox big = {{-FLT_MAX, -FLT_MAX, -FLT_MAX, 1}, {FLT_MAX, FLT_MAX, FLT_MAX, 0}};
+	double eb = 2.0 * (double)FLT_MAX;
+	assert_true(bvh_fbox_half_area(&big) == eb * eb + eb * eb + eb * eb);
+	assert_true(isfinite(bvh_fbox_half_area(&big)));
 }
 
 /* The largest float <= v (below) or the least float >= v, from the
@@ -968,6 +992,51 @@ static void test_sampled_split(void **state)
 	free(ids);
 }
 
+/* A sampled node whose sample fills neither end bin: the sweeps run
+ * between the sample's first and last bins that hold references. 4096
+ * unit cubes [x, x + 1] on the x axis (y and z the same for all: one
+ * usable axis); the sample is every 4th (4096 / 1024), ids 0, 4, 8, ...:
+ * x = 20 (i % 8 == 0, A) and x = 120 (i % 8 == 4, B); the others x = 0 (i
+ * % 4 == 1), x = 150 (i % 4 == 2) and x = 30 (i % 4 == 3). Doubled
+ * centroids 2x + 1 from 1 to 301, 16 bins: bin trunc(32x / 300), so x =
+ * 0, 20, 30, 120, 150 fall in bins 0, 2, 3, 12, 15. The sample is in bins
+ * 2 and 12 only: every split from after bin 2 to after bin 11 has A
+ * alone on the left and B on the right, the same cost, and the first
+ * (after bin 2) wins. So the root's left child holds x = 0 and A (1024 +
+ * 512), box x [0, 21], and the right x = 30, B and x = 150, x [30, 151].
+ * A sweep that started one bin late would put x = 30 on the left. */
+static void test_sampled_ends(void **state)
+{
+	(void)state;
+	size_t n = 4096;
+	box *bx = malloc(n * sizeof *bx);
+	uint32_t *ids = malloc(n * sizeof *ids);
+	assert_non_null(bx && ids);
+	for (size_t i = 0; i < n; i++) {
+		double x = i % 8 == 0 ? 20 : i % 8 == 4 ? 120 : i % 4 == 1 ? 0 : i % 4 == 2 ? 150 : 30;
+		bx[i] = (box){v3(x, 0, 0), v3(x + 1, 1, 1)};
+	}
+	bvh2 t;
+	rt_error err;
+	assert_true(bvh2_build(bx, n, &(bvh_build_opts){.trav = 4}, &t, &err));
+	assert_int_equal(t.root_meta, 0);
+	const bvh2_node *root = &t.nodes[t.root];
+	size_t nl = refs_under(&t, root->child[0], root->meta[0], ids);
+	assert_int_equal(nl, 1536);
+	for (size_t i = 0; i < nl; i++)
+		if (ids[i] % 8 != 0 && ids[i] % 4 != 1)
+			fail_msg("reference %u on the root's left, expected only x = 0 and x = 20", ids[i]);
+	const float want[2][2][3] = {{{0, 0, 0}, {21, 1, 1}}, {{30, 0, 0}, {151, 1, 1}}};
+	for (int c = 0; c < 2; c++)
+		for (int a = 0; a < 3; a++) {
+			assert_true(root->box[c].lo[a] == want[c][0][a]);
+			assert_true(root->box[c].hi[a] == want[c][1][a]);
+		}
+	bvh2_free(&t);
+	free(bx);
+	free(ids);
+}
+
 /* The world's bounds are the union of its bounded primitives' boxes
  * (world.c makes them in line): three spheres by hand, centres and
  * diameters (-7, 2, 1) 2, (5, -4, 20) 4 and (1, 9, -3) 1, give lo (-8, -6,
@@ -1017,6 +1086,7 @@ int main(void)
 		cmocka_unit_test(test_sah_splits),
 		cmocka_unit_test(test_leaf_order),
 		cmocka_unit_test(test_sampled_split),
+		cmocka_unit_test(test_sampled_ends),
 		cmocka_unit_test(test_world_bounds),
 	};
 	return cmocka_run_group_tests_name("bvh", tests, NULL, NULL);

@@ -262,6 +262,28 @@ static void test_apply(void **state)
 	a = keymode_map('+', editor_scene(ed), camera_sel, 0.5);
 	assert_true(keymode_apply(ed, &a, &err));
 	assert_near(scene_camera(editor_scene(ed)).fov, 65, 1e-12);
+	/* An orthographic camera has no field of view (the fov would change and
+	 * the picture not): + shows a height 1.1 times smaller, - 1.1 larger,
+	 * and its fov stays as written. */
+	{
+		editor *oe = editor_new(load("A 0.3 255,255,255\nC 0,0,-10 0,0,1 70 ortho=2\nsp 0,0,0 1 255,0,0\n"), "o.rt");
+		assert_non_null(oe);
+		km_action z = keymode_map('+', editor_scene(oe), camera_sel, 0.5);
+		assert_true(keymode_apply(oe, &z, &err));
+		assert_near(scene_camera(editor_scene(oe)).ortho, 2 / 1.1, 1e-12);
+		assert_near(scene_camera(editor_scene(oe)).fov, 70, 0);
+		z = keymode_map('-', editor_scene(oe), camera_sel, 0.5);
+		assert_true(keymode_apply(oe, &z, &err));
+		z = keymode_map('-', editor_scene(oe), camera_sel, 0.5);
+		assert_true(keymode_apply(oe, &z, &err));
+		assert_near(scene_camera(editor_scene(oe)).ortho, 2 * 1.1, 1e-12);
+		assert_near(scene_camera(editor_scene(oe)).fov, 70, 0);
+		/* the shell's camera fov is refused there, and says why */
+		assert_false(editor_camera_fov(oe, 30, &err));
+		assert_non_null(strstr(err.msg, "orthographic"));
+		assert_near(scene_camera(editor_scene(oe)).fov, 70, 0);
+		editor_free(oe);
+	}
 	/* ] turns the cube's front to the right: -15 degrees about Y, a twist
 	 * for an upright cube. */
 	a = keymode_map(']', editor_scene(ed), cube, 0.5);
@@ -723,6 +745,27 @@ static void test_model_keys(void **state)
 	assert_int_equal(keymode_map_model('F', s, camera_sel, 0.5).op, KM_MOVE);
 	assert_int_equal(keymode_map_model('0', s, camera_sel, 0.5).op, KM_HOME);
 	assert_true(keymode_is_edit(KM_ORBIT));
+	/* The viewer's help bar names its keys: "up/down" the two keys that
+	 * move the camera by one step up (+Y) and one down there (the bar said
+	 * "r f", and f frames in the viewer). */
+	keyview_item bar[32];
+	size_t nbar = keymode_help_bar_model(bar, 32);
+	size_t updown = nbar;
+	for (size_t i = 0; i < nbar; i++)
+		if (strcmp(bar[i].what, "up/down") == 0)
+			updown = i;
+	assert_true(updown < nbar);
+	char up = 0, down = 0;
+	assert_int_equal(sscanf(bar[updown].keys, "%c %c", &up, &down), 2);
+	km_action k = keymode_map_model((unsigned char)up, s, camera_sel, 0.5);
+	assert_int_equal(k.op, KM_MOVE);
+	assert_vec_near(k.d, v3(0, 0.5, 0), 1e-12);
+	k = keymode_map_model((unsigned char)down, s, camera_sel, 0.5);
+	assert_int_equal(k.op, KM_MOVE);
+	assert_vec_near(k.d, v3(0, -0.5, 0), 1e-12);
+	for (size_t i = 0; i < nbar; i++)
+		if (strcmp(bar[i].what, "move") == 0)
+			fail_msg("the viewer's bar says the arrows move; they orbit");
 	/* Applied: the camera at (0,0,-10) goes to its left on the circle of
 	 * radius |(-1.25, 0, -10)| about the centre, by 5 degrees. */
 	editor *ed = editor_new(s, "k.rt");

@@ -107,6 +107,39 @@ static void test_frame(void **state)
 	assert_vec_near(e.pos, c.pos, 0);
 }
 
+/* Framing a glTF camera (vertical=1: 60 degrees is the height's) and an
+ * orthographic one, and the wheel on the latter. By hand: box radius
+ * sqrt(3) about (0,1,0). Vertical 60 on a wide image (aspect 2): the
+ * vertical half angle 30 is the narrower, distance r / sin 30 = 2r (it was
+ * framed as 60 degrees wide: atan(tan 30 / 2), 3.6r). On a tall one (0.5):
+ * the horizontal, atan(tan 30 / 2). Orthographic: the half height r on a
+ * wide image, 2r on a tall one (its width, h x 0.5, holds r), from 2r in
+ * front; the wheel multiplies the half height, the camera stays. */
+static void test_frame_kinds(void **state)
+{
+	(void)state;
+	box b = {v3(-1, 0, -1), v3(1, 2, 1)};
+	double r = sqrt(3.0);
+	camera v = cam(v3(7, 1, 2), v3(0, 0, -1));
+	v.vertical = true;
+	camera w = orbit_frame(v, b, 2.0);
+	assert_near(v3_len(v3_sub(w.pos, v3(0, 1, 0))), 2 * r, 1e-9);
+	assert_vec_near(w.pos, v3(0, 1, 2 * r), 1e-9);
+	assert_near(w.fov, 60, 0);
+	camera t = orbit_frame(v, b, 0.5);
+	assert_near(v3_len(v3_sub(t.pos, v3(0, 1, 0))), r / sin(atan(tan(deg_to_rad(30)) / 2)), 1e-9);
+	camera o = cam(v3(7, 1, 2), v3(0, 0, -1));
+	o.ortho = 5;
+	camera ow = orbit_frame(o, b, 2.0);
+	assert_near(ow.ortho, r, 1e-12);
+	assert_vec_near(ow.pos, v3(0, 1, 2 * r), 1e-9);
+	assert_near(orbit_frame(o, b, 0.5).ortho, 2 * r, 1e-12);
+	camera n = orbit_dolly(o, v3(1, 2, 3), 0.1);
+	assert_near(n.ortho, 4.5, 1e-12);
+	assert_vec_near(n.pos, o.pos, 0);
+	assert_near(orbit_dolly(n, v3(1, 2, 3), 1.0 - 1.0 / 0.9).ortho, 5, 1e-12);
+}
+
 /* The turntable: frame k of n is a yaw of 360 k / n; frame 0 is the
  * camera itself, half a turn is the same for 2 of 4 and 1 of 2. The
  * scene's centre is the box of its bounded objects (the plane left out). */
@@ -137,6 +170,7 @@ int main(void)
 		cmocka_unit_test(test_yaw_by_hand), cmocka_unit_test(test_pitch_by_hand),
 		cmocka_unit_test(test_properties),  cmocka_unit_test(test_dolly),
 		cmocka_unit_test(test_frame),       cmocka_unit_test(test_turntable),
+		cmocka_unit_test(test_frame_kinds),
 	};
 	return cmocka_run_group_tests_name("orbit", tests, NULL, NULL);
 }

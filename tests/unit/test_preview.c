@@ -102,11 +102,38 @@ static void test_past_budget_is_the_coarse_picture(void **state)
 	world_free(w);
 }
 
+/* A scene's camera in a pane wider than 16:9 (64 x 18 pixels): a
+ * horizontal fov of 60 widens to 2 atan(tan 30 x 9/16 x 64/18) = 2 atan(2
+ * tan 30) = 98.2132 degrees (by hand); a vertical=1 fov keeps the height
+ * as it is (it was widened too: a glTF camera zoomed out); an orthographic
+ * camera is left alone. A 16:9 pane changes none. */
+static void test_scene_camera_in_a_wide_pane(void **state)
+{
+	(void)state;
+	camera h = {v3(0, 0, -5), v3(0, 0, 1), 60, false, 0, 0};
+	camera v = h, o = h;
+	v.vertical = true;
+	o.ortho = 2;
+	box none = box_empty();
+	preview_camera(&h, false, none, 64, 18);
+	assert_near(h.fov, 98.2132107, 1e-6);
+	preview_camera(&v, false, none, 64, 18);
+	assert_near(v.fov, 60, 0);
+	assert_true(v.vertical);
+	preview_camera(&o, false, none, 64, 18);
+	assert_near(o.fov, 60, 0);
+	assert_near(o.ortho, 2, 0);
+	camera n = {v3(0, 0, -5), v3(0, 0, 1), 60, false, 0, 0};
+	preview_camera(&n, false, none, 32, 18);
+	assert_near(n.fov, 60, 1e-12);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_within_budget_is_the_full_picture),
 		cmocka_unit_test(test_past_budget_is_the_coarse_picture),
+		cmocka_unit_test(test_scene_camera_in_a_wide_pane),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

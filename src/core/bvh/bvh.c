@@ -52,6 +52,7 @@
 #define SPATIAL_ALPHA 1e-2
 
 typedef bvh_fbox fbox;
+_Static_assert(sizeof(fbox) == 32, "bin_refs finds a bin by its byte offset: 32 x its index");
 typedef bvh2_node node2;
 
 typedef struct builder {
@@ -140,12 +141,15 @@ static inline double fbox_half_area(const fbox *b)
 {
 #if defined(__SSE2__)
 	__m128 lo = _mm_loadu_ps(b->lo), hi = _mm_loadu_ps(b->hi);
+	/* e0 >= 0, e1 >= 0 and e2 >= 0 (false for NaN), tested on the float
+	 * differences: a float difference keeps the sign of the exact one and
+	 * is 0 only for equal floats (gradual underflow: no flush to zero is
+	 * set anywhere), and inf - inf or a NaN gives NaN in floats as in
+	 * doubles, so the test is the doubles' */
+	if ((_mm_movemask_ps(_mm_cmpge_ps(_mm_sub_ps(hi, lo), _mm_setzero_ps())) & 7) != 7)
+		return 0.0;
 	__m128d e01 = _mm_sub_pd(_mm_cvtps_pd(hi), _mm_cvtps_pd(lo));
 	__m128d e2x = _mm_sub_pd(_mm_cvtps_pd(_mm_movehl_ps(hi, hi)), _mm_cvtps_pd(_mm_movehl_ps(lo, lo)));
-	__m128d zero = _mm_setzero_pd();
-	/* e0 >= 0, e1 >= 0 and e2 >= 0 (false for NaN) */
-	if ((_mm_movemask_pd(_mm_cmpge_pd(e01, zero)) & 3) != 3 || !_mm_ucomige_sd(e2x, zero))
-		return 0.0;
 	double e0 = _mm_cvtsd_f64(e01), e1 = _mm_cvtsd_f64(_mm_unpackhi_pd(e01, e01)), e2 = _mm_cvtsd_f64(e2x);
 	return e0 * e1 + e1 * e2 + e2 * e0;
 #else
@@ -309,10 +313,12 @@ static void bin_refs(const fbox *refs, size_t n, size_t step, const binning *bn,
 		__m128 lo = _mm_loadu_ps(refs->lo), hi = _mm_loadu_ps(refs->hi);
 		__m128 cost = _mm_or_ps(_mm_and_ps(lo, lane3), negz); /* (-0, -0, -0, cost) */
 		__m128 v = _mm_mul_ps(_mm_sub_ps(_mm_add_ps(lo, hi), blo), bsc);
-		__m128i k = _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(v, zero), top));
-		int k0 = _mm_cvtsi128_si32(k), k1 = _mm_cvtsi128_si32(_mm_shuffle_epi32(k, 1)),
-		    k2 = _mm_cvtsi128_si32(_mm_shuffle_epi32(k, 2));
-		fbox *x = &bbox[0][k0], *y = &bbox[1][k1], *z = &bbox[2][k2];
+		/* the bins' byte offsets: the indices times sizeof (fbox), 32 */
+		__m128i k = _mm_slli_epi32(_mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(v, zero), top)), 5);
+		size_t k0 = (uint32_t)_mm_cvtsi128_si32(k), k1 = (uint32_t)_mm_cvtsi128_si32(_mm_shuffle_epi32(k, 1)),
+		       k2 = (uint32_t)_mm_cvtsi128_si32(_mm_shuffle_epi32(k, 2));
+		fbox *x = (fbox *)((char *)bbox[0] + k0), *y = (fbox *)((char *)bbox[1] + k1),
+		     *z = (fbox *)((char *)bbox[2] + k2);
 		_mm_storeu_ps(x->lo, _mm_min_ps(_mm_loadu_ps(x->lo), lo));
 		_mm_storeu_ps(x->hi, _mm_add_ps(_mm_max_ps(_mm_loadu_ps(x->hi), hi), cost));
 		_mm_storeu_ps(y->lo, _mm_min_ps(_mm_loadu_ps(y->lo), lo));
@@ -346,27 +352,37 @@ static inline double sweep_cost(unsigned block, double sum)
  * cheapest split into *best (axis and bin; best->cost is the cost to beat). */
 static inline void sweep_bins(fbox bbox[3][BINS], const binning *bn, unsigned block, split *best)
 {
-	int nbins = bn->nbins;
+	size_t nbins = (size_t)bn->nbins;
 	for (int a = 0; a < 3; a++) {
 		if (!bn->usable[a])
 			continue;
+		/* Only the splits between the first and the last bin that hold a
+		 * reference (cost >= 1, so an empty bin's sum is 0) have both
+		 * sides: the sweeps run from one to the other. The bins outside
+		 * are empty boxes (the union leaves them out) of cost 0, so the
+		 * sums and boxes are the ones sweeps over every bin make. A whole
+		 * node's centroid bounds put references in its first and last
+		 * bins: the loops below usually stop at once. */
+		size_t first = 0, last = nbins - 1;
+		while (first < last && bbox[a][first].hi[3] == 0.0f)
+			first++;
+		while (last > first && bbox[a][last].hi[3] == 0.0f)
+			last--;
 		/* right-to-left sweep: the area and cost right of each split */
 		double right_area[BINS], right_cost[BINS];
 		fbox acc = fbox_empty();
 		double sum = 0.0;
-		for (int k = nbins - 1; k > 0; k--) {
+		for (size_t k = last; k > first; k--) {
 			fbox_union(&acc, &bbox[a][k]);
 			sum += bbox[a][k].hi[3];
-			right_area[k] = sum > 0.0 ? fbox_half_area(&acc) : 0.0;
+			right_area[k] = fbox_half_area(&acc);
 			right_cost[k] = sum;
 		}
 		acc = fbox_empty();
 		sum = 0.0;
-		for (int k = 0; k < nbins - 1; k++) {
+		for (size_t k = first; k < last; k++) {
 			fbox_union(&acc, &bbox[a][k]);
 			sum += bbox[a][k].hi[3];
-			if (sum == 0.0 || right_cost[k + 1] == 0.0)
-				continue;
 			/* the left term is >= 0: a right term that alone reaches
 			 * the best cost cannot win, and its left area is not needed */
 			double right = right_area[k + 1] * sweep_cost(block, right_cost[k + 1]);
@@ -376,7 +392,7 @@ static inline void sweep_bins(fbox bbox[3][BINS], const binning *bn, unsigned bl
 			if (cost < best->cost) {
 				best->cost = cost;
 				best->axis = a;
-				best->at = k + 1;
+				best->at = (int)k + 1;
 			}
 		}
 	}
@@ -404,9 +420,8 @@ static split find_split(const builder *b, size_t begin, size_t end, const fbox *
 	/* per bin: the box and the summed cost in hi[3] (every cost is >= 1,
 	 * so a bin is empty when its cost is 0; float sums are exact to 2^24) */
 	fbox bbox[3][BINS];
-	for (int a = 0; a < 3; a++)
-		for (int k = 0; k < nbins; k++)
-			bbox[a][k] = fbox_empty();
+	for (int k = 0; k < nbins; k++)
+		bbox[0][k] = bbox[1][k] = bbox[2][k] = fbox_empty();
 	bin_refs(b->refs + begin, (end - begin + step - 1) / step, step, &bn, bbox);
 	/* the sweeps, made twice: for unit costs leaf_cost is the sum itself */
 	if (b->block > 1)
@@ -415,8 +430,10 @@ static split find_split(const builder *b, size_t begin, size_t end, const fbox *
 		sweep_bins(bbox, &bn, 1, &best);
 	if (best.axis >= 0) {
 		best.lb = best.rb = fbox_empty();
-		for (int k = 0; k < nbins; k++)
-			fbox_union(k < best.at ? &best.lb : &best.rb, &bbox[best.axis][k]);
+		for (int k = 0; k < best.at; k++)
+			fbox_union(&best.lb, &bbox[best.axis][k]);
+		for (int k = best.at; k < nbins; k++)
+			fbox_union(&best.rb, &bbox[best.axis][k]);
 		best.lb.hi[3] = best.rb.hi[3] = 0.0f; /* a box's, not the costs' */
 	}
 	return best;
