@@ -1501,6 +1501,10 @@ static char *read_file(void *ctx, const char *path, size_t *len, rt_error *err)
 {
 	(void)ctx;
 	struct stat st;
+	if (!path[0]) { /* rtsh "": the message would name no file */
+		rt_error_set(err, "the scene's file name is empty; expected a .rt file");
+		return NULL;
+	}
 	if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
 		rt_error_at(err, path, 0, 0, "is a directory; expected a .rt file");
 		return NULL;
