@@ -279,6 +279,9 @@ static void first_surface(const world *w, ray r, int ks, double f[9])
 	double gl_d = 0.0;
 	/* the glass surfaces' reflections on the way, as albedo */
 	vec3 refl = v3(0, 0, 0);
+	/* the normal where the ray first entered glass (0 if it did not) */
+	vec3 glass_n = v3(0, 0, 0);
+	bool in_glass = false;
 	for (int k = 0;; k++) {
 		hit h;
 		if (!(k == 0 ? world_intersect_coherent : world_intersect)(w, &r, 0.0, INFINITY, &h)) {
@@ -299,6 +302,20 @@ static void first_surface(const world *w, ray r, int ks, double f[9])
 			f[0] += clamp01(bg.x + refl.x);
 			f[1] += clamp01(bg.y + refl.y);
 			f[2] += clamp01(bg.z + refl.z);
+			/* The sky seen through glass: the glass's own normal
+			 * where the ray entered it. Its Fresnel shares (F in
+			 * the albedo where the ray enters, F leaving in the
+			 * lighting) grow toward the rim of what a sphere shows,
+			 * and the lighting there falls (final.rt's big sphere
+			 * before the sky: reference 0.43 at its rim, 0.9-1.0
+			 * inside, over the same albedo); with no normal the
+			 * rim's fits took the inside's lighting and came out
+			 * 0.1 to 0.15 too bright, and the choice's window could
+			 * not tell the rim's estimates from the inside's
+			 * (bench/README, the denoise13 session). */
+			f[3] += glass_n.x;
+			f[4] += glass_n.y;
+			f[5] += glass_n.z;
 			f[6] += dist;
 			return;
 		}
@@ -380,6 +397,10 @@ static void first_surface(const world *w, ray r, int ks, double f[9])
 			double fr = fresnel_dielectric(b.cos_o, eta, &cos_t);
 			if (b.front)
 				refl = v3_add(refl, v3_scale(tint, b.wg * fr));
+			if (b.front && !in_glass) {
+				glass_n = b.n;
+				in_glass = true;
+			}
 			if (ks >= 0 && ks < DENOISE_FEATURE_SAMPLES && env_lit(w)) {
 				/* and that share of the sky in the mirror direction
 				 * (or of a surface's there, env_feature's rule) joins

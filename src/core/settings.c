@@ -176,8 +176,8 @@ static bool set_value(render_settings *s, const setting_def *def, const char *va
 	case SETTING_U64: {
 		unsigned long long v;
 		if (num_scan_u64(value, &v) != NUM_OK)
-			return rt_error_set(err, "%s \"%s\" is not valid; expected a whole number >= 0",
-			                    def->name, value);
+			return rt_error_set(err, "%s \"%s\" is not valid; expected a whole number in 0..%llu",
+			                    def->name, value, (unsigned long long)UINT64_MAX);
 		*(uint64_t *)field(s, def) = v;
 		return true;
 	}
@@ -186,7 +186,7 @@ static bool set_value(render_settings *s, const setting_def *def, const char *va
 		if (num_scan_str(value, HUGE_VAL, &v) != NUM_OK || !(v >= def->min && v <= def->max))
 			return rt_error_set(err, "%s \"%s\" is not valid; expected a number in %g..%g",
 			                    def->name, value, def->min, def->max);
-		*(double *)field(s, def) = v;
+		*(double *)field(s, def) = v + 0.0; /* -0 is 0: shown and saved as 0 */
 		return true;
 	}
 	case SETTING_RESOLUTION: {

@@ -1367,8 +1367,8 @@ static bool parse_tokens(parser *p)
 		            p->strict ? " (strict mode)" : "");
 	}
 	p->np = p->ntoks - 1;
-	for (size_t i = 1; i < p->ntoks; i++)
-		if (memchr(p->toks[i].s, '=', p->toks[i].len)) {
+	for (size_t i = 1; i < p->ntoks; i++) /* a quoted file name with '=' in it is no key */
+		if (!p->toks[i].quoted && memchr(p->toks[i].s, '=', p->toks[i].len)) {
 			p->np = i - 1;
 			break;
 		}
@@ -1501,6 +1501,10 @@ static char *read_file(void *ctx, const char *path, size_t *len, rt_error *err)
 {
 	(void)ctx;
 	struct stat st;
+	if (!path[0]) { /* rtsh "": the message would name no file */
+		rt_error_set(err, "the scene's file name is empty; expected a .rt file");
+		return NULL;
+	}
 	if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
 		rt_error_at(err, path, 0, 0, "is a directory; expected a .rt file");
 		return NULL;

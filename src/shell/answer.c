@@ -118,13 +118,25 @@ void answer_object_fields(shell *sh, size_t i)
 	shell_out(sh, "  %-11s diffuse %g, specular %g, shininess %g, reflective %g\n", "material", m->diffuse,
 	          m->specular, m->shininess, m->reflective);
 	/* The key=value extensions, as the line writes them (non-defaults only). */
-	char keys[512] = "";
-	char *save = NULL;
-	for (char *t = strtok_r(line, " ", &save); t; t = strtok_r(NULL, " ", &save))
-		if (strchr(t, '=')) {
+	char keys[1024] = "";
+	/* the fields split at blanks outside double quotes: a quoted file name
+	 * with a blank stays whole (texture="my wood.png" was cut at the
+	 * blank), and a quoted one with '=' in it is not a key */
+	for (char *t = line; *t;) {
+		while (*t == ' ')
+			t++;
+		char *end = t;
+		for (bool quoted = false; *end && (quoted || *end != ' '); end++)
+			if (*end == '"')
+				quoted = !quoted;
+		size_t n = (size_t)(end - t);
+		char *eq = memchr(t, '=', n);
+		if (n && t[0] != '"' && eq && (!memchr(t, '"', n) || memchr(t, '"', n) > (void *)eq)) {
 			size_t l = strlen(keys);
-			snprintf(keys + l, sizeof keys - l, "%s%s", l ? " " : "", t);
+			snprintf(keys + l, sizeof keys - l, "%s%.*s", l ? " " : "", (int)n, t);
 		}
+		t = end;
+	}
 	if (keys[0])
 		shell_out(sh, "  %-11s %s\n", "extensions", keys);
 }

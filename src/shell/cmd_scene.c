@@ -36,6 +36,8 @@ bool cmd_load(shell *sh, int argc, char **argv, const char *rest)
 {
 	(void)argc, (void)rest;
 	render_settings before = sh->set;
+	if (!argv[0][0]) /* load "": the message had no name in it */
+		return shell_fail(sh, "load: \"\" is not a file name; expected a .rt file or a model");
 	if (!shell_load(sh, argv[0]))
 		return false;
 	answer_loaded(sh, "loaded", &before);

@@ -29,10 +29,14 @@ static const char *settings_help(void)
 		char values[256];
 		if (d->type == SETTING_ENUM)
 			settings_choices_text(d, "|", "|", values, sizeof values);
+		else if (d->type == SETTING_RESOLUTION) /* with the ranges `set` checks */
+			snprintf(values, sizeof values, "WxH (each %.0f..%.0f)", d->min, d->max);
+		else if (d->type == SETTING_DOUBLE)
+			snprintf(values, sizeof values, "NUMBER (%g..%g)", d->min, d->max);
+		else if (d->type == SETTING_U64)
+			snprintf(values, sizeof values, "N (0..2^64-1)");
 		else
-			snprintf(values, sizeof values, "%s", d->type == SETTING_RESOLUTION ? "WxH"
-			                                      : d->type == SETTING_DOUBLE   ? "NUMBER"
-			                                                                    : "N");
+			snprintf(values, sizeof values, "N (%.0f..%.0f)", d->min, d->max);
 		used += (size_t)snprintf(text + used, sizeof text - used, "  %-10s %-34s %s\n", d->name, values,
 		                         d->help);
 	}

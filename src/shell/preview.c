@@ -283,6 +283,8 @@ int preview_main(const rtsh_options *o)
 	/* Only regular files: a FIFO would block the open, a device or a
 	 * folder means nothing. */
 	struct stat st;
+	if (!file[0])
+		return fail("--preview", "the file name is empty; expected a scene (.rt) or model file");
 	if (stat(file, &st) != 0) {
 		char msg[160];
 		snprintf(msg, sizeof msg, "cannot open: %s; expected a readable scene (.rt) or model file", strerror(errno));

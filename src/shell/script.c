@@ -190,6 +190,8 @@ bool shell_run_file(shell *sh, const char *path)
 	if (!f && kind)
 		return shell_fail(sh, "%s: is %s; expected a command file (a regular file, or - for standard input)",
 		                  path, kind);
+	if (!f && !path[0])
+		return shell_fail(sh, "the command file's name is empty; expected a file name (or - for standard input)");
 	if (!f)
 		return shell_fail(sh, "cannot open %s: %s", path, strerror(errno));
 	const char *name = strcmp(path, "-") == 0 ? "stdin" : path;

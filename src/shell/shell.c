@@ -524,8 +524,8 @@ frame *shell_picture_frame(shell *sh, frame_palette pal, int cols)
 		}
 		world_release(wd);
 		shell_refresh(sh);
-		if (!fb) {
-			shell_fail(sh, "%s", err.msg);
+		if (!fb) { /* as the full image's failures say it */
+			shell_fail(sh, "render: %s", err.msg);
 			return NULL;
 		}
 		rgb = fb->rgb;

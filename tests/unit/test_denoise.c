@@ -920,6 +920,33 @@ static void test_sky_feature(void **state)
 	}
 }
 
+/* The sky seen through glass has the glass's normal where the ray entered
+ * it: a clear glass sphere (ior 1.5) of diameter 2 centred at (0.5, 0, 4),
+ * nothing behind it. The centre ray (0, 0, 1) meets it where
+ * (0 - 0.5)^2 + (z - 4)^2 = 1, z = 4 - sqrt(0.75), and its outward normal
+ * there is ((0, 0, z) - (0.5, 0, 4)) / 1 = (-0.5, 0, -sqrt(0.75)); the
+ * refracted ray meets the back face at 32 degrees from its normal (below
+ * the critical 41.8) and leaves to the sky. The old code gave the sky no
+ * normal, (0, 0, 0). The same sphere before a wall keeps the wall's normal
+ * (0, 0, -1): only the sky takes the glass's. */
+static void test_sky_through_glass_normal(void **state)
+{
+	(void)state;
+	double f[DENOISE_ACC];
+	centre_features("C 0,0,0 0,0,1 10\nsp 0.5,0,4 0,1,0 2,2,2 255,255,255 0 0 1 0 ior=1.5\n", 1, f);
+	print_message("sky through the sphere: normal %.6f %.6f %.6f (want -0.5 0 %.6f)\n", f[3], f[4], f[5],
+	              -sqrt(0.75));
+	assert_near(f[3], -0.5, 1e-6);
+	assert_near(f[4], 0.0, 1e-6);
+	assert_near(f[5], -sqrt(0.75), 1e-6);
+	centre_features("C 0,0,0 0,0,1 10\nsp 0.5,0,4 0,1,0 2,2,2 255,255,255 0 0 1 0 ior=1.5\n"
+	                "pl 0,0,8 0,0,-1 1,1,1 255,255,255 1 0 1 0\n",
+	                1, f);
+	assert_near(f[3], 0.0, 1e-6);
+	assert_near(f[4], 0.0, 1e-6);
+	assert_near(f[5], -1.0, 1e-6);
+}
+
 /* Glass's reflection in the direct-light feature: the clear glass plane of
  * test_features_through_glass (ior 1.5, at z = 2 facing the camera) under a
  * uniform sky of radiance 0.5, nothing behind it. The refracted ray meets
@@ -1896,6 +1923,7 @@ int main(void)
 		cmocka_unit_test(test_sky_feature),
 		cmocka_unit_test(test_features_through_glass_sphere),
 		cmocka_unit_test(test_glass_reflection_feature),
+		cmocka_unit_test(test_sky_through_glass_normal),
 		cmocka_unit_test(test_direct_feature),
 		cmocka_unit_test(test_env_feature),
 		cmocka_unit_test(test_lamp_through_glossy),

@@ -473,7 +473,7 @@ static void test_kept_settings_errors(void **state)
 	(void)state;
 	/* The row's own range and message, at the value's column. */
 	expect_error(KCAM "set exposure 30\n", 2, 14, "set exposure \"30\" is not valid; expected a number in -20..20");
-	expect_error(KCAM "set seed -1\n", 2, 10, "set seed \"-1\" is not valid; expected a whole number >= 0");
+	expect_error(KCAM "set seed -1\n", 2, 10, "set seed \"-1\" is not valid; expected a whole number in 0..18446744073709551615");
 	expect_error(KCAM "set denoise xyz\n", 2, 13, "set denoise \"xyz\" is not valid; expected auto, on or off");
 	expect_error(KCAM "set denoise onn\n", 2, 13,
 	             "set denoise \"onn\" is not valid; did you mean \"on\"? (expected auto, on or off)");
