@@ -16,6 +16,10 @@ double srgb_to_linear(double v);
 double srgb8_to_linear(double code);
 /* The three channels of an sRGB colour 0..255 to linear. */
 vec3 srgb255_to_linear(vec3 c);
+/* The table srgb8_to_linear reads for the whole codes 0..255 (made at the
+ * first call): for a caller that decodes a million colours in line
+ * (world_build's materials), the same bits without a call a colour. */
+const double *srgb8_table(void);
 /* Linear [0,1] (and above) to sRGB codes 0..255, not rounded: the inverse of
  * srgb255_to_linear, for readers whose colours are linear (glTF factors). */
 vec3 linear_to_srgb255(vec3 c);

@@ -22,6 +22,12 @@ static void decode_table_init(void)
 		decode_table[i] = srgb_to_linear(i / 255.0);
 }
 
+const double *srgb8_table(void)
+{
+	pthread_once(&decode_once, decode_table_init);
+	return decode_table;
+}
+
 static inline bool whole_code(double code)
 {
 	return code >= 0.0 && code <= 255.0 && code == (double)(int)code;

@@ -22,9 +22,19 @@
 /* mat_lin_make into *l, whose bytes are zero on entry: world_build fills
  * its calloc'ed array in place rather than copying a zeroed value in and out
  * (a million objects). */
-static inline void mat_lin_fill(mat_lin *restrict l, const material *m)
+/* srgb255_to_linear(c), with tab its table (srgb8_table): whole codes
+ * from the table in line, the same bits; others through the call. */
+static inline vec3 srgb255_lin(const double *tab, vec3 c)
 {
-	l->albedo = srgb255_to_linear(m->color);
+	if (c.x >= 0.0 && c.x <= 255.0 && c.x == (double)(int)c.x && c.y >= 0.0 && c.y <= 255.0 &&
+	    c.y == (double)(int)c.y && c.z >= 0.0 && c.z <= 255.0 && c.z == (double)(int)c.z)
+		return v3(tab[(int)c.x], tab[(int)c.y], tab[(int)c.z]);
+	return srgb255_to_linear(c);
+}
+
+static inline void mat_lin_fill(mat_lin *restrict l, const material *m, const double *tab)
+{
+	l->albedo = srgb255_lin(tab, m->color);
 	l->diffuse = m->diffuse;
 	l->specular = m->specular;
 	l->shininess = m->shininess;
@@ -67,7 +77,7 @@ static inline void mat_lin_fill(mat_lin *restrict l, const material *m)
 mat_lin mat_lin_make(const material *m)
 {
 	mat_lin l = {0};
-	mat_lin_fill(&l, m);
+	mat_lin_fill(&l, m, srgb8_table());
 	return l;
 }
 
@@ -278,8 +288,9 @@ static void *mats_fill_run(void *arg)
 {
 	mats_job *j = arg;
 	mem_prefault(j->mats, j->n * sizeof *j->mats);
+	const double *tab = srgb8_table();
 	for (size_t i = 0; i < j->n; i++)
-		mat_lin_fill(&j->mats[i], &j->objs[i].mat); /* calloc'ed: zero */
+		mat_lin_fill(&j->mats[i], &j->objs[i].mat, tab); /* calloc'ed: zero */
 	return NULL;
 }
 
@@ -456,6 +467,7 @@ world *world_build_threads(const scene *s, int threads, const atomic_bool *cance
 	}
 	w->bounds = box_empty();
 	double extent = v3_max_abs(c.pos);
+	const double *tab = srgb8_table();
 	for (size_t i = 0; i < s->nobjs; i++) {
 		const object *o = &s->objs[i];
 		if ((i & 0xffff) == 0 && cancel && atomic_load(cancel)) {
@@ -467,7 +479,7 @@ world *world_build_threads(const scene *s, int threads, const atomic_bool *cance
 			return NULL;
 		}
 		if (!mats_apart)
-			mat_lin_fill(&w->mats[i], &o->mat); /* calloc'ed: zero */
+			mat_lin_fill(&w->mats[i], &o->mat, tab); /* calloc'ed: zero */
 		box bx;
 		unsigned f = kf[i] & ~(unsigned)OBJ_FAST_SPHERE;
 		bool plane = (f & KIND_UNBOUNDED) != 0, fast = (kf[i] & OBJ_FAST_SPHERE) != 0;

@@ -1037,6 +1037,53 @@ static void test_sampled_ends(void **state)
 	free(ids);
 }
 
+/* The materials' colours in linear light (world_build decodes the whole
+ * codes from srgb8_table in line): srgb8_table()[k] is the decoding of k /
+ * 255 by its definition (IEC 61966-2-1: v / 12.92 up to 0.04045, else
+ * ((v + 0.055) / 1.055)^2.4); a world's albedos are srgb255_to_linear's,
+ * the same bits, for whole codes, for 127.5 and 254.999 (not whole: the
+ * formula, not a table entry), for -0 (whole: code 0) and for a colour
+ * whose one channel only is not whole; at 1 and 2 threads (the materials'
+ * thread from 4096 objects). */
+static void test_material_colours(void **state)
+{
+	(void)state;
+	const double *tab = srgb8_table();
+	for (int k = 0; k < 256; k++) {
+		double v = k / 255.0;
+		double want = v <= 0.04045 ? v / 12.92 : pow((v + 0.055) / 1.055, 2.4);
+		assert_true(tab[k] == want);
+	}
+	const vec3 cols[] = {v3(0, 128, 255), v3(127.5, 3, 4), v3(-0.0, 254.999, 17), v3(9, 10, 200.25),
+	                     v3(1, 2, 3)};
+	size_t nc = sizeof cols / sizeof cols[0];
+	scene *s = scene_new();
+	camera cam = {v3(0, 0, -30), v3(0, 0, 1), 60, false, 0, 0};
+	assert_true(scene_add_camera(s, &cam, NULL));
+	for (size_t i = 0; i < 5000; i++) {
+		object o = object_make(OBJ_SPHERE, cols[i % nc]);
+		o.pos = v3((double)(i % 100), (double)(i / 100), 0);
+		assert_true(scene_add_object(s, &o, NULL));
+	}
+	/* 127.5 decodes by the formula: between codes 127 and 128 */
+	assert_true(srgb255_to_linear(cols[1]).x > tab[127] && srgb255_to_linear(cols[1]).x < tab[128]);
+	for (int t = 1; t <= 2; t++) {
+		rt_error err;
+		world *w = world_build_threads(s, t, NULL, &err);
+		assert_non_null(w);
+		for (size_t i = 0; i < s->nobjs; i++) {
+			vec3 want = srgb255_to_linear(cols[i % nc]), got = w->mats[i].albedo;
+			if (memcmp(&got, &want, sizeof got) != 0)
+				fail_msg("object %zu (%d threads): albedo (%.17g, %.17g, %.17g), expected (%.17g, %.17g, %.17g)",
+				         i, t, got.x, got.y, got.z, want.x, want.y, want.z);
+		}
+		assert_true(w->mats[0].albedo.x == tab[0] && w->mats[0].albedo.y == tab[128] &&
+		            w->mats[0].albedo.z == tab[255]);
+		world_free(w);
+	}
+	scene_free(s);
+}
+
 /* The world's bounds are the union of its bounded primitives' boxes
  * (world.c makes them in line): three spheres by hand, centres and
  * diameters (-7, 2, 1) 2, (5, -4, 20) 4 and (1, 9, -3) 1, give lo (-8, -6,
@@ -1087,6 +1134,7 @@ int main(void)
 		cmocka_unit_test(test_leaf_order),
 		cmocka_unit_test(test_sampled_split),
 		cmocka_unit_test(test_sampled_ends),
+		cmocka_unit_test(test_material_colours),
 		cmocka_unit_test(test_world_bounds),
 	};
 	return cmocka_run_group_tests_name("bvh", tests, NULL, NULL);
