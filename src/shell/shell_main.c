@@ -20,6 +20,9 @@ int shell_main(const rtsh_options *o)
 	bool tty_in = isatty(STDIN_FILENO);
 	bool script = o->commands || o->file || !tty_in;
 	bool then_interactive = !script || (o->interactive && tty_in);
+	if (o->interactive && !tty_in) /* it was dropped without a word */
+		fprintf(stderr, "rtsh: -i: standard input is not a terminal: no interactive shell after the commands "
+		                "(warning)\n");
 	bool screen_ok = then_interactive && caps_screen_ok(STDOUT_FILENO);
 	/* --turntable without -o turns the scene in the full screen: with no
 	 * terminal to show it, it was dropped without a word (status 0). */
