@@ -130,7 +130,7 @@ void rt_write_file_name(const char *file, char *out, size_t size)
 		name = file + n + 1;
 	else if (n && file[0] != '/' && realpath(file, abs))
 		name = strncmp(abs, dir, n) == 0 && abs[n] == '/' ? abs + n + 1 : abs; /* below it after all */
-	bool quote = strpbrk(name, " \t,#\"") != NULL || strstr(name, "//") != NULL || !name[0];
+	bool quote = strpbrk(name, " \t,#\"=") != NULL || strstr(name, "//") != NULL || !name[0]; /* = : not a key */
 	snprintf(out, size, "%s%s%s", quote ? "\"" : "", name, quote ? "\"" : "");
 }
 

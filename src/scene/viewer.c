@@ -189,7 +189,7 @@ static char *gltf_text(const char *path, const rt_load_opts *opts, size_t *len, 
 		longest = 1;
 	const char *slash = strrchr(path, '/');
 	const char *base = slash ? slash + 1 : path;
-	bool quote = strpbrk(base, " \t,#\"") != NULL;
+	bool quote = strpbrk(base, " \t,#\"=") != NULL; /* = : not a key */
 	bool stage = gi.nlights == 0 && !gi.emissive;
 	*stage_lit = stage;
 	size_t size = 4096 + 256 * (gi.ncams + gi.nlights) + (split ? (160 + strlen(base)) * gi.nmesh_nodes : 0), n = 0;
@@ -405,8 +405,8 @@ static char *model_text(const char *path, const rt_load_opts *opts, size_t *len,
 	vec3 lamp = v3_add(target, v3(1.2 * dist, 2.0 * dist, 1.5 * dist));
 	const char *slash = strrchr(path, '/');
 	const char *base = slash ? slash + 1 : path;
-	bool quote = strpbrk(base, " \t,#\"") != NULL;
-	bool tquote = textured && strpbrk(tex, " \t,#\"") != NULL;
+	bool quote = strpbrk(base, " \t,#\"=") != NULL; /* = : not a key */
+	bool tquote = textured && strpbrk(tex, " \t,#\"=") != NULL;
 	char *text = malloc(8192);
 	if (!text) {
 		rt_error_set(err, "out of memory");

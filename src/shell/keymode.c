@@ -1220,7 +1220,7 @@ bool keymode_turntable(shell *sh, double seconds)
 	shell_refresh(sh);
 	sh->redraw = true;
 	if (ok && steps > 0)
-		shell_info(sh, "view: %zu change%s kept; undo takes %s back (a run of one key is one change)\n", steps,
-		           steps == 1 ? "" : "s", steps == 1 ? "it" : "them");
+		shell_info(sh, "%s: %zu change%s kept; undo takes %s back (a run of one key is one change)\n", cmd,
+		           steps, steps == 1 ? "" : "s", steps == 1 ? "it" : "them");
 	return ok;
 }

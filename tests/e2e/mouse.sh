@@ -119,6 +119,8 @@ keys x
 wait_for "turntable stopped" "a key did not stop the turntable"
 keys Escape
 wait_for "rtsh>" "Esc after the turntable"
+# the summary names the command that ran (it said "view:")
+wait_for "turntable: 1 change kept" "no turntable summary after Esc"
 keys "save $TMP/spin.rt" Enter
 wait_for "saved the scene to $TMP/spin.rt" "save spin.rt"
 echo "$(cam start) $(cam spin) $(pivot start)" | awk '{
