@@ -147,8 +147,21 @@ bool rt_model_images_ok(const char *path, const mesh *m, rt_error *err)
 	return true;
 }
 
+/* The scene made for a model is written as .rt lines, which cannot hold a
+ * line break: the rest of such a name became lines of their own (its
+ * comment's), and its mesh line an unclosed quote. */
+static bool name_fits_a_line(const char *path, rt_error *err)
+{
+	if (!strpbrk(path, "\n\r"))
+		return true;
+	return rt_error_set(err, "%s: the file name has a line break, which a scene line cannot hold; expected a "
+	                         "name without one (rename the file)", path);
+}
+
 static char *gltf_text(const char *path, const rt_load_opts *opts, size_t *len, bool *stage_lit, rt_error *err)
 {
+	if (!name_fits_a_line(path, err))
+		return NULL;
 	gltf_info gi;
 	if (!gltf_read_info(path, &gi, err))
 		return NULL;
@@ -375,6 +388,8 @@ static bool beside_texture(const char *path, const mesh *m, const rt_load_opts *
 static char *model_text(const char *path, const rt_load_opts *opts, size_t *len, char *tex, size_t tex_size,
                         rt_error *err)
 {
+	if (!name_fits_a_line(path, err))
+		return NULL;
 	bool stage;
 	if (has_ext(path, "gltf") || has_ext(path, "glb"))
 		return gltf_text(path, opts, len, &stage, err);

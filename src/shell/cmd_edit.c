@@ -72,6 +72,8 @@ bool cmd_camera(shell *sh, int argc, char **argv, const char *rest)
 		answer_camera_fields(sh, s->cam < s->ncams ? s->cam : 0);
 		return true;
 	}
+	if (argc > 1 && argv[0][0] >= '0' && argv[0][0] <= '9') /* it said "2" is not a camera command */
+		return shell_fail(sh, "camera: too many arguments; usage: camera N (N alone makes camera N active)");
 	if (argc == 1 && argv[0][0] >= '0' && argv[0][0] <= '9') {
 		size_t i;
 		if (!arg_index(sh, "camera", argv[0], "camera", s->ncams, &i))
