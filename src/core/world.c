@@ -89,7 +89,7 @@ _Static_assert((KIND_UNBOUNDED | KIND_VERTICES | KIND_TUBE | KIND_MODEL) < OBJ_F
 
 /* A sphere with a uniform scale, no shear and no texture that its rotation
  * could turn is traced directly in world space. */
-static bool is_fast_sphere(const object *o)
+static inline bool is_fast_sphere(const object *o)
 {
 	if (o->kind >= OBJ_KIND_COUNT || !shape_kinds[o->kind]->world_sphere || o->scale.x != o->scale.y || o->scale.y != o->scale.z)
 		return false;
@@ -307,9 +307,14 @@ static void *counts_run(void *arg)
 {
 	counts_job *j = arg;
 	size_t nplanes = 0, ntris = 0, nshapes = 0, nmodels = 0;
+	/* obj_kind_flags of each kind, looked up here rather than called an
+	 * object (the same flags; 0 for a kind out of range, as it gives) */
+	unsigned kflags[OBJ_KIND_COUNT];
+	for (int k = 0; k < OBJ_KIND_COUNT; k++)
+		kflags[k] = obj_kind_flags((obj_kind)k);
 	for (size_t i = j->begin; i < j->end; i++) {
 		const object *o = &j->objs[i];
-		unsigned f = obj_kind_flags(o->kind);
+		unsigned f = (unsigned)o->kind < OBJ_KIND_COUNT ? kflags[o->kind] : 0;
 		bool fast = !(f & (KIND_VERTICES | KIND_MODEL)) && is_fast_sphere(o);
 		j->kf[i] = (uint8_t)(f | (fast ? OBJ_FAST_SPHERE : 0));
 		nplanes += (f & KIND_UNBOUNDED) != 0;
