@@ -155,6 +155,12 @@ mesh *mesh_parse_ply(const char *name, const char *buf, size_t len, rt_error *er
 mesh *mesh_parse_gltf(const char *name, const char *dir, const char *buf, size_t len, rt_error *err);
 /* True when the extension is one mesh_load reads. */
 bool mesh_format_known(const char *path);
+
+/* The model's own image files (an MTL's maps, a glTF's images) are there
+ * (looked up with stat, not decoded); else false with err naming the model
+ * (path), the material and the image. The model viewer's load and a .rt's
+ * mesh line check them, so that a missing one fails the load. */
+bool mesh_images_ok(const char *path, const mesh *m, rt_error *err);
 /* The extensions mesh_load reads as a message lists them (".obj, .ply, ...
  * or .stl"), into buf (truncated to size). */
 void mesh_format_list(char *buf, size_t size);

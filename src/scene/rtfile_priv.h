@@ -80,11 +80,4 @@ void rt_numloc_leave(rt_numloc *l);
 /* True when name ends in ".rt" (strict mode asks for it). */
 bool rt_name_is_rt(const char *name);
 
-/* The model's own image files (an MTL's maps, a glTF's images) are there
- * (looked up, not decoded); else false with err naming the model (path),
- * the material and the image (viewer.c). The model viewer's load and a
- * .rt's mesh line check them, so that a missing one fails the load. */
-struct mesh;
-bool rt_model_images_ok(const char *path, const struct mesh *m, rt_error *err);
-
 #endif

@@ -1235,7 +1235,7 @@ static bool parse_mesh(parser *p, const elem_def *e)
 		rt_warn(p->warn, p->name, p->line, t[1].col, "mesh file \"%s\": %s", quoted(p, &t[1]), m->warning);
 	/* its own images too: a missing one failed every render after the
 	 * load (the shell's load and add took the scene without a word) */
-	bool images = rt_model_images_ok(o.file, m, &merr);
+	bool images = mesh_images_ok(o.file, m, &merr);
 	mesh_cache_put(m);
 	if (!images) {
 		char msg[RT_ERROR_MSG_MAX];

@@ -17,7 +17,6 @@
  * spot_triangulated.obj), which the status line names.
  */
 #include <dirent.h>
-#include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -32,7 +31,6 @@
 #include "rtsh/rtfile.h"
 #include "rtsh/texture.h"
 #include "rtsh/world.h"
-#include "scene/rtfile_priv.h"
 
 /* --- glTF 2.0 scenes --- */
 
@@ -106,47 +104,6 @@ static bool node_bounds(const char *path, const gltf_info *gi, const rt_load_opt
 	return true;
 }
 
-/* The model's own image files (an MTL's maps, a glTF's images beside it)
- * are there, as a .rt's texture= is checked (rtfile_read.c): a missing one
- * makes the load fail with the model's name, the material's and the
- * image's, rather than every render after it (rtsh(5), "Meshes"). Only
- * looked up (stat), not decoded: a scene of a hundred images is not read
- * twice; a corrupt one is the render's error, in the same words
- * (surface.c). */
-bool rt_model_images_ok(const char *path, const mesh *m, rt_error *err)
-{
-	for (uint32_t k = 0; k < m->nmats; k++) {
-		const mesh_mat *mm = &m->mats[k];
-		const struct {
-			const char *file, *what;
-		} f[] = {{mm->map_kd, "colour texture"},
-		         {mm->map_norm, "normal map"},
-		         {mm->map_bump, "bump map"},
-		         {mm->gltf ? mm->map_mr : NULL, "metallic-roughness texture"},
-		         {mm->gltf ? mm->map_emit : NULL, "emissive texture"}};
-		for (size_t i = 0; i < sizeof f / sizeof f[0]; i++) {
-			struct stat st;
-			if (!f[i].file)
-				continue;
-			const char *why = NULL, *kind = NULL;
-			if (rt_file_stat(f[i].file, &st) != 0)
-				why = strerror(errno);
-			else if ((kind = rt_file_kind(st.st_mode)) != NULL)
-				why = "not a regular file";
-			if (!why)
-				continue;
-			char mat[96];
-			if (mm->name && mm->name[0])
-				snprintf(mat, sizeof mat, "\"%.80s\"", mm->name);
-			else
-				snprintf(mat, sizeof mat, "%u", k + 1);
-			return rt_error_set(err, "%s: the %s of material %s: %s: cannot read the image: %s%s%s", path,
-			                    f[i].what, mat, f[i].file, why, kind ? " but " : "", kind ? kind : "");
-		}
-	}
-	return true;
-}
-
 /* The scene made for a model is written as .rt lines, which cannot hold a
  * line break: the rest of such a name became lines of their own (its
  * comment's), and its mesh line an unclosed quote. */
@@ -178,7 +135,7 @@ static char *gltf_text(const char *path, const rt_load_opts *opts, size_t *len, 
 		bb = m->bounds;
 		if (m->warning) /* duplicate triangles dropped, say */
 			rt_warn(opts ? opts->warn : NULL, NULL, 0, 0, "%s", m->warning);
-		bool images = rt_model_images_ok(path, m, err);
+		bool images = mesh_images_ok(path, m, err);
 		mesh_cache_put(m);
 		if (!images) {
 			free(nb);
@@ -188,7 +145,7 @@ static char *gltf_text(const char *path, const rt_load_opts *opts, size_t *len, 
 	} else {
 		/* a node's mesh holds all the file's materials */
 		mesh *m = mesh_cache_get_node(path, gi.mesh_nodes[0], true, 60, opts ? opts->cancel : NULL, err);
-		bool images = m && rt_model_images_ok(path, m, err);
+		bool images = m && mesh_images_ok(path, m, err);
 		mesh_cache_put(m);
 		if (!images) {
 			free(nb);
@@ -398,7 +355,7 @@ static char *model_text(const char *path, const rt_load_opts *opts, size_t *len,
 		return NULL;
 	if (m->warning) /* a missing material library, say */
 		rt_warn(opts ? opts->warn : NULL, NULL, 0, 0, "%s", m->warning);
-	if (!rt_model_images_ok(path, m, err)) {
+	if (!mesh_images_ok(path, m, err)) {
 		mesh_cache_put(m);
 		return NULL;
 	}

@@ -716,13 +716,22 @@ static void test_model_ties(void **state)
 	char path[] = "/tmp/rtsh-test-packet-XXXXXX.obj";
 	FILE *f = open_temp_obj(path);
 	int nv = 0;
+	/* The copies differ in their texture coordinate only (one vt each), so
+	 * that the loader keeps them: exact duplicates are dropped at load, and
+	 * these are there to meet the ray at exactly the same distance. Every
+	 * corner has a uv (vt 19 for the grid's), else the mesh keeps none and
+	 * the copies are duplicates again. */
+	for (int c = 0; c < 19; c++)
+		fprintf(f, "vt %g 0\n", c / 32.0);
 	for (int c = 0; c < 12; c++) { /* the same triangle twelve times */
-		fprintf(f, "v -2 -2 0\nv 2 -2 0\nv 0 2 0\nf %d %d %d\n", nv + 1, nv + 2, nv + 3);
+		fprintf(f, "v -2 -2 0\nv 2 -2 0\nv 0 2 0\nf %d/%d %d/%d %d/%d\n", nv + 1, c + 1, nv + 2, c + 1, nv + 3,
+		        c + 1);
 		nv += 3;
 	}
 	for (int c = 0; c < 6; c++) { /* another, its corners turned */
 		fprintf(f, "v -2.5 -1 1\nv 2.5 -1.5 1\nv 0 2.5 1\n");
-		fprintf(f, "f %d %d %d\n", nv + 1 + c % 3, nv + 1 + (c + 1) % 3, nv + 1 + (c + 2) % 3);
+		fprintf(f, "f %d/%d %d/%d %d/%d\n", nv + 1 + c % 3, 13 + c, nv + 1 + (c + 1) % 3, 13 + c,
+		        nv + 1 + (c + 2) % 3, 13 + c);
 		nv += 3;
 	}
 	for (int j = 0; j <= 8; j++) /* a grid of 8 x 8 quads at z = 2 */
@@ -731,7 +740,7 @@ static void test_model_ties(void **state)
 	for (int j = 0; j < 8; j++)
 		for (int i = 0; i < 8; i++) {
 			int a = nv + j * 9 + i + 1, b = a + 1, c = a + 9, d = c + 1;
-			fprintf(f, "f %d %d %d\nf %d %d %d\n", a, b, d, a, d, c);
+			fprintf(f, "f %d/19 %d/19 %d/19\nf %d/19 %d/19 %d/19\n", a, b, d, a, d, c);
 		}
 	nv += 81;
 	assert_int_equal(fclose(f), 0);
