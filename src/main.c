@@ -1,8 +1,10 @@
 /* rtsh — the command line (shell/args.h), then a batch render or the shell. */
 #include <errno.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -104,10 +106,16 @@ static int batch_render(const rtsh_options *o)
 	rt_error err;
 	char msg[RT_ERROR_MSG_MAX + RT_ERROR_FILE_MAX + 32];
 	if (!image_type_of(o->output)) {
-		char exts[128], fmt[512]; /* the extensions from image.c's table of formats */
+		char exts[128], fmt[640]; /* the extensions from image.c's table of formats */
 		image_extensions(exts, sizeof exts, false);
-		snprintf(fmt, sizeof fmt, "output \"%%s\" has an unknown type; expected %s", exts);
-		return usage_error(fmt, o->output);
+		/* a scene or a picture as text is the shell's save, not -o's */
+		const char *dot = strrchr(o->output, '.');
+		bool text = dot && (strcasecmp(dot, ".rt") == 0 || strcasecmp(dot, ".ans") == 0);
+		snprintf(fmt, sizeof fmt, "output \"%%s\" has an unknown type; expected %s%s", exts,
+		         text ? " (a .rt scene or an .ans picture is written by the shell's save: -c 'save FILE')" : "");
+		char shown[4096]; /* escape sequences visible, not run */
+		text_visible(shown, sizeof shown, o->output, false);
+		return usage_error(fmt, shown);
 	}
 	if (!o->scene)
 		return usage_error("-o needs a scene file%s", "");
