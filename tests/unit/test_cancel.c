@@ -299,6 +299,17 @@ typedef struct stopper {
 	long done_then, total;
 } stopper;
 
+/* A generated scene of n objects (seed) and its world, both checked. */
+static world *generated_world(int n, uint64_t seed, scene **s)
+{
+	rt_error err;
+	*s = scene_generate(n, seed, NULL, &err);
+	assert_non_null(*s);
+	world *w = world_build(*s, &err);
+	assert_non_null(w);
+	return w;
+}
+
 static void stop_in_flight(void *ctx, long done, long total)
 {
 	stopper *st = ctx;
@@ -329,11 +340,8 @@ static render_status two_passes(const world *w, const render_settings *set, fram
 static void test_render_stops_in_flight(void **state)
 {
 	(void)state;
-	rt_error err;
-	scene *s = scene_generate(60, 11, NULL, &err);
-	assert_non_null(s);
-	world *w = world_build(s, &err);
-	assert_non_null(w);
+	scene *s;
+	world *w = generated_world(60, 11, &s);
 	render_settings set = render_settings_default();
 	set.width = 160;
 	set.height = 120; /* 80 tiles */
@@ -392,10 +400,8 @@ static void test_render_stops_within_a_tile(void **state)
 {
 	(void)state;
 	rt_error err;
-	scene *s = scene_generate(5, 3, NULL, &err);
-	assert_non_null(s);
-	world *w = world_build(s, &err);
-	assert_non_null(w);
+	scene *s;
+	world *w = generated_world(5, 3, &s);
 	render_settings set = render_settings_default();
 	set.width = set.height = RENDER_TILE; /* one tile */
 	set.threads = 1;
@@ -454,10 +460,8 @@ static void test_progress_reported_at_once(void **state)
 {
 	(void)state;
 	rt_error err;
-	scene *s = scene_generate(5, 3, NULL, &err);
-	assert_non_null(s);
-	world *w = world_build(s, &err);
-	assert_non_null(w);
+	scene *s;
+	world *w = generated_world(5, 3, &s);
 	render_settings set = render_settings_default();
 	set.width = 4 * RENDER_TILE;
 	set.height = 2 * RENDER_TILE; /* 8 tiles */
